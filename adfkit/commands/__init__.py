@@ -1,0 +1,1 @@
+"""Subcommands of the adfkit CLI, discovered by adfkit.cli."""

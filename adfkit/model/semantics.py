@@ -1,0 +1,239 @@
+"""What AMBF makes of the raw values: canonical kinds for the spellings it accepts, and
+the effective defaults it uses for keys a file leaves out (adf-format.md §7–§11)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+from .common import Geometry, ShapeEntry
+from .pose import IDENTITY, Pose, Quat, Vec3
+
+
+class JointKind(str, Enum):
+    REVOLUTE = "revolute"          # revolute, hinge, continuous
+    PRISMATIC = "prismatic"        # prismatic, slider
+    FIXED = "fixed"
+    LINEAR_SPRING = "linear spring"
+    TORSION_SPRING = "torsion spring"
+    P2P = "p2p"
+    CONE_TWIST = "cone twist"
+    SIX_DOF = "six dof"
+    SIX_DOF_SPRING = "six dof spring"
+
+
+JOINT_TYPE_NAMES: dict[str, JointKind] = {
+    "revolute": JointKind.REVOLUTE, "hinge": JointKind.REVOLUTE, "continuous": JointKind.REVOLUTE,
+    "prismatic": JointKind.PRISMATIC, "slider": JointKind.PRISMATIC,
+    "fixed": JointKind.FIXED,
+    "linear spring": JointKind.LINEAR_SPRING, "spring": JointKind.LINEAR_SPRING,
+    "torsion spring": JointKind.TORSION_SPRING, "torsional spring": JointKind.TORSION_SPRING,
+    "angular spring": JointKind.TORSION_SPRING,
+    "p2p": JointKind.P2P,
+    "cone twist": JointKind.CONE_TWIST,
+    "six dof": JointKind.SIX_DOF,
+    "six dof spring": JointKind.SIX_DOF_SPRING,
+}
+
+# Reference axis d of §8.1: the axis of the Bullet constraint frame the ADF axis maps onto.
+REFERENCE_AXIS = {JointKind.PRISMATIC: Vec3(1.0, 0.0, 0.0)}
+
+
+def joint_kind(type_text: str | None) -> JointKind | None:
+    """The joint kind AMBF builds for a `type` string (exact, case-sensitive), or None."""
+    return JOINT_TYPE_NAMES.get(type_text) if type_text is not None else None
+
+
+def reference_axis(kind: JointKind) -> Vec3:
+    return REFERENCE_AXIS.get(kind, Vec3(0.0, 0.0, 1.0))
+
+
+class ShapeKind(str, Enum):
+    BOX = "box"
+    SPHERE = "sphere"
+    CYLINDER = "cylinder"
+    CAPSULE = "capsule"
+    CONE = "cone"
+    PLANE = "plane"
+
+
+def shape_kind(text: str | None) -> ShapeKind | None:
+    """`Box`, `box` or `BOX` → BOX; any other spelling → None (AMBF: undefined behaviour)."""
+    if text is None:
+        return None
+    for k in ShapeKind:
+        if text in (k.value, k.value.capitalize(), k.value.upper()):
+            return k
+    return None
+
+
+SHAPE_KEYS = {
+    ShapeKind.BOX: ("x", "y", "z"),
+    ShapeKind.SPHERE: ("radius",),
+    ShapeKind.CYLINDER: ("radius", "height"),
+    ShapeKind.CAPSULE: ("radius", "height"),
+    ShapeKind.CONE: ("radius", "height"),
+    ShapeKind.PLANE: ("normal", "offset"),
+}
+
+
+def axis_vector(axis: str | None) -> Vec3:
+    """`axis` of cylinders, capsules and cones; Z when absent or unknown (AMBF warns)."""
+    return {"x": Vec3(1, 0, 0), "y": Vec3(0, 1, 0)}.get((axis or "z").lower(), Vec3(0, 0, 1))
+
+
+class CollisionMeshType(str, Enum):
+    CONVEX_HULL = "convex hull"
+    CONVEX_MESH = "convex mesh"
+    CONCAVE_MESH = "concave mesh"
+    POINT_CLOUD = "point cloud"
+
+
+_MESH_TYPES = {
+    "CONVEX_HULL": CollisionMeshType.CONVEX_HULL, "convex_hull": CollisionMeshType.CONVEX_HULL,
+    "hull": CollisionMeshType.CONVEX_HULL,
+    "CONVEX_MESH": CollisionMeshType.CONVEX_MESH, "convex_mesh": CollisionMeshType.CONVEX_MESH,
+    "CONCAVE_MESH": CollisionMeshType.CONCAVE_MESH, "TRIMESH": CollisionMeshType.CONCAVE_MESH,
+    "trimesh": CollisionMeshType.CONCAVE_MESH,
+    "POINT_CLOUD": CollisionMeshType.POINT_CLOUD, "point_cloud": CollisionMeshType.POINT_CLOUD,
+}
+
+
+def collision_mesh_type(text: str | None) -> tuple[CollisionMeshType, bool]:
+    """(effective type, spelling accepted). Unknown or empty spellings fall back to concave."""
+    if text is None:
+        return CollisionMeshType.CONCAVE_MESH, True
+    t = _MESH_TYPES.get(text)
+    return (t, True) if t else (CollisionMeshType.CONCAVE_MESH, False)
+
+
+SENSOR_TYPES = {"Proximity": "proximity", "proximity": "proximity", "PROXIMITY": "proximity",
+                "Resistance": "resistance", "resistance": "resistance", "RESISTANCE": "resistance"}
+ACTUATOR_TYPES = {"Constraint": "constraint", "constraint": "constraint", "CONSTRAINT": "constraint"}
+CONTROLLER_OUTPUT_TYPES = {"FORCE": "force", "EFFORT": "force", "force": "force", "effort": "force",
+                           "VELOCITY": "velocity", "velocity": "velocity",
+                           "POSITION": "position", "position": "position"}
+
+
+# --- effective defaults --------------------------------------------------------------------
+
+DEFAULT_MASS = 1.0
+DEFAULT_FRICTION_STATIC = 0.5
+DEFAULT_FRICTION_ROLLING = 0.01
+DEFAULT_RESTITUTION = 0.1
+DEFAULT_LINEAR_DAMPING = 0.04
+DEFAULT_ANGULAR_DAMPING = 0.1
+DEFAULT_COLLISION_MARGIN = 0.001
+DEFAULT_GRAVITY = Vec3(0.0, 0.0, -9.8)
+DEFAULT_MAX_ITERATIONS = 10
+DEFAULT_JOINT_MAX_MOTOR_IMPULSE = 0.1
+DEFAULT_JOINT_ERP = 0.1
+DEFAULT_JOINT_CFM = 0.1
+DEFAULT_SENSOR_RANGE = 0.5
+DEFAULT_ACTUATOR_MAX_IMPULSE = 10.0
+DEFAULT_ACTUATOR_TAU = 1.0
+DEFAULT_CAMERA_FOV = 0.7
+DEFAULT_CAMERA_NEAR = 0.1
+DEFAULT_CAMERA_FAR = 10.0
+DEFAULT_IMAGE_SIZE = (640, 480)
+DEFAULT_SIX_DOF_LIMIT = 1.2
+DEFAULT_SIX_DOF_SPRING = {"stiffness": 1.0, "damping": 0.7, "equilibrium point": 0.0}
+
+
+def effective_mass(body) -> float:
+    return DEFAULT_MASS if body.mass is None else body.mass
+
+
+def pose_or_identity(p: Pose | None) -> Pose:
+    return p if p is not None else Pose()
+
+
+def inertial_offset(body) -> Pose:
+    """The COM frame in the body frame (identity unless written and mass is written)."""
+    if body.mass is None:
+        return Pose()
+    return pose_or_identity(body.inertial_offset)
+
+
+def collision_offset(body) -> Pose:
+    """Pose of a single collision primitive: `collision offset`, else the inertial offset (§7.4)."""
+    if body.collision_offset is not None:
+        return body.collision_offset
+    return pose_or_identity(getattr(body, "inertial_offset", None))
+
+
+@dataclass(frozen=True)
+class Primitive:
+    """A primitive shape with its pose in the body frame, dimensions in metres, ADF meaning."""
+
+    kind: ShapeKind
+    geometry: Geometry
+    pose: Pose = Pose()
+
+    @property
+    def axis(self) -> Vec3:
+        return axis_vector(self.geometry.axis)
+
+
+def collision_primitives(body) -> list[Primitive] | None:
+    """The body's collision primitives in precedence order (§7.4), or None when collision
+    comes from a mesh. Entries with an unknown shape name are left out."""
+    if body.collision_shape:
+        k = shape_kind(body.collision_shape)
+        if k is None or body.collision_geometry is None:
+            return []
+        return [Primitive(k, body.collision_geometry, collision_offset(body))]
+    if body.compound_collision_shape:
+        out = []
+        for e in body.compound_collision_shape:
+            k = shape_kind(e.shape)
+            if k is not None and e.geometry is not None:
+                out.append(Primitive(k, e.geometry, pose_or_identity(e.offset)))
+        return out
+    return None
+
+
+def normalized_or(v: Vec3 | None, fallback: Vec3) -> Vec3:
+    if v is None:
+        return fallback
+    n = math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2)
+    return Vec3(v[0] / n, v[1] / n, v[2] / n) if n > 0 else fallback
+
+
+def shortest_arc(u: Vec3, v: Vec3) -> Quat:
+    """AMBF's Rmin(u→v) (§8.2): identity below 0.001 rad; antiparallel: 180° about u×X
+    (or about v×Y when u is parallel to X)."""
+    u = Vec3(*u).normalized()
+    v = Vec3(*v).normalized()
+    d = max(-1.0, min(1.0, u.dot(v)))
+    angle = math.acos(d)
+    if angle < 0.001:
+        return IDENTITY
+    if math.pi - angle < 0.001:
+        axis = u.cross(Vec3(1, 0, 0))
+        if axis.norm() < 1e-9:
+            axis = v.cross(Vec3(0, 1, 0))
+        return Quat.from_axis_angle(axis, math.pi)
+    return Quat.from_axis_angle(u.cross(v), angle)
+
+
+def joint_frames(joint, parent_scale: float = 1.0, child_scale: float = 1.0) -> tuple[Pose, Pose]:
+    """Frames A (in the parent body frame) and B (in the child body frame) of §8.2.
+
+    At joint value zero they coincide in the world.
+    """
+    kind = joint_kind(joint.type) or JointKind.REVOLUTE
+    d = reference_axis(kind)
+    a = normalized_or(joint.parent_axis, Vec3(0, 0, 1))
+    b = normalized_or(joint.child_axis, Vec3(0, 0, 1))
+    joint_offset = joint.joint_offset or 0.0
+    offset = joint.offset if joint.offset is not None else (joint.child_offset or 0.0)
+    r_a = Quat.from_axis_angle(a, joint_offset) * shortest_arc(d, a)
+    r_b = (shortest_arc(b, a).inverse() * Quat.from_axis_angle(a, offset).inverse()
+           * Quat.from_axis_angle(a, joint_offset) * shortest_arc(d, a))
+    pa = Vec3(*(joint.parent_pivot or Vec3())).scaled(parent_scale)
+    pb = Vec3(*(joint.child_pivot or Vec3())).scaled(child_scale)
+    return Pose(pa, r_a), Pose(pb, r_b)
+
+
+__all__ = [n for n in dir() if not n.startswith("_")] + ["ShapeEntry"]
