@@ -5,6 +5,7 @@ keys the reader did not recognise, so a file read and written back keeps everyth
 """
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -42,9 +43,21 @@ def _vec(v) -> _Flow:
     return _Flow(x=float(v[0]), y=float(v[1]), z=float(v[2]))
 
 
+RPY_DECIMALS = 10
+
+
+def _angle(a: float) -> float:
+    # Rounding to 1e-10 rad makes write → read → write byte-identical (the quaternion
+    # round trip alone wobbles in the last bit) and turns 1e-17 noise into 0.0. Near gimbal lock roll and yaw lose ~1e-12.
+    a = round(a, RPY_DECIMALS) + 0.0
+    if a <= round(-math.pi, RPY_DECIMALS):  # -pi and +pi are the same angle: write +pi
+        a = round(math.pi, RPY_DECIMALS)
+    return a
+
+
 def _rpy(q: Quat) -> _Flow:
     r, p, y = quat_to_rpy(q)
-    return _Flow(r=r, p=p, y=y)
+    return _Flow(r=_angle(r), p=_angle(p), y=_angle(y))
 
 
 def value_to_plain(kind, value) -> Any:

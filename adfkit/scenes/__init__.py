@@ -1,0 +1,4 @@
+"""Builders that author the sample scenes from parameters (the project's own scenes)."""
+from .suturing_pad import SuturingPadParams, build_suturing_pad, write_suturing_pad  # noqa: F401
+
+BUILDERS = {"suturing-pad": write_suturing_pad}
