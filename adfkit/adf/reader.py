@@ -23,6 +23,9 @@ _BOOL_WORDS = {"true": True, "yes": True, "on": True, "y": True,
                "false": False, "no": False, "off": False, "n": False}
 
 
+_NUMBER_TAGS = ("tag:yaml.org,2002:float", "tag:yaml.org,2002:int")
+
+
 class BadValue(Exception):
     def __init__(self, rule: str, message: str, node: yaml.Node, hint: str | None = None, severity=Severity.ERROR):
         super().__init__(message)
@@ -44,6 +47,11 @@ class Reader:
         return scalar_value(node)
 
     def as_float(self, node) -> float:
+        if node.__class__ is yaml.ScalarNode and node.tag in _NUMBER_TAGS:
+            try:  # fast path for plain decimal literals
+                return float(node.value)
+            except ValueError:
+                pass
         v = self.scalar(node, "a number")
         if isinstance(v, bool) or v is None:
             raise BadValue("bad-type", f"expected a number, found {node.value!r}", node)

@@ -81,26 +81,30 @@ def compose(text: str, file: str, diagnostics: list[Diagnostic] | None = None) -
 def check_tree(root: yaml.Node, file: str) -> list[Diagnostic]:
     """Find duplicate keys; reject recursive aliases and alias bombs, with positions."""
     diags: list[Diagnostic] = []
-    expanded = 0
     sizes: dict[int, int] = {}
+    on_stack: set[int] = set()
+    Mapping, Sequence = yaml.MappingNode, yaml.SequenceNode
 
-    def walk(node: yaml.Node, stack: set[int]) -> int:
-        nonlocal expanded
+    def walk(node: yaml.Node) -> int:
+        cls = node.__class__
+        if cls is not Mapping and cls is not Sequence:
+            return 1
         nid = id(node)
-        if nid in sizes:
-            return sizes[nid]
-        if nid in stack:
+        known = sizes.get(nid)
+        if known is not None:
+            return known
+        if nid in on_stack:
             raise AdfError(error("yaml-recursive-alias", "an alias refers to a node that contains it",
                                  location(file, node), "ADF data is a tree; replace the recursive alias with data"))
+        on_stack.add(nid)
         size = 1
-        if isinstance(node, yaml.MappingNode):
-            stack.add(nid)
+        if cls is Mapping:
             seen: dict[Any, yaml.Node] = {}
             for k, v in node.value:
-                if isinstance(k, yaml.ScalarNode):
+                if k.__class__ is yaml.ScalarNode:
                     kv = k.value
-                    if kv in seen:
-                        first = seen[kv]
+                    first = seen.get(kv)
+                    if first is not None:
                         diags.append(error(
                             "yaml-duplicate-key",
                             f"duplicate key '{kv}' (first at line {first.start_mark.line + 1}); "
@@ -108,17 +112,17 @@ def check_tree(root: yaml.Node, file: str) -> list[Diagnostic]:
                             location(file, k), "remove one of the two entries"))
                     else:
                         seen[kv] = k
-                size += walk(k, stack) + walk(v, stack)
-            stack.discard(nid)
-        elif isinstance(node, yaml.SequenceNode):
-            stack.add(nid)
+                    size += 1 + walk(v)
+                else:
+                    size += walk(k) + walk(v)
+        else:
             for item in node.value:
-                size += walk(item, stack)
-            stack.discard(nid)
+                size += walk(item)
+        on_stack.discard(nid)
         sizes[nid] = size
         return size
 
-    expanded = walk(root, set())
+    expanded = walk(root)
     if expanded > MAX_EXPANDED_NODES:
         raise AdfError(error("yaml-alias-bomb", f"aliases expand this file to {expanded:,} nodes",
                              location(file, root), "an ADF file never needs this; remove the nested aliases"))
