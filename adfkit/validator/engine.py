@@ -1,0 +1,159 @@
+"""Validate ADF files: reader diagnostics, JSON Schema with positions, semantic and path rules.
+
+``validate_file`` checks one file; ``validate_paths`` takes files and folders and follows a
+launch file to everything it names (world, environment, input devices, colors, models),
+checking each model's references against the models AMBF would have loaded before it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from ..adf.reader import read_file
+from ..adf.yamlnodes import compose, read_text
+from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation
+from ..model import FILE_KINDS, Launch, ModelFile, World
+from . import paths_check, schema_check, semantic
+from .rules import RULES
+from .yamlcompat import repair
+
+KIND_OF = {cls: name for name, cls in FILE_KINDS.items()}
+YAML_SUFFIXES = (".yaml", ".yml")
+# Reader findings whose severity the validator sets from what AMBF does:
+# duplicate keys load in AMBF (it keeps the first value; sb/cloth.yaml), so a warning.
+SEVERITY_OVERRIDES = {"yaml-duplicate-key": Severity.WARNING}
+
+
+@dataclass
+class FileResult:
+    path: Path
+    kind: str | None = None
+    doc: object = None
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    text: str | None = None
+
+
+def _read_with_compat(path: Path, kind: str | None, text: str):
+    """read_file, retrying layouts yaml-cpp accepts and PyYAML does not (see yamlcompat)."""
+    try:
+        doc, diags = read_file(path, kind, text=text)
+        return doc, diags, text, []
+    except AdfError as exc:
+        if not exc.diagnostics or exc.diagnostics[0].rule != "yaml-syntax":
+            raise
+        fixed, moved = repair(text)
+        if not moved:
+            raise
+        try:
+            doc, diags = read_file(path, kind, text=fixed)
+        except AdfError as again:
+            if again.diagnostics and again.diagnostics[0].rule == "yaml-syntax":
+                raise exc from None
+            raise
+        first = exc.diagnostics[0]
+        note = Diagnostic(RULES["pyyaml-unparseable"].severity, "pyyaml-unparseable",
+                          f"PyYAML cannot parse this file ({first.message.removeprefix('not valid YAML: ')}), "
+                          f"but AMBF's yaml-cpp does: a flow collection starts at its key's indentation "
+                          f"(line {moved[0]}). Validated after re-indenting it",
+                          SourceLocation(str(path), moved[0], 1),
+                          "indent the '{' or '[' block under its key so every YAML tool reads the file")
+        return doc, [note, *diags], fixed, moved
+
+
+def _adjust(d: Diagnostic) -> Diagnostic:
+    sev = SEVERITY_OVERRIDES.get(d.rule)
+    if sev is not None and d.severity != sev:
+        return replace(d, severity=sev)
+    if d.rule == "bad-bool" and d.message.startswith("'enable motor'"):
+        # AMBF never converts `enable motor` (it reads `enable feedback` in its place).
+        return replace(d, severity=Severity.WARNING, message=d.message + " (AMBF never reads this value)")
+    return d
+
+
+def validate_file(path: str | Path, kind: str | None = None, context_models=(), text: str | None = None) -> FileResult:
+    path = Path(path)
+    res = FileResult(path)
+    try:
+        if text is None:
+            text = read_text(path)
+        res.text = text
+        doc, reader_diags, text, moved = _read_with_compat(path, kind, text)
+    except AdfError as exc:
+        res.diagnostics = [_adjust(d) for d in exc.diagnostics]
+        return res
+    res.doc, res.text = doc, text
+    res.kind = KIND_OF[type(doc)]
+    diags = [_adjust(d) for d in reader_diags]
+    root = compose(text, str(path))
+    located_errors = {d.location for d in diags if d.severity >= Severity.ERROR}
+    for d in schema_check.check(root, res.kind, str(path)):
+        if d.location not in located_errors:
+            diags.append(d)
+    diags += semantic.check(doc, context_models)
+    diags += paths_check.check(doc)
+    res.diagnostics = _unique(diags)
+    return res
+
+
+def _unique(diags: list[Diagnostic]) -> list[Diagnostic]:
+    seen, out = set(), []
+    for d in diags:
+        key = (d.rule, d.location, d.message)
+        if key not in seen:
+            seen.add(key)
+            out.append(d)
+    return sorted(out, key=lambda d: (d.location.line if d.location else 0, d.location.column if d.location else 0))
+
+
+def expand(paths) -> tuple[list[Path], list[Diagnostic]]:
+    """Files to check from command-line paths (folders are searched recursively)."""
+    files, problems = [], []
+    for p in map(Path, paths):
+        if p.is_dir():
+            files += sorted(f for f in p.rglob("*") if f.suffix.lower() in YAML_SUFFIXES and f.is_file())
+        elif p.exists():
+            files.append(p)
+        else:
+            problems.append(Diagnostic(Severity.ERROR, "file-not-found", f"no such file or folder: {p}",
+                                       SourceLocation(str(p)), "check the path"))
+    return files, problems
+
+
+def validate_paths(paths, kind: str | None = None, follow: bool = True) -> tuple[list[FileResult], list[Diagnostic]]:
+    files, problems = expand(paths)
+    results: dict[Path, FileResult] = {}
+
+    def run(path: Path, k: str | None, context=()) -> FileResult:
+        key = path.resolve()
+        if key in results:
+            return results[key]
+        res = validate_file(path, k, context)
+        results[key] = res
+        if follow and isinstance(res.doc, Launch):
+            follow_launch(res.doc)
+        if follow and isinstance(res.doc, World) and res.doc.environment:
+            env = paths_check.relative_to_file(res.doc.path, res.doc.environment)
+            if env.is_file():
+                run(env, "model")
+        return res
+
+    def follow_launch(launch: Launch) -> None:
+        targets = paths_check.launch_targets(launch)
+        context: list[ModelFile] = []
+        for slot, k in (("world config", "world"), ("input devices config", "input_devices"), ("color config", "colors")):
+            for p in targets.get(slot, []):
+                if p.is_file():
+                    res = run(p, k)
+                    if k == "world" and isinstance(res.doc, World) and res.doc.environment:
+                        env = results.get(paths_check.relative_to_file(res.doc.path, res.doc.environment).resolve())
+                        if env is not None and isinstance(env.doc, ModelFile):
+                            context.append(env.doc)
+        for p in targets.get("multibody configs", []):
+            if p.is_file():
+                res = run(p, "model", tuple(context))
+                if isinstance(res.doc, ModelFile):
+                    context.append(res.doc)
+
+    for f in files:
+        run(f, kind)
+    return list(results.values()), problems

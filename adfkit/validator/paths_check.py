@@ -1,0 +1,167 @@
+"""Rules about files an ADF names: meshes (§6.2), their OBJ material libraries and textures,
+shaders, skyboxes, sensor meshes, and the files launch, world and input-devices files chain to."""
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
+from ..diagnostics import Diagnostic, SourceLocation
+from ..model import InputDevices, Launch, ModelFile, World
+from .rules import RULES
+
+TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")
+
+
+def _d(rule: str, message: str, loc: SourceLocation | None, hint: str | None = None) -> Diagnostic:
+    return Diagnostic(RULES[rule].severity, rule, message, loc, hint)
+
+
+@lru_cache(maxsize=4096)
+def _exists(path: str) -> bool:
+    return Path(path).is_file()
+
+
+@lru_cache(maxsize=1024)
+def obj_material_problems(obj_path: str) -> tuple[str, ...]:
+    """Missing MTL libraries and textures of an OBJ file (names as written)."""
+    missing: list[str] = []
+    base = Path(obj_path).parent
+    try:
+        with open(obj_path, "r", encoding="utf-8", errors="replace") as fh:
+            libs = [line.split(None, 1)[1].strip() for line in fh if line.startswith("mtllib") and " " in line]
+    except OSError:
+        return ()
+    for lib in libs:
+        mtl = base / lib
+        if not mtl.is_file():
+            missing.append(f"material library {lib}")
+            continue
+        try:
+            lines = mtl.read_text(encoding="utf-8", errors="replace").splitlines()
+        except OSError:
+            continue
+        for line in lines:
+            parts = line.strip().split()
+            if len(parts) >= 2 and parts[0].lower().startswith(TEXTURE_KEYS):
+                tex = parts[-1]
+                if not (mtl.parent / tex).is_file() and not (mtl.parent / tex.replace("\\", "/")).is_file():
+                    missing.append(f"texture {tex} (in {lib})")
+    return tuple(dict.fromkeys(missing))
+
+
+def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:
+    out = []
+    if shaders is None or shaders.path is None:
+        return out
+    base = relative_to_file(doc_path, shaders.path)
+    for name in (shaders.vertex, shaders.fragment):
+        if name and not _exists(str(base / name)):
+            out.append(_d("missing-shader", f"shader {base / name} of {owner} not found", loc,
+                          "shader paths are relative to the file that declares them"))
+    return out
+
+
+def model_paths(m: ModelFile) -> list[Diagnostic]:
+    out: list[Diagnostic] = []
+    for obj in [*m.bodies, *m.soft_bodies, *m.ghost_objects]:
+        if not obj.defined:
+            continue
+        seen = set()
+        checks = []
+        if not obj.shape and not obj.compound_shape:
+            checks.append(("mesh", visual_mesh_path(m, obj)))
+        if uses_collision_mesh(obj):
+            checks.append(("collision mesh" if obj.collision_mesh is not None else "mesh", collision_mesh_path(m, obj)))
+        for key, path in checks:
+            if path is None or str(path) in seen:
+                continue
+            seen.add(str(path))
+            if not _exists(str(path)):
+                out.append(_d("missing-mesh", f"mesh file {path} of '{obj.identifier}' not found", obj.where(key),
+                              "paths resolve against the body's and model's high/low resolution paths, "
+                              "then the model file's directory"))
+            elif path.suffix.lower() == ".obj":
+                for what in obj_material_problems(str(path)):
+                    out.append(_d("missing-texture", f"{what} of mesh {path.name} ('{obj.identifier}') not found",
+                                  obj.where(key), "textures come from the mesh's own material (MTL) file"))
+        out += _shaders(m.path, getattr(obj, "shaders", None), f"'{obj.identifier}'", obj.where("shaders"))
+    for s in m.sensors:
+        if s.mesh and not _exists(str(m.directory / s.mesh)):
+            out.append(_d("missing-mesh", f"sensor mesh {m.directory / s.mesh} of '{s.identifier}' not found",
+                          s.where("mesh"), "sensor meshes resolve against the model directory only"))
+    for v in m.volumes:
+        out += _shaders(m.path, v.shaders, f"'{v.identifier}'", v.where("shaders"))
+    for c in m.cameras:
+        out += _camera_shaders(m.path, c)
+    out += _shaders(m.path, m.shaders, "the model", m.where("shaders"))
+    return out
+
+
+def _camera_shaders(path, c) -> list[Diagnostic]:
+    return (_shaders(path, c.preprocessing_shaders, f"camera '{c.identifier}'", c.where("preprocessing shaders"))
+            + _shaders(path, c.depth_compute_shaders, f"camera '{c.identifier}'", c.where("depth compute shaders")))
+
+
+def world_paths(w: World) -> list[Diagnostic]:
+    out: list[Diagnostic] = []
+    if w.environment and not _exists(str(relative_to_file(w.path, w.environment))):
+        out.append(_d("missing-file", f"environment {relative_to_file(w.path, w.environment)} not found",
+                      w.where("environment"), "the environment path is relative to the world file"))
+    out += _shaders(w.path, w.shaders, "the world", w.where("shaders"))
+    if w.skybox is not None and w.skybox.path:
+        base = relative_to_file(w.path, w.skybox.path)
+        for face in ("right", "left", "top", "bottom", "front", "back"):
+            name = getattr(w.skybox, face)
+            if name and not _exists(str(base / name)):
+                out.append(_d("missing-shader", f"skybox {face} image {base / name} not found", w.skybox.where(face)))
+        out += _shaders(w.path, w.skybox.shaders, "the skybox", w.skybox.where("shaders"))
+    for c in w.cameras:
+        out += _camera_shaders(w.path, c)
+    return out
+
+
+def launch_targets(launch: Launch) -> dict[str, list[Path]]:
+    """Files a launch file chains to, by slot (only slots that are set)."""
+    out: dict[str, list[Path]] = {}
+    for key, attr in (("world config", "world_config"), ("color config", "color_config"),
+                      ("input devices config", "input_devices_config")):
+        value = getattr(launch, attr)
+        if value:
+            out[key] = [relative_to_file(launch.path, value)]
+    out["multibody configs"] = [relative_to_file(launch.path, p) for p in launch.multibody_configs or []]
+    return out
+
+
+def launch_paths(launch: Launch) -> list[Diagnostic]:
+    out = []
+    for key, paths in launch_targets(launch).items():
+        for p in paths:
+            if _exists(str(p)):
+                continue
+            rule = "missing-model-file" if key == "multibody configs" else "missing-file"
+            out.append(_d(rule, f"'{key}' names {p}, which does not exist", launch.where(key),
+                          "paths in a launch file are relative to the launch file's directory"))
+    return out
+
+
+def input_device_paths(d: InputDevices) -> list[Diagnostic]:
+    out = []
+    for dev in d.input_devices:
+        if dev.simulated_multibody and not _exists(str(relative_to_file(d.path, dev.simulated_multibody))):
+            out.append(_d("input-device", f"simulated multibody {relative_to_file(d.path, dev.simulated_multibody)} "
+                          f"of '{dev.identifier}' not found; the device loads without it",
+                          dev.where("simulated multibody"), "the path is relative to the input-devices file"))
+    return out
+
+
+def check(doc) -> list[Diagnostic]:
+    if isinstance(doc, ModelFile):
+        return model_paths(doc)
+    if isinstance(doc, World):
+        return world_paths(doc)
+    if isinstance(doc, Launch):
+        return launch_paths(doc)
+    if isinstance(doc, InputDevices):
+        return input_device_paths(doc)
+    return []

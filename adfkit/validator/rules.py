@@ -1,0 +1,109 @@
+"""Every rule the validator can report: stable id, severity, what it means, an example.
+
+Severity follows what AMBF 2.x does (adf-format.md §15): ERROR when AMBF rejects the file
+or crashes (undefined behaviour), WARNING when it loads the file but drops or changes
+something, INFO for style and portability.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..diagnostics import Severity
+
+E, W, I = Severity.ERROR, Severity.WARNING, Severity.INFO
+
+
+@dataclass(frozen=True)
+class Rule:
+    id: str
+    severity: Severity
+    summary: str
+    example: str
+
+
+_RULES = [
+    # --- reader (adfkit.adf) -----------------------------------------------------------
+    Rule("yaml-syntax", E, "Not YAML that yaml-cpp or PyYAML reads", "`a: [1, 2` (unclosed flow list)"),
+    Rule("pyyaml-unparseable", W, "yaml-cpp (AMBF) reads it, PyYAML does not; checked after re-indenting",
+         "`key: &anchor` followed by `{` at column 1 (rover_info.yaml)"),
+    Rule("yaml-duplicate-key", W, "A key appears twice; AMBF keeps the first value, PyYAML the last",
+         "`collision margin` twice in one body (sb/cloth.yaml)"),
+    Rule("yaml-encoding", E, "The file is not UTF-8", "a Latin-1 byte 0xe9 in a name"),
+    Rule("yaml-alias-bomb", E, "Aliases expand to millions of nodes", "the billion-laughs pattern"),
+    Rule("yaml-recursive-alias", E, "An alias refers to a node containing it", "`a: &x [*x]`"),
+    Rule("empty-file", E, "The file holds no YAML document", "a 0-byte file"),
+    Rule("not-a-mapping", E, "The top level is not a mapping", "`- bodies` (a list)"),
+    Rule("unknown-kind", E, "Cannot tell launch/world/model/input-devices/colors apart", "a file with only `name: x`"),
+    Rule("wrong-kind", E, "The file does not match --kind or the slot it is loaded into",
+         "a model file named in `world config`"),
+    Rule("bad-type", E, "A value has the wrong type", "`mass: heavy`"),
+    Rule("bad-bool", E, "A boolean is not a yaml-cpp boolean word", "`passive: 1`"),
+    Rule("bad-int", E, "An integer field holds a fraction or a negative uint", "`shadow quality: 2.5`"),
+    Rule("missing-component", E, "A vector, orientation or colour lacks a component", "`location: {position: {x: 0, y: 0}}`"),
+    Rule("bad-pose", W, "A pose block has keys other than position/orientation; AMBF uses identity",
+         "`location: {x: 1, y: 0, z: 0}`"),
+    Rule("undefined-object", W, "A listed identifier has no mapping in the file", "`bodies: [BODY a]` without `BODY a:`"),
+    Rule("unknown-key", I, "A key AMBF does not read (WARNING when it is a near miss of a real key)",
+         "`colision mesh: a.stl` (did you mean `collision mesh`?)"),
+    Rule("file-not-found", E, "A path given on the command line does not exist", "`adfkit validate nope.yaml`"),
+    # --- schema ------------------------------------------------------------------------
+    Rule("schema-required", E, "A key AMBF requires is missing (the file is rejected)",
+         "a joint without `parent axis`"),
+    Rule("schema-type", E, "A value has a type AMBF cannot convert (the file is rejected)", "`scale: big`"),
+    Rule("schema-value", E, "A value is outside what the schema allows", "`publish frequency: {low: -1, high: 5}`"),
+    # --- semantic ----------------------------------------------------------------------
+    Rule("adf-version", E, "`adf version` is not exactly 1.0", "`adf version: 2.0`"),
+    Rule("enable-motor-without-feedback", E, "`enable motor` without `enable feedback`: AMBF reads the missing "
+         "`enable feedback` and rejects the file", "`enable motor: 1` alone (urdf-*.yaml)"),
+    Rule("joint-type", W, "Unknown joint type; AMBF keeps the joint but creates no constraint", "`type: Revolute`"),
+    Rule("joint-zero-axis", E, "A joint axis is the zero vector (NaN frames)", "`parent axis: {x: 0, y: 0, z: 0}`"),
+    Rule("joint-same-body", W, "A joint's parent and child are the same body", "`parent: BODY a`, `child: BODY a`"),
+    Rule("joint-limits", W, "Limits incomplete or low > high (limits disabled / hinge free)",
+         "`joint limits: {low: 1, high: -1}`"),
+    Rule("spring-without-limits", W, "A spring joint without limits stays locked", "`type: linear spring` and no limits"),
+    Rule("dangling-reference", W, "A parent/child/chassis/root link names no body (AMBF skips the object)",
+         "`child: BODY nonexistent`"),
+    Rule("ambiguous-reference", W, "A reference matches several bodies by substring (AMBF fails)",
+         "`parent: Entry1` with `BODY Entry1` and `BODY Entry10`"),
+    Rule("external-reference", I, "A reference is not in this file; AMBF looks in models loaded earlier",
+         "`parent: BODY world` defined in another model"),
+    Rule("missing-file", E, "A launch/world file names a file that does not exist", "`world config: ./nope.yaml`"),
+    Rule("missing-model-file", W, "A launch `multibody configs` entry does not exist (skipped at -l time)",
+         "`- sb/magic_box.yaml` that is not there"),
+    Rule("missing-mesh", W, "A mesh file is not found after §6.2 resolution (AMBF skips the body)",
+         "`mesh: link1.STL` with no such file"),
+    Rule("missing-texture", W, "A material library or texture named by an OBJ/MTL is not found",
+         "`map_Kd wood.png` missing"),
+    Rule("missing-shader", W, "A shader, skybox or sensor mesh file is not found", "`vertex: shader.vs` missing"),
+    Rule("no-environment", E, "The world has no `environment` model (AMBF dereferences an uninitialised pointer)",
+         "a world with only `enclosure size`"),
+    Rule("shape-name", E, "Unknown primitive shape name (undefined behaviour in AMBF)", "`shape: Cube`"),
+    Rule("collision-mesh-type", W, "Unknown `collision mesh type`; AMBF uses CONCAVE_MESH", "`collision mesh type: ''`"),
+    Rule("geometry-axis", W, "Primitive axis is not x/y/z; AMBF uses z", "`axis: w`"),
+    Rule("sensor-type", E, "Unknown sensor/actuator type (AMBF segfaults)", "`type: RayTracer`"),
+    Rule("missing-type", W, "Sensor or actuator without `type` (skipped)", "a sensor with no type"),
+    Rule("sensor-rays", W, "A sensor without exactly one of array/mesh/parametric, or resolution < 2",
+         "a proximity sensor with only `range`"),
+    Rule("missing-mass", W, "A body without `mass` (AMBF uses 1 kg and ignores inertia)", "a body with no mass"),
+    Rule("negative-mass", E, "Negative mass", "`mass: -1`"),
+    Rule("inertia", W, "Inertia not positive, or violates the triangle inequality", "`inertia: {ix: 1, iy: 1, iz: 5}`"),
+    Rule("static-joint", W, "A joint whose child body is static (mass 0) while its parent moves, or both static",
+         "`child` with `mass: 0` on a revolute joint"),
+    Rule("bad-scale", W, "Scale not positive or implausible (< 0.001 or > 1000)", "`scale: 0`"),
+    Rule("non-finite-number", E, "A number is NaN or infinite", "`mass: .nan`"),
+    Rule("absurd-value", W, "A magnitude above 1e6 where metres, kilograms or radians are expected",
+         "`position: {x: 1e300, ...}`"),
+    Rule("collision-groups", W, "Collision group outside 0–999 (dropped), or groups on a ghost", "`collision groups: [1000]`"),
+    Rule("name-collision", W, "Two objects' names coincide once AMBF strips spaces", "`name: base link` and `name: baselink`"),
+    Rule("name-spaces", I, "A name contains spaces; AMBF removes them", "`name: base link`"),
+    Rule("namespace-slash", I, "A namespace that is glued to identifiers without a trailing /",
+         "`namespace: /ambf/env/phantom`"),
+    Rule("ignored-key", I, "A key AMBF 2.x reads nowhere", "`color: red`, `enclosure size`"),
+    Rule("unlisted-object", I, "A BODY/JOINT/... mapping that no list names (AMBF ignores it)",
+         "`BODY finger:` not in `bodies`"),
+    Rule("light-shadow", W, "A light without `shadow quality` (uninitialised in AMBF) or above 5", "a light with no shadow quality"),
+    Rule("input-device", W, "An input device without `hardware name`, or with a missing simulated multibody",
+         "a device with only `root link`"),
+]
+
+RULES: dict[str, Rule] = {r.id: r for r in _RULES}
