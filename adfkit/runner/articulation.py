@@ -1,0 +1,135 @@
+"""Trees of revolute/prismatic(/fixed) joints as PyBullet multibodies: exact joints with
+native limits and position motors; no constraint drift. Loops stay outside (joints.py)."""
+from __future__ import annotations
+
+from collections import defaultdict, deque
+
+import numpy as np
+import pybullet as pb
+
+from ..model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, joint_frames, joint_kind
+from .rotations import invert, matrix_to_pq, pose_matrix
+
+TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+
+
+def components(joints):
+    """Group (joint, kind, parent SimBody, child SimBody) records joined by revolute/prismatic
+    joints into trees. Returns [(root, [records in BFS order])] and the leftover records."""
+    adj = defaultdict(list)
+    for r in joints:
+        if r[1] in TREE_KINDS:
+            adj[id(r[2])].append(r)
+            adj[id(r[3])].append(r)
+    seen_bodies: set[int] = set()
+    used: set[int] = set()
+    trees = []
+    children = {id(r[3]) for r in joints if r[1] in TREE_KINDS}
+    for r in joints:
+        if r[1] not in TREE_KINDS or id(r[2]) in seen_bodies:
+            continue
+        # walk up to a root: a body that is no tree joint's child
+        root = r[2]
+        guard = 0
+        while id(root) in children and guard < 1000:
+            root = next(x[2] for x in joints if x[1] in TREE_KINDS and x[3] is root)
+            guard += 1
+        if id(root) in seen_bodies:
+            continue
+        order, queue = [], deque([root])
+        seen_bodies.add(id(root))
+        while queue:
+            b = queue.popleft()
+            for rec in adj[id(b)] + [x for x in joints if x[1] is JointKind.FIXED and x[2] is b]:
+                if id(rec) in used or rec[2] is not b or id(rec[3]) in seen_bodies:
+                    continue
+                if rec[3].static:
+                    continue
+                used.add(id(rec))
+                seen_bodies.add(id(rec[3]))
+                order.append(rec)
+                queue.append(rec[3])
+        if order:
+            trees.append((root, order))
+    leftover = [r for r in joints if id(r) not in used]
+    return trees, leftover
+
+
+class Articulation:
+    """One multibody: its joints, their home values (held by position motors)."""
+
+    def __init__(self, uid, root, records, cid):
+        self.uid, self.root, self.records, self.cid = uid, root, records, cid
+        self.joint_names = [r[0].identifier for r in records]
+        self.kinds = [r[1] for r in records]
+        self.targets = [0.0] * len(records)
+        self.forces = []
+
+    def joint_values(self) -> list[float]:
+        return [s[0] for s in pb.getJointStates(self.uid, list(range(len(self.records))), physicsClientId=self.cid)]
+
+    def drive(self) -> None:
+        pb.setJointMotorControlArray(self.uid, list(range(len(self.records))), pb.POSITION_CONTROL,
+                                     targetPositions=self.targets, forces=self.forces,
+                                     physicsClientId=self.cid)
+
+
+def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) -> Articulation:
+    """Create the multibody. ``shapes_for(simbody, frame_in_body) -> (collision, visual)``."""
+    idx = {id(root): -1}
+    for n, r in enumerate(records):
+        idx[id(r[3])] = n
+    lm, lc, lv, lp, lo, lip, lio, lpi, lt, la = ([] for _ in range(10))
+    for n, (joint, kind, parent, child) in enumerate(records):
+        ps = parent.body.scale if parent.body.scale is not None else 1.0
+        cs = child.body.scale if child.body.scale is not None else 1.0
+        if kind is JointKind.FIXED:
+            fa = pose_matrix(*_pose(joint_frames(joint, ps, cs)[0]))
+            fb = pose_matrix(*_pose(joint_frames(joint, ps, cs)[1]))
+        else:
+            a, b = joint_frames(joint, ps, cs)
+            fa, fb = pose_matrix(*_pose(a)), pose_matrix(*_pose(b))
+        child.ref_in_body = fb                       # link frame = joint frame B
+        rel = invert(parent.ref_in_body) @ fa        # joint frame in the parent's link frame
+        col, vis = shapes_for(child, fb)
+        pos, orn = matrix_to_pq(rel)
+        ipos, iorn = matrix_to_pq(invert(fb) @ child.com_in_body)
+        lm.append(child.mass); lc.append(col); lv.append(vis)
+        lp.append(pos); lo.append(orn); lip.append(ipos); lio.append(iorn)
+        lpi.append(idx[id(parent)] + 1)
+        lt.append({JointKind.REVOLUTE: pb.JOINT_REVOLUTE, JointKind.PRISMATIC: pb.JOINT_PRISMATIC}
+                  .get(kind, pb.JOINT_FIXED))
+        la.append([1, 0, 0] if kind is JointKind.PRISMATIC else [0, 0, 1])
+    bcol, bvis = shapes_for(root, root.ref_in_body)
+    world = root.body_world_matrix
+    bpos, born = matrix_to_pq(world @ root.ref_in_body)
+    flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT if self_collision else 0
+    uid = pb.createMultiBody(root.mass, bcol, bvis, bpos, born, linkMasses=lm, linkCollisionShapeIndices=lc,
+                             linkVisualShapeIndices=lv, linkPositions=lp, linkOrientations=lo,
+                             linkInertialFramePositions=lip, linkInertialFrameOrientations=lio,
+                             linkParentIndices=lpi, linkJointTypes=lt, linkJointAxis=la, flags=flags,
+                             physicsClientId=cid)
+    art = Articulation(uid, root, records, cid)
+    root.uid, root.link, root.articulation = uid, -1, art
+    for n, r in enumerate(records):
+        r[3].uid, r[3].link, r[3].articulation = uid, n, art
+    # start where the files place the bodies: the joint value that best matches `location`
+    for n, (joint, kind, parent, child) in enumerate(records):
+        q = 0.0
+        if kind in TREE_KINDS:
+            rel = invert(parent.body_world_matrix @ parent.ref_in_body) @ (child.body_world_matrix @ child.ref_in_body)
+            rel = invert(pose_matrix(lp[n], lo[n])) @ rel
+            q = float(np.arctan2(rel[1, 0], rel[0, 0])) if kind is JointKind.REVOLUTE else float(rel[0, 3])
+            lim = joint.joint_limits
+            if lim is not None and lim.low is not None and lim.high is not None and lim.low <= lim.high:
+                pb.changeDynamics(uid, n, jointLowerLimit=lim.low, jointUpperLimit=lim.high, physicsClientId=cid)
+        pb.resetJointState(uid, n, q, physicsClientId=cid)
+        art.targets[n] = q
+        impulse = joint.max_motor_impulse if joint.max_motor_impulse is not None else DEFAULT_JOINT_MAX_MOTOR_IMPULSE
+        art.forces.append(impulse / dt)
+    art.drive()
+    return art
+
+
+def _pose(p):
+    return p.position, p.orientation

@@ -1,0 +1,105 @@
+"""Rigid bodies: free (maximal-coordinate) bodies and Featherstone articulations for the
+revolute/prismatic trees (adf-format.md §7, §8.2)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as pb
+
+from ..model.pose import Vec3
+from ..model.semantics import (
+    DEFAULT_ANGULAR_DAMPING, DEFAULT_FRICTION_ROLLING, DEFAULT_FRICTION_STATIC, DEFAULT_LINEAR_DAMPING,
+    DEFAULT_RESTITUTION, effective_mass, inertial_offset,
+)
+from .rotations import pose_to_matrix
+
+
+@dataclass(eq=False)
+class SimBody:
+    """One ADF body as PyBullet holds it: (uid, link); link -1 is a base or a free body."""
+    key: str
+    body: object
+    model: object
+    mass: float
+    com_in_body: np.ndarray          # 4×4, §7.2
+    ref_in_body: np.ndarray = None   # PyBullet frame of the body (COM, or the joint frame for a link)
+    uid: int = -1
+    link: int = -1
+    cid: int = 0
+    gravity: np.ndarray | None = None
+    inertia: tuple = (1.0, 1.0, 1.0)
+    articulation: object = None
+    body_world_matrix: np.ndarray = None  # the file's `location`
+    extra_force: list = field(default_factory=list)
+
+    @property
+    def static(self) -> bool:
+        return self.mass == 0.0
+
+    @property
+    def name(self) -> str:
+        return self.body.name or self.body.identifier
+
+    def state(self):
+        """(position, quaternion, linear velocity, angular velocity) of the PyBullet frame."""
+        if self.link < 0:
+            p, q = pb.getBasePositionAndOrientation(self.uid, physicsClientId=self.cid)
+            v, w = pb.getBaseVelocity(self.uid, physicsClientId=self.cid)
+            return p, q, v, w
+        s = pb.getLinkState(self.uid, self.link, computeLinkVelocity=1, physicsClientId=self.cid)
+        return s[4], s[5], s[6], s[7]
+
+    def com_position(self):
+        if self.link < 0:
+            return pb.getBasePositionAndOrientation(self.uid, physicsClientId=self.cid)[0]
+        return pb.getLinkState(self.uid, self.link, physicsClientId=self.cid)[0]
+
+    def world_matrix(self) -> np.ndarray:
+        """Pose of the ADF body frame (the mesh origin) in the world, 4×4."""
+        from .rotations import invert, pose_matrix
+        p, q, _, _ = self.state()
+        return pose_matrix(p, q) @ invert(self.ref_in_body)
+
+    def torque(self, t) -> None:
+        pb.applyExternalTorque(self.uid, self.link, t, pb.WORLD_FRAME, physicsClientId=self.cid)
+
+    def force(self, f, at) -> None:
+        pb.applyExternalForce(self.uid, self.link, f, at, pb.WORLD_FRAME, physicsClientId=self.cid)
+
+
+def make_sim_body(key: str, body, model) -> SimBody:
+    mass = effective_mass(body)
+    com = pose_to_matrix(inertial_offset(body))
+    from ..model.semantics import pose_or_identity
+    return SimBody(key=key, body=body, model=model, mass=max(mass, 0.0), com_in_body=com, ref_in_body=com,
+                   body_world_matrix=pose_to_matrix(pose_or_identity(body.location)))
+
+
+def body_gravity(body, model, world_g: np.ndarray) -> np.ndarray | None:
+    """The gravity override of a body (body `gravity` beats model `gravity`, §7.2), or None."""
+    g = body.gravity if body.mass is not None and body.gravity is not None else model.gravity
+    if g is None:
+        return None
+    g = np.array(g, dtype=float)
+    return None if np.allclose(g, world_g) else g
+
+
+def set_dynamics(sb: SimBody) -> None:
+    b = sb.body
+    fr = b.friction
+    kw = dict(
+        lateralFriction=fr.static if fr is not None and fr.static is not None else DEFAULT_FRICTION_STATIC,
+        rollingFriction=fr.rolling if fr is not None and fr.rolling is not None else DEFAULT_FRICTION_ROLLING,
+        restitution=b.restitution if b.restitution is not None else DEFAULT_RESTITUTION,
+        linearDamping=b.damping.linear if b.damping is not None and b.damping.linear is not None
+        else DEFAULT_LINEAR_DAMPING,
+        angularDamping=b.damping.angular if b.damping is not None and b.damping.angular is not None
+        else DEFAULT_ANGULAR_DAMPING,
+    )
+    if not sb.static and b.mass is not None and b.inertia is not None and None not in (
+            b.inertia.ix, b.inertia.iy, b.inertia.iz) and min(b.inertia.ix, b.inertia.iy, b.inertia.iz) > 0:
+        kw["localInertiaDiagonal"] = [b.inertia.ix, b.inertia.iy, b.inertia.iz]
+    pb.changeDynamics(sb.uid, sb.link, physicsClientId=sb.cid, **kw)
+    info = pb.getDynamicsInfo(sb.uid, sb.link, physicsClientId=sb.cid)
+    sb.inertia = tuple(info[2]) if not sb.static else (0.0, 0.0, 0.0)

@@ -1,0 +1,137 @@
+"""Cameras (adf-format.md §9): RGB, depth in metres along the optical axis, per-body
+segmentation, pinhole intrinsics, rendered headless with TinyRenderer."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as pb
+
+from ..model.semantics import DEFAULT_CAMERA_FAR, DEFAULT_CAMERA_FOV, DEFAULT_CAMERA_NEAR, DEFAULT_IMAGE_SIZE
+from .names import merge_namespace
+
+
+@dataclass(eq=False)
+class SimCamera:
+    name: str
+    key: str
+    camera: object
+    parent: object            # SimBody or None
+    eye: np.ndarray           # in the parent body frame (or world)
+    target: np.ndarray
+    up: np.ndarray
+    fov: float                # vertical, rad
+    near: float
+    far: float
+    width: int
+    height: int
+    eye_offset: float = 0.0   # along the image's right axis (stereo eyes)
+
+    def intrinsics(self) -> np.ndarray:
+        fy = (self.height / 2) / math.tan(self.fov / 2)
+        return np.array([[fy, 0, self.width / 2], [0, fy, self.height / 2], [0, 0, 1.0]])
+
+    def view(self, world) -> tuple[list, list, list]:
+        if self.parent is not None:
+            t = self.parent.world_matrix()
+            r, p = t[:3, :3], t[:3, 3]
+        else:
+            r, p = np.eye(3), np.zeros(3)
+        eye, target, up = r @ self.eye + p, r @ self.target + p, r @ self.up
+        if self.eye_offset:
+            fwd = target - eye
+            right = np.cross(fwd, up)
+            right /= np.linalg.norm(right) or 1.0
+            eye, target = eye + self.eye_offset * right, target + self.eye_offset * right
+        return eye.tolist(), target.tolist(), up.tolist()
+
+    def render(self, world) -> dict:
+        """{'rgb': H×W×3 uint8, 'depth': H×W float32 m, 'segmentation': H×W int32 (body index, -1 none)}."""
+        eye, target, up = self.view(world)
+        vm = pb.computeViewMatrix(eye, target, up, physicsClientId=world.cid)
+        pm = pb.computeProjectionMatrixFOV(math.degrees(self.fov), self.width / self.height, self.near, self.far,
+                                           physicsClientId=world.cid)
+        _, _, rgba, zbuf, seg = pb.getCameraImage(self.width, self.height, vm, pm, renderer=pb.ER_TINY_RENDERER,
+                                                  flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,
+                                                  physicsClientId=world.cid)
+        rgb = np.reshape(np.asarray(rgba, dtype=np.uint8), (self.height, self.width, 4))[:, :, :3]
+        z = np.reshape(np.asarray(zbuf, dtype=np.float64), (self.height, self.width))
+        n, f = self.near, self.far
+        depth = (f * n / (f - (f - n) * z)).astype(np.float32)   # linearised z-buffer
+        depth[z >= 1.0] = np.inf
+        seg = np.reshape(np.asarray(seg, dtype=np.int64), (self.height, self.width))
+        labels = np.full(seg.shape, -1, dtype=np.int32)
+        valid = seg >= 0
+        uid = seg & ((1 << 24) - 1)
+        link = (seg >> 24) - 1
+        index = {(sb.uid, sb.link): i for i, sb in enumerate(world.bodies)}
+        for u, l in set(zip(uid[valid].tolist(), link[valid].tolist())):
+            i = index.get((u, l))
+            if i is not None:
+                labels[(uid == u) & (link == l) & valid] = i
+        return {"rgb": rgb, "depth": depth, "segmentation": labels}
+
+
+def _camera(world, cam, ns: str) -> list[SimCamera]:
+    parent = None
+    if cam.parent:
+        key, hit = world.registry.find(cam.parent)
+        if key is None or hit is None:
+            world._warn("runner-camera", f"{cam.identifier}: parent {cam.parent!r} is not a body; camera skipped", cam)
+            return []
+        parent = hit
+    loc = np.array(cam.location or (0, 0, 0), float)
+    look = np.array(cam.look_at or (0, 0, 0), float)
+    up = np.array(cam.up or (0, 0, 1), float)
+    if np.allclose(loc, look) or np.linalg.norm(np.cross(look - loc, up)) < 1e-12:
+        world._warn("runner-camera", f"{cam.identifier}: look at equals location or up is parallel to the view",
+                    cam)
+    clip = cam.clipping_plane
+    near = clip.near if clip is not None and clip.near is not None else DEFAULT_CAMERA_NEAR
+    far = clip.far if clip is not None and clip.far is not None else DEFAULT_CAMERA_FAR
+    res = cam.publish_image_resolution
+    w = int(res.width) if res is not None and res.width else DEFAULT_IMAGE_SIZE[0]
+    h = int(res.height) if res is not None and res.height else DEFAULT_IMAGE_SIZE[1]
+    fov = cam.field_view_angle if cam.field_view_angle is not None else DEFAULT_CAMERA_FOV
+    name = cam.name or cam.identifier
+    key = merge_namespace(ns, cam.namespace) + cam.identifier
+    base = SimCamera(name, key, cam, parent, loc, look, up, fov, near, far, w, h)
+    if cam.stereo is None:
+        return [base]
+    sep = cam.stereo.eye_separation if cam.stereo.eye_separation is not None else 0.2
+    return [SimCamera(name + "_left", key, cam, parent, loc, look, up, fov, near, far, w, h, -sep / 2),
+            SimCamera(name + "_right", key, cam, parent, loc, look, up, fov, near, far, w, h, sep / 2)]
+
+
+def build_cameras(world) -> list[SimCamera]:
+    out = []
+    w = world.scene.world
+    if w is not None:
+        for cam in w.cameras:
+            out += _camera(world, cam, w.namespace or "")
+    for m in world.scene.all_models():
+        for cam in m.cameras:
+            out += _camera(world, cam, m.namespace or "")
+    return out
+
+
+def save_frames(world, out_dir, size_limit: int | None = None) -> list[str]:
+    """Write <camera>_rgb.png, <camera>_depth.npy, <camera>_seg.npy (+ _seg.png) for every camera."""
+    from pathlib import Path
+    from PIL import Image
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for cam in world.cameras:
+        frame = cam.render(world)
+        stem = cam.name.replace("/", "_")
+        Image.fromarray(frame["rgb"]).save(out / f"{stem}_rgb.png")
+        np.save(out / f"{stem}_depth.npy", frame["depth"])
+        np.save(out / f"{stem}_seg.npy", frame["segmentation"])
+        seg = frame["segmentation"]
+        vis = ((seg.astype(np.int64) * 2654435761) % 255).astype(np.uint8)
+        vis[seg < 0] = 0
+        Image.fromarray(vis).save(out / f"{stem}_seg.png")
+        written += [f"{stem}_rgb.png", f"{stem}_depth.npy", f"{stem}_seg.npy", f"{stem}_seg.png"]
+    return written

@@ -1,0 +1,229 @@
+"""Joints between bodies that PyBullet cannot make as Featherstone links, and the per-step
+spring, damping and limit forces PyBullet's constraints lack (adf-format.md §8).
+
+PyBullet's createConstraint joins maximal-coordinate bodies only with JOINT_FIXED,
+JOINT_POINT2POINT and JOINT_GEAR. So:
+- `fixed` → JOINT_FIXED; `p2p` → JOINT_POINT2POINT at the pivots;
+- `six dof`/`six dof spring`/`cone twist`/springs whose linear range is locked → a
+  JOINT_POINT2POINT at the pivot plus angular spring-damper and limit torques applied each
+  control step (the 6-DOF spring approximation, see docs/runner.md);
+- the same types with a free linear range → no constraint at all; linear and angular
+  springs and limits are all applied as forces;
+- a revolute joint that closes a loop → two JOINT_POINT2POINT constraints along the axis.
+Spring and damping gains are clamped to what an explicit step keeps stable
+(k ≤ 0.25·I/dt², c ≤ 0.5·I/dt); limits are velocity corrections with Baumgarte feedback.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as pb
+
+from ..model.semantics import DEFAULT_SIX_DOF_LIMIT, DEFAULT_SIX_DOF_SPRING, JointKind
+from .rotations import euler_xyz, matrix_to_pq, quat_to_matrix
+
+HINGE_HALF_SPAN = 0.01  # m: the two p2p constraints of a loop-closing hinge sit ±this along the axis
+
+
+@dataclass
+class SpringJoint:
+    name: str
+    parent: object   # SimBody
+    child: object
+    frame_a: np.ndarray   # joint frame in the parent's PyBullet frame (4×4)
+    frame_b: np.ndarray   # joint frame in the child's PyBullet frame
+    lin_low: np.ndarray
+    lin_high: np.ndarray
+    ang_low: np.ndarray
+    ang_high: np.ndarray
+    k_lin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    c_lin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    eq_lin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    k_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    c_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    eq_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    linear_constrained: bool = True   # a p2p holds the pivots together
+
+
+def _vec(v, default: float) -> np.ndarray:
+    if v is None:
+        return np.full(3, float(default))
+    return np.array([default if c is None else c for c in v], dtype=float)
+
+
+def spring_joint(joint, kind: JointKind, parent, child, frame_a, frame_b) -> SpringJoint:
+    """Limits and gains of a six-dof-family joint in the joint frame (§8.1)."""
+    lim = joint.joint_limits
+    big = np.full(3, np.inf)
+    zero = np.zeros(3)
+    if kind in (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING):
+        d = DEFAULT_SIX_DOF_LIMIT
+        lin_low, lin_high = np.full(3, -d), np.full(3, d)
+        ang_low, ang_high = np.full(3, -d), np.full(3, d)
+        if lim is not None and lim.linear is not None:
+            lin_low, lin_high = _vec(lim.linear.low, -d), _vec(lim.linear.high, d)
+        if lim is not None and lim.angular is not None:
+            ang_low, ang_high = _vec(lim.angular.low, -d), _vec(lim.angular.high, d)
+    elif kind is JointKind.CONE_TWIST:
+        lin_low = lin_high = zero
+        sx = lim.x if lim is not None and lim.x is not None else 0.7
+        sy = lim.y if lim is not None and lim.y is not None else 0.7
+        sz = lim.z if lim is not None and lim.z is not None else 0.7
+        ang_high = np.array([sx, sy, sz])
+        ang_low = -ang_high
+    else:  # linear or torsion spring: all locked but the spring axis (z) when limits exist
+        lin_low = lin_high = zero.copy()
+        ang_low, ang_high = zero.copy(), zero.copy()
+        has = lim is not None and lim.low is not None and lim.high is not None
+        if has:
+            if kind is JointKind.LINEAR_SPRING:
+                lin_low, lin_high = np.array([0, 0, lim.low]), np.array([0, 0, lim.high])
+            else:
+                ang_low, ang_high = np.array([0, 0, lim.low]), np.array([0, 0, lim.high])
+    sj = SpringJoint(joint.identifier, parent, child, frame_a, frame_b, lin_low, lin_high, ang_low, ang_high)
+    sj.linear_constrained = bool(np.all(lin_low == 0) and np.all(lin_high == 0))
+    if kind is JointKind.SIX_DOF_SPRING:
+        for attr, key in (("stiffness", "stiffness"), ("damping", "damping"), ("equilibrium_point", "equilibrium point")):
+            block = getattr(joint, attr)
+            dflt = DEFAULT_SIX_DOF_SPRING[key]
+            lin = _vec(getattr(block, "linear", None), dflt)
+            ang = _vec(getattr(block, "angular", None), dflt)
+            tag = {"stiffness": "k", "damping": "c", "equilibrium_point": "eq"}[attr]
+            setattr(sj, f"{tag}_lin", lin)
+            setattr(sj, f"{tag}_ang", ang)
+    elif kind in (JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING):
+        k = joint.stiffness if isinstance(joint.stiffness, (int, float)) else 0.0
+        c = joint.damping if isinstance(joint.damping, (int, float)) else 0.0
+        lim_ok = lim is not None and lim.low is not None and lim.high is not None
+        eq = joint.equilibrium_point if isinstance(joint.equilibrium_point, (int, float)) else (
+            (lim.low + lim.high) / 2 if lim_ok else 0.0)
+        if lim_ok:
+            if kind is JointKind.LINEAR_SPRING:
+                sj.k_lin, sj.c_lin, sj.eq_lin = np.array([0, 0, k]), np.array([0, 0, c]), np.array([0, 0, eq])
+            else:
+                sj.k_ang, sj.c_ang, sj.eq_ang = np.array([0, 0, k]), np.array([0, 0, c]), np.array([0, 0, eq])
+    return sj
+
+
+def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray,
+                    max_force: float) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child frame)]."""
+    out = []
+
+    def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1)):
+        c = pb.createConstraint(parent.uid, parent.link, child.uid, child.link, jtype, [0, 0, 0],
+                                list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
+                                physicsClientId=cid)
+        pb.changeConstraint(c, maxForce=max_force, physicsClientId=cid)
+        out.append((c, np.asarray(pa, float), np.asarray(pb_, float)))
+
+    if kind is JointKind.FIXED:
+        pa, oa = matrix_to_pq(frame_a)
+        pbp, ob = matrix_to_pq(frame_b)
+        add(pb.JOINT_FIXED, pa, pbp, oa, ob)
+    elif kind is JointKind.REVOLUTE:
+        for s in (-HINGE_HALF_SPAN, HINGE_HALF_SPAN):
+            add(pb.JOINT_POINT2POINT, frame_a[:3, 3] + s * frame_a[:3, 2], frame_b[:3, 3] + s * frame_b[:3, 2])
+    else:
+        add(pb.JOINT_POINT2POINT, frame_a[:3, 3], frame_b[:3, 3])
+    return out
+
+
+class SpringSet:
+    """All force-driven joints, evaluated together with numpy each control step."""
+
+    def __init__(self, joints: list[SpringJoint], cid: int) -> None:
+        self.joints = joints
+        self.cid = cid
+        n = len(joints)
+        if not n:
+            return
+        st = np.stack
+        self.fa, self.fb = st([j.frame_a for j in joints]), st([j.frame_b for j in joints])
+        for name in ("lin_low", "lin_high", "ang_low", "ang_high", "k_lin", "c_lin", "eq_lin",
+                     "k_ang", "c_ang", "eq_ang"):
+            setattr(self, name, st([getattr(j, name) for j in joints]))
+        self.free_lin = np.array([not j.linear_constrained for j in joints])
+        bodies = []
+        for j in joints:
+            for b in (j.parent, j.child):
+                if b not in bodies:
+                    bodies.append(b)
+        self.bodies = bodies
+        idx = {id(b): i for i, b in enumerate(bodies)}
+        self.ip = np.array([idx[id(j.parent)] for j in joints])
+        self.ic = np.array([idx[id(j.child)] for j in joints])
+        self.dynamic = np.array([not b.static for b in bodies])
+        inv_m = np.array([0.0 if b.static else 1.0 / b.mass for b in bodies])
+        inv_i = np.array([0.0 if b.static else 1.0 / max(min(b.inertia), 1e-12) for b in bodies])
+        self.m_eff = 1.0 / np.maximum(inv_m[self.ip] + inv_m[self.ic], 1e-12)
+        self.i_eff = 1.0 / np.maximum(inv_i[self.ip] + inv_i[self.ic], 1e-12)
+
+    def states(self):
+        pos, orn, lv, av = [], [], [], []
+        for b in self.bodies:
+            p, q, v, w = b.state()
+            pos.append(p); orn.append(q); lv.append(v); av.append(w)
+        return np.array(pos), quat_to_matrix(np.array(orn)), np.array(lv), np.array(av)
+
+    def apply(self, dt: float, erp: float = 0.2) -> None:
+        if not self.joints:
+            return
+        pos, rot, lv, av = self.states()
+        rp, rc = rot[self.ip], rot[self.ic]
+        ra = rp @ self.fa[:, :3, :3]
+        rb = rc @ self.fb[:, :3, :3]
+        pa = pos[self.ip] + np.einsum("nij,nj->ni", rp, self.fa[:, :3, 3])
+        pbw = pos[self.ic] + np.einsum("nij,nj->ni", rc, self.fb[:, :3, 3])
+        rat = np.transpose(ra, (0, 2, 1))
+        rel = rat @ rb
+        ang = euler_xyz(rel)
+        w_rel = np.einsum("nij,nj->ni", rat, av[self.ic] - av[self.ip])
+        # angular springs and limits, in joint frame A
+        i_eff = self.i_eff[:, None]
+        k = np.minimum(self.k_ang, 0.25 * i_eff / dt ** 2)
+        c = np.minimum(self.c_ang, 0.5 * i_eff / dt)
+        tau = -k * (ang - self.eq_ang) - c * w_rel
+        tau += self._limit(ang, w_rel, self.ang_low, self.ang_high, i_eff, dt, erp)
+        tau_w = np.einsum("nij,nj->ni", ra, tau)
+        force_w = np.zeros_like(tau_w)
+        if self.free_lin.any():
+            d = np.einsum("nij,nj->ni", rat, pbw - pa)
+            v_rel = np.einsum("nij,nj->ni", rat, lv[self.ic] - lv[self.ip])
+            m_eff = self.m_eff[:, None]
+            kl = np.minimum(self.k_lin, 0.25 * m_eff / dt ** 2)
+            cl = np.minimum(self.c_lin, 0.5 * m_eff / dt)
+            f = -kl * (d - self.eq_lin) - cl * v_rel
+            f += self._limit(d, v_rel, self.lin_low, self.lin_high, m_eff, dt, erp)
+            force_w = np.where(self.free_lin[:, None], np.einsum("nij,nj->ni", ra, f), 0.0)
+        cid = self.cid
+        for n, j in enumerate(self.joints):
+            t = tau_w[n].tolist()
+            if not j.child.static:
+                j.child.torque(t)
+            if not j.parent.static:
+                j.parent.torque([-x for x in t])
+            if self.free_lin[n]:
+                f = force_w[n].tolist()
+                if not j.child.static:
+                    j.child.force(f, pbw[n].tolist())
+                if not j.parent.static:
+                    j.parent.force([-x for x in f], pbw[n].tolist())
+
+    @staticmethod
+    def _limit(x, v, low, high, inertia, dt, erp):
+        """Velocity-correcting force that keeps x within [low, high] (inf bounds ignored)."""
+        out = np.zeros_like(x)
+        active = low <= high  # low > high: free (Bullet)
+        over = active & (x > high)
+        under = active & (x < low)
+        # drive the violation back: target velocity -erp·err/dt, only push, never pull
+        v_over = np.where(over, -erp * (x - high) / dt, 0.0)
+        v_under = np.where(under, -erp * (x - low) / dt, 0.0)
+        f_over = np.minimum(inertia * (v_over - v) / dt, 0.0)
+        f_under = np.maximum(inertia * (v_under - v) / dt, 0.0)
+        out = np.where(over, f_over, out)
+        out = np.where(under, f_under, out)
+        return out

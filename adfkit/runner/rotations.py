@@ -1,0 +1,61 @@
+"""Vectorised rotation helpers (numpy, quaternions as x, y, z, w like PyBullet)."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def quat_to_matrix(q: np.ndarray) -> np.ndarray:
+    """(..., 4) quaternions → (..., 3, 3) rotation matrices."""
+    q = np.asarray(q, dtype=float)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    out = np.empty(q.shape[:-1] + (3, 3))
+    out[..., 0, 0] = 1 - 2 * (y * y + z * z)
+    out[..., 0, 1] = 2 * (x * y - z * w)
+    out[..., 0, 2] = 2 * (x * z + y * w)
+    out[..., 1, 0] = 2 * (x * y + z * w)
+    out[..., 1, 1] = 1 - 2 * (x * x + z * z)
+    out[..., 1, 2] = 2 * (y * z - x * w)
+    out[..., 2, 0] = 2 * (x * z - y * w)
+    out[..., 2, 1] = 2 * (y * z + x * w)
+    out[..., 2, 2] = 1 - 2 * (x * x + y * y)
+    return out
+
+
+def matrix_to_quat(m: np.ndarray) -> np.ndarray:
+    """One 3×3 rotation matrix → quaternion (x, y, z, w)."""
+    from ..model.pose import Quat
+    return np.array(Quat.from_matrix(np.asarray(m).tolist()))
+
+
+def euler_xyz(r: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) → Bullet 6DOF-spring2 RO_XYZ angles (..., 3): R = Rx·Ry·Rz."""
+    sy = np.clip(r[..., 0, 2], -1.0, 1.0)
+    ax = np.arctan2(-r[..., 1, 2], r[..., 2, 2])
+    ay = np.arcsin(sy)
+    az = np.arctan2(-r[..., 0, 1], r[..., 0, 0])
+    return np.stack([ax, ay, az], axis=-1)
+
+
+def pose_matrix(position, quat) -> np.ndarray:
+    t = np.eye(4)
+    t[:3, :3] = quat_to_matrix(np.asarray(quat))
+    t[:3, 3] = position
+    return t
+
+
+def pose_to_matrix(pose) -> np.ndarray:
+    """An adfkit Pose → 4×4 homogeneous matrix."""
+    return pose_matrix(pose.position, pose.orientation)
+
+
+def matrix_to_pq(t: np.ndarray) -> tuple[list[float], list[float]]:
+    """4×4 → (position list, quaternion list) for PyBullet calls."""
+    return list(map(float, t[:3, 3])), list(map(float, matrix_to_quat(t[:3, :3])))
+
+
+def invert(t: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    r = t[:3, :3].T
+    out[:3, :3] = r
+    out[:3, 3] = -r @ t[:3, 3]
+    return out

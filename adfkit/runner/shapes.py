@@ -1,0 +1,220 @@
+"""Collision and visual shapes of bodies and ghosts (adf-format.md §7.3–§7.5, §12.3).
+
+Every shape pose is given in the object's COM frame, the frame PyBullet uses as the base
+frame. Primitive collision dimensions are not scaled; meshes are (§12.3).
+"""
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+
+from ..adf.paths import collision_mesh_path, visual_mesh_path
+from ..diagnostics import Diagnostic, warning
+from ..model.pose import Pose, Quat, Vec3
+from ..model.semantics import (
+    CollisionMeshType, Primitive, ShapeKind, axis_vector, collision_mesh_type,
+    collision_primitives, shape_kind, shortest_arc,
+)
+from .rotations import invert, matrix_to_pq, pose_to_matrix
+
+MESH_SUFFIXES = {".obj", ".stl"}  # what PyBullet's GEOM_MESH reads from a file
+
+
+@dataclass
+class ShapeParts:
+    """Arguments for createCollisionShapeArray (one entry per child shape)."""
+    types: list[int] = field(default_factory=list)
+    kwargs: list[dict] = field(default_factory=list)
+    plane: tuple[list[float], float] | None = None   # a lone PLANE (added directly, §7.4)
+
+    def add(self, shape_type: int, **kw) -> None:
+        self.types.append(shape_type)
+        self.kwargs.append(kw)
+
+
+_CONE_CACHE: dict[tuple[float, float], str] = {}
+_CONE_DIR = None
+
+
+def cone_obj(radius: float, height: float) -> str:
+    """A cone along +z centred on half its height (Bullet's btConeShapeZ), as an OBJ file."""
+    global _CONE_DIR
+    key = (round(radius, 9), round(height, 9))
+    if key in _CONE_CACHE:
+        return _CONE_CACHE[key]
+    if _CONE_DIR is None:
+        _CONE_DIR = tempfile.mkdtemp(prefix="adfkit-cones-")
+    n = 24
+    lines = [f"v 0 0 {height / 2:.9g}", f"v 0 0 {-height / 2:.9g}"]
+    for i in range(n):
+        a = 2 * math.pi * i / n
+        lines.append(f"v {radius * math.cos(a):.9g} {radius * math.sin(a):.9g} {-height / 2:.9g}")
+    for i in range(n):
+        j = (i + 1) % n
+        lines.append(f"f 1 {i + 3} {j + 3}")
+        lines.append(f"f 2 {j + 3} {i + 3}")
+    path = os.path.join(_CONE_DIR, f"cone_{len(_CONE_CACHE)}.obj")
+    Path(path).write_text("\n".join(lines) + "\n")
+    _CONE_CACHE[key] = path
+    return path
+
+
+def _axis_rotation(axis: Vec3) -> Quat:
+    """Rotation taking PyBullet's z-aligned primitive onto the ADF `axis`."""
+    return shortest_arc(Vec3(0, 0, 1), axis)
+
+
+def _primitive(parts: ShapeParts, prim: Primitive, pose_in_com: np.ndarray, margin: float) -> None:
+    g = prim.geometry
+    rot = pose_in_com @ pose_to_matrix(Pose(Vec3(), _axis_rotation(prim.axis)))
+    pos, orn = matrix_to_pq(rot)
+    if prim.kind is ShapeKind.BOX:
+        parts.add(pb.GEOM_BOX, halfExtents=[g.x / 2, g.y / 2, g.z / 2],
+                  collisionFramePosition=matrix_to_pq(pose_in_com)[0],
+                  collisionFrameOrientation=matrix_to_pq(pose_in_com)[1])
+    elif prim.kind is ShapeKind.SPHERE:
+        parts.add(pb.GEOM_SPHERE, radius=g.radius, collisionFramePosition=pos, collisionFrameOrientation=orn)
+    elif prim.kind is ShapeKind.CYLINDER:
+        parts.add(pb.GEOM_CYLINDER, radius=g.radius, height=g.height,
+                  collisionFramePosition=pos, collisionFrameOrientation=orn)
+    elif prim.kind is ShapeKind.CAPSULE:  # ADF height includes the caps
+        parts.add(pb.GEOM_CAPSULE, radius=g.radius, height=max(g.height - 2 * g.radius, 0.0),
+                  collisionFramePosition=pos, collisionFrameOrientation=orn)
+    elif prim.kind is ShapeKind.CONE:
+        parts.add(pb.GEOM_MESH, fileName=cone_obj(g.radius, g.height), meshScale=[1, 1, 1],
+                  collisionFramePosition=pos, collisionFrameOrientation=orn)
+    elif prim.kind is ShapeKind.PLANE:
+        n = np.array(g.normal or (0, 0, 1), dtype=float)
+        n = n / (np.linalg.norm(n) or 1.0)
+        parts.plane = (list(map(float, n)), float(g.offset or 0.0))
+
+
+def collision_parts(model, obj, frame_in_body, scale: float,
+                    static: bool, diags: list[Diagnostic]) -> ShapeParts | None:
+    """The collision shape of a body or ghost, or None when AMBF would skip the object."""
+    parts = ShapeParts()
+    margin = obj.collision_margin if obj.collision_margin is not None else 0.001
+    body_to_com = invert(frame_in_body)
+    prims = collision_primitives(obj)
+    if prims is not None:
+        if not prims:
+            diags.append(warning("runner-no-collision", f"{obj.identifier}: no usable collision primitive",
+                                 obj.source, "check `collision shape` and `collision geometry`"))
+        for prim in prims:
+            _primitive(parts, prim, body_to_com @ pose_to_matrix(prim.pose), margin)
+        return parts
+    path = collision_mesh_path(model, obj)
+    if path is None:
+        return parts  # no collision geometry: an empty shape (AMBF prints an error)
+    if not path.is_file():
+        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: collision mesh {path} not found; "
+                             "the body is skipped as AMBF does", obj.where("collision mesh") or obj.source,
+                             "fix `collision mesh`/`mesh` or the resolution paths"))
+        return None
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        diags.append(warning("runner-mesh-format", f"{obj.identifier}: {path.suffix} meshes are not readable "
+                             "by PyBullet; no collision shape", obj.source, "convert the mesh to OBJ or STL"))
+        return parts
+    kind, _ = collision_mesh_type(obj.collision_mesh_type)
+    pos, orn = matrix_to_pq(body_to_com)
+    kw = dict(fileName=str(path), meshScale=[scale] * 3, collisionFramePosition=pos,
+              collisionFrameOrientation=orn)
+    if kind is CollisionMeshType.CONCAVE_MESH and static:
+        kw["flags"] = pb.GEOM_FORCE_CONCAVE_TRIMESH  # exact triangles: only static bodies in PyBullet
+    # Dynamic concave meshes: PyBullet builds one convex hull per OBJ sub-mesh (documented approximation).
+    parts.add(pb.GEOM_MESH, **kw)
+    return parts
+
+
+def create_collision(parts: ShapeParts, cid: int) -> int:
+    """Create the PyBullet collision shape; -1 for an empty one."""
+    if parts.plane is not None and not parts.types:
+        n, off = parts.plane
+        return pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=n,
+                                       collisionFramePosition=[c * off for c in n], physicsClientId=cid)
+    if not parts.types:
+        return -1
+    if len(parts.types) == 1:
+        return pb.createCollisionShape(parts.types[0], physicsClientId=cid, **parts.kwargs[0])
+    arrays: dict[str, list] = {k: [] for k in ("radii", "halfExtents", "lengths", "fileNames", "meshScales",
+                                                "collisionFramePositions", "collisionFrameOrientations", "flags")}
+    for t, kw in zip(parts.types, parts.kwargs):
+        arrays["radii"].append(kw.get("radius", 0.5))
+        arrays["halfExtents"].append(kw.get("halfExtents", [0.5, 0.5, 0.5]))
+        arrays["lengths"].append(kw.get("height", 1.0))
+        arrays["fileNames"].append(kw.get("fileName", ""))
+        arrays["meshScales"].append(kw.get("meshScale", [1, 1, 1]))
+        arrays["collisionFramePositions"].append(kw.get("collisionFramePosition", [0, 0, 0]))
+        arrays["collisionFrameOrientations"].append(kw.get("collisionFrameOrientation", [0, 0, 0, 1]))
+        arrays["flags"].append(kw.get("flags", 0))
+    return pb.createCollisionShapeArray(shapeTypes=parts.types, physicsClientId=cid, **arrays)
+
+
+def rgba(obj) -> list[float] | None:
+    """Colour of §7.3: `color rgba`, then `color components` (diffuse + transparency), else None."""
+    if obj.use_material is False:
+        return None
+    c = obj.color_rgba
+    if c is not None and None not in (c.r, c.g, c.b, c.a):
+        return [c.r, c.g, c.b, c.a]
+    cc = obj.color_components
+    if cc is not None:
+        d = cc.diffuse
+        col = [d.r or 0.0, d.g or 0.0, d.b or 0.0] if d is not None else [0.7, 0.7, 0.7]
+        return col + [cc.transparency if cc.transparency is not None else 1.0]
+    return None
+
+
+def create_visual(model, obj, frame_in_body, scale: float, cid: int,
+                  diags: list[Diagnostic]) -> int:
+    """Visual shape (primitive beats mesh; compound parts drawn at the body origin, §7.3)."""
+    colour = rgba(obj) or [0.8, 0.8, 0.8, 1.0]
+    pos, orn = matrix_to_pq(invert(frame_in_body))
+    base = dict(visualFramePosition=pos, visualFrameOrientation=orn, rgbaColor=colour, physicsClientId=cid)
+    entries = []
+    if obj.shape and obj.geometry is not None:
+        entries = [(obj.shape, obj.geometry)]
+    elif obj.compound_shape:
+        entries = [(e.shape, e.geometry) for e in obj.compound_shape if e.geometry is not None]
+    if entries:
+        shape, g = entries[0]  # PyBullet visual shapes are single; draw the first part
+        k = shape_kind(shape)
+        try:
+            if k is ShapeKind.BOX:
+                return pb.createVisualShape(pb.GEOM_BOX, halfExtents=[g.x * scale / 2, g.y * scale / 2,
+                                                                      g.z * scale / 2], **base)
+            if k is ShapeKind.SPHERE:
+                return pb.createVisualShape(pb.GEOM_SPHERE, radius=g.radius * scale, **base)
+            if k in (ShapeKind.CYLINDER, ShapeKind.CAPSULE):  # always along Z (§7.3)
+                return pb.createVisualShape(pb.GEOM_CYLINDER, radius=g.radius * scale,
+                                            length=g.height * scale, **base)
+            if k is ShapeKind.CONE:
+                return pb.createVisualShape(pb.GEOM_MESH, fileName=cone_obj(g.radius * scale, g.height * scale),
+                                            **base)
+        except (TypeError, pb.error):
+            pass
+        return -1
+    path = visual_mesh_path(model, obj)
+    if path is None:
+        return -1
+    if not path.is_file():
+        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: visual mesh {path} not found",
+                             obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
+        return -1
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        return -1
+    kw = dict(base)
+    if rgba(obj) is None:
+        kw.pop("rgbaColor")
+    try:
+        return pb.createVisualShape(pb.GEOM_MESH, fileName=str(path), meshScale=[scale] * 3, **kw)
+    except pb.error:
+        diags.append(warning("runner-visual", f"{obj.identifier}: PyBullet could not read {path}",
+                             obj.source, "re-export the mesh"))
+        return -1

@@ -1,0 +1,475 @@
+"""SimWorld: an ADF scene (adfkit.model.Scene) built in PyBullet and stepped.
+
+Bodies joined by revolute/prismatic trees become multibodies (exact joints, native limits and
+position motors); every other body is a maximal-coordinate rigid body and every other joint a
+createConstraint plus per-step forces (joints.py). See docs/runner.md for why.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as pb
+
+from ..diagnostics import Diagnostic, warning
+from ..model.semantics import (
+    ACTUATOR_TYPES, DEFAULT_ACTUATOR_MAX_IMPULSE, DEFAULT_GRAVITY, DEFAULT_SENSOR_RANGE, JointKind,
+    SENSOR_TYPES, joint_frames, joint_kind, pose_or_identity,
+)
+from . import articulation
+from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
+from .joints import SpringSet, make_constraint, spring_joint
+from .names import Registry, merge_namespace
+from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
+from .shapes import collision_parts, create_collision, create_visual
+
+SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
+                JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING)
+
+
+@dataclass
+class Options:
+    physics_hz: float = 1000.0           # internal Bullet step (AMBF: fixed 1 ms)
+    control_substeps: int = 1            # physics steps per control step (springs, ghosts, drives)
+    solver_iterations: int | None = None  # None: PyBullet default (50)
+    gravity: tuple | None = None          # override the world's
+    visuals: bool = True
+    hole_friction: float = 2.0            # K of F = -K·v_rel inside hole ghosts, N·s/m
+    hole_ghost_words: tuple = ("entry", "exit", "hole")
+
+
+@dataclass(eq=False)
+class SimGhost:
+    key: str
+    ghost: object
+    uid: int
+    parent: SimBody | None
+    pose_in_parent: np.ndarray       # ghost COM frame in the parent's PyBullet frame (or world)
+    friction: bool = False
+    overlapping: list = field(default_factory=list)
+
+
+@dataclass(eq=False)
+class SimActuator:
+    key: str
+    actuator: object
+    parent: SimBody
+    location: np.ndarray            # in the parent body frame
+    max_force: float
+    constraint: int | None = None
+    target: SimBody | None = None
+
+
+@dataclass(eq=False)
+class SimSensor:
+    key: str
+    sensor: object
+    parent: SimBody
+    location: np.ndarray
+    starts: np.ndarray
+    ends: np.ndarray
+    sensed: list = field(default_factory=list)
+
+
+class SimWorld:
+    def __init__(self, scene, options: Options | None = None, gui: bool = False) -> None:
+        self.scene = scene
+        self.opt = options or Options()
+        self.diagnostics: list[Diagnostic] = []
+        self.cid = pb.connect(pb.GUI if gui else pb.DIRECT)
+        self.dt = 1.0 / self.opt.physics_hz
+        w = scene.world
+        g = self.opt.gravity or (tuple(w.gravity) if w is not None and w.gravity is not None else DEFAULT_GRAVITY)
+        self.gravity = np.array(g, dtype=float)
+        self.max_substeps = w.max_iterations if w is not None and w.max_iterations else 10
+        pb.setGravity(*self.gravity, physicsClientId=self.cid)
+        params = dict(fixedTimeStep=self.dt, numSubSteps=self.opt.control_substeps)
+        if self.opt.solver_iterations:
+            params["numSolverIterations"] = self.opt.solver_iterations
+        pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
+        self.registry = Registry()
+        self.bodies: list[SimBody] = []
+        self.constraints: list[tuple] = []   # (joint name, constraint id, parent, child, pivot a, pivot b)
+        self.articulations: list = []
+        self.ghosts: list[SimGhost] = []
+        self.actuators: list[SimActuator] = []
+        self.sensors: list[SimSensor] = []
+        self.cameras: list = []
+        self.joint_names: list[str] = []
+        self.skipped: list[str] = []
+        self.steps = 0
+        self.sim_time = 0.0
+        self.wall_time = 0.0
+        pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
+        self._build()
+
+    # ---- building ------------------------------------------------------------------------
+    def _build(self) -> None:
+        models = self.scene.all_models()
+        records = []
+        self._model_bodies: dict[int, list[SimBody]] = {}
+        for m in models:
+            ns = m.namespace or ""
+            mine = []
+            for b in m.bodies:
+                sb = make_sim_body(merge_namespace(ns, b.namespace) + b.identifier, b, m)
+                sb.cid = self.cid
+                sb.gravity = body_gravity(b, m, self.gravity)
+                sb._parts = collision_parts(m, b, sb.ref_in_body, b.scale or 1.0, sb.static, self.diagnostics)
+                if sb._parts is None:
+                    self.skipped.append(sb.key)
+                    continue
+                sb.key = self.registry.add(sb.key, sb)
+                mine.append(sb)
+                self.bodies.append(sb)
+            self._model_bodies[id(m)] = mine
+            local = Registry()
+            for sb in mine:
+                local.items[sb.key] = sb
+            for j in m.joints:
+                kind = joint_kind(j.type)
+                if kind is None:
+                    self._warn("runner-joint-type", f"{j.identifier}: unknown joint type {j.type!r}; skipped", j)
+                    continue
+                jns = merge_namespace(ns, j.namespace)
+                ends = []
+                for ref in (j.parent, j.child):
+                    key, hit = local.find(ref)
+                    if key is None:
+                        key, hit = local.find(jns + (ref or ""))
+                    if key is None:
+                        key, hit = self.registry.find(jns + (ref or ""))
+                    if key is None:
+                        key, hit = self.registry.find(ref)
+                    ends.append(hit if key is not None else None)
+                if None in ends:
+                    self._warn("runner-joint-body", f"{j.identifier}: parent or child body not found; skipped", j)
+                    continue
+                records.append((j, kind, ends[0], ends[1]))
+        trees, leftover = articulation.components(records)
+        in_tree = set()
+        for root, recs in trees:
+            in_tree.add(id(root))
+            in_tree.update(id(r[3]) for r in recs)
+        for sb in self.bodies:
+            if id(sb) not in in_tree:
+                self._create_free(sb)
+        for root, recs in trees:
+            self_coll = not all(r[3].model.ignore_inter_collision for r in recs)
+            art = articulation.build(root, recs, self._shapes_for, self.dt, self.cid, self_coll)
+            self.articulations.append(art)
+            self.joint_names.extend(art.joint_names)
+            for sb in [root] + [r[3] for r in recs]:
+                set_dynamics(sb)
+        self._collision_filters(records)
+        springs = []
+        for j, kind, parent, child in leftover:
+            ps = parent.body.scale or 1.0
+            cs = child.body.scale or 1.0
+            a, b = joint_frames(j, ps, cs)
+            fa = invert(parent.ref_in_body) @ pose_to_matrix(a)
+            fb = invert(child.ref_in_body) @ pose_to_matrix(b)
+            self.joint_names.append(j.identifier)
+            sj = None
+            if kind in SPRING_KINDS:
+                sj = spring_joint(j, kind, parent, child, fa, fb)
+                springs.append(sj)
+                if not sj.linear_constrained:
+                    continue
+                kind_c = JointKind.P2P
+            else:
+                kind_c = kind
+            if kind is JointKind.PRISMATIC:
+                self._warn("runner-prismatic-loop", f"{j.identifier}: a prismatic joint outside a tree is "
+                           "not supported by PyBullet's maximal constraints; built as fixed", j)
+                kind_c = JointKind.FIXED
+            for c, pa, pbv in make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5):
+                self.constraints.append((j.identifier, c, parent, child, pa, pbv))
+        self.springs = SpringSet(springs, self.cid)
+        for m in models:
+            self._build_ghosts(m)
+            self._build_actuators(m)
+            self._build_sensors(m)
+        from .cameras import build_cameras
+        self.cameras = build_cameras(self)
+        self._floor_z = self._floor()
+        self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
+
+    def _warn(self, rule, msg, obj, hint="") -> None:
+        self.diagnostics.append(warning(rule, msg, getattr(obj, "source", None), hint or None))
+
+    def _shapes_for(self, sb: SimBody, frame_in_body) -> tuple[int, int]:
+        b, m = sb.body, sb.model
+        if frame_in_body is not sb.ref_in_body or sb._parts is None:
+            sb._parts = collision_parts(m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics)
+        col = create_collision(sb._parts, self.cid) if sb._parts is not None else -1
+        vis = create_visual(m, b, frame_in_body, b.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
+        return col, vis
+
+    def _create_free(self, sb: SimBody) -> None:
+        col, vis = self._shapes_for(sb, sb.ref_in_body)
+        pos, orn = matrix_to_pq(sb.body_world_matrix @ sb.ref_in_body)
+        if sb._parts is not None and sb._parts.plane is not None and not sb.static:
+            self._warn("runner-plane", f"{sb.key}: a PLANE shape on a dynamic body; made static", sb.body)
+            sb.mass = 0.0
+        sb.uid = pb.createMultiBody(sb.mass, col, vis, pos, orn, useMaximalCoordinates=True,
+                                    physicsClientId=self.cid)
+        sb.link = -1
+        set_dynamics(sb)
+
+    def _collision_filters(self, records) -> None:
+        groups = sorted({g for sb in self.bodies for g in (sb.body.collision_groups or []) if 0 <= g <= 999})
+        bit = {g: 1 << (i % 30) for i, g in enumerate(groups)}
+        if len(groups) > 30:
+            self._warn("runner-groups", "more than 30 collision groups: groups share mask bits", None)
+        allbits = (1 << 31) - 1
+        for sb in self.bodies:
+            gs = [g for g in (sb.body.collision_groups or []) if 0 <= g <= 999]
+            if gs:
+                mask = 0
+                for g in gs:
+                    mask |= bit[g]
+                pb.setCollisionFilterGroupMask(sb.uid, sb.link, mask, mask, physicsClientId=self.cid)
+            else:
+                pb.setCollisionFilterGroupMask(sb.uid, sb.link, allbits, allbits, physicsClientId=self.cid)
+        for j, kind, parent, child in records:
+            if j.ignore_inter_collision is not False:
+                self._no_collision(parent, child)
+        for m in self.scene.all_models():
+            if m.ignore_inter_collision:
+                mine = self._model_bodies.get(id(m), [])
+                for i, a in enumerate(mine):
+                    for b in mine[i + 1:]:
+                        self._no_collision(a, b)
+
+    def _no_collision(self, a: SimBody, b: SimBody) -> None:
+        pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, 0, physicsClientId=self.cid)
+
+    def _parent(self, ref: str | None, ns: str, obj):
+        key, hit = self.registry.find(ref)
+        if key is None and ref:
+            key, hit = self.registry.find(ns + ref)
+        if key is None:
+            self._warn("runner-parent", f"{obj.identifier}: parent {ref!r} not found"
+                       + (f" (matches: {', '.join(hit)})" if hit else ""), obj)
+            return None
+        return hit
+
+    def _build_ghosts(self, m) -> None:
+        ns = m.namespace or ""
+        for gh in m.ghost_objects:
+            parts = collision_parts(m, gh, np.eye(4), gh.scale or 1.0, True, self.diagnostics)
+            if parts is None or (not parts.types and parts.plane is None):
+                self._warn("runner-ghost", f"{gh.identifier}: no collision geometry; ghost skipped", gh)
+                continue
+            parent = self._parent(gh.parent, ns, gh) if gh.parent else None
+            loc = pose_to_matrix(pose_or_identity(gh.location))
+            rel = invert(parent.ref_in_body) @ loc if parent is not None else loc
+            col = create_collision(parts, self.cid)
+            vis = create_visual(m, gh, np.eye(4), gh.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
+            world = (self._frame(parent) @ rel) if parent is not None else rel
+            pos, orn = matrix_to_pq(world)
+            uid = pb.createMultiBody(0, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid)
+            pb.setCollisionFilterGroupMask(uid, -1, 0, 0, physicsClientId=self.cid)
+            name = (gh.name or gh.identifier).lower()
+            friction = any(w in name for w in self.opt.hole_ghost_words)
+            key = self.registry.add(merge_namespace(ns, gh.namespace) + gh.identifier, None)
+            self.ghosts.append(SimGhost(key, gh, uid, parent, rel, friction))
+
+    def _build_actuators(self, m) -> None:
+        ns = m.namespace or ""
+        for a in m.actuators:
+            if ACTUATOR_TYPES.get(a.type) != "constraint":
+                self._warn("runner-actuator", f"{a.identifier}: actuator type {a.type!r} not supported; skipped", a)
+                continue
+            parent = self._parent(a.parent, ns, a)
+            if parent is None:
+                continue
+            imp = a.max_impulse if a.max_impulse is not None else DEFAULT_ACTUATOR_MAX_IMPULSE
+            key = merge_namespace(ns, a.namespace) + a.identifier
+            self.actuators.append(SimActuator(key, a, parent, pose_to_matrix(pose_or_identity(a.location)),
+                                              imp / self.dt))
+
+    def _build_sensors(self, m) -> None:
+        ns = m.namespace or ""
+        for s in m.sensors:
+            if SENSOR_TYPES.get(s.type) != "proximity" or not s.array:
+                self._warn("runner-sensor", f"{s.identifier}: only proximity sensors with an `array` of rays "
+                           "are played; skipped", s)
+                continue
+            parent = self._parent(s.parent, ns, s)
+            if parent is None:
+                continue
+            rng = s.range if s.range is not None else DEFAULT_SENSOR_RANGE
+            starts = np.array([r.offset or (0, 0, 0) for r in s.array], dtype=float)
+            dirs = np.array([r.direction or (1, 0, 0) for r in s.array], dtype=float)
+            key = merge_namespace(ns, s.namespace) + s.identifier
+            self.sensors.append(SimSensor(key, s, parent, pose_to_matrix(pose_or_identity(s.location)),
+                                          starts, starts + dirs * rng))
+
+    def _frame(self, sb: SimBody) -> np.ndarray:
+        """World pose of the PyBullet frame of a body."""
+        p, q, _, _ = sb.state()
+        return pose_matrix(p, q)
+
+    def _floor(self) -> float:
+        zs = []
+        for sb in self.bodies:
+            if sb.static:
+                if sb._parts is not None and sb._parts.plane is not None:
+                    zs.append(sb.body_world_matrix[2, 3] + sb._parts.plane[1])
+                else:
+                    zs.append(pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2])
+        return min(zs) if zs else -math.inf
+
+    # ---- queries -------------------------------------------------------------------------
+    def body(self, text: str) -> SimBody:
+        key, hit = self.registry.find(text)
+        if key is None or not isinstance(hit, SimBody):
+            raise KeyError(f"no unique body matches {text!r}")
+        return hit
+
+    def by_uid(self):
+        return {(sb.uid, sb.link): sb for sb in self.bodies}
+
+    # ---- stepping ------------------------------------------------------------------------
+    def control(self) -> None:
+        """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors."""
+        cdt = self.dt * self.opt.control_substeps
+        for sb in self.bodies:
+            if sb.gravity is not None and not sb.static:
+                f = (sb.mass * (sb.gravity - self.gravity)).tolist()
+                sb.force(f, list(sb.com_position()))
+        self.springs.apply(cdt)
+        self._update_ghosts()
+        for s in self.sensors:
+            self._sense(s)
+
+    def step(self, n: int = 1) -> None:
+        """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
+        t0 = time.perf_counter()
+        sub = self.opt.control_substeps
+        for _ in range(n):
+            self.control()
+            pb.stepSimulation(physicsClientId=self.cid)
+        self.steps += n * sub
+        self.sim_time = self.steps * self.dt
+        self.wall_time += time.perf_counter() - t0
+
+    def run(self, seconds: float, progress=None) -> None:
+        per = self.dt * self.opt.control_substeps
+        total = int(round(seconds / per))
+        chunk = max(1, int(0.05 / per))
+        done = 0
+        while done < total:
+            k = min(chunk, total - done)
+            self.step(k)
+            done += k
+            if progress is not None:
+                rtf = self.sim_time / self.wall_time if self.wall_time else 0.0
+                progress.update(k, suffix=f"{rtf:.2f}x real time")
+
+    # ---- ghosts, sensors, actuators -------------------------------------------------------
+    def _update_ghosts(self) -> None:
+        lookup = None
+        for g in self.ghosts:
+            if g.parent is not None:
+                pos, orn = matrix_to_pq(self._frame(g.parent) @ g.pose_in_parent)
+                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=self.cid)
+            lo, hi = pb.getAABB(g.uid, -1, physicsClientId=self.cid)
+            over = pb.getOverlappingObjects(lo, hi, physicsClientId=self.cid) or []
+            found = []
+            if over:
+                lookup = lookup or self.by_uid()
+                for uid, link in over:
+                    sb = lookup.get((uid, link))
+                    if sb is None or sb.static or sb is g.parent:
+                        continue
+                    if pb.getClosestPoints(g.uid, uid, 0.0, -1, link, physicsClientId=self.cid):
+                        found.append(sb)
+            g.overlapping = found
+            if g.friction and found:
+                self._viscous(g, found)
+
+    def _viscous(self, g: SimGhost, found) -> None:
+        """F = -K·(v_body - v_phantom) on every body inside a hole ghost (the paper's needle friction)."""
+        k = self.opt.hole_friction
+        v_ref = np.array(g.parent.state()[2]) if g.parent is not None and not g.parent.static else np.zeros(3)
+        for sb in found:
+            v = np.array(sb.state()[2])
+            sb.force((-k * (v - v_ref)).tolist(), list(sb.com_position()))
+
+    def _sense(self, s: SimSensor) -> None:
+        t = self._frame(s.parent) @ invert(s.parent.ref_in_body) @ s.location
+        a = (t[:3, :3] @ s.starts.T).T + t[:3, 3]
+        b = (t[:3, :3] @ s.ends.T).T + t[:3, 3]
+        hits = pb.rayTestBatch(a.tolist(), b.tolist(), physicsClientId=self.cid)
+        lookup = self.by_uid()
+        s.sensed = []
+        for h in hits:
+            sb = lookup.get((h[0], h[1]))
+            if sb is not None and sb is not s.parent and sb not in s.sensed:
+                s.sensed.append(sb)
+
+    def actuate(self, actuator: SimActuator, target: SimBody) -> None:
+        """Fix ``target`` to the actuator's parent at their current relative pose."""
+        self.release(actuator)
+        pw = self._frame(actuator.parent)
+        tw = self._frame(target)
+        at_world = pw @ invert(actuator.parent.ref_in_body) @ actuator.location
+        fa = invert(pw) @ at_world
+        fb = invert(tw) @ at_world
+        pa, oa = matrix_to_pq(fa)
+        pbp, ob = matrix_to_pq(fb)
+        c = pb.createConstraint(actuator.parent.uid, actuator.parent.link, target.uid, target.link,
+                                pb.JOINT_FIXED, [0, 0, 0], pa, pbp, oa, ob, physicsClientId=self.cid)
+        pb.changeConstraint(c, maxForce=actuator.max_force, physicsClientId=self.cid)
+        actuator.constraint, actuator.target = c, target
+
+    def release(self, actuator: SimActuator) -> None:
+        if actuator.constraint is not None:
+            pb.removeConstraint(actuator.constraint, physicsClientId=self.cid)
+        actuator.constraint, actuator.target = None, None
+
+    # ---- measures -----------------------------------------------------------------------
+    def constraint_error(self) -> float:
+        """Largest distance, m, between the two pivots of any joint (constraints and springs
+        with a locked linear range); multibody joints are exact."""
+        worst = 0.0
+        for _, _, parent, child, pa, pbv in self.constraints:
+            a = self._frame(parent)
+            b = self._frame(child)
+            worst = max(worst, float(np.linalg.norm((a[:3, :3] @ pa + a[:3, 3]) - (b[:3, :3] @ pbv + b[:3, 3]))))
+        return worst
+
+    def report(self) -> dict:
+        fell, fast, nan = [], [], []
+        for sb in self.bodies:
+            if sb.static:
+                continue
+            p, _, v, w = sb.state()
+            if not np.all(np.isfinite(p)) or not np.all(np.isfinite(v)):
+                nan.append(sb.key)
+                continue
+            if p[2] < self._floor_z - 0.1:
+                fell.append(sb.key)
+            if np.linalg.norm(v) > 10.0:
+                fast.append(sb.key)
+        return {
+            "bodies": len(self.bodies), "skipped_bodies": self.skipped,
+            "joints": len(self.joint_names), "multibodies": len(self.articulations),
+            "constraints": len(self.constraints), "spring_joints": len(self.springs.joints),
+            "ghosts": len(self.ghosts), "sensors": len(self.sensors), "actuators": len(self.actuators),
+            "cameras": [c.name for c in self.cameras],
+            "steps": self.steps, "physics_hz": self.opt.physics_hz, "control_substeps": self.opt.control_substeps,
+            "simulated_time_s": self.sim_time, "wall_time_s": self.wall_time,
+            "real_time_factor": self.sim_time / self.wall_time if self.wall_time else None,
+            "max_constraint_error_m": self.constraint_error(),
+            "fell_through_floor": fell, "exploded": fast, "nan": nan,
+        }
+
+    def close(self) -> None:
+        if pb.isConnected(self.cid):
+            pb.disconnect(self.cid)
