@@ -49,8 +49,7 @@ _RULES = [
     # --- schema ------------------------------------------------------------------------
     Rule("schema-required", E, "A key AMBF requires is missing (the file is rejected)",
          "a joint without `parent axis`"),
-    Rule("schema-type", E, "A value has a type AMBF cannot convert (the file is rejected)", "`scale: big`"),
-    Rule("schema-value", E, "A value is outside what the schema allows", "`publish frequency: {low: -1, high: 5}`"),
+    Rule("schema-type", E, "A value AMBF cannot convert (the file is rejected)", "`restitution:` (null)"),
     # --- semantic ----------------------------------------------------------------------
     Rule("adf-version", E, "`adf version` is not exactly 1.0", "`adf version: 2.0`"),
     Rule("enable-motor-without-feedback", E, "`enable motor` without `enable feedback`: AMBF reads the missing "

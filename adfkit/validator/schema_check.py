@@ -61,7 +61,7 @@ def node_at(node: yaml.Node, path) -> tuple[yaml.Node, str | None]:
 
 
 def _diagnostic(err, base: yaml.Node, file: str, context: str, at: yaml.Node | None) -> Diagnostic:
-    rule = _RULE_BY_KEYWORD.get(err.validator, "schema-value")
+    rule = _RULE_BY_KEYWORD.get(err.validator, "schema-type")
     node, last = node_at(base, err.absolute_path)
     where = location(file, at if at is not None else node)
     label = f"'{last}'" if last else context

@@ -33,6 +33,9 @@ IGNORED_KEYS = {
     "SoftBodyConfig": {"margin", "cutting"},
 }
 IGNORED_PREFIXES = ("resistive surface",)
+# Keys the model declares (so they round-trip) although AMBF 2.x does not use them.
+IGNORED_FIELDS = {"Body": {"color"}, "SoftBody": {"color"}, "Ghost": {"color"}, "Volume": {"color"},
+                  "ModelFile": {"joint erp", "joint cfm"}, "Camera": {"publish depth resolution"}}
 OBJECT_PREFIXES = ("BODY ", "JOINT ", "GHOST ", "SENSOR ", "ACTUATOR ", "SOFTBODY ", "SOFT BODY ")
 
 
@@ -103,6 +106,11 @@ class Checker:
     # --- unknown and ignored keys ---------------------------------------------------------
     def keys(self, node: Node, cls_name: str, top_level: bool = False) -> None:
         known = adf_keys(node)
+        for key in IGNORED_FIELDS.get(cls_name, ()):
+            if key in node.key_sources:
+                what = "parsed but unused" if key == "publish depth resolution" else "not read"
+                self.emit("ignored-key", f"'{key}' is {what} by AMBF 2.x", node.where(key),
+                          "remove it, or move the value to a key AMBF reads")
         for key in node.extras:
             if key in known:
                 continue  # a read key whose value was null or failed to decode (reported elsewhere)

