@@ -100,6 +100,7 @@ def set_dynamics(sb: SimBody) -> None:
     if not sb.static and b.mass is not None and b.inertia is not None and None not in (
             b.inertia.ix, b.inertia.iy, b.inertia.iz) and min(b.inertia.ix, b.inertia.iy, b.inertia.iz) > 0:
         kw["localInertiaDiagonal"] = [b.inertia.ix, b.inertia.iy, b.inertia.iz]
+        kw["mass"] = sb.mass  # PyBullet zeroes a maximal body's mass when only the inertia is given
     pb.changeDynamics(sb.uid, sb.link, physicsClientId=sb.cid, **kw)
     info = pb.getDynamicsInfo(sb.uid, sb.link, physicsClientId=sb.cid)
     sb.inertia = tuple(info[2]) if not sb.static else (0.0, 0.0, 0.0)

@@ -32,7 +32,7 @@ SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIS
 @dataclass
 class Options:
     physics_hz: float = 1000.0           # internal Bullet step (AMBF: fixed 1 ms)
-    control_substeps: int = 1            # physics steps per control step (springs, ghosts, drives)
+    control_substeps: int = 4            # physics steps per control step (springs, ghosts, drives held between)
     solver_iterations: int | None = None  # None: PyBullet default (50)
     gravity: tuple | None = None          # override the world's
     visuals: bool = True
