@@ -85,7 +85,8 @@ class SimWorld:
         self.gravity = np.array(g, dtype=float)
         self.max_substeps = w.max_iterations if w is not None and w.max_iterations else 10
         pb.setGravity(*self.gravity, physicsClientId=self.cid)
-        params = dict(fixedTimeStep=self.dt, numSubSteps=self.opt.control_substeps)
+        # PyBullet: each stepSimulation advances fixedTimeStep, split into numSubSteps internal steps
+        params = dict(fixedTimeStep=self.dt * self.opt.control_substeps, numSubSteps=self.opt.control_substeps)
         if self.opt.solver_iterations:
             params["numSolverIterations"] = self.opt.solver_iterations
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
@@ -396,10 +397,13 @@ class SimWorld:
     def _viscous(self, g: SimGhost, found) -> None:
         """F = -K·(v_body - v_phantom) on every body inside a hole ghost (the paper's needle friction)."""
         k = self.opt.hole_friction
+        cdt = self.dt * self.opt.control_substeps
         v_ref = np.array(g.parent.state()[2]) if g.parent is not None and not g.parent.static else np.zeros(3)
         for sb in found:
-            v = np.array(sb.state()[2])
-            sb.force((-k * (v - v_ref)).tolist(), list(sb.com_position()))
+            v = np.array(sb.state()[2]) - v_ref
+            # held for a control step, this force gives the exact exp(-K·t/m) decay of dv/dt = -K·v/m
+            f = -sb.mass * v * (1.0 - math.exp(-k * cdt / sb.mass)) / cdt
+            sb.force(f.tolist(), list(sb.com_position()))
 
     def _sense(self, s: SimSensor) -> None:
         t = self._frame(s.parent) @ invert(s.parent.ref_in_body) @ s.location
@@ -427,6 +431,43 @@ class SimWorld:
                                 pb.JOINT_FIXED, [0, 0, 0], pa, pbp, oa, ob, physicsClientId=self.cid)
         pb.changeConstraint(c, maxForce=actuator.max_force, physicsClientId=self.cid)
         actuator.constraint, actuator.target = c, target
+
+    def grasp(self, psm: str, on: bool) -> SimBody | None:
+        """What the suturing scene does: close the jaws of ``psm`` and fix the body the finger
+        ghosts (or a sensor) detect to the tool with its constraint actuator; ``on=False``
+        releases it and opens the jaws. Returns the grasped body."""
+        act = next((a for a in self.actuators if psm in a.key or psm in a.parent.key), None)
+        if act is None:
+            raise KeyError(f"no constraint actuator for {psm!r}")
+        art = act.parent.articulation
+        jaws = [i for i, n in enumerate(art.joint_names) if "gripper" in n] if art is not None else []
+        if not on:
+            self.release(act)
+            for i in jaws:
+                art.targets[i] = 0.5
+            if art is not None:
+                art.drive()
+            return None
+        for i in jaws:
+            art.targets[i] = 0.0
+        if art is not None:
+            art.drive()
+        self._update_ghosts()
+        found = [b for g in self.ghosts if psm in g.key for b in g.overlapping]
+        found += [b for s in self.sensors if psm in s.key for b in s.sensed]
+        own = {id(b) for b in self.bodies if b.articulation is not None and b.articulation is art}
+        found = [b for b in found if id(b) not in own]
+        if not found:
+            at = (act.parent.world_matrix() @ act.location)[:3, 3]
+            free = [b for b in self.bodies if not b.static and id(b) not in own]
+            if not free:
+                return None
+            near = min(free, key=lambda b: np.linalg.norm(np.array(b.com_position()) - at))
+            if np.linalg.norm(np.array(near.com_position()) - at) > 0.02:
+                return None
+            found = [near]
+        self.actuate(act, found[0])
+        return found[0]
 
     def release(self, actuator: SimActuator) -> None:
         if actuator.constraint is not None:

@@ -1,0 +1,168 @@
+"""PyBullet reference runner: real PyBullet, real corpus scenes, no mocks."""
+from __future__ import annotations
+
+import math
+import textwrap
+
+import numpy as np
+import pytest
+
+from conftest import CORPUS, require_corpus
+
+pb = pytest.importorskip("pybullet")
+
+from adfkit.adf import load_scene  # noqa: E402
+from adfkit.runner.world import Options, SimWorld  # noqa: E402
+
+SUTURING = [6, 7, 8, 9, 10, 11]
+
+
+@pytest.fixture(scope="module")
+def suturing():
+    require_corpus()
+    scene = load_scene(CORPUS / "src" / "launch.yaml", SUTURING)
+    world = SimWorld(scene, Options(visuals=False))
+    yield scene, world
+    world.close()
+
+
+def test_suturing_scene_is_complete(suturing):
+    scene, world = suturing
+    models = scene.all_models()
+    assert len(world.bodies) == sum(len(m.bodies) for m in models) == 75
+    assert len(world.joint_names) == sum(len(m.joints) for m in models) == 64
+    assert len(world.ghosts) == sum(len(m.ghost_objects) for m in models) == 12
+    assert len(world.actuators) == sum(len(m.actuators) for m in models) == 2
+    assert len(world.sensors) == sum(len(m.sensors) for m in models)
+    assert [c.name for c in world.cameras] == ["cameraL", "cameraR"]
+    assert len(world.articulations) == 2          # the two PSMs as multibodies
+    assert len(world.springs.joints) == 47        # thread + hole boundaries (six dof spring)
+
+
+def test_suturing_plays_stable_and_thread_holds(suturing):
+    _, world = suturing
+    thread = [world.registry.items["/ambf/env/phantom/BODY Thread"]] + [world.body(f"BODY Thread_{i:03d}") for i in range(1, 40)]
+    pivots = [(j.frame_a[:3, 3], j.frame_b[:3, 3]) for j in world.springs.joints if "Thread" in j.name]
+    world.run(1.0)
+    rep = world.report()
+    assert rep["nan"] == [] and rep["exploded"] == [] and rep["fell_through_floor"] == []
+    assert rep["max_constraint_error_m"] < 1e-3
+    # adjacent elements stay joined: pivots of each thread joint within 1 mm
+    for j in world.springs.joints:
+        if "Thread" not in j.name:
+            continue
+        a = j.parent.world_matrix() @ j.parent.ref_in_body
+        b = j.child.world_matrix() @ j.child.ref_in_body
+        pa = a[:3, :3] @ j.frame_a[:3, 3] + a[:3, 3]
+        pbv = b[:3, :3] @ j.frame_b[:3, 3] + b[:3, 3]
+        assert np.linalg.norm(pa - pbv) < 1e-3, j.name
+    assert len(pivots) == 39 and len(thread) == 40
+    for art in world.articulations:  # PSMs hold their home pose
+        assert np.max(np.abs(np.array(art.joint_values()) - np.array(art.targets))) < 1e-3
+
+
+def _model(tmp_path, text: str):
+    p = tmp_path / "model.yaml"
+    p.write_text(textwrap.dedent(text))
+    return load_scene(p)
+
+
+BOX_CAMERA = """
+bodies: [BODY box]
+cameras: [CAMERA cam]
+BODY box:
+  name: box
+  mass: 0.0
+  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.2, y: 0.2, z: 0.2}
+  shape: BOX
+  geometry: {x: 0.2, y: 0.2, z: 0.2}
+  color rgba: {r: 0.9, g: 0.2, b: 0.1, a: 1.0}
+CAMERA cam:
+  name: cam
+  location: {x: 1.0, y: 0.0, z: 0.0}
+  look at: {x: 0.0, y: 0.0, z: 0.0}
+  up: {x: 0.0, y: 0.0, z: 1.0}
+  clipping plane: {near: 0.01, far: 10.0}
+  field view angle: 0.7
+  publish image resolution: {width: 64, height: 48}
+"""
+
+
+def test_camera_depth_segmentation_rgb(tmp_path):
+    world = SimWorld(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0)))
+    try:
+        cam = world.cameras[0]
+        k = cam.intrinsics()
+        assert k[1, 1] == pytest.approx(24 / math.tan(0.35)) and k[0, 2] == 32 and k[1, 2] == 24
+        f = cam.render(world)
+        assert abs(float(f["depth"][24, 32]) - 0.9) < 1e-3      # box face 0.1 m in front of the centre
+        assert np.isinf(f["depth"][0, 0])                        # background
+        assert f["segmentation"][24, 32] == 0 and f["segmentation"][0, 0] == -1
+        assert set(np.unique(f["segmentation"])) == {-1, 0}
+        rgb = f["rgb"].astype(float)
+        assert rgb[24, 32, 0] > 2 * rgb[24, 32, 2] and rgb.std() > 10   # red box, non-trivial image
+    finally:
+        world.close()
+
+
+GHOST = """
+bodies: [BODY needle]
+ghost objects: [GHOST hole]
+BODY needle:
+  name: needle
+  mass: 0.1
+  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
+  location: {position: {x: -0.05, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: SPHERE
+  collision geometry: {radius: 0.002}
+  damping: {linear: 0.0, angular: 0.0}
+GHOST hole:
+  name: entry_hole_ghost
+  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.2, y: 0.05, z: 0.05}
+"""
+
+
+def test_ghost_viscous_friction_matches_exponential(tmp_path):
+    k = 0.5
+    world = SimWorld(_model(tmp_path, GHOST), Options(gravity=(0, 0, 0), hole_friction=k, visuals=False))
+    try:
+        needle = world.body("needle")
+        pb.resetBaseVelocity(needle.uid, [0.1, 0, 0], [0, 0, 0], physicsClientId=world.cid)
+        world.run(0.4)
+        assert world.ghosts[0].overlapping == [needle]
+        v = pb.getBaseVelocity(needle.uid, physicsClientId=world.cid)[0][0]
+        expected = 0.1 * math.exp(-k * 0.4 / 0.1)
+        assert v == pytest.approx(expected, rel=0.05)
+        assert expected < 0.02   # it really slowed
+    finally:
+        world.close()
+
+
+@pytest.mark.slow
+def test_grasp_moves_needle_with_tool_and_release_drops_it(suturing):
+    _, world = suturing
+    act = next(a for a in world.actuators if "psm1" in a.key)
+    needle = world.body("BODY Needle")
+    at = (act.parent.world_matrix() @ act.location)[:3, 3]
+    pos, orn = pb.getBasePositionAndOrientation(needle.uid, physicsClientId=world.cid)
+    pb.resetBasePositionAndOrientation(needle.uid, at.tolist(), orn, physicsClientId=world.cid)
+    pb.resetBaseVelocity(needle.uid, [0, 0, 0], [0, 0, 0], physicsClientId=world.cid)
+    assert world.grasp("psm1", True) is needle
+    rel0 = np.linalg.inv(act.parent.world_matrix()) @ needle.world_matrix()
+    art = act.parent.articulation
+    i = art.kinds.index(next(k for k in art.kinds if k.value == "prismatic"))
+    tool0 = act.parent.world_matrix()[:3, 3]
+    art.targets[i] += 0.05
+    art.drive()
+    world.run(1.0)
+    assert np.linalg.norm(act.parent.world_matrix()[:3, 3] - tool0) == pytest.approx(0.05, abs=0.005)
+    rel1 = np.linalg.inv(act.parent.world_matrix()) @ needle.world_matrix()
+    assert np.linalg.norm(rel1[:3, 3] - rel0[:3, 3]) <= 1e-3
+    world.grasp("psm1", False)
+    z0 = needle.com_position()[2]
+    world.run(0.3)
+    assert needle.com_position()[2] < z0 - 0.05
