@@ -3,3 +3,5 @@ mass properties. The only package that imports trimesh, manifold3d and coacd."""
 from .meshio import MESH_SUFFIXES, load_mesh
 
 __all__ = ["MESH_SUFFIXES", "load_mesh"]
+# Heavier pieces are imported from their modules (adfkit.geometry.repair, .decompose, .mass,
+# .primitives) so that ``load_mesh`` does not pull in manifold3d or coacd.
