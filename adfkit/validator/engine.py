@@ -79,7 +79,7 @@ def validate_file(path: str | Path, kind: str | None = None, context_models=(), 
         res.text = text
         doc, reader_diags, text, moved = _read_with_compat(path, kind, text)
     except AdfError as exc:
-        res.diagnostics = [_adjust(d) for d in exc.diagnostics]
+        res.diagnostics = [_inside(_adjust(d), res.text) for d in exc.diagnostics]
         return res
     res.doc, res.text = doc, text
     res.kind = KIND_OF[type(doc)]
@@ -93,6 +93,19 @@ def validate_file(path: str | Path, kind: str | None = None, context_models=(), 
     diags += paths_check.check(doc)
     res.diagnostics = _unique(diags)
     return res
+
+
+def _inside(d: Diagnostic, text: str | None) -> Diagnostic:
+    """PyYAML marks the end of a stream one line past the last one; point at the last line."""
+    loc = d.location
+    if text is None or loc is None or not loc.line:
+        return d
+    lines = text.split("\n")
+    if text.endswith("\n") and len(lines) > 1:
+        lines.pop()
+    if loc.line > len(lines):
+        return replace(d, location=SourceLocation(loc.file, len(lines), len(lines[-1]) + 1))
+    return d
 
 
 def _unique(diags: list[Diagnostic]) -> list[Diagnostic]:
