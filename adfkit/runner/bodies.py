@@ -42,13 +42,13 @@ class SimBody:
         return self.body.name or self.body.identifier
 
     def state(self):
-        """(position, quaternion, linear velocity, angular velocity) of the PyBullet frame."""
+        """(position, quaternion, linear velocity, angular velocity) of the COM frame."""
         if self.link < 0:
             p, q = pb.getBasePositionAndOrientation(self.uid, physicsClientId=self.cid)
             v, w = pb.getBaseVelocity(self.uid, physicsClientId=self.cid)
             return p, q, v, w
         s = pb.getLinkState(self.uid, self.link, computeLinkVelocity=1, physicsClientId=self.cid)
-        return s[4], s[5], s[6], s[7]
+        return s[0], s[1], s[6], s[7]  # the COM frame: constraint pivots are relative to it
 
     def com_position(self):
         if self.link < 0:
@@ -59,7 +59,7 @@ class SimBody:
         """Pose of the ADF body frame (the mesh origin) in the world, 4×4."""
         from .rotations import invert, pose_matrix
         p, q, _, _ = self.state()
-        return pose_matrix(p, q) @ invert(self.ref_in_body)
+        return pose_matrix(p, q) @ invert(self.com_in_body)
 
     def torque(self, t) -> None:
         pb.applyExternalTorque(self.uid, self.link, t, pb.WORLD_FRAME, physicsClientId=self.cid)

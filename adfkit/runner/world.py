@@ -170,8 +170,8 @@ class SimWorld:
             ps = parent.body.scale or 1.0
             cs = child.body.scale or 1.0
             a, b = joint_frames(j, ps, cs)
-            fa = invert(parent.ref_in_body) @ pose_to_matrix(a)
-            fb = invert(child.ref_in_body) @ pose_to_matrix(b)
+            fa = invert(parent.com_in_body) @ pose_to_matrix(a)
+            fb = invert(child.com_in_body) @ pose_to_matrix(b)
             self.joint_names.append(j.identifier)
             sj = None
             if kind in SPRING_KINDS:
@@ -267,7 +267,7 @@ class SimWorld:
                 continue
             parent = self._parent(gh.parent, ns, gh) if gh.parent else None
             loc = pose_to_matrix(pose_or_identity(gh.location))
-            rel = invert(parent.ref_in_body) @ loc if parent is not None else loc
+            rel = invert(parent.com_in_body) @ loc if parent is not None else loc
             col = create_collision(parts, self.cid)
             vis = create_visual(m, gh, np.eye(4), gh.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
             world = (self._frame(parent) @ rel) if parent is not None else rel
@@ -406,7 +406,7 @@ class SimWorld:
             sb.force(f.tolist(), list(sb.com_position()))
 
     def _sense(self, s: SimSensor) -> None:
-        t = self._frame(s.parent) @ invert(s.parent.ref_in_body) @ s.location
+        t = self._frame(s.parent) @ invert(s.parent.com_in_body) @ s.location
         a = (t[:3, :3] @ s.starts.T).T + t[:3, 3]
         b = (t[:3, :3] @ s.ends.T).T + t[:3, 3]
         hits = pb.rayTestBatch(a.tolist(), b.tolist(), physicsClientId=self.cid)
@@ -422,7 +422,7 @@ class SimWorld:
         self.release(actuator)
         pw = self._frame(actuator.parent)
         tw = self._frame(target)
-        at_world = pw @ invert(actuator.parent.ref_in_body) @ actuator.location
+        at_world = pw @ invert(actuator.parent.com_in_body) @ actuator.location
         fa = invert(pw) @ at_world
         fb = invert(tw) @ at_world
         pa, oa = matrix_to_pq(fa)
