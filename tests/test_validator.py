@@ -85,7 +85,7 @@ CLEAN = MODEL_HEAD + BODY_A + BODY_B + JOINT
 
 EXAMPLES = {
     # rule: (file text, expected line, expected severity)
-    "yaml-syntax": ("bodies: [a, b\n", 2, "error"),
+    "yaml-syntax": ("bodies: [a, b\n", 1, "error"),  # end of stream: clamped to the last line
     "yaml-duplicate-key": (CLEAN + "bodies: []\n", CLEAN.count("\n") + 1, "warning"),
     "yaml-alias-bomb": ("a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
         f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"

@@ -200,10 +200,12 @@ def _shape(node) -> str:
     return f"scalar {node.value!r}"
 
 
-def read_file(path: str | Path, kind: str | None = None, text: str | None = None) -> tuple[AdfFile, list[Diagnostic]]:
+def read_file(path: str | Path, kind: str | None = None, text: str | None = None,
+              root_out: list | None = None) -> tuple[AdfFile, list[Diagnostic]]:
     """Read one ADF file. Returns the model element and the diagnostics met on the way.
 
     Raises AdfError when the file cannot be read at all (missing, not YAML, wrong kind).
+    ``root_out``, if given, receives the composed YAML root node (the validator reuses it).
     """
     path = Path(path)
     shown = str(path)
@@ -211,6 +213,8 @@ def read_file(path: str | Path, kind: str | None = None, text: str | None = None
         text = read_text(path)
     reader = Reader(shown)
     root = compose(text, shown, reader.diagnostics)
+    if root_out is not None:
+        root_out.append(root)
     if root is None:
         raise AdfError(error("empty-file", "the file is empty", SourceLocation(shown, 1, 1),
                              "an ADF file is a YAML mapping of keys such as bodies:, joints: or world config:"))

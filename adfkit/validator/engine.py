@@ -10,7 +10,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..adf.reader import read_file
-from ..adf.yamlnodes import compose, read_text
+from ..adf.yamlnodes import read_text
 from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation
 from ..model import FILE_KINDS, Launch, ModelFile, World
 from . import paths_check, schema_check, semantic
@@ -33,10 +33,10 @@ class FileResult:
     text: str | None = None
 
 
-def _read_with_compat(path: Path, kind: str | None, text: str):
+def _read_with_compat(path: Path, kind: str | None, text: str, roots: list):
     """read_file, retrying layouts yaml-cpp accepts and PyYAML does not (see yamlcompat)."""
     try:
-        doc, diags = read_file(path, kind, text=text)
+        doc, diags = read_file(path, kind, text=text, root_out=roots)
         return doc, diags, text, []
     except AdfError as exc:
         if not exc.diagnostics or exc.diagnostics[0].rule != "yaml-syntax":
@@ -45,7 +45,8 @@ def _read_with_compat(path: Path, kind: str | None, text: str):
         if not moved:
             raise
         try:
-            doc, diags = read_file(path, kind, text=fixed)
+            roots.clear()
+            doc, diags = read_file(path, kind, text=fixed, root_out=roots)
         except AdfError as again:
             if again.diagnostics and again.diagnostics[0].rule == "yaml-syntax":
                 raise exc from None
@@ -77,14 +78,15 @@ def validate_file(path: str | Path, kind: str | None = None, context_models=(), 
         if text is None:
             text = read_text(path)
         res.text = text
-        doc, reader_diags, text, moved = _read_with_compat(path, kind, text)
+        roots: list = []
+        doc, reader_diags, text, moved = _read_with_compat(path, kind, text, roots)
     except AdfError as exc:
         res.diagnostics = [_inside(_adjust(d), res.text) for d in exc.diagnostics]
         return res
     res.doc, res.text = doc, text
     res.kind = KIND_OF[type(doc)]
     diags = [_adjust(d) for d in reader_diags]
-    root = compose(text, str(path))
+    root = roots[-1]
     located_errors = {d.location for d in diags if d.severity >= Severity.ERROR}
     for d in schema_check.check(root, res.kind, str(path)):
         if d.location not in located_errors:

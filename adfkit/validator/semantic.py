@@ -4,15 +4,36 @@ from __future__ import annotations
 
 import difflib
 import math
+from functools import lru_cache
 
 from ..diagnostics import Diagnostic, Severity, SourceLocation
 from ..model import Colors, InputDevices, Launch, ModelFile, Pose, Quat, Vec3, World
 from ..model.semantics import (
     ACTUATOR_TYPES, SENSOR_TYPES, JointKind, collision_mesh_type, joint_kind, shape_kind,
 )
-from ..model.spec import Node, adf_fields, adf_keys
+from ..model.spec import Node
+from ..model.spec import adf_fields as _adf_fields
+from ..model.spec import adf_keys as _adf_keys
 from .references import Registry, body_registry, merge_namespace
 from .rules import RULES
+
+@lru_cache(maxsize=None)
+def _fields_of(cls) -> tuple:
+    return tuple(_adf_fields(cls))
+
+
+@lru_cache(maxsize=None)
+def _keys_of(cls) -> frozenset:
+    return frozenset(_adf_keys(cls))
+
+
+def adf_fields(node) -> tuple:
+    return _fields_of(type(node))
+
+
+def adf_keys(node) -> frozenset:
+    return _keys_of(type(node))
+
 
 SPRINGS = {JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING}
 ONE_DOF = {JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING}
