@@ -6,6 +6,7 @@ import json
 import re
 import textwrap
 from importlib import resources
+from pathlib import Path
 
 import jsonschema
 import pytest
@@ -167,7 +168,6 @@ def test_clean_model_has_no_findings(tmp_path):
 
 
 def test_every_rule_is_documented_and_examples_cover_most():
-    from pathlib import Path
     doc = Path(__file__).resolve().parent.parent / "docs" / "validator.md"
     text = doc.read_text(encoding="utf-8")
     for rid in RULES:
@@ -213,6 +213,18 @@ def test_exit_codes_and_fail_on(broken, tmp_path, capsys):
     data = json.loads(out)
     assert data["files"] == 2 and [d["rule"] for d in data["diagnostics"]] == ["joint-type"]
     assert rc == 0  # only the selected warning is left
+
+
+def test_skip_non_adf_for_pre_commit(tmp_path, capsys):
+    ci = tmp_path / "ci.yml"
+    ci.write_text("on: [push]\njobs: {}\n", encoding="utf-8")
+    assert _run(["validate", str(ci)], capsys)[0] == 1  # unknown-kind is an error by default
+    rc, out, _ = _run(["validate", str(ci), "--skip-non-adf", "-f", "json"], capsys)
+    assert rc == 0 and json.loads(out) == {"files": 0, "diagnostics": []}
+    import yaml
+    hooks = yaml.safe_load((Path(__file__).resolve().parent.parent / ".pre-commit-hooks.yaml").read_text())
+    assert [h["id"] for h in hooks] == ["adfkit-validate", "adfkit-validate-strict"]
+    assert all(h["entry"].startswith("adfkit validate ") and "--skip-non-adf" in h["entry"] for h in hooks)
 
 
 def test_text_output_shows_source_line_and_caret(broken, capsys):

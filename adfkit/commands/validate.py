@@ -22,6 +22,8 @@ def add_arguments(p) -> None:
     p.add_argument("--ignore", action="append", default=[], metavar="RULE",
                    help="do not report these rules (repeatable, comma-separated)")
     p.add_argument("--no-follow", action="store_true", help="do not follow launch/world files to the files they name")
+    p.add_argument("--skip-non-adf", action="store_true",
+                   help="silently skip YAML files that are not ADF (unknown kind), e.g. in a pre-commit hook")
     p.add_argument("--min-severity", choices=["error", "warning", "info"], default="info",
                    help="hide findings below this severity (default: show all)")
 
@@ -44,16 +46,20 @@ def run(args) -> int:
     shown_min = Severity.parse(args.min_severity)
     diags = list(problems)
     texts = {}
+    checked = 0
     for res in results:
+        if args.skip_non_adf and res.kind is None and [d.rule for d in res.diagnostics] == ["unknown-kind"]:
+            continue
+        checked += 1
         texts[str(res.path)] = res.text
         diags += res.diagnostics
     diags = [d for d in diags if (not select or d.rule in select) and d.rule not in ignore
              and d.severity >= shown_min]
     out = sys.stdout
     if args.format == "text":
-        reporters.write_text(diags, out, texts, files=len(results))
+        reporters.write_text(diags, out, texts, files=checked)
     elif args.format == "json":
-        reporters.write_json(diags, out, files=len(results))
+        reporters.write_json(diags, out, files=checked)
     elif args.format == "github":
         reporters.write_github(diags, out)
     else:
