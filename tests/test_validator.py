@@ -61,12 +61,16 @@ def test_duplicate_keys_are_warnings_as_ambf_loads_cloth(corpus):
     assert [(d.location.line, d.severity) for d in dups] == [(45, Severity.WARNING), (46, Severity.WARNING)]
 
 
-def test_launch_follows_every_file_and_resolves_cross_model_references(corpus):
-    results, problems = validate_paths([corpus / "src/launch.yaml"])
+@pytest.mark.parametrize("given", ["src/launch.yaml", "src"])
+def test_launch_follows_every_file_and_resolves_cross_model_references(corpus, given):
+    results, problems = validate_paths([corpus / given])
     assert problems == []
     kinds = sorted(r.kind for r in results)
-    assert kinds.count("launch") == 1 and kinds.count("world") == 1 and kinds.count("input_devices") == 1
-    assert kinds.count("colors") == 1 and kinds.count("model") == 15  # 14 configs + the environment
+    if given == "src":  # the folder: every file once, the launch file's models with their context
+        assert len(results) == len(corpus_files("src/**/*.yaml")) == 21
+    else:
+        assert kinds.count("launch") == 1 and kinds.count("world") == 1 and kinds.count("input_devices") == 1
+        assert kinds.count("colors") == 1 and kinds.count("model") == 15  # 14 configs + the environment
     # ghosts_actuators_psm1 names psm1's body: found in the model loaded before it.
     ghosts = next(r for r in results if r.path.name == "ghosts_actuators_psm1.yaml" and "400006" in str(r.path))
     assert not [d for d in ghosts.diagnostics if d.rule in ("dangling-reference", "external-reference")]

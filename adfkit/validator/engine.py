@@ -6,6 +6,7 @@ checking each model's references against the models AMBF would have loaded befor
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -169,6 +170,15 @@ def validate_paths(paths, kind: str | None = None, follow: bool = True) -> tuple
                 if isinstance(res.doc, ModelFile):
                     context.append(res.doc)
 
-    for f in files:
+    # Launch files first, so the models they name are checked with the models loaded before them.
+    for f in sorted(files, key=lambda f: not _looks_like_launch(f)):
         run(f, kind)
     return list(results.values()), problems
+
+
+def _looks_like_launch(path: Path) -> bool:
+    try:
+        head = path.read_bytes()[:65536].decode("utf-8", errors="replace")
+    except OSError:
+        return False
+    return re.search(r"^(world config|multibody configs)\s*:", head, flags=re.M) is not None
