@@ -1,0 +1,225 @@
+"""Authoring actions behind the operators (Blender-level; geometry work is adfkit.geometry's).
+
+Each function raises :class:`adfkit.diagnostics.AdfError` with a readable message for bad
+input, so operators and scripts report the same thing.
+"""
+from __future__ import annotations
+
+import math
+import tempfile
+from pathlib import Path
+
+import bpy
+from mathutils import Matrix, Quaternion, Vector
+
+from adfkit.diagnostics import AdfError, SourceLocation, error
+from adfkit.model.pose import quat_to_rpy
+
+from . import gather, meshes
+
+
+def _fail(rule: str, msg: str, obj=None, hint: str | None = None):
+    raise AdfError(error(rule, msg, SourceLocation(f"blender:{obj.name}") if obj is not None else None, hint))
+
+
+def _link(obj, scene=None):
+    (scene or bpy.context.scene).collection.objects.link(obj)
+    return obj
+
+
+def mark(obj, kind: str) -> None:
+    obj.adf.kind = kind
+    if kind == "BODY" and not obj.adf.body.use_mass:
+        obj.adf.body.use_mass = True
+
+
+def _trimesh_of(obj):
+    """The object's mesh as adfkit.geometry loads it (via a temporary OBJ)."""
+    from adfkit.geometry import load_mesh
+    if obj.type != "MESH" or not len(obj.data.polygons):
+        _fail("no-mesh", f"'{obj.name}' has no mesh faces", obj, "select a mesh object")
+    with tempfile.TemporaryDirectory() as tmp:
+        arr = meshes.mesh_arrays(obj)
+        arr.materials, arr.uv = [], None
+        meshes.write_obj([arr], Path(tmp), "m.obj")
+        return load_mesh(Path(tmp) / "m.obj")
+
+
+def generate_collision(obj, threshold: float = 0.05, max_hulls: int = 16, repair: bool = False) -> list:
+    """CoACD convex hulls of a body's mesh as COLLISION_MESH children (CONVEX_HULL)."""
+    from adfkit.geometry.decompose import DecompositionParams, decompose
+    mesh = _trimesh_of(obj)
+    if not mesh.is_watertight:
+        if not repair:
+            _fail("mesh-not-manifold", f"'{obj.name}' is not a closed 2-manifold mesh "
+                  f"({len(mesh.faces)} faces with open or non-manifold edges); convex decomposition needs a closed mesh",
+                  obj, "close the mesh (Mesh > Clean Up > Fill Holes, 3D-Print toolbox) or use primitive collision")
+        from adfkit.geometry.repair import repair_mesh
+        mesh, _ = repair_mesh(mesh)
+    dec = decompose(mesh, DecompositionParams(threshold=threshold, max_hulls=max_hulls))
+    for c in [c for c in obj.children if c.adf.kind in ("COLLISION_MESH", "COLLISION_SHAPE")]:
+        bpy.data.objects.remove(c, do_unlink=True)
+    made = []
+    for i, h in enumerate(dec.hulls):
+        me = bpy.data.meshes.new(f"{obj.name}.hull{i}")
+        me.from_pydata([tuple(map(float, v)) for v in h.vertices], [], [tuple(map(int, f)) for f in h.faces])
+        me.update()
+        c = _link(bpy.data.objects.new(f"{obj.name}.hull{i}", me))
+        c.adf.kind = "COLLISION_MESH"
+        c.display_type = "WIRE"
+        c.hide_render = True
+        c.parent = obj
+        c.matrix_parent_inverse = Matrix.Identity(4)
+        made.append(c)
+    obj.adf.body.use_collision_mesh_type = True
+    obj.adf.body.collision_mesh_type = "CONVEX_HULL"
+    return made
+
+
+def add_collision_primitive(obj, shape: str = "BOX", size=(0.1, 0.1, 0.1), radius=0.05, height=0.1,
+                            axis: str = "z", offset: Matrix | None = None):
+    e = _link(bpy.data.objects.new(f"{obj.name}.{shape.lower()}", None))
+    e.adf.kind = "COLLISION_SHAPE"
+    s = e.adf.shape
+    s.shape, s.size, s.radius, s.height, s.axis = shape, size, radius, height, axis
+    e.empty_display_type = "SPHERE" if shape == "SPHERE" else "CUBE"
+    e.empty_display_size = max(max(size) / 2 if shape == "BOX" else max(radius, height / 2), 1e-4)
+    e.parent = obj
+    e.matrix_parent_inverse = Matrix.Identity(4)
+    e.matrix_basis = offset or Matrix.Identity(4)
+    return e
+
+
+def estimate_inertia(obj, mass: float | None = None, density: float | None = None) -> None:
+    """Mass, principal inertia and inertial offset from the body's closed mesh."""
+    from adfkit.geometry.mass import mesh_mass_properties, to_adf
+    mesh = _trimesh_of(obj)
+    if not mesh.is_watertight:
+        _fail("mesh-not-closed", f"'{obj.name}' is not closed; its volume and inertia are undefined", obj,
+              "close the mesh, or give the inertia by hand")
+    if mass is None and density is None:
+        density = obj.adf.density
+    props = mesh_mass_properties(mesh, density=density, mass=mass)
+    inertia, offset = to_adf(props)
+    b = obj.adf.body
+    b.use_mass, b.mass = True, float(props.mass)
+    b.use_inertia, b.inertia = True, (inertia.ix, inertia.iy, inertia.iz)
+    b.use_inertial_offset = True
+    b.inertial_offset = (*offset.position, *quat_to_rpy(offset.orientation))
+
+
+def add_joint(parent, child, joint_type: str = "revolute", frame: Matrix | None = None, name: str | None = None):
+    """An Empty with a rigid body constraint between two bodies; the Empty is the joint frame
+    (Z: axis of hinge/spring joints, X: axis of prismatic joints)."""
+    from .build import RBC_TYPE, ensure_rigidbody_world
+    from adfkit.model.semantics import joint_kind
+    scene = bpy.context.scene
+    ensure_rigidbody_world(scene)
+    e = _link(bpy.data.objects.new(name or f"{parent.name}-{child.name}", None))
+    e.empty_display_type, e.empty_display_size = "ARROWS", 0.02
+    e.matrix_world = frame if frame is not None else Matrix.Translation(child.matrix_world.translation)
+    for o in bpy.context.view_layer.objects:
+        o.select_set(False)
+    bpy.context.view_layer.objects.active = e
+    e.select_set(True)
+    bpy.ops.rigidbody.constraint_add(type=RBC_TYPE.get(joint_kind(joint_type), "GENERIC_SPRING"))
+    e.rigid_body_constraint.object1, e.rigid_body_constraint.object2 = parent, child
+    e.adf.kind = "JOINT"
+    e.adf.joint.use_type, e.adf.joint.type = True, joint_type
+    return e
+
+
+def _cylinder(name: str, radius: float, length: float, segments: int = 8):
+    verts, faces = [], []
+    for z in (-length / 2, length / 2):
+        for i in range(segments):
+            a = 2 * math.pi * i / segments
+            verts.append((radius * math.cos(a), radius * math.sin(a), z))
+    for i in range(segments):
+        j = (i + 1) % segments
+        faces.append((i, j, segments + j, segments + i))
+    faces.append(tuple(range(segments - 1, -1, -1)))
+    faces.append(tuple(range(segments, 2 * segments)))
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(verts, [], faces)
+    me.update()
+    return me
+
+
+def create_rope(name: str, count: int, length: float, radius: float, mass: float, origin=(0, 0, 0),
+                stiffness: float = 0.5, damping: float = 0.05) -> tuple[list, list]:
+    """A thread of ``count`` capsule bodies along +X joined by six-dof springs."""
+    seg = length / count
+    bodies, joints = [], []
+    rot = Quaternion((0, 1, 0), math.pi / 2).to_matrix().to_4x4()  # segment axis Z -> world X
+    for i in range(count):
+        o = _link(bpy.data.objects.new(f"{name}_{i:03d}", _cylinder(f"{name}_{i:03d}", radius, seg)))
+        o.matrix_world = Matrix.Translation(Vector(origin) + Vector(((i + 0.5) * seg, 0, 0))) @ rot
+        mark(o, "BODY")
+        b = o.adf.body
+        b.mass = mass / count
+        b.use_inertia = True
+        m = mass / count
+        ia = m * (3 * radius ** 2 + seg ** 2) / 12
+        b.inertia = (ia, ia, m * radius ** 2 / 2)
+        add_collision_primitive(o, "CAPSULE", radius=radius, height=seg + 2 * radius * 0.5, axis="z")
+        bodies.append(o)
+    bpy.context.view_layer.update()
+    for i in range(count - 1):
+        frame = Matrix.Translation(Vector(origin) + Vector(((i + 1) * seg, 0, 0))) @ rot
+        j = add_joint(bodies[i], bodies[i + 1], "six dof spring", frame, f"{name}_{i:03d}-{i + 1:03d}")
+        p = j.adf.joint
+        for attr, val in (("linear_low", (0.0,) * 3), ("linear_high", (0.0,) * 3), ("angular_low", (-0.6,) * 3),
+                          ("angular_high", (0.6,) * 3), ("stiffness_linear", (0.0,) * 3),
+                          ("stiffness_angular", (stiffness,) * 3), ("damping_linear", (0.0,) * 3),
+                          ("damping_angular", (damping,) * 3), ("equilibrium_linear", (0.0,) * 3),
+                          ("equilibrium_angular", (0.0,) * 3)):
+            setattr(p, "use_" + attr, True)
+            setattr(p, attr, val)
+        joints.append(j)
+    return bodies, joints
+
+
+def add_grasp(body, range_m: float = 0.01, rays: int = 3):
+    """A proximity sensor and a constraint actuator on a gripper body, at its origin."""
+    if body.adf.kind != "BODY":
+        _fail("not-a-body", f"'{body.name}' is not an ADF body", body, "mark it as an ADF body first")
+    made = []
+    for kind, name in (("SENSOR", f"{body.name}_sensor"), ("ACTUATOR", f"{body.name}_actuator")):
+        o = _link(bpy.data.objects.new(name, None))
+        o.adf.kind = kind
+        o.empty_display_type, o.empty_display_size = "SINGLE_ARROW", 0.01
+        o.parent = body
+        o.matrix_parent_inverse = Matrix.Identity(4)
+        made.append(o)
+    s = made[0].adf.sensor
+    s.use_type, s.use_range, s.range = True, True, range_m
+    for i in range(rays):
+        r = s.rays.add()
+        r.offset = (0.0, (i - (rays - 1) / 2) * 0.002, 0.0)
+        r.direction = (0.0, 0.0, 1.0)
+    made[1].adf.actuator.use_type = True
+    return made
+
+
+def add_ghost(name: str, radius: float = 0.005, parent=None, location=(0, 0, 0)):
+    g = _link(bpy.data.objects.new(name, None))
+    g.adf.kind = "GHOST"
+    g.empty_display_type, g.empty_display_size = "SPHERE", radius
+    if parent is not None:
+        g.parent = parent
+        g.matrix_parent_inverse = Matrix.Identity(4)
+    g.location = location
+    add_collision_primitive(g, "SPHERE", radius=radius)
+    return g
+
+
+def problems(scene) -> list[str]:
+    """Readable findings for the UI (what export would refuse)."""
+    from .export import gather_model
+    return [f"{d.severity.name}: {d.message}" + (f" ({d.hint})" if d.hint else "")
+            for d in gather_model(scene).diagnostics]
+
+
+__all__ = ["mark", "generate_collision", "add_collision_primitive", "estimate_inertia", "add_joint",
+           "create_rope", "add_grasp", "add_ghost", "problems", "gather"]

@@ -1,0 +1,153 @@
+"""Export the Blender scene as an ADF model: gather -> validate -> write (nothing on failure)."""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from adfkit.adf import dumps, read_file
+from adfkit.adf.writer import atomic_write_text
+from adfkit.diagnostics import Diagnostic, Severity, error
+from adfkit.model import ModelFile
+
+from . import gather, meshes
+
+HASH_FILE = ".adfkit-meshes.json"
+
+
+@dataclass
+class ExportResult:
+    path: Path | None
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    written: list[Path] = field(default_factory=list)
+    skipped: list[Path] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return self.path is not None
+
+
+def _model_level(scene) -> tuple[ModelFile, dict]:
+    snap = json.loads(scene.adf.snapshot) if scene.adf.snapshot else {}
+    if snap.get("keys"):
+        doc, _ = read_file("snapshot.yaml", kind="model", text=snap["keys"])
+        doc.path = None
+    else:
+        doc = ModelFile()
+    doc.present_lists = set(snap.get("present", []))
+    if scene.adf.use_namespace:
+        doc.namespace = scene.adf.namespace
+    if scene.adf.use_ignore_inter_collision:
+        doc.ignore_inter_collision = scene.adf.ignore_inter_collision
+    return doc, snap.get("order", {})
+
+
+def _mesh_paths(doc: ModelFile) -> tuple[str, str]:
+    out = []
+    for attr, default in (("high_resolution_path", gather.MESH_DIRS[0]), ("low_resolution_path", gather.MESH_DIRS[1])):
+        p = getattr(doc, attr)
+        if not p or os.path.isabs(p) or ".." in Path(p).parts:
+            p = default  # keep every mesh inside the output folder
+            setattr(doc, attr, p)
+        out.append(p)
+    return out[0], out[1]
+
+
+def _ordered(objs, order: list[str]):
+    rank = {ident: i for i, ident in enumerate(order)}
+    return sorted(objs, key=lambda o: (rank.get(o.identifier, len(rank)), o.identifier))
+
+
+def gather_model(scene, objects=None) -> gather.Gathered:
+    doc, order = _model_level(scene)
+    hi, lo = _mesh_paths(doc)
+    out = gather.Gathered(doc)
+    objs = sorted(objects if objects is not None else scene.objects, key=lambda o: o.name)
+    bodies, ghosts, joints, other = [], [], [], {k: [] for k in ("sensors", "actuators", "cameras", "lights")}
+    for o in objs:
+        k = o.adf.kind
+        if k == "BODY":
+            bodies.append(gather.gather_body(o, out, (hi, lo)))
+            for b in bodies[-1:]:
+                for attr in ("high_resolution_path", "low_resolution_path"):
+                    setattr(b, attr, None)  # per-body folders are folded into the model folders
+        elif k == "GHOST":
+            ghosts.append(gather.gather_ghost(o, out, (hi, lo)))
+        elif k == "JOINT":
+            j = gather.gather_joint(o, out)
+            if j is not None:
+                joints.append(j)
+        elif k in gather.GATHER:
+            key, fn = gather.GATHER[k]
+            other[key].append(fn(o, out))
+    doc.bodies = _ordered(bodies, order.get("bodies", []))
+    doc.ghost_objects = _ordered(ghosts, order.get("ghost objects", []))
+    doc.joints = _ordered(joints, order.get("joints", []))
+    for key, items in other.items():
+        setattr(doc, key, _ordered(items, order.get(key, [])))
+    seen: dict[str, str] = {}
+    for job in out.jobs:
+        rel = job.directory + job.filename
+        if seen.get(rel, job.digest) != job.digest:
+            out.diagnostics.append(error("mesh-name-clash", f"two different meshes would be written as {rel}", None,
+                                         "rename one of the objects"))
+        seen[rel] = job.digest
+    return out
+
+
+def validate(text: str, target: Path, pending: set[Path]) -> list[Diagnostic]:
+    """Validator findings for the text about to be written (reader diagnostics if the
+    validator is unavailable). Missing-file findings for meshes still to be written are dropped."""
+    try:
+        from adfkit.validator import validate_file
+    except ImportError:  # pragma: no cover - validator not installed
+        _, diags = read_file(target, kind="model", text=text)
+        return diags
+    res = validate_file(target, kind="model", text=text)
+    keep = []
+    for d in res.diagnostics:
+        if d.rule in ("missing-file", "missing-mesh") and any(p.name in d.message for p in pending):
+            continue
+        keep.append(d)
+    return keep
+
+
+def export_scene(scene, out_dir: str | Path, name: str = "model", objects=None) -> ExportResult:
+    out_dir = Path(out_dir)
+    target = out_dir / f"{name}.yaml"
+    g = gather_model(scene, objects)
+    result = ExportResult(None, list(g.diagnostics))
+    if any(d.severity >= Severity.ERROR for d in result.diagnostics):
+        return result
+    text = dumps(g.model)
+    pending = {out_dir / j.directory / j.filename for j in g.jobs}
+    result.diagnostics += validate(text, target, pending)
+    if any(d.severity >= Severity.ERROR for d in result.diagnostics):
+        return result
+    _run_jobs(g.jobs, out_dir, result)
+    atomic_write_text(target, text)
+    result.path = target
+    result.written.append(target)
+    return result
+
+
+def _run_jobs(jobs, out_dir: Path, result: ExportResult) -> None:
+    hashes_path = out_dir / HASH_FILE
+    try:
+        known = json.loads(hashes_path.read_text()) if hashes_path.is_file() else {}
+    except (OSError, ValueError):
+        known = {}
+    for job in jobs:
+        rel = job.directory + job.filename
+        dst = out_dir / rel
+        if known.get(rel) == job.digest and dst.is_file():
+            result.skipped.append(dst)
+            continue
+        if job.source is not None and job.parts is None:
+            result.written += meshes.copy_mesh_file(job.source, dst.parent, job.filename)
+        else:
+            result.written += meshes.write_obj(job.parts, dst.parent, job.filename)
+        known[rel] = job.digest
+    if jobs:
+        atomic_write_text(hashes_path, json.dumps(known, indent=1, sort_keys=True))

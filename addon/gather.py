@@ -1,0 +1,347 @@
+"""Blender scene -> adfkit model: one small gatherer per ADF object kind.
+
+Blender-level code only reads Blender data here; ADF semantics come from adfkit and
+:mod:`.fields`. Mesh files are not written here: gatherers return *mesh jobs* that the
+exporter runs only after the model has been validated.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from adfkit.diagnostics import Diagnostic, SourceLocation, error, warning
+from adfkit.model import Actuator, Body, Camera, Ghost, Joint, Light, ModelFile, Pose, Sensor
+from adfkit.model.common import Geometry, ShapeEntry
+from adfkit.model.objects import Ray
+from adfkit.model.pose import Quat, Vec3
+
+from . import fields, joint_frames, meshes
+from .properties import read_group
+
+MESH_DIRS = ("meshes/high_res/", "meshes/low_res/")
+
+
+@dataclass
+class MeshJob:
+    directory: str            # relative to the output directory
+    filename: str
+    digest: str
+    parts: list | None = None  # MeshArrays to write, or None to copy ``source``
+    source: Path | None = None
+
+
+@dataclass
+class Gathered:
+    model: ModelFile
+    jobs: list[MeshJob] = field(default_factory=list)
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+
+def where(obj) -> SourceLocation:
+    return SourceLocation(f"blender:{obj.name}")
+
+
+def identifier(obj) -> str:
+    return obj.adf.identifier or fields.PREFIX.get(obj.adf.kind, "") + obj.name
+
+
+def matrix_key(obj) -> str:
+    return json.dumps([round(float(v), 9) for row in obj.matrix_world for v in row])
+
+
+def unchanged(obj) -> bool:
+    """True while the object sits where it was at import (exact snapshot poses apply)."""
+    return bool(obj.adf.snapshot_matrix) and obj.adf.snapshot_matrix == matrix_key(obj)
+
+
+def world_pose(obj) -> Pose:
+    loc, rot, _ = obj.matrix_world.decompose()
+    return Pose(Vec3(*map(float, loc)), Quat(float(rot.x), float(rot.y), float(rot.z), float(rot.w)).normalized())
+
+
+def uniform_scale(obj) -> float:
+    s = obj.matrix_world.to_scale()
+    return float(sum(s) / 3.0)
+
+
+def relative_pose(obj, parent) -> Pose:
+    return world_pose(parent).inverse() * world_pose(obj) if parent is not None else world_pose(obj)
+
+
+def adf_parent(obj):
+    p = obj.parent
+    while p is not None and p.adf.kind != "BODY":
+        p = p.parent
+    return p
+
+
+# --- bodies and ghosts ---------------------------------------------------------------------
+
+def gather_body(obj, out: Gathered, paths: tuple[str, str]) -> Body:
+    b = fields.from_snapshot(Body, obj.adf.snapshot, f"blender:{obj.name}")
+    b.identifier = identifier(obj)
+    if b.name is None:
+        b.name = obj.name
+    values = read_group(obj.adf.body, fields.BODY)
+    if values.get("mass") is None:
+        out.diagnostics.append(error("body-mass", f"body '{obj.name}' has no mass", where(obj),
+                                     "tick 'Write Mass' in the ADF Body panel (0 makes it static)"))
+    try:
+        fields.merge(b, fields.BODY, values)
+    except ValueError as exc:
+        out.diagnostics.append(error("body-value", f"body '{obj.name}': {exc}", where(obj)))
+    _pose_and_scale(obj, b)
+    _gather_geometry(obj, b, out, paths)
+    return b
+
+
+def _pose_and_scale(obj, b) -> None:
+    if not (unchanged(obj) and b.location is not None):
+        b.location = world_pose(obj)
+    s = uniform_scale(obj)
+    old = b.scale if b.scale is not None else 1.0
+    if not unchanged(obj) and abs(s - old) > 1e-6 * max(1.0, abs(old)):  # matrix decomposition noise
+        b.scale = round(s, 9)
+
+
+def gather_ghost(obj, out: Gathered, paths: tuple[str, str]) -> Ghost:
+    g = fields.from_snapshot(Ghost, obj.adf.snapshot, f"blender:{obj.name}")
+    g.identifier = identifier(obj)
+    if g.name is None:
+        g.name = obj.name
+    fields.merge(g, fields.GHOST, read_group(obj.adf.ghost, fields.GHOST))
+    parent = adf_parent(obj)
+    g.parent = _parent_ref(g.parent, parent)
+    if not (unchanged(obj) and g.location is not None):
+        g.location = relative_pose(obj, parent)
+    _gather_geometry(obj, g, out, paths)
+    if not (g.collision_shape or g.compound_collision_shape or g.collision_mesh or g.mesh):
+        out.diagnostics.append(error("ghost-collision", f"ghost '{obj.name}' has no collision geometry", where(obj),
+                                     "add a collision primitive or mesh; AMBF skips a ghost without one"))
+    return g
+
+
+def _parent_ref(old: str | None, parent) -> str | None:
+    if parent is None:
+        return None
+    ident = identifier(parent)
+    return old if old and old in ident else ident
+
+
+def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
+    hi, lo = paths
+    visual = None
+    if obj.type == "MESH" and len(obj.data.polygons):
+        arr = meshes.mesh_arrays(obj)
+        digest = meshes.digest([arr])
+        name = b.mesh if b.mesh else f"{obj.name}.OBJ"
+        src = Path(obj.adf.mesh_source) if obj.adf.mesh_source else None
+        if digest == obj.adf.mesh_hash and src is not None and src.is_file():
+            job = MeshJob(hi, name, digest, source=src)
+        else:
+            if Path(name).suffix.lower() != ".obj":
+                name = Path(name).stem + ".OBJ"
+            job = MeshJob(hi, name, digest, parts=[arr])
+        b.mesh = name
+        out.jobs.append(job)
+        visual = job
+    _gather_collision(obj, b, out, lo, visual)
+
+
+def _shape_entry(child, body_obj) -> ShapeEntry:
+    s = child.adf.shape
+    geo = Geometry()
+    if s.shape == "BOX":
+        geo.x, geo.y, geo.z = (float(v) for v in s.size)
+    elif s.shape == "SPHERE":
+        geo.radius = float(s.radius)
+    else:
+        geo.radius, geo.height, geo.axis = float(s.radius), float(s.height), s.axis
+    return ShapeEntry(shape=s.shape.title(), geometry=geo, offset=relative_pose(child, body_obj))
+
+
+def _entry_key(e: ShapeEntry):
+    g = e.geometry
+    rpy = e.offset.rpy() if e.offset is not None else (0, 0, 0)
+    pos = tuple(e.offset.position) if e.offset is not None else (0, 0, 0)
+    return ((e.shape or "").upper(), g.x, g.y, g.z, g.radius, g.height, (g.axis or "z").lower(), *pos, *rpy)
+
+
+def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None) -> None:
+    kids = sorted(obj.children, key=lambda c: c.name)
+    shapes = [c for c in kids if c.adf.kind == "COLLISION_SHAPE"]
+    parts = [c for c in kids if c.adf.kind == "COLLISION_MESH" and c.type == "MESH"]
+    if shapes:
+        entries = [_shape_entry(c, obj) for c in shapes]
+        if b.collision_shape and len(entries) == 1:
+            old = ShapeEntry(shape=b.collision_shape, geometry=b.collision_geometry, offset=b.collision_offset)
+            if not fields.same32(_entry_key(old), _entry_key(entries[0])):
+                b.collision_shape, b.collision_geometry = entries[0].shape, entries[0].geometry
+                b.collision_offset = entries[0].offset
+        else:
+            old = b.compound_collision_shape or []
+            same = len(old) == len(entries) and all(fields.same32(_entry_key(x), _entry_key(y))
+                                                   for x, y in zip(old, entries))
+            if not same:
+                b.collision_shape = b.collision_geometry = b.collision_offset = None
+                b.compound_collision_shape = entries
+        return
+    if parts:
+        body_inv = np.array(obj.matrix_world.inverted(), dtype=np.float64)
+        arrays = []
+        for c in parts:
+            a = meshes.mesh_arrays(c)
+            m = body_inv @ np.array(c.matrix_world, dtype=np.float64)
+            if not np.allclose(m, np.eye(4), atol=1e-7):
+                co = a.co.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
+                a.co = co.astype(np.float32)
+            arrays.append(a)
+        digest = meshes.digest(arrays)
+        name = b.collision_mesh or (b.mesh if b.mesh and obj.adf.collision_source and b.collision_mesh is None
+                                    else f"{obj.name}_collision.OBJ")
+        src = Path(obj.adf.collision_source) if obj.adf.collision_source else None
+        if digest == obj.adf.collision_hash and src is not None and src.is_file():
+            out.jobs.append(MeshJob(lo, name, digest, source=src))
+        else:
+            if Path(name).suffix.lower() != ".obj":
+                name = Path(name).stem + ".OBJ"
+            out.jobs.append(MeshJob(lo, name, digest, parts=arrays))
+            if b.collision_mesh_type is None:
+                b.collision_mesh_type = "CONVEX_HULL" if len(arrays) > 1 else None
+        if name != b.mesh or b.collision_mesh is not None:
+            b.collision_mesh = name
+        return
+    if visual is not None and not (b.collision_shape or b.compound_collision_shape):
+        # no collision of its own: AMBF looks the visual file name up in the low-res folder
+        name = b.collision_mesh or visual.filename
+        out.jobs.append(MeshJob(lo, name, visual.digest, parts=visual.parts, source=visual.source))
+
+
+# --- joints --------------------------------------------------------------------------------
+
+def gather_joint(obj, out: Gathered) -> Joint | None:
+    j = fields.from_snapshot(Joint, obj.adf.snapshot, f"blender:{obj.name}")
+    j.identifier = identifier(obj)
+    if j.name is None:
+        j.name = obj.name
+    fields.merge(j, fields.JOINT, read_group(obj.adf.joint, fields.JOINT))
+    rbc = obj.rigid_body_constraint
+    p = rbc.object1 if rbc is not None else None
+    c = rbc.object2 if rbc is not None else None
+    for role, o in (("parent", p), ("child", c)):
+        if o is None or o.adf.kind != "BODY":
+            what = "no object" if o is None else f"'{o.name}', which is not an ADF body"
+            out.diagnostics.append(error("joint-reference", f"joint '{obj.name}': its {role} is {what}", where(obj),
+                                         f"set the rigid body constraint's {'first' if role == 'parent' else 'second'}"
+                                         " object to an ADF body"))
+            return None
+    if p == c:
+        out.diagnostics.append(error("joint-reference", f"joint '{obj.name}' joins '{p.name}' to itself", where(obj)))
+        return None
+    j.parent = _parent_ref(j.parent, p)
+    j.child = _parent_ref(j.child, c)
+    keep = unchanged(obj) and unchanged(p) and unchanged(c) and j.parent_pivot is not None
+    if not keep:
+        d = joint_frames.derive(j.type, world_pose(p), world_pose(c), world_pose(obj),
+                                uniform_scale(p), uniform_scale(c))
+        for k, v in d.items():
+            if k in ("offset", "joint_offset") and v == 0.0 and getattr(j, k) is None:
+                continue
+            setattr(j, k, v)
+        if j.child_offset is not None and j.offset is None:
+            j.child_offset = None
+    return j
+
+
+# --- sensors, actuators, cameras, lights ---------------------------------------------------
+
+def _attached(obj, x, out: Gathered, what: str):
+    parent = adf_parent(obj)
+    if parent is None:
+        out.diagnostics.append(error(f"{what}-parent", f"{what} '{obj.name}' is not parented to an ADF body", where(obj),
+                                     "parent it to the body it is mounted on"))
+    x.parent = _parent_ref(x.parent, parent)
+    if not (unchanged(obj) and x.location is not None):
+        x.location = relative_pose(obj, parent)
+    return x
+
+
+def gather_sensor(obj, out: Gathered) -> Sensor:
+    s = fields.from_snapshot(Sensor, obj.adf.snapshot, f"blender:{obj.name}")
+    s.identifier, s.name = identifier(obj), s.name or obj.name
+    fields.merge(s, fields.SENSOR, read_group(obj.adf.sensor, fields.SENSOR))
+    rays = [Ray(offset=Vec3(*map(float, r.offset)), direction=Vec3(*map(float, r.direction))) for r in obj.adf.sensor.rays]
+    old = [(*r.offset, *r.direction) for r in (s.array or []) if r.offset is not None and r.direction is not None]
+    if rays and not fields.same32(old, [(*r.offset, *r.direction) for r in rays]):
+        s.array = rays
+    if not (s.array or s.mesh or s.parametric):
+        out.diagnostics.append(error("sensor-rays", f"sensor '{obj.name}' has no rays", where(obj),
+                                     "add rays in the ADF Sensor panel; AMBF skips a sensor without them"))
+    return _attached(obj, s, out, "sensor")
+
+
+def gather_actuator(obj, out: Gathered) -> Actuator:
+    a = fields.from_snapshot(Actuator, obj.adf.snapshot, f"blender:{obj.name}")
+    a.identifier, a.name = identifier(obj), a.name or obj.name
+    fields.merge(a, fields.ACTUATOR, read_group(obj.adf.actuator, fields.ACTUATOR))
+    return _attached(obj, a, out, "actuator")
+
+
+def _vec_in_parent(obj, local, point: bool):
+    parent = adf_parent(obj)
+    v = obj.matrix_world @ local if point else obj.matrix_world.to_3x3() @ local
+    if parent is not None:
+        inv = parent.matrix_world.inverted()
+        v = inv @ v if point else inv.to_3x3() @ v
+    return Vec3(*(round(float(c), 9) + 0.0 for c in v))
+
+
+def gather_camera(obj, out: Gathered) -> Camera:
+    from mathutils import Vector
+    c = fields.from_snapshot(Camera, obj.adf.snapshot, f"blender:{obj.name}")
+    c.identifier, c.name = identifier(obj), c.name or obj.name
+    fields.merge(c, fields.CAMERA, read_group(obj.adf.camera, fields.CAMERA))
+    parent = adf_parent(obj)
+    c.parent = _parent_ref(c.parent, parent)
+    if not (unchanged(obj) and c.location is not None):
+        dist = 1.0
+        if c.location is not None and c.look_at is not None:
+            dist = max((Vec3(*c.look_at) - Vec3(*c.location)).norm(), 1e-6)
+        c.location = _vec_in_parent(obj, Vector((0, 0, 0)), True)
+        c.look_at = _vec_in_parent(obj, Vector((0, 0, -dist)), True)
+        c.up = _vec_in_parent(obj, Vector((0, 1, 0)), False)
+    if obj.type == "CAMERA":
+        cam = obj.data
+        if not fields.same32(c.field_view_angle, cam.angle_y):
+            c.field_view_angle = float(cam.angle_y)
+        from adfkit.model.objects import ClippingPlane
+        cp = c.clipping_plane or ClippingPlane()
+        if not fields.same32((cp.near, cp.far), (cam.clip_start, cam.clip_end)):
+            c.clipping_plane = ClippingPlane(near=float(cam.clip_start), far=float(cam.clip_end))
+    return c
+
+
+def gather_light(obj, out: Gathered) -> Light:
+    from mathutils import Vector
+    li = fields.from_snapshot(Light, obj.adf.snapshot, f"blender:{obj.name}")
+    li.identifier, li.name = identifier(obj), li.name or obj.name
+    fields.merge(li, fields.LIGHT, read_group(obj.adf.light, fields.LIGHT))
+    parent = adf_parent(obj)
+    li.parent = _parent_ref(li.parent, parent)
+    if not (unchanged(obj) and li.location is not None):
+        li.location = _vec_in_parent(obj, Vector((0, 0, 0)), True)
+        li.direction = _vec_in_parent(obj, Vector((0, 0, -1)), False)
+    if obj.type == "LIGHT" and obj.data.type == "SPOT":
+        if not fields.same32(li.cutoff_angle, obj.data.spot_size / 2.0):
+            li.cutoff_angle = float(obj.data.spot_size) / 2.0
+    if li.shadow_quality is None:
+        out.diagnostics.append(warning("light-shadow", f"light '{obj.name}' has no shadow quality", where(obj),
+                                       "AMBF leaves it uninitialised; set it (0-5)"))
+    return li
+
+
+GATHER = {"SENSOR": ("sensors", gather_sensor), "ACTUATOR": ("actuators", gather_actuator),
+          "CAMERA": ("cameras", gather_camera), "LIGHT": ("lights", gather_light)}

@@ -1,0 +1,191 @@
+"""Blender meshes to files: OBJ + MTL (base-colour texture, normal map) and content hashes.
+
+``mesh_arrays`` is the only Blender-level function; the OBJ/MTL text writers are plain
+Python over NumPy arrays, so exports of unchanged meshes can be skipped by hash.
+"""
+from __future__ import annotations
+
+import hashlib
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclass
+class MeshArrays:
+    name: str
+    co: np.ndarray                    # (n, 3) float32 vertex positions in the object frame
+    loops: np.ndarray                 # (m,) int32 vertex index per face corner
+    loop_start: np.ndarray            # (f,) int32
+    loop_total: np.ndarray            # (f,) int32
+    uv: np.ndarray | None = None      # (m, 2) float32 per corner
+    material_index: np.ndarray | None = None
+    materials: list = field(default_factory=list)   # [MaterialInfo]
+
+
+@dataclass
+class MaterialInfo:
+    name: str
+    base_color: tuple = (0.8, 0.8, 0.8, 1.0)
+    texture: str | None = None        # image file path
+    normal_map: str | None = None
+
+
+def mesh_arrays(obj, name: str | None = None) -> MeshArrays:
+    """Arrays of an object's own mesh data (no modifiers, object frame)."""
+    me = obj.data
+    n, m, f = len(me.vertices), len(me.loops), len(me.polygons)
+    co = np.empty(n * 3, np.float32)
+    me.vertices.foreach_get("co", co)
+    loops = np.empty(m, np.int32)
+    me.loops.foreach_get("vertex_index", loops)
+    start = np.empty(f, np.int32)
+    me.polygons.foreach_get("loop_start", start)
+    total = np.empty(f, np.int32)
+    me.polygons.foreach_get("loop_total", total)
+    uv = None
+    if me.uv_layers.active is not None and m:
+        uv = np.empty(m * 2, np.float32)
+        me.uv_layers.active.data.foreach_get("uv", uv)
+        uv = uv.reshape(-1, 2)
+    mi = np.empty(f, np.int32)
+    me.polygons.foreach_get("material_index", mi)
+    mats = [material_info(s.material) for s in obj.material_slots if s.material is not None]
+    return MeshArrays(name or obj.name, co.reshape(-1, 3), loops, start, total, uv, mi, mats)
+
+
+def material_info(mat) -> MaterialInfo:
+    info = MaterialInfo(mat.name, tuple(mat.diffuse_color))
+    if not mat.use_nodes or mat.node_tree is None:
+        return info
+    bsdf = next((n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
+    if bsdf is None:
+        return info
+    base = bsdf.inputs["Base Color"]
+    info.base_color = tuple(base.default_value)
+    img = _linked_image(base)
+    if img is not None:
+        info.texture = _image_file(img)
+    normal = bsdf.inputs["Normal"]
+    if normal.is_linked and normal.links[0].from_node.type == "NORMAL_MAP":
+        img = _linked_image(normal.links[0].from_node.inputs["Color"])
+        if img is not None:
+            info.normal_map = _image_file(img)
+    return info
+
+
+def _linked_image(socket):
+    if socket.is_linked and socket.links[0].from_node.type == "TEX_IMAGE":
+        return socket.links[0].from_node.image
+    return None
+
+
+def _image_file(img) -> str | None:
+    import bpy
+    path = bpy.path.abspath(img.filepath) if img.filepath else ""
+    return path if path and Path(path).is_file() else None
+
+
+def digest(parts: list[MeshArrays]) -> str:
+    h = hashlib.sha1()
+    for p in parts:
+        for a in (p.co, p.loops, p.loop_start, p.loop_total, p.uv, p.material_index):
+            if a is not None:
+                h.update(np.ascontiguousarray(a).tobytes())
+        for mi in p.materials:
+            h.update(repr((mi.name, mi.base_color, mi.texture, mi.normal_map)).encode())
+    return h.hexdigest()
+
+
+def _fmt(a: np.ndarray) -> str:
+    return np.array2string(a, precision=9, floatmode="maxprec_equal", separator=" ", threshold=10 ** 9)
+
+
+def obj_text(parts: list[MeshArrays], mtl_name: str | None) -> str:
+    """OBJ with one ``o`` per part (AMBF makes one collision child shape per sub-mesh)."""
+    out = ["# written by adfkit (Blender add-on)\n"]
+    if mtl_name:
+        out.append(f"mtllib {mtl_name}\n")
+    v_base = vt_base = 1
+    for p in parts:
+        out.append(f"o {p.name}\n")
+        if len(p.co):
+            out.append("".join(f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in p.co.tolist()))
+        if p.uv is not None:
+            out.append("".join(f"vt {u:.9g} {v:.9g}\n" for u, v in p.uv.tolist()))
+        vidx = (p.loops + v_base).tolist()
+        cur_mat = None
+        for fi, (s, t) in enumerate(zip(p.loop_start.tolist(), p.loop_total.tolist())):
+            if p.materials and p.material_index is not None:
+                mi = min(int(p.material_index[fi]), len(p.materials) - 1)
+                if mi != cur_mat:
+                    out.append(f"usemtl {p.materials[mi].name}\n")
+                    cur_mat = mi
+            if p.uv is not None:
+                out.append("f " + " ".join(f"{vidx[k]}/{k + vt_base}" for k in range(s, s + t)) + "\n")
+            else:
+                out.append("f " + " ".join(str(vidx[k]) for k in range(s, s + t)) + "\n")
+        v_base += len(p.co)
+        vt_base += 0 if p.uv is None else len(p.uv)
+    return "".join(out)
+
+
+def mtl_text(materials: list[MaterialInfo], texture_names: dict[str, str]) -> str:
+    out = ["# written by adfkit (Blender add-on)\n"]
+    for m in materials:
+        r, g, b, a = m.base_color
+        out.append(f"newmtl {m.name}\nKa 0.2 0.2 0.2\nKd {r:.6g} {g:.6g} {b:.6g}\nKs 0.5 0.5 0.5\nNs 64\nd {a:.6g}\n")
+        if m.texture:
+            out.append(f"map_Kd {texture_names[m.texture]}\n")
+        if m.normal_map:
+            out.append(f"map_bump {texture_names[m.normal_map]}\n")
+    return "".join(out)
+
+
+def write_obj(parts: list[MeshArrays], directory: Path, filename: str) -> list[Path]:
+    """Write OBJ (+ MTL and copied textures when materials exist). Returns the files written."""
+    directory.mkdir(parents=True, exist_ok=True)
+    mats = {m.name: m for p in parts for m in p.materials}
+    written = []
+    mtl = None
+    if mats:
+        mtl = Path(filename).stem + ".mtl"
+        tex = {}
+        for m in mats.values():
+            for src in (m.texture, m.normal_map):
+                if src and src not in tex:
+                    tex[src] = Path(src).name
+                    dst = directory / tex[src]
+                    if not dst.exists() or dst.stat().st_size != Path(src).stat().st_size:
+                        shutil.copyfile(src, dst)
+                    written.append(dst)
+        (directory / mtl).write_text(mtl_text(list(mats.values()), tex), encoding="utf-8")
+        written.append(directory / mtl)
+    (directory / filename).write_text(obj_text(parts, mtl), encoding="utf-8")
+    written.append(directory / filename)
+    return written
+
+
+def copy_mesh_file(src: Path, directory: Path, filename: str) -> list[Path]:
+    """Copy an unchanged mesh file (and, for OBJ, its MTL and the images the MTL names)."""
+    directory.mkdir(parents=True, exist_ok=True)
+    dst = directory / filename
+    shutil.copyfile(src, dst)
+    out = [dst]
+    if src.suffix.lower() == ".obj":
+        for line in src.read_text(encoding="utf-8", errors="replace").splitlines():
+            if line.startswith("mtllib "):
+                mtl = src.parent / line[7:].strip()
+                if mtl.is_file():
+                    shutil.copyfile(mtl, directory / mtl.name)
+                    out.append(directory / mtl.name)
+                    for ml in mtl.read_text(encoding="utf-8", errors="replace").splitlines():
+                        parts = ml.strip().split()
+                        if parts and parts[0].lower() in ("map_kd", "map_bump", "bump", "norm", "map_ks") and len(parts) > 1:
+                            img = src.parent / parts[-1]
+                            if img.is_file():
+                                shutil.copyfile(img, directory / img.name)
+                                out.append(directory / img.name)
+    return out

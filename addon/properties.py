@@ -1,0 +1,157 @@
+"""Blender PropertyGroups for ADF data, generated from the tables in :mod:`.fields`.
+
+Every optional ADF key gets a ``use_<name>`` switch: off means "not written" (AMBF uses
+its default), which is not the same as writing the default value.
+"""
+from __future__ import annotations
+
+import bpy
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
+                       IntProperty, PointerProperty, StringProperty)
+
+from . import fields
+
+KINDS = (("NONE", "None", "Not part of the ADF model"), ("BODY", "Body", "Rigid body"),
+         ("GHOST", "Ghost", "Non-colliding trigger volume"), ("SENSOR", "Sensor", "Ray sensor"),
+         ("ACTUATOR", "Actuator", "Constraint actuator"), ("CAMERA", "Camera", "ADF camera"),
+         ("LIGHT", "Light", "ADF spot light"), ("JOINT", "Joint", "Joint (rigid body constraint on this object)"),
+         ("COLLISION_SHAPE", "Collision primitive", "A primitive of its parent body's collision"),
+         ("COLLISION_MESH", "Collision mesh", "A (convex) collision mesh part of its parent body"))
+SHAPES = ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE")
+
+
+def _prop(f: fields.Field):
+    kw = {"name": f.label, "description": f.desc or f.label}
+    if f.kind == "float":
+        kw.update(default=f.default, precision=6)
+        if f.min is not None:
+            kw["min"] = f.min
+        return FloatProperty(**kw)
+    if f.kind == "int":
+        return IntProperty(default=f.default, min=int(f.min or 0), **kw)
+    if f.kind == "bool":
+        return BoolProperty(default=f.default, **kw)
+    if f.kind == "enum":
+        return EnumProperty(items=[(i, i, i) for i in f.items], default=f.default, **kw)
+    if f.kind in ("vec3", "inertia", "conelimits"):
+        return FloatVectorProperty(size=3, default=f.default, precision=6, **kw)
+    if f.kind == "pose":
+        return FloatVectorProperty(size=6, default=f.default, precision=6, **kw)
+    return StringProperty(default=str(f.default), **kw)
+
+
+def _make_group(name: str, table: list[fields.Field], extra: dict | None = None):
+    ann = {}
+    for f in table:
+        ann[f.prop] = _prop(f)
+        ann["use_" + f.prop] = BoolProperty(name=f"Write {f.label}", default=False,
+                                            description=f"Write '{' '.join(f.path)}' (off: AMBF default)")
+    ann.update(extra or {})
+    return type(name, (bpy.types.PropertyGroup,), {"__annotations__": ann})
+
+
+class AdfRay(bpy.types.PropertyGroup):
+    offset: FloatVectorProperty(name="Offset", size=3, precision=6)
+    direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0), precision=6)
+
+
+class AdfShape(bpy.types.PropertyGroup):
+    shape: EnumProperty(name="Shape", items=[(s, s.title(), s.title()) for s in SHAPES], default="BOX")
+    size: FloatVectorProperty(name="Box size", size=3, default=(0.1, 0.1, 0.1), min=0.0, precision=6,
+                              description="full edge lengths x, y, z (m)")
+    radius: FloatProperty(name="Radius", default=0.05, min=0.0, precision=6)
+    height: FloatProperty(name="Height", default=0.1, min=0.0, precision=6)
+    axis: EnumProperty(name="Axis", items=[(a, a, a) for a in "xyzXYZ"], default="z")
+
+
+BodyProps = _make_group("AdfBodyProps", fields.BODY)
+GhostProps = _make_group("AdfGhostProps", fields.GHOST)
+JointProps = _make_group("AdfJointProps", fields.JOINT)
+SensorProps = _make_group("AdfSensorProps", fields.SENSOR, {"rays": CollectionProperty(type=AdfRay)})
+ActuatorProps = _make_group("AdfActuatorProps", fields.ACTUATOR)
+CameraProps = _make_group("AdfCameraProps", fields.CAMERA)
+LightProps = _make_group("AdfLightProps", fields.LIGHT)
+GROUP_OF = {"BODY": "body", "GHOST": "ghost", "JOINT": "joint", "SENSOR": "sensor", "ACTUATOR": "actuator",
+            "CAMERA": "camera", "LIGHT": "light"}
+
+
+class AdfObjectProps(bpy.types.PropertyGroup):
+    kind: EnumProperty(name="ADF kind", items=KINDS, default="NONE")
+    identifier: StringProperty(name="Identifier", description="ADF mapping key; empty: '<KIND> <object name>'")
+    body: PointerProperty(type=BodyProps)
+    ghost: PointerProperty(type=GhostProps)
+    joint: PointerProperty(type=JointProps)
+    sensor: PointerProperty(type=SensorProps)
+    actuator: PointerProperty(type=ActuatorProps)
+    camera: PointerProperty(type=CameraProps)
+    light: PointerProperty(type=LightProps)
+    shape: PointerProperty(type=AdfShape)
+    # exact state at import/export time (see fields.py): ADF text and the world matrix then
+    snapshot: StringProperty(options={"HIDDEN"})
+    snapshot_matrix: StringProperty(options={"HIDDEN"})
+    mesh_source: StringProperty(name="Mesh source", description="file the visual mesh came from")
+    mesh_hash: StringProperty(options={"HIDDEN"})
+    collision_source: StringProperty(name="Collision source", description="file the collision mesh came from")
+    collision_hash: StringProperty(options={"HIDDEN"})
+    density: FloatProperty(name="Density", default=1000.0, min=0.0, description="kg/m³, for inertia estimation")
+
+
+class AdfSceneProps(bpy.types.PropertyGroup):
+    snapshot: StringProperty(options={"HIDDEN"}, description="model-level ADF keys at import")
+    namespace: StringProperty(name="Namespace", default="")
+    use_namespace: BoolProperty(name="Write namespace", default=False)
+    ignore_inter_collision: BoolProperty(name="Ignore inter-collision", default=False)
+    use_ignore_inter_collision: BoolProperty(name="Write ignore inter-collision", default=False)
+    findings: StringProperty(name="Findings", description="last export's validation findings")
+    rope_count: IntProperty(name="Elements", default=20, min=2, max=500)
+    rope_length: FloatProperty(name="Length", default=0.2, min=0.001, precision=4)
+    rope_radius: FloatProperty(name="Radius", default=0.001, min=0.0001, precision=5)
+    rope_mass: FloatProperty(name="Total mass", default=0.002, min=0.0, precision=5)
+
+
+CLASSES = (AdfRay, AdfShape, BodyProps, GhostProps, JointProps, SensorProps, ActuatorProps, CameraProps,
+           LightProps, AdfObjectProps, AdfSceneProps)
+
+
+def register() -> None:
+    for c in CLASSES:
+        bpy.utils.register_class(c)
+    bpy.types.Object.adf = PointerProperty(type=AdfObjectProps)
+    bpy.types.Scene.adf = PointerProperty(type=AdfSceneProps)
+
+
+def unregister() -> None:
+    del bpy.types.Scene.adf
+    del bpy.types.Object.adf
+    for c in reversed(CLASSES):
+        bpy.utils.unregister_class(c)
+
+
+def group(obj):
+    """The kind-specific PropertyGroup of an object (None for other kinds)."""
+    name = GROUP_OF.get(obj.adf.kind)
+    return getattr(obj.adf, name) if name else None
+
+
+def read_group(pg, table) -> dict:
+    """{prop: value or None} from a PropertyGroup (None where the use_ switch is off)."""
+    out = {}
+    for f in table:
+        if not getattr(pg, "use_" + f.prop):
+            out[f.prop] = None
+            continue
+        v = getattr(pg, f.prop)
+        out[f.prop] = tuple(v) if f.kind in ("vec3", "inertia", "pose", "conelimits") else v
+    return out
+
+
+def write_group(pg, table, values: dict) -> None:
+    for f in table:
+        v = values.get(f.prop)
+        setattr(pg, "use_" + f.prop, v is not None)
+        if v is None:
+            continue
+        if f.kind == "enum" and v not in f.items:
+            setattr(pg, "use_" + f.prop, False)  # unusual spelling: kept exact in the snapshot
+            continue
+        setattr(pg, f.prop, v)

@@ -1,0 +1,140 @@
+"""Panels: Properties editor (Object tab) and the 3D view N-panel, drawn from the field tables."""
+from __future__ import annotations
+
+import bpy
+
+from . import fields
+from .properties import group
+
+
+
+def _visible(kind: str, pg, f: fields.Field) -> bool:
+    if kind != "JOINT":
+        return True
+    t = pg.type
+    six = t in ("six dof", "six dof spring")
+    spring_axes = ("damping_linear", "damping_angular", "stiffness_linear", "stiffness_angular",
+                   "equilibrium_linear", "equilibrium_angular")
+    if f.prop in ("linear_low", "linear_high", "angular_low", "angular_high"):
+        return six
+    if f.prop in spring_axes:
+        return t == "six dof spring"
+    if f.prop == "cone_limits":
+        return t == "cone twist"
+    if f.prop in ("limit_low", "limit_high"):
+        return not six and t not in ("cone twist", "p2p", "fixed")
+    if f.prop in ("damping", "stiffness", "equilibrium"):
+        return "spring" in t and t != "six dof spring"
+    return True
+
+
+def draw_object(layout, obj) -> None:
+    adf = obj.adf
+    layout.prop(adf, "kind")
+    if adf.kind == "NONE":
+        return
+    layout.prop(adf, "identifier")
+    pg = group(obj)
+    if adf.kind == "COLLISION_SHAPE":
+        s = adf.shape
+        layout.prop(s, "shape")
+        if s.shape == "BOX":
+            layout.prop(s, "size")
+        else:
+            layout.prop(s, "radius")
+            if s.shape != "SPHERE":
+                layout.prop(s, "height")
+                layout.prop(s, "axis")
+        return
+    if pg is None:
+        return
+    table = fields.TABLES[adf.kind][1]
+    for f in table:
+        if not _visible(adf.kind, pg, f):
+            continue
+        row = layout.row(align=True)
+        row.prop(pg, "use_" + f.prop, text="")
+        sub = row.row()
+        sub.enabled = getattr(pg, "use_" + f.prop)
+        sub.prop(pg, f.prop)
+    if adf.kind == "BODY":
+        if not pg.use_mass:
+            layout.label(text="No mass: AMBF warns and uses 1 kg with an estimated inertia", icon="ERROR")
+        try:
+            fields.parse_groups(pg.collision_groups)
+        except ValueError as exc:
+            layout.label(text=str(exc), icon="ERROR")
+        layout.prop(adf, "density")
+        col = layout.column(align=True)
+        col.operator("adf.estimate_inertia")
+        col.operator("adf.generate_collision")
+        col.operator_menu_enum("adf.add_collision_primitive", "shape")
+        col.operator("adf.add_grasp")
+    if adf.kind == "JOINT":
+        rbc = obj.rigid_body_constraint
+        if rbc is None or rbc.object1 is None or rbc.object2 is None:
+            layout.label(text="Set the constraint's parent (Object 1) and child (Object 2) bodies", icon="ERROR")
+    if adf.kind == "SENSOR":
+        layout.label(text=f"{len(pg.rays)} rays")
+        for r in pg.rays:
+            row = layout.row()
+            row.prop(r, "offset", text="")
+            row.prop(r, "direction", text="")
+
+
+class ADF_PT_object(bpy.types.Panel):
+    bl_label = "ADF"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "object"
+
+    @classmethod
+    def poll(cls, context):
+        return context.object is not None
+
+    def draw(self, context):
+        draw_object(self.layout, context.object)
+
+
+class ADF_PT_sidebar(bpy.types.Panel):
+    bl_label = "ADF"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "ADF"
+
+    def draw(self, context):
+        lay = self.layout
+        sc = context.scene.adf
+        col = lay.column(align=True)
+        col.operator("adf.import_model")
+        col.operator("adf.export_model")
+        col.operator("adf.check")
+        row = lay.row(align=True)
+        row.prop(sc, "use_namespace", text="")
+        row.prop(sc, "namespace")
+        box = lay.box()
+        box.label(text="Thread")
+        box.prop(sc, "rope_count")
+        box.prop(sc, "rope_length")
+        box.prop(sc, "rope_radius")
+        box.prop(sc, "rope_mass")
+        box.operator("adf.create_rope")
+        lay.operator("adf.add_ghost")
+        lay.operator_menu_enum("adf.add_joint", "joint_type")
+        for line in sc.findings.splitlines()[:12]:
+            lay.label(text=line, icon="ERROR" if line.startswith("ERROR") else "INFO")
+        if context.object is not None:
+            draw_object(lay.box(), context.object)
+
+
+CLASSES = (ADF_PT_object, ADF_PT_sidebar)
+
+
+def register():
+    for c in CLASSES:
+        bpy.utils.register_class(c)
+
+
+def unregister():
+    for c in reversed(CLASSES):
+        bpy.utils.unregister_class(c)

@@ -1,0 +1,60 @@
+"""adfkit blend-import MODEL.yaml OUT.blend: build a Blender scene from an ADF model, headless."""
+from __future__ import annotations
+
+NAME = "blend-import"
+HELP = "import an ADF model into a new .blend file (needs the bpy module)"
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("model", help="ADF model file")
+    parser.add_argument("out_blend", help=".blend file to write")
+
+
+def load_addon():
+    """bpy plus the adfkit add-on package (addon/ beside this package), registered."""
+    import importlib
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    from ..diagnostics import AdfError, error
+    try:
+        import bpy
+    except ImportError:
+        raise AdfError(error("no-bpy", "the bpy module (Blender as a Python module) is not installed", None,
+                             "pip install bpy (Python 3.11), or run inside Blender")) from None
+    name = "adfkit_blender_addon"
+    if name not in sys.modules:
+        root = Path(__file__).resolve().parents[2] / "addon"
+        if not (root / "__init__.py").is_file():
+            raise AdfError(error("no-addon", f"the Blender add-on is not at {root}", None,
+                                 "run from a source checkout of adfkit"))
+        spec = importlib.util.spec_from_file_location(name, root / "__init__.py", submodule_search_locations=[str(root)])
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod
+        spec.loader.exec_module(mod)
+    mod = sys.modules[name]
+    if not hasattr(bpy.types.Object, "adf"):
+        mod.register()
+    for sub in ("export", "build", "gather"):
+        importlib.import_module(f"{name}.{sub}")
+    return bpy, mod
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from ..report import print_diagnostics
+
+    bpy, addon = load_addon()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    made, diags = addon.build.import_model(Path(args.model))
+    if diags:
+        print_diagnostics(diags)
+    out = Path(args.out_blend).resolve()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.tmp.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp), check_existing=False)
+    tmp.replace(out)
+    print(f"wrote {out} ({len(made)} objects)")
+    return 0
