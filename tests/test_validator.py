@@ -141,6 +141,10 @@ EXAMPLES = {
     "missing-file": ("world config: nope.yaml\ncolor config: c.yaml\ninput devices config: i.yaml\n"
                      "multibody configs: []\n", 1, "error"),
     "light-shadow": ("environment: e.yaml\nlights: [L]\nL:\n  location: {x: 0, y: 0, z: 1}\n", 4, "warning"),
+    "camera-view": ("environment: e.yaml\ncameras: [C]\nC:\n  location: {x: 1, y: 0, z: 0}\n"
+                    "  look at: {x: 1, y: 0, z: 0}\n", 5, "warning"),
+    "randomize-constraints": ("soft bodies: [S]\nS:\n  mesh: ''\n  randomize constraints: false\n", 4, "warning"),
+    "missing-plugin": ("plugins: [{name: p, filename: libp.so, path: ./lib}]\n" + CLEAN, 1, "warning"),
     "input-device": ("input devices: [D]\nD:\n  root link: BODY a\n", 3, "warning"),
 }
 
@@ -176,7 +180,7 @@ def test_every_rule_is_documented_and_examples_cover_most():
     text = doc.read_text(encoding="utf-8")
     for rid in RULES:
         assert f"`{rid}`" in text, rid
-    assert len(set(EXAMPLES) & set(RULES)) >= 45
+    assert len(set(EXAMPLES) & set(RULES)) >= 48
 
 
 def test_ambf_scalar_forms_accepted(tmp_path):

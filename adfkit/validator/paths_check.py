@@ -155,13 +155,30 @@ def input_device_paths(d: InputDevices) -> list[Diagnostic]:
     return out
 
 
+def plugin_paths(doc) -> list[Diagnostic]:
+    """Plugins with a `path`: AMBF tries path/filename first, then its plugin path list and
+    the bare name, so only a `path` that lacks the library is reported."""
+    out = []
+    owners = [doc] + (doc.all_objects() if isinstance(doc, ModelFile) else [])
+    for owner in owners:
+        for plugin in getattr(owner, "plugins", None) or []:
+            if plugin.path and plugin.filename:
+                lib = relative_to_file(doc.path, plugin.path) / plugin.filename
+                if not _exists(str(lib)):
+                    out.append(_d("missing-plugin", f"plugin library {lib} not found", owner.where("plugins"),
+                                  "plugin paths are relative to the declaring file; AMBF then tries its plugin "
+                                  "path list and the bare file name"))
+    return out
+
+
 def check(doc) -> list[Diagnostic]:
+    out = plugin_paths(doc) if hasattr(doc, "plugins") else []
     if isinstance(doc, ModelFile):
-        return model_paths(doc)
+        return out + model_paths(doc)
     if isinstance(doc, World):
-        return world_paths(doc)
+        return out + world_paths(doc)
     if isinstance(doc, Launch):
-        return launch_paths(doc)
+        return out + launch_paths(doc)
     if isinstance(doc, InputDevices):
-        return input_device_paths(doc)
-    return []
+        return out + input_device_paths(doc)
+    return out

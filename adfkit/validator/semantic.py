@@ -189,6 +189,13 @@ class Checker:
                     self.reference(m, w, "body", Registry(), earlier, immediate=True, world_only=True, owner=v)
         for light in m.lights:
             self.light(light)
+        for c in m.cameras:
+            self.camera(c)
+        for sb in m.soft_bodies:
+            if sb.randomize_constraints is False:
+                self.emit("randomize-constraints", f"soft body '{sb.identifier}': 'randomize constraints: false' "
+                          "still turns randomisation on in AMBF", sb.where("randomize constraints"),
+                          "remove the key to keep constraints in order")
 
     def namespace(self, obj) -> None:
         ns = getattr(obj, "namespace", None)
@@ -294,6 +301,16 @@ class Checker:
             elif lim.low is not None and lim.high is not None and lim.low > lim.high:
                 self.emit("joint-limits", f"joint '{j.identifier}': low {lim.low:g} > high {lim.high:g}; Bullet "
                           "treats the joint as free", j.where("joint limits"), "swap low and high")
+        if kind in (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING) and lim is not None:
+            parts = [lim.linear, lim.angular]
+            if any(p is None or p.low is None or p.high is None for p in parts):
+                self.emit("joint-limits", f"six-dof joint '{j.identifier}' limits lack the full "
+                          "{linear, angular}{low, high}{x, y, z} structure; AMBF keeps the defaults (±1.2)",
+                          j.where("joint limits"), "write linear: {low: {x,y,z}, high: {x,y,z}} and the same for angular")
+        if kind is JointKind.CONE_TWIST and (lim is None or None in (lim.x, lim.y, lim.z)):
+            self.emit("joint-limits", f"cone-twist joint '{j.identifier}' needs joint limits {{x, y, z}}; AMBF "
+                      "prints an error and uses 0.7", j.where("joint limits") if lim else j.where("type"),
+                      "write joint limits: {x: ..., y: ..., z: ...} in radians")
         if kind in SPRINGS and (lim is None or lim.low is None or lim.high is None):
             self.emit("spring-without-limits", f"spring joint '{j.identifier}' has no limits; AMBF keeps its "
                       "axis locked", j.where("type"), "add `joint limits: {low: ..., high: ...}`")
@@ -354,9 +371,28 @@ class Checker:
                 self.emit("sensor-rays", f"sensor '{s.identifier}' has {len(forms)} ray forms "
                           f"({', '.join(forms) or 'none'}); AMBF needs exactly one", s.where(),
                           "give exactly one of array, mesh or parametric")
+            if s.range is not None and s.range < 0:
+                self.emit("sensor-rays", f"sensor '{s.identifier}' has a negative range {s.range:g}", s.where("range"),
+                          "range is a length in metres, >= 0")
             if s.parametric is not None and s.parametric.resolution is not None and s.parametric.resolution < 2:
                 self.emit("sensor-rays", f"sensor '{s.identifier}': parametric resolution "
                           f"{s.parametric.resolution} < 2", s.parametric.where("resolution"), "use 2 or more")
+
+    def camera(self, c) -> None:
+        if not c.defined:
+            return
+        loc = c.location or Vec3(0.0, 0.0, 0.0)
+        look = c.look_at or Vec3(0.0, 0.0, 0.0)
+        up = c.up or Vec3(0.0, 0.0, 1.0)
+        view = look - loc
+        if not all(math.isfinite(v) for v in (*view, *up)):
+            return
+        if view.norm() < 1e-12:
+            self.emit("camera-view", f"camera '{c.identifier}': 'look at' equals 'location'; AMBF silently "
+                      "does not set the view", c.where("look at"), "look at a point away from the camera")
+        elif up.norm() < 1e-12 or view.cross(up).norm() < 1e-9 * view.norm() * up.norm():
+            self.emit("camera-view", f"camera '{c.identifier}': 'up' is parallel to the view direction; AMBF "
+                      "silently does not set the view", c.where("up"), "choose an up vector across the view direction")
 
     def light(self, light) -> None:
         if light.defined and light.shadow_quality is None:
@@ -375,6 +411,8 @@ class Checker:
             self.names_and_namespace(obj)
         for light in w.lights:
             self.light(light)
+        for c in w.cameras:
+            self.camera(c)
 
     def input_devices(self, d: InputDevices) -> None:
         for dev in d.input_devices:
