@@ -32,8 +32,14 @@ Two choices, documented here because callers depend on them:
   reproduces the pose within limits. Every configuration within limits is recovered (tested
   on random samples), not only the deep ones.
 
-Every solution is verified with forward kinematics (step 5); a pose no configuration reaches
-(e.g. an orientation the wrist cannot take at that point) raises :class:`UnreachablePoseError`.
+Every solution is verified with forward kinematics (step 5). Ignoring limits, a generic pose
+has a solution; :class:`UnreachablePoseError` is raised for the degenerate ones (the yaw or
+pitch point exactly at the RCM) or when no branch reproduces the pose within ``tol``.
+
+Conventions checked against forward kinematics rather than taken from prose: the yaw point is
+at -L2 along z_E (the reference writes T_E^0·[I | (0,0,L2)]; the last link's TransZ(d) puts
+the end frame +L2 from the yaw axis, as the challenge's code has it); alpha is exactly pi/2
+where the dVRK configuration files write 1.5708.
 The jaw (optional 7th value) does not move the end-effector frame; it is only range-checked.
 """
 from __future__ import annotations
