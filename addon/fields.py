@@ -260,6 +260,18 @@ def same32(a, b) -> bool:
     return f32(a) == f32(b)
 
 
+def close(a, b, tol: float = 1e-6) -> bool:
+    """Equal within ``tol`` (absolute, or relative for large values): for values Blender
+    recomputes from single-precision matrices (poses of child objects)."""
+    if a is None or b is None:
+        return a is None and b is None
+    if isinstance(a, (tuple, list)):
+        return len(a) == len(b) and all(close(x, y, tol) for x, y in zip(a, b))
+    if isinstance(a, (bool, str)) or isinstance(b, (bool, str)):
+        return a == b
+    return abs(a - b) <= tol * max(1.0, abs(a), abs(b))
+
+
 def merge(obj: Node, table: list[Field], values: dict) -> None:
     """Apply Blender values onto ``obj`` (the snapshot), keeping exact snapshot values that
     Blender's single-precision storage did not change."""

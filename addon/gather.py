@@ -134,6 +134,7 @@ def _parent_ref(old: str | None, parent) -> str | None:
 def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
     hi, lo = paths
     visual = None
+    first_name = b.mesh
     if obj.type == "MESH" and len(obj.data.polygons):
         arr = meshes.mesh_arrays(obj)
         digest = meshes.digest([arr])
@@ -148,7 +149,7 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
         b.mesh = name
         out.jobs.append(job)
         visual = job
-    _gather_collision(obj, b, out, lo, visual)
+    _gather_collision(obj, b, out, lo, visual, first_name)
 
 
 def _shape_entry(child, body_obj) -> ShapeEntry:
@@ -170,7 +171,7 @@ def _entry_key(e: ShapeEntry):
     return ((e.shape or "").upper(), g.x, g.y, g.z, g.radius, g.height, (g.axis or "z").lower(), *pos, *rpy)
 
 
-def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None) -> None:
+def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, first_name: str | None) -> None:
     kids = sorted(obj.children, key=lambda c: c.name)
     shapes = [c for c in kids if c.adf.kind == "COLLISION_SHAPE"]
     parts = [c for c in kids if c.adf.kind == "COLLISION_MESH" and c.type == "MESH"]
@@ -178,12 +179,12 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None) ->
         entries = [_shape_entry(c, obj) for c in shapes]
         if b.collision_shape and len(entries) == 1:
             old = ShapeEntry(shape=b.collision_shape, geometry=b.collision_geometry, offset=b.collision_offset)
-            if not fields.same32(_entry_key(old), _entry_key(entries[0])):
+            if not fields.close(_entry_key(old), _entry_key(entries[0])):
                 b.collision_shape, b.collision_geometry = entries[0].shape, entries[0].geometry
                 b.collision_offset = entries[0].offset
         else:
             old = b.compound_collision_shape or []
-            same = len(old) == len(entries) and all(fields.same32(_entry_key(x), _entry_key(y))
+            same = len(old) == len(entries) and all(fields.close(_entry_key(x), _entry_key(y))
                                                    for x, y in zip(old, entries))
             if not same:
                 b.collision_shape = b.collision_geometry = b.collision_offset = None
@@ -200,7 +201,7 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None) ->
                 a.co = co.astype(np.float32)
             arrays.append(a)
         digest = meshes.digest(arrays)
-        name = b.collision_mesh or (b.mesh if b.mesh and obj.adf.collision_source and b.collision_mesh is None
+        name = b.collision_mesh or (first_name if first_name and obj.adf.collision_source
                                     else f"{obj.name}_collision.OBJ")
         src = Path(obj.adf.collision_source) if obj.adf.collision_source else None
         if digest == obj.adf.collision_hash and src is not None and src.is_file():

@@ -58,7 +58,7 @@ def mesh_arrays(obj, name: str | None = None) -> MeshArrays:
 
 def material_info(mat) -> MaterialInfo:
     info = MaterialInfo(mat.name, tuple(mat.diffuse_color))
-    if not mat.use_nodes or mat.node_tree is None:
+    if mat.node_tree is None:
         return info
     bsdf = next((n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED"), None)
     if bsdf is None:
@@ -97,10 +97,6 @@ def digest(parts: list[MeshArrays]) -> str:
         for mi in p.materials:
             h.update(repr((mi.name, mi.base_color, mi.texture, mi.normal_map)).encode())
     return h.hexdigest()
-
-
-def _fmt(a: np.ndarray) -> str:
-    return np.array2string(a, precision=9, floatmode="maxprec_equal", separator=" ", threshold=10 ** 9)
 
 
 def obj_text(parts: list[MeshArrays], mtl_name: str | None) -> str:
