@@ -11,7 +11,6 @@ from __future__ import annotations
 from functools import lru_cache
 
 import yaml
-from jsonschema import Draft202012Validator
 
 from ..adf.yamlnodes import location, mapping_items, plain
 from ..adf_schema import load_schema
@@ -47,7 +46,9 @@ def _inline(node, defs: dict, depth: int = 0):
 
 
 @lru_cache(maxsize=None)
-def _validator(kind: str, definition: str | None) -> Draft202012Validator:
+def _validator(kind: str, definition: str | None):
+    from jsonschema import Draft202012Validator  # imported on first use: keeps `adfkit --help` fast
+
     schema = load_schema(kind)
     defs = schema["$defs"]
     target = defs[definition] if definition is not None else schema
