@@ -47,13 +47,14 @@ class SimBody:
             p, q = pb.getBasePositionAndOrientation(self.uid, physicsClientId=self.cid)
             v, w = pb.getBaseVelocity(self.uid, physicsClientId=self.cid)
             return p, q, v, w
-        s = pb.getLinkState(self.uid, self.link, computeLinkVelocity=1, physicsClientId=self.cid)
+        s = pb.getLinkState(self.uid, self.link, computeLinkVelocity=1, computeForwardKinematics=1,
+                           physicsClientId=self.cid)
         return s[0], s[1], s[6], s[7]  # the COM frame: constraint pivots are relative to it
 
     def com_position(self):
         if self.link < 0:
             return pb.getBasePositionAndOrientation(self.uid, physicsClientId=self.cid)[0]
-        return pb.getLinkState(self.uid, self.link, physicsClientId=self.cid)[0]
+        return pb.getLinkState(self.uid, self.link, computeForwardKinematics=1, physicsClientId=self.cid)[0]
 
     def world_matrix(self) -> np.ndarray:
         """Pose of the ADF body frame (the mesh origin) in the world, 4×4."""

@@ -25,6 +25,7 @@ from .names import Registry, merge_namespace
 from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
 from .shapes import collision_parts, create_collision, create_visual
 
+GRASP_SPAN = 0.005   # m between the three point constraints of a grasp (SimWorld.actuate)
 SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
                 JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING)
 
@@ -58,7 +59,7 @@ class SimActuator:
     parent: SimBody
     location: np.ndarray            # in the parent body frame
     max_force: float
-    constraint: int | None = None
+    constraint: list | None = None  # the grasp's constraint ids (see SimWorld.actuate)
     target: SimBody | None = None
 
 
@@ -418,19 +419,35 @@ class SimWorld:
                 s.sensed.append(sb)
 
     def actuate(self, actuator: SimActuator, target: SimBody) -> None:
-        """Fix ``target`` to the actuator's parent at their current relative pose."""
+        """Fix ``target`` to the actuator's parent at their current relative pose.
+
+        Three POINT2POINT constraints at non-collinear points (the actuator location and
+        GRASP_SPAN along its x and y axes) rather than one JOINT_FIXED: PyBullet's fixed constraint
+        between a multibody link and a maximal body drives the pair to a wrong relative
+        orientation (measured: 120° off within 20 ms on the suturing PSM), while point pivots are
+        exact, and three of them lock all six degrees of freedom."""
         self.release(actuator)
         pw = self._frame(actuator.parent)
         tw = self._frame(target)
         at_world = pw @ invert(actuator.parent.com_in_body) @ actuator.location
         fa = invert(pw) @ at_world
         fb = invert(tw) @ at_world
-        pa, oa = matrix_to_pq(fa)
-        pbp, ob = matrix_to_pq(fb)
-        c = pb.createConstraint(actuator.parent.uid, actuator.parent.link, target.uid, target.link,
-                                pb.JOINT_FIXED, [0, 0, 0], pa, pbp, oa, ob, physicsClientId=self.cid)
-        pb.changeConstraint(c, maxForce=actuator.max_force, physicsClientId=self.cid)
-        actuator.constraint, actuator.target = c, target
+        ids = []
+        for e in (np.zeros(3), np.array([GRASP_SPAN, 0, 0]), np.array([0, GRASP_SPAN, 0])):
+            pa = fa[:3, :3] @ e + fa[:3, 3]
+            pbv = fb[:3, :3] @ e + fb[:3, 3]
+            c = pb.createConstraint(actuator.parent.uid, actuator.parent.link, target.uid, target.link,
+                                    pb.JOINT_POINT2POINT, [0, 0, 0], pa.tolist(), pbv.tolist(),
+                                    physicsClientId=self.cid)
+            pb.changeConstraint(c, maxForce=actuator.max_force, physicsClientId=self.cid)
+            ids.append(c)
+        actuator.constraint, actuator.target = ids, target
+        for link in self._links(actuator.parent):   # the closed jaws would push the held body out
+            pb.setCollisionFilterPair(actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid)
+
+    def _links(self, sb: SimBody):
+        art = sb.articulation
+        return range(-1, len(art.records)) if art is not None else [sb.link]
 
     def grasp(self, psm: str, on: bool) -> SimBody | None:
         """What the suturing scene does: close the jaws of ``psm`` and fix the body the finger
@@ -471,7 +488,11 @@ class SimWorld:
 
     def release(self, actuator: SimActuator) -> None:
         if actuator.constraint is not None:
-            pb.removeConstraint(actuator.constraint, physicsClientId=self.cid)
+            for c in actuator.constraint:
+                pb.removeConstraint(c, physicsClientId=self.cid)
+            t = actuator.target
+            for link in self._links(actuator.parent):
+                pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
         actuator.constraint, actuator.target = None, None
 
     # ---- measures -----------------------------------------------------------------------
