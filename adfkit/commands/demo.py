@@ -1,34 +1,78 @@
-"""`adfkit demo`: what `make run` does — load the bundled sample scene and show it."""
+"""`adfkit demo`: what `make run` does — play the suturing scene headless for a few seconds in
+the PyBullet runner and write a report and camera images into run-output/.
+
+The scene is the corpus suturing set (launch indices 6-11) when ../shared/corpus is present,
+else the bundled primitive-only suturing-pad sample scene."""
 from __future__ import annotations
 
 from pathlib import Path
 
 NAME = "demo"
-HELP = "load the bundled suturing-pad sample scene and print its summary"
+HELP = "play the suturing scene headless for a few seconds and write a report and camera images"
 
-BUNDLED = Path(__file__).resolve().parents[2] / "sample_scenes" / "suturing_pad" / "launch.yaml"
+ROOT = Path(__file__).resolve().parents[2]
+BUNDLED = ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"
+CORPUS_LAUNCH = ROOT.parent / "shared" / "corpus" / "src" / "launch.yaml"
+CORPUS_INDICES = "6-11"
 
 
 def add_arguments(p) -> None:
-    p.add_argument("--scene", default=None, help="launch file to use instead of the bundled sample scene")
+    p.add_argument("--scene", default=None, help="launch file to play instead of the default scene")
+    p.add_argument("-l", "--indices", default=None, help="launch indices with --scene (e.g. 6-11)")
+    p.add_argument("--seconds", type=float, default=3.0, help="simulated time (default 3)")
+    p.add_argument("--out", default="run-output", help="folder for report.json and images (default run-output)")
 
 
 def run(args) -> int:
+    import json
     import sys
     import tempfile
 
-    from ..adf import load_scene
+    from ..adf import atomic_write_text, load_scene, parse_indices
     from ..diagnostics import Severity
-    from ..report import print_diagnostics
-    from ..scenes import write_suturing_pad
+    from ..report import Progress, print_diagnostics
     from ..summary import format_summary, scene_summary
 
-    launch = Path(args.scene) if args.scene else BUNDLED
-    if not launch.exists():  # installed without the repository's sample_scenes/: author it now
-        launch = write_suturing_pad(Path(tempfile.mkdtemp(prefix="adfkit-demo-")))
+    if args.scene:
+        launch, indices = Path(args.scene), args.indices
+    elif CORPUS_LAUNCH.is_file():
+        launch, indices = CORPUS_LAUNCH, CORPUS_INDICES
+    else:
+        launch, indices = BUNDLED, None
+        if not launch.exists():  # installed without the repository's sample_scenes/: author it now
+            from ..scenes import write_suturing_pad
+            launch = write_suturing_pad(Path(tempfile.mkdtemp(prefix="adfkit-demo-")))
     diags: list = []
-    scene = load_scene(launch, None, diags)
+    scene = load_scene(launch, parse_indices(indices) if indices else None, diags)
     print_diagnostics(diags, sys.stderr)
-    print(f"scene: {launch}")
+    print(f"scene: {launch}" + (f" (indices {indices})" if indices else ""))
     print(format_summary(scene_summary(scene)))
-    return 2 if any(d.severity >= Severity.ERROR for d in diags) else 0
+    if any(d.severity >= Severity.ERROR for d in diags):
+        return 2
+
+    from ..runner.cameras import save_frames
+    from ..runner.world import Options, SimWorld
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    world = SimWorld(scene, Options())
+    try:
+        steps = int(round(args.seconds / (world.dt * world.opt.control_substeps)))
+        with Progress(steps, "simulating") as bar:
+            world.run(args.seconds, bar)
+        report = world.report()
+        report["scene"] = str(launch)
+        report["diagnostics"] = [f"{d.rule}: {d.message}" for d in world.diagnostics]
+        report["frames"] = save_frames(world, out)
+        atomic_write_text(out / "report.json", json.dumps(report, indent=2))
+    finally:
+        world.close()
+    bad = report["nan"] or report["exploded"] or report["fell_through_floor"]
+    print(f"played {report['simulated_time_s']:.2f} s in {report['wall_time_s']:.2f} s "
+          f"({report['real_time_factor']:.2f}x real time): {report['bodies']} bodies, {report['joints']} joints, "
+          f"max constraint error {report['max_constraint_error_m'] * 1000:.3f} mm, "
+          + ("UNSTABLE" if bad else "stable"))
+    print(f"report: {(out / 'report.json').resolve()}")
+    for f in report["frames"]:
+        if f.endswith(".png"):
+            print(f"image:  {(out / f).resolve()}")
+    return 1 if bad else 0
