@@ -294,7 +294,7 @@ def from_snapshot(cls, text: str, where: str = "<blender>"):
     """Parse a snapshot back into a model object (an empty one when there is none)."""
     if not text.strip():
         return cls()
-    node = yaml.compose(text)
+    node = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     if not isinstance(node, yaml.MappingNode):
         return cls()
     reader = Reader(where)

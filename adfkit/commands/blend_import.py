@@ -36,7 +36,7 @@ def load_addon():
     mod = sys.modules[name]
     if not hasattr(bpy.types.Object, "adf"):
         mod.register()
-    for sub in ("export", "build", "gather"):
+    for sub in ("export", "build", "gather", "render", "authoring"):
         importlib.import_module(f"{name}.{sub}")
     return bpy, mod
 
