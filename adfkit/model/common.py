@@ -105,21 +105,6 @@ class CartesianController(Node):
     angular: PID | None = key("angular", PID)
 
 
-@dataclass(kw_only=True)
-class Identified(Node):
-    """Fields every named object carries (§1.1): identification and communication."""
-
-    name: str | None = key("name", "str")
-    namespace: str | None = key("namespace", "str")
-
-
-@dataclass(kw_only=True)
-class Communication(Node):
-    passive: bool | None = key("passive", "bool")
-    publish_frequency: PublishFrequency | None = key("publish frequency", PublishFrequency)
-    plugins: list[Plugin] | None = key("plugins", ListOf(Plugin))
-
-
 __all__ = [
     "Plugin", "PublishFrequency", "Shaders", "RGBA", "RGB", "AmbientLevel", "ColorComponents",
     "Geometry", "ShapeEntry", "Friction", "VelocityDamping", "PID", "CartesianController",
