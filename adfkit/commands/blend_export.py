@@ -22,9 +22,8 @@ def run(args) -> int:
     if not blend.is_file():
         raise AdfError(error("missing-file", f"{blend} does not exist", SourceLocation(str(blend)),
                              "give the path of a .blend file"))
-    bpy, addon = load_addon()
-    bpy.ops.wm.open_mainfile(filepath=str(blend))
-    res = addon.export.export_scene(bpy.context.scene, args.out_dir, args.name or blend.stem)
+    _, addon = load_addon()
+    res = addon.headless.export_blend(blend, args.out_dir, args.name or blend.stem)
     if res.diagnostics:
         print_diagnostics(res.diagnostics)
     if not res.ok:

@@ -11,18 +11,16 @@ def add_arguments(parser) -> None:
 
 
 def load_addon():
-    """bpy plus the adfkit add-on package (addon/ beside this package), registered."""
+    """The adfkit add-on package (addon/ beside this package), registered, and its bpy.
+
+    bpy itself is imported only inside addon/ (addon/headless.py)."""
     import importlib
     import importlib.util
     import sys
     from pathlib import Path
 
     from ..diagnostics import AdfError, error
-    try:
-        import bpy
-    except ImportError:
-        raise AdfError(error("no-bpy", "the bpy module (Blender as a Python module) is not installed", None,
-                             "pip install bpy (Python 3.11), or run inside Blender")) from None
+
     name = "adfkit_blender_addon"
     if name not in sys.modules:
         root = Path(__file__).resolve().parents[2] / "addon"
@@ -34,11 +32,17 @@ def load_addon():
         sys.modules[name] = mod
         spec.loader.exec_module(mod)
     mod = sys.modules[name]
-    if not hasattr(bpy.types.Object, "adf"):
-        mod.register()
+    try:
+        headless = importlib.import_module(f"{name}.headless")
+    except ImportError as exc:
+        if "bpy" not in str(exc):
+            raise
+        raise AdfError(error("no-bpy", "the bpy module (Blender as a Python module) is not installed", None,
+                             "pip install bpy (Python 3.11), or run inside Blender")) from None
+    headless.ensure_registered()
     for sub in ("export", "build", "gather", "render", "authoring"):
         importlib.import_module(f"{name}.{sub}")
-    return bpy, mod
+    return headless.bpy, mod
 
 
 def run(args) -> int:
@@ -46,15 +50,9 @@ def run(args) -> int:
 
     from ..report import print_diagnostics
 
-    bpy, addon = load_addon()
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    made, diags = addon.build.import_model(Path(args.model))
+    _, addon = load_addon()
+    made, diags = addon.headless.import_to_blend(Path(args.model), Path(args.out_blend))
     if diags:
         print_diagnostics(diags)
-    out = Path(args.out_blend).resolve()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=str(tmp), check_existing=False)
-    tmp.replace(out)
-    print(f"wrote {out} ({len(made)} objects)")
+    print(f"wrote {Path(args.out_blend).resolve()} ({len(made)} objects)")
     return 0
