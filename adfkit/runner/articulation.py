@@ -74,8 +74,25 @@ class Articulation:
                                      physicsClientId=self.cid)
 
 
+def depth_first(root, records):
+    """The records in depth-first pre-order (children in their given order): the link order
+    PyBullet's createMultiBody gives links, whatever order the lists are passed in (it builds
+    a URDF-like tree and numbers links depth-first). With any other order link n of the
+    multibody is not record n."""
+    kids = defaultdict(list)
+    for r in records:
+        kids[id(r[2])].append(r)
+    out, stack = [], list(reversed(kids[id(root)]))
+    while stack:
+        r = stack.pop()
+        out.append(r)
+        stack.extend(reversed(kids[id(r[3])]))
+    return out
+
+
 def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) -> Articulation:
     """Create the multibody. ``shapes_for(simbody, frame_in_body) -> (collision, visual)``."""
+    records = depth_first(root, records)
     idx = {id(root): -1}
     for n, r in enumerate(records):
         idx[id(r[3])] = n
@@ -109,6 +126,10 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
                              linkInertialFramePositions=lip, linkInertialFrameOrientations=lio,
                              linkParentIndices=lpi, linkJointTypes=lt, linkJointAxis=la, flags=flags,
                              physicsClientId=cid)
+    # PyBullet names joint n "joint{n+1}" after the position in our lists; check the link order
+    order = [int(pb.getJointInfo(uid, n, physicsClientId=cid)[1].decode()[5:]) - 1 for n in range(len(records))]
+    if order != list(range(len(records))):
+        raise RuntimeError(f"PyBullet reordered the links of {root.key}: {order}")
     art = Articulation(uid, root, records, cid)
     root.uid, root.link, root.articulation = uid, -1, art
     for n, r in enumerate(records):
