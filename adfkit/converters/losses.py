@@ -1,0 +1,22 @@
+"""What a conversion could not carry over: one record per element and feature, never silent."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, order=True)
+class Loss:
+    """``element`` is the object as the source names it (an ADF identifier, a URDF link or
+    joint name, an MJCF element), ``feature`` what was dropped or changed, ``reason`` why."""
+
+    element: str
+    feature: str
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{self.element}: {self.feature}: {self.reason}"
+
+
+def loss_keys(losses) -> list[tuple[str, str]]:
+    """(element, feature) pairs, sorted: what tests compare."""
+    return sorted((l.element, l.feature) for l in losses)

@@ -1,0 +1,179 @@
+"""The kinematic tree of an ADF model, as URDF and MJCF need it.
+
+ADF places every body in the world (`location`) and joins bodies by joints whose frames
+A (in the parent body) and B (in the child body) coincide at joint value zero
+(adf-format.md §8.2, ``semantics.joint_frames``). Tree formats place each child *relative to
+its parent through the joint*. This module chooses a spanning tree, gives every body a
+**link frame** (its joint frame B; the body frame for a root), the joint origin in the
+parent's link frame, the initial joint value that reproduces the file's `location`s, and
+forward kinematics. Both converters build on it; nothing here knows a file format.
+"""
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass, field
+
+from ..model.files import ModelFile
+from ..model.objects import Body, Joint
+from ..model.pose import Pose, Quat, Vec3
+from ..model.semantics import JointKind, effective_mass, joint_frames, joint_kind, reference_axis
+
+ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+
+
+@dataclass(eq=False)
+class Link:
+    """One body in the tree. ``frame_in_body``: the link frame in the ADF body frame (joint
+    frame B; identity for a root). ``origin``: the joint frame at value 0 in the parent's link
+    frame (for a root: the link's world pose). ``axis``: the joint axis in the link frame."""
+
+    body: Body
+    parent: "Link | None" = None
+    joint: Joint | None = None
+    kind: JointKind | None = None
+    frame_in_body: Pose = field(default_factory=Pose)
+    origin: Pose = field(default_factory=Pose)
+    q0: float = 0.0
+    children: list["Link"] = field(default_factory=list)
+
+    @property
+    def name(self) -> str:
+        return self.body.name or self.body.identifier
+
+    @property
+    def axis(self) -> Vec3:
+        return reference_axis(self.kind) if self.kind is not None else Vec3(0.0, 0.0, 1.0)
+
+    def in_link(self, pose_in_body: Pose) -> Pose:
+        """A pose given in the ADF body frame, expressed in the link frame."""
+        return self.frame_in_body.inverse() * pose_in_body
+
+
+@dataclass
+class KinematicTree:
+    roots: list[Link]
+    links: dict[str, Link]                 # body identifier -> link
+    loops: list[tuple[Joint, JointKind, Body, Body]]   # joints left out of the tree
+    unresolved: list[Joint]                # joints whose parent or child is not a body here
+
+    def ordered(self) -> list[Link]:
+        """Every link, parents before children (depth first from each root)."""
+        out: list[Link] = []
+        stack = list(reversed(self.roots))
+        while stack:
+            link = stack.pop()
+            out.append(link)
+            stack.extend(reversed(link.children))
+        return out
+
+    def fk(self, q: dict[str, float] | None = None) -> dict[str, Pose]:
+        """World pose of every body frame for joint values ``q`` (joint identifier -> value;
+        missing joints take their initial value ``q0``). Joints other than revolute and
+        prismatic are rigid at their zero."""
+        q = q or {}
+        world: dict[str, Pose] = {}
+        link_world: dict[int, Pose] = {}
+        for link in self.ordered():
+            if link.parent is None:
+                lw = link.origin
+            else:
+                value = q.get(link.joint.identifier, link.q0)
+                lw = link_world[id(link.parent)] * link.origin * motion(link.kind, value)
+            link_world[id(link)] = lw
+            world[link.body.identifier] = lw * link.frame_in_body.inverse()
+        return world
+
+
+def motion(kind: JointKind | None, value: float) -> Pose:
+    """The child link frame in the joint frame at ``value`` (rad or m)."""
+    if kind is JointKind.REVOLUTE:
+        return Pose(Vec3(), Quat.from_axis_angle(Vec3(0.0, 0.0, 1.0), value))
+    if kind is JointKind.PRISMATIC:
+        return Pose(Vec3(value, 0.0, 0.0))
+    return Pose()
+
+
+def find_body(model: ModelFile, ref: str | None) -> Body | None:
+    """A joint's `parent`/`child` as AMBF resolves it in one file: the identifier, else the
+    body whose name or identifier contains the text uniquely (§12.1)."""
+    if not ref:
+        return None
+    for b in model.bodies:
+        if b.identifier == ref:
+            return b
+    for b in model.bodies:
+        if b.name == ref or b.identifier == "BODY " + ref:
+            return b
+    hits = [b for b in model.bodies if ref in b.identifier]
+    return hits[0] if len(hits) == 1 else None
+
+
+def _scale(b: Body) -> float:
+    return b.scale if b.scale is not None else 1.0
+
+
+def build_tree(model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)) -> KinematicTree:
+    """Spanning tree over the joints whose kind is in ``tree_kinds``.
+
+    Roots, in file order: static bodies (mass 0) first, then bodies that are no joint's child;
+    a body reached twice closes a loop (that joint goes to ``loops``); bodies no joint reaches
+    are roots of their own."""
+    records, unresolved = [], []
+    for j in model.joints:
+        kind = joint_kind(j.type)
+        parent, child = find_body(model, j.parent), find_body(model, j.child)
+        if kind is None or parent is None or child is None or parent is child:
+            unresolved.append(j)
+            continue
+        records.append((j, kind, parent, child))
+    edges = defaultdict(list)
+    is_child = set()
+    for r in records:
+        if r[1] in tree_kinds:
+            edges[id(r[2])].append(r)
+            is_child.add(id(r[3]))
+    order = sorted(model.bodies, key=lambda b: (effective_mass(b) != 0.0, id(b) in is_child))
+    links: dict[str, Link] = {}
+    roots: list[Link] = []
+    used: set[int] = set()
+    for start in order:
+        if start.identifier in links:
+            continue
+        root = Link(start, origin=_location(start))
+        links[start.identifier] = root
+        roots.append(root)
+        stack = [root]
+        while stack:
+            link = stack.pop()
+            for r in edges[id(link.body)]:
+                j, kind, parent, child = r
+                if child.identifier in links:
+                    continue
+                used.add(id(r))
+                a, b = joint_frames(j, _scale(parent), _scale(child))
+                node = Link(child, parent=link, joint=j, kind=kind, frame_in_body=b,
+                            origin=link.in_link(a))
+                node.q0 = _initial_value(link, node)
+                link.children.append(node)
+                links[child.identifier] = node
+                stack.append(node)
+    loops = [r for r in records if id(r) not in used]
+    return KinematicTree(roots, links, loops, unresolved)
+
+
+def _location(b: Body) -> Pose:
+    return b.location if b.location is not None else Pose()
+
+
+def _initial_value(parent: Link, link: Link) -> float:
+    """The joint value that puts the child where its `location` says, given the parent's."""
+    if link.kind not in ONE_DOF:
+        return 0.0
+    parent_link_world = _location(parent.body) * parent.frame_in_body
+    child_link_world = _location(link.body) * link.frame_in_body
+    rel = (parent_link_world * link.origin).inverse() * child_link_world
+    if link.kind is JointKind.PRISMATIC:
+        return rel.position[0]
+    m = rel.orientation.matrix()
+    return math.atan2(m[1][0], m[0][0])
