@@ -77,7 +77,17 @@ def test_defaults_and_descriptions_follow_the_reference():
 def _accepts(definition: str, value) -> bool:
     schema = load_schema("model")
     v = jsonschema.Draft202012Validator({"$defs": schema["$defs"], "$ref": f"#/$defs/{definition}"})
-    return v.is_valid(value)
+    ok = v.is_valid(value)
+    # the compiled validator the CLI uses as a fast path must agree (regex dialects differ)
+    fast = _fast_validator_for(definition)
+    if fast is not None:
+        assert fast.is_valid(value) is ok, (definition, value)
+    return ok
+
+
+def _fast_validator_for(definition):
+    from adfkit.validator.schema_check import _fast_validator
+    return _fast_validator("model", definition)
 
 
 @pytest.mark.parametrize("value, ok", [(0.5, True), (3, True), ("0.5", True), (" -1.5e3 ", True), ("1e-3", True),
@@ -120,3 +130,34 @@ def test_schema_command_matches_package_data(capsys):
     for kind in KINDS:
         assert main(["schema", kind]) == 0
         assert json.loads(capsys.readouterr().out) == load_schema(kind)
+
+
+def test_fast_schema_path_agrees_with_jsonschema_on_corpus_objects_and_mutations():
+    """jsonschema-rs answers "valid?" before the located jsonschema pass: a disagreement would
+    hide findings. Check every corpus object and a bad-value variant of each of its scalars."""
+    pytest.importorskip("jsonschema_rs", reason="jsonschema-rs (the validator's accelerator) is not installed")
+    from adfkit.validator.schema_check import _fast_validator, _validator, object_lists
+    checked = disagreements = invalid = 0
+    bad_values = ["abc", "1", "tRue", -1, 2.5, None, [1], {"x": 1}, " -1.5e3 ", "off"]
+    for path in corpus_files():
+        res = validate_file(path)
+        if res.kind not in ("model", "world", "input_devices"):
+            continue
+        data = yaml.safe_load(repair(path.read_text(encoding="utf-8"))[0])
+        for list_key, definition in object_lists(res.kind).items():
+            slow, fast = _validator(res.kind, definition), _fast_validator(res.kind, definition)
+            for ident in data.get(list_key) or []:
+                obj = data.get(ident)
+                if not isinstance(obj, dict):
+                    continue
+                scalars = [k for k in obj if not isinstance(obj[k], (dict, list))]
+                picks = scalars[checked % max(1, len(scalars))::max(1, len(scalars) // 2)][:2]
+                variants = [obj] + [{**obj, k: bad_values[(checked + n) % len(bad_values)]}
+                                    for n, k in enumerate(picks)]
+                for v in variants:
+                    checked += 1
+                    ok = slow.is_valid(v)
+                    invalid += not ok
+                    disagreements += fast.is_valid(v) is not ok
+    assert checked > 2000 and invalid > 500  # both answers exercised
+    assert disagreements == 0

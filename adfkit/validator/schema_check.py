@@ -57,6 +57,26 @@ def _validator(kind: str, definition: str | None):
     return Draft202012Validator(inlined)
 
 
+@lru_cache(maxsize=None)
+def _fast_validator(kind: str, definition: str | None):
+    """jsonschema-rs (compiled) for the same inlined schema, or None when not installed.
+
+    Only used to answer "valid?"; a file it finds invalid goes through ``jsonschema`` for the
+    located findings, so both must agree on validity (tests/test_schema.py checks they do)."""
+    try:
+        import jsonschema_rs
+    except ImportError:  # pragma: no cover - optional accelerator
+        return None
+    return jsonschema_rs.Draft202012Validator(_validator(kind, definition).schema)
+
+
+def _errors(kind: str, definition: str | None, instance):
+    fast = _fast_validator(kind, definition)
+    if fast is not None and fast.is_valid(instance):
+        return ()
+    return _validator(kind, definition).iter_errors(instance)
+
+
 def object_lists(kind: str) -> dict[str, str]:
     """Top-level list key → $defs name of the objects it lists."""
     return {f.metadata["adf_key"]: f.metadata["kind"].kind.__name__
@@ -104,7 +124,7 @@ def _diagnostic(err, base: yaml.Node, file: str, context: str, at: yaml.Node | N
 def check(root: yaml.MappingNode, kind: str, file: str) -> list[Diagnostic]:
     out: list[Diagnostic] = []
     if kind in ("launch", "colors"):
-        for err in _validator(kind, None).iter_errors(plain(root)):
+        for err in _errors(kind, None, plain(root)):
             out.append(_diagnostic(err, root, file, "the file", None))
         return out
     lists = object_lists(kind)
@@ -113,23 +133,22 @@ def check(root: yaml.MappingNode, kind: str, file: str) -> list[Diagnostic]:
     items = {text: (k, v) for text, k, v in mapping_items(root)}
     top = yaml.MappingNode(root.tag, [(k, v) for text, (k, v) in items.items() if text in known],
                            root.start_mark, root.end_mark)
-    for err in _validator(kind, None).iter_errors(plain(top)):
+    for err in _errors(kind, None, plain(top)):
         out.append(_diagnostic(err, top, file, "the file", None))
     for list_key, definition in lists.items():
         lnode = items.get(list_key, (None, None))[1]
         if not isinstance(lnode, yaml.SequenceNode):
             continue
-        validator = _validator(kind, definition)
         for entry in lnode.value:
             if not isinstance(entry, yaml.ScalarNode):
                 continue
             target = items.get(entry.value, (None, None))[1]
             if isinstance(target, yaml.MappingNode):
-                for err in validator.iter_errors(plain(target)):
+                for err in _errors(kind, definition, plain(target)):
                     if err.validator in COVERED_BY_RULES:
                         continue
                     out.append(_diagnostic(err, target, file, f"'{entry.value}'", None))
             elif target is None:
-                for err in validator.iter_errors({}):  # AMBF builds it from an empty node
+                for err in _errors(kind, definition, {}):  # AMBF builds it from an empty node
                     out.append(_diagnostic(err, entry, file, f"'{entry.value}'", entry))
     return out
