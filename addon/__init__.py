@@ -1,7 +1,7 @@
 """adfkit Blender extension: author, export and import AMBF Description Format (ADF) models.
 
 Blender-level code lives in this package; the ADF model, reader, writer and validator
-come from the ``adfkit`` package (bundled as a wheel, see docs/addon.md).
+come from the ``adfkit`` package (bundled as a wheel, see the README, "Blender add-on").
 """
 from __future__ import annotations
 

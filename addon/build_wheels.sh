@@ -1,5 +1,5 @@
 #!/bin/sh
-# Build the wheels the Blender extension bundles (see docs/addon.md), then the extension zip.
+# Build the wheels the Blender extension bundles (see the README, "Blender add-on"), then the extension zip.
 #   addon/build_wheels.sh [BLENDER]   (BLENDER: path of a blender binary, for `extension build`)
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)

@@ -40,7 +40,7 @@ def run(args) -> int:
     select, ignore = _rules(args.select), _rules(args.ignore)
     unknown = sorted((select | ignore) - set(RULES))
     if unknown:
-        print(f"adfkit validate: unknown rule(s): {', '.join(unknown)} (see docs/validator.md)", file=sys.stderr)
+        print(f"adfkit validate: unknown rule(s): {', '.join(unknown)} (the README lists the rules)", file=sys.stderr)
         return 2
     results, problems = validate_paths(args.paths, args.kind, follow=not args.no_follow)
     shown_min = Severity.parse(args.min_severity)
