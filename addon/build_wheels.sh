@@ -1,14 +1,28 @@
 #!/bin/sh
-# Build the wheels the Blender extension bundles (see the README, "Blender add-on"), then the extension zip.
-#   addon/build_wheels.sh [BLENDER]   (BLENDER: path of a blender binary, for `extension build`)
+# Build the extension zip(s): the adfkit wheel plus its pure and binary dependencies for
+# Linux x64, macOS arm64 and Windows x64 (Python 3.11, Blender 4.2-5.0), the manifest's
+# `wheels`/`platforms` lists rewritten from what was downloaded, then Blender's own
+# `extension build` (from a Blender binary if given, else the copy inside the bpy wheel).
+#   addon/build_wheels.sh [BLENDER]
+# See the README, "Blender add-on".
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(dirname "$here")
 python=${PYTHON:-"$root/.venv/bin/python"}
-mkdir -p "$here/wheels"
-"$python" -m pip wheel --no-deps -w "$here/wheels" "$root"
-"$python" -m pip download --only-binary=:all: --python-version 3.11 --platform manylinux2014_x86_64 \
-    --no-deps -d "$here/wheels" "PyYAML==6.0.2"
+rm -rf "$here/wheels" && mkdir -p "$here/wheels"
+"$python" -m pip wheel --quiet --no-deps -w "$here/wheels" "$root"
+pins="PyYAML==6.0.3 jsonschema==4.26.0 attrs==26.1.0 referencing==0.37.0 jsonschema-specifications==2025.9.1
+      rpds-py==2026.9.1 typing-extensions==4.16.0 jsonschema-rs==0.60.3"
+for platform in manylinux2014_x86_64 macosx_11_0_arm64 win_amd64; do
+    # shellcheck disable=SC2086
+    "$python" -m pip download --quiet --only-binary=:all: --python-version 3.11 --platform "$platform" \
+        --no-deps -d "$here/wheels" $pins
+done
+"$python" "$here/manifest_wheels.py" "$here"
 if [ "${1:-}" ]; then
-    "$1" --command extension build --source-dir "$here" --output-dir "$root/dist"
+    "$1" --command extension build --source-dir "$here" --output-dir "$root/dist" --split-platforms
+else
+    ext=$("$python" -c "import importlib.util as u, pathlib; print(next(pathlib.Path(u.find_spec('bpy').submodule_search_locations[0]).glob('*/scripts/addons_core/bl_pkg/cli/blender_ext.py')))")
+    mkdir -p "$root/dist"
+    "$python" "$ext" build --source-dir "$here" --output-dir "$root/dist" --split-platforms
 fi
