@@ -116,7 +116,8 @@ def _scale(b: Body) -> float:
 def build_tree(model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)) -> KinematicTree:
     """Spanning tree over the joints whose kind is in ``tree_kinds``.
 
-    Roots, in file order: static bodies (mass 0) first, then bodies that are no joint's child;
+    Roots, in file order: bodies that are no joint's child (static ones, mass 0, first), then
+    the rest;
     a body reached twice closes a loop (that joint goes to ``loops``); bodies no joint reaches
     are roots of their own."""
     records, unresolved = [], []
@@ -133,7 +134,7 @@ def build_tree(model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISM
         if r[1] in tree_kinds:
             edges[id(r[2])].append(r)
             is_child.add(id(r[3]))
-    order = sorted(model.bodies, key=lambda b: (effective_mass(b) != 0.0, id(b) in is_child))
+    order = sorted(model.bodies, key=lambda b: (id(b) in is_child, effective_mass(b) != 0.0))
     links: dict[str, Link] = {}
     roots: list[Link] = []
     used: set[int] = set()
