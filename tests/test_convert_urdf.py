@@ -14,7 +14,6 @@ import pytest
 pb = pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
 pybullet_data = pytest.importorskip("pybullet_data")
 
-from adfkit.adf.paths import visual_mesh_path  # noqa: E402
 from adfkit.adf.reader import load  # noqa: E402
 from adfkit.converters import read, write  # noqa: E402
 from adfkit.converters.inertia import world_tensor  # noqa: E402
@@ -22,8 +21,10 @@ from adfkit.converters.losses import loss_keys  # noqa: E402
 from adfkit.converters.tree import build_tree  # noqa: E402
 from adfkit.diagnostics import AdfError  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
-from adfkit.model.semantics import JointKind, inertial_offset, joint_frames, joint_kind  # noqa: E402
+from adfkit.model.semantics import JointKind, inertial_offset  # noqa: E402
 from conftest import CORPUS  # noqa: E402
+from convert_checks import assert_same_kinematics as _assert_same_kinematics  # noqa: E402
+from convert_checks import close_pose as _close_pose  # noqa: E402
 
 ROBOTS = CORPUS / "ambf" / "ambf_models" / "descriptions" / "multi-bodies" / "robots"
 needs_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason="../shared/corpus is absent (public ADF corpus)")
@@ -94,10 +95,6 @@ def _visual_frames(cid, uid) -> dict[int, Pose]:
     for row in pb.getVisualShapeData(uid, physicsClientId=cid):
         out.setdefault(row[1], Pose(Vec3(*row[5]), Quat(*row[6])))
     return out
-
-
-def _close_pose(a: Pose, b: Pose, tol=TOL) -> bool:
-    return (a.position - b.position).norm() < tol and a.orientation.angle_to(b.orientation) < tol
 
 
 # --- URDF -> ADF -> URDF, both in PyBullet ----------------------------------------------------
@@ -286,56 +283,6 @@ def test_tree_at_initial_values_reproduces_the_files_locations(name):
 
 
 # --- ADF -> URDF -> ADF -------------------------------------------------------------------------
-
-def _joint_transform(joint, q: float) -> Pose:
-    a, b = joint_frames(joint)
-    kind = joint_kind(joint.type)
-    motion = Pose(Vec3(), Quat.from_axis_angle(Vec3(0, 0, 1), q)) if kind is JointKind.REVOLUTE else \
-        Pose(Vec3(q, 0, 0)) if kind is JointKind.PRISMATIC else Pose()
-    return a * motion * b.inverse()
-
-
-def _assert_same_kinematics(orig, back, lost: set[str]):
-    """Equal models up to URDF's spelling: the same bodies (mass, inertia in the world, meshes),
-    the same joints (kind, limits, parent→child transform at several values). Normalisation:
-    URDF starts every joint at 0, so each body comes back where the joints put it at 0 (the
-    file's `location` differs by its rounding or by a reported initial value)."""
-    at_zero = build_tree(orig).fk({j.identifier: 0.0 for j in orig.joints})
-    ob = {b.identifier: b for b in orig.bodies if b.identifier not in lost}
-    bb = {b.identifier: b for b in back.bodies}
-    assert set(bb) == set(ob)
-    for ident, b in ob.items():
-        c = bb[ident]
-        assert _close_pose(c.location, at_zero[ident], 1e-9), ident
-        assert (c.mass or 0.0) == pytest.approx(b.mass or 0.0, rel=1e-12)
-        if b.mesh:
-            assert Path(c.mesh).resolve() == visual_mesh_path(orig, b).resolve(), ident
-        if b.inertia is not None:
-            wb = world_tensor((b.inertia.ix, b.inertia.iy, b.inertia.iz),
-                              (at_zero[ident] * inertial_offset(b)).orientation)
-            wc = world_tensor((c.inertia.ix, c.inertia.iy, c.inertia.iz), (c.location * inertial_offset(c)).orientation)
-            assert np.allclose(wb, wc, rtol=1e-9, atol=1e-15), ident
-            assert (((at_zero[ident] * inertial_offset(b)).position - (c.location * inertial_offset(c)).position).norm()
-                    < 1e-9)
-    oj = {j.identifier: j for j in orig.joints if j.identifier not in lost}
-    bj = {j.identifier: j for j in back.joints}
-    assert set(bj) == set(oj)
-    for ident, j in oj.items():
-        k = bj[ident]
-        assert joint_kind(k.type) is joint_kind(j.type)
-        assert (k.parent.removeprefix("BODY "), k.child.removeprefix("BODY ")) == \
-            (j.parent.removeprefix("BODY "), j.child.removeprefix("BODY "))
-        if j.joint_limits is not None and joint_kind(j.type) is not JointKind.FIXED:
-            assert (k.joint_limits.low, k.joint_limits.high) == pytest.approx((j.joint_limits.low, j.joint_limits.high))
-        # AMBF's shortest arc is the identity below 1e-3 rad (§8.2): a child frame tilted less
-        # than that from the axis has no exact ADF spelling; such joints come back within it.
-        tilt = Vec3(*k.parent_axis).normalized().cross(Vec3(*k.child_axis).normalized()).norm()
-        rot_tol = 1e-9 if tilt < 1e-12 or tilt >= 1e-3 else 1e-3
-        for q in (0.0, 0.3, -1.1):
-            ta, tb = _joint_transform(k, q), _joint_transform(j, q)
-            assert (ta.position - tb.position).norm() < 1e-9, (ident, q)
-            assert ta.orientation.angle_to(tb.orientation) < rot_tol, (ident, q)
-
 
 @needs_corpus
 def test_kuka_adf_urdf_adf_round_trip_and_exact_losses(tmp_path):

@@ -405,6 +405,8 @@ def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
         if name in links:
             raise AdfError(error("urdf-duplicate", f"link {name!r} defined twice", doc.where(el), "rename one of them"))
         links[name] = el
+    if not links:
+        raise AdfError(error("urdf-empty", "the robot has no links", doc.where(root), "a URDF robot needs at least one <link>"))
     joints = root.findall("joint")
     parent_of: dict[str, tuple[str, ET.Element]] = {}
     for j in joints:

@@ -1,0 +1,292 @@
+"""MJCF → scene model, through MuJoCo's own parser and compiler.
+
+The file is first checked by ``safexml`` (no DTD or entities). MuJoCo then resolves what
+MJCF leaves implicit (default classes, `childclass`, `fromto`, euler sequences and degrees,
+includes, mesh recentring) and we read the compiled model at ``qpos0``: body frames become
+ADF body frames, principal inertias and their frames become `inertia` and `inertial offset`
+directly, hinge/slide joints become revolute/prismatic joints whose ADF value equals MuJoCo's
+``qpos`` (the `ref` of a joint is the initial value the bodies' `location`s show).
+"""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+from ..diagnostics import AdfError, SourceLocation, error
+from ..model.common import RGBA, Geometry, ShapeEntry
+from ..model.files import ModelFile
+from ..model.objects import Body, Inertia, Joint, JointLimits
+from ..model.pose import Pose, Quat, Vec3
+from ..model.semantics import shortest_arc
+from .losses import Loss
+from .safexml import parse_xml
+
+# mjtGeom / mjtJoint values (MuJoCo's enums, stable across 2.x-4.x)
+PLANE, HFIELD, SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = range(8)
+FREE, BALL, SLIDE, HINGE = range(4)
+_GEOM_NAMES = {PLANE: "plane", HFIELD: "height field", ELLIPSOID: "ellipsoid", 8: "sdf"}
+
+
+def _pose(pos, quat_wxyz) -> Pose:
+    w, x, y, z = (float(v) for v in quat_wxyz)
+    return Pose(Vec3(*(float(v) for v in pos)), Quat(x, y, z, w).normalized())
+
+
+def _compile(path: Path):
+    import mujoco
+
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+        model = spec.compile()
+    except (ValueError, mujoco.FatalError) as exc:  # MuJoCo reports "XML Error: ... line N, column M"
+        text = str(exc).strip()
+        m = re.search(r"[Ll]ine\s*=?\s*(\d+)(?:.*?[Cc]olumn\s*=?\s*(\d+))?", text)
+        line = int(m.group(1)) if m else None
+        col = int(m.group(2)) if m and m.group(2) else None
+        raise AdfError(error("mjcf-compile", f"MuJoCo cannot load the file: {text.splitlines()[0] if text else exc}",
+                             SourceLocation(str(path), line, col),
+                             "fix what MuJoCo names; `python -m mujoco.viewer` shows the same message")) from None
+    return mujoco, spec, model
+
+
+def _mesh_files(spec, path: Path) -> list[tuple[str | None, float | None]]:
+    """(file, uniform scale) of every mesh asset, in the compiled model's order."""
+    base = path.parent / (getattr(spec, "meshdir", "") or "")
+    out = []
+    for mesh in spec.meshes:
+        f = mesh.file
+        if not f:
+            out.append((None, None))
+            continue
+        s = [float(v) for v in mesh.scale]
+        scale = s[0] if max(s) - min(s) < 1e-12 else None
+        out.append((str((base / f).resolve()), scale))
+    return out
+
+
+def read(path: Path) -> tuple[ModelFile, list[Loss]]:
+    path = Path(path)
+    doc = parse_xml(path)
+    if doc.root.tag != "mujoco":
+        raise AdfError(error("mjcf-root", f"the root element is <{doc.root.tag}>, not <mujoco>", doc.where(doc.root),
+                             "an MJCF file holds one <mujoco> element"))
+    mujoco, spec, m = _compile(path)
+    d = mujoco.MjData(m)
+    d.qpos[:] = m.qpos0
+    mujoco.mj_kinematics(m, d)
+    meshes = _mesh_files(spec, path)
+    losses: list[Loss] = []
+    model = ModelFile()
+    names: dict[int, str] = {}
+    world_pose: dict[int, Pose] = {}
+    frames: dict[int, Pose] = {}
+    for b in range(1, m.nbody):
+        name = m.body(b).name or f"body{b}"
+        names[b] = name
+        frames[b] = _visual_mesh_frame(m, b, meshes)
+        world_pose[b] = _pose(d.xpos[b], d.xquat[b]) * frames[b]
+    bodies: dict[int, Body] = {}
+    # the world body becomes a static ADF body when something is attached to it
+    needs_world = any(m.geom_bodyid[g] == 0 for g in range(m.ngeom)) or any(
+        m.body_parentid[b] == 0 and m.body_jntnum[b] > 0 and m.jnt_type[m.body_jntadr[b]] != FREE
+        for b in range(1, m.nbody))
+    if needs_world:
+        names[0], frames[0], world_pose[0] = "world", Pose(), Pose()
+        bodies[0] = Body(identifier="BODY world", name="world", location=Pose(), mass=0.0)
+        _read_geoms(m, 0, bodies[0], meshes, losses, Pose())
+        model.bodies.append(bodies[0])
+    for b in range(1, m.nbody):
+        who = f"BODY {names[b]}"
+        body = Body(identifier=who, name=names[b], location=world_pose[b])
+        body.mass = float(m.body_mass[b])
+        ix, iy, iz = (float(v) for v in m.body_inertia[b])
+        body.inertia = Inertia(ix=ix, iy=iy, iz=iz)
+        body.inertial_offset = frames[b].inverse() * _pose(m.body_ipos[b], m.body_iquat[b])
+        _read_geoms(m, b, body, meshes, losses, frames[b])
+        bodies[b] = body
+        model.bodies.append(body)
+    for b in range(1, m.nbody):
+        _read_joint(m, b, names, bodies, world_pose, frames, model, losses)
+    _read_equalities(m, names, bodies, world_pose, frames, model, losses)
+    for kind, count, label in (("camera", m.ncam, "camera"), ("light", m.nlight, "light"),
+                               ("actuator", m.nu, "actuator"), ("sensor", m.nsensor, "sensor"),
+                               ("tendon", m.ntendon, "tendon"), ("site", m.nsite, "site")):
+        for i in range(count):
+            nm = getattr(m, kind)(i).name or f"{label} {i}"
+            losses.append(Loss(nm, label, "not converted to ADF"))
+    model.present_lists.update({"bodies", "joints"})
+    return model, sorted(set(losses))
+
+
+def _visual_mesh_frame(m, b: int, meshes) -> Pose:
+    """The file frame of the body's only visual mesh (ADF draws a mesh at the body frame),
+    else the identity."""
+    found = []
+    for g in range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]):
+        if int(m.geom_type[g]) == MESH and m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0:
+            mid = int(m.geom_dataid[g])
+            if 0 <= mid < len(meshes) and meshes[mid][0] is not None:
+                found.append(_mesh_file_frame(m, g))
+    return found[0] if len(found) == 1 else Pose()
+
+
+def _mesh_file_frame(m, g: int) -> Pose:
+    """Where the mesh file's own frame sits in the body: MuJoCo recentres a mesh on its COM
+    and principal axes and moves the geom frame to match; undo it."""
+    mid = int(m.geom_dataid[g])
+    return _pose(m.geom_pos[g], m.geom_quat[g]) * _pose(m.mesh_pos[mid], m.mesh_quat[mid]).inverse()
+
+
+def _read_geoms(m, b: int, body: Body, meshes, losses, frame: Pose) -> None:
+    who = body.identifier
+    to_body = frame.inverse()
+    collision: list[ShapeEntry] = []
+    visual: list[ShapeEntry] = []
+    for g in range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]):
+        gtype = int(m.geom_type[g])
+        pose = to_body * _pose(m.geom_pos[g], m.geom_quat[g])
+        visual_only = m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0
+        size = [float(v) for v in m.geom_size[g]]
+        entry = None
+        if gtype == SPHERE:
+            entry = ShapeEntry(shape="sphere", geometry=Geometry(radius=size[0]), offset=pose)
+        elif gtype == CAPSULE:
+            entry = ShapeEntry(shape="capsule", geometry=Geometry(radius=size[0], height=2 * size[1] + 2 * size[0],
+                                                                  axis="z"), offset=pose)
+        elif gtype == CYLINDER:
+            entry = ShapeEntry(shape="cylinder", geometry=Geometry(radius=size[0], height=2 * size[1], axis="z"),
+                               offset=pose)
+        elif gtype == BOX:
+            entry = ShapeEntry(shape="box", geometry=Geometry(x=2 * size[0], y=2 * size[1], z=2 * size[2]), offset=pose)
+        elif gtype == MESH:
+            mid = int(m.geom_dataid[g])
+            fn, scale = meshes[mid] if 0 <= mid < len(meshes) else (None, None)
+            if fn is None:
+                losses.append(Loss(who, "inline mesh", "a mesh given by vertices in the XML has no file for ADF"))
+                continue
+            at = to_body * _mesh_file_frame(m, g)
+            if at.position.norm() > 1e-9 or at.orientation.angle_to(Quat(0, 0, 0, 1)) > 1e-9:
+                losses.append(Loss(who, "mesh offset", "ADF meshes sit at the body frame; this one is offset"))
+            if scale is None:
+                losses.append(Loss(who, "mesh scale", "non-uniform mesh scale; ADF scales uniformly"))
+            if visual_only:
+                if body.mesh is None:
+                    body.mesh, body.scale = fn, (scale if scale not in (None, 1.0) else None)
+                    rgba = [float(v) for v in m.geom_rgba[g]]
+                    body.color_rgba = RGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
+                else:
+                    losses.append(Loss(who, "visual mesh", "ADF has one visual mesh per body; extra dropped"))
+            elif body.collision_mesh is None and not collision:
+                body.collision_mesh = fn
+                if body.mesh is None:
+                    body.mesh = fn
+            else:
+                losses.append(Loss(who, "collision mesh", "ADF has one collision mesh per body; extra dropped"))
+            continue
+        else:
+            losses.append(Loss(who, f"collision {_GEOM_NAMES.get(gtype, str(gtype))}", "no ADF shape for it"))
+            continue
+        (visual if visual_only else collision).append(entry)
+    if collision and body.collision_mesh is not None:
+        losses.append(Loss(who, "collision mesh", "ADF takes primitives or a mesh, not both; mesh dropped"))
+        body.collision_mesh = None
+    if collision:
+        body.compound_collision_shape = collision
+    if visual:
+        body.compound_shape = visual
+
+
+def _angle_about(axis: Vec3, q: Quat) -> float:
+    return 2.0 * math.atan2(q.x * axis[0] + q.y * axis[1] + q.z * axis[2], q.w)
+
+
+def _read_joint(m, b: int, names, bodies, world_pose, frames, model: ModelFile, losses) -> None:
+    parent_id = int(m.body_parentid[b])
+    child = bodies[b]
+    n, adr = int(m.body_jntnum[b]), int(m.body_jntadr[b])
+    if n == 0:
+        if parent_id == 0 and 0 not in bodies:
+            if child.mass:
+                losses.append(Loss(child.identifier, "mass", "welded to the world: an ADF body fixed to the world "
+                                                             "is static (mass 0)"))
+            child.mass = 0.0
+            return
+        _add_joint(model, f"{names[parent_id]}-{names[b]}", "fixed", bodies[parent_id], child,
+                   world_pose[parent_id].inverse() * world_pose[b], Vec3(), Vec3(0.0, 0.0, 1.0), 0.0, None, losses)
+        return
+    if n > 1:
+        losses.append(Loss(child.identifier, "joints", f"{n} joints on one body; ADF joins two bodies by one "
+                                                       "joint: only the first is kept"))
+    j = adr
+    jtype = int(m.jnt_type[j])
+    jname = m.joint(j).name or f"{names[b]}_joint"
+    if jtype == FREE:
+        return  # a free body: no ADF joint
+    rel = world_pose[parent_id].inverse() * world_pose[b]
+    to_body = frames[b].inverse()
+    pivot = to_body.transform(Vec3(*(float(v) for v in m.jnt_pos[j])))
+    axis = to_body.orientation.rotate(Vec3(*(float(v) for v in m.jnt_axis[j]))).normalized()
+    if jtype == BALL:
+        _add_joint(model, jname, "p2p", bodies[parent_id], child, rel, pivot, axis, 0.0, None, losses)
+        return
+    ref = float(m.qpos0[m.jnt_qposadr[j]])
+    # the ADF zero configuration is MuJoCo's qpos = 0: undo the reference value
+    undo = Pose(axis.scaled(-ref)) if jtype == SLIDE else \
+        Pose(pivot) * Pose(Vec3(), Quat.from_axis_angle(axis, -ref)) * Pose(pivot.scaled(-1.0))
+    limits = None
+    if m.jnt_limited[j]:
+        lo, hi = (float(v) for v in m.jnt_range[j])
+        limits = JointLimits(low=lo, high=hi)
+    joint = _add_joint(model, jname, "revolute" if jtype == HINGE else "prismatic", bodies[parent_id], child,
+                       rel * undo, pivot, axis, ref, limits, losses)
+    damping = float(m.dof_damping[m.jnt_dofadr[j]])
+    if damping:
+        joint.damping = damping
+    for attr, label in (("jnt_stiffness", "stiffness"), ("dof_armature", "armature"),
+                        ("dof_frictionloss", "friction loss")):
+        arr = getattr(m, attr)
+        idx = j if attr.startswith("jnt") else m.jnt_dofadr[j]
+        if float(arr[idx]) != 0.0:
+            losses.append(Loss(joint.identifier, label, "ADF revolute/prismatic joints have no such property"))
+
+
+def _add_joint(model, name, jtype, parent: Body, child: Body, rel0: Pose, pivot: Vec3, axis: Vec3, ref,
+               limits, losses) -> Joint:
+    """An ADF joint whose frames put ``child`` at ``rel0`` (in the parent body frame) at value 0,
+    rotating about ``axis`` through ``pivot`` (both in the child body frame)."""
+    who = f"JOINT {name}"
+    a = rel0.orientation.rotate(axis)
+    pa = rel0.transform(pivot)
+    d = Vec3(1.0, 0.0, 0.0) if jtype == "prismatic" else Vec3(0.0, 0.0, 1.0)
+    tilt = sum(t for t in (d.cross(a).norm(), a.cross(axis).norm()) if 1e-12 < t < 1e-3)
+    if tilt:
+        losses.append(Loss(who, "axis tilt", f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
+                                             "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away"))
+    twist = rel0.orientation * shortest_arc(axis, a).inverse()
+    offset = _angle_about(a, twist)
+    joint = Joint(identifier=who, name=name, parent=parent.identifier, child=child.identifier, type=jtype,
+                  parent_pivot=pa, parent_axis=a, child_pivot=pivot, child_axis=axis, joint_limits=limits)
+    if abs(offset) > 1e-12:
+        joint.offset = offset
+    model.joints.append(joint)
+    return joint
+
+
+def _read_equalities(m, names, bodies, world_pose, frames, model, losses) -> None:
+    import mujoco
+
+    for e in range(m.neq):
+        etype = int(m.eq_type[e])
+        b1, b2 = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+        name = m.eq(e).name or f"equality{e}"
+        if etype == int(mujoco.mjtEq.mjEQ_CONNECT) and b1 > 0 and b2 > 0 and m.eq_objtype[e] == mujoco.mjtObj.mjOBJ_BODY:
+            anchor1 = frames[b1].inverse().transform(Vec3(*(float(v) for v in m.eq_data[e][0:3])))
+            rel = world_pose[b2].inverse() * world_pose[b1]
+            _add_joint(model, name, "p2p", bodies[b1], bodies[b2], rel.inverse(), rel.transform(anchor1),
+                       Vec3(0.0, 0.0, 1.0), 0.0, None, losses)
+        elif etype == int(mujoco.mjtEq.mjEQ_WELD) and b1 > 0 and b2 > 0 and m.eq_objtype[e] == mujoco.mjtObj.mjOBJ_BODY:
+            _add_joint(model, name, "fixed", bodies[b1], bodies[b2], world_pose[b1].inverse() * world_pose[b2],
+                       Vec3(), Vec3(0.0, 0.0, 1.0), 0.0, None, losses)
+        else:
+            losses.append(Loss(name, "equality", "only body connect/weld equalities map to ADF joints"))

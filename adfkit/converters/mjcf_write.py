@@ -1,0 +1,252 @@
+"""Scene model → MJCF (format-mapping.md).
+
+Each ADF body becomes an MJCF body whose frame is its link frame (``tree.py``: the joint
+frame B; the body frame for a root). Bodies sit where the ADF `location`s put them: a hinge
+or slide is written with ``ref`` = the initial joint value and the child placed at that
+value, so MuJoCo's qpos0 reproduces the file and ``qpos`` is the ADF joint value. A static
+root (mass 0) is welded to the world; a dynamic root gets a free joint. Joints outside the
+tree become ``equality/connect`` at the child pivot (their axis is lost, and reported).
+Inertials are written explicitly (``inertiafromgeom="false"``); visual meshes are geoms in
+group 1 that do not collide; collision primitives and meshes are geoms in group 3.
+"""
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from ..adf.paths import collision_mesh_path, visual_mesh_path
+from ..adf.writer import atomic_write_text
+from ..diagnostics import AdfError, error
+from ..model.files import ModelFile
+from ..model.pose import Pose, Quat, Vec3
+from ..model.semantics import (
+    JointKind, ShapeKind, collision_primitives, effective_mass, inertial_offset, joint_frames,
+)
+from . import inertia as inertia_math
+from .losses import Loss
+from .tree import Link, build_tree, motion
+from .urdf import INITIAL_VALUE_TOLERANCE, _AXIS_TO_Z, _BODY_ONLY, _link_name, _joint_name, _material, _num, _unique, _vec
+
+# Moving bodies need mass and inertia above MuJoCo's mjMINVAL; massless ADF links get this.
+MIN_MASS = 1e-6
+MIN_INERTIA = 1e-9
+
+_LOSSY_OBJECTS = (("ghost_objects", "ghost object"), ("sensors", "sensor"), ("actuators", "actuator"),
+                  ("cameras", "camera"), ("lights", "light"), ("soft_bodies", "soft body"),
+                  ("vehicles", "vehicle"), ("volumes", "volume"))
+
+
+def _place(el: ET.Element, pose: Pose) -> None:
+    if pose.position.norm() > 1e-15:
+        el.set("pos", _vec(pose.position))
+    q = pose.orientation
+    if abs(q.w - 1.0) > 1e-15 or abs(q.x) + abs(q.y) + abs(q.z) > 1e-15:
+        el.set("quat", _vec((q.w, q.x, q.y, q.z)))
+
+
+class _Assets:
+    def __init__(self, root: ET.Element, out_dir: Path):
+        self.el = ET.SubElement(root, "asset")
+        self.out_dir = out_dir
+        self.names: dict[tuple[str, float], str] = {}
+        self.used: set[str] = set()
+
+    def mesh(self, path: Path, scale: float) -> str:
+        key = (str(path.resolve()), scale)
+        if key not in self.names:
+            name = _unique(path.stem.replace(" ", "_"), self.used)
+            m = ET.SubElement(self.el, "mesh", name=name,
+                              file=Path(os.path.relpath(path.resolve(), self.out_dir.resolve())).as_posix())
+            if scale != 1.0:
+                m.set("scale", _vec((scale,) * 3))
+            self.names[key] = name
+        return self.names[key]
+
+
+def _geom_primitive(body_el: ET.Element, kind: ShapeKind, g, pose: Pose, name: str) -> bool:
+    if kind is ShapeKind.BOX:
+        el = ET.SubElement(body_el, "geom", name=name, type="box",
+                           size=_vec(((g.x or 0) / 2, (g.y or 0) / 2, (g.z or 0) / 2)))
+        _place(el, pose)
+    elif kind is ShapeKind.SPHERE:
+        el = ET.SubElement(body_el, "geom", name=name, type="sphere", size=_num(g.radius or 0.0))
+        _place(el, pose)
+    elif kind in (ShapeKind.CYLINDER, ShapeKind.CAPSULE):
+        turn = Pose(Vec3(), _AXIS_TO_Z.get((g.axis or "z").lower(), _AXIS_TO_Z["z"]))
+        r, h = g.radius or 0.0, g.height or 0.0
+        half = h / 2 if kind is ShapeKind.CYLINDER else max(h / 2 - r, 0.0)
+        el = ET.SubElement(body_el, "geom", name=name, type=kind.value, size=_vec((r, half)))
+        _place(el, pose * turn)
+    else:
+        return False
+    el.set("group", "3")
+    return True
+
+
+def _write_body(parent_el: ET.Element, model: ModelFile, link: Link, names: dict, assets: _Assets,
+                losses: list[Loss], used: dict[str, set[str]]) -> ET.Element:
+    body = link.body
+    who = body.identifier
+    el = ET.SubElement(parent_el, "body", name=names[id(link)])
+    q0 = link.q0 if abs(link.q0) > INITIAL_VALUE_TOLERANCE else 0.0
+    _place(el, link.origin if link.parent is None else link.origin * motion(link.kind, q0))
+    mass = effective_mass(body)
+    moving = not (link.parent is None and mass == 0.0)
+    if link.parent is None and mass > 0.0:
+        ET.SubElement(el, "freejoint", name=_unique(f"{names[id(link)]}_free", used["joint"]))
+    elif link.parent is not None and link.kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+        j = link.joint
+        jel = ET.SubElement(el, "joint", name=_unique(_joint_name(j), used["joint"]),
+                            type="hinge" if link.kind is JointKind.REVOLUTE else "slide",
+                            axis=_vec(link.axis))
+        if q0:
+            jel.set("ref", _num(q0))
+        lim = j.joint_limits
+        if lim is not None and lim.low is not None and lim.high is not None:
+            jel.set("limited", "true")
+            jel.set("range", _vec((lim.low, lim.high)))
+        if isinstance(j.damping, float):
+            jel.set("damping", _num(j.damping))
+        for attr, key in (("controller", "controller"), ("max_motor_impulse", "max motor impulse")):
+            if getattr(j, attr, None) is not None:
+                losses.append(Loss(j.identifier, key, "no MJCF actuator is written for it"))
+    if moving:
+        ix, iy, iz = inertia_math.adf_principal(body)
+        if body.inertia is None and mass > 0:
+            est = inertia_math.estimate_from_collision(model, body, mass)
+            if est is not None:
+                ix, iy, iz = est
+                losses.append(Loss(who, "inertia", "not in the ADF file: written as Bullet's estimate "
+                                                   "(box inertia of the collision shape's bounding box)"))
+        if mass < MIN_MASS or min(ix, iy, iz) < MIN_INERTIA:
+            losses.append(Loss(who, "mass", f"a moving MuJoCo body needs mass and inertia: written as at least "
+                                            f"{MIN_MASS:g} kg and {MIN_INERTIA:g} kg·m²"))
+            mass, ix, iy, iz = max(mass, MIN_MASS), max(ix, MIN_INERTIA), max(iy, MIN_INERTIA), max(iz, MIN_INERTIA)
+        com = link.in_link(inertial_offset(body))
+        inertial = ET.SubElement(el, "inertial", pos=_vec(com.position))
+        _place(inertial, Pose(Vec3(), com.orientation))
+        inertial.set("mass", _num(mass))
+        inertial.set("diaginertia", _vec((ix, iy, iz)))
+    _write_geoms(el, model, link, names[id(link)], assets, losses, used)
+    for attr, key in _BODY_ONLY.items():
+        if attr in ("friction", "damping"):
+            continue
+        if getattr(body, attr, None) not in (None, [], False):
+            losses.append(Loss(who, key, "MJCF has no element for it"))
+    if body.friction is not None:
+        losses.append(Loss(who, "friction", "not written (MuJoCo's friction is per geom, sliding/torsional/rolling)"))
+    if body.damping is not None:
+        losses.append(Loss(who, "damping", "MuJoCo has no body velocity damping"))
+    return el
+
+
+def _is_world(link: Link) -> bool:
+    b = link.body
+    return (link.parent is None and b.name == "world" and effective_mass(b) == 0.0
+            and link.origin.position.norm() < 1e-12 and link.origin.orientation.angle_to(Quat(0, 0, 0, 1)) < 1e-12)
+
+
+def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets: _Assets, losses, used) -> None:
+    body = link.body
+    who = body.identifier
+    scale = body.scale if body.scale is not None else 1.0
+    to_link = link.frame_in_body.inverse()
+    mesh = visual_mesh_path(model, body)
+    if mesh is not None:
+        g = ET.SubElement(el, "geom", name=_unique(f"{name}_visual", used["geom"]), type="mesh",
+                          mesh=assets.mesh(mesh, scale), contype="0", conaffinity="0", group="1")
+        _place(g, to_link)
+        rgba = _material(body)
+        if rgba is not None:
+            g.set("rgba", _vec(rgba))
+    prims = collision_primitives(body)
+    if prims is None:
+        cmesh = collision_mesh_path(model, body)
+        if cmesh is not None:
+            g = ET.SubElement(el, "geom", name=_unique(f"{name}_collision", used["geom"]), type="mesh",
+                              mesh=assets.mesh(cmesh, scale), group="3")
+            _place(g, to_link)
+            losses.append(Loss(who, "collision mesh", "MuJoCo collides with the convex hull of a mesh"))
+    else:
+        for n, p in enumerate(prims):
+            if not _geom_primitive(el, p.kind, p.geometry, to_link * p.pose,
+                                   _unique(f"{name}_collision{n}", used["geom"])):
+                losses.append(Loss(who, f"collision {p.kind.value}", "MJCF has no such primitive"))
+    for n, e in enumerate(body.compound_shape or []):
+        from ..model.semantics import pose_or_identity, shape_kind
+        k = shape_kind(e.shape)
+        g = ET.Element("g")
+        if k is None or e.geometry is None or not _geom_primitive(g, k, e.geometry, to_link * pose_or_identity(e.offset),
+                                                                  _unique(f"{name}_visual{n}", used["geom"])):
+            losses.append(Loss(who, f"visual {e.shape}", "MJCF has no such primitive"))
+            continue
+        geom = g[0]
+        geom.set("contype", "0"), geom.set("conaffinity", "0"), geom.set("group", "1")
+        el.append(geom)
+
+
+def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None) -> tuple[str, list[Loss]]:
+    losses: list[Loss] = []
+    tree = build_tree(model)
+    if not tree.roots:
+        raise AdfError(error("convert-empty", "the model has no bodies; there is nothing to write as MJCF",
+                             model.where(), "convert a model file with at least one body"))
+    root = ET.Element("mujoco", model=name or model.name)
+    ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
+    assets = _Assets(root, out_dir)
+    world = ET.SubElement(root, "worldbody")
+    # MuJoCo keeps one namespace per element type; "world" is the world body's name
+    used: dict[str, set[str]] = {"body": {"world"}, "joint": set(), "geom": set(), "equality": set()}
+    names: dict[int, str] = {}
+    elements: dict[int, ET.Element] = {}
+    for lk in tree.ordered():
+        names[id(lk)] = _unique(_link_name(lk.body), used["body"])
+    for lk in tree.ordered():
+        parent_el = world if lk.parent is None else elements[id(lk.parent)]
+        if _is_world(lk):  # ADF's stand-in for the world: its geoms and children go in <worldbody>
+            elements[id(lk)] = world
+            _write_geoms(world, model, lk, names[id(lk)], assets, losses, used)
+            continue
+        elements[id(lk)] = _write_body(parent_el, model, lk, names, assets, losses, used)
+        if lk.parent is not None and lk.kind is JointKind.FIXED and lk.joint.damping is not None:
+            losses.append(Loss(lk.joint.identifier, "damping", "a fixed joint has nothing to damp"))
+    by_body = {lk.body.identifier: lk for lk in tree.ordered()}
+    eq = None
+    for j, kind, parent, child in tree.loops:
+        if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
+            eq = eq if eq is not None else ET.Element("equality")
+            a, _b = joint_frames(j, parent.scale or 1.0, child.scale or 1.0)
+            pl = by_body[parent.identifier]
+            anchor = pl.in_link(a).position
+            tag = "weld" if kind is JointKind.FIXED else "connect"
+            e = ET.SubElement(eq, tag, name=_unique(_joint_name(j), used["equality"]), body1=names[id(pl)],
+                              body2=names[id(by_body[child.identifier])])
+            if tag == "connect":
+                e.set("anchor", _vec(anchor))
+            if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+                losses.append(Loss(j.identifier, "joint axis", f"a {kind.value} joint closing a loop is written as "
+                                                               "equality/connect: a ball joint at the pivot"))
+        else:
+            losses.append(Loss(j.identifier, "joint", f"no MJCF form for a {kind.value} joint here"))
+    if eq is not None:
+        root.append(eq)
+    for j in tree.unresolved:
+        losses.append(Loss(j.identifier, "joint", "unknown type or parent/child body not in this file"))
+    for attr, label in _LOSSY_OBJECTS:
+        for obj in getattr(model, attr):
+            losses.append(Loss(obj.identifier, label, "not written to MJCF"))
+    if not len(assets.el):
+        root.remove(assets.el)
+    ET.indent(root, "  ")
+    return ET.tostring(root, encoding="unicode") + "\n", sorted(set(losses))
+
+
+def write(model: ModelFile, path: Path) -> list[Loss]:
+    path = Path(path)
+    text, losses = to_mjcf(model, path.parent, path.stem)
+    atomic_write_text(path, text)
+    return losses
+
+
+__all__ = ["to_mjcf", "write", "MIN_MASS", "MIN_INERTIA"]
