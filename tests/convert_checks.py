@@ -1,6 +1,8 @@
 """Checks shared by the converter tests: models equal up to a tree format's spelling."""
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -65,3 +67,22 @@ def assert_same_kinematics(orig, back, lost: set[str]):
             ta, tb = joint_transform(k, q), joint_transform(j, q)
             assert (ta.position - tb.position).norm() < 1e-9, (ident, q)
             assert ta.orientation.angle_to(tb.orientation) < rot_tol, (ident, q)
+
+
+def assert_located_error(read_fn, path: Path, text: str, rule: str, line: int | None) -> None:
+    """Reading ``text`` raises AdfError with ``rule``, this file, ``line`` (when given) and a hint."""
+    from adfkit.diagnostics import AdfError
+
+    path.write_text(text)
+    with pytest.raises(AdfError) as exc:
+        read_fn(path)
+    d = exc.value.diagnostics[0]
+    assert d.rule == rule
+    assert d.location.file == str(path)
+    if line is not None:
+        assert d.location.line == line
+    assert d.hint
+
+
+def convert_cli(*args) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "adfkit", "convert", *map(str, args)], capture_output=True, text=True)

@@ -3,8 +3,6 @@ world inertias agree at random configurations; round trips; exact losses; bad in
 from __future__ import annotations
 
 import random
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,11 +15,10 @@ from adfkit.converters import mjcf, read, write  # noqa: E402
 from adfkit.converters.inertia import world_tensor  # noqa: E402
 from adfkit.converters.losses import loss_keys  # noqa: E402
 from adfkit.converters.tree import build_tree  # noqa: E402
-from adfkit.diagnostics import AdfError  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
 from adfkit.model.semantics import inertial_offset  # noqa: E402
 from conftest import CORPUS  # noqa: E402
-from convert_checks import assert_same_kinematics, close_pose  # noqa: E402
+from convert_checks import assert_located_error, convert_cli, assert_same_kinematics, close_pose  # noqa: E402
 
 ROBOTS = CORPUS / "ambf" / "ambf_models" / "descriptions" / "multi-bodies" / "robots"
 needs_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason="../shared/corpus is absent (public ADF corpus)")
@@ -239,29 +236,17 @@ BAD = {
 @pytest.mark.parametrize("case", sorted(BAD))
 def test_bad_mjcf_is_a_located_diagnostic(case, tmp_path):
     text, rule, line = BAD[case]
-    f = tmp_path / "bad.xml"
-    f.write_text(text)
-    with pytest.raises(AdfError) as exc:
-        mjcf.read(f)
-    d = exc.value.diagnostics[0]
-    assert d.rule == rule
-    assert d.location.file == str(f)
-    assert d.location.line == line
-    assert d.hint
-
-
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "adfkit", "convert", *map(str, args)], capture_output=True, text=True)
+    assert_located_error(mjcf.read, tmp_path / "bad.xml", text, rule, line)
 
 
 @needs_corpus
 def test_convert_command_adf_to_mjcf(tmp_path):
-    res = _cli(ROBOTS / "blender-kuka.yaml", tmp_path / "kuka.xml", "--json")
+    res = convert_cli(ROBOTS / "blender-kuka.yaml", tmp_path / "kuka.xml", "--json")
     assert res.returncode == 0, res.stderr
     assert '"to": "mjcf"' in res.stdout
     _compile(tmp_path / "kuka.xml")
-    assert _cli(ROBOTS / "blender-kuka.yaml", tmp_path / "k2.xml", "--fail-on-loss").returncode == 1
+    assert convert_cli(ROBOTS / "blender-kuka.yaml", tmp_path / "k2.xml", "--fail-on-loss").returncode == 1
     bad = tmp_path / "bad.xml"
     bad.write_text(BAD["compile error"][0])
-    res = _cli(bad, tmp_path / "bad.yaml")
+    res = convert_cli(bad, tmp_path / "bad.yaml")
     assert res.returncode == 2 and "mjcf-compile" in res.stderr

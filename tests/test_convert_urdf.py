@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import math
 import random
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,10 +17,10 @@ from adfkit.converters import read, write  # noqa: E402
 from adfkit.converters.inertia import world_tensor  # noqa: E402
 from adfkit.converters.losses import loss_keys  # noqa: E402
 from adfkit.converters.tree import build_tree  # noqa: E402
-from adfkit.diagnostics import AdfError  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
 from adfkit.model.semantics import JointKind, inertial_offset  # noqa: E402
 from conftest import CORPUS  # noqa: E402
+from convert_checks import assert_located_error, convert_cli  # noqa: E402
 from convert_checks import assert_same_kinematics as _assert_same_kinematics  # noqa: E402
 from convert_checks import close_pose as _close_pose  # noqa: E402
 
@@ -350,32 +348,19 @@ BAD = {
 @pytest.mark.parametrize("case", sorted(BAD))
 def test_bad_urdf_is_a_located_diagnostic(case, tmp_path):
     text, rule, line = BAD[case]
-    f = tmp_path / "bad.urdf"
-    f.write_text(text)
-    with pytest.raises(AdfError) as exc:
-        read(f)
-    d = exc.value.diagnostics[0]
-    assert d.rule == rule
-    assert d.location.file == str(f)
-    if line is not None:
-        assert d.location.line == line
-    assert d.hint
-
-
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "adfkit", "convert", *map(str, args)], capture_output=True, text=True)
+    assert_located_error(read, tmp_path / "bad.urdf", text, rule, line)
 
 
 def test_convert_command_exit_codes(tmp_path):
     src = DATA / "r2d2.urdf"
-    res = _cli(src, tmp_path / "r2d2.yaml")
+    res = convert_cli(src, tmp_path / "r2d2.yaml")
     assert res.returncode == 0, res.stderr
     assert "item(s) not carried over" in res.stdout and "visual primitive" in res.stdout
     assert (tmp_path / "r2d2.yaml").is_file()
-    assert _cli(src, tmp_path / "again.yaml", "--fail-on-loss").returncode == 1
+    assert convert_cli(src, tmp_path / "again.yaml", "--fail-on-loss").returncode == 1
     bad = tmp_path / "bad.urdf"
     bad.write_text(BAD["missing parent"][0])
-    res = _cli(bad, tmp_path / "bad.yaml")
+    res = convert_cli(bad, tmp_path / "bad.yaml")
     assert res.returncode == 2
     assert f"{bad}:4" in res.stderr and "urdf-reference" in res.stderr
     assert not (tmp_path / "bad.yaml").exists()

@@ -133,6 +133,16 @@ def _material(body: Body) -> tuple[float, float, float, float] | None:
     return None
 
 
+def _mesh_element(link_el: ET.Element, tag: str, pose: Pose, mesh: Path, scale: float, out_dir: Path) -> ET.Element:
+    """A <visual> or <collision> holding a mesh at ``pose`` in the link frame."""
+    el = ET.SubElement(link_el, tag)
+    _origin(el, pose)
+    m = ET.SubElement(ET.SubElement(el, "geometry"), "mesh", filename=_mesh_ref(mesh, out_dir))
+    if scale != 1.0:
+        m.set("scale", _vec((scale,) * 3))
+    return el
+
+
 def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_dir: Path, losses: list[Loss]) -> None:
     body = link.body
     el = ET.SubElement(robot, "link", name=name)
@@ -155,12 +165,7 @@ def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_
     to_link = link.frame_in_body.inverse()
     mesh = visual_mesh_path(model, body)
     if mesh is not None:
-        vis = ET.SubElement(el, "visual")
-        _origin(vis, to_link)
-        geo = ET.SubElement(vis, "geometry")
-        m = ET.SubElement(geo, "mesh", filename=_mesh_ref(mesh, out_dir))
-        if scale != 1.0:
-            m.set("scale", _vec((scale,) * 3))
+        vis = _mesh_element(el, "visual", to_link, mesh, scale, out_dir)
         rgba = _material(body)
         if rgba is not None:
             mat = ET.SubElement(vis, "material", name=f"{name}_material")
@@ -171,12 +176,7 @@ def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_
     if prims is None:
         cmesh = collision_mesh_path(model, body)
         if cmesh is not None:
-            col = ET.SubElement(el, "collision")
-            _origin(col, to_link)
-            geo = ET.SubElement(col, "geometry")
-            m = ET.SubElement(geo, "mesh", filename=_mesh_ref(cmesh, out_dir))
-            if scale != 1.0:
-                m.set("scale", _vec((scale,) * 3))
+            _mesh_element(el, "collision", to_link, cmesh, scale, out_dir)
             if body.collision_mesh_type is not None:
                 losses.append(Loss(who, "collision mesh type", "URDF has none; PyBullet uses the convex hull"))
     else:
