@@ -23,6 +23,8 @@ def add_arguments(p) -> None:
     p.add_argument("--gravity", help="override the world gravity, e.g. 0,0,-9.81")
     p.add_argument("--hole-friction", type=float, default=2.0, help="K of F = -K·v inside hole ghosts, N·s/m")
     p.add_argument("--no-frames", action="store_true", help="do not render camera frames")
+    p.add_argument("--no-ground", action="store_true",
+                   help="a model file played alone gets a floor 1 mm under its lowest body; this leaves it out")
 
 
 def run(args) -> int:
@@ -51,7 +53,8 @@ def run(args) -> int:
     if any(d.severity >= Severity.ERROR for d in diags):
         return 2
     opt = Options(physics_hz=args.physics_hz, control_substeps=args.control_substeps,
-                  solver_iterations=args.solver_iterations, gravity=gravity, hole_friction=args.hole_friction)
+                  solver_iterations=args.solver_iterations, gravity=gravity, hole_friction=args.hole_friction,
+                  ground=not args.no_ground)
     world = SimWorld(scene, opt, gui=args.gui)
     try:
         print_diagnostics(world.diagnostics, sys.stderr)

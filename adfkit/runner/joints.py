@@ -22,7 +22,7 @@ import numpy as np
 import pybullet as pb
 
 from ..model.semantics import DEFAULT_SIX_DOF_LIMIT, DEFAULT_SIX_DOF_SPRING, JointKind
-from .rotations import euler_xyz, matrix_to_pq, quat_to_matrix
+from .rotations import euler_xyz, matrix_to_pq, pose_matrix, quat_to_matrix
 
 HINGE_HALF_SPAN = 0.01  # m: the two p2p constraints of a loop-closing hinge sit ±this along the axis
 
@@ -107,15 +107,31 @@ def spring_joint(joint, kind: JointKind, parent, child, frame_a, frame_b) -> Spr
     return sj
 
 
+def _static_frame(cid: int, body):
+    if body.link == -1:
+        return pb.getBasePositionAndOrientation(body.uid, physicsClientId=cid)
+    st = pb.getLinkState(body.uid, body.link, computeForwardKinematics=True, physicsClientId=cid)
+    return st[0], st[1]  # constraint pivots are in the link's inertial frame
+
+
 def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray,
                     max_force: float) -> list[tuple[int, np.ndarray, np.ndarray]]:
     """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child frame)]."""
     out = []
 
     def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1)):
-        c = pb.createConstraint(parent.uid, parent.link, child.uid, child.link, jtype, [0, 0, 0],
-                                list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
-                                physicsClientId=cid)
+        try:
+            c = pb.createConstraint(parent.uid, parent.link, child.uid, child.link, jtype, [0, 0, 0],
+                                    list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
+                                    physicsClientId=cid)
+        except pb.error:
+            # PyBullet refuses e.g. a fixed constraint from a static (mass 0) body to a multibody
+            # base; a static parent never moves, so build it from the child to the world frame
+            if not getattr(parent, "static", False):
+                raise
+            pw, ow = matrix_to_pq(pose_matrix(*_static_frame(cid, parent)) @ pose_matrix(pa, oa))
+            c = pb.createConstraint(child.uid, child.link, -1, -1, jtype, [0, 0, 0], list(map(float, pb_)),
+                                    list(map(float, pw)), list(ob), list(ow), physicsClientId=cid)
         pb.changeConstraint(c, maxForce=max_force, physicsClientId=cid)
         out.append((c, np.asarray(pa, float), np.asarray(pb_, float)))
 

@@ -39,6 +39,7 @@ class Options:
     visuals: bool = True
     hole_friction: float = 2.0            # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
+    ground: bool = True                   # a model played without a world gets a floor under it
 
 
 @dataclass(eq=False)
@@ -115,6 +116,10 @@ class SimWorld:
         for m in models:
             ns = m.namespace or ""
             mine = []
+            for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles)):
+                for o in objs:
+                    self._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
+                               "PyBullet runner; skipped", o, "play this object in AMBF itself")
             for b in m.bodies:
                 sb = make_sim_body(merge_namespace(ns, b.namespace) + b.identifier, b, m)
                 sb.cid = self.cid
@@ -197,7 +202,21 @@ class SimWorld:
         from .cameras import build_cameras
         self.cameras = build_cameras(self)
         self._floor_z = self._floor()
+        self.ground_z = None
+        if self.opt.ground and self.scene.world is None and self.scene.environment is None:
+            self._add_ground()
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
+
+    def _add_ground(self) -> None:
+        """A model played without a world gets what AMBF's worlds give it: a floor, here a
+        static plane 1 mm below the lowest point of every body."""
+        lows = [pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2] for sb in self.bodies if sb.uid is not None]
+        if not lows:
+            return
+        self.ground_z = min(lows) - 1e-3
+        shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=self.cid)
+        self.ground_uid = pb.createMultiBody(0.0, shape, -1, [0.0, 0.0, self.ground_z], physicsClientId=self.cid)
+        self._floor_z = self.ground_z
 
     def _warn(self, rule, msg, obj, hint="") -> None:
         self.diagnostics.append(warning(rule, msg, getattr(obj, "source", None), hint or None))
@@ -507,13 +526,18 @@ class SimWorld:
         return worst
 
     def report(self) -> dict:
-        fell, fast, nan = [], [], []
+        fell, fast, nan, shapeless = [], [], [], []
         for sb in self.bodies:
             if sb.static:
                 continue
             p, _, v, w = sb.state()
             if not np.all(np.isfinite(p)) or not np.all(np.isfinite(v)):
                 nan.append(sb.key)
+                continue
+            parts = getattr(sb, "_parts", None)
+            if parts is not None and not parts.types and parts.plane is None:
+                # nothing to collide with: it falls freely under gravity, in AMBF too
+                shapeless.append(sb.key)
                 continue
             if p[2] < self._floor_z - 0.1:
                 fell.append(sb.key)
@@ -528,8 +552,8 @@ class SimWorld:
             "steps": self.steps, "physics_hz": self.opt.physics_hz, "control_substeps": self.opt.control_substeps,
             "simulated_time_s": self.sim_time, "wall_time_s": self.wall_time,
             "real_time_factor": self.sim_time / self.wall_time if self.wall_time else None,
-            "max_constraint_error_m": self.constraint_error(),
-            "fell_through_floor": fell, "exploded": fast, "nan": nan,
+            "max_constraint_error_m": self.constraint_error(), "ground_plane_z": self.ground_z,
+            "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
         }
 
     def close(self) -> None:

@@ -1,0 +1,75 @@
+"""Every corpus model whose meshes are present (MANIFEST.md) loads in the PyBullet runner and
+plays: no NaN, nothing faster than 10 m/s, joint constraints closed to 1 mm at the end.
+A short run of two models by default; 5 s of every model under `-m slow`."""
+from __future__ import annotations
+
+import pytest
+
+pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
+
+from adfkit.adf import load_scene  # noqa: E402
+from adfkit.runner.world import Options, SimWorld  # noqa: E402
+from conftest import CORPUS, require_corpus  # noqa: E402
+
+MB = "ambf/ambf_models/descriptions/multi-bodies"
+WITH_MESHES = [  # MANIFEST.md: models whose meshes and textures are in the corpus
+    f"{MB}/robots/blender-psm.yaml", f"{MB}/robots/blender-ecm.yaml", f"{MB}/robots/blender-mtm.yaml",
+    f"{MB}/robots/blender-kuka.yaml", f"{MB}/robots/blender-kuka-springy.yaml",
+    f"{MB}/puzzles/puzzle1.yaml", f"{MB}/puzzles/puzzle2.yaml", f"{MB}/puzzles/puzzle4.yaml",
+    f"{MB}/puzzles/puzzle5.yaml", f"{MB}/puzzles/puzzle6.yaml", f"{MB}/puzzles/parallel_structure.yaml",
+    f"{MB}/puzzles/peg_and_base.yaml", f"{MB}/grippers/resistive/gripper1/gripperA.yaml",
+    pytest.param(f"{MB}/grippers/resistive/gripper3/gripper.yaml", marks=pytest.mark.xfail(
+        strict=True, reason="known gap: the finger linkage's loop joints (point constraints on maximal bodies) "
+                            "chatter: LeftL2/RightL2 above 10 m/s, joint error 2-6 mm")),
+    f"{MB}/tools/cylinder.yaml",
+    "src/ADF/Phantoms/Simple/phantom.yaml", "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml",
+    "src/ADF/PSMs/LND_400006_SIMPLE/psm2.yaml",
+]
+SOFT = [f"{MB}/sb/cloth.yaml"]
+FAST = [f"{MB}/robots/blender-kuka.yaml", f"{MB}/puzzles/puzzle1.yaml"]
+
+
+def _play(rel: str, seconds: float) -> dict:
+    require_corpus()
+    path = CORPUS / rel
+    diags: list = []
+    scene = load_scene(path, None, diags)
+    world = SimWorld(scene, Options(visuals=False))
+    try:
+        assert world.skipped == [], f"bodies the runner could not build: {world.skipped}"
+        world.run(seconds)
+        return world.report()
+    finally:
+        world.close()
+
+
+def _check(rep: dict, rel: str) -> None:
+    assert rep["nan"] == [], rel
+    assert rep["exploded"] == [], rel
+    assert rep["max_constraint_error_m"] < 1e-3, (rel, rep["max_constraint_error_m"])
+
+
+@pytest.mark.parametrize("rel", FAST, ids=lambda r: r.rsplit("/", 1)[-1])
+def test_corpus_model_plays_briefly(rel):
+    rep = _play(rel, 0.5)
+    _check(rep, rel)
+    assert rep["bodies"] > 1 and rep["steps"] >= 500
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rel", WITH_MESHES, ids=lambda r: str(r).rsplit("/", 1)[-1])
+def test_corpus_model_plays_5_seconds(rel):
+    _check(_play(rel, 5.0), rel)
+
+
+@pytest.mark.parametrize("rel", SOFT, ids=lambda r: r.rsplit("/", 1)[-1])
+def test_soft_body_is_reported_not_played(rel):
+    """Soft bodies are a known gap of the runner: it must say so, never skip them silently."""
+    require_corpus()
+    scene = load_scene(CORPUS / rel, None, [])
+    world = SimWorld(scene, Options(visuals=False))
+    try:
+        rules = {d.rule for d in world.diagnostics}
+        assert any("soft" in r for r in rules), rules
+    finally:
+        world.close()
