@@ -146,7 +146,7 @@ def test_ghost_viscous_friction_matches_exponential(tmp_path):
 @pytest.mark.xfail(strict=True, reason="known gap: with the tool standing still the held needle (40 thread "
                    "elements hanging) turns ~15° (2 mm) about the grasp within 20 ms and PyBullet only corrects "
                    "it once the multibody moves, so the pose before and after a 5 cm move differs by ~2 mm; "
-                   "see docs/runner.md")
+                   "see the README, "PyBullet reference runner"")
 def test_grasp_moves_needle_with_tool_and_release_drops_it(suturing):
     _, world = suturing
     world.step(1)   # link poses are valid after a step
