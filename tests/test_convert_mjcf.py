@@ -194,6 +194,24 @@ def test_corpus_robot_to_mjcf_matches_adf_kinematics(name, tmp_path):
 
 
 @needs_corpus
+def test_kuka_adf_mjcf_adf_round_trip_and_exact_losses(tmp_path):
+    orig = load(ROBOTS / "blender-kuka.yaml")
+    out = tmp_path / "kuka.xml"
+    losses = write(orig, out)
+    expected = [(b.identifier, k) for b in orig.bodies for k in ("collision groups", "collision margin", "damping",
+                                                                 "friction")
+                if getattr(b, k.replace(" ", "_")) not in (None, [], False)]
+    expected += [(b.identifier, "collision mesh") for b in orig.bodies if b.mesh]  # MuJoCo collides with hulls
+    expected += [(b.identifier, "inertia") for b in orig.bodies if b.inertia is None and (b.mass or 0) > 0]
+    expected += [(j.identifier, "controller") for j in orig.joints if j.controller is not None]
+    assert loss_keys(losses) == sorted(expected)
+    assert len(losses) == 54
+    back, read_losses = read(out)
+    assert read_losses == []
+    assert_same_kinematics(orig, back, set())
+
+
+@needs_corpus
 def test_psm_adf_mjcf_adf_round_trip_and_exact_losses(tmp_path):
     orig = load(ROBOTS / "blender-psm.yaml")
     out = tmp_path / "psm.xml"
