@@ -86,3 +86,15 @@ def assert_located_error(read_fn, path: Path, text: str, rule: str, line: int | 
 
 def convert_cli(*args) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "adfkit", "convert", *map(str, args)], capture_output=True, text=True)
+
+
+def expected_losses(model, body_keys=(), joint_keys=()) -> list[tuple[str, str]]:
+    """(identifier, key) for every body/joint that sets one of the ADF keys a format cannot hold,
+    plus the inertia the writers estimate for bodies with mass and no `inertia`."""
+    def is_set(obj, key):
+        return getattr(obj, key.replace(" ", "_")) not in (None, [], False)
+
+    out = [(b.identifier, k) for b in model.bodies for k in body_keys if is_set(b, k)]
+    out += [(b.identifier, "inertia") for b in model.bodies if b.inertia is None and (b.mass or 0) > 0]
+    out += [(j.identifier, k) for j in model.joints for k in joint_keys if is_set(j, k)]
+    return sorted(out)

@@ -18,7 +18,7 @@ from adfkit.converters.tree import build_tree  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
 from adfkit.model.semantics import inertial_offset  # noqa: E402
 from conftest import CORPUS  # noqa: E402
-from convert_checks import assert_located_error, convert_cli, assert_same_kinematics, close_pose  # noqa: E402
+from convert_checks import assert_located_error, assert_same_kinematics, close_pose, convert_cli, expected_losses  # noqa: E402
 
 ROBOTS = CORPUS / "ambf" / "ambf_models" / "descriptions" / "multi-bodies" / "robots"
 needs_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason="../shared/corpus is absent (public ADF corpus)")
@@ -198,12 +198,8 @@ def test_kuka_adf_mjcf_adf_round_trip_and_exact_losses(tmp_path):
     orig = load(ROBOTS / "blender-kuka.yaml")
     out = tmp_path / "kuka.xml"
     losses = write(orig, out)
-    expected = [(b.identifier, k) for b in orig.bodies for k in ("collision groups", "collision margin", "damping",
-                                                                 "friction")
-                if getattr(b, k.replace(" ", "_")) not in (None, [], False)]
+    expected = expected_losses(orig, ("collision groups", "collision margin", "damping", "friction"), ("controller",))
     expected += [(b.identifier, "collision mesh") for b in orig.bodies if b.mesh]  # MuJoCo collides with hulls
-    expected += [(b.identifier, "inertia") for b in orig.bodies if b.inertia is None and (b.mass or 0) > 0]
-    expected += [(j.identifier, "controller") for j in orig.joints if j.controller is not None]
     assert loss_keys(losses) == sorted(expected)
     assert len(losses) == 54
     back, read_losses = read(out)

@@ -20,7 +20,7 @@ from adfkit.converters.tree import build_tree  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
 from adfkit.model.semantics import JointKind, inertial_offset  # noqa: E402
 from conftest import CORPUS  # noqa: E402
-from convert_checks import assert_located_error, convert_cli  # noqa: E402
+from convert_checks import assert_located_error, convert_cli, expected_losses  # noqa: E402
 from convert_checks import assert_same_kinematics as _assert_same_kinematics  # noqa: E402
 from convert_checks import close_pose as _close_pose  # noqa: E402
 
@@ -287,14 +287,9 @@ def test_kuka_adf_urdf_adf_round_trip_and_exact_losses(tmp_path):
     orig = load(ROBOTS / "blender-kuka.yaml")
     out = tmp_path / "kuka.urdf"
     losses = write(orig, out)
-    body_keys = {"collision groups", "collision margin", "damping", "friction"}
-    expected = [(b.identifier, k) for b in orig.bodies for k in sorted(body_keys)
-                if getattr(b, k.replace(" ", "_")) not in (None, [], False)]
-    expected += [(b.identifier, "passive") for b in orig.bodies if b.passive]
-    expected += [(b.identifier, "inertia") for b in orig.bodies if b.inertia is None and (b.mass or 0) > 0]
-    expected += [(j.identifier, "max motor impulse") for j in orig.joints if j.max_motor_impulse is not None]
-    expected += [(j.identifier, "controller") for j in orig.joints if j.controller is not None]
-    assert loss_keys(losses) == sorted(expected)
+    expected = expected_losses(orig, ("collision groups", "collision margin", "damping", "friction", "passive"),
+                               ("max motor impulse", "controller"))
+    assert loss_keys(losses) == expected
     assert len(losses) == 46  # friction, damping, margin, groups on 8 links; 7 inertias, 7 controllers
     back, read_losses = read(out)
     assert read_losses == []
