@@ -112,6 +112,21 @@ def test_atomic_write_keeps_the_old_file_on_failure(tmp_path, monkeypatch):
     assert [p.name for p in tmp_path.iterdir()] == ["m.yaml"]  # no temp file left behind
 
 
+def test_atomic_write_gives_new_files_the_umask_mode_and_keeps_an_existing_mode(tmp_path):
+    doc = ModelFile(bodies=[Body(identifier="BODY a", mass=1.0)])
+    old = os.umask(0o022)
+    try:
+        write_file(doc, tmp_path / "new.yaml")
+        assert (tmp_path / "new.yaml").stat().st_mode & 0o777 == 0o644  # not mkstemp's private 0600
+        kept = tmp_path / "kept.yaml"
+        kept.write_text("x\n")
+        kept.chmod(0o640)
+        write_file(doc, kept)
+        assert kept.stat().st_mode & 0o777 == 0o640
+    finally:
+        os.umask(old)
+
+
 def test_suturing_pad_scene_round_trips_and_counts(tmp_path):
     p = SuturingPadParams(thread_elements=40)
     launch = write_suturing_pad(tmp_path, p)
