@@ -27,6 +27,18 @@ def principal(tensor) -> tuple[tuple[float, float, float], Quat]:
     return (float(moments[0]), float(moments[1]), float(moments[2])), Quat.from_matrix(axes.tolist())
 
 
+def physical_problem(moments, rel: float = 1e-9) -> str | None:
+    """Why principal moments cannot belong to a rigid body (negative, or one larger than the
+    sum of the other two: the triangle inequality), or None when they can."""
+    a, b, c = moments
+    if min(moments) < 0.0:
+        return "include a negative moment"
+    tol = rel * max(a, b, c)
+    if a + b < c - tol or a + c < b - tol or b + c < a - tol:
+        return "break the triangle inequality"
+    return None
+
+
 def world_tensor(moments, rotation) -> np.ndarray:
     """R diag(m) Rᵀ for a principal frame with orientation ``rotation`` (a Quat)."""
     r = np.asarray(rotation.matrix())

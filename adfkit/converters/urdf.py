@@ -258,9 +258,8 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     if static_root:
         world = _unique("world", used)
         ET.SubElement(robot, "link", name=world)
-    elif main.origin.position.norm() > 1e-12 or main.origin.orientation.angle_to(Quat(0, 0, 0, 1)) > 1e-12:
-        losses.append(Loss(main.body.identifier, "location", "a floating URDF root has no world pose; "
-                                                             "pass it as the base pose when loading"))
+    else:
+        _root_frame_at_world(main)
     for lk in order:
         names[id(lk)] = _unique(_link_name(lk.body), used)
         _write_link(robot, model, lk, names[id(lk)], out_dir, losses)
@@ -284,6 +283,18 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     ET.indent(robot, "  ")
     text = '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
     return text, sorted(set(losses))
+
+
+def _root_frame_at_world(root: Link) -> None:
+    """A floating URDF root has no world pose, so its link frame is put where the world frame
+    is when the bodies stand at their `location`s: loaded at the origin (PyBullet's default
+    base pose) the robot stands where the ADF file puts it, and reading the URDF back gives
+    the same `location`s. Visual, collision and inertial origins carry the root's location."""
+    shift = root.origin
+    root.frame_in_body = shift.inverse()
+    root.origin = Pose()
+    for child in root.children:
+        child.origin = shift * child.origin
 
 
 def _root_of(link: Link) -> Link:
@@ -509,6 +520,10 @@ def _read_inertial(doc, el, frame: Pose, body: Body, losses) -> None:
                   [vals["ixz"], vals["iyz"], vals["izz"]]]
     (ix, iy, iz), rot = inertia_math.principal(tensor)
     body.inertia = Inertia(ix=ix, iy=iy, iz=iz)
+    problem = inertia_math.physical_problem((ix, iy, iz))
+    if problem:
+        losses.append(Loss(body.identifier, "inertia", f"principal moments {_vec((ix, iy, iz))} {problem}: "
+                                                       "kept as written; PyBullet sets such an inertia to zero"))
     offset = frame.inverse() * _pose_of(doc, inertial) * Pose(Vec3(), rot)
     body.inertial_offset = offset
 
