@@ -20,7 +20,7 @@ from pathlib import Path
 from ..adf.paths import collision_mesh_path, visual_mesh_path
 from ..adf.writer import atomic_write_text
 from ..diagnostics import AdfError, error
-from ..model.common import RGBA, Geometry, ShapeEntry
+from ..model.common import RGBA, Friction, Geometry, ShapeEntry
 from ..model.files import ModelFile
 from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
@@ -191,9 +191,23 @@ def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_
                 col = ET.SubElement(el, "collision")
                 _origin(col, to_link * prim.pose * local)
                 col.append(geo)
+    _body_only_losses(body, losses)
+
+
+def _body_only_losses(body: Body, losses: list[Loss]) -> None:
     for attr, key in _BODY_ONLY.items():
         if getattr(body, attr, None) not in (None, [], False):
-            losses.append(Loss(who, key, "URDF has no element for it"))
+            losses.append(Loss(body.identifier, key, "URDF has no element for it"))
+
+
+def _is_bare(model: ModelFile, body: Body) -> bool:
+    """A static body with nothing to show, collide or weigh, at the world origin: an empty
+    URDF link (what a URDF's `world` link reads as)."""
+    loc = body.location or Pose()
+    return (visual_mesh_path(model, body) is None and not body.shape and not body.compound_shape
+            and collision_primitives(body) is None and collision_mesh_path(model, body) is None
+            and body.inertia is None and loc.position.norm() < 1e-12
+            and loc.orientation.angle_to(Quat(0.0, 0.0, 0.0, 1.0)) < 1e-12)
 
 
 def _write_joint(robot: ET.Element, link: Link, name: str, parent: str, child: str, losses: list[Loss]) -> None:
@@ -255,14 +269,21 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     names: dict[int, str] = {}
     order = [lk for lk in tree.ordered() if _root_of(lk) is main]
     static_root = effective_mass(main.body) == 0.0
-    if static_root:
+    bare_root = static_root and _is_bare(model, main.body)
+    if bare_root:  # a shapeless static body at the origin is the world link itself
+        static_root = False
+    elif static_root:
         world = _unique("world", used)
         ET.SubElement(robot, "link", name=world)
     else:
         _root_frame_at_world(main)
     for lk in order:
         names[id(lk)] = _unique(_link_name(lk.body), used)
-        _write_link(robot, model, lk, names[id(lk)], out_dir, losses)
+        if bare_root and lk is main:
+            ET.SubElement(robot, "link", name=names[id(lk)])
+            _body_only_losses(lk.body, losses)
+        else:
+            _write_link(robot, model, lk, names[id(lk)], out_dir, losses)
     if static_root:
         el = ET.SubElement(robot, "joint", name=_unique(f"world_to_{names[id(main)]}", used), type="fixed")
         _origin(el, main.origin)
@@ -459,7 +480,12 @@ def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
                 world[name] = Pose()
         return world[name]
 
-    ground = {n for n, el in links.items() if n not in parent_of and _is_empty(el)}
+    # an empty root whose joints are all fixed is the world frame: its children are welded to
+    # the world (static ADF bodies); an empty root with moving joints stays, as a static body
+    fixed_only = {n: all(jel.get("type") == "fixed" for _c, (p, jel) in parent_of.items() if p == n) for n in links}
+    ground = {n for n, el in links.items()
+              if n not in parent_of and _is_empty(el) and fixed_only[n] and any(p == n for p, _j in parent_of.values())}
+    colors = _named_colors(doc, root)
     model = ModelFile()
     bodies: dict[str, Body] = {}
     frame_in_link: dict[str, Pose] = {}
@@ -478,15 +504,20 @@ def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
                 body.mesh, body.scale = _mesh_file(doc, mesh)
             else:
                 losses.append(Loss(who, "visual primitive", "ADF visual shapes are not read from URDF; collision kept"))
-            col = visuals[0].find("material/color")
+            mat = visuals[0].find("material")
+            col = mat.find("color") if mat is not None else None
             if col is not None:
                 r, g, b, a = _floats(doc, col, "rgba", 4)
                 body.color_rgba = RGBA(r=r, g=g, b=b, a=a)
-            elif visuals[0].find("material") is not None:
-                losses.append(Loss(who, "material", "named or textured URDF materials are not carried"))
+            elif mat is not None and mat.get("name") in colors:
+                r, g, b, a = colors[mat.get("name")]
+                body.color_rgba = RGBA(r=r, g=g, b=b, a=a)
+            if mat is not None and (mat.find("texture") is not None or (col is None and mat.get("name") not in colors)):
+                losses.append(Loss(who, "material", "URDF textures (and materials without a colour) are not carried"))
             for extra in visuals[1:]:
                 losses.append(Loss(who, "visual", "ADF has one visual mesh per body; extra visuals dropped"))
-        _read_inertial(doc, el, frame, body, losses)
+        _read_inertial(doc, el, frame, body, losses, quiet=name not in parent_of and _is_empty(el) and name == "world")
+        _read_contact(doc, el, body, losses)
         _read_collisions(doc, el, frame, body, losses)
         if parent_of.get(name, ("",))[0] in ground:
             if (body.mass or 0.0) != 0.0:
@@ -500,15 +531,53 @@ def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
     return model, sorted(set(losses))
 
 
+def _named_colors(doc: XmlDocument, root: ET.Element) -> dict[str, tuple[float, ...]]:
+    """The robot-level <material name=...><color rgba/></material> definitions."""
+    out = {}
+    for mat in root.findall("material"):
+        col = mat.find("color")
+        if mat.get("name") and col is not None:
+            out[mat.get("name")] = _floats(doc, col, "rgba", 4)
+    return out
+
+
+# PyBullet's <contact> extension (inside <link>) -> ADF body keys
+_CONTACT_KEPT = ("lateral_friction", "rolling_friction", "restitution", "inertia_scaling")
+
+
+def _read_contact(doc: XmlDocument, el: ET.Element, body: Body, losses: list[Loss]) -> None:
+    contact = el.find("contact")
+    if contact is None:
+        return
+    values = {}
+    for kid in contact:
+        if kid.tag in _CONTACT_KEPT:
+            values[kid.tag] = _floats(doc, kid, "value", 1)[0]
+        else:
+            losses.append(Loss(body.identifier, f"contact {kid.tag}", "PyBullet's <contact> extension: ADF has no such key"))
+    if "lateral_friction" in values or "rolling_friction" in values:
+        body.friction = Friction(static=values.get("lateral_friction"), rolling=values.get("rolling_friction"))
+    if "restitution" in values:
+        body.restitution = values["restitution"]
+    k = values.get("inertia_scaling")
+    if k is not None and k != 1.0 and body.inertia is not None:
+        i = body.inertia
+        body.inertia = Inertia(ix=i.ix * k, iy=i.iy * k, iz=i.iz * k)
+        losses.append(Loss(body.identifier, "contact inertia_scaling",
+                           f"PyBullet's inertia scaling ({k!r}) is folded into the ADF inertia"))
+
+
 def _is_empty(el: ET.Element) -> bool:
     return el.find("inertial") is None and el.find("visual") is None and el.find("collision") is None
 
 
-def _read_inertial(doc, el, frame: Pose, body: Body, losses) -> None:
+def _read_inertial(doc, el, frame: Pose, body: Body, losses, quiet: bool = False) -> None:
     inertial = el.find("inertial")
     if inertial is None:
         body.mass = 0.0
-        losses.append(Loss(body.identifier, "inertial", "no <inertial>: mass 0, which makes the ADF body static"))
+        if not quiet:  # an empty root link named world: static in PyBullet too
+            losses.append(Loss(body.identifier, "inertial", "no <inertial>: mass 0 as ROS reads it (PyBullet assumes 1 kg), which makes the "
+                                                           "ADF body static"))
         return
     m = inertial.find("mass")
     body.mass = _floats(doc, m, "value", 1)[0] if m is not None else 0.0
