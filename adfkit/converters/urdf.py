@@ -255,8 +255,10 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     if not roots:
         raise AdfError(error("convert-empty", "the model has no bodies; there is nothing to write as URDF",
                              model.where(), "convert a model file with at least one body"))
-    main = roots[0]
-    for other in roots[1:]:
+    # URDF holds one tree: the one with the most bodies (the first of equals, in file order)
+    sizes = {id(r): sum(1 for lk in tree.ordered() if _root_of(lk) is r) for r in roots}
+    main = max(roots, key=lambda r: sizes[id(r)])
+    for other in [r for r in roots if r is not main]:
         stack = [other]
         while stack:
             lk = stack.pop()
