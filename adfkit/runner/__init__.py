@@ -6,4 +6,7 @@ def __getattr__(name):
     if name in ("SimWorld", "Options"):
         from . import world
         return getattr(world, name)
+    if name in ("PSM", "PSMModelError"):
+        from . import psm
+        return getattr(psm, name)
     raise AttributeError(name)
