@@ -24,13 +24,12 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    import json
     import sys
     import tempfile
 
-    from ..adf import atomic_write_text, load_scene, parse_indices
+    from ..adf import load_scene, parse_indices
     from ..diagnostics import Severity
-    from ..report import Progress, print_diagnostics
+    from ..report import print_diagnostics
     from ..summary import format_summary, scene_summary
 
     if args.scene:
@@ -50,29 +49,17 @@ def run(args) -> int:
     if any(d.severity >= Severity.ERROR for d in diags):
         return 2
 
-    from ..runner.cameras import save_frames
+    from ..runner.play import play, summary, unstable
     from ..runner.world import Options, SimWorld
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     world = SimWorld(scene, Options())
     try:
-        steps = int(round(args.seconds / (world.dt * world.opt.control_substeps)))
-        with Progress(steps, "simulating") as bar:
-            world.run(args.seconds, bar)
-        report = world.report()
-        report["scene"] = str(launch)
-        report["diagnostics"] = [f"{d.rule}: {d.message}" for d in world.diagnostics]
-        report["frames"] = save_frames(world, out)
-        atomic_write_text(out / "report.json", json.dumps(report, indent=2))
+        report = play(world, args.seconds, out, True, str(launch))
     finally:
         world.close()
-    bad = report["nan"] or report["exploded"] or report["fell_through_floor"]
-    print(f"played {report['simulated_time_s']:.2f} s in {report['wall_time_s']:.2f} s "
-          f"({report['real_time_factor']:.2f}x real time): {report['bodies']} bodies, {report['joints']} joints, "
-          f"max constraint error {report['max_constraint_error_m'] * 1000:.3f} mm, "
-          + ("UNSTABLE" if bad else "stable"))
+    print(summary(report) + (", UNSTABLE" if unstable(report) else ", stable"))
     print(f"report: {(out / 'report.json').resolve()}")
     for f in report["frames"]:
         if f.endswith(".png"):
             print(f"image:  {(out / f).resolve()}")
-    return 1 if bad else 0
+    return 1 if unstable(report) else 0

@@ -2,7 +2,6 @@
 and write report.json plus each camera's RGB/depth/segmentation frames."""
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -19,7 +18,10 @@ def add_arguments(p) -> None:
     p.add_argument("--physics-hz", type=float, default=1000.0, help="physics rate (AMBF: 1000)")
     p.add_argument("--control-substeps", type=int, default=4,
                    help="physics steps per control step (springs, ghosts, gravity overrides); default 4")
-    p.add_argument("--solver-iterations", type=int, help="Bullet solver iterations (PyBullet default 50)")
+    p.add_argument("--solver-iterations", type=int, default=10,
+                   help="Bullet solver iterations (default 10: Bullet's, as AMBF; PyBullet's own is 50)")
+    p.add_argument("--contact-threshold", type=float,
+                   help="Bullet contact breaking threshold, m (default Bullet's 0.02; 0.001 plays small scenes faster)")
     p.add_argument("--gravity", help="override the world gravity, e.g. 0,0,-9.81")
     p.add_argument("--hole-friction", type=float, default=2.0, help="K of F = -K·v inside hole ghosts, N·s/m")
     p.add_argument("--no-frames", action="store_true", help="do not render camera frames")
@@ -30,15 +32,17 @@ def add_arguments(p) -> None:
 def run(args) -> int:
     from ..adf import load_scene, parse_indices
     from ..diagnostics import AdfError, Severity, error
-    from ..report import Progress, print_diagnostics
-    from ..runner.cameras import save_frames
+    from ..report import print_diagnostics
+    from ..runner.play import play, summary, unstable
     from ..runner.world import Options, SimWorld
 
     if not Path(args.path).is_file():
         raise AdfError(error("no-file", f"{args.path} does not exist", None, "give a launch, world or model file"))
-    if args.seconds <= 0 or args.physics_hz <= 0 or args.control_substeps < 1:
-        raise AdfError(error("bad-option", "--seconds, --physics-hz must be positive and --control-substeps ≥ 1",
-                             None, "e.g. --seconds 5 --physics-hz 1000"))
+    if (args.seconds <= 0 or args.physics_hz <= 0 or args.control_substeps < 1 or args.solver_iterations < 1
+            or (args.contact_threshold is not None and args.contact_threshold <= 0)):
+        raise AdfError(error("bad-option", "--seconds, --physics-hz and --contact-threshold must be positive, "
+                             "--control-substeps and --solver-iterations ≥ 1",
+                             None, "e.g. --seconds 5 --physics-hz 1000 --solver-iterations 10"))
     gravity = None
     if args.gravity:
         try:
@@ -53,32 +57,20 @@ def run(args) -> int:
     if any(d.severity >= Severity.ERROR for d in diags):
         return 2
     opt = Options(physics_hz=args.physics_hz, control_substeps=args.control_substeps,
-                  solver_iterations=args.solver_iterations, gravity=gravity, hole_friction=args.hole_friction,
+                  solver_iterations=args.solver_iterations, contact_threshold=args.contact_threshold,
+                  gravity=gravity, hole_friction=args.hole_friction,
                   ground=not args.no_ground)
     world = SimWorld(scene, opt, gui=args.gui)
     try:
         print_diagnostics(world.diagnostics, sys.stderr)
-        steps = int(round(args.seconds * args.physics_hz / args.control_substeps))
-        with Progress(steps, "simulating") as bar:
-            world.run(args.seconds, bar)
-        report = world.report()
-        report["scene"] = str(args.path)
-        report["diagnostics"] = [f"{d.rule}: {d.message}" for d in world.diagnostics]
-        if args.out:
-            out = Path(args.out)
-            out.mkdir(parents=True, exist_ok=True)
-            if not args.no_frames:
-                report["frames"] = save_frames(world, out)
-            from ..adf import atomic_write_text
-            atomic_write_text(out / "report.json", json.dumps(report, indent=2))
-        print(f"{report['bodies']} bodies, {report['joints']} joints, {report['steps']} steps, "
-              f"{report['simulated_time_s']:.2f} s simulated in {report['wall_time_s']:.2f} s "
-              f"({report['real_time_factor']:.2f}x real time); max constraint error "
-              f"{report['max_constraint_error_m'] * 1000:.3f} mm")
-        bad = report["nan"] or report["exploded"] or report["fell_through_floor"]
-        if bad:
-            print(f"unstable: nan {report['nan']}, exploded {report['exploded']}, "
-                  f"fell {report['fell_through_floor']}", file=sys.stderr)
-        return 1 if bad else 0
+        report = play(world, args.seconds, Path(args.out) if args.out else None, not args.no_frames, str(args.path))
     finally:
         world.close()
+    print(summary(report))
+    if args.out:
+        print(f"report: {(Path(args.out) / 'report.json').resolve()}")
+    if unstable(report):
+        print(f"unstable: nan {report['nan']}, exploded {report['exploded']}, "
+              f"fell {report['fell_through_floor']}", file=sys.stderr)
+        return 1
+    return 0

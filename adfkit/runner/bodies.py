@@ -41,14 +41,19 @@ class SimBody:
     def name(self) -> str:
         return self.body.name or self.body.identifier
 
-    def state(self):
-        """(position, quaternion, linear velocity, angular velocity) of the COM frame."""
+    def state(self, velocity: bool = True):
+        """(position, quaternion, linear velocity, angular velocity) of the COM frame; the
+        velocities are None when ``velocity`` is False (cheaper for multibody links)."""
         if self.link < 0:
             p, q = pb.getBasePositionAndOrientation(self.uid, physicsClientId=self.cid)
+            if not velocity:
+                return p, q, None, None
             v, w = pb.getBaseVelocity(self.uid, physicsClientId=self.cid)
             return p, q, v, w
-        s = pb.getLinkState(self.uid, self.link, computeLinkVelocity=1, computeForwardKinematics=1,
+        s = pb.getLinkState(self.uid, self.link, computeLinkVelocity=int(velocity), computeForwardKinematics=1,
                            physicsClientId=self.cid)
+        if not velocity:
+            return s[0], s[1], None, None
         return s[0], s[1], s[6], s[7]  # the COM frame: constraint pivots are relative to it
 
     def com_position(self):
@@ -59,7 +64,7 @@ class SimBody:
     def world_matrix(self) -> np.ndarray:
         """Pose of the ADF body frame (the mesh origin) in the world, 4×4."""
         from .rotations import invert, pose_matrix
-        p, q, _, _ = self.state()
+        p, q, _, _ = self.state(velocity=False)
         return pose_matrix(p, q) @ invert(self.com_in_body)
 
     def torque(self, t) -> None:

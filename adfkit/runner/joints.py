@@ -214,19 +214,23 @@ class SpringSet:
             f = -kl * (d - self.eq_lin) - cl * v_rel
             f += self._limit(d, v_rel, self.lin_low, self.lin_high, m_eff, dt, erp)
             force_w = np.where(self.free_lin[:, None], np.einsum("nij,nj->ni", ra, f), 0.0)
-        cid = self.cid
-        for n, j in enumerate(self.joints):
-            t = tau_w[n].tolist()
-            if not j.child.static:
-                j.child.torque(t)
-            if not j.parent.static:
-                j.parent.torque([-x for x in t])
-            if self.free_lin[n]:
-                f = force_w[n].tolist()
-                if not j.child.static:
-                    j.child.force(f, pbw[n].tolist())
-                if not j.parent.static:
-                    j.parent.force([-x for x in f], pbw[n].tolist())
+        # one net force and torque per body (a force at the pivot = the same force at the COM
+        # plus its moment about the COM): one PyBullet call each instead of one per joint end
+        nb = len(self.bodies)
+        torque = np.zeros((nb, 3))
+        force = np.zeros((nb, 3))
+        np.add.at(torque, self.ic, tau_w)
+        np.add.at(torque, self.ip, -tau_w)
+        if self.free_lin.any():
+            np.add.at(force, self.ic, force_w)
+            np.add.at(force, self.ip, -force_w)
+            np.add.at(torque, self.ic, np.cross(pbw - pos[self.ic], force_w))
+            np.add.at(torque, self.ip, np.cross(pbw - pos[self.ip], -force_w))
+        for i in np.flatnonzero(self.dynamic):
+            b = self.bodies[i]
+            b.torque(torque[i].tolist())
+            if self.free_lin.any():
+                b.force(force[i].tolist(), pos[i].tolist())
 
     @staticmethod
     def _limit(x, v, low, high, inertia, dt, erp):

@@ -34,7 +34,8 @@ SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIS
 class Options:
     physics_hz: float = 1000.0           # internal Bullet step (AMBF: fixed 1 ms)
     control_substeps: int = 4            # physics steps per control step (springs, ghosts, drives held between)
-    solver_iterations: int | None = None  # None: PyBullet default (50)
+    solver_iterations: int | None = 10    # Bullet's own default, which AMBF runs with (PyBullet raises it to 50)
+    contact_threshold: float | None = None  # Bullet's contact breaking threshold; None: its default 0.02
     gravity: tuple | None = None          # override the world's
     visuals: bool = True
     hole_friction: float = 2.0            # K of F = -K·v_rel inside hole ghosts, N·s/m
@@ -51,6 +52,8 @@ class SimGhost:
     pose_in_parent: np.ndarray       # ghost COM frame in the parent's PyBullet frame (or world)
     friction: bool = False
     overlapping: list = field(default_factory=list)
+    pq_in_parent: tuple = ()         # pose_in_parent as PyBullet (position, quaternion)
+    moves: bool = False              # a dynamic parent: the ghost follows it every step
 
 
 @dataclass(eq=False)
@@ -91,6 +94,10 @@ class SimWorld:
         params = dict(fixedTimeStep=self.dt * self.opt.control_substeps, numSubSteps=self.opt.control_substeps)
         if self.opt.solver_iterations:
             params["numSolverIterations"] = self.opt.solver_iterations
+        if self.opt.contact_threshold is not None:
+            # AABBs grow by it and contact points are made within (a size-scaled share of) it;
+            # a millimetre-sized scene plays ~1.4x faster at 0.001 (bench/run_suturing.py)
+            params["contactBreakingThreshold"] = self.opt.contact_threshold
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         self.registry = Registry()
         self.bodies: list[SimBody] = []
@@ -206,6 +213,21 @@ class SimWorld:
         if self.opt.ground and self.scene.world is None and self.scene.environment is None:
             self._add_ground()
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
+        self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
+        self._gravity_overrides = self._group_gravity_overrides()
+
+    def _group_gravity_overrides(self):
+        """Bodies whose gravity differs from the world's, grouped per multibody so each control
+        step reads their COMs with one getLinkStates call: [(uid, links, bodies, forces)]."""
+        groups: dict[int, list] = {}
+        for sb in self.bodies:
+            if sb.gravity is not None and not sb.static:
+                groups.setdefault(sb.uid, []).append(sb)
+        out = []
+        for uid, sbs in groups.items():
+            out.append((uid, [sb.link for sb in sbs], sbs,
+                        [(sb.mass * (sb.gravity - self.gravity)).tolist() for sb in sbs]))
+        return out
 
     def _add_ground(self) -> None:
         """A model played without a world gets what AMBF's worlds give it: a floor, here a
@@ -297,7 +319,9 @@ class SimWorld:
             name = (gh.name or gh.identifier).lower()
             friction = any(w in name for w in self.opt.hole_ghost_words)
             key = self.registry.add(merge_namespace(ns, gh.namespace) + gh.identifier, None)
-            self.ghosts.append(SimGhost(key, gh, uid, parent, rel, friction))
+            moves = parent is not None and not parent.static
+            self.ghosts.append(SimGhost(key, gh, uid, parent, rel, friction, pq_in_parent=matrix_to_pq(rel),
+                                        moves=moves))
 
     def _build_actuators(self, m) -> None:
         ns = m.namespace or ""
@@ -332,7 +356,7 @@ class SimWorld:
 
     def _frame(self, sb: SimBody) -> np.ndarray:
         """World pose of the PyBullet frame of a body."""
-        p, q, _, _ = sb.state()
+        p, q, _, _ = sb.state(velocity=False)
         return pose_matrix(p, q)
 
     def _floor(self) -> float:
@@ -353,16 +377,23 @@ class SimWorld:
         return hit
 
     def by_uid(self):
-        return {(sb.uid, sb.link): sb for sb in self.bodies}
+        """{(PyBullet uid, link): SimBody}"""
+        return self._lookup
 
     # ---- stepping ------------------------------------------------------------------------
     def control(self) -> None:
         """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors."""
         cdt = self.dt * self.opt.control_substeps
-        for sb in self.bodies:
-            if sb.gravity is not None and not sb.static:
-                f = (sb.mass * (sb.gravity - self.gravity)).tolist()
-                sb.force(f, list(sb.com_position()))
+        cid = self.cid
+        for uid, links, sbs, forces in self._gravity_overrides:
+            if links == [-1]:
+                coms = [pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0]]
+            else:
+                coms = [pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0] if k < 0 else s[0]
+                        for k, s in zip(links, pb.getLinkStates(uid, [max(k, 0) for k in links],
+                                                                computeForwardKinematics=1, physicsClientId=cid))]
+            for k, f, at in zip(links, forces, coms):
+                pb.applyExternalForce(uid, k, f, at, pb.WORLD_FRAME, physicsClientId=cid)
         self.springs.apply(cdt)
         self._update_ghosts()
         for s in self.sensors:
@@ -394,16 +425,17 @@ class SimWorld:
 
     # ---- ghosts, sensors, actuators -------------------------------------------------------
     def _update_ghosts(self) -> None:
-        lookup = None
+        lookup = self._lookup
+        cid = self.cid
         for g in self.ghosts:
-            if g.parent is not None:
-                pos, orn = matrix_to_pq(self._frame(g.parent) @ g.pose_in_parent)
-                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=self.cid)
-            lo, hi = pb.getAABB(g.uid, -1, physicsClientId=self.cid)
-            over = pb.getOverlappingObjects(lo, hi, physicsClientId=self.cid) or []
+            if g.moves:
+                p, q, _, _ = g.parent.state(velocity=False)
+                pos, orn = pb.multiplyTransforms(p, q, *g.pq_in_parent)
+                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=cid)
+            lo, hi = pb.getAABB(g.uid, -1, physicsClientId=cid)
+            over = pb.getOverlappingObjects(lo, hi, physicsClientId=cid) or []
             found = []
             if over:
-                lookup = lookup or self.by_uid()
                 for uid, link in over:
                     sb = lookup.get((uid, link))
                     if sb is None or sb.static or sb is g.parent:
@@ -430,7 +462,7 @@ class SimWorld:
         a = (t[:3, :3] @ s.starts.T).T + t[:3, 3]
         b = (t[:3, :3] @ s.ends.T).T + t[:3, 3]
         hits = pb.rayTestBatch(a.tolist(), b.tolist(), physicsClientId=self.cid)
-        lookup = self.by_uid()
+        lookup = self._lookup
         s.sensed = []
         for h in hits:
             sb = lookup.get((h[0], h[1]))

@@ -1,0 +1,117 @@
+"""`adfkit run` and `adfkit demo` end to end: real PyBullet, the files they leave behind, exit
+statuses and located errors for bad input."""
+from __future__ import annotations
+
+import json
+import textwrap
+
+import numpy as np
+import pytest
+
+from conftest import CORPUS, ROOT, require_corpus
+
+pytest.importorskip("pybullet")
+Image = pytest.importorskip("PIL.Image")
+
+from adfkit.cli import main  # noqa: E402
+
+BOX_AND_CAMERA = """
+bodies: [BODY box]
+cameras: [CAMERA cam]
+BODY box:
+  name: box
+  mass: 0.5
+  inertia: {ix: 1.0e-3, iy: 1.0e-3, iz: 1.0e-3}
+  location: {position: {x: 0.0, y: 0.0, z: 0.1}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.2, y: 0.2, z: 0.2}
+  shape: BOX
+  geometry: {x: 0.2, y: 0.2, z: 0.2}
+  color rgba: {r: 0.1, g: 0.8, b: 0.2, a: 1.0}
+CAMERA cam:
+  name: cam
+  location: {x: 1.0, y: 0.0, z: 0.1}
+  look at: {x: 0.0, y: 0.0, z: 0.1}
+  up: {x: 0.0, y: 0.0, z: 1.0}
+  clipping plane: {near: 0.01, far: 10.0}
+  field view angle: 0.7
+  publish image resolution: {width: 64, height: 48}
+"""
+
+
+@pytest.fixture
+def box_model(tmp_path):
+    p = tmp_path / "box.yaml"
+    p.write_text(textwrap.dedent(BOX_AND_CAMERA))
+    return p
+
+
+def test_run_writes_report_and_camera_frames(box_model, tmp_path, capsys):
+    out = tmp_path / "out"
+    rc = main(["run", str(box_model), "--seconds", "0.2", "--out", str(out)])
+    assert rc == 0
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["bodies"] == 1 and rep["steps"] == 200 and rep["simulated_time_s"] == pytest.approx(0.2)
+    assert rep["cameras"] == ["cam"] and rep["physics_hz"] == 1000.0
+    assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
+    # the box rests on the floor the runner puts under a model played alone
+    assert rep["ground_plane_z"] == pytest.approx(-0.001, abs=1e-6)
+    assert sorted(rep["frames"]) == ["cam_depth.npy", "cam_rgb.png", "cam_seg.npy", "cam_seg.png"]
+    rgb = np.asarray(Image.open(out / "cam_rgb.png"))
+    assert rgb.shape == (48, 64, 3) and rgb[24, 32, 1] > 2 * rgb[24, 32, 0]   # the green box in the middle
+    depth = np.load(out / "cam_depth.npy")
+    assert abs(float(depth[24, 32]) - 0.9) < 2e-3       # its near face, 0.1 m in front of its centre
+    seg = np.load(out / "cam_seg.npy")
+    assert seg[24, 32] == 0
+    printed = capsys.readouterr().out
+    assert "1 bodies" in printed and str((out / "report.json").resolve()) in printed
+
+
+def test_run_selects_launch_indices(tmp_path, capsys):
+    require_corpus()
+    out = tmp_path / "out"
+    rc = main(["run", str(CORPUS / "src" / "launch.yaml"), "-l", "6", "--seconds", "0.05", "--no-frames",
+               "--out", str(out)])
+    assert rc == 0
+    rep = json.loads((out / "report.json").read_text())
+    # psm1 alone, with the world's floor (its environment model)
+    assert rep["bodies"] == 11 and rep["joints"] == 8 and rep["multibodies"] == 1
+    assert rep["steps"] == 48   # 0.05 s in whole control steps of 4 ms
+    # the world's stereo pair hangs from the phantom's CameraFrame, which index 10 would load
+    assert "frames" not in rep and rep["cameras"] == []
+    assert capsys.readouterr().err.count("warning[runner-camera]") == 2
+
+
+def test_run_reports_an_unstable_scene_with_exit_status_1(box_model, capsys):
+    # 1000 m/s² and no floor: the box is past 10 m/s within the run
+    rc = main(["run", str(box_model), "--seconds", "0.1", "--gravity", "0,0,-1000", "--no-ground"])
+    assert rc == 1
+    assert "unstable" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--seconds", "0"], "--seconds"),
+    (["--solver-iterations", "0"], "--solver-iterations"),
+    (["--contact-threshold", "-1"], "--contact-threshold"),
+    (["--gravity", "0,0"], "is not x,y,z"),
+])
+def test_run_refuses_bad_options(box_model, capsys, args, said):
+    assert main(["run", str(box_model)] + args) == 2
+    assert said in capsys.readouterr().err
+
+
+def test_run_refuses_a_missing_file(tmp_path, capsys):
+    assert main(["run", str(tmp_path / "nothing.yaml")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+
+
+def test_demo_plays_the_bundled_scene(tmp_path, capsys):
+    out = tmp_path / "demo"
+    rc = main(["demo", "--scene", str(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"),
+               "--seconds", "0.1", "--out", str(out)])
+    assert rc == 0
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["steps"] == 100 and rep["bodies"] > 0
+    printed = capsys.readouterr().out
+    assert "stable" in printed and "image:" in printed
+    assert all((out / f).is_file() for f in rep["frames"])
