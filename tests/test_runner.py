@@ -195,3 +195,79 @@ def test_grasp_moves_needle_with_tool_and_release_drops_it():
         assert needle.com_position()[2] < z0 - 0.05
     finally:
         world.close()
+
+
+SLIDER_LOOP = """
+bodies: [BODY base, BODY a, BODY b]
+joints: [JOINT base-a, JOINT base-b, JOINT a-b]
+BODY base:
+  name: base
+  mass: 0.0
+  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.02, y: 0.02, z: 0.02}
+BODY a:
+  name: a
+  mass: 0.1
+  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
+  location: {position: {x: 0.0, y: 0.1, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.02, y: 0.02, z: 0.02}
+BODY b:
+  name: b
+  mass: 0.1
+  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
+  location: {position: {x: 0.0, y: 0.2, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.02, y: 0.02, z: 0.02}
+JOINT base-a:
+  name: base-a
+  parent: BODY base
+  child: BODY a
+  type: prismatic
+  parent pivot: {x: 0.0, y: 0.1, z: 0.0}
+  child pivot: {x: 0.0, y: 0.0, z: 0.0}
+  parent axis: {x: 1.0, y: 0.0, z: 0.0}
+  child axis: {x: 1.0, y: 0.0, z: 0.0}
+  joint limits: {low: -0.2, high: 0.2}
+JOINT base-b:
+  name: base-b
+  parent: BODY base
+  child: BODY b
+  type: prismatic
+  parent pivot: {x: 0.0, y: 0.2, z: 0.0}
+  child pivot: {x: 0.0, y: 0.0, z: 0.0}
+  parent axis: {x: 1.0, y: 0.0, z: 0.0}
+  child axis: {x: 1.0, y: 0.0, z: 0.0}
+  joint limits: {low: -0.2, high: 0.2}
+JOINT a-b:
+  name: a-b
+  parent: BODY a
+  child: BODY b
+  type: prismatic
+  parent pivot: {x: 0.0, y: 0.1, z: 0.0}
+  child pivot: {x: 0.0, y: 0.0, z: 0.0}
+  parent axis: {x: 1.0, y: 0.0, z: 0.0}
+  child axis: {x: 1.0, y: 0.0, z: 0.0}
+  joint limits: {low: -0.2, high: 0.2}
+"""
+
+
+def test_prismatic_joint_closing_a_loop_slides(tmp_path):
+    """A prismatic joint between two links of one multibody is a slider (PyBullet's multibody
+    slider constraint), not a fixed joint: one end moves 5 cm along the axis while the other
+    stays, and nothing opens across the axis."""
+    world = SimWorld(_model(tmp_path, SLIDER_LOOP), Options(gravity=(0, 0, 0), visuals=False, ground=False))
+    try:
+        assert not [d for d in world.diagnostics if d.rule == "runner-prismatic-loop"]
+        (art,) = world.articulations
+        a, b = world.body("BODY a"), world.body("BODY b")
+        b0 = np.array(b.com_position())
+        art.targets[art.joint_names.index("JOINT base-a")] = 0.05
+        art.drive()
+        world.run(1.0)
+        assert np.array(a.com_position()) == pytest.approx([0.05, 0.1, 0.0], abs=1e-3)
+        assert np.array(b.com_position()) == pytest.approx(b0, abs=1e-3)
+        assert world.report()["max_constraint_error_m"] < 1e-4
+    finally:
+        world.close()

@@ -115,13 +115,15 @@ def _static_frame(cid: int, body):
 
 
 def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray,
-                    max_force: float) -> list[tuple[int, np.ndarray, np.ndarray]]:
-    """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child frame)]."""
+                    max_force: float) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray | None]]:
+    """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child
+    frame, slide axis in the parent frame or None)]."""
     out = []
 
-    def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1)):
+    def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1), axis=None):
         try:
-            c = pb.createConstraint(parent.uid, parent.link, child.uid, child.link, jtype, [0, 0, 0],
+            c = pb.createConstraint(parent.uid, parent.link, child.uid, child.link, jtype,
+                                    list(map(float, axis)) if axis is not None else [0, 0, 0],
                                     list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
                                     physicsClientId=cid)
         except pb.error:
@@ -133,12 +135,19 @@ def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarra
             c = pb.createConstraint(child.uid, child.link, -1, -1, jtype, [0, 0, 0], list(map(float, pb_)),
                                     list(map(float, pw)), list(ob), list(ow), physicsClientId=cid)
         pb.changeConstraint(c, maxForce=max_force, physicsClientId=cid)
-        out.append((c, np.asarray(pa, float), np.asarray(pb_, float)))
+        out.append((c, np.asarray(pa, float), np.asarray(pb_, float), None if axis is None else np.asarray(axis, float)))
 
     if kind is JointKind.FIXED:
         pa, oa = matrix_to_pq(frame_a)
         pbp, ob = matrix_to_pq(frame_b)
         add(pb.JOINT_FIXED, pa, pbp, oa, ob)
+    elif kind is JointKind.PRISMATIC:
+        # between multibody links only (the caller checks): btMultiBodySliderConstraint, its
+        # axis given in the parent's link (COM) frame, along the joint's x axis as the
+        # multibody's own prismatic joints are (articulation.py); orientation held as it is
+        pa, oa = matrix_to_pq(frame_a)
+        pbp, ob = matrix_to_pq(frame_b)
+        add(pb.JOINT_PRISMATIC, pa, pbp, oa, ob, axis=frame_a[:3, 0])
     elif kind is JointKind.REVOLUTE:
         for s in (-HINGE_HALF_SPAN, HINGE_HALF_SPAN):
             add(pb.JOINT_POINT2POINT, frame_a[:3, 3] + s * frame_a[:3, 2], frame_b[:3, 3] + s * frame_b[:3, 2])

@@ -101,7 +101,7 @@ class SimWorld:
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         self.registry = Registry()
         self.bodies: list[SimBody] = []
-        self.constraints: list[tuple] = []   # (joint name, constraint id, parent, child, pivot a, pivot b)
+        self.constraints: list[tuple] = []   # (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self.articulations: list = []
         self.ghosts: list[SimGhost] = []
         self.actuators: list[SimActuator] = []
@@ -195,12 +195,13 @@ class SimWorld:
                 kind_c = JointKind.P2P
             else:
                 kind_c = kind
-            if kind is JointKind.PRISMATIC:
-                self._warn("runner-prismatic-loop", f"{j.identifier}: a prismatic joint outside a tree is "
-                           "not supported by PyBullet's maximal constraints; built as fixed", j)
+            if kind is JointKind.PRISMATIC and not (parent.articulation and child.articulation):
+                # PyBullet slides only between multibody links (btMultiBodySliderConstraint)
+                self._warn("runner-prismatic-loop", f"{j.identifier}: a prismatic joint closing a loop through "
+                           "a maximal-coordinate body is not supported by PyBullet's constraints; built as fixed", j)
                 kind_c = JointKind.FIXED
-            for c, pa, pbv in make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5):
-                self.constraints.append((j.identifier, c, parent, child, pa, pbv))
+            for c, pa, pbv, axis in make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5):
+                self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
         self.springs = SpringSet(springs, self.cid)
         for m in models:
             self._build_ghosts(m)
@@ -551,10 +552,14 @@ class SimWorld:
         """Largest distance, m, between the two pivots of any joint (constraints and springs
         with a locked linear range); multibody joints are exact."""
         worst = 0.0
-        for _, _, parent, child, pa, pbv in self.constraints:
+        for _, _, parent, child, pa, pbv, axis in self.constraints:
             a = self._frame(parent)
             b = self._frame(child)
-            worst = max(worst, float(np.linalg.norm((a[:3, :3] @ pa + a[:3, 3]) - (b[:3, :3] @ pbv + b[:3, 3]))))
+            gap = (a[:3, :3] @ pa + a[:3, 3]) - (b[:3, :3] @ pbv + b[:3, 3])
+            if axis is not None:   # a slider: only the gap across its axis is an error
+                u = a[:3, :3] @ axis
+                gap = gap - np.dot(gap, u) * u
+            worst = max(worst, float(np.linalg.norm(gap)))
         return worst
 
     def report(self) -> dict:
