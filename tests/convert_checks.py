@@ -10,7 +10,7 @@ import pytest
 
 from adfkit.adf.paths import visual_mesh_path
 from adfkit.converters.inertia import world_tensor
-from adfkit.converters.tree import build_tree
+from adfkit.model.tree import build_tree
 from adfkit.model.pose import Pose, Quat, Vec3
 from adfkit.model.semantics import JointKind, inertial_offset, joint_frames, joint_kind
 

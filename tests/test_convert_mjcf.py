@@ -14,7 +14,7 @@ from adfkit.adf.reader import load  # noqa: E402
 from adfkit.converters import mjcf, read, write  # noqa: E402
 from adfkit.converters.inertia import world_tensor  # noqa: E402
 from adfkit.converters.losses import loss_keys  # noqa: E402
-from adfkit.converters.tree import build_tree  # noqa: E402
+from adfkit.model.tree import build_tree  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
 from adfkit.model.semantics import inertial_offset  # noqa: E402
 from conftest import CORPUS  # noqa: E402

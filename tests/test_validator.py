@@ -110,6 +110,9 @@ EXAMPLES = {
     "joint-zero-axis": (CLEAN.replace("parent axis: {x: 0, y: 0, z: 1}", "parent axis: {x: 0, y: 0, z: 0}"), 18, "error"),
     "joint-same-body": (CLEAN.replace("child: BODY b", "child: BODY a"), 14, "warning"),
     "joint-limits": (CLEAN + "  joint limits: {low: 1.0, high: -1.0}\n", 20, "warning"),
+    "joint-pose": (CLEAN.replace("BODY a:\n", "BODY a:\n  location: {position: {x: 0, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 0}}\n")
+                   .replace("BODY b:\n", "BODY b:\n  location: {position: {x: 0.05, y: 0, z: 0}, "
+                            "orientation: {r: 0, p: 0, y: 0}}\n"), 9, "warning"),
     "spring-without-limits": (CLEAN.replace("type: revolute", "type: linear spring"), 15, "warning"),
     "dangling-reference": (CLEAN.replace("child: BODY b", "child: BODY nothing"), 14, "warning"),
     "ambiguous-reference": (CLEAN.replace("child: BODY b", "child: BODY"), 14, "warning"),
@@ -159,6 +162,46 @@ def test_rule_example(rule, tmp_path):
     assert hits, [str(d) for d in res.diagnostics]
     assert (hits[0].location.line, str(hits[0].severity)) == (line, severity), str(hits[0])
     assert hits[0].location.file == str(f)
+
+
+LOC = "  location: {{position: {{x: {x}, y: 0, z: 0}}, orientation: {{r: 0, p: 0, y: {yaw}}}}}\n"
+
+
+def _pose_case(tmp_path, x_b: float, yaw_b: float, limits: str = "") -> list:
+    text = (CLEAN.replace("BODY a:\n", "BODY a:\n" + LOC.format(x=0, yaw=0))
+            .replace("BODY b:\n", "BODY b:\n" + LOC.format(x=x_b, yaw=yaw_b)) + limits)
+    f = tmp_path / "pose.yaml"
+    f.write_text(text, encoding="utf-8")
+    return [d for d in validate_file(f).diagnostics if d.rule == "joint-pose"]
+
+
+def test_joint_pose_reports_children_off_their_joint_and_outside_limits(tmp_path):
+    # on the joint, turned about its axis within the limits: nothing
+    assert _pose_case(tmp_path, 0, 0.3, "  joint limits: {low: -0.5, high: 0.5}\n") == []
+    # within the add-on's 3-decimal rounding: nothing
+    assert _pose_case(tmp_path, 0.0015, 0.0) == []
+    # 5 cm off the pivot: located at the child's location, the distance given
+    (off,) = _pose_case(tmp_path, 0.05, 0.0)
+    assert off.location.line == 9 and "50.0 mm" in off.message and "'BODY b'" in off.message
+    # turned 1 rad about the axis with limits ±0.5: located at the limits, the value given
+    (lim,) = _pose_case(tmp_path, 0, 1.0, "  joint limits: {low: -0.5, high: 0.5}\n")
+    assert lim.location.line == 22 and "at 1 rad, outside its limits -0.5…0.5" in lim.message
+    # an angle outside the limits only by a whole turn is within them
+    assert _pose_case(tmp_path, 0, -1.0, "  joint limits: {low: 5.0, high: 5.5}\n") == []
+
+
+@pytest.mark.parametrize("rel, expected", [
+    (MB + "robots/blender-psm.yaml", 0), (MB + "robots/blender-kuka.yaml", 0),
+    (MB + "robots/blender-kuka-lbr-med.yaml", 1), (MB + "grippers/resistive/gripper3/gripper.yaml", 2),
+    ("src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", 0), ("src/ADF/Phantoms/Simple/phantom.yaml", 0),
+])
+def test_joint_pose_on_the_corpus(corpus, rel, expected):
+    hits = [d for d in validate_file(corpus / rel).diagnostics if d.rule == "joint-pose"]
+    assert len(hits) == expected, [str(d) for d in hits]
+    if "lbr-med" in rel:
+        assert "1000.0 mm" in hits[0].message   # Link1 a metre from where base-Link1 puts it
+    if "gripper3" in rel:
+        assert all("-0.676 rad, outside its limits -1.2…-0.8" in d.message for d in hits)
 
 
 def test_primitive_geometry_keys_are_required_per_shape(tmp_path):

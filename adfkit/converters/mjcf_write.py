@@ -25,7 +25,7 @@ from ..model.semantics import (
 )
 from . import inertia as inertia_math
 from .losses import Loss
-from .tree import Link, build_tree, motion
+from ..model.tree import Link, build_tree, motion
 from .urdf import INITIAL_VALUE_TOLERANCE, _AXIS_TO_Z, _BODY_ONLY, _link_name, _joint_name, _material, _num, _unique, _vec
 
 # Moving bodies need mass and inertia above MuJoCo's mjMINVAL; massless ADF links get this.

@@ -30,7 +30,7 @@ from ..model.semantics import (
 from . import inertia as inertia_math
 from .losses import Loss
 from .safexml import XmlDocument, parse_xml
-from .tree import Link, build_tree
+from ..model.tree import Link, build_tree
 
 # --- writing ------------------------------------------------------------------------------
 

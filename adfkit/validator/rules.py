@@ -59,6 +59,9 @@ _RULES = [
     Rule("joint-same-body", W, "A joint's parent and child are the same body", "`parent: BODY a`, `child: BODY a`"),
     Rule("joint-limits", W, "Limits incomplete, low > high, or missing the six-dof / cone-twist structure",
          "`joint limits: {low: 1, high: -1}`"),
+    Rule("joint-pose", W, "The bodies' `location`s put a revolute/prismatic joint outside its limits, or "
+         "the child off the joint (AMBF moves it on the first step)",
+         "a child body 5 cm from its parent's pivot"),
     Rule("spring-without-limits", W, "A spring joint without limits stays locked", "`type: linear spring` and no limits"),
     Rule("dangling-reference", W, "A parent/child/chassis/root link names no body (AMBF skips the object)",
          "`child: BODY nonexistent`"),

@@ -37,6 +37,9 @@ def adf_keys(node) -> frozenset:
 
 SPRINGS = {JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING}
 ONE_DOF = {JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING}
+TREE_ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+POSE_TOLERANCE = 2e-3   # m, and rad for limits: beyond the add-on's 3-decimal rounding of locations and pivots
+POSE_ANGLE_TOLERANCE = math.radians(1.0)
 ABSURD = 1e6
 # Keys whose magnitudes may legitimately be large (gains, impulses, stiffness, powers).
 UNBOUNDED_KEYS = {"stiffness", "damping", "P", "I", "D", "max motor impulse", "max impulse", "max force",
@@ -177,6 +180,7 @@ class Checker:
         earlier = body_registry(self.context)
         for j in m.joints:
             self.joint(m, j, own, earlier)
+        self.joint_poses(m)
         for s in [*m.sensors, *m.actuators]:
             self.sensor(s)
             self.reference(m, s, "parent", own, earlier, immediate=True)
@@ -327,6 +331,39 @@ class Checker:
                 self.emit("static-joint", f"joint '{j.identifier}': child '{j.child}' is static (mass 0) under a "
                           "moving parent", j.where("child"), "give the child a mass")
 
+    def joint_poses(self, m: ModelFile) -> None:
+        """Where the file's `location`s put each revolute/prismatic joint of the kinematic
+        tree: within its limits, and with the child on the joint (its pose reproduced by the
+        parent's location and one joint value)."""
+        if not any(joint_kind(j.type) in TREE_ONE_DOF for j in m.joints):
+            return
+        from ..model.tree import build_tree, motion
+        tree = build_tree(m)
+        for link in tree.ordered():
+            j, parent = link.joint, link.parent
+            if link.kind not in TREE_ONE_DOF or j is None or not j.defined:
+                continue
+            if link.body.location is None or parent.body.location is None:
+                continue
+            unit = "rad" if link.kind is JointKind.REVOLUTE else "m"
+            lim = j.joint_limits
+            if (lim is not None and lim.low is not None and lim.high is not None and lim.low <= lim.high
+                    and not _within(link.q0, lim.low, lim.high, link.kind is JointKind.REVOLUTE)):
+                self.emit("joint-pose", f"the locations of '{parent.body.identifier}' and '{link.body.identifier}' put "
+                          f"joint '{j.identifier}' at {link.q0:.4g} {unit}, outside its limits {lim.low:g}…{lim.high:g}; "
+                          "AMBF's limit moves the child on the first step", j.where("joint limits"),
+                          "move the child body to a pose within the limits, or widen the limits")
+            fits = (parent.body.location * parent.frame_in_body * link.origin * motion(link.kind, link.q0)
+                    * link.frame_in_body.inverse())
+            off = (fits.position - link.body.location.position).norm()
+            turn = fits.orientation.angle_to(link.body.location.orientation)
+            if off > POSE_TOLERANCE or turn > POSE_ANGLE_TOLERANCE:
+                self.emit("joint-pose", f"'{link.body.identifier}' is not where joint '{j.identifier}' puts it: "
+                          f"{off * 1000:.1f} mm and {math.degrees(turn):.1f}° away at the best joint value "
+                          f"({link.q0:.4g} {unit}); AMBF snaps it onto the joint on the first step",
+                          link.body.where("location"), "fix the body's location or the joint's pivots and axes "
+                          "(the Blender add-on writes both from the scene)")
+
     def reference(self, m, obj, key: str, own: Registry, earlier: Registry, *, immediate: bool,
                   world_only: bool = False, owner=None):
         text = getattr(obj, key)
@@ -419,6 +456,12 @@ class Checker:
             if dev.defined and not dev.hardware_name:
                 self.emit("input-device", f"input device '{dev.identifier}' has no 'hardware name'; AMBF skips it",
                           dev.where(), "add `hardware name:` with the CHAI3D driver's model name")
+
+
+def _within(q: float, low: float, high: float, angular: bool) -> bool:
+    """q within [low, high] (to POSE_TOLERANCE), for an angle at any turn."""
+    turns = (-1, 0, 1) if angular else (0,)
+    return any(low - POSE_TOLERANCE <= q + 2 * math.pi * k <= high + POSE_TOLERANCE for k in turns)
 
 
 def check(doc, context_models=()) -> list[Diagnostic]:

@@ -1,4 +1,4 @@
-"""The kinematic tree of an ADF model, as URDF and MJCF need it.
+"""The kinematic tree of an ADF model: what URDF and MJCF need, and what the validator checks.
 
 ADF places every body in the world (`location`) and joins bodies by joints whose frames
 A (in the parent body) and B (in the child body) coincide at joint value zero
@@ -6,7 +6,8 @@ A (in the parent body) and B (in the child body) coincide at joint value zero
 its parent through the joint*. This module chooses a spanning tree, gives every body a
 **link frame** (its joint frame B; the body frame for a root), the joint origin in the
 parent's link frame, the initial joint value that reproduces the file's `location`s, and
-forward kinematics. Both converters build on it; nothing here knows a file format.
+forward kinematics. The converters and the validator build on it; nothing here knows a file
+format.
 """
 from __future__ import annotations
 
@@ -14,10 +15,10 @@ import math
 from collections import defaultdict
 from dataclasses import dataclass, field
 
-from ..model.files import ModelFile
-from ..model.objects import Body, Joint
-from ..model.pose import Pose, Quat, Vec3
-from ..model.semantics import JointKind, effective_mass, joint_frames, joint_kind, reference_axis
+from .files import ModelFile
+from .objects import Body, Joint
+from .pose import Pose, Quat, Vec3
+from .semantics import JointKind, effective_mass, joint_frames, joint_kind, reference_axis
 
 ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
 
