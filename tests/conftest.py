@@ -33,3 +33,30 @@ def corpus() -> Path:
 def require_corpus() -> None:
     if not CORPUS.is_dir():
         pytest.skip(SKIP_CORPUS)
+
+
+def box_camera_model(mass: float = 0.0, z: float = 0.0, rgb=(0.9, 0.2, 0.1)) -> str:
+    """A 0.2 m box at height ``z`` and a 64x48 camera 1 m away on +x looking at its centre."""
+    r, g, b = rgb
+    return f"""
+bodies: [BODY box]
+cameras: [CAMERA cam]
+BODY box:
+  name: box
+  mass: {mass}
+  inertia: {{ix: 1.0e-3, iy: 1.0e-3, iz: 1.0e-3}}
+  location: {{position: {{x: 0.0, y: 0.0, z: {z}}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+  collision shape: BOX
+  collision geometry: {{x: 0.2, y: 0.2, z: 0.2}}
+  shape: BOX
+  geometry: {{x: 0.2, y: 0.2, z: 0.2}}
+  color rgba: {{r: {r}, g: {g}, b: {b}, a: 1.0}}
+CAMERA cam:
+  name: cam
+  location: {{x: 1.0, y: 0.0, z: {z}}}
+  look at: {{x: 0.0, y: 0.0, z: {z}}}
+  up: {{x: 0.0, y: 0.0, z: 1.0}}
+  clipping plane: {{near: 0.01, far: 10.0}}
+  field view angle: 0.7
+  publish image resolution: {{width: 64, height: 48}}
+"""

@@ -8,35 +8,14 @@ import textwrap
 import numpy as np
 import pytest
 
-from conftest import CORPUS, ROOT, require_corpus
+from conftest import CORPUS, ROOT, box_camera_model, require_corpus
 
 pytest.importorskip("pybullet")
 Image = pytest.importorskip("PIL.Image")
 
 from adfkit.cli import main  # noqa: E402
 
-BOX_AND_CAMERA = """
-bodies: [BODY box]
-cameras: [CAMERA cam]
-BODY box:
-  name: box
-  mass: 0.5
-  inertia: {ix: 1.0e-3, iy: 1.0e-3, iz: 1.0e-3}
-  location: {position: {x: 0.0, y: 0.0, z: 0.1}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
-  collision shape: BOX
-  collision geometry: {x: 0.2, y: 0.2, z: 0.2}
-  shape: BOX
-  geometry: {x: 0.2, y: 0.2, z: 0.2}
-  color rgba: {r: 0.1, g: 0.8, b: 0.2, a: 1.0}
-CAMERA cam:
-  name: cam
-  location: {x: 1.0, y: 0.0, z: 0.1}
-  look at: {x: 0.0, y: 0.0, z: 0.1}
-  up: {x: 0.0, y: 0.0, z: 1.0}
-  clipping plane: {near: 0.01, far: 10.0}
-  field view angle: 0.7
-  publish image resolution: {width: 64, height: 48}
-"""
+BOX_AND_CAMERA = box_camera_model(mass=0.5, z=0.1, rgb=(0.1, 0.8, 0.2))
 
 
 @pytest.fixture

@@ -7,7 +7,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from conftest import CORPUS, require_corpus
+from conftest import CORPUS, box_camera_model, require_corpus
 
 pb = pytest.importorskip("pybullet")
 
@@ -81,27 +81,7 @@ def _model(tmp_path, text: str):
     return load_scene(p)
 
 
-BOX_CAMERA = """
-bodies: [BODY box]
-cameras: [CAMERA cam]
-BODY box:
-  name: box
-  mass: 0.0
-  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
-  collision shape: BOX
-  collision geometry: {x: 0.2, y: 0.2, z: 0.2}
-  shape: BOX
-  geometry: {x: 0.2, y: 0.2, z: 0.2}
-  color rgba: {r: 0.9, g: 0.2, b: 0.1, a: 1.0}
-CAMERA cam:
-  name: cam
-  location: {x: 1.0, y: 0.0, z: 0.0}
-  look at: {x: 0.0, y: 0.0, z: 0.0}
-  up: {x: 0.0, y: 0.0, z: 1.0}
-  clipping plane: {near: 0.01, far: 10.0}
-  field view angle: 0.7
-  publish image resolution: {width: 64, height: 48}
-"""
+BOX_CAMERA = box_camera_model()
 
 
 def test_camera_depth_segmentation_rgb(tmp_path):
@@ -197,60 +177,24 @@ def test_grasp_moves_needle_with_tool_and_release_drops_it():
         world.close()
 
 
-SLIDER_LOOP = """
-bodies: [BODY base, BODY a, BODY b]
-joints: [JOINT base-a, JOINT base-b, JOINT a-b]
-BODY base:
-  name: base
-  mass: 0.0
-  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
-  collision shape: BOX
-  collision geometry: {x: 0.02, y: 0.02, z: 0.02}
-BODY a:
-  name: a
-  mass: 0.1
-  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
-  location: {position: {x: 0.0, y: 0.1, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
-  collision shape: BOX
-  collision geometry: {x: 0.02, y: 0.02, z: 0.02}
-BODY b:
-  name: b
-  mass: 0.1
-  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
-  location: {position: {x: 0.0, y: 0.2, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
-  collision shape: BOX
-  collision geometry: {x: 0.02, y: 0.02, z: 0.02}
-JOINT base-a:
-  name: base-a
-  parent: BODY base
-  child: BODY a
-  type: prismatic
-  parent pivot: {x: 0.0, y: 0.1, z: 0.0}
-  child pivot: {x: 0.0, y: 0.0, z: 0.0}
-  parent axis: {x: 1.0, y: 0.0, z: 0.0}
-  child axis: {x: 1.0, y: 0.0, z: 0.0}
-  joint limits: {low: -0.2, high: 0.2}
-JOINT base-b:
-  name: base-b
-  parent: BODY base
-  child: BODY b
-  type: prismatic
-  parent pivot: {x: 0.0, y: 0.2, z: 0.0}
-  child pivot: {x: 0.0, y: 0.0, z: 0.0}
-  parent axis: {x: 1.0, y: 0.0, z: 0.0}
-  child axis: {x: 1.0, y: 0.0, z: 0.0}
-  joint limits: {low: -0.2, high: 0.2}
-JOINT a-b:
-  name: a-b
-  parent: BODY a
-  child: BODY b
-  type: prismatic
-  parent pivot: {x: 0.0, y: 0.1, z: 0.0}
-  child pivot: {x: 0.0, y: 0.0, z: 0.0}
-  parent axis: {x: 1.0, y: 0.0, z: 0.0}
-  child axis: {x: 1.0, y: 0.0, z: 0.0}
-  joint limits: {low: -0.2, high: 0.2}
-"""
+def _box(name: str, mass: float, y: float) -> str:
+    inertia = "  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}\n" if mass else ""
+    return (f"BODY {name}:\n  name: {name}\n  mass: {mass}\n{inertia}"
+            f"  location: {{position: {{x: 0.0, y: {y}, z: 0.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
+            "  collision shape: BOX\n  collision geometry: {x: 0.02, y: 0.02, z: 0.02}\n")
+
+
+def _slider(parent: str, child: str, y: float) -> str:
+    return (f"JOINT {parent}-{child}:\n  name: {parent}-{child}\n  parent: BODY {parent}\n  child: BODY {child}\n"
+            f"  type: prismatic\n  parent pivot: {{x: 0.0, y: {y}, z: 0.0}}\n  child pivot: {{x: 0.0, y: 0.0, z: 0.0}}\n"
+            "  parent axis: {x: 1.0, y: 0.0, z: 0.0}\n  child axis: {x: 1.0, y: 0.0, z: 0.0}\n"
+            "  joint limits: {low: -0.2, high: 0.2}\n")
+
+
+# base -> a and base -> b slide along x; a -> b, also along x, closes the loop
+SLIDER_LOOP = ("bodies: [BODY base, BODY a, BODY b]\njoints: [JOINT base-a, JOINT base-b, JOINT a-b]\n"
+               + _box("base", 0.0, 0.0) + _box("a", 0.1, 0.1) + _box("b", 0.1, 0.2)
+               + _slider("base", "a", 0.1) + _slider("base", "b", 0.2) + _slider("a", "b", 0.1))
 
 
 def test_prismatic_joint_closing_a_loop_slides(tmp_path):
