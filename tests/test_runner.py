@@ -136,6 +136,55 @@ def test_ghost_viscous_friction_matches_exponential(tmp_path):
         world.close()
 
 
+CARRIED_GHOST = """
+bodies: [BODY carrier, BODY probe]
+ghost objects: [GHOST finger]
+BODY carrier:
+  name: carrier
+  mass: 0.1
+  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
+  location: {position: {x: 0.0, y: 0.05, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: SPHERE
+  collision geometry: {radius: 0.002}
+  damping: {linear: 0.0, angular: 0.0}
+BODY probe:
+  name: probe
+  mass: 0.1
+  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
+  location: {position: {x: 0.05, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: SPHERE
+  collision geometry: {radius: 0.002}
+GHOST finger:
+  name: finger_ghost
+  parent: BODY carrier
+  location: {position: {x: 0.0, y: -0.05, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.01, y: 0.01, z: 0.01}
+"""
+
+
+def test_a_carried_ghost_senses_where_its_parent_has_taken_it(tmp_path):
+    """A ghost without friction is placed on its moving parent when asked (not every step):
+    it finds the probe only once the carrier has brought it there, 5 cm along x."""
+    world = SimWorld(_model(tmp_path, CARRIED_GHOST), Options(gravity=(0, 0, 0), visuals=False))
+    try:
+        g = world.ghosts[0]
+        carrier, probe = world.body("carrier"), world.body("probe")
+        assert g.moves and not g.friction
+        assert world.overlapping(g) == []
+        pb.resetBaseVelocity(carrier.uid, [0.1, 0, 0], [0, 0, 0], physicsClientId=world.cid)
+        world.run(0.5)
+        assert world.overlapping(g) == [probe]
+        ghost_at = pb.getBasePositionAndOrientation(g.uid, physicsClientId=world.cid)[0]
+        carrier_at = carrier.com_position()
+        assert np.allclose(np.array(ghost_at) - carrier_at, [0, -0.05, 0], atol=1e-9)
+        assert carrier_at[0] == pytest.approx(0.05, abs=1e-4)
+        world.run(0.2)   # carried past the probe: empty again
+        assert world.overlapping(g) == []
+    finally:
+        world.close()
+
+
 def test_grasp_moves_needle_with_tool_and_release_drops_it():
     """The suturing scene's grasp: the needle placed between the jaws of an inserted tool,
     the jaws close, the actuator fixes it; a 5 cm Cartesian move through the closed-form IK

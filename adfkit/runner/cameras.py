@@ -48,6 +48,7 @@ class SimCamera:
 
     def render(self, world) -> dict:
         """{'rgb': H×W×3 uint8, 'depth': H×W float32 m, 'segmentation': H×W int32 (body index, -1 none)}."""
+        world.place_ghosts()
         eye, target, up = self.view(world)
         vm = pb.computeViewMatrix(eye, target, up, physicsClientId=world.cid)
         pm = pb.computeProjectionMatrixFOV(math.degrees(self.fov), self.width / self.height, self.near, self.far,

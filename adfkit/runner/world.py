@@ -83,6 +83,7 @@ class SimWorld:
         self.scene = scene
         self.opt = options or Options()
         self.diagnostics: list[Diagnostic] = []
+        self.gui = gui
         self.cid = pb.connect(pb.GUI if gui else pb.DIRECT)
         self.dt = 1.0 / self.opt.physics_hz
         w = scene.world
@@ -216,6 +217,7 @@ class SimWorld:
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
         self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
         self._gravity_overrides = self._group_gravity_overrides()
+        self._friction_ghosts = [g for g in self.ghosts if g.friction]
 
     def _group_gravity_overrides(self):
         """Bodies whose gravity differs from the world's, grouped per multibody so each control
@@ -426,26 +428,43 @@ class SimWorld:
 
     # ---- ghosts, sensors, actuators -------------------------------------------------------
     def _update_ghosts(self) -> None:
-        lookup = self._lookup
-        cid = self.cid
-        for g in self.ghosts:
-            if g.moves:
-                p, q, _, _ = g.parent.state(velocity=False)
-                pos, orn = pb.multiplyTransforms(p, q, *g.pq_in_parent)
-                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=cid)
-            lo, hi = pb.getAABB(g.uid, -1, physicsClientId=cid)
-            over = pb.getOverlappingObjects(lo, hi, physicsClientId=cid) or []
-            found = []
-            if over:
-                for uid, link in over:
-                    sb = lookup.get((uid, link))
-                    if sb is None or sb.static or sb is g.parent:
-                        continue
-                    if pb.getClosestPoints(g.uid, uid, 0.0, -1, link, physicsClientId=self.cid):
-                        found.append(sb)
-            g.overlapping = found
-            if g.friction and found:
+        """Hole ghosts (the ones with viscous friction) sense every control step; the others
+        only when asked (overlapping()): a moving ghost costs a pose reset and a distance query
+        per nearby body, and the PSMs' finger ghosts are only read when grasping."""
+        if self.gui:
+            self.place_ghosts()
+        for g in self._friction_ghosts:
+            found = self.overlapping(g)
+            if found:
                 self._viscous(g, found)
+
+    def place_ghosts(self) -> None:
+        """Move every ghost with a moving parent to it (before a picture is taken)."""
+        for g in self.ghosts:
+            self._place(g)
+
+    def _place(self, g: SimGhost) -> None:
+        if g.moves:
+            p, q, _, _ = g.parent.state(velocity=False)
+            pos, orn = pb.multiplyTransforms(p, q, *g.pq_in_parent)
+            pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=self.cid)
+
+    def overlapping(self, g: SimGhost) -> list[SimBody]:
+        """The dynamic bodies inside ghost ``g`` now (moved to its parent first); also kept in
+        ``g.overlapping``."""
+        cid = self.cid
+        self._place(g)
+        lo, hi = pb.getAABB(g.uid, -1, physicsClientId=cid)
+        found = []
+        lookup = self._lookup
+        for uid, link in pb.getOverlappingObjects(lo, hi, physicsClientId=cid) or ():
+            sb = lookup.get((uid, link))
+            if sb is None or sb.static or sb is g.parent:
+                continue
+            if pb.getClosestPoints(g.uid, uid, 0.0, -1, link, physicsClientId=cid):
+                found.append(sb)
+        g.overlapping = found
+        return found
 
     def _viscous(self, g: SimGhost, found) -> None:
         """F = -K·(v_body - v_phantom) on every body inside a hole ghost (the paper's needle friction)."""
@@ -521,8 +540,7 @@ class SimWorld:
             art.targets[i] = 0.0
         if art is not None:
             art.drive()
-        self._update_ghosts()
-        found = [b for g in self.ghosts if psm in g.key for b in g.overlapping]
+        found = [b for g in self.ghosts if psm in g.key for b in self.overlapping(g)]
         found += [b for s in self.sensors if psm in s.key for b in s.sensed]
         own = {id(b) for b in self.bodies if b.articulation is not None and b.articulation is art}
         found = [b for b in found if id(b) not in own]
