@@ -7,18 +7,13 @@ import numpy as np
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
     """(..., 4) quaternions → (..., 3, 3) rotation matrices."""
     q = np.asarray(q, dtype=float)
-    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    out = np.empty(q.shape[:-1] + (3, 3))
-    out[..., 0, 0] = 1 - 2 * (y * y + z * z)
-    out[..., 0, 1] = 2 * (x * y - z * w)
-    out[..., 0, 2] = 2 * (x * z + y * w)
-    out[..., 1, 0] = 2 * (x * y + z * w)
-    out[..., 1, 1] = 1 - 2 * (x * x + z * z)
-    out[..., 1, 2] = 2 * (y * z - x * w)
-    out[..., 2, 0] = 2 * (x * z - y * w)
-    out[..., 2, 1] = 2 * (y * z + x * w)
-    out[..., 2, 2] = 1 - 2 * (x * x + y * y)
-    return out
+    x, y, z, w = np.moveaxis(q, -1, 0)
+    xx, yy, zz = x * x, y * y, z * z
+    xy, xz, yz, xw, yw, zw = x * y, x * z, y * z, x * w, y * w, z * w
+    m = np.stack([1 - 2 * (yy + zz), 2 * (xy - zw), 2 * (xz + yw),
+                  2 * (xy + zw), 1 - 2 * (xx + zz), 2 * (yz - xw),
+                  2 * (xz - yw), 2 * (yz + xw), 1 - 2 * (xx + yy)], axis=-1)
+    return m.reshape(q.shape[:-1] + (3, 3))
 
 
 def matrix_to_quat(m: np.ndarray) -> np.ndarray:
