@@ -215,20 +215,58 @@ def _read_joint(m, b: int, names, bodies, world_pose, frames, model: ModelFile, 
         _add_joint(model, f"{names[parent_id]}-{names[b]}", "fixed", bodies[parent_id], child,
                    world_pose[parent_id].inverse() * world_pose[b], Vec3(), Vec3(0.0, 0.0, 1.0), 0.0, None, losses)
         return
-    if n > 1:
-        losses.append(Loss(child.identifier, "joints", f"{n} joints on one body; ADF joins two bodies by one "
-                                                       "joint: only the first is kept"))
-    j = adr
+    if int(m.jnt_type[adr]) == FREE:
+        return  # a free body: no ADF joint (MuJoCo allows a free joint only alone)
+    # Several joints on one body act in order, each about axes of the frame the previous ones
+    # turned, and at qpos0 every one of them is the identity (MuJoCo applies qpos - qpos0): so
+    # they are a chain through bodies that all sit at the body frame at qpos0. ADF joins two
+    # bodies by one joint, and a dynamic ADF body needs a mass: the added ones get 1 %.
+    body_frame = world_pose[b] * frames[b].inverse()
+    used = {x.name for x in model.bodies}
+    previous, previous_pose = bodies[parent_id], world_pose[parent_id]
+    added = []
+    for k, j in enumerate(range(adr, adr + n)):
+        jname = m.joint(j).name or (f"{names[b]}_joint" if n == 1 else f"{names[b]}_joint{k}")
+        if k == n - 1:
+            nxt, nxt_pose, to_body = child, world_pose[b], frames[b].inverse()
+        else:
+            nxt = _chain_body(m, b, _unique(f"{names[b]}_{jname}", used), body_frame)
+            model.bodies.append(nxt)
+            added.append(nxt.name)
+            nxt_pose, to_body = body_frame, Pose()
+        _read_one_joint(m, j, jname, previous, nxt, previous_pose.inverse() * nxt_pose, to_body, model, losses)
+        previous, previous_pose = nxt, nxt_pose
+    if added:
+        losses.append(Loss(child.identifier, "joints", f"{n} joints on one body; ADF joins two bodies by one joint: "
+                                                       f"built as a chain through {', '.join(added)} (1 % of the "
+                                                       "body's mass and inertia each)"))
+
+
+def _unique(name: str, used: set) -> str:
+    out, i = name, 2
+    while out in used:
+        out, i = f"{name}{i}", i + 1
+    used.add(out)
+    return out
+
+
+def _chain_body(m, b: int, name: str, frame: Pose) -> Body:
+    """A shapeless body between two of a multi-joint body's joints, at the body frame."""
+    mass = max(0.01 * float(m.body_mass[b]), 1e-6)
+    i = max(0.01 * float(sum(m.body_inertia[b])) / 3.0, 1e-9)
+    return Body(identifier=f"BODY {name}", name=name, location=frame, mass=mass,
+                inertia=Inertia(ix=i, iy=i, iz=i), inertial_offset=Pose())
+
+
+def _read_one_joint(m, j: int, jname: str, parent: Body, child: Body, rel: Pose, to_body: Pose, model,
+                    losses) -> None:
+    """MuJoCo joint ``j`` between ``parent`` and ``child`` (``rel``: child frame in the parent
+    frame at qpos0; ``to_body``: MuJoCo body coordinates → the child's ADF frame)."""
     jtype = int(m.jnt_type[j])
-    jname = m.joint(j).name or f"{names[b]}_joint"
-    if jtype == FREE:
-        return  # a free body: no ADF joint
-    rel = world_pose[parent_id].inverse() * world_pose[b]
-    to_body = frames[b].inverse()
     pivot = to_body.transform(Vec3(*(float(v) for v in m.jnt_pos[j])))
     axis = to_body.orientation.rotate(Vec3(*(float(v) for v in m.jnt_axis[j]))).normalized()
     if jtype == BALL:
-        _add_joint(model, jname, "p2p", bodies[parent_id], child, rel, pivot, axis, 0.0, None, losses)
+        _add_joint(model, jname, "p2p", parent, child, rel, pivot, axis, 0.0, None, losses)
         return
     ref = float(m.qpos0[m.jnt_qposadr[j]])
     # the ADF zero configuration is MuJoCo's qpos = 0: undo the reference value
@@ -238,7 +276,7 @@ def _read_joint(m, b: int, names, bodies, world_pose, frames, model: ModelFile, 
     if m.jnt_limited[j]:
         lo, hi = (float(v) for v in m.jnt_range[j])
         limits = JointLimits(low=lo, high=hi)
-    joint = _add_joint(model, jname, "revolute" if jtype == HINGE else "prismatic", bodies[parent_id], child,
+    joint = _add_joint(model, jname, "revolute" if jtype == HINGE else "prismatic", parent, child,
                        rel * undo, pivot, axis, ref, limits, losses)
     damping = float(m.dof_damping[m.jnt_dofadr[j]])
     if damping:
