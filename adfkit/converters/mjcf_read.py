@@ -20,6 +20,7 @@ from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import shortest_arc
 from .losses import Loss
+from .mjcf_cameras import read_cameras, read_lights
 from .safexml import parse_xml
 
 # mjtGeom / mjtJoint values (MuJoCo's enums, stable across 2.x-4.x)
@@ -109,13 +110,16 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
     for b in range(1, m.nbody):
         _read_joint(m, b, names, bodies, world_pose, frames, model, losses)
     _read_equalities(m, names, bodies, world_pose, frames, model, losses)
-    for kind, count, label in (("camera", m.ncam, "camera"), ("light", m.nlight, "light"),
-                               ("actuator", m.nu, "actuator"), ("sensor", m.nsensor, "sensor"),
+    mujoco.mj_comPos(m, d)
+    mujoco.mj_camlight(m, d)  # cameras and lights where they are at qpos0, tracking modes included
+    model.cameras = read_cameras(m, d, names, world_pose, losses)
+    model.lights = read_lights(m, d, names, world_pose, losses)
+    for kind, count, label in (("actuator", m.nu, "actuator"), ("sensor", m.nsensor, "sensor"),
                                ("tendon", m.ntendon, "tendon"), ("site", m.nsite, "site")):
         for i in range(count):
             nm = getattr(m, kind)(i).name or f"{label} {i}"
             losses.append(Loss(nm, label, "not converted to ADF"))
-    model.present_lists.update({"bodies", "joints"})
+    model.present_lists.update({"bodies", "joints"} | {k for k in ("cameras", "lights") if getattr(model, k)})
     return model, sorted(set(losses))
 
 

@@ -25,6 +25,7 @@ from ..model.semantics import (
 )
 from . import inertia as inertia_math
 from .losses import Loss
+from .mjcf_cameras import write_cameras_lights
 from ..model.tree import Link, build_tree, motion
 from .urdf import INITIAL_VALUE_TOLERANCE, _AXIS_TO_Z, _BODY_ONLY, _link_name, _joint_name, _material, _num, _unique, _vec
 
@@ -33,7 +34,7 @@ MIN_MASS = 1e-6
 MIN_INERTIA = 1e-9
 
 _LOSSY_OBJECTS = (("ghost_objects", "ghost object"), ("sensors", "sensor"), ("actuators", "actuator"),
-                  ("cameras", "camera"), ("lights", "light"), ("soft_bodies", "soft body"),
+                  ("soft_bodies", "soft body"),
                   ("vehicles", "vehicle"), ("volumes", "volume"))
 
 
@@ -231,6 +232,7 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None) -> tuple[s
             losses.append(Loss(j.identifier, "joint", f"no MJCF form for a {kind.value} joint here"))
     if eq is not None:
         root.append(eq)
+    write_cameras_lights(model, tree, elements, world, used, losses)
     for j in tree.unresolved:
         losses.append(Loss(j.identifier, "joint", "unknown type or parent/child body not in this file"))
     for attr, label in _LOSSY_OBJECTS:
