@@ -17,6 +17,7 @@ from ..model.pose import Pose, Quat, Vec3
 from ..model.spec import adf_fields
 from ..model.tree import find_body
 from .losses import Loss
+from .urdf import _num, _unique, _vec
 
 # MuJoCo's compiled-model enums and defaults (stable across 3.x–4.x)
 _FIXED = 0
@@ -38,14 +39,6 @@ _LIGHT_KEYS = {"name", "parent", "location", "direction", "spot exponent", "cuto
 
 def _v(a) -> Vec3:
     return Vec3(*(float(x) for x in a))
-
-
-def _num(x: float) -> str:
-    return repr(float(x))
-
-
-def _vec(v) -> str:
-    return " ".join(_num(x) for x in v)
 
 
 # ---- MJCF → ADF ------------------------------------------------------------------------------
@@ -155,14 +148,6 @@ def _parent_frame(model, tree, obj, elements, world, losses, label):
         return None
     el = elements[id(link)]
     return el, (Pose() if el is world else link.frame_in_body.inverse())
-
-
-def _unique(name: str, used: set) -> str:
-    out, i = name, 2
-    while out in used:
-        out, i = f"{name}_{i}", i + 1
-    used.add(out)
-    return out
 
 
 def _write_camera(cam: Camera, el: ET.Element, to_frame: Pose, used, losses) -> None:

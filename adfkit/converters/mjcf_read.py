@@ -20,6 +20,7 @@ from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import shortest_arc
 from .losses import Loss
+from .urdf import _unique
 from .mjcf_cameras import read_cameras, read_lights
 from .safexml import parse_xml
 
@@ -244,14 +245,6 @@ def _read_joint(m, b: int, names, bodies, world_pose, frames, model: ModelFile, 
         losses.append(Loss(child.identifier, "joints", f"{n} joints on one body; ADF joins two bodies by one joint: "
                                                        f"built as a chain through {', '.join(added)} (1 % of the "
                                                        "body's mass and inertia each)"))
-
-
-def _unique(name: str, used: set) -> str:
-    out, i = name, 2
-    while out in used:
-        out, i = f"{name}{i}", i + 1
-    used.add(out)
-    return out
 
 
 def _chain_body(m, b: int, name: str, frame: Pose) -> Body:
