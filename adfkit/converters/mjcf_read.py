@@ -227,7 +227,7 @@ def _read_joint(m, b: int, names, bodies, world_pose, frames, model: ModelFile, 
     # they are a chain through bodies that all sit at the body frame at qpos0. ADF joins two
     # bodies by one joint, and a dynamic ADF body needs a mass: the added ones get 1 %.
     body_frame = world_pose[b] * frames[b].inverse()
-    used = {x.name for x in model.bodies}
+    used = {x.name for x in model.bodies} if n > 1 else set()  # names for the added chain bodies
     previous, previous_pose = bodies[parent_id], world_pose[parent_id]
     added = []
     for k, j in enumerate(range(adr, adr + n)):

@@ -215,12 +215,8 @@ class SpringSet:
 
     def states(self):
         pos, orn, lv, av = [], [], [], []
-        base_pose, base_velocity, cid = pb.getBasePositionAndOrientation, pb.getBaseVelocity, self.cid
         for b in self.bodies:
-            if b.link < 0:  # most spring ends are free bodies: two direct calls, no SimBody.state()
-                (p, q), (v, w) = base_pose(b.uid, physicsClientId=cid), base_velocity(b.uid, physicsClientId=cid)
-            else:
-                p, q, v, w = b.state()
+            p, q, v, w = b.state()
             pos.append(p); orn.append(q); lv.append(v); av.append(w)
         return np.array(pos), quat_to_matrix(np.array(orn)), np.array(lv), np.array(av)
 
