@@ -204,3 +204,243 @@ def test_fixed_nodes_rule_on_the_corpus_cloth(tmp_path):
     hits = [d for d in validate_file(f).diagnostics if d.rule == "soft-body-fixed-nodes"]
     assert len(hits) == 1 and "386 outside the 386 nodes of cloth.3DS" in hits[0].message
     assert not [d for d in validate_file(_cloth("cloth2.yaml")).diagnostics if d.rule.startswith("soft-body")]
+
+
+# --- runner: PyBullet's deformable world ------------------------------------------------------------
+
+pb = pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
+from adfkit.adf import load_scene  # noqa: E402
+from adfkit.cli import main  # noqa: E402
+from adfkit.runner.world import Options, SimWorld  # noqa: E402
+
+BOX_UNDER_CLOTH = """bodies: [BODY table]
+BODY table:
+  name: table
+  mass: 0.0
+  location: {position: {x: 0.0, y: 2.0, z: -0.35}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.4, y: 0.4, z: 0.5}
+  shape: BOX
+  geometry: {x: 0.4, y: 0.4, z: 0.5}
+"""
+
+
+def _world(path, seconds: float, **opt):
+    world = SimWorld(load_scene(path, None, []), Options(visuals=False, **opt))
+    world.run(seconds)
+    return world
+
+
+def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path):
+    """cloth.yaml (386 nodes, hung from node 0) over a 0.4 m box whose top is 0.1 m below it."""
+    cloth = _cloth("cloth.yaml")
+    (tmp_path / "box.yaml").write_text(BOX_UNDER_CLOTH)
+    (tmp_path / "launch.yaml").write_text(f"multibody configs:\n  - {cloth}\n  - box.yaml\n")
+    world = _world(tmp_path / "launch.yaml", 1.0)
+    try:
+        (soft,) = world.soft.items
+        nodes = soft.nodes(world.cid)
+        rep = world.report()
+    finally:
+        world.close()
+    assert (soft.node_count, soft.triangles, soft.fixed) == (386, 768, [0])
+    (row,) = rep["soft_bodies"]
+    assert (row["name"], row["nodes"], row["fixed_nodes"]) == ("/ambf/env/BODY Cloth", 386, 1)
+    assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
+    assert np.all(np.isfinite(nodes))
+    np.testing.assert_allclose(nodes[0], [0.38972265, 2.67708838, 0.0], atol=1e-6)   # the anchored corner
+    top = -0.1
+    on_box = (np.abs(nodes[:, 0]) < 0.2) & (np.abs(nodes[:, 1] - 2.0) < 0.2)
+    assert on_box.sum() >= 10
+    # over the box the cloth is held up by it (tensioned towards the corner pinned 0.1 m above
+    # the top); everywhere else it hangs far lower, over the box's sides
+    assert nodes[on_box, 2].min() > top - 0.005, nodes[on_box, 2]
+    assert nodes[on_box, 2].max() < -0.02
+    assert nodes[~on_box, 2].min() < top - 0.3
+    assert row["size_m"] < 1.5 * row["rest_size_m"]                            # stretched, not exploded
+
+
+def test_adfkit_run_plays_corpus_cloth2_and_reports_it(tmp_path, capsys):
+    rc = main(["run", str(_cloth("cloth2.yaml")), "--seconds", "0.2", "--out", str(tmp_path), "--no-frames"])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert "warning[yaml-duplicate-key]" in err and "runner-soft-body-approx" in err
+    import json
+    rep = json.loads((tmp_path / "report.json").read_text())
+    (row,) = rep["soft_bodies"]
+    assert (row["nodes"], row["triangles"], row["fixed_nodes"]) == (386, 768, 1)
+    assert row["not_played"] == ["randomize constraints"]
+    assert rep["nan"] == rep["exploded"] == []
+
+
+SHEET = """bodies: [BODY hook, BODY weight]
+soft bodies: [SOFT sheet]
+joints: [JOINT sheet-weight]
+BODY hook:
+  name: hook
+  mass: 0.0
+  location: {{position: {{x: 0.0, y: 0.0, z: 1.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+  collision shape: SPHERE
+  collision geometry: {{radius: 0.005}}
+BODY weight:
+  name: weight
+  mass: 0.05
+  inertia: {{ix: 1.0e-5, iy: 1.0e-5, iz: 1.0e-5}}
+  location: {{position: {{x: 0.1, y: 0.1, z: 1.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+  collision shape: SPHERE
+  collision geometry: {{radius: 0.005}}
+SOFT sheet:
+  name: sheet
+  mesh: sheet.obj
+  mass: 0.02
+  collision margin: 0.002
+  location: {{position: {{x: 0.0, y: 0.0, z: 1.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+  config: {{kLST: 0.5, piterations: 4, kDP: 0.5, kAST: 0.3, clusters: 2, fixed nodes: [0]}}
+JOINT sheet-weight:
+  name: sheet-weight
+  parent: SOFT sheet
+  child: BODY weight
+  type: fixed
+  parent pivot: {{x: 0.1, y: 0.1, z: 0.0}}
+  child pivot: {{x: 0.0, y: 0.0, z: 0.0}}
+  parent axis: {{x: 0.0, y: 0.0, z: 1.0}}
+  child axis: {{x: 0.0, y: 0.0, z: 1.0}}
+"""
+
+
+def test_soft_rigid_attachment_and_parameter_mapping(tmp_path):
+    """A 0.1 m sheet pinned at node 0 carries a 50 g weight joined to its far corner."""
+    from adfkit.scenes.soft_phantom import grid_obj
+
+    # grid_obj is centred; shift it so node 0 is at the origin and node 24 at (0.1, 0.1)
+    text = grid_obj(0.1, 4).splitlines()
+    shifted = [f"v {float(l.split()[1]) + 0.05:.6f} {float(l.split()[2]) + 0.05:.6f} 0.0" if l.startswith("v ")
+               else l for l in text]
+    (tmp_path / "sheet.obj").write_text("\n".join(shifted) + "\n")
+    (tmp_path / "sheet.yaml").write_text(SHEET.format())
+    world = _world(tmp_path / "sheet.yaml", 0.6, ground=False)
+    try:
+        (soft,) = world.soft.items
+        nodes = soft.nodes(world.cid)
+        weight = np.array(world.body("weight").com_position())
+        rules = {d.rule: d.message for d in world.diagnostics}
+        rep = world.report()
+    finally:
+        world.close()
+    assert soft.attached == {"BODY weight": [24]}
+    assert world.joint_names == []                       # the joint became an anchor, not a rigid joint
+    np.testing.assert_allclose(nodes[0], [0.0, 0.0, 1.0], atol=1e-6)
+    assert np.linalg.norm(nodes[24] - weight) < 0.01     # the weight hangs on its node
+    assert 0.8 < weight[2] < 0.99                        # held up by the sheet, not falling freely
+    assert "config.kAST, config.clusters not played" in rules["runner-soft-body-approx"]
+    p = soft.params
+    m_node = 0.02 / 25
+    assert p["springElasticStiffness"] == pytest.approx(min(1 - 0.5 ** 4, 0.4) * m_node / 1e-6)
+    assert p["springDampingStiffness"] == pytest.approx(0.5 * m_node / 1e-3)
+    assert (p["collisionMargin"], p["frictionCoeff"], p["useBendingSprings"]) == (0.002, 0.2, 0)
+    assert rep["soft_bodies"][0]["attached_nodes"] == {"BODY weight": 1}
+
+
+# --- the soft phantom sample scene -------------------------------------------------------------------
+
+def _skin_under_probe(launch, seconds):
+    world = _world(launch, seconds)
+    try:
+        (skin,) = world.soft.items
+        nodes = skin.nodes(world.cid)
+        rep = world.report()
+        probe = world.body("Probe").com_position() if any("Probe" in k for k in world.registry.items) else None
+    finally:
+        world.close()
+    assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
+    return nodes, probe
+
+
+def test_soft_phantom_is_indented_by_the_probe(tmp_path):
+    from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
+
+    p = SoftPhantomParams()
+    with_probe, probe = _skin_under_probe(write_soft_phantom(tmp_path / "a", p), 0.5)
+    alone, _ = _skin_under_probe(write_soft_phantom(tmp_path / "b", SoftPhantomParams(with_probe=False)), 0.5)
+    centre = np.linalg.norm(with_probe[:, :2], axis=1) < 0.006
+    far = np.linalg.norm(with_probe[:, :2], axis=1) > 0.035
+    depth = p.height - with_probe[centre, 2].min()
+    sag = p.height - alone[centre, 2].min()
+    indentation = depth - sag
+    print(f"skin indentation under the probe: {indentation * 1000:.1f} mm (sag alone {sag * 1000:.1f} mm)")
+    assert 0.005 < indentation < 0.03                           # visibly indented: millimetres to centimetres
+    assert probe[2] - p.probe_radius == pytest.approx(with_probe[centre, 2].min(), abs=0.004)  # tip on the skin
+    # the dent is local: far from the probe the skin moved much less than under it
+    assert (p.height - with_probe[far, 2].min()) < 0.5 * depth
+
+
+def test_soft_phantom_sample_scene_is_generated(tmp_path):
+    from pathlib import Path
+
+    from adfkit.scenes import BUILDERS
+
+    bundled = Path(__file__).resolve().parent.parent / "sample_scenes" / "soft_phantom"
+    BUILDERS["soft-phantom"](tmp_path)
+    for f in sorted(bundled.iterdir()):
+        assert (tmp_path / f.name).read_bytes() == f.read_bytes(), f.name
+    assert sorted(x.name for x in tmp_path.iterdir()) == sorted(x.name for x in bundled.iterdir())
+    res = validate_file(bundled / "phantom.yaml")
+    assert [d for d in res.diagnostics if d.severity >= 1] == [], [str(d) for d in res.diagnostics]
+
+
+# --- MJCF and URDF ---------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", CLOTHS)
+def test_convert_cloth_to_mjcf_loads_and_plays_in_mujoco(name, tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    out = tmp_path / "cloth.xml"
+    assert main(["convert", str(_cloth(name)), str(out), "--to", "mjcf"]) == 0
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert (model.nflex, list(model.flex_vertnum)) == (1, [386])
+    data = mujoco.MjData(model)
+    start = data.flexvert_xpos.copy() if data.flexvert_xpos.size else None
+    for _ in range(300):
+        mujoco.mj_step(model, data)
+    pos = data.flexvert_xpos
+    assert np.all(np.isfinite(pos))
+    np.testing.assert_allclose(pos[0], [0.38972265, {"cloth.yaml": 2.67708838, "cloth2.yaml": 0.17708838}[name], 0.0],
+                               atol=1e-6)                     # fixed node 0: a pin
+    assert pos[:, 2].min() < -0.05                            # the rest falls
+    assert start is None or np.linalg.norm(pos - start, axis=1).max() < 5.0
+
+
+def test_mjcf_flex_parameters_and_losses(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    from adfkit.converters import write
+    from adfkit.model.objects import SoftBody
+
+    (tmp_path / "sq.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n")
+    m = ModelFile(path=tmp_path / "m.yaml")
+    m.soft_bodies.append(SoftBody(identifier="SOFT s", name="s", mesh="sq.obj", mass=0.4, collision_margin=0.01,
+                                  config=SoftBodyConfig(kLST=0.5, piterations=2, kDF=0.7, kVC=3.0, kDP=0.2,
+                                                        fixed_nodes=[1, 9]),
+                                  randomize_constraints=True))
+    losses = write(m, tmp_path / "m.xml", "mjcf")
+    flex = ET.parse(tmp_path / "m.xml").getroot().find("worldbody/flexcomp")
+    assert flex.get("point") == "0.0 0.0 0.0 1.0 0.0 0.0 1.0 1.0 0.0 0.0 1.0 0.0"
+    assert (flex.get("element"), flex.get("mass"), flex.get("radius")) == ("0 1 2 0 2 3", "0.4", "0.01")
+    k = (1 - 0.5 ** 2) * 0.1 / 1e-6
+    el = flex.find("elasticity")
+    assert float(el.get("young")) * float(el.get("thickness")) == pytest.approx(k)
+    assert el.get("elastic2d") == "stretch"
+    assert flex.find("contact").get("friction") == "0.7" and flex.find("pin").get("id") == "1"
+    feats = {(l.element, l.feature) for l in losses}
+    assert {("SOFT s", "config.kVC"), ("SOFT s", "randomize constraints"), ("SOFT s", "fixed nodes"),
+            ("SOFT s", "soft body")} <= feats
+
+
+def test_urdf_names_the_soft_body_loss(tmp_path):
+    from adfkit.converters import write
+    from adfkit.model.objects import Body, SoftBody
+
+    m = ModelFile(path=tmp_path / "m.yaml")
+    m.bodies.append(Body(identifier="BODY b", name="b", mass=1.0))
+    m.soft_bodies.append(SoftBody(identifier="SOFT s", name="s", mesh="sq.obj", mass=0.4))
+    losses = write(m, tmp_path / "m.urdf", "urdf")
+    assert ("SOFT s", "soft body") in {(l.element, l.feature) for l in losses}

@@ -125,6 +125,38 @@ def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0) -> SoftMesh:
     return mesh
 
 
+def placed_soft_mesh(model, sb) -> SoftMesh:
+    """The soft body's nodes in the world: its collision mesh (adf-format.md §6.2) times
+    `scale`, moved by `location`. Raises AdfError when there is no mesh or it cannot be read."""
+    from ..adf.paths import collision_mesh_path  # noqa: PLC0415
+
+    path = collision_mesh_path(model, sb) if sb.mesh else None
+    if path is None:
+        raise AdfError(error("mesh-not-found", f"soft body '{sb.identifier}' names no mesh", sb.where(),
+                             "AMBF builds soft bodies from their collision mesh; name one with `mesh`"))
+    mesh = load_soft_mesh(path, sb.scale or 1.0)
+    if sb.location is not None:
+        rot = np.array(sb.location.orientation.matrix())
+        mesh.nodes = mesh.nodes @ rot.T + np.array([*sb.location.position])
+    return mesh
+
+
+DEFAULT_SOFT_MASS = 1.0     # AMBF's when `mass` is missing
+
+
+def link_stiffness(sb, nodes: int, dt: float) -> float:
+    """A spring stiffness (N/m) standing for Bullet's position-based links: each of
+    `piterations` (default 1) moves a link a share `kLST` (default 1) of the way back to its
+    rest length, so one step removes 1 − (1 − kLST)^piterations of a stretch; a spring on a
+    node of mass m removes the same share in one step of ``dt`` when k = share·m/dt²."""
+    cfg = sb.config
+    klst = cfg.kLST if cfg is not None and cfg.kLST is not None else 1.0
+    pit = cfg.piterations if cfg is not None and cfg.piterations is not None else 1
+    mass = sb.mass if sb.mass is not None and sb.mass > 0 else DEFAULT_SOFT_MASS
+    share = 1.0 - (1.0 - min(max(klst, 0.0), 1.0)) ** max(pit, 1)
+    return share * (mass / max(nodes, 1)) / dt ** 2
+
+
 def write_obj(mesh: SoftMesh, path: str | os.PathLike) -> Path:
     """The nodes and triangles as a plain OBJ (what PyBullet's loadSoftBody reads)."""
     p = Path(path)
@@ -134,4 +166,5 @@ def write_obj(mesh: SoftMesh, path: str | os.PathLike) -> Path:
     return p
 
 
-__all__ = ["SoftMesh", "read_3ds", "unique_nodes", "load_soft_mesh", "write_obj"]
+__all__ = ["SoftMesh", "read_3ds", "unique_nodes", "load_soft_mesh", "placed_soft_mesh", "link_stiffness",
+           "write_obj", "DEFAULT_SOFT_MASS"]
