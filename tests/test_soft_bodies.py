@@ -433,6 +433,12 @@ def test_mjcf_flex_parameters_and_losses(tmp_path):
     feats = {(l.element, l.feature) for l in losses}
     assert {("SOFT s", "config.kVC"), ("SOFT s", "randomize constraints"), ("SOFT s", "fixed nodes"),
             ("SOFT s", "soft body")} <= feats
+    # and back: MuJoCo's flex is a named loss, its vertex bodies are not made ADF bodies
+    from adfkit.converters import read
+
+    back, read_losses = read(tmp_path / "m.xml", "mjcf")
+    assert back.bodies == [] and back.joints == []
+    assert [(l.element, l.feature) for l in read_losses] == [("s", "flex")]
 
 
 def test_urdf_names_the_soft_body_loss(tmp_path):
