@@ -260,6 +260,25 @@ def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path):
     assert row["size_m"] < 1.5 * row["rest_size_m"]                            # stretched, not exploded
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("name", CLOTHS)
+def test_corpus_cloth_plays_5_seconds_on_a_box(name, tmp_path):
+    cloth = _cloth(name)
+    y = {"cloth.yaml": 2.0, "cloth2.yaml": -0.5}[name]
+    (tmp_path / "box.yaml").write_text(BOX_UNDER_CLOTH.replace("y: 2.0", f"y: {y}"))
+    (tmp_path / "launch.yaml").write_text(f"multibody configs:\n  - {cloth}\n  - box.yaml\n")
+    world = _world(tmp_path / "launch.yaml", 5.0)
+    try:
+        rep = world.report()
+        nodes = world.soft.items[0].nodes(world.cid)
+    finally:
+        world.close()
+    assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
+    on_box = (np.abs(nodes[:, 0]) < 0.2) & (np.abs(nodes[:, 1] - y) < 0.2)
+    # held up by the box top (z = -0.1): cloth2's 0.1 m collision margin holds it higher still
+    assert on_box.sum() >= 10 and nodes[on_box, 2].min() > -0.1 - 0.005
+
+
 def test_adfkit_run_plays_corpus_cloth2_and_reports_it(tmp_path, capsys):
     rc = main(["run", str(_cloth("cloth2.yaml")), "--seconds", "0.2", "--out", str(tmp_path), "--no-frames"])
     err = capsys.readouterr().err
