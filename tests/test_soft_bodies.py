@@ -385,35 +385,59 @@ def test_plane_beside_a_soft_body_is_warned_and_the_default_floor_is_a_slab(tmp_
 
 # --- the soft phantom sample scene -------------------------------------------------------------------
 
-def _skin_under_probe(launch, seconds):
+def _skin_under_tool(launch, seconds, tool="Probe"):
     world = _world(launch, seconds)
     try:
         (skin,) = world.soft.items
         nodes = skin.nodes(world.cid)
         rep = world.report()
-        probe = world.body("Probe").com_position() if any("Probe" in k for k in world.registry.items) else None
+        at = world.body(tool).com_position() if any(tool in k for k in world.registry.items) else None
     finally:
         world.close()
     assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
-    return nodes, probe
+    return nodes, at
 
 
-def test_soft_phantom_is_indented_by_the_probe(tmp_path):
+@pytest.fixture(scope="module")
+def sag(tmp_path_factory):
+    """How far the skin sinks under its own weight, at its centre, without a tool."""
+    from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
+
+    p = SoftPhantomParams(with_probe=False)
+    alone, _ = _skin_under_tool(write_soft_phantom(tmp_path_factory.mktemp("alone"), p), 0.5)
+    return p.height - alone[np.linalg.norm(alone[:, :2], axis=1) < 0.006, 2].min()
+
+
+def test_soft_phantom_is_indented_by_a_spherical_probe(tmp_path, sag):
+    from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
+
+    p = SoftPhantomParams(tool="sphere")
+    nodes, probe = _skin_under_tool(write_soft_phantom(tmp_path, p), 0.5)
+    centre = np.linalg.norm(nodes[:, :2], axis=1) < 0.006
+    far = np.linalg.norm(nodes[:, :2], axis=1) > 0.035
+    depth = p.height - nodes[centre, 2].min()
+    print(f"skin indentation under the probe: {(depth - sag) * 1000:.1f} mm (sag alone {sag * 1000:.1f} mm)")
+    assert 0.005 < depth - sag < 0.03                           # visibly indented: millimetres to centimetres
+    assert probe[2] - p.probe_radius == pytest.approx(nodes[centre, 2].min(), abs=0.004)  # tip on the skin
+    # the dent is local: far from the probe the skin moved much less than under it
+    assert (p.height - nodes[far, 2].min()) < 0.5 * depth
+
+
+@pytest.mark.slow   # six capsules against the skin: ~3x the sphere's contact cost
+def test_soft_phantom_is_indented_by_the_suturing_needle(tmp_path, sag):
+    """The bundled scene's tool: the suturing pad's needle lying flat, pressed with 0.49 N."""
     from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
 
     p = SoftPhantomParams()
-    with_probe, probe = _skin_under_probe(write_soft_phantom(tmp_path / "a", p), 0.5)
-    alone, _ = _skin_under_probe(write_soft_phantom(tmp_path / "b", SoftPhantomParams(with_probe=False)), 0.5)
-    centre = np.linalg.norm(with_probe[:, :2], axis=1) < 0.006
-    far = np.linalg.norm(with_probe[:, :2], axis=1) > 0.035
-    depth = p.height - with_probe[centre, 2].min()
-    sag = p.height - alone[centre, 2].min()
-    indentation = depth - sag
-    print(f"skin indentation under the probe: {indentation * 1000:.1f} mm (sag alone {sag * 1000:.1f} mm)")
-    assert 0.005 < indentation < 0.03                           # visibly indented: millimetres to centimetres
-    assert probe[2] - p.probe_radius == pytest.approx(with_probe[centre, 2].min(), abs=0.004)  # tip on the skin
-    # the dent is local: far from the probe the skin moved much less than under it
-    assert (p.height - with_probe[far, 2].min()) < 0.5 * depth
+    assert p.tool == "needle"
+    nodes, needle = _skin_under_tool(write_soft_phantom(tmp_path, p), 0.6, "Needle")
+    under = np.linalg.norm(nodes[:, :2], axis=1) < 0.015
+    depth = p.height - nodes[under, 2].min()
+    print(f"skin indentation under the needle: {(depth - sag) * 1000:.1f} mm")
+    assert 0.005 < depth - sag < 0.03
+    # the needle rests on the skin (its wire within a few millimetres of the skin's lowest node), not through it
+    assert -0.002 < needle[2] - nodes[under, 2].min() < 0.006
+    assert needle[2] > 0.015                                    # well above the tray (top at 0.01)
 
 
 def test_soft_phantom_sample_scene_is_generated(tmp_path):
