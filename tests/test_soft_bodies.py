@@ -155,6 +155,17 @@ def test_3ds_reader_and_node_merge_on_a_written_square(tmp_path):
     assert info.value.diagnostics[0].rule in ("mesh-unreadable", "mesh-empty")
 
 
+def test_nodes_at_maps_editor_vertices_to_fixed_nodes():
+    from adfkit.geometry.softmesh import nodes_at
+
+    v = np.array([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 0, 0), (1, 1, 0), (0, 1, 0)], float)
+    mesh = unique_nodes(v, np.array([(0, 1, 2), (3, 4, 5)]))
+    # a vertex group holding the repeated corner twice and the last vertex: nodes 0 and 3
+    assert nodes_at(mesh, [v[3], v[0], v[5]]) == [0, 3]
+    with pytest.raises(ValueError, match="no node at"):
+        nodes_at(mesh, [(0.5, 0.5, 0.0)])
+
+
 def test_unique_nodes_drops_collapsed_triangles():
     v = np.array([(0, 0, 0), (1, 0, 0), (1, 0, 0), (0, 1, 0)], float)
     m = unique_nodes(v, np.array([(0, 1, 2), (0, 2, 3)]))
