@@ -8,6 +8,7 @@ from pathlib import Path
 from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
 from ..diagnostics import Diagnostic, SourceLocation
 from ..model import InputDevices, Launch, ModelFile, World
+from . import softbody_rules
 from .rules import RULES
 
 TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")
@@ -174,7 +175,7 @@ def plugin_paths(doc) -> list[Diagnostic]:
 def check(doc) -> list[Diagnostic]:
     out = plugin_paths(doc) if hasattr(doc, "plugins") else []
     if isinstance(doc, ModelFile):
-        return out + model_paths(doc)
+        return out + model_paths(doc) + softbody_rules.mesh_rules(doc)
     if isinstance(doc, World):
         return out + world_paths(doc)
     if isinstance(doc, Launch):

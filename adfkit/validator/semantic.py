@@ -15,6 +15,7 @@ from ..model.spec import Node
 from ..model.spec import adf_fields as _adf_fields
 from ..model.spec import adf_keys as _adf_keys
 from .references import Registry, body_registry, merge_namespace
+from . import softbody_rules
 from .rules import RULES
 
 @lru_cache(maxsize=None)
@@ -195,6 +196,7 @@ class Checker:
             self.light(light)
         for c in m.cameras:
             self.camera(c)
+        self.out += softbody_rules.check(m)
         for sb in m.soft_bodies:
             if sb.randomize_constraints is False:
                 self.emit("randomize-constraints", f"soft body '{sb.identifier}': 'randomize constraints: false' "
