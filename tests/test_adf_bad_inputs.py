@@ -60,7 +60,7 @@ def test_missing_file_and_directory(tmp_path, capsys):
     assert main(["info", str(tmp_path / "absent.yaml")]) == 2
     assert "error[file-not-found]" in capsys.readouterr().err
     assert main(["info", str(tmp_path)]) == 2
-    assert "error[file-unreadable]" in capsys.readouterr().err
+    assert "error[not-a-regular-file]" in capsys.readouterr().err
 
 
 def test_wrong_kind_is_reported(tmp_path, capsys):

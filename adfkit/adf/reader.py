@@ -11,6 +11,7 @@ from typing import Any
 
 import yaml
 
+from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation, error, warning
 from ..model import FILE_KINDS, AdfFile, Colors, Pose, Quat, Vec3, rpy_to_quat
 from ..model.common import RGBA
@@ -201,16 +202,20 @@ def _shape(node) -> str:
 
 
 def read_file(path: str | Path, kind: str | None = None, text: str | None = None,
-              root_out: list | None = None) -> tuple[AdfFile, list[Diagnostic]]:
+              root_out: list | None = None, tree: inputs.Tree | None = None,
+              referrer: SourceLocation | None = None) -> tuple[AdfFile, list[Diagnostic]]:
     """Read one ADF file. Returns the model element and the diagnostics met on the way.
 
     Raises AdfError when the file cannot be read at all (missing, not YAML, wrong kind).
     ``root_out``, if given, receives the composed YAML root node (the validator reuses it).
+    ``tree`` None: the user named this file (read wherever it is; its own tree is computed
+    for the files it names). Otherwise the file was named by another one (``referrer``) and
+    must lie inside ``tree`` (adfkit.inputs).
     """
     path = Path(path)
     shown = str(path)
     if text is None:
-        text = read_text(path)
+        text = read_text(path, tree, referrer)
     reader = Reader(shown)
     root = compose(text, shown, reader.diagnostics)
     if root_out is not None:
@@ -242,6 +247,7 @@ def read_file(path: str | Path, kind: str | None = None, text: str | None = None
     else:
         obj = _read_with_objects(reader, cls, root)
     obj.path = path
+    obj.tree = tree if tree is not None else inputs.tree_of(path)
     return obj, reader.diagnostics
 
 

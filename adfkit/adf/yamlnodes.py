@@ -10,6 +10,7 @@ from typing import Any
 
 import yaml
 
+from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, SourceLocation, error
 
 try:  # libyaml is much faster and keeps marks
@@ -32,27 +33,10 @@ def location(file: str, node: yaml.Node | None) -> SourceLocation:
     return SourceLocation(file, node.start_mark.line + 1, node.start_mark.column + 1)
 
 
-def read_text(path: Path) -> str:
-    """Read a file as UTF-8, turning every failure into a located diagnostic."""
-    shown = str(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise AdfError(error("file-not-found", f"no such file: {shown}", SourceLocation(shown),
-                             "check the path; relative paths resolve against the current directory")) from None
-    except IsADirectoryError:
-        raise AdfError(error("file-unreadable", f"{shown} is a directory, not an ADF file", SourceLocation(shown),
-                             "pass a .yaml file")) from None
-    except OSError as exc:
-        raise AdfError(error("file-unreadable", f"cannot read {shown}: {exc.strerror}", SourceLocation(shown))) from None
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        before = data[: exc.start]
-        line = before.count(b"\n") + 1
-        col = exc.start - (before.rfind(b"\n") + 1) + 1
-        raise AdfError(error("yaml-encoding", f"invalid UTF-8 byte 0x{data[exc.start]:02x}",
-                             SourceLocation(shown, line, col), "save the file as UTF-8")) from None
+def read_text(path: Path, tree=None, referrer: SourceLocation | None = None) -> str:
+    """Read an ADF file as UTF-8 through the input policy (adfkit.inputs): a regular file,
+    under the size cap, inside ``tree`` when given; every failure is a located diagnostic."""
+    return inputs.read_text(path, "adf", tree=tree, referrer=referrer, what="ADF file")
 
 
 def compose(text: str, file: str, diagnostics: list[Diagnostic] | None = None) -> yaml.Node | None:

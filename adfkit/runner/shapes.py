@@ -15,7 +15,8 @@ import numpy as np
 import pybullet as pb
 
 from ..adf.paths import collision_mesh_path, visual_mesh_path
-from ..diagnostics import Diagnostic, warning
+from .. import inputs
+from ..diagnostics import AdfError, Diagnostic, warning
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import (
     CollisionMeshType, Primitive, ShapeKind, axis_vector, collision_mesh_type,
@@ -95,6 +96,17 @@ def _primitive(parts: ShapeParts, prim: Primitive, pose_in_com: np.ndarray, marg
         parts.plane = (list(map(float, n)), float(g.offset or 0.0))
 
 
+def mesh_refusal(model, path: Path) -> str | None:
+    """Why the input policy (adfkit.inputs) keeps PyBullet from reading this mesh, or None:
+    missing, not a regular file, over the size cap, outside the model's tree."""
+    try:
+        inputs.check_file(path, "mesh", tree=getattr(model, "tree", None), what="mesh file")
+    except AdfError as exc:
+        d = exc.diagnostics[0]
+        return f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
+    return None
+
+
 def collision_parts(model, obj, frame_in_body, scale: float,
                     static: bool, diags: list[Diagnostic]) -> ShapeParts | None:
     """The collision shape of a body or ghost, or None when AMBF would skip the object."""
@@ -112,8 +124,9 @@ def collision_parts(model, obj, frame_in_body, scale: float,
     path = collision_mesh_path(model, obj)
     if path is None:
         return parts  # no collision geometry: an empty shape (AMBF prints an error)
-    if not path.is_file():
-        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: collision mesh {path} not found; "
+    refused = mesh_refusal(model, path)
+    if refused is not None:
+        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: collision mesh {refused}; "
                              "the body is skipped as AMBF does", obj.where("collision mesh") or obj.source,
                              "fix `collision mesh`/`mesh` or the resolution paths"))
         return None
@@ -203,8 +216,9 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
     path = visual_mesh_path(model, obj)
     if path is None:
         return -1
-    if not path.is_file():
-        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: visual mesh {path} not found",
+    refused = mesh_refusal(model, path)
+    if refused is not None:
+        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: visual mesh {refused}",
                              obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
         return -1
     if path.suffix.lower() not in MESH_SUFFIXES:

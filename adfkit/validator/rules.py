@@ -46,6 +46,13 @@ _RULES = [
     Rule("unknown-key", I, "A key AMBF does not read (WARNING when it is a near miss of a real key)",
          "`colision mesh: a.stl` (did you mean `collision mesh`?)"),
     Rule("file-not-found", E, "A path given on the command line does not exist", "`adfkit validate nope.yaml`"),
+    # --- input policy (adfkit.inputs) -----------------------------------------------------
+    Rule("file-unreadable", E, "A file cannot be read (permissions, I/O error)", "a file with mode 000"),
+    Rule("bad-path", E, "A path holds a NUL byte or a name over 255 bytes", "`mesh: \"a\\0b.stl\"`"),
+    Rule("not-a-regular-file", E, "A path names a folder, device, FIFO or socket", "`world config: /dev/zero`"),
+    Rule("outside-tree", E, "A file named by an ADF file lies outside the scene's folder tree (not read)",
+         "`input devices config: /etc/passwd`"),
+    Rule("file-too-large", E, "A file is over the size cap for its kind (16 MiB for ADF)", "a 20 MB YAML file"),
     # --- schema ------------------------------------------------------------------------
     Rule("schema-required", E, "A key AMBF requires is missing (the file is rejected)",
          "a joint without `parent axis`"),
@@ -70,6 +77,8 @@ _RULES = [
     Rule("external-reference", I, "A reference is not in this file; AMBF looks in models loaded earlier",
          "`parent: BODY world` defined in another model"),
     Rule("missing-file", E, "A launch/world file names a file that does not exist", "`world config: ./nope.yaml`"),
+    Rule("missing-color-file", W, "A launch file's `color config` does not exist (AMBF 2.0 never opens it)",
+         "`color config: colors.yaml` that is not there"),
     Rule("missing-model-file", W, "A launch `multibody configs` entry does not exist (skipped at -l time)",
          "`- sb/magic_box.yaml` that is not there"),
     Rule("missing-mesh", W, "A mesh file is not found after §6.2 resolution (AMBF skips the body)",
