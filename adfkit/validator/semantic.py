@@ -400,8 +400,12 @@ class Checker:
             self.emit("missing-type", f"{what} '{s.identifier}' has no type; AMBF skips it", s.where(),
                       f"add `type: {next(iter(types))}`")
         elif s.type not in types:
-            self.emit("sensor-type", f"{what} '{s.identifier}' has type {s.type!r}; AMBF segfaults on unknown "
-                      "types", s.where("type"), f"use one of {', '.join(types)}")
+            self.emit("sensor-type", f"{what} '{s.identifier}' has type {str(s.type)[:60]!r}, unknown to AMBF 2.0 "
+                      "(which crashes on it; later AMBF versions and plugins define more types)", s.where("type"),
+                      f"for AMBF 2.0 use one of {', '.join(types)}")
+        if s.parent is None or s.parent == "":
+            self.emit("missing-parent", f"{what} '{s.identifier}' has no parent; AMBF attaches it to nothing "
+                      "and skips it", s.where(), "add `parent: BODY ...`")
         if type(s).__name__ == "Sensor":
             forms = [k for k in ("array", "mesh", "parametric") if getattr(s, k) is not None]
             if len(forms) != 1:
