@@ -767,6 +767,21 @@ def problems(o: Outcome) -> list[str]:
     return bad
 
 
+_FRAME = re.compile(r'File "[^"]*/(adfkit/[^"]+)", line \d+, in (\w+)')
+_EXC = re.compile(r"^(\w+(?:Error|Exception|error))\b", re.M)
+
+
+def crash_site(o: Outcome) -> tuple[str, str, str] | None:
+    """(module, function, exception) of an exception that escaped: the innermost adfkit frame."""
+    if not o.error or o.error.startswith("timeout"):
+        return None
+    frames = _FRAME.findall(o.error)
+    exc = _EXC.findall(o.error)
+    if not frames or not exc:
+        return None
+    return frames[-1][0], frames[-1][1], exc[-1]
+
+
 def tally(outcomes) -> dict:
     t = {"cases": 0, "exit 0": 0, "exit 1": 0, "exit 2": 0, "failed": 0}
     for o in outcomes:
