@@ -44,6 +44,8 @@ KNOWN: dict[str, str] = {}  # exact case ids (none today)
 
 
 def _known(outcome, bad) -> str | None:
+    if (outcome.error or "").startswith("timeout") and any(b"<include" in v for v in outcome.case.files.values()):
+        return "MJCF <include> followed by MuJoCo's compiler, which blocks opening a FIFO (mjcf_read.py)"
     site = fuzzkit.crash_site(outcome)
     if site in KNOWN_SITES and len(bad) == 1:
         return f"{KNOWN_SITES[site]} ({site[0]}:{site[1]} {site[2]})"
