@@ -42,14 +42,24 @@ class Diagnostic:
     related: tuple[SourceLocation, ...] = field(default=())
 
     def format(self) -> str:
-        where = f"{self.location}: " if self.location else ""
-        text = f"{where}{self.severity}[{self.rule}]: {self.message}"
+        where = f"{one_line(str(self.location))}: " if self.location else ""
+        text = f"{where}{self.severity}[{self.rule}]: {one_line(self.message)}"
         if self.hint:
-            text += f"\n  hint: {self.hint}"
+            text += f"\n  hint: {one_line(self.hint)}"
         return text
 
     def __str__(self) -> str:
         return self.format()
+
+
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(9), *range(10, 32), 127)}
+_CONTROL.update({0x85: "\\x85", 0x2028: "\\u2028", 0x2029: "\\u2029"})
+
+
+def one_line(text: str) -> str:
+    """Text for one output line: control characters (newlines included) escaped, so a name
+    or value from a file can never start a line of its own in a report."""
+    return text.translate(_CONTROL)
 
 
 class AdfError(Exception):

@@ -135,8 +135,14 @@ EXAMPLES = {
     "unknown-key": (CLEAN.replace("BODY b:\n", "BODY b:\n  colision mesh: b.stl\n"), 8, "warning"),
     "unlisted-object": (CLEAN + "BODY c:\n  mass: 1\n", 21, "info"),
     "undefined-object": (CLEAN.replace("bodies: [BODY a, BODY b]", "bodies: [BODY a, BODY b, BODY z]"), 1, "warning"),
-    "sensor-type": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Laser\n  parent: BODY a\n"
-                    "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n", 22, "error"),
+    "sensor-type": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: CONTACT\n  parent: BODY a\n"
+                    "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n", 22, "warning"),
+    "missing-parent": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Proximity\n"
+                       "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n", 22, "warning"),
+    "yaml-key-type": (CLEAN.replace("BODY b:\n", "BODY b:\n  controller: {kDP, 0.001}\n"), 8, "warning"),
+    "yaml-bad-tag": (CLEAN.replace("BODY b:\n", "BODY b:\n  passive: !!bool maybe\n"), 8, "error"),
+    "yaml-too-deep": ("bodies: []\nx: " + "[" * 1000 + "]" * 1000 + "\n", 2, "error"),
+    "missing-color-file": ("world config: w.yaml\ncolor config: nope.yaml\nmultibody configs: []\n", 2, "warning"),
     "sensor-rays": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Proximity\n  parent: BODY a\n",
                     22, "warning"),
     "missing-type": (CLEAN.replace("joints:", "actuators: [A]\njoints:") + "A:\n  parent: BODY a\n", 22, "warning"),

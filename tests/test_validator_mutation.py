@@ -125,7 +125,7 @@ OPERATORS = {
                                              "unknown-kind", "undefined-object", "bad-type"}),
     "wrong_type": (op_wrong_type, {"bad-type", "bad-bool", "schema-type", "missing-component"}),
     "dangling": (op_dangling, {"dangling-reference", "external-reference", "input-device"}),
-    "bad_path": (op_bad_path, {"missing-mesh", "missing-file"}),
+    "bad_path": (op_bad_path, {"missing-mesh", "missing-file", "missing-color-file", "missing-model-file"}),
     "alias_bomb": (op_alias_bomb, {"yaml-alias-bomb"}),
     "recursive_alias": (op_recursive_alias, {"yaml-recursive-alias"}),
     "nan": (op_nan, {"non-finite-number"}),

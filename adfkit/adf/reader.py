@@ -11,6 +11,7 @@ from typing import Any
 
 import yaml
 
+from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation, error, warning
 from ..model import FILE_KINDS, AdfFile, Colors, Pose, Quat, Vec3, rpy_to_quat
 from ..model.common import RGBA
@@ -47,20 +48,29 @@ class Reader:
         return scalar_value(node)
 
     def as_float(self, node) -> float:
+        v = self._number(node)
+        if v - v != 0.0:  # NaN or infinite (faster than math.isfinite on the hot path)
+            raise BadValue("non-finite-number", f"{_short(node.value)} is not a finite number", node,
+                           "write a finite number; Bullet turns NaN and infinity into a broken simulation")
+        return v
+
+    def _number(self, node) -> float:
         if node.__class__ is yaml.ScalarNode and node.tag in _NUMBER_TAGS:
             try:  # fast path for plain decimal literals
                 return float(node.value)
-            except ValueError:
+            except (ValueError, OverflowError):
                 pass
         v = self.scalar(node, "a number")
         if isinstance(v, bool) or v is None:
-            raise BadValue("bad-type", f"expected a number, found {node.value!r}", node)
-        if isinstance(v, (int, float)):
-            return float(v)
-        try:  # AMBF (yaml-cpp) reads quoted numbers as doubles
-            return float(str(v).strip())
+            raise BadValue("bad-type", f"expected a number, found {_short(node.value)}", node)
+        try:
+            if isinstance(v, (int, float)):
+                return float(v)
+            return float(str(v).strip())  # AMBF (yaml-cpp) reads quoted numbers as doubles
+        except OverflowError:  # a 400-digit integer: what strtod makes of it
+            return math.inf
         except ValueError:
-            raise BadValue("bad-type", f"expected a number, found {node.value!r}", node) from None
+            raise BadValue("bad-type", f"expected a number, found {_short(node.value)}", node) from None
 
     def as_bool(self, node) -> bool:
         v = self.scalar(node, "true or false")
@@ -69,7 +79,7 @@ class Reader:
         if isinstance(v, str) and v.strip().lower() in _BOOL_WORDS and (v.strip() in
                                                                          (v.strip().lower(), v.strip().upper(), v.strip().capitalize())):
             return _BOOL_WORDS[v.strip().lower()]
-        raise BadValue("bad-bool", f"expected true or false, found {node.value!r}", node,
+        raise BadValue("bad-bool", f"expected true or false, found {_short(node.value)}", node,
                        "AMBF reads true/false/yes/no/on/off/y/n; 1 and 0 make it reject the file")
 
     def as_int(self, node, unsigned: bool = False) -> int:
@@ -80,10 +90,13 @@ class Reader:
             except ValueError:
                 pass
         if isinstance(v, bool) or not isinstance(v, int):
-            raise BadValue("bad-int", f"expected an integer, found {node.value!r}", node,
+            raise BadValue("bad-int", f"expected an integer, found {_short(node.value)}", node,
                            "AMBF rejects the file when an integer field holds 2.5 or 5.0")
         if unsigned and v < 0:
-            raise BadValue("bad-int", f"expected a non-negative integer, found {v}", node)
+            raise BadValue("bad-int", f"expected a non-negative integer, found {_short(node.value)}", node)
+        if not -2**63 <= v < 2**64:
+            raise BadValue("bad-int", f"{_short(node.value)} is out of range for an integer", node,
+                           "AMBF reads integers as 32-bit values")
         return v
 
     def as_str(self, node) -> str:
@@ -192,25 +205,35 @@ def _is_null(node) -> bool:
     return isinstance(node, yaml.ScalarNode) and node.tag == "tag:yaml.org,2002:null"
 
 
+def _short(text, limit: int = 60) -> str:
+    """A value quoted in a message: repr, at most ``limit`` characters."""
+    r = repr(text)
+    return r if len(r) <= limit else r[: limit - 5] + "...'"
+
+
 def _shape(node) -> str:
     if isinstance(node, yaml.MappingNode):
         return "mapping"
     if isinstance(node, yaml.SequenceNode):
         return "list"
-    return f"scalar {node.value!r}"
+    return f"scalar {_short(node.value)}"
 
 
 def read_file(path: str | Path, kind: str | None = None, text: str | None = None,
-              root_out: list | None = None) -> tuple[AdfFile, list[Diagnostic]]:
+              root_out: list | None = None, tree: inputs.Tree | None = None,
+              referrer: SourceLocation | None = None) -> tuple[AdfFile, list[Diagnostic]]:
     """Read one ADF file. Returns the model element and the diagnostics met on the way.
 
     Raises AdfError when the file cannot be read at all (missing, not YAML, wrong kind).
     ``root_out``, if given, receives the composed YAML root node (the validator reuses it).
+    ``tree`` None: the user named this file (read wherever it is; its own tree is computed
+    for the files it names). Otherwise the file was named by another one (``referrer``) and
+    must lie inside ``tree`` (adfkit.inputs).
     """
     path = Path(path)
     shown = str(path)
     if text is None:
-        text = read_text(path)
+        text = read_text(path, tree, referrer)
     reader = Reader(shown)
     root = compose(text, shown, reader.diagnostics)
     if root_out is not None:
@@ -242,6 +265,7 @@ def read_file(path: str | Path, kind: str | None = None, text: str | None = None
     else:
         obj = _read_with_objects(reader, cls, root)
     obj.path = path
+    obj.tree = tree if tree is not None else inputs.tree_of(path)
     return obj, reader.diagnostics
 
 

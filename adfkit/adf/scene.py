@@ -51,7 +51,8 @@ def load_scene(path: str | Path, indices: Iterable[int] | None = None,
                              "launch, world or model file", SourceLocation(str(path))))
     scene.launch = doc
     if doc.world_config:
-        world, found = read_file(relative_to_file(doc.path, doc.world_config), "world")
+        world, found = read_file(relative_to_file(doc.path, doc.world_config), "world",
+                                 tree=doc.tree, referrer=doc.where("world config"))
         diags.extend(found)
         _attach_world(scene, world, diags)
     configs = doc.multibody_configs or []
@@ -61,7 +62,8 @@ def load_scene(path: str | Path, indices: Iterable[int] | None = None,
             raise AdfError(error("bad-index", f"index {i} is out of range: the launch file lists "
                                  f"{len(configs)} model files (0–{len(configs) - 1})",
                                  doc.where("multibody configs"), "pick indices from the multibody configs list"))
-        model, found = read_file(relative_to_file(doc.path, configs[i]), "model")
+        model, found = read_file(relative_to_file(doc.path, configs[i]), "model",
+                                 tree=doc.tree, referrer=doc.where("multibody configs"))
         diags.extend(found)
         scene.models.append(model)
     return scene
@@ -71,7 +73,7 @@ def _attach_world(scene: Scene, world: World, diags: list[Diagnostic]) -> None:
     scene.world = world
     if world.environment:
         env_path = relative_to_file(world.path, world.environment)
-        env, found = read_file(env_path, "model")
+        env, found = read_file(env_path, "model", tree=world.tree, referrer=world.where("environment"))
         diags.extend(found)
         scene.environment = env
 
@@ -79,5 +81,6 @@ def _attach_world(scene: Scene, world: World, diags: list[Diagnostic]) -> None:
 def load_input_devices(launch: Launch) -> InputDevices | None:
     if not launch.input_devices_config:
         return None
-    doc, _ = read_file(relative_to_file(launch.path, launch.input_devices_config), "input_devices")
+    doc, _ = read_file(relative_to_file(launch.path, launch.input_devices_config), "input_devices",
+                       tree=launch.tree, referrer=launch.where("input devices config"))
     return doc  # type: ignore[return-value]

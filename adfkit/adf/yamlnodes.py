@@ -10,12 +10,33 @@ from typing import Any
 
 import yaml
 
-from ..diagnostics import AdfError, Diagnostic, SourceLocation, error
+from .. import inputs
+from ..diagnostics import AdfError, Diagnostic, SourceLocation, error, warning
 
 try:  # libyaml is much faster and keeps marks
-    _Loader = yaml.CSafeLoader
+    _BaseLoader = yaml.CSafeLoader
 except AttributeError:  # pragma: no cover - depends on the PyYAML build
-    _Loader = yaml.SafeLoader
+    _BaseLoader = yaml.SafeLoader
+
+_PLAIN = (True, False)
+_RESOLVED: dict[str, str] = {}
+
+
+class _Loader(_BaseLoader):  # type: ignore[misc, valid-type]
+    """The safe loader with plain-scalar tags resolved once per distinct text.
+
+    The C composer asks Python's regex resolver for every scalar (174,000 calls over the
+    corpus, a third of composing); ADF files repeat few texts (0.0, 1.0, true, ...)."""
+
+    def resolve(self, kind, value, implicit):
+        if kind is yaml.ScalarNode and implicit == _PLAIN:
+            tag = _RESOLVED.get(value)
+            if tag is None:
+                tag = _BaseLoader.resolve(self, kind, value, implicit)
+                if len(_RESOLVED) < 200_000 and len(value) < 200:
+                    _RESOLVED[value] = tag
+            return tag
+        return _BaseLoader.resolve(self, kind, value, implicit)
 
 _constructor = yaml.constructor.SafeConstructor()
 
@@ -32,62 +53,109 @@ def location(file: str, node: yaml.Node | None) -> SourceLocation:
     return SourceLocation(file, node.start_mark.line + 1, node.start_mark.column + 1)
 
 
-def read_text(path: Path) -> str:
-    """Read a file as UTF-8, turning every failure into a located diagnostic."""
-    shown = str(path)
+def read_text(path: Path, tree=None, referrer: SourceLocation | None = None) -> str:
+    """Read an ADF file as UTF-8 through the input policy (adfkit.inputs): a regular file,
+    under the size cap, inside ``tree`` when given; every failure is a located diagnostic."""
+    return inputs.read_text(path, "adf", tree=tree, referrer=referrer, what="ADF file")
+
+
+#: Deepest nesting of collections read (ADF needs about 6). Deeper files are an error: the C
+#: composer recurses (its stack overflows near 100,000 levels) and so do YAML writers.
+MAX_DEPTH = 100
+# Below this bound on the nesting (see _depth_bound) the C composer is safe without a pre-scan.
+_SAFE_BOUND = 3000
+
+_SCALAR_TAGS_CHECKED = {"tag:yaml.org,2002:bool", "tag:yaml.org,2002:int", "tag:yaml.org,2002:float",
+                        "tag:yaml.org,2002:null", "tag:yaml.org,2002:timestamp", "tag:yaml.org,2002:binary"}
+
+
+def _syntax_error(exc: yaml.YAMLError, file: str, text: str) -> AdfError:
+    if isinstance(exc, yaml.MarkedYAMLError):
+        mark = exc.problem_mark or exc.context_mark
+        loc = SourceLocation(file, mark.line + 1, mark.column + 1) if mark else SourceLocation(file, 1, 1)
+        problem = exc.problem or "invalid YAML"
+        ctx = f" ({exc.context})" if exc.context else ""
+        return AdfError(error("yaml-syntax", f"not valid YAML: {problem}{ctx}", loc,
+                              "fix the YAML syntax; an online or editor YAML linter shows the exact spot"))
+    line = col = 1
+    position = getattr(exc, "position", None)  # ReaderError: a character YAML does not allow
+    if isinstance(position, int):
+        before = text[:position]
+        line, col = before.count("\n") + 1, position - (before.rfind("\n") + 1) + 1
+    return AdfError(error("yaml-syntax", f"not valid YAML: {exc}", SourceLocation(file, line, col),
+                          "remove control characters; YAML allows tab, newline and printable text"))
+
+
+def _depth_bound(text: str) -> int:
+    """An upper bound on the collection nesting of ``text``, from counts alone: each flow level
+    needs a '[' or '{', and each block level needs indentation or an indicator on its line
+    (both at most the longest line's length, twice over)."""
+    longest = max(map(len, text.split("\n"))) if len(text) > 200 else len(text)
+    return text.count("[") + text.count("{") + 2 * longest + 2
+
+
+def _check_depth(text: str, file: str) -> None:
+    """Refuse nesting deeper than MAX_DEPTH from the parser's events (iterative, no node built)."""
+    depth = 0
+    starts = (yaml.MappingStartEvent, yaml.SequenceStartEvent)
+    ends = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
     try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise AdfError(error("file-not-found", f"no such file: {shown}", SourceLocation(shown),
-                             "check the path; relative paths resolve against the current directory")) from None
-    except IsADirectoryError:
-        raise AdfError(error("file-unreadable", f"{shown} is a directory, not an ADF file", SourceLocation(shown),
-                             "pass a .yaml file")) from None
-    except OSError as exc:
-        raise AdfError(error("file-unreadable", f"cannot read {shown}: {exc.strerror}", SourceLocation(shown))) from None
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        before = data[: exc.start]
-        line = before.count(b"\n") + 1
-        col = exc.start - (before.rfind(b"\n") + 1) + 1
-        raise AdfError(error("yaml-encoding", f"invalid UTF-8 byte 0x{data[exc.start]:02x}",
-                             SourceLocation(shown, line, col), "save the file as UTF-8")) from None
+        for ev in yaml.parse(text, Loader=_Loader):
+            if isinstance(ev, starts):
+                depth += 1
+                if depth > MAX_DEPTH:
+                    m = ev.start_mark
+                    raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
+                                         SourceLocation(file, m.line + 1, m.column + 1),
+                                         "an ADF file nests a few levels; flatten the data"))
+            elif isinstance(ev, ends):
+                depth -= 1
+    except yaml.YAMLError:
+        return  # the composer reports it, located
 
 
 def compose(text: str, file: str, diagnostics: list[Diagnostic] | None = None) -> yaml.Node | None:
     """Parse YAML text into a node tree; syntax errors raise AdfError.
 
-    Duplicate keys are reported into ``diagnostics`` (AMBF keeps the first occurrence,
-    and so does :func:`mapping_items`)."""
+    Duplicate keys, keys that are not text and explicit tags with bad values are reported into
+    ``diagnostics`` (AMBF keeps the first occurrence of a key, and so does :func:`mapping_items`).
+    Nesting deeper than MAX_DEPTH, recursive aliases and alias bombs raise AdfError."""
+    if _depth_bound(text) > _SAFE_BOUND:
+        _check_depth(text, file)
     try:
         root = yaml.compose(text, Loader=_Loader)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        loc = SourceLocation(file, mark.line + 1, mark.column + 1) if mark else SourceLocation(file)
-        problem = exc.problem or "invalid YAML"
-        ctx = f" ({exc.context})" if exc.context else ""
-        raise AdfError(error("yaml-syntax", f"not valid YAML: {problem}{ctx}", loc,
-                             "fix the YAML syntax; an online or editor YAML linter shows the exact spot")) from None
     except yaml.YAMLError as exc:
-        raise AdfError(error("yaml-syntax", f"not valid YAML: {exc}", SourceLocation(file))) from None
+        raise _syntax_error(exc, file, text) from None
     if root is not None:
-        found = check_tree(root, file)
+        found = check_tree(root, file, check_tags="!" in text, aliases="*" in text)
         if diagnostics is not None:
             diagnostics.extend(found)
     return root
 
 
-def check_tree(root: yaml.Node, file: str) -> list[Diagnostic]:
-    """Find duplicate keys; reject recursive aliases and alias bombs, with positions."""
+def check_tree(root: yaml.Node, file: str, check_tags: bool = True, aliases: bool = True) -> list[Diagnostic]:
+    """Find duplicate keys, keys that are not text and explicit tags with bad values; reject
+    recursive aliases, alias bombs and nesting deeper than MAX_DEPTH, with positions.
+
+    An explicit stack, no recursion: any depth is walked. ``check_tags`` False skips the tag
+    check (a text without '!' has no explicit tags); ``aliases`` False (no '*' in the text)
+    walks the tree without the bookkeeping shared nodes need."""
     diags: list[Diagnostic] = []
+    if not aliases:
+        _check_alias_free(root, file, check_tags, diags)
+        return diags
     sizes: dict[int, int] = {}
     on_stack: set[int] = set()
-    Mapping, Sequence = yaml.MappingNode, yaml.SequenceNode
+    Mapping, Sequence, Scalar = yaml.MappingNode, yaml.SequenceNode, yaml.ScalarNode
+    # Frames: [node, child iterator, size so far]; a node's size is counted when it is left.
+    stack: list[list] = []
 
-    def walk(node: yaml.Node) -> int:
+    def enter(node) -> int | None:
+        """Push a collection (None) or return the size of a leaf / already-sized node."""
         cls = node.__class__
-        if cls is not Mapping and cls is not Sequence:
+        if cls is Scalar:
+            if check_tags and node.tag in _SCALAR_TAGS_CHECKED:
+                _check_scalar_tag(node, file, diags)
             return 1
         nid = id(node)
         known = sizes.get(nid)
@@ -96,72 +164,213 @@ def check_tree(root: yaml.Node, file: str) -> list[Diagnostic]:
         if nid in on_stack:
             raise AdfError(error("yaml-recursive-alias", "an alias refers to a node that contains it",
                                  location(file, node), "ADF data is a tree; replace the recursive alias with data"))
+        if len(stack) >= MAX_DEPTH:
+            raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
+                                 location(file, node), "an ADF file nests a few levels; flatten the data"))
         on_stack.add(nid)
-        size = 1
         if cls is Mapping:
-            seen: dict[Any, yaml.Node] = {}
-            for k, v in node.value:
-                if k.__class__ is yaml.ScalarNode:
-                    kv = k.value
-                    first = seen.get(kv)
-                    if first is not None:
-                        diags.append(error(
-                            "yaml-duplicate-key",
-                            f"duplicate key '{kv}' (first at line {first.start_mark.line + 1}); "
-                            "AMBF keeps the first value, PyYAML the last",
-                            location(file, k), "remove one of the two entries"))
-                    else:
-                        seen[kv] = k
-                    size += 1 + walk(v)
-                else:
-                    size += walk(k) + walk(v)
+            _check_keys(node, file, diags)
+            children = (n for pair in node.value for n in pair)
         else:
-            for item in node.value:
-                size += walk(item)
-        on_stack.discard(nid)
-        sizes[nid] = size
-        return size
+            children = iter(node.value)
+        stack.append([node, children, 1])
+        return None
 
-    expanded = walk(root)
-    if expanded > MAX_EXPANDED_NODES:
-        raise AdfError(error("yaml-alias-bomb", f"aliases expand this file to {expanded:,} nodes",
+    first = enter(root)
+    expanded = first if first is not None else 0
+    while stack:
+        frame = stack[-1]
+        child = next(frame[1], None)
+        if child is not None:
+            size = enter(child)
+            if size is not None:
+                frame[2] += size
+            continue
+        stack.pop()
+        node, _, size = frame
+        on_stack.discard(id(node))
+        sizes[id(node)] = size
+        if stack:
+            stack[-1][2] += size
+        else:
+            expanded = size
+        if size > MAX_EXPANDED_NODES:
+            break
+    if expanded > MAX_EXPANDED_NODES or any(f[2] > MAX_EXPANDED_NODES for f in stack):
+        raise AdfError(error("yaml-alias-bomb", f"aliases expand this file to over {MAX_EXPANDED_NODES:,} nodes",
                              location(file, root), "an ADF file never needs this; remove the nested aliases"))
     return diags
 
 
+def _check_alias_free(root: yaml.Node, file: str, check_tags: bool, diags: list[Diagnostic]) -> None:
+    """check_tree for a tree without aliases: every node is visited once, so no sizes."""
+    Mapping, Sequence, Scalar = yaml.MappingNode, yaml.SequenceNode, yaml.ScalarNode
+    stack = [(root, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
+                                 location(file, node), "an ADF file nests a few levels; flatten the data"))
+        if node.__class__ is Mapping:
+            _check_keys(node, file, diags)
+            for k, v in node.value:
+                cls = v.__class__
+                if cls is not Scalar:
+                    stack.append((v, depth + 1))
+                elif check_tags and v.tag in _SCALAR_TAGS_CHECKED:
+                    _check_scalar_tag(v, file, diags)
+                if k.__class__ is not Scalar:
+                    stack.append((k, depth + 1))
+        elif node.__class__ is Sequence:
+            for v in node.value:
+                if v.__class__ is not Scalar:
+                    stack.append((v, depth + 1))
+                elif check_tags and v.tag in _SCALAR_TAGS_CHECKED:
+                    _check_scalar_tag(v, file, diags)
+        elif check_tags and node.tag in _SCALAR_TAGS_CHECKED:
+            _check_scalar_tag(node, file, diags)
+
+
+
+
+def _check_keys(node: yaml.MappingNode, file: str, diags: list[Diagnostic]) -> None:
+    seen: dict[Any, yaml.Node] = {}
+    Scalar = yaml.ScalarNode
+    for k, _ in node.value:
+        if k.__class__ is Scalar:
+            kv = k.value
+            if k.tag != STR_TAG:
+                diags.append(warning(
+                    "yaml-key-type", f"the key {_quote(kv)} is read as {_tag_name(k.tag)}, not text; "
+                    "AMBF (yaml-cpp) compares it as the text written",
+                    location(file, k), "quote the key, or check the mapping: `{a, b}` is a mapping of two keys"))
+            first = seen.get(kv)
+            if first is not None:
+                diags.append(warning(  # AMBF loads the file (sb/cloth.yaml): every command reads it
+                    "yaml-duplicate-key",
+                    f"duplicate key {_quote(kv)} (first at line {first.start_mark.line + 1}); "
+                    "AMBF keeps the first value, PyYAML the last",
+                    location(file, k), "remove one of the two entries"))
+            else:
+                seen[kv] = k
+        else:
+            diags.append(warning("yaml-key-type", f"a {'mapping' if isinstance(k, yaml.MappingNode) else 'list'} "
+                                 "is used as a key; AMBF reads it as text", location(file, k),
+                                 "use a text key"))
+
+
+def _check_scalar_tag(node: yaml.ScalarNode, file: str, diags: list[Diagnostic]) -> None:
+    """A scalar whose (explicit) tag cannot construct its value: `!!bool maybe`."""
+    construct = _constructor.yaml_constructors.get(node.tag)
+    if construct is None:
+        return
+    try:
+        construct(_constructor, node)
+    except Exception:  # noqa: BLE001 - every constructor failure is the same finding
+        diags.append(error("yaml-bad-tag", f"{_quote(node.value)} is not a valid {_tag_name(node.tag)}",
+                           location(file, node), "remove the explicit tag (`!!...`) or fix the value"))
+
+
+def _tag_name(tag: str) -> str:
+    return tag.rsplit(":", 1)[-1] if tag.startswith("tag:yaml.org,2002:") else tag
+
+
+def _quote(text: str, limit: int = 60) -> str:
+    r = repr(text)
+    return r if len(r) <= limit else r[: limit - 5] + "...'"
+
+
 def plain(node: yaml.Node) -> Any:
-    """A node as plain Python data (what ``yaml.safe_load`` would give)."""
-    if isinstance(node, yaml.ScalarNode):
-        return scalar_value(node)
-    if isinstance(node, yaml.SequenceNode):
-        return [plain(n) for n in node.value]
-    if isinstance(node, yaml.MappingNode):
-        out = {}
-        for k, v in node.value:
-            key = plain(k)
-            if isinstance(key, (list, dict)):
-                key = str(key)
-            out.setdefault(key, plain(v))
-        return out
-    raise TypeError(node)  # pragma: no cover
+    """A node as plain Python data (what ``yaml.safe_load`` would give, but keys are always the
+    text written, as AMBF's yaml-cpp compares them, and the first of duplicate keys wins).
+
+    Iterative: any depth; aliases are shared, not copied."""
+    if node.__class__ is yaml.ScalarNode:
+        return _cached_value(node)
+    made: dict[int, Any] = {}
+    root_out = [] if isinstance(node, yaml.SequenceNode) else {}
+    made[id(node)] = root_out
+    stack = [(node, root_out)]
+    while stack:
+        src, out = stack.pop()
+        if src.__class__ is yaml.SequenceNode:
+            for item in src.value:
+                out.append(_plain_child(item, made, stack))
+        else:
+            for k, v in src.value:
+                key = k.value if k.__class__ is yaml.ScalarNode else _key_text(k)
+                if key not in out:
+                    out[key] = _plain_child(v, made, stack)
+    return root_out
+
+
+def _plain_child(node, made: dict, stack: list):
+    if node.__class__ is yaml.ScalarNode:
+        return _cached_value(node)
+    done = made.get(id(node))
+    if done is not None:
+        return done
+    out = [] if node.__class__ is yaml.SequenceNode else {}
+    made[id(node)] = out
+    stack.append((node, out))
+    return out
+
+
+def _key_text(node: yaml.Node) -> str:
+    """A collection used as a key, as one line of text (yaml-cpp compares keys as text)."""
+    parts, stack = [], [node]
+    while stack and len(parts) < 200:
+        n = stack.pop()
+        if isinstance(n, yaml.ScalarNode):
+            parts.append(n.value)
+        else:
+            items = [x for pair in n.value for x in pair] if isinstance(n, yaml.MappingNode) else list(n.value)
+            stack.extend(reversed(items))
+    return "[" + ", ".join(parts) + "]"
+
+
+_VALUES: dict[tuple[str, str], Any] = {}
+
+
+def _cached_value(node: yaml.ScalarNode) -> Any:
+    """scalar_value, remembered per (tag, text): the values are immutable (str, int, float,
+    bool, None) and ADF files repeat few texts."""
+    key = (node.tag, node.value)
+    try:
+        return _VALUES[key]
+    except KeyError:
+        pass
+    v = scalar_value(node)
+    if len(_VALUES) < 200_000 and len(node.value) < 200:
+        _VALUES[key] = v
+    return v
 
 
 def scalar_value(node: yaml.ScalarNode) -> Any:
-    """A scalar as YAML 1.1 (PyYAML's safe schema) reads it; unknown tags stay text."""
-    construct = _constructor.yaml_constructors.get(node.tag)
+    """A scalar as YAML 1.1 (PyYAML's safe schema) reads it; unknown tags, and values their
+    tag cannot construct (`!!bool maybe`, reported by check_tree), stay text."""
+    tag = node.tag
+    if tag in _TEXT_TAGS:
+        return node.value
+    construct = _constructor.yaml_constructors.get(tag)
     if construct is None:
         return node.value
     try:
         return construct(_constructor, node)
-    except (yaml.YAMLError, ValueError, TypeError):
+    except Exception:  # noqa: BLE001 - KeyError, ValueError, AttributeError... all mean "not this type"
         return node.value
+
+
+# yaml-cpp has no date or binary values: AMBF reads `2001-12-14` and `!!binary ...` as the text
+# written, and so does adfkit (their Python types are not JSON either).
+_TEXT_TAGS = frozenset({STR_TAG, "tag:yaml.org,2002:timestamp", "tag:yaml.org,2002:binary"})
 
 
 def mapping_items(node: yaml.MappingNode) -> list[tuple[str, yaml.Node, yaml.Node]]:
     """(key text, key node, value node) for each entry; keys are compared as text like yaml-cpp."""
     out, seen = [], set()
     for k, v in node.value:
-        text = k.value if isinstance(k, yaml.ScalarNode) else str(plain(k))
+        text = k.value if isinstance(k, yaml.ScalarNode) else _key_text(k)
         if text not in seen:  # first occurrence wins, as in AMBF (yaml-cpp)
             seen.add(text)
             out.append((text, k, v))

@@ -20,13 +20,13 @@ def add_arguments(p) -> None:
 def run(args) -> int:
     from pathlib import Path
 
+    from .. import inputs
     from ..converters import format_of, read, write
     from ..diagnostics import AdfError, SourceLocation, error
 
     src, dst = Path(args.input), Path(args.output)
-    if not src.is_file():
-        raise AdfError(error("file-missing", f"{src} does not exist", SourceLocation(str(src)),
-                             "check the path"))
+    inputs.check_file(src, "xml", what="model file")  # a regular file (adfkit.inputs); readers check again
+    inputs.check_path_text(dst)
     if src.resolve() == dst.resolve():
         raise AdfError(error("convert-overwrite", "input and output are the same file", SourceLocation(str(dst)),
                              "write the converted model to a new file"))

@@ -36,8 +36,9 @@ def run(args) -> int:
     from ..runner.play import play, summary, unstable
     from ..runner.world import Options, SimWorld
 
-    if not Path(args.path).is_file():
-        raise AdfError(error("no-file", f"{args.path} does not exist", None, "give a launch, world or model file"))
+    from .. import inputs
+
+    inputs.check_file(args.path, what="ADF file")  # a regular file (adfkit.inputs), located errors
     if (args.seconds <= 0 or args.physics_hz <= 0 or args.control_substeps < 1 or args.solver_iterations < 1
             or (args.contact_threshold is not None and args.contact_threshold <= 0)):
         raise AdfError(error("bad-option", "--seconds, --physics-hz and --contact-threshold must be positive, "

@@ -7,6 +7,7 @@ import sys
 NAME = "validate"
 HELP = "validate ADF files, folders or a launch file (schema + semantic rules)"
 DESCRIPTION = (HELP + ". Exit status: 0 clean, 1 findings at or above --fail-on, 2 usage error or unreadable input.")
+UNREADABLE = ("file-not-found", "file-unreadable", "bad-path", "not-a-regular-file", "file-too-large")
 KIND_CHOICES = ["launch", "world", "input_devices", "model", "colors"]
 
 
@@ -64,7 +65,9 @@ def run(args) -> int:
         reporters.write_github(diags, out)
     else:
         reporters.write_sarif(diags, out)
-    if problems or any(d.rule in ("file-not-found", "file-unreadable") for d in diags):
+    # A file named on the command line that cannot be read at all: usage error. (A file that
+    # another one names is located at the naming key, a finding in that file.)
+    if problems or any(d.rule in UNREADABLE and (d.location is None or not d.location.line) for d in diags):
         return 2
     if args.fail_on == "never":
         return 0

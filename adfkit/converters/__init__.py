@@ -8,6 +8,7 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
+from .. import inputs
 from ..diagnostics import AdfError, SourceLocation, error
 from .losses import Loss
 
@@ -25,8 +26,9 @@ def format_of(path: str | Path, given: str | None = None) -> str:
     if fmt is None:
         raise AdfError(error("convert-format", f"cannot tell the format of {p.name!r} from its extension",
                              SourceLocation(str(p)), "use .yaml (ADF), .urdf or .xml (MJCF), or pass --from/--to"))
-    if fmt == "mjcf" and p.is_file():
-        head = p.read_bytes()[:4096].decode("utf-8", "replace")
+    if fmt == "mjcf" and inputs.is_regular(p):
+        with open(inputs.check_file(p, "xml", what="XML file"), "rb") as fh:  # regular file only
+            head = fh.read(4096).decode("utf-8", "replace")
         if "<robot" in head and "<mujoco" not in head:
             return "urdf"
     return fmt

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import inputs
 from ..model.pose import Quat
 
 
@@ -74,13 +75,14 @@ def estimate_from_collision(model, body, mass: float) -> tuple[float, float, flo
                         points.append((com * p.pose).transform((sx * h[0], sy * h[1], sz * h[2])))
     elif prims is None:
         path = collision_mesh_path(model, body)
-        if path is None or not path.is_file():
+        if path is None or not inputs.is_regular(path):
             return None
         try:
             from ..geometry.meshio import load_mesh
         except ImportError:
             return None
-        mesh = load_mesh(path, scale=body.scale if body.scale is not None else 1.0)
+        mesh = load_mesh(path, scale=body.scale if body.scale is not None else 1.0,
+                         tree=getattr(model, "tree", None), referrer=body.where("mesh"))
         r = np.asarray(com.orientation.matrix())
         pts = np.asarray(mesh.vertices) @ r.T + np.asarray(com.position)
         points = pts.tolist()

@@ -6,6 +6,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from xml.parsers import expat
 
+from .. import inputs
 from ..diagnostics import AdfError, SourceLocation, error
 
 
@@ -33,11 +34,7 @@ def parse_xml(path: str | Path | None = None, text: str | bytes | None = None) -
     ``file-unreadable``) with the line, never an expat or OS exception."""
     where = str(path) if path is not None else "<xml>"
     if text is None:
-        try:
-            text = Path(path).read_bytes()
-        except OSError as exc:
-            raise AdfError(error("file-unreadable", f"cannot read {where}: {exc.strerror}",
-                                 SourceLocation(where), "check the path and permissions")) from None
+        text = inputs.read_bytes(path, "xml", what="XML file")  # regular file, size cap (adfkit.inputs)
     builder = ET.TreeBuilder()
     lines: dict[int, int] = {}
     parser = expat.ParserCreate()

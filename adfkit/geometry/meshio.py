@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from .. import inputs
 from ..diagnostics import AdfError, SourceLocation, error
 
 #: Suffixes we hand to trimesh (lower case). DAE needs pycollada; trimesh says so if absent.
@@ -19,7 +20,7 @@ MESH_SUFFIXES = (".stl", ".obj", ".ply", ".dae", ".off", ".glb", ".gltf")
 
 
 def _fail(rule: str, message: str, path: str | os.PathLike, hint: str) -> AdfError:
-    return AdfError(error(rule, message, SourceLocation(str(path)), hint))
+    return AdfError(error(rule, message, SourceLocation(inputs.shown(path)), hint))
 
 
 def _as_single_mesh(loaded, path) -> trimesh.Trimesh:
@@ -41,7 +42,8 @@ def _as_single_mesh(loaded, path) -> trimesh.Trimesh:
                 "export the object as a triangle mesh (not only points or lines)")
 
 
-def load_mesh(path: str | os.PathLike, scale: float = 1.0) -> trimesh.Trimesh:
+def load_mesh(path: str | os.PathLike, scale: float = 1.0, tree: inputs.Tree | None = None,
+              referrer: SourceLocation | None = None) -> trimesh.Trimesh:
     """Load STL/OBJ/PLY/DAE (whatever trimesh reads) as one triangle mesh, times ``scale``.
 
     ``scale`` multiplies vertex coordinates about the mesh origin, as ADF's per-body
@@ -50,17 +52,22 @@ def load_mesh(path: str | os.PathLike, scale: float = 1.0) -> trimesh.Trimesh:
     a position are merged (ignoring normals and UVs) so closed meshes read as watertight.
 
     Raises ``AdfError`` with rule ``mesh-not-found``, ``mesh-unreadable``, ``mesh-empty``,
-    ``mesh-non-finite`` or ``mesh-bad-scale``.
+    ``mesh-non-finite`` or ``mesh-bad-scale``, or an input-policy rule (adfkit.inputs:
+    ``bad-path``, ``not-a-regular-file``, ``file-too-large``, ``outside-tree`` when ``tree``
+    is given: the tree of the ADF file that names the mesh).
     """
+    inputs.check_path_text(path, referrer)
     p = Path(path)
-    if not p.is_file():
+    if not os.path.lexists(p):
         hint = "check the path (ADF resolves mesh paths as in adf-format.md §6.2)"
         if p.parent.is_dir():
             stem = p.name.lower()
             near = [q.name for q in p.parent.iterdir() if q.name.lower() == stem]
             if near:
                 hint = f"file names are case-sensitive: did you mean '{near[0]}'?"
-        raise _fail("mesh-not-found", f"mesh file not found: {p}", p, hint)
+        raise _fail("mesh-not-found", f"mesh file not found: {inputs.shown(p)}", p, hint)
+    # A regular file under the mesh size cap, inside ``tree`` when another file named it.
+    inputs.check_file(p, "mesh", tree=tree, referrer=referrer, what="mesh file")
     if not np.isfinite(scale) or scale <= 0:
         raise _fail("mesh-bad-scale", f"scale must be a positive finite number, got {scale!r}", p,
                     "ADF 'scale' is a positive factor (default 1.0)")

@@ -29,6 +29,8 @@ class AdfFile(Node):
     """Common to every file: where it lives (for path resolution) and its version marker."""
 
     path: Path | None = field(default=None, compare=False, repr=False)
+    # The folder the files this one names must lie in (adfkit.inputs.Tree); None: no limit.
+    tree: object = field(default=None, compare=False, repr=False)
     adf_version: str | None = key("adf version", "str")
 
     @property

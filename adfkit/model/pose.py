@@ -31,7 +31,7 @@ class Vec3(NamedTuple):
         return Vec3(self.y * o[2] - self.z * o[1], self.z * o[0] - self.x * o[2], self.x * o[1] - self.y * o[0])
 
     def norm(self) -> float:
-        return math.sqrt(self.dot(self))
+        return math.hypot(self.x, self.y, self.z)  # no overflow for components near 1e308
 
     def normalized(self) -> "Vec3":
         n = self.norm()
@@ -65,6 +65,8 @@ class Quat(NamedTuple):
 
     def normalized(self) -> "Quat":
         n = math.sqrt(sum(c * c for c in self))
+        if not 0.0 < n < math.inf:  # zero, infinite or NaN: no rotation can be read from it
+            return NAN_QUAT
         return Quat(*(c / n for c in self))
 
     def rotate(self, v) -> Vec3:
@@ -83,6 +85,8 @@ class Quat(NamedTuple):
     @classmethod
     def from_axis_angle(cls, axis, angle: float) -> "Quat":
         a = Vec3(*axis).normalized()
+        if not math.isfinite(angle) or not all(map(math.isfinite, a)):
+            return NAN_QUAT
         s = math.sin(angle / 2.0)
         return cls(a.x * s, a.y * s, a.z * s, math.cos(angle / 2.0))
 
@@ -91,6 +95,15 @@ class Quat(NamedTuple):
         m00, m01, m02 = m[0]
         m10, m11, m12 = m[1]
         m20, m21, m22 = m[2]
+        if not all(math.isfinite(v) for v in (m00, m01, m02, m10, m11, m12, m20, m21, m22)):
+            return NAN_QUAT
+        try:
+            return cls._from_finite_matrix(m00, m01, m02, m10, m11, m12, m20, m21, m22)
+        except (ValueError, ZeroDivisionError):  # not a rotation matrix
+            return NAN_QUAT
+
+    @classmethod
+    def _from_finite_matrix(cls, m00, m01, m02, m10, m11, m12, m20, m21, m22) -> "Quat":
         tr = m00 + m11 + m22
         if tr > 0:
             s = math.sqrt(tr + 1.0) * 2
@@ -113,10 +126,16 @@ class Quat(NamedTuple):
 
 
 IDENTITY = Quat()
+#: What the rotation helpers return for non-finite input (they never raise on it): every
+#: component NaN, so the validator's non-finite-number rule and the writers see it.
+NAN_QUAT = Quat(math.nan, math.nan, math.nan, math.nan)
 
 
 def rpy_to_quat(roll: float, pitch: float, yaw: float) -> Quat:
-    """ADF/URDF roll-pitch-yaw (R = Rz(y)·Ry(p)·Rx(r)) to a unit quaternion."""
+    """ADF/URDF roll-pitch-yaw (R = Rz(y)·Ry(p)·Rx(r)) to a unit quaternion (:data:`NAN_QUAT`
+    for an infinite or NaN angle)."""
+    if not (math.isfinite(roll) and math.isfinite(pitch) and math.isfinite(yaw)):
+        return NAN_QUAT
     cr, sr = math.cos(roll / 2), math.sin(roll / 2)
     cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
     cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)

@@ -6,10 +6,12 @@ checking each model's references against the models AMBF would have loaded befor
 """
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from .. import inputs
 from ..adf.reader import read_file
 from ..adf.yamlnodes import read_text
 from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation
@@ -34,10 +36,10 @@ class FileResult:
     text: str | None = None
 
 
-def _read_with_compat(path: Path, kind: str | None, text: str, roots: list):
+def _read_with_compat(path: Path, kind: str | None, text: str, roots: list, tree=None, referrer=None):
     """read_file, retrying layouts yaml-cpp accepts and PyYAML does not (see yamlcompat)."""
     try:
-        doc, diags = read_file(path, kind, text=text, root_out=roots)
+        doc, diags = read_file(path, kind, text=text, root_out=roots, tree=tree, referrer=referrer)
         return doc, diags, text, []
     except AdfError as exc:
         if not exc.diagnostics or exc.diagnostics[0].rule != "yaml-syntax":
@@ -47,7 +49,7 @@ def _read_with_compat(path: Path, kind: str | None, text: str, roots: list):
             raise
         try:
             roots.clear()
-            doc, diags = read_file(path, kind, text=fixed, root_out=roots)
+            doc, diags = read_file(path, kind, text=fixed, root_out=roots, tree=tree, referrer=referrer)
         except AdfError as again:
             if again.diagnostics and again.diagnostics[0].rule == "yaml-syntax":
                 raise exc from None
@@ -72,15 +74,18 @@ def _adjust(d: Diagnostic) -> Diagnostic:
     return d
 
 
-def validate_file(path: str | Path, kind: str | None = None, context_models=(), text: str | None = None) -> FileResult:
+def validate_file(path: str | Path, kind: str | None = None, context_models=(), text: str | None = None,
+                  tree=None, referrer: SourceLocation | None = None) -> FileResult:
+    """Check one file. ``tree``/``referrer``: the file was named by another one and must lie
+    in that scene's tree (adfkit.inputs); None when the user named it."""
     path = Path(path)
     res = FileResult(path)
     try:
         if text is None:
-            text = read_text(path)
+            text = read_text(path, tree, referrer)
         res.text = text
         roots: list = []
-        doc, reader_diags, text, moved = _read_with_compat(path, kind, text, roots)
+        doc, reader_diags, text, moved = _read_with_compat(path, kind, text, roots, tree, referrer)
     except AdfError as exc:
         res.diagnostics = [_inside(_adjust(d), res.text) for d in exc.diagnostics]
         return res
@@ -121,17 +126,27 @@ def _unique(diags: list[Diagnostic]) -> list[Diagnostic]:
     return sorted(out, key=lambda d: (d.location.line if d.location else 0, d.location.column if d.location else 0))
 
 
-def expand(paths) -> tuple[list[Path], list[Diagnostic]]:
-    """Files to check from command-line paths (folders are searched recursively)."""
+def expand(paths) -> tuple[list[tuple[Path, object]], list[Diagnostic]]:
+    """Files to check from command-line paths, each with the tree it must lie in: None for a
+    file named on the command line, the folder's tree for files found in a named folder
+    (searched recursively; a symlink found there that leads out of the folder is refused)."""
     files, problems = [], []
     for p in map(Path, paths):
-        if p.is_dir():
-            files += sorted(f for f in p.rglob("*") if f.suffix.lower() in YAML_SUFFIXES and f.is_file())
-        elif p.exists():
-            files.append(p)
+        try:
+            inputs.check_path_text(p)
+            is_dir = p.is_dir()
+        except AdfError as exc:
+            problems += exc.diagnostics
+            continue
+        if is_dir:
+            tree = inputs.Tree(Path(os.path.realpath(p)))
+            files += [(f, tree) for f in sorted(f for f in p.rglob("*")
+                                                 if f.suffix.lower() in YAML_SUFFIXES and f.is_file())]
+        elif os.path.lexists(p):
+            files.append((p, None))
         else:
-            problems.append(Diagnostic(Severity.ERROR, "file-not-found", f"no such file or folder: {p}",
-                                       SourceLocation(str(p)), "check the path"))
+            problems.append(Diagnostic(Severity.ERROR, "file-not-found", f"no such file or folder: {inputs.shown(p)}",
+                                       SourceLocation(inputs.shown(p)), "check the path"))
     return files, problems
 
 
@@ -139,18 +154,18 @@ def validate_paths(paths, kind: str | None = None, follow: bool = True) -> tuple
     files, problems = expand(paths)
     results: dict[Path, FileResult] = {}
 
-    def run(path: Path, k: str | None, context=()) -> FileResult:
-        key = path.resolve()
+    def run(path: Path, k: str | None, context=(), tree=None, referrer=None) -> FileResult:
+        key = Path(os.path.realpath(path))
         if key in results:
             return results[key]
-        res = validate_file(path, k, context)
+        res = validate_file(path, k, context, tree=tree, referrer=referrer)
         results[key] = res
-        if follow and isinstance(res.doc, Launch):
-            follow_launch(res.doc)
         if follow and isinstance(res.doc, World) and res.doc.environment:
             env = paths_check.relative_to_file(res.doc.path, res.doc.environment)
-            if env.is_file():
-                run(env, "model")
+            if os.path.lexists(env):
+                run(env, "model", tree=res.doc.tree, referrer=res.doc.where("environment"))
+        if follow and isinstance(res.doc, Launch):
+            follow_launch(res.doc)
         return res
 
     def follow_launch(launch: Launch) -> None:
@@ -158,27 +173,29 @@ def validate_paths(paths, kind: str | None = None, follow: bool = True) -> tuple
         context: list[ModelFile] = []
         for slot, k in (("world config", "world"), ("input devices config", "input_devices"), ("color config", "colors")):
             for p in targets.get(slot, []):
-                if p.is_file():
-                    res = run(p, k)
+                if os.path.lexists(p):
+                    res = run(p, k, tree=launch.tree, referrer=launch.where(slot))
                     if k == "world" and isinstance(res.doc, World) and res.doc.environment:
-                        env = results.get(paths_check.relative_to_file(res.doc.path, res.doc.environment).resolve())
+                        env_path = paths_check.relative_to_file(res.doc.path, res.doc.environment)
+                        env = results.get(Path(os.path.realpath(env_path)))
                         if env is not None and isinstance(env.doc, ModelFile):
                             context.append(env.doc)
         for p in targets.get("multibody configs", []):
-            if p.is_file():
-                res = run(p, "model", tuple(context))
+            if os.path.lexists(p):
+                res = run(p, "model", tuple(context), tree=launch.tree, referrer=launch.where("multibody configs"))
                 if isinstance(res.doc, ModelFile):
                     context.append(res.doc)
 
     # Launch files first, so the models they name are checked with the models loaded before them.
-    for f in sorted(files, key=lambda f: not _looks_like_launch(f)):
-        run(f, kind)
+    for f, tree in sorted(files, key=lambda ft: not _looks_like_launch(ft[0])):
+        run(f, kind, tree=tree)
     return list(results.values()), problems
 
 
 def _looks_like_launch(path: Path) -> bool:
     try:
-        head = path.read_bytes()[:65536].decode("utf-8", errors="replace")
-    except OSError:
+        with open(inputs.check_file(path), "rb") as fh:
+            head = fh.read(65536).decode("utf-8", errors="replace")
+    except (OSError, AdfError):
         return False
     return re.search(r"^(world config|multibody configs)\s*:", head, flags=re.M) is not None

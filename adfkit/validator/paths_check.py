@@ -2,11 +2,14 @@
 shaders, skyboxes, sensor meshes, and the files launch, world and input-devices files chain to."""
 from __future__ import annotations
 
+import os
+import stat
 from functools import lru_cache
 from pathlib import Path
 
 from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
-from ..diagnostics import Diagnostic, SourceLocation
+from .. import inputs
+from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..model import InputDevices, Launch, ModelFile, World
 from . import softbody_rules
 from .rules import RULES
@@ -20,7 +23,40 @@ def _d(rule: str, message: str, loc: SourceLocation | None, hint: str | None = N
 
 @lru_cache(maxsize=4096)
 def _exists(path: str) -> bool:
-    return Path(path).is_file()
+    """A regular file is there (never raises: odd paths are simply not there)."""
+    try:
+        return stat.S_ISREG(os.stat(path).st_mode)
+    except (OSError, ValueError):
+        return False
+
+
+def _present(path) -> bool:
+    """Something is there (a device or a folder counts: the input policy then says what)."""
+    try:
+        return os.path.lexists(path)
+    except (OSError, ValueError):
+        return False
+
+
+@lru_cache(maxsize=4096)
+def _refusal(path: str, root: str | None, kind: str) -> tuple[str, str, str | None] | None:
+    """(rule, message, hint) when the input policy refuses a file that is there, else None."""
+    try:
+        inputs.check_file(path, kind, tree=inputs.Tree(Path(root)) if root else None)
+    except AdfError as exc:
+        d = exc.diagnostics[0]
+        return d.rule, d.message, d.hint
+    return None
+
+
+def _policy(path, doc, kind: str, loc, owner: str) -> Diagnostic | None:
+    """The input policy's finding for a file ``doc`` names, located at the naming key."""
+    tree = getattr(doc, "tree", None)
+    found = _refusal(str(path), str(tree.root) if tree is not None else None, kind)
+    if found is None:
+        return None
+    rule, message, hint = found
+    return _d(rule, f"{owner}: {message}", loc, hint)
 
 
 @lru_cache(maxsize=1024)
@@ -29,25 +65,28 @@ def obj_material_problems(obj_path: str) -> tuple[str, ...]:
     missing: list[str] = []
     base = Path(obj_path).parent
     try:
+        inputs.check_file(obj_path, "mesh")
         with open(obj_path, "r", encoding="utf-8", errors="replace") as fh:
             libs = [line.split(None, 1)[1].strip() for line in fh if line.startswith("mtllib") and " " in line]
-    except OSError:
+    except (OSError, ValueError, AdfError):
         return ()
     for lib in libs:
         mtl = base / lib
-        if not mtl.is_file():
-            missing.append(f"material library {lib}")
+        if not _exists(str(mtl)):
+            missing.append(f"material library {inputs.shown(lib, 80)}")
             continue
         try:
-            lines = mtl.read_text(encoding="utf-8", errors="replace").splitlines()
-        except OSError:
+            lines = inputs.read_bytes(mtl, "text", tree=inputs.Tree(Path(os.path.realpath(base))))
+            lines = lines.decode("utf-8", errors="replace").splitlines()
+        except AdfError:
+            missing.append(f"material library {inputs.shown(lib, 80)} (outside the mesh's folder or not readable)")
             continue
         for line in lines:
             parts = line.strip().split()
             if len(parts) >= 2 and parts[0].lower().startswith(TEXTURE_KEYS):
                 tex = parts[-1]
-                if not (mtl.parent / tex).is_file() and not (mtl.parent / tex.replace("\\", "/")).is_file():
-                    missing.append(f"texture {tex} (in {lib})")
+                if not _exists(str(mtl.parent / tex)) and not _exists(str(mtl.parent / tex.replace("\\", "/"))):
+                    missing.append(f"texture {inputs.shown(tex, 80)} (in {inputs.shown(lib, 80)})")
     return tuple(dict.fromkeys(missing))
 
 
@@ -78,10 +117,12 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
             if path is None or str(path) in seen:
                 continue
             seen.add(str(path))
-            if not _exists(str(path)):
-                out.append(_d("missing-mesh", f"mesh file {path} of '{obj.identifier}' not found", obj.where(key),
-                              "paths resolve against the body's and model's high/low resolution paths, "
-                              "then the model file's directory"))
+            if not _present(path):
+                out.append(_d("missing-mesh", f"mesh file {inputs.shown(path)} of '{obj.identifier}' not found",
+                              obj.where(key), "paths resolve against the body's and model's high/low resolution "
+                              "paths, then the model file's directory"))
+            elif (refused := _policy(path, m, "mesh", obj.where(key), f"mesh of '{obj.identifier}'")) is not None:
+                out.append(refused)
             elif path.suffix.lower() == ".obj":
                 for what in obj_material_problems(str(path)):
                     out.append(_d("missing-texture", f"{what} of mesh {path.name} ('{obj.identifier}') not found",
@@ -106,7 +147,7 @@ def _camera_shaders(path, c) -> list[Diagnostic]:
 
 def world_paths(w: World) -> list[Diagnostic]:
     out: list[Diagnostic] = []
-    if w.environment and not _exists(str(relative_to_file(w.path, w.environment))):
+    if w.environment and not _present(relative_to_file(w.path, w.environment)):
         out.append(_d("missing-file", f"environment {relative_to_file(w.path, w.environment)} not found",
                       w.where("environment"), "the environment path is relative to the world file"))
     out += _shaders(w.path, w.shaders, "the world", w.where("shaders"))
@@ -135,13 +176,17 @@ def launch_targets(launch: Launch) -> dict[str, list[Path]]:
 
 
 def launch_paths(launch: Launch) -> list[Diagnostic]:
+    """Files a launch file names that are not there. A path that is there but refused by the
+    input policy (a device, a file outside the scene's tree) is reported by the validator
+    when it follows the launch file (adfkit.validator.engine)."""
     out = []
     for key, paths in launch_targets(launch).items():
         for p in paths:
-            if _exists(str(p)):
+            if _present(p):
                 continue
-            rule = "missing-model-file" if key == "multibody configs" else "missing-file"
-            out.append(_d(rule, f"'{key}' names {p}, which does not exist", launch.where(key),
+            rule = {"multibody configs": "missing-model-file", "color config": "missing-color-file"}.get(key, "missing-file")
+            out.append(_d(rule, f"'{key}' names {inputs.shown(p)}, which does not exist", launch.where(key),
+                          "AMBF 2.0 stores this path and never opens it" if key == "color config" else
                           "paths in a launch file are relative to the launch file's directory"))
     return out
 

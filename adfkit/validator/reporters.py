@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import IO
 
 from .. import __version__
-from ..diagnostics import Diagnostic, Severity
+from ..diagnostics import Diagnostic, Severity, one_line
 from .rules import RULES
 
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -16,19 +16,18 @@ _GITHUB = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: 
 
 
 def _source_line(texts: dict[str, str | None], d: Diagnostic) -> str | None:
+    """The offending line, only from a file being reported on (``texts``: what the validator
+    read); never read from disk here, so no other file's content can be quoted."""
     if not d.location or not d.location.line:
         return None
     text = texts.get(d.location.file)
-    if text is None:
-        try:
-            text = Path(d.location.file).read_text(encoding="utf-8", errors="replace")
-        except OSError:
-            text = ""
-        texts[d.location.file] = text
+    if not text:
+        return None
     lines = text.split("\n")
     if d.location.line > len(lines):
         return None
-    return lines[d.location.line - 1].rstrip("\r")
+    line = lines[d.location.line - 1].rstrip("\r")
+    return one_line(line[:400] + (" ..." if len(line) > 400 else ""))
 
 
 def write_text(diags: list[Diagnostic], stream: IO[str], texts: dict[str, str | None] | None = None,
@@ -36,14 +35,14 @@ def write_text(diags: list[Diagnostic], stream: IO[str], texts: dict[str, str | 
     texts = dict(texts or {})
     for d in diags:
         where = f"{d.location}: " if d.location else ""
-        stream.write(f"{where}{d.severity}[{d.rule}]: {d.message}\n")
+        stream.write(f"{where}{d.severity}[{d.rule}]: {one_line(d.message)}\n")
         line = _source_line(texts, d)
         if line is not None:
             col = max(1, d.location.column)
             stream.write(f"  {d.location.line:>5} | {line}\n")
             stream.write(f"        | {' ' * (col - 1)}^\n")
         if d.hint:
-            stream.write(f"  hint: {d.hint}\n")
+            stream.write(f"  hint: {one_line(d.hint)}\n")
     if summary:
         counts = {s: sum(1 for d in diags if d.severity == s) for s in Severity}
         stream.write(f"{files} file(s) checked: {counts[Severity.ERROR]} error(s), "

@@ -94,18 +94,30 @@ class Checker:
 
     # --- numbers (NaN, inf, absurd magnitudes) --------------------------------------------
     def numbers(self, node: Node) -> None:
-        for f in adf_fields(node):
-            key = f.metadata["adf_key"]
-            value = getattr(node, f.name)
-            self._number(key, value, node.where(key))
-            if isinstance(value, Node):
-                self.numbers(value)
-            elif isinstance(value, list):
-                for item in value:
-                    if isinstance(item, Node):
-                        self.numbers(item)
-                    else:
-                        self._number(key, item, node.where(key))
+        """Non-finite and absurd numbers anywhere in the element (an explicit stack; plain
+        floats, the common case, are checked without building lists)."""
+        stack = [node]
+        while stack:
+            n = stack.pop()
+            for f in adf_fields(n):
+                value = getattr(n, f.name)
+                if value is None:
+                    continue
+                cls = value.__class__
+                key = f.metadata["adf_key"]
+                if cls is float:
+                    if value - value != 0.0 or (abs(value) > ABSURD and key not in UNBOUNDED_KEYS):
+                        self._number(key, value, n.where(key))
+                elif isinstance(value, Node):
+                    stack.append(value)
+                elif cls is list:
+                    for item in value:
+                        if isinstance(item, Node):
+                            stack.append(item)
+                        else:
+                            self._number(key, item, n.where(key))
+                else:
+                    self._number(key, value, n.where(key))
 
     def _number(self, key: str, value, loc) -> None:
         if isinstance(value, bool):
@@ -402,8 +414,12 @@ class Checker:
             self.emit("missing-type", f"{what} '{s.identifier}' has no type; AMBF skips it", s.where(),
                       f"add `type: {next(iter(types))}`")
         elif s.type not in types:
-            self.emit("sensor-type", f"{what} '{s.identifier}' has type {s.type!r}; AMBF segfaults on unknown "
-                      "types", s.where("type"), f"use one of {', '.join(types)}")
+            self.emit("sensor-type", f"{what} '{s.identifier}' has type {str(s.type)[:60]!r}, unknown to AMBF 2.0 "
+                      "(which crashes on it; later AMBF versions and plugins define more types)", s.where("type"),
+                      f"for AMBF 2.0 use one of {', '.join(types)}")
+        if s.parent is None or s.parent == "":
+            self.emit("missing-parent", f"{what} '{s.identifier}' has no parent; AMBF attaches it to nothing "
+                      "and skips it", s.where(), "add `parent: BODY ...`")
         if type(s).__name__ == "Sensor":
             forms = [k for k in ("array", "mesh", "parametric") if getattr(s, k) is not None]
             if len(forms) != 1:
