@@ -15,7 +15,7 @@ import numpy as np
 from adfkit.diagnostics import Diagnostic, SourceLocation, error, warning
 from adfkit.model import Actuator, Body, Camera, Ghost, Joint, Light, ModelFile, Pose, Sensor
 from adfkit.model.common import Geometry, ShapeEntry
-from adfkit.model.objects import Ray
+from adfkit.model.objects import Ray, SoftBody
 from adfkit.model.pose import Quat, Vec3
 
 from . import fields, joint_frames, meshes
@@ -34,10 +34,17 @@ class MeshJob:
 
 
 @dataclass
+class Options:
+    apply_modifiers: bool = True     # export the evaluated mesh (depsgraph)
+    low_res_ratio: float = 1.0       # decimate collision meshes made from the visual one
+
+
+@dataclass
 class Gathered:
     model: ModelFile
     jobs: list[MeshJob] = field(default_factory=list)
     diagnostics: list[Diagnostic] = field(default_factory=list)
+    options: Options = field(default_factory=Options)
 
 
 def where(obj) -> SourceLocation:
@@ -59,7 +66,7 @@ def unchanged(obj) -> bool:
 
 def world_pose(obj) -> Pose:
     loc, rot, _ = obj.matrix_world.decompose()
-    return Pose(Vec3(*map(float, loc)), Quat(float(rot.x), float(rot.y), float(rot.z), float(rot.w)).normalized())
+    return Pose(Vec3(*map(fields.tidy, loc)), Quat(float(rot.x), float(rot.y), float(rot.z), float(rot.w)).normalized())
 
 
 def uniform_scale(obj) -> float:
@@ -68,7 +75,10 @@ def uniform_scale(obj) -> float:
 
 
 def relative_pose(obj, parent) -> Pose:
-    return world_pose(parent).inverse() * world_pose(obj) if parent is not None else world_pose(obj)
+    if parent is None:
+        return world_pose(obj)
+    p = world_pose(parent).inverse() * world_pose(obj)
+    return Pose(Vec3(*(round(c, 12) + 0.0 for c in p.position)), p.orientation)
 
 
 def adf_parent(obj):
@@ -126,9 +136,9 @@ def gather_ghost(obj, out: Gathered, paths: tuple[str, str]) -> Ghost:
 
 def _parent_ref(old: str | None, parent) -> str | None:
     if parent is None:
-        return None
+        return old  # a parent in another file (or not found at import) is carried through
     ident = identifier(parent)
-    return old if old and old in ident else ident
+    return old if old and (old in ident or old.endswith("/" + ident)) else ident
 
 
 def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
@@ -136,7 +146,7 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
     visual = None
     first_name = b.mesh
     if obj.type == "MESH" and len(obj.data.polygons):
-        arr = meshes.mesh_arrays(obj)
+        arr = meshes.mesh_arrays(obj, evaluated=out.options.apply_modifiers)
         digest = meshes.digest([arr])
         name = b.mesh if b.mesh else f"{obj.name}.OBJ"
         src = Path(obj.adf.mesh_source) if obj.adf.mesh_source else None
@@ -194,7 +204,7 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
         body_inv = np.array(obj.matrix_world.inverted(), dtype=np.float64)
         arrays = []
         for c in parts:
-            a = meshes.mesh_arrays(c)
+            a = meshes.mesh_arrays(c, evaluated=out.options.apply_modifiers)
             m = body_inv @ np.array(c.matrix_world, dtype=np.float64)
             if not np.allclose(m, np.eye(4), atol=1e-7):
                 co = a.co.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
@@ -218,6 +228,14 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
     if visual is not None and not (b.collision_shape or b.compound_collision_shape):
         # no collision of its own: AMBF looks the visual file name up in the low-res folder
         name = b.collision_mesh or visual.filename
+        ratio = out.options.low_res_ratio
+        if ratio < 1.0 and obj.type == "MESH" and b.collision_mesh is None and not isinstance(b, SoftBody):
+            low = meshes.decimated_arrays(obj, ratio)
+            if Path(name).suffix.lower() != ".obj":
+                name = Path(name).stem + ".OBJ"
+                b.collision_mesh = name
+            out.jobs.append(MeshJob(lo, name, meshes.digest([low]), parts=[low]))
+            return
         out.jobs.append(MeshJob(lo, name, visual.digest, parts=visual.parts, source=visual.source))
 
 
@@ -232,8 +250,18 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
     rbc = obj.rigid_body_constraint
     p = rbc.object1 if rbc is not None else None
     c = rbc.object2 if rbc is not None else None
+    if (p is None and j.parent) or (c is None and j.child):
+        # imported with a body that lives in another file: carried through as written
+        out.diagnostics.append(warning("joint-reference", f"joint '{obj.name}': "
+                                       f"{'parent' if p is None else 'child'} body is not in this scene; kept as written",
+                                       where(obj)))
+        if p is not None:
+            j.parent = _parent_ref(j.parent, p)
+        if c is not None:
+            j.child = _parent_ref(j.child, c)
+        return j
     for role, o in (("parent", p), ("child", c)):
-        if o is None or o.adf.kind != "BODY":
+        if o is None or o.adf.kind not in ("BODY", "SOFT_BODY"):
             what = "no object" if o is None else f"'{o.name}', which is not an ADF body"
             out.diagnostics.append(error("joint-reference", f"joint '{obj.name}': its {role} is {what}", where(obj),
                                          f"set the rigid body constraint's {'first' if role == 'parent' else 'second'}"
@@ -261,6 +289,13 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
 
 def _attached(obj, x, out: Gathered, what: str):
     parent = adf_parent(obj)
+    if parent is None and x.parent:
+        # imported with a parent in another file (or not found): carried through as written
+        out.diagnostics.append(warning(f"{what}-parent", f"{what} '{obj.name}': parent '{x.parent}' is not in this "
+                                       "scene; kept as written", where(obj)))
+        if not (unchanged(obj) and x.location is not None):
+            x.location = world_pose(obj)
+        return x
     if parent is None:
         out.diagnostics.append(error(f"{what}-parent", f"{what} '{obj.name}' is not parented to an ADF body", where(obj),
                                      "parent it to the body it is mounted on"))
@@ -342,6 +377,59 @@ def gather_light(obj, out: Gathered) -> Light:
         out.diagnostics.append(warning("light-shadow", f"light '{obj.name}' has no shadow quality", where(obj),
                                        "AMBF leaves it uninitialised; set it (0-5)"))
     return li
+
+
+# --- soft bodies ----------------------------------------------------------------------------
+
+def node_indices(co: np.ndarray) -> np.ndarray:
+    """The soft-body node index of each vertex: AMBF merges vertices at one position and
+    numbers the unique ones in order of first appearance (adfkit.geometry.softmesh)."""
+    if len(co) == 0:
+        return np.zeros(0, dtype=np.int64)
+    key = np.round(co.astype(np.float64), 9)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first)
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return rank[inverse.reshape(-1)]
+
+
+def fixed_nodes(obj) -> list[int] | None:
+    """Node indices of the vertices in the soft body's fixed-node vertex group (None: no group)."""
+    grp = obj.vertex_groups.get(obj.adf.soft.fixed_group) if obj.type == "MESH" else None
+    if grp is None:
+        return None
+    members = [v.index for v in obj.data.vertices if any(g.group == grp.index and g.weight > 0 for g in v.groups)]
+    if not members:
+        return []
+    co = np.empty(len(obj.data.vertices) * 3, np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    nodes = node_indices(co.reshape(-1, 3))
+    return sorted({int(nodes[i]) for i in members})
+
+
+def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
+    from adfkit.model.objects import SoftBodyConfig
+    sb = fields.from_snapshot(SoftBody, obj.adf.snapshot, f"blender:{obj.name}")
+    sb.identifier = identifier(obj)
+    if sb.name is None:
+        sb.name = obj.name
+    try:
+        fields.merge(sb, fields.SOFT, read_group(obj.adf.soft, fields.SOFT))
+    except ValueError as exc:
+        out.diagnostics.append(error("body-value", f"soft body '{obj.name}': {exc}", where(obj)))
+    _pose_and_scale(obj, sb)
+    _gather_geometry(obj, sb, out, paths)
+    fixed = fixed_nodes(obj)
+    old = sb.config.fixed_nodes if sb.config is not None else None
+    if fixed is not None and sorted(set(old or [])) != fixed and not (fixed == [] and old is None):
+        if sb.config is None:
+            sb.config = SoftBodyConfig()
+        sb.config.fixed_nodes = fixed
+    if obj.type != "MESH" and not sb.mesh:
+        out.diagnostics.append(error("soft-body-mesh", f"soft body '{obj.name}' has no mesh", where(obj),
+                                     "a soft body's nodes are its mesh's vertices: make it a mesh object"))
+    return sb
 
 
 GATHER = {"SENSOR": ("sensors", gather_sensor), "ACTUATOR": ("actuators", gather_actuator),
