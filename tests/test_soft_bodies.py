@@ -341,6 +341,29 @@ def test_soft_rigid_attachment_and_parameter_mapping(tmp_path):
     assert rep["soft_bodies"][0]["attached_nodes"] == {"BODY weight": 1}
 
 
+def test_plane_beside_a_soft_body_is_warned_and_the_default_floor_is_a_slab(tmp_path):
+    (tmp_path / "sq.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n")
+    soft = "SOFT s:\n  name: s\n  mesh: sq.obj\n  mass: 0.01\n"
+    (tmp_path / "plane.yaml").write_text(
+        "bodies: [BODY floor]\nsoft bodies: [SOFT s]\nBODY floor:\n  name: floor\n  mass: 0.0\n"
+        "  location: {position: {x: 0, y: 0, z: -0.5}, orientation: {r: 0, p: 0, y: 0}}\n"
+        "  collision shape: PLANE\n  collision geometry: {normal: {x: 0, y: 0, z: 1}, offset: 0}\n" + soft)
+    world = _world(tmp_path / "plane.yaml", 0.0)
+    try:
+        assert "runner-soft-plane" in {d.rule for d in world.diagnostics}
+    finally:
+        world.close()
+    (tmp_path / "alone.yaml").write_text("soft bodies: [SOFT s]\n" + soft.replace("mesh", "location: {position: "
+                                         "{x: 0, y: 0, z: 0.3}, orientation: {r: 0, p: 0, y: 0}}\n  mesh"))
+    world = _world(tmp_path / "alone.yaml", 0.5)
+    try:
+        z = world.soft.items[0].nodes(world.cid)[:, 2]
+        assert world.ground_z == pytest.approx(0.299)            # 1 mm under the sheet, as for rigid bodies
+        assert np.all(np.abs(z - 0.3) < 0.003), z                # resting on it, not centimetres above
+    finally:
+        world.close()
+
+
 # --- the soft phantom sample scene -------------------------------------------------------------------
 
 def _skin_under_probe(launch, seconds):
@@ -433,6 +456,12 @@ def test_mjcf_flex_parameters_and_losses(tmp_path):
     feats = {(l.element, l.feature) for l in losses}
     assert {("SOFT s", "config.kVC"), ("SOFT s", "randomize constraints"), ("SOFT s", "fixed nodes"),
             ("SOFT s", "soft body")} <= feats
+    # and back: MuJoCo's flex is a named loss, its vertex bodies are not made ADF bodies
+    from adfkit.converters import read
+
+    back, read_losses = read(tmp_path / "m.xml", "mjcf")
+    assert back.bodies == [] and back.joints == []
+    assert [(l.element, l.feature) for l in read_losses] == [("s", "flex")]
 
 
 def test_urdf_names_the_soft_body_loss(tmp_path):

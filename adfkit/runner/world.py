@@ -252,7 +252,7 @@ class SimWorld:
         if self.soft is None:
             shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=self.cid)
             self.ground_uid = pb.createMultiBody(0.0, shape, -1, [0.0, 0.0, self.ground_z], physicsClientId=self.cid)
-        else:   # soft bodies meet a static plane at z = 0 whatever its position: a thick slab instead
+        else:   # soft bodies stop centimetres above a static plane: a thick slab instead
             self.ground_uid = self.soft.ground_slab(self.ground_z)
         self._floor_z = self.ground_z
 

@@ -82,7 +82,7 @@ def build_soft_phantom(p: SoftPhantomParams | None = None) -> ModelFile:
     holder = Geometry(x=0.02, y=0.02, z=0.01)
     m.bodies.append(Body(identifier="BODY Holder", name="Holder", mass=0.0, location=Pose(Vec3(0, 0, holder_z)),
                          shape="Box", geometry=holder, color_rgba=STEEL))
-    # a sphere: PyBullet's soft contact lets a capsule tip through a membrane that holds a sphere
+    # a sphere: PyBullet's soft contact lets an upright capsule's end through a membrane that holds a sphere
     tip = Geometry(radius=p.probe_radius)
     i = 0.4 * p.probe_mass * p.probe_radius ** 2
     m.bodies.append(Body(identifier="BODY Probe", name="Probe", mass=p.probe_mass, location=Pose(Vec3(0, 0, probe_z)),
