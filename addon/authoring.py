@@ -178,8 +178,10 @@ def fit_collision_primitive(obj, shape: str = "CAPSULE", replace: bool = True):
             bpy.data.objects.remove(c, do_unlink=True)
     g = entry.geometry
     size = (g.x, g.y, g.z) if kind == "BOX" else (0.1, 0.1, 0.1)
-    return add_collision_primitive(obj, kind, size=size, radius=g.radius or 0.05, height=g.height or 0.1,
+    made = add_collision_primitive(obj, kind, size=size, radius=g.radius or 0.05, height=g.height or 0.1,
                                    axis=g.axis or "z", offset=_pose_matrix(entry.offset))
+    bpy.context.view_layer.update()
+    return made
 
 
 def _cone_from_cylinder(entry, mesh):

@@ -213,6 +213,10 @@ def _look_matrix(loc, look_at, up, forward_axis) -> Matrix:
 def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     scene = scene or bpy.context.scene
     doc, diags = read_file(Path(path), kind="model")
+    # the validator's severities: what AMBF loads anyway (duplicate keys, sb/cloth.yaml) is a warning
+    from dataclasses import replace
+    from adfkit.validator.engine import SEVERITY_OVERRIDES
+    diags = [replace(d, severity=SEVERITY_OVERRIDES.get(d.rule, d.severity)) for d in diags]
     errors = [d for d in diags if d.severity >= Severity.ERROR]
     if errors:
         raise AdfError(errors)

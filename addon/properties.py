@@ -48,8 +48,9 @@ def _make_group(name: str, table: list[fields.Field], extra: dict | None = None,
     updates = updates or {}
     for f in table:
         up = updates.get(f.prop)
-        ann[f.prop] = _prop(f, up)
-        kw = {"update": up} if up is not None else {}
+        value_up, use_up = up if isinstance(up, tuple) else (up, up)
+        ann[f.prop] = _prop(f, value_up)
+        kw = {"update": use_up} if use_up is not None else {}
         ann["use_" + f.prop] = BoolProperty(name=f"Write {f.label}", default=False,
                                             description=f"Write '{' '.join(f.path)}' (off: AMBF default)", **kw)
     ann.update(extra or {})
@@ -89,11 +90,11 @@ _LIMIT_PROPS = ("type", "limit_low", "limit_high", "cone_limits", "linear_low", 
                 "angular_high")
 _TYPED = {"mass_typed": BoolProperty(name="Mass typed by hand", default=False,
                                      description="off: mass follows density × mesh volume")}
-BodyProps = _make_group("AdfBodyProps", fields.BODY, dict(_TYPED), {"mass": _mass_typed})
+BodyProps = _make_group("AdfBodyProps", fields.BODY, dict(_TYPED), {"mass": (_mass_typed, None)})
 SoftProps = _make_group("AdfSoftProps", fields.SOFT, {
     **_TYPED, "fixed_group": StringProperty(name="Fixed nodes group", default="fixed nodes",
                                              description="vertex group whose vertices are the soft body's fixed nodes")},
-    {"mass": _mass_typed})
+    {"mass": (_mass_typed, None)})
 GhostProps = _make_group("AdfGhostProps", fields.GHOST)
 JointProps = _make_group("AdfJointProps", fields.JOINT, None, {k: _joint_limits for k in _LIMIT_PROPS})
 SensorProps = _make_group("AdfSensorProps", fields.SENSOR, {"rays": CollectionProperty(type=AdfRay)})
