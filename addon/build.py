@@ -102,7 +102,9 @@ def _shape_child(body_obj, prim, i, scene):
 
 def _geometry(obj, x, doc, scene) -> None:
     vis = visual_mesh_path(doc, x) if x.mesh else None
-    prims = collision_primitives(x)
+    prims = collision_primitives(x) or []
+    if any(p.kind.name not in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE") for p in prims):
+        return  # a plane (or another shape the panel does not offer): kept exactly in the snapshot
     if prims:
         for i, p in enumerate(prims):
             _shape_child(obj, p, i, scene)

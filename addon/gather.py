@@ -97,8 +97,10 @@ def gather_body(obj, out: Gathered, paths: tuple[str, str]) -> Body:
         b.name = obj.name
     values = read_group(obj.adf.body, fields.BODY)
     if values.get("mass") is None:
-        out.diagnostics.append(error("body-mass", f"body '{obj.name}' has no mass", where(obj),
-                                     "tick 'Write Mass' in the ADF Body panel (0 makes it static)"))
+        # refused when authored here; a file imported without mass is carried through as AMBF loads it
+        out.diagnostics.append((warning if obj.adf.snapshot and b.mass is None else error)(
+            "body-mass", f"body '{obj.name}' has no mass", where(obj),
+            "tick 'Write Mass' in the ADF Body panel (0 makes it static)"))
     try:
         fields.merge(b, fields.BODY, values)
     except ValueError as exc:
@@ -293,15 +295,17 @@ def _attached(obj, x, out: Gathered, what: str):
         # imported with a parent in another file (or not found): carried through as written
         out.diagnostics.append(warning(f"{what}-parent", f"{what} '{obj.name}': parent '{x.parent}' is not in this "
                                        "scene; kept as written", where(obj)))
-        if not (unchanged(obj) and x.location is not None):
+        if not unchanged(obj):
             x.location = world_pose(obj)
+            x.extras.pop("location", None)
         return x
     if parent is None:
         out.diagnostics.append(error(f"{what}-parent", f"{what} '{obj.name}' is not parented to an ADF body", where(obj),
                                      "parent it to the body it is mounted on"))
     x.parent = _parent_ref(x.parent, parent)
-    if not (unchanged(obj) and x.location is not None):
+    if not unchanged(obj):   # unchanged: the location as the file wrote it (or left it out)
         x.location = relative_pose(obj, parent)
+        x.extras.pop("location", None)
     return x
 
 
@@ -314,7 +318,7 @@ def gather_sensor(obj, out: Gathered) -> Sensor:
     if rays and not fields.same32(old, [(*r.offset, *r.direction) for r in rays]):
         s.array = rays
     if not (s.array or s.mesh or s.parametric):
-        out.diagnostics.append(error("sensor-rays", f"sensor '{obj.name}' has no rays", where(obj),
+        out.diagnostics.append((warning if obj.adf.snapshot else error)("sensor-rays", f"sensor '{obj.name}' has no rays", where(obj),
                                      "add rays in the ADF Sensor panel; AMBF skips a sensor without them"))
     return _attached(obj, s, out, "sensor")
 
