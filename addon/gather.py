@@ -148,7 +148,8 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
     visual = None
     first_name = b.mesh
     if obj.type == "MESH" and len(obj.data.polygons):
-        arr = meshes.mesh_arrays(obj, evaluated=out.options.apply_modifiers)
+        # a soft body's nodes are its own vertices (fixed nodes index them): no modifiers there
+        arr = meshes.mesh_arrays(obj, evaluated=out.options.apply_modifiers and not isinstance(b, SoftBody))
         digest = meshes.digest([arr])
         name = b.mesh if b.mesh else f"{obj.name}.OBJ"
         src = Path(obj.adf.mesh_source) if obj.adf.mesh_source else None

@@ -247,7 +247,7 @@ SENSOR heel:
     assert (h.use_contact_stiffness, h.contact_stiffness, h.use_friction_variable) == (True, 800.0, True)
     h.contact_stiffness = 900.0                       # edited in the panel
     res = _export(addon, scene, tmp_path / "out", "exo")
-    assert any(d.rule == "sensor-type" and "unknown to AMBF 2.0" in d.message and d.severity == Severity.WARNING
+    assert any(d.rule == "sensor-type" and "AMBF 2.0" in d.message and d.severity == Severity.WARNING
                for d in res.diagnostics)
     doc, _ = read_file(res.path)
     t, hh = doc.sensors
