@@ -59,6 +59,23 @@ def mark(obj, kind: str) -> None:
         obj.vertex_groups.new(name=obj.adf.soft.fixed_group)
 
 
+def fix_selected_nodes(obj, replace: bool = True) -> list[int]:
+    """Put the mesh's selected vertices in the soft body's fixed-node vertex group (Edit Mode
+    selection; the object is switched to Object Mode to read it). Returns the vertex indices."""
+    if obj.type != "MESH":
+        _fail("no-mesh", f"'{obj.name}' is not a mesh", obj, "a soft body's nodes are its mesh's vertices")
+    if obj.mode == "EDIT":
+        obj.update_from_editmode()
+    name = obj.adf.soft.fixed_group
+    grp = obj.vertex_groups.get(name) or obj.vertex_groups.new(name=name)
+    picked = [v.index for v in obj.data.vertices if v.select]
+    if replace:
+        grp.remove(list(range(len(obj.data.vertices))))
+    if picked:
+        grp.add(picked, 1.0, "REPLACE")
+    return picked
+
+
 def mesh_volume(obj) -> tuple[float, bool]:
     """(volume in m³ with the object's scale, closed?) of a mesh object; an open mesh gives
     its convex hull's volume (bmesh, no geometry packages needed)."""

@@ -141,6 +141,22 @@ class ADF_OT_fit_primitive(_ActiveBody, bpy.types.Operator):
         return {"FINISHED"}
 
 
+class ADF_OT_fix_nodes(bpy.types.Operator):
+    bl_idname = "adf.fix_selected_nodes"
+    bl_label = "Fixed nodes = selected vertices"
+    bl_description = "The soft body's fixed nodes become the selected vertices (its fixed-node vertex group)"
+
+    @classmethod
+    def poll(cls, context):
+        o = context.active_object
+        return o is not None and o.adf.kind == "SOFT_BODY" and o.type == "MESH"
+
+    def execute(self, context):
+        picked = authoring.fix_selected_nodes(context.active_object)
+        self.report({"INFO"}, f"{len(picked)} fixed nodes")
+        return {"FINISHED"}
+
+
 class ADF_OT_estimate_gains(bpy.types.Operator):
     bl_idname = "adf.estimate_gains"
     bl_label = "Estimate joint controller gains"
@@ -256,7 +272,7 @@ class ADF_OT_check(bpy.types.Operator):
 CLASSES = (ADF_OT_export, ADF_OT_import, ADF_OT_mark, ADF_OT_generate_collision, ADF_OT_add_primitive,
            ADF_OT_estimate_inertia, ADF_OT_add_joint, ADF_OT_rope, ADF_OT_grasp, ADF_OT_ghost, ADF_OT_check,
            ADF_OT_estimate_all, ADF_OT_fit_primitive, ADF_OT_estimate_gains, ADF_OT_show_joints, ADF_OT_cleanup,
-           ADF_OT_strip)
+           ADF_OT_strip, ADF_OT_fix_nodes)
 
 
 def _menu_export(self, context):

@@ -63,6 +63,7 @@ def draw_object(layout, obj) -> None:
         layout.prop(adf, "density")
         if obj.type == "MESH":
             layout.prop_search(pg, "fixed_group", obj, "vertex_groups", text="Fixed nodes")
+            layout.operator("adf.fix_selected_nodes")
             if pg.fixed_group not in obj.vertex_groups:
                 layout.label(text="No such vertex group: no fixed nodes written", icon="INFO")
         else:

@@ -133,7 +133,9 @@ def test_soft_body_authored_with_fixed_nodes_from_a_vertex_group(addon, scene, t
         setattr(s, prop, value)
     corners = [v.index for v in pad.data.vertices if v.co.y > 0.049 and abs(v.co.x) > 0.049]
     assert len(corners) == 2
-    pad.vertex_groups[s.fixed_group].add(corners, 1.0, "REPLACE")
+    for v in pad.data.vertices:
+        v.select = v.index in corners
+    assert addon.authoring.fix_selected_nodes(pad) == corners
     res = _export(addon, scene, tmp_path)
     doc, _ = read_file(res.path)
     (sb,) = doc.soft_bodies
