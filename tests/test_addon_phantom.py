@@ -452,3 +452,28 @@ def test_panels_offer_gravity_publish_and_resistance_keys(addon, scene, tmp_path
     assert "contact_stiffness" not in shown()
     s.use_type, s.type = True, "Resistance"
     assert fields.RESISTANCE_ONLY <= shown()
+
+
+def test_operators_run_from_blender(addon, scene, tmp_path):
+    """The buttons, through bpy.ops as the UI calls them (poll included)."""
+    rod = _tilted_cylinder()
+    bpy.context.view_layer.objects.active = rod
+    assert bpy.ops.adf.mark(kind="BODY") == {"FINISHED"}
+    assert bpy.ops.adf.fit_collision_primitive(shape="CYLINDER") == {"FINISHED"}
+    assert [c.adf.shape.shape for c in rod.children] == ["CYLINDER"]
+    assert bpy.ops.adf.estimate_all() == {"FINISHED"}
+    assert rod.adf.body.inertia[0] > 0 and not rod.adf.body.mass_typed
+    assert bpy.ops.adf.estimate_gains() == {"FINISHED"}
+    assert bpy.ops.adf.show_joints(show=False) == {"FINISHED"}
+    assert bpy.ops.adf.check() == {"FINISHED"}
+    assert bpy.ops.adf.cleanup() == {"FINISHED"}
+    pad = _grid("Pad")
+    bpy.context.view_layer.objects.active = pad
+    pad.select_set(True)
+    rod.select_set(False)
+    assert bpy.ops.adf.mark(kind="SOFT_BODY") == {"FINISHED"}
+    assert bpy.ops.adf.fix_selected_nodes() == {"FINISHED"}
+    assert bpy.ops.adf.export_model(directory=str(tmp_path), model_name="ops") == {"FINISHED"}
+    doc, _ = read_file(tmp_path / "ops.yaml")
+    assert [b.identifier for b in doc.bodies] == ["BODY Rod"] and len(doc.soft_bodies) == 1
+    assert len(doc.soft_bodies[0].config.fixed_nodes) == len(pad.data.vertices)   # all were selected
