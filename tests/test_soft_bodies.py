@@ -155,6 +155,17 @@ def test_3ds_reader_and_node_merge_on_a_written_square(tmp_path):
     assert info.value.diagnostics[0].rule in ("mesh-unreadable", "mesh-empty")
 
 
+def test_nodes_at_maps_editor_vertices_to_fixed_nodes():
+    from adfkit.geometry.softmesh import nodes_at
+
+    v = np.array([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 0, 0), (1, 1, 0), (0, 1, 0)], float)
+    mesh = unique_nodes(v, np.array([(0, 1, 2), (3, 4, 5)]))
+    # a vertex group holding the repeated corner twice and the last vertex: nodes 0 and 3
+    assert nodes_at(mesh, [v[3], v[0], v[5]]) == [0, 3]
+    with pytest.raises(ValueError, match="no node at"):
+        nodes_at(mesh, [(0.5, 0.5, 0.0)])
+
+
 def test_unique_nodes_drops_collapsed_triangles():
     v = np.array([(0, 0, 0), (1, 0, 0), (1, 0, 0), (0, 1, 0)], float)
     m = unique_nodes(v, np.array([(0, 1, 2), (0, 2, 3)]))
@@ -258,6 +269,25 @@ def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path):
     assert nodes[on_box, 2].max() < -0.02
     assert nodes[~on_box, 2].min() < top - 0.3
     assert row["size_m"] < 1.5 * row["rest_size_m"]                            # stretched, not exploded
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", CLOTHS)
+def test_corpus_cloth_plays_5_seconds_on_a_box(name, tmp_path):
+    cloth = _cloth(name)
+    y = {"cloth.yaml": 2.0, "cloth2.yaml": -0.5}[name]
+    (tmp_path / "box.yaml").write_text(BOX_UNDER_CLOTH.replace("y: 2.0", f"y: {y}"))
+    (tmp_path / "launch.yaml").write_text(f"multibody configs:\n  - {cloth}\n  - box.yaml\n")
+    world = _world(tmp_path / "launch.yaml", 5.0)
+    try:
+        rep = world.report()
+        nodes = world.soft.items[0].nodes(world.cid)
+    finally:
+        world.close()
+    assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
+    on_box = (np.abs(nodes[:, 0]) < 0.2) & (np.abs(nodes[:, 1] - y) < 0.2)
+    # held up by the box top (z = -0.1): cloth2's 0.1 m collision margin holds it higher still
+    assert on_box.sum() >= 10 and nodes[on_box, 2].min() > -0.1 - 0.005
 
 
 def test_adfkit_run_plays_corpus_cloth2_and_reports_it(tmp_path, capsys):
@@ -366,35 +396,59 @@ def test_plane_beside_a_soft_body_is_warned_and_the_default_floor_is_a_slab(tmp_
 
 # --- the soft phantom sample scene -------------------------------------------------------------------
 
-def _skin_under_probe(launch, seconds):
+def _skin_under_tool(launch, seconds, tool="Probe"):
     world = _world(launch, seconds)
     try:
         (skin,) = world.soft.items
         nodes = skin.nodes(world.cid)
         rep = world.report()
-        probe = world.body("Probe").com_position() if any("Probe" in k for k in world.registry.items) else None
+        at = world.body(tool).com_position() if any(tool in k for k in world.registry.items) else None
     finally:
         world.close()
     assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
-    return nodes, probe
+    return nodes, at
 
 
-def test_soft_phantom_is_indented_by_the_probe(tmp_path):
+@pytest.fixture(scope="module")
+def sag(tmp_path_factory):
+    """How far the skin sinks under its own weight, at its centre, without a tool."""
+    from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
+
+    p = SoftPhantomParams(with_probe=False)
+    alone, _ = _skin_under_tool(write_soft_phantom(tmp_path_factory.mktemp("alone"), p), 0.5)
+    return p.height - alone[np.linalg.norm(alone[:, :2], axis=1) < 0.006, 2].min()
+
+
+def test_soft_phantom_is_indented_by_a_spherical_probe(tmp_path, sag):
+    from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
+
+    p = SoftPhantomParams(tool="sphere")
+    nodes, probe = _skin_under_tool(write_soft_phantom(tmp_path, p), 0.5)
+    centre = np.linalg.norm(nodes[:, :2], axis=1) < 0.006
+    far = np.linalg.norm(nodes[:, :2], axis=1) > 0.035
+    depth = p.height - nodes[centre, 2].min()
+    print(f"skin indentation under the probe: {(depth - sag) * 1000:.1f} mm (sag alone {sag * 1000:.1f} mm)")
+    assert 0.005 < depth - sag < 0.03                           # visibly indented: millimetres to centimetres
+    assert probe[2] - p.probe_radius == pytest.approx(nodes[centre, 2].min(), abs=0.004)  # tip on the skin
+    # the dent is local: far from the probe the skin moved much less than under it
+    assert (p.height - nodes[far, 2].min()) < 0.5 * depth
+
+
+@pytest.mark.slow   # six capsules against the skin: ~3x the sphere's contact cost
+def test_soft_phantom_is_indented_by_the_suturing_needle(tmp_path, sag):
+    """The bundled scene's tool: the suturing pad's needle lying flat, pressed with 0.49 N."""
     from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
 
     p = SoftPhantomParams()
-    with_probe, probe = _skin_under_probe(write_soft_phantom(tmp_path / "a", p), 0.5)
-    alone, _ = _skin_under_probe(write_soft_phantom(tmp_path / "b", SoftPhantomParams(with_probe=False)), 0.5)
-    centre = np.linalg.norm(with_probe[:, :2], axis=1) < 0.006
-    far = np.linalg.norm(with_probe[:, :2], axis=1) > 0.035
-    depth = p.height - with_probe[centre, 2].min()
-    sag = p.height - alone[centre, 2].min()
-    indentation = depth - sag
-    print(f"skin indentation under the probe: {indentation * 1000:.1f} mm (sag alone {sag * 1000:.1f} mm)")
-    assert 0.005 < indentation < 0.03                           # visibly indented: millimetres to centimetres
-    assert probe[2] - p.probe_radius == pytest.approx(with_probe[centre, 2].min(), abs=0.004)  # tip on the skin
-    # the dent is local: far from the probe the skin moved much less than under it
-    assert (p.height - with_probe[far, 2].min()) < 0.5 * depth
+    assert p.tool == "needle"
+    nodes, needle = _skin_under_tool(write_soft_phantom(tmp_path, p), 0.6, "Needle")
+    under = np.linalg.norm(nodes[:, :2], axis=1) < 0.015
+    depth = p.height - nodes[under, 2].min()
+    print(f"skin indentation under the needle: {(depth - sag) * 1000:.1f} mm")
+    assert 0.005 < depth - sag < 0.03
+    # the needle rests on the skin (its wire within a few millimetres of the skin's lowest node), not through it
+    assert -0.002 < needle[2] - nodes[under, 2].min() < 0.006
+    assert needle[2] > 0.015                                    # well above the tray (top at 0.01)
 
 
 def test_soft_phantom_sample_scene_is_generated(tmp_path):

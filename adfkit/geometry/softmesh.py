@@ -107,6 +107,22 @@ def unique_nodes(vertices: np.ndarray, faces: np.ndarray) -> SoftMesh:
     return SoftMesh(nodes, tris[ok])
 
 
+def nodes_at(mesh: SoftMesh, points, tol: float = 1e-6) -> list[int]:
+    """Node indices of the nodes at ``points`` (n × 3, the mesh's frame, within ``tol``):
+    how an editor turns selected vertices (a Blender vertex group) into `fixed nodes`.
+    Raises ValueError naming the first point no node is at."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    out: list[int] = []
+    for p in pts:
+        d = np.linalg.norm(mesh.nodes - p, axis=1)
+        i = int(np.argmin(d)) if len(d) else -1
+        if i < 0 or d[i] > tol:
+            raise ValueError(f"no node at {p.tolist()}")
+        if i not in out:
+            out.append(i)
+    return sorted(out)
+
+
 def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0) -> SoftMesh:
     """The soft body AMBF makes of a collision mesh file: unique nodes (times ``scale``) and
     triangles. Raises AdfError (mesh-not-found, mesh-unreadable, mesh-empty)."""
@@ -166,5 +182,5 @@ def write_obj(mesh: SoftMesh, path: str | os.PathLike) -> Path:
     return p
 
 
-__all__ = ["SoftMesh", "read_3ds", "unique_nodes", "load_soft_mesh", "placed_soft_mesh", "link_stiffness",
+__all__ = ["SoftMesh", "read_3ds", "unique_nodes", "nodes_at", "load_soft_mesh", "placed_soft_mesh", "link_stiffness",
            "write_obj", "DEFAULT_SOFT_MASS"]

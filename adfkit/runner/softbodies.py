@@ -125,6 +125,7 @@ class SoftBodies:
                     by_obj[id(sb)] = made
         for m, j in self.joints:
             self._attach(m, j, by_obj)
+        shutil.rmtree(self._tmp, ignore_errors=True)   # loadSoftBody has read the OBJ files
         planes = [b.key for b in self.world.bodies if getattr(b, "_parts", None) is not None and b._parts.plane is not None]
         if self.items and planes:
             self.world._warn("runner-soft-plane", f"{', '.join(planes)}: PyBullet's soft bodies stop centimetres above a "

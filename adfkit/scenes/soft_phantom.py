@@ -1,7 +1,9 @@
 """A soft tissue phantom: a skin membrane (an ADF soft body, a square grid mesh) held at its
-border over a rigid tray, and a rigid spherical probe on a free vertical slide (no motor:
-`max motor impulse: 0`) above its centre. Under gravity the probe sinks into the skin;
-tests/test_soft_bodies.py measures the indentation. The world has a floor, a camera looking at the skin and a light.
+border over a rigid tray, and a rigid tool on a free vertical slide (no motor:
+`max motor impulse: 0`) above its centre: the suturing needle lying flat (the default), or
+a spherical probe (``tool="sphere"``). Under gravity the tool sinks into the skin;
+tests/test_soft_bodies.py measures the indentation. The world has a floor, a camera looking
+along the skin and a light.
 
 The skin's settings are Bullet soft-body keys (config: kLST, piterations, kDP, kDF, fixed
 nodes) as AMBF reads them; the PyBullet runner maps them as the README ("Soft bodies")
@@ -9,13 +11,14 @@ says. The mesh is written beside the model file as skin.obj.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..adf.writer import atomic_write_text, write_file
 from ..model import (
     RGBA, Body, Camera, ClippingPlane, Colors, Friction, Geometry, Inertia, InputDevices, Joint, JointLimits,
-    Launch, Light, ModelFile, Pose, Resolution, Vec3, World,
+    Launch, Light, ModelFile, Pose, Quat, Resolution, ShapeEntry, Vec3, World,
 )
 from ..model.objects import SoftBody, SoftBodyConfig
 from .suturing_pad import FLOOR, STEEL, TISSUE, build_floor
@@ -36,6 +39,9 @@ class SoftPhantomParams:
     margin: float = 0.001          # collision margin, m
     probe_mass: float = 0.05       # kg
     probe_radius: float = 0.008    # spherical tip, m
+    tool: str = "needle"           # the suturing needle lying flat, or "sphere": a probe
+    needle_radius: float = 0.012   # arc radius, m (the suturing pad's)
+    needle_wire: float = 0.0005    # wire radius, m
     probe_gap: float = 0.002       # tip above the skin at the start, m
     with_probe: bool = True
 
@@ -77,24 +83,51 @@ def build_soft_phantom(p: SoftPhantomParams | None = None) -> ModelFile:
                          restitution=0.0))
     if not p.with_probe:
         return m
-    probe_z = p.height + p.probe_gap + p.probe_radius
-    holder_z = probe_z + 0.04
+    tool, tool_z = _needle(p) if p.tool == "needle" else _sphere_probe(p)
+    holder_z = tool_z + 0.04
     holder = Geometry(x=0.02, y=0.02, z=0.01)
     m.bodies.append(Body(identifier="BODY Holder", name="Holder", mass=0.0, location=Pose(Vec3(0, 0, holder_z)),
                          shape="Box", geometry=holder, color_rgba=STEEL))
-    # a sphere: PyBullet's soft contact lets an upright capsule's end through a membrane that holds a sphere
-    tip = Geometry(radius=p.probe_radius)
-    i = 0.4 * p.probe_mass * p.probe_radius ** 2
-    m.bodies.append(Body(identifier="BODY Probe", name="Probe", mass=p.probe_mass, location=Pose(Vec3(0, 0, probe_z)),
-                         shape="Sphere", geometry=tip, collision_shape="Sphere", collision_geometry=tip,
-                         collision_offset=Pose(), inertia=Inertia(ix=i, iy=i, iz=i), inertial_offset=Pose(),
-                         color_rgba=STEEL, friction=Friction(static=0.3, rolling=0.01), restitution=0.0))
-    drop = holder_z - probe_z
-    m.joints.append(Joint(identifier="JOINT Holder-Probe", name="Holder-Probe", parent="BODY Holder",
-                          child="BODY Probe", type="prismatic", parent_pivot=Vec3(0, 0, -drop),
+    m.bodies.append(tool)
+    m.joints.append(Joint(identifier=f"JOINT Holder-{tool.name}", name=f"Holder-{tool.name}", parent="BODY Holder",
+                          child=tool.identifier, type="prismatic", parent_pivot=Vec3(0, 0, tool_z - holder_z),
                           child_pivot=Vec3(), parent_axis=Vec3(0, 0, 1), child_axis=Vec3(0, 0, 1),
                           joint_limits=JointLimits(low=-0.04, high=0.0), max_motor_impulse=0.0))
     return m
+
+
+def _sphere_probe(p: SoftPhantomParams) -> tuple[Body, float]:
+    # a sphere: PyBullet's soft contact lets an upright capsule's end through a membrane that holds a sphere
+    z = p.height + p.probe_gap + p.probe_radius
+    tip = Geometry(radius=p.probe_radius)
+    i = 0.4 * p.probe_mass * p.probe_radius ** 2
+    return Body(identifier="BODY Probe", name="Probe", mass=p.probe_mass, location=Pose(Vec3(0, 0, z)),
+                shape="Sphere", geometry=tip, collision_shape="Sphere", collision_geometry=tip,
+                collision_offset=Pose(), inertia=Inertia(ix=i, iy=i, iz=i), inertial_offset=Pose(),
+                color_rgba=STEEL, friction=Friction(static=0.3, rolling=0.01), restitution=0.0), z
+
+
+def _needle(p: SoftPhantomParams) -> tuple[Body, float]:
+    """The suturing pad's needle (a 3/8 circle of 12 mm radius, 0.5 mm wire, as capsules along
+    the arc) lying flat on the skin, pressed by `probe_mass` (its weight and a driver's push)."""
+    n = 6
+    r, wire, arc = p.needle_radius, p.needle_wire, 3 * math.pi / 4
+    step = arc / n
+    chord = 2 * r * math.sin(step / 2)
+    parts = []
+    for k in range(n):
+        mid = -arc / 2 + (k + 0.5) * step
+        # the arc's mid-point at the body origin, so the needle presses on the skin's centre
+        pos = Vec3(r * math.cos(mid) - r, r * math.sin(mid), 0.0)
+        parts.append(ShapeEntry(shape="Capsule", offset=Pose(pos, Quat.from_axis_angle((0, 0, 1), mid + math.pi / 2)),
+                                geometry=Geometry(radius=wire, height=chord + 2 * wire, axis="x")))
+    z = p.height + p.probe_gap + wire
+    mass = p.probe_mass
+    return Body(identifier="BODY Needle", name="Needle", mass=mass, location=Pose(Vec3(0, 0, z)),
+                compound_shape=[ShapeEntry(shape=e.shape, geometry=e.geometry, offset=e.offset) for e in parts],
+                compound_collision_shape=parts, color_rgba=STEEL,
+                inertia=Inertia(ix=mass * r * r / 2, iy=mass * r * r / 2, iz=mass * r * r), inertial_offset=Pose(),
+                friction=Friction(static=0.3, rolling=0.01), restitution=0.0), z
 
 
 def build_world(p: SoftPhantomParams) -> World:
