@@ -386,19 +386,6 @@ def gather_light(obj, out: Gathered) -> Light:
 
 # --- soft bodies ----------------------------------------------------------------------------
 
-def node_indices(co: np.ndarray) -> np.ndarray:
-    """The soft-body node index of each vertex: AMBF merges vertices at one position and
-    numbers the unique ones in order of first appearance (adfkit.geometry.softmesh)."""
-    if len(co) == 0:
-        return np.zeros(0, dtype=np.int64)
-    key = np.round(co.astype(np.float64), 9)
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    order = np.argsort(first)
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    return rank[inverse.reshape(-1)]
-
-
 def fixed_nodes(obj) -> list[int] | None:
     """Node indices of the vertices in the soft body's fixed-node vertex group (None: no group)."""
     grp = obj.vertex_groups.get(obj.adf.soft.fixed_group) if obj.type == "MESH" else None
@@ -407,10 +394,12 @@ def fixed_nodes(obj) -> list[int] | None:
     members = [v.index for v in obj.data.vertices if any(g.group == grp.index and g.weight > 0 for g in v.groups)]
     if not members:
         return []
+    from adfkit.geometry.softmesh import nodes_at, unique_nodes
     co = np.empty(len(obj.data.vertices) * 3, np.float32)
     obj.data.vertices.foreach_get("co", co)
-    nodes = node_indices(co.reshape(-1, 3))
-    return sorted({int(nodes[i]) for i in members})
+    co = co.reshape(-1, 3).astype(np.float64)
+    # AMBF's numbering: unique vertex positions in order of first appearance
+    return nodes_at(unique_nodes(co, np.zeros((0, 3), dtype=np.int64)), co[members])
 
 
 def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
