@@ -116,3 +116,95 @@ def test_a_short_play_is_stable(world):
     needle = world.body("Needle").world_matrix()
     assert np.linalg.norm(needle[:3, 3] - layout.needle_start()[:3, 3]) < 1e-3
     assert needle[2, 2] > np.cos(np.radians(2))
+
+
+def test_psm1_picks_the_needle_up_from_above(built):
+    """IK to the needle's start pose from above, jaws open, down, grasp through the actuator,
+    lift 2 cm: the needle (not a thread element) comes along, held within a millimetre."""
+    from adfkit.runner.psm import PSM
+    from adfkit.runner.world import SimWorld
+    world = SimWorld(load_scene(built / "launch.yaml", None, []))
+    try:
+        psm = PSM(world, "psm1")
+        needle = world.body("Needle")
+        start = needle.world_matrix()
+        to_base = np.linalg.inv(psm.base_in_world())
+        angle = layout.NEEDLE_GRASP_ANGLE
+        grasp = to_base @ layout.grasp_ee_pose(start, angle, layout.shaft_direction("psm1", start, angle))
+        above = grasp.copy()
+        above[:3, 3] += to_base[:3, :3] @ np.array([0.0, 0.0, 0.02])
+        psm.servo_jaw(0.8)
+        psm.move_cp(above, 0.4)
+        psm.move_cp(grasp, 0.3)
+        world.step(10)
+        assert np.linalg.norm(psm.measured_cp()[:3, 3] - grasp[:3, 3]) < 1e-4
+        sensed = {b.key for s in world.sensors if "psm1" in s.key for b in s.sensed}
+        assert needle.key in sensed
+        held = np.linalg.inv(psm.base_in_world() @ psm.measured_cp()) @ needle.world_matrix()
+        assert psm.grasp(True) is needle
+        world.step(10)
+        psm.move_cp(above, 0.4)
+        world.step(10)
+        now = np.linalg.inv(psm.base_in_world() @ psm.measured_cp()) @ needle.world_matrix()
+        assert needle.world_matrix()[2, 3] - start[2, 3] > 0.018
+        assert np.linalg.norm(now[:3, 3] - held[:3, 3]) < 1e-3
+        psm.grasp(False)
+        world.step(50)
+        assert needle.world_matrix()[2, 3] - start[2, 3] < 0.01     # released: it fell back
+    finally:
+        world.close()
+
+
+def test_help_does_not_import_the_scene_builders():
+    import subprocess
+    import sys
+    code = ("import sys; from adfkit.cli import build_parser; build_parser(); "
+            "print(any(m.startswith('adfkit.scenes.') for m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_needle_hulls_cover_the_needle():
+    import trimesh
+
+    from adfkit.geometry.decompose import load_hulls
+    from adfkit.scenes.suturing.needle import HULLS_FILE, needle_mesh
+    v, f = needle_mesh()
+    mesh = trimesh.Trimesh(v, f, process=False)
+    assert mesh.is_watertight and mesh.volume > 0
+    hulls = load_hulls(HULLS_FILE)
+    assert 4 <= len(hulls) <= 16 and all(h.is_watertight and h.volume > 0 for h in hulls)
+    from scipy.spatial import ConvexHull
+    inside = np.zeros(len(v), bool)
+    for h in hulls:
+        eq = ConvexHull(h.vertices).equations            # outward normals: inside is <= 0
+        inside |= (v @ eq[:, :3].T + eq[:, 3]).max(axis=1) < 2e-5
+    assert inside.all()
+    assert sum(h.volume for h in hulls) < 1.6 * mesh.volume      # tight: no hull spans the arc's chord
+
+
+@pytest.mark.slow
+def test_committed_needle_hulls_are_coacds_output(tmp_path, monkeypatch):
+    from adfkit.scenes.suturing.needle import HULLS_FILE, needle_hulls_text
+    monkeypatch.setenv("ADFKIT_CACHE", str(tmp_path))
+    assert needle_hulls_text(refresh=True)[0] == HULLS_FILE.read_text()
+
+
+def test_needle_matches_the_challenge_needle():
+    """Radius and arc of the corpus Needle.OBJ (a circle fitted to its vertices) are the layout's."""
+    import math
+
+    import trimesh
+    from conftest import CORPUS, require_corpus
+    require_corpus()
+    v = trimesh.load(CORPUS / "src/ADF/Phantoms/Simple/high_res/Needle.OBJ", force="mesh").vertices
+    a = np.c_[2 * v[:, 0], 2 * v[:, 1], np.ones(len(v))]
+    cx, cy, c = np.linalg.lstsq(a, v[:, 0] ** 2 + v[:, 1] ** 2, rcond=None)[0]
+    radius = math.sqrt(c + cx * cx + cy * cy)
+    assert abs(radius - layout.NEEDLE_RADIUS) < 3e-4
+    ang = np.sort(np.arctan2(v[:, 1] - cy, v[:, 0] - cx) % (2 * math.pi))
+    gaps = np.diff(np.concatenate([ang, ang[:1] + 2 * math.pi]))
+    arc = 2 * math.pi - gaps.max()                       # the circle minus its largest empty gap
+    assert abs(arc - layout.NEEDLE_ARC) < math.radians(10)
+    wire = (np.hypot(v[:, 0] - cx, v[:, 1] - cy).max() - np.hypot(v[:, 0] - cx, v[:, 1] - cy).min()) / 2
+    assert abs(wire - layout.NEEDLE_WIRE) < 1.5e-4
