@@ -211,3 +211,31 @@ def test_needle_matches_the_challenge_needle():
     assert abs(arc - layout.NEEDLE_ARC) < math.radians(10)
     wire = (np.hypot(v[:, 0] - cx, v[:, 1] - cy).max() - np.hypot(v[:, 0] - cx, v[:, 1] - cy).min()) / 2
     assert abs(wire - layout.NEEDLE_WIRE) < 1.5e-4
+
+
+def test_the_needle_turns_through_every_pair_without_touching(built):
+    """The needle set (kinematically) along its arc from entry k to exit k keeps clear of the
+    phantom, the ridge and the holes' capsule boundaries (at least 0.3 mm, its collision's
+    margin included)."""
+    import math
+
+    import pybullet as pb
+
+    from adfkit.runner.rotations import matrix_to_pq
+    from adfkit.runner.world import SimWorld
+    from adfkit.scenes.suturing.frames import rot_z
+    world = SimWorld(load_scene(built / "launch.yaml", None, []))
+    try:
+        needle = world.body("Needle")
+        statics = [b for b in world.bodies if b.static]
+        turn = 2 * (math.pi / 2 - layout.entry_angle())
+        for k in range(1, 5):
+            for s in np.linspace(-0.1, 1.1, 13):
+                pose = layout.needle_at_entry(k) @ rot_z(-s * turn)
+                pb.resetBasePositionAndOrientation(needle.uid, *matrix_to_pq(pose @ needle.com_in_body),
+                                                   physicsClientId=world.cid)
+                near = [b.key for b in statics
+                        if pb.getClosestPoints(needle.uid, b.uid, 0.0003, -1, b.link, physicsClientId=world.cid)]
+                assert not near, (k, s, near)
+    finally:
+        world.close()
