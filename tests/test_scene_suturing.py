@@ -3,7 +3,6 @@ clean validation, the expected objects in the runner, PSMs that calibrate to the
 kinematics and reach every hole from above, a stable short play, the bundled copy current."""
 from __future__ import annotations
 
-import filecmp
 from pathlib import Path
 
 import numpy as np

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...model import (
-    RGBA, Body, Friction, Geometry, Ghost, ModelFile, Pose, ShapeEntry, Vec3, VelocityDamping,
+    RGBA, Body, Friction, Geometry, Ghost, ModelFile, Pose, ShapeEntry, Vec3,
 )
 from . import layout as L
 from .frames import look_frame, pose, r, vec
