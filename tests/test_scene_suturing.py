@@ -238,3 +238,31 @@ def test_the_needle_turns_through_every_pair_without_touching(built):
                 assert not near, (k, s, near)
     finally:
         world.close()
+
+
+def test_demo_plays_the_bundled_suturing_scene_by_default(tmp_path, capsys):
+    assert main(["demo", "--seconds", "0.1", "--out", str(tmp_path / "demo")]) == 0
+    out = capsys.readouterr().out
+    assert f"scene: {BUNDLED / 'launch.yaml'}" in out
+    assert (tmp_path / "demo" / "cameraL_rgb.png").is_file() and (tmp_path / "demo" / "cameraR_rgb.png").is_file()
+
+
+@pytest.mark.slow
+def test_ten_seconds_of_play_stay_still(built):
+    """Left alone for 10 s the scene stays where it was built: arms at home, needle flat on
+    the slab, the thread lying on it with its pivots together."""
+    from adfkit.runner.world import Options, SimWorld
+    world = SimWorld(load_scene(built / "launch.yaml", None, []), Options(visuals=False))
+    try:
+        needle = world.body("Needle")
+        start = needle.world_matrix()
+        world.run(10.0)
+        rep = world.report()
+        assert not rep["nan"] and not rep["exploded"] and not rep["fell_through_floor"]
+        assert rep["max_constraint_error_m"] < 1e-3
+        now = needle.world_matrix()
+        assert np.linalg.norm(now[:3, 3] - start[:3, 3]) < 1e-3 and now[2, 2] > np.cos(np.radians(2))
+        for art in world.articulations:
+            assert np.allclose(art.joint_values(), art.targets, atol=1e-4)
+    finally:
+        world.close()
