@@ -23,7 +23,13 @@ def play(world, seconds: float, out: Path | None = None, frames: bool = True, sc
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         if frames:
-            report["frames"] = save_frames(world, out)
+            try:
+                report["frames"] = save_frames(world, out)
+            except RuntimeError as e:   # the MuJoCo engine without a headless OpenGL (CameraUnavailable)
+                if type(e).__name__ != "CameraUnavailable":
+                    raise
+                report["frames"] = []
+                report["camera_problem"] = str(e)
         atomic_write_text(out / "report.json", json.dumps(report, indent=2))
     return report
 

@@ -21,6 +21,7 @@ import mujoco
 import numpy as np
 
 from ...converters.mjcf_write import to_mjcf
+from ...converters.urdf import _material
 from ...model.semantics import JointKind, collision_primitives, joint_frames, joint_kind, pose_or_identity
 from ...model.tree import ONE_DOF
 from ..rotations import matrix_to_quat, pose_to_matrix
@@ -228,7 +229,7 @@ def build_plan(world) -> Plan:
 
 def _resolve_meshes(world, child, out_dir: Path, model) -> None:
     """Absolute mesh paths; a mesh file that is not there drops its geoms, with a warning."""
-    missing = {}
+    missing, missing_paths = {}, {}
     for mesh in list(child.meshes):
         path = (out_dir / mesh.file).resolve()
         if path.is_file():
@@ -237,13 +238,14 @@ def _resolve_meshes(world, child, out_dir: Path, model) -> None:
             mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
         else:
             missing[mesh.name] = mesh
+            missing_paths[mesh.name] = path
     if not missing:
         return
     for g in list(child.geoms):
         if g.meshname in missing:
             child.delete(g)
     for name, mesh in missing.items():
-        world._warn("runner-mesh", f"{model.name}: mesh file {mesh.file} not found; its shapes are left out", model)
+        world._warn("runner-mesh", f"{model.name}: mesh file {missing_paths[name]} not found; its shapes are left out", model)
         child.delete(mesh)
 
 
@@ -275,9 +277,12 @@ def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
         fr = bp.body.friction
         geoms = spec.body(bp.mjname).geoms
         drawn = any(g.group == 1 for g in geoms)
+        rgba = _material(bp.body)
         for g in geoms:
             if not drawn and g.group == 3:
                 g.group = 0     # no visual shape written: the camera sees the collision shape
+                if rgba is not None:
+                    g.rgba = rgba
 
             if g.contype == 0 and g.conaffinity == 0:
                 continue
