@@ -169,6 +169,9 @@ def prepare_cameras(world, plan) -> _Pending:
                       resolution=[c.width, c.height])
         names.append(name)
         maxw, maxh = max(maxw, c.width), max(maxh, c.height)
+    # no multisampling: it would blend the segmentation pass's id colours at edges (and it
+    # doubles the cost of a software-rendered frame)
+    spec.visual.quality.offsamples = 0
     spec.visual.global_.offwidth = max(maxw, 640)
     spec.visual.global_.offheight = max(maxh, 480)
     return _Pending(sims, names)
