@@ -127,9 +127,10 @@ def build_plan(world) -> Plan:
     losses = []
     for i, m in enumerate(scene.all_models()):
         ns = m.namespace or ""
-        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles)):
+        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles), ("sensor", m.sensors)):
             for o in objs:
-                world._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played; skipped", o)
+                world._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
+                            "MuJoCo engine; skipped", o, "play it with --engine pybullet")
         mine = {}
         if m.bodies:
             names: dict = {}
