@@ -17,6 +17,7 @@ def play(world, seconds: float, out: Path | None = None, frames: bool = True, sc
     with Progress(steps, "simulating") as bar:
         world.run(seconds, bar)
     report = world.report()
+    report.setdefault("engine", getattr(world, "engine", "pybullet"))
     report["scene"] = scene_label
     report["diagnostics"] = [f"{d.rule}: {d.message}" for d in world.diagnostics]
     if out is not None:
