@@ -323,6 +323,54 @@ def test_grasp_weld_carries_the_body_and_release_drops_it(tmp_path):
         world.close()
 
 
+SENSOR = f"""
+bodies: [BODY eye, BODY near, BODY far]
+sensors: [SENSOR ray]
+BODY eye:
+  name: eye
+  mass: 0.0
+  location: {_pose()}
+  collision shape: SPHERE
+  collision geometry: {{radius: 0.005}}
+BODY near:
+  name: near
+  mass: 0.1
+  inertia: {{ix: 1.0e-5, iy: 1.0e-5, iz: 1.0e-5}}
+  location: {_pose(x=0.06, z=0.01)}
+  collision shape: BOX
+  collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
+BODY far:
+  name: far
+  mass: 0.1
+  inertia: {{ix: 1.0e-5, iy: 1.0e-5, iz: 1.0e-5}}
+  location: {_pose(x=0.2, z=0.01)}
+  collision shape: BOX
+  collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
+SENSOR ray:
+  name: ray
+  type: Proximity
+  parent: BODY eye
+  location: {_pose(z=0.01)}
+  range: 0.1
+  array:
+  - offset: {{x: 0.0, y: 0.0, z: 0.0}}
+    direction: {{x: 1.0, y: 0.0, z: 0.0}}
+  - offset: {{x: 0.0, y: 0.0, z: 0.02}}
+    direction: {{x: 1.0, y: 0.0, z: 0.0}}
+"""
+
+
+def test_proximity_sensor_rays_see_what_is_in_range(tmp_path):
+    """A sensor 1 cm up on a static body, two rays along +x, 10 cm long: the box at 6 cm is
+    hit by the lower ray, the one at 20 cm by neither; the sensor's own body is never reported."""
+    world = MjWorld(_model(tmp_path, SENSOR), Options(gravity=(0, 0, 0), ground=False))
+    try:
+        world.step(1)
+        assert [b.name for b in world.sensors[0].sensed] == ["near"]
+    finally:
+        world.close()
+
+
 # ---- cameras and CLI -------------------------------------------------------------------------
 def test_mujoco_camera_depth_segmentation_rgb(tmp_path):
     from adfkit.runner.mj.render import CameraUnavailable

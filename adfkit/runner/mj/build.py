@@ -63,6 +63,7 @@ class Plan:
     springs: int = 0
     losses: list = field(default_factory=list)
     tmp: object = None
+    sensors: list = field(default_factory=list)   # (key, ADF sensor, parent BodyPlan)
 
 
 def _spring_axes(joint, kind):
@@ -127,7 +128,7 @@ def build_plan(world) -> Plan:
     losses = []
     for i, m in enumerate(scene.all_models()):
         ns = m.namespace or ""
-        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles), ("sensor", m.sensors)):
+        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles)):
             for o in objs:
                 world._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
                             "MuJoCo engine; skipped", o, "play it with --engine pybullet")
@@ -192,8 +193,7 @@ def build_plan(world) -> Plan:
                 world._warn("runner-loop", f"{j.identifier}: a {kind.value} joint closing a loop is not played by the "
                             "MuJoCo engine; skipped", j)
     _collision_filters(world, spec, bodies, joints, plans_by_model)
-    ghosts = []
-    actuators = []
+    ghosts, actuators, sensors = [], [], []
     for m, mine, tree in plans_by_model:
         ns = m.namespace or ""
         for gh in m.ghost_objects:
@@ -208,7 +208,15 @@ def build_plan(world) -> Plan:
                            any(w in name for w in opt.hole_ghost_words))
             if gp.geoms:
                 ghosts.append(gp)
-        from ...model.semantics import ACTUATOR_TYPES
+        from ...model.semantics import ACTUATOR_TYPES, SENSOR_TYPES
+        for sn in m.sensors:
+            if SENSOR_TYPES.get(sn.type) != "proximity" or not sn.array:
+                world._warn("runner-sensor", f"{sn.identifier}: only proximity sensors with an `array` of rays "
+                            "are played; skipped", sn)
+                continue
+            parent = _parent(world, sn.parent, ns, sn)
+            if parent is not None:
+                sensors.append((merge_namespace(ns, sn.namespace) + sn.identifier, sn, parent))
         for a in m.actuators:
             if ACTUATOR_TYPES.get(a.type) != "constraint":
                 world._warn("runner-actuator", f"{a.identifier}: actuator type {a.type!r} not supported; skipped", a)
@@ -225,7 +233,7 @@ def build_plan(world) -> Plan:
         if kind in ONE_DOF and jn:
             act = spec.add_actuator(name=f"motor:{jn[0]}", target=jn[0], trntype=mujoco.mjtTrn.mjTRN_JOINT)
             act.set_to_position(kp=1.0, kv=0.0)   # gains are set per joint once the model is compiled
-    return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp)
+    return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors)
 
 
 def _resolve_meshes(world, child, out_dir: Path, model) -> None:

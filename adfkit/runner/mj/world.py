@@ -130,6 +130,19 @@ class MjActuator:
     constraint: object = None
 
 
+@dataclass(eq=False)
+class MjSensor:
+    """A proximity sensor: rays from ``starts`` to ``ends`` in its frame (``location`` in the
+    parent body frame); ``sensed``: the bodies its rays hit at the last control step."""
+    key: str
+    sensor: object
+    parent: MjBody
+    location: np.ndarray
+    starts: np.ndarray
+    ends: np.ndarray
+    sensed: list = field(default_factory=list)
+
+
 class MjWorld:
     engine = "mujoco"
 
@@ -150,7 +163,6 @@ class MjWorld:
         self.sim_time = 0.0
         self.wall_time = 0.0
         self.skipped: list[str] = []
-        self.sensors: list = []
         self._render = None
         self._vel6 = np.zeros(6)
         self.camera_problem = ""
@@ -224,6 +236,18 @@ class MjWorld:
             from ...model.semantics import pose_or_identity
             self.actuators.append(MjActuator(key, a, by_plan[id(parent)], mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, weld),
                                              pose_to_matrix(pose_or_identity(a.location)), imp / self.dt))
+        from ...model.semantics import DEFAULT_SENSOR_RANGE, pose_or_identity
+        self.sensors = []
+        for key, sn, parent in plan.sensors:
+            rng = sn.range if sn.range is not None else DEFAULT_SENSOR_RANGE
+            starts = np.array([r.offset or (0, 0, 0) for r in sn.array], dtype=float)
+            dirs = np.array([r.direction or (1, 0, 0) for r in sn.array], dtype=float)
+            self.sensors.append(MjSensor(key, sn, by_plan[id(parent)], pose_to_matrix(pose_or_identity(sn.location)),
+                                         starts, starts + dirs * rng))
+        # rays see collision geoms (groups 0 and 3), not visuals (1) or ghosts (4)
+        self._ray_groups = np.array([1, 0, 1, 1, 0, 0], dtype=np.uint8)
+        self._ray_hit = np.zeros(1, dtype=np.int32)
+        self._body_of_id = {sb.id: sb for sb in self.bodies}
         self.constraints = [(j.identifier, None, by_plan[id(p)], by_plan[id(c)], pa, pb_, None)
                             for j, kind, p, c, pa, pb_ in plan.loops]
         self.springs_count = plan.springs
@@ -369,10 +393,25 @@ class MjWorld:
         mujoco.mj_comPos(self.model, d)
 
     # ---- stepping ------------------------------------------------------------------------
+    def _sense(self, s: MjSensor) -> None:
+        m, d = self.model, self.data
+        t = s.parent.world_matrix() @ s.location
+        a = s.starts @ t[:3, :3].T + t[:3, 3]
+        b = s.ends @ t[:3, :3].T + t[:3, 3]
+        s.sensed = []
+        for p, q in zip(a, b):
+            x = mujoco.mj_ray(m, d, p, q - p, self._ray_groups, 1, s.parent.id, self._ray_hit)
+            if 0.0 <= x <= 1.0 and self._ray_hit[0] >= 0:
+                sb = self._body_of_id.get(int(m.geom_bodyid[self._ray_hit[0]]))
+                if sb is not None and sb not in s.sensed:
+                    s.sensed.append(sb)
+
     def control(self) -> None:
-        """Per-control-step forces: hole ghosts' viscous friction (sensors: none are played).
+        """Per-control-step forces and senses: proximity sensors' rays, hole ghosts' viscous friction.
         One bounding-sphere test of every hole-ghost geom against every candidate geom, then
         MuJoCo's exact distance only for the pairs that pass."""
+        for s in self.sensors:
+            self._sense(s)
         fg = self._friction_geoms
         cg = self._cand_geoms
         if not len(fg) or not len(cg):
@@ -492,6 +531,7 @@ class MjWorld:
         if art is not None:
             art.drive()
         found = [b for g in self.ghosts if psm in g.key for b in self.overlapping(g)]
+        found += [b for s in self.sensors if psm in s.key for b in s.sensed]
         own = {id(b) for b in self.bodies if b.articulation is not None and b.articulation is art}
         found = [b for b in found if id(b) not in own]
         if not found:
