@@ -175,26 +175,28 @@ def thread_equilibrium() -> np.ndarray:
 def test_thread_hangs_to_its_static_equilibrium():
     """The chain starts straight and horizontal and sags under gravity to where the spring
     torques balance it. MuJoCo (springs as joint stiffness) ends within 0.2 mm of the energy
-    minimum after 4 s. PyBullet (springs as explicit per-step torques) keeps its pivots
-    together (< 1 mm) and the chain in its plane, but does not settle on this chain (it
-    still swings 40-75 mm about after 8 s; see the README, "MuJoCo engine"), so only that
-    is asserted for it."""
+    minimum after 4 s without sleeping, and within 1 mm with island sleeping on (the default:
+    the chain falls asleep once slower than the sleep tolerance, 0.6 mm short). PyBullet
+    (springs as explicit per-step torques) keeps its pivots together (< 1 mm) and the chain in
+    its plane, but does not settle on this chain (it still swings 40-75 mm about after 8 s;
+    see the README, "MuJoCo engine"), so only that is asserted for it."""
     import tempfile
     from pathlib import Path
     expected = thread_equilibrium()
     assert expected[-1, 1] < -0.01          # a real sag (the tip drops more than 1 cm)
     with tempfile.TemporaryDirectory() as d:
         scene = _model(Path(d), thread_model())
-        for engine in ENGINES:
-            world = engine(scene, Options(gravity=(0, 0, -G), ground=False, visuals=False))
+        opt = Options(gravity=(0, 0, -G), ground=False, visuals=False)
+        for engine, tol in ((lambda s, o: MjWorld(s, o, sleep=False), 2e-4), (MjWorld, 1e-3), (SimWorld, None)):
+            world = engine(scene, opt)
             try:
                 world.run(4.0)
                 got = np.array([world.body(f"e{i}").com_position() for i in range(N_ELEMENTS)])
-                assert np.abs(got[:, 1]).max() < 1e-6, engine.__name__       # stays in its plane
-                assert world.constraint_error() < 1e-3, engine.__name__
-                if engine is MjWorld:
+                assert np.abs(got[:, 1]).max() < 1e-6                          # stays in its plane
+                assert world.constraint_error() < 1e-3
+                if tol is not None:
                     err = np.linalg.norm(got[:, [0, 2]] - expected, axis=1).max()
-                    assert err < 2e-4, f"{err * 1e3:.3f} mm from the equilibrium"
+                    assert err < tol, f"{err * 1e3:.3f} mm from the equilibrium (sleep {world.sleep})"
                     assert world.diagnostics == []          # no spring was softened for stability
             finally:
                 world.close()

@@ -25,6 +25,10 @@ from .build import BodyPlan, build_plan, compile_spec
 
 DRIVE_BANDWIDTH = 0.25    # ω·dt of the joint position servos (explicit stiffness is stable below 2)
 SOLVER_TOLERANCE = 1e-6
+WAKE_FORCE = 1e-12        # N
+# MuJoCo's 1e-3 puts a mm-scale chain to sleep 2 mm short of its rest pose, 3e-4 0.6 mm short;
+# at 1e-4 the suturing thread lying on the phantom never sleeps (its contacts jitter above it)
+SLEEP_TOLERANCE = 3e-4
 SPRING_LIMIT = 0.25       # k ≤ SPRING_LIMIT·M_ii/dt²: the PyBullet runner's clamp for explicit springs
 
 
@@ -73,7 +77,7 @@ class MjBody:
         return tuple((self.world_matrix() @ self.com_in_body)[:3, 3])
 
     def force(self, f, at) -> None:
-        """A world-frame force at point ``at`` for the next control step."""
+        """A world-frame force at point ``at`` for the next control step (it wakes a sleeping tree)."""
         f = np.asarray(f, float)
         xf = self.world.data.xfrc_applied[self.id]
         xf[:3] += f
@@ -146,7 +150,9 @@ class MjSensor:
 class MjWorld:
     engine = "mujoco"
 
-    def __init__(self, scene, options=None, gui: bool = False) -> None:
+    def __init__(self, scene, options=None, gui: bool = False, sleep: bool = True) -> None:
+        """``sleep``: MuJoCo's island sleeping (resting trees are not integrated until a contact,
+        a force or a constraint with an awake tree wakes them; driven trees never sleep)."""
         from ..world import Options
         if gui:
             raise ValueError("the MuJoCo engine plays headless only (use --engine pybullet for --gui)")
@@ -163,6 +169,7 @@ class MjWorld:
         self.sim_time = 0.0
         self.wall_time = 0.0
         self.skipped: list[str] = []
+        self.sleep = sleep
         self._render = None
         self._vel6 = np.zeros(6)
         self.camera_problem = ""
@@ -183,6 +190,9 @@ class MjWorld:
         # Newton stops at a 1e-6 relative improvement (MuJoCo's 1e-8 costs 1.8x the time here)
         spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
         spec.option.tolerance = SOLVER_TOLERANCE
+        if self.sleep:
+            spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
+            spec.option.sleep_tolerance = SLEEP_TOLERANCE
         if self.opt.solver_iterations:
             spec.option.iterations = max(self.opt.solver_iterations, 1)
         from .render import prepare_cameras
@@ -563,6 +573,7 @@ class MjWorld:
         m.eq_data[e, 6:10] = (q[3], q[0], q[1], q[2])
         m.eq_data[e, 10] = 1.0
         d.eq_active[e] = 1
+        self.wake(target)
         actuator.target = target
         art = actuator.parent.articulation
         links = [r[3] for r in art.records] + [art.root] if art is not None else [actuator.parent]
@@ -575,8 +586,15 @@ class MjWorld:
             if np.linalg.norm(d.geom_xpos[gid] - d.xpos[b]) < 0.05:
                 m.geom_contype[gid] = m.geom_conaffinity[gid] = 0
 
+    def wake(self, sb: MjBody) -> None:
+        """Wake the sleeping tree of ``sb`` (MuJoCo wakes a tree a force is applied to: a
+        1e-12 N force at the COM for one control step does it and nothing else)."""
+        if self.sleep and sb.id > 0:
+            self.data.xfrc_applied[sb.id, 2] += WAKE_FORCE
+
     def release(self, actuator: MjActuator) -> None:
         if actuator.target is not None:
+            self.wake(actuator.target)
             self.data.eq_active[actuator.eq] = 0
             for gid, ct, ca in actuator.constraint or ():
                 self.model.geom_contype[gid], self.model.geom_conaffinity[gid] = ct, ca
@@ -610,7 +628,7 @@ class MjWorld:
             if np.linalg.norm(v) > 10.0:
                 fast.append(sb.key)
         return {
-            "engine": "mujoco",
+            "engine": "mujoco", "awake_trees": int(self.data.ntree_awake), "trees": int(self.model.ntree),
             "bodies": len(self.bodies), "skipped_bodies": self.skipped,
             "joints": len(self.joint_names), "multibodies": len(self.articulations),
             "constraints": len(self.constraints), "spring_joints": self.springs_count,
