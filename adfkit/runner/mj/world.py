@@ -269,6 +269,7 @@ class MjWorld:
         self._cand_geoms = np.array([g for g in gids if m.geom_bodyid[g] in body_of], dtype=int)
         self._cand_geom_body = [body_of[m.geom_bodyid[g]] for g in self._cand_geoms]
         self._cand_rbound = np.array(m.geom_rbound[self._cand_geoms])
+        self._cand_geom_bodyid = np.array(m.geom_bodyid[self._cand_geoms], dtype=int)
         self._geom_label = np.full(m.ngeom, -1, dtype=np.int32)
         for i, sb in enumerate(self.bodies):
             if sb.id > 0:
@@ -427,9 +428,16 @@ class MjWorld:
         if not len(fg) or not len(cg):
             return
         m, d = self.model, self.data
+        rb = self._cand_rbound
+        if self.sleep:     # a sleeping body does not move: no friction to apply
+            awake = d.body_awake[self._cand_geom_bodyid] == mujoco.mjtSleepState.mjS_AWAKE
+            cg, rb = cg[awake], rb[awake]
+            body_of = [b for b, a in zip(self._cand_geom_body, awake) if a]
+        else:
+            body_of = self._cand_geom_body
         gx = d.geom_xpos
         diff = gx[cg][None, :, :] - gx[fg][:, None, :]
-        reach = (self._cand_rbound[None, :] + m.geom_rbound[fg][:, None]) ** 2
+        reach = (rb[None, :] + m.geom_rbound[fg][:, None]) ** 2
         near = np.einsum("ijk,ijk->ij", diff, diff) <= reach
         if not near.any():
             for g in self._friction_ghosts:
@@ -438,7 +446,7 @@ class MjWorld:
         hits: dict[int, list] = {}
         for i, k in zip(*np.nonzero(near)):
             g = self._friction_owner[i]
-            sb = self._cand_geom_body[k]
+            sb = body_of[k]
             lst = hits.setdefault(id(g), [])
             if sb in lst or sb is g.parent:
                 continue
