@@ -270,6 +270,10 @@ class MjWorld:
         self._cand_geom_body = [body_of[m.geom_bodyid[g]] for g in self._cand_geoms]
         self._cand_rbound = np.array(m.geom_rbound[self._cand_geoms])
         self._cand_geom_bodyid = np.array(m.geom_bodyid[self._cand_geoms], dtype=int)
+        self._all_cand = np.arange(len(self._cand_geoms))
+        self._geom_xpos, self._body_awake = d.geom_xpos, d.body_awake
+        self._AWAKE = int(mujoco.mjtSleepState.mjS_AWAKE)
+        self._fg_rbound = np.array(m.geom_rbound[self._friction_geoms])[:, None]
         self._geom_label = np.full(m.ngeom, -1, dtype=np.int32)
         for i, sb in enumerate(self.bodies):
             if sb.id > 0:
@@ -428,21 +432,20 @@ class MjWorld:
         if not len(fg) or not len(cg):
             return
         m, d = self.model, self.data
-        rb = self._cand_rbound
+        gx = self._geom_xpos            # views into MjData/MjModel, made once (attribute access costs)
         if self.sleep:     # a sleeping body does not move: no friction to apply
-            awake = d.body_awake[self._cand_geom_bodyid] == mujoco.mjtSleepState.mjS_AWAKE
-            cg, rb = cg[awake], rb[awake]
-            body_of = [b for b, a in zip(self._cand_geom_body, awake) if a]
+            idx = np.flatnonzero(self._body_awake[self._cand_geom_bodyid] == self._AWAKE)
         else:
-            body_of = self._cand_geom_body
-        gx = d.geom_xpos
-        diff = gx[cg][None, :, :] - gx[fg][:, None, :]
-        reach = (rb[None, :] + m.geom_rbound[fg][:, None]) ** 2
+            idx = self._all_cand
+        diff = gx[cg[idx]][None, :, :] - self._fg_pos(gx)
+        reach = (self._cand_rbound[idx][None, :] + self._fg_rbound) ** 2
         near = np.einsum("ijk,ijk->ij", diff, diff) <= reach
         if not near.any():
             for g in self._friction_ghosts:
                 g.overlapping = []
             return
+        cg = cg[idx]
+        body_of = [self._cand_geom_body[i] for i in idx]
         hits: dict[int, list] = {}
         for i, k in zip(*np.nonzero(near)):
             g = self._friction_owner[i]
@@ -456,6 +459,9 @@ class MjWorld:
             g.overlapping = hits.get(id(g), [])
             if g.overlapping:
                 self._viscous(g, g.overlapping)
+
+    def _fg_pos(self, gx) -> np.ndarray:
+        return gx[self._friction_geoms][:, None, :]
 
     def step(self, n: int = 1) -> None:
         """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
