@@ -457,3 +457,29 @@ def test_suturing_set_grasp_in_mujoco():
         assert r["nan"] == [] and r["exploded"] == [] and r["fell_through_floor"] == []
     finally:
         world.close()
+
+
+def test_both_engines_answer_the_same_public_api(tmp_path):
+    """What PSM, `adfkit run` and tasks use exists on both worlds, and MuJoCo's report has
+    every key PyBullet's has (plus its engine and sleeping trees)."""
+    scene = _model(tmp_path, box_camera_model(mass=1.0, z=0.5))
+    reports = {}
+    for engine in ENGINES:
+        world = engine(scene, Options())
+        try:
+            for name in ("dt", "opt", "sim_time", "ghosts", "actuators", "sensors", "cameras", "articulations",
+                         "bodies", "diagnostics", "step", "run", "body", "grasp", "overlapping", "place_ghosts",
+                         "joint_state", "reset_joints", "constraint_error", "report", "close"):
+                assert hasattr(world, name), (engine.__name__, name)
+            box = world.body("box")
+            for name in ("world_matrix", "com_position", "state", "force", "torque", "static", "mass", "key"):
+                assert hasattr(box, name), (engine.__name__, name)
+            world.step(10)
+            assert world.sim_time == pytest.approx(0.04)
+            reports[engine.__name__] = world.report()
+        finally:
+            world.close()
+    assert set(reports["SimWorld"]) <= set(reports["MjWorld"])
+    assert set(reports["MjWorld"]) - set(reports["SimWorld"]) == {"engine", "awake_trees", "trees"}
+    p_mj, p_pb = reports["MjWorld"]["ground_plane_z"], reports["SimWorld"]["ground_plane_z"]
+    assert p_mj == pytest.approx(p_pb, abs=1e-6)      # the same floor 1 mm under the box

@@ -192,6 +192,7 @@ def build_plan(world) -> Plan:
             else:
                 world._warn("runner-loop", f"{j.identifier}: a {kind.value} joint closing a loop is not played by the "
                             "MuJoCo engine; skipped", j)
+    _world_lights(world, spec)
     _collision_filters(world, spec, bodies, joints, plans_by_model)
     ghosts, actuators, sensors = [], [], []
     for m, mine, tree in plans_by_model:
@@ -256,6 +257,31 @@ def _resolve_meshes(world, child, out_dir: Path, model) -> None:
     for name, mesh in missing.items():
         world._warn("runner-mesh", f"{model.name}: mesh file {missing_paths[name]} not found; its shapes are left out", model)
         child.delete(mesh)
+
+
+def _world_lights(world, spec) -> None:
+    """The world file's spot lights (the writer handles model files' lights), without shadows:
+    a shadow map is a render pass per light per camera."""
+    import math
+    from ...converters.mjcf_cameras import ADF_CUTOFF, ADF_SPOT_EXPONENT
+    w = world.scene.world
+    for light in (w.lights if w is not None else []):
+        el, to_link = spec.worldbody, np.eye(4)
+        if light.parent:
+            parent = _parent(world, light.parent, w.namespace or "", light)
+            if parent is None:
+                continue
+            to_link = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body))
+            if parent.mjname != "world":
+                el = spec.body(parent.mjname)
+        d = np.array(light.direction if light.direction is not None else (1.0, 0.0, 0.0), float)
+        if np.linalg.norm(d) == 0:
+            d = np.array([1.0, 0.0, 0.0])
+        pos = to_link[:3, :3] @ np.array(light.location or (0.0, 0.0, 0.0), float) + to_link[:3, 3]
+        el.add_light(pos=list(pos), dir=list(to_link[:3, :3] @ (d / np.linalg.norm(d))),
+                     cutoff=math.degrees(light.cutoff_angle if light.cutoff_angle is not None else ADF_CUTOFF),
+                     exponent=light.spot_exponent if light.spot_exponent is not None else ADF_SPOT_EXPONENT,
+                     castshadow=False)
 
 
 def _parent(world, ref, ns, obj):
