@@ -22,7 +22,7 @@ import numpy as np
 
 from ...converters.mjcf_write import to_mjcf
 from ...converters.urdf import _material
-from ...model.semantics import JointKind, collision_primitives, joint_frames, joint_kind, pose_or_identity
+from ...model.semantics import JointKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
 from ..rotations import matrix_to_quat, pose_to_matrix
 
