@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from ..rotations import matrix_to_quat
+from ..rotations import invert, matrix_to_quat
 
 
 @dataclass(eq=False)
@@ -25,6 +25,9 @@ class MjBody:
     articulation: object = None
     gravity: np.ndarray | None = None
     has_collision: bool = True
+
+    def __post_init__(self) -> None:
+        self._body_in_link = invert(self.link_in_body)
 
     @property
     def static(self) -> bool:

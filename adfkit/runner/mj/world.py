@@ -103,7 +103,6 @@ class MjWorld:
             mass = effective_mass(bp.body)
             sb = MjBody(bp.key, bp.body, bp.model, max(mass, 0.0), pose_to_matrix(inertial_offset(bp.body)),
                         pose_to_matrix(bp.link.frame_in_body), bid, self)
-            sb._body_in_link = invert(sb.link_in_body)
             sb.has_collision = bool(np.any((m.geom_bodyid == bid) & ((m.geom_contype != 0) | (m.geom_conaffinity != 0))))
             if bid > 0 and m.body_weldid[bid] == 0:
                 sb.mass = 0.0     # welded to the world: static whatever the file says
