@@ -54,7 +54,7 @@ class MjWorld:
         self.sim_time = 0.0
         self.wall_time = 0.0
         self.skipped: list[str] = []
-        self.sleep = sleep
+        self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")   # MuJoCo 4's island sleeping
         self._render = None
         self._vel6 = np.zeros(6)
         self.camera_problem = ""
@@ -526,7 +526,8 @@ class MjWorld:
             if np.linalg.norm(v) > 10.0:
                 fast.append(sb.key)
         return {
-            "engine": "mujoco", "awake_trees": int(self.data.ntree_awake), "trees": int(self.model.ntree),
+            "engine": "mujoco", "awake_trees": int(getattr(self.data, "ntree_awake", self.model.ntree)),
+            "trees": int(self.model.ntree),
             "bodies": len(self.bodies), "skipped_bodies": self.skipped,
             "joints": len(self.joint_names), "multibodies": len(self.articulations),
             "constraints": len(self.constraints), "spring_joints": self.springs_count,
