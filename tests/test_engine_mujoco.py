@@ -483,3 +483,43 @@ def test_both_engines_answer_the_same_public_api(tmp_path):
     assert set(reports["MjWorld"]) - set(reports["SimWorld"]) == {"engine", "awake_trees", "trees"}
     p_mj, p_pb = reports["MjWorld"]["ground_plane_z"], reports["SimWorld"]["ground_plane_z"]
     assert p_mj == pytest.approx(p_pb, abs=1e-6)      # the same floor 1 mm under the box
+
+
+def test_missing_and_flat_meshes_are_warned_not_fatal(tmp_path):
+    """A collision mesh file that is not there drops its shape (runner-mesh); a flat mesh,
+    which MuJoCo cannot hull, collides as its bounding box (runner-flat-mesh): a box dropped
+    on a 1 x 1 m flat square comes to rest on it."""
+    (tmp_path / "flat.obj").write_text("v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nf 1 2 3\nf 1 3 4\n")
+    text = f"""
+bodies: [BODY floor, BODY ghostly, BODY box]
+high resolution path: ./
+low resolution path: ./
+BODY floor:
+  name: floor
+  mass: 0.0
+  location: {_pose()}
+  collision mesh: flat.obj
+  mesh: flat.obj
+BODY ghostly:
+  name: ghostly
+  mass: 0.0
+  location: {_pose(x=2.0)}
+  collision mesh: nowhere.obj
+  mesh: nowhere.obj
+BODY box:
+  name: box
+  mass: 0.1
+  inertia: {{ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}}
+  location: {_pose(z=0.1)}
+  collision shape: BOX
+  collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
+"""
+    world = MjWorld(_model(tmp_path, text), Options(gravity=(0, 0, -G), ground=False))
+    try:
+        rules = sorted({d.rule for d in world.diagnostics})
+        assert rules == ["runner-flat-mesh", "runner-mesh"]
+        world.run(1.0)
+        z = world.body("box").com_position()[2]
+        assert z == pytest.approx(0.01 + 5e-4, abs=1e-3)   # on the floor's 1 mm box, not through it
+    finally:
+        world.close()
