@@ -538,6 +538,7 @@ class MjWorld:
             "real_time_factor": self.sim_time / self.wall_time if self.wall_time else None,
             "max_constraint_error_m": self.constraint_error(), "ground_plane_z": self.ground_z,
             "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
+            "soft_bodies": [],   # not played by this engine (a runner-soft-body warning names each)
         }
 
     def _renderer(self):
