@@ -767,12 +767,13 @@ def problems(o: Outcome) -> list[str]:
     return bad
 
 
-_FRAME = re.compile(r'File "[^"]*/(adfkit/[^"]+)", line \d+, in (\w+)')
+_FRAME = re.compile(r'File "[^"]*/((?:adfkit|addon)/[^"]+)", line \d+, in (\w+)')
 _EXC = re.compile(r"^(\w+(?:Error|Exception|error))\b", re.M)
 
 
 def crash_site(o: Outcome) -> tuple[str, str, str] | None:
-    """(module, function, exception) of an exception that escaped: the innermost adfkit frame."""
+    """(module, function, exception) of an exception that escaped: the innermost frame in
+    adfkit/ or addon/."""
     if not o.error or o.error.startswith("timeout"):
         return None
     frames = _FRAME.findall(o.error)

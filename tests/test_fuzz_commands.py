@@ -39,6 +39,9 @@ KNOWN_SITES: dict[tuple[str, str, str], str] = {
         "runner: a primitive whose geometry lacks a dimension (None) after a bad value",
     ("adfkit/converters/mjcf_write.py", "_write_body", "RecursionError"):
         "MJCF writer recurses over the body tree (a chain of 1,000 bodies)",
+    # the Blender add-on (another engineer's part)
+    ("addon/build.py", "_import_file", "RuntimeError"):
+        "add-on: Blender's STL importer raises on a garbage mesh file (blend-import)",
 }
 KNOWN: dict[str, str] = {}  # exact case ids (none today)
 
@@ -110,6 +113,32 @@ def test_fuzz_group(group, tmp_path):
     assert not failures, "\n".join(failures)
     if known:
         pytest.xfail("known crashes in the robust branch's code: " + "; ".join(known))
+
+
+def test_fuzz_blender(tmp_path):
+    """16 mutated models through blend-import, and each .blend it writes back through
+    blend-export; bpy imported once (~1 s), then ~0.1 s a case."""
+    pytest.importorskip("bpy", reason="bpy (Blender as a Python module) is not installed")
+    seed = [s for s in fuzzkit.builtin_seeds() if s.name == "small-model"][0]
+    failures, known = [], []
+    for i in range(16):
+        c = fuzzkit.make_case(seed, 500 + i)
+        cases = [fuzzkit.Case(c.seed, c.index, c.op, "blend-import", c.files,
+                              ["blend-import", "{dir}/model.yaml", "{dir}/out.blend"])]
+        for case in cases:
+            outcome = fuzzkit.run_case(case, tmp_path / str(i), timeout=60)
+            bad = fuzzkit.problems(outcome)
+            if not bad and outcome.rc == 0:
+                export = fuzzkit.Case(c.seed, c.index, c.op, "blend-export", {},
+                                      ["blend-export", "{dir}/out.blend", "{dir}/exported"])
+                outcome = fuzzkit.run_case(export, tmp_path / str(i), timeout=60)
+                bad = fuzzkit.problems(outcome)
+            if bad:
+                why = _known(outcome, bad)
+                (known if why else failures).append(f"{outcome.case.id}: {why or bad[0][:400]}")
+    assert not failures, "\n".join(failures)
+    if known:
+        pytest.xfail("known crashes in another branch's code: " + "; ".join(known))
 
 
 @pytest.mark.parametrize("case", fuzzkit.explicit_cases(), ids=lambda c: f"{c.command}:{c.argv[-1][-40:]!r}")
