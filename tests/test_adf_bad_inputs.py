@@ -217,3 +217,14 @@ def test_unknown_sensor_type_is_a_warning_and_survives_a_round_trip(tmp_path, ca
     again, diags = read_file(out)
     assert [s.type for s in again.sensors] == ["CONTACT"] and not [d for d in diags if d.severity >= 2]
     assert main(["convert", str(f), str(tmp_path / "c.yaml")]) == 0
+
+
+def test_a_symlink_out_of_a_named_folder_is_not_read(tmp_path, capsys):
+    (tmp_path / "outside.yaml").write_text("bodies: [BODY SECRET-TOKEN]\n")
+    folder = tmp_path / "models"
+    folder.mkdir()
+    (folder / "ok.yaml").write_text("bodies: []\n")
+    (folder / "out.yaml").symlink_to(tmp_path / "outside.yaml")
+    assert main(["validate", str(folder)]) == 1
+    out = capsys.readouterr().out
+    assert f"{folder / 'out.yaml'}: error[outside-tree]" in out and "SECRET-TOKEN" not in out
