@@ -37,6 +37,8 @@ KNOWN_SITES: dict[tuple[str, str, str], str] = {
         "URDF writer resolves a mesh path over 255 bytes",
     ("adfkit/runner/shapes.py", "_primitive", "TypeError"):
         "runner: a primitive whose geometry lacks a dimension (None) after a bad value",
+    ("adfkit/runner/shapes.py", "create_collision", "TypeError"):
+        "runner: a collision shape argument is None (a geometry value lost to a bad alias)",
     ("adfkit/converters/mjcf_write.py", "_write_body", "RecursionError"):
         "MJCF writer recurses over the body tree (a chain of 1,000 bodies)",
     # the Blender add-on (another engineer's part)
