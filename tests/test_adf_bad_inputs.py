@@ -197,3 +197,34 @@ def test_files_named_by_a_launch_outside_its_tree_are_not_read(tmp_path, capsys,
             assert "outside-tree" in text
         main(["validate", str(launch)])
         assert f"{launch}:3:{col}: error[outside-tree]" in capsys.readouterr().out
+
+
+def test_unknown_sensor_type_is_a_warning_and_survives_a_round_trip(tmp_path, capsys):
+    """`type: CONTACT` (newer AMBF, public projects): "unknown to AMBF 2.0", read and written back."""
+    from adfkit.adf import read_file
+    from adfkit.adf.writer import write_file
+    from adfkit.validator import validate_file
+
+    f = tmp_path / "s.yaml"
+    f.write_text("bodies: [BODY a]\nsensors: [S]\nBODY a:\n  name: a\n  mass: 1.0\nS:\n  name: s\n  type: CONTACT\n"
+                 "  parent: BODY a\n  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n")
+    hits = [d for d in validate_file(f).diagnostics if d.rule == "sensor-type"]
+    assert [(str(d.severity), d.location.line) for d in hits] == [("warning", 8)]
+    assert "unknown to AMBF 2.0" in hits[0].message
+    doc, _ = read_file(f)
+    out = tmp_path / "out.yaml"
+    write_file(doc, out)
+    again, diags = read_file(out)
+    assert [s.type for s in again.sensors] == ["CONTACT"] and not [d for d in diags if d.severity >= 2]
+    assert main(["convert", str(f), str(tmp_path / "c.yaml")]) == 0
+
+
+def test_a_symlink_out_of_a_named_folder_is_not_read(tmp_path, capsys):
+    (tmp_path / "outside.yaml").write_text("bodies: [BODY SECRET-TOKEN]\n")
+    folder = tmp_path / "models"
+    folder.mkdir()
+    (folder / "ok.yaml").write_text("bodies: []\n")
+    (folder / "out.yaml").symlink_to(tmp_path / "outside.yaml")
+    assert main(["validate", str(folder)]) == 1
+    out = capsys.readouterr().out
+    assert f"{folder / 'out.yaml'}: error[outside-tree]" in out and "SECRET-TOKEN" not in out

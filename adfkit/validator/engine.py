@@ -187,14 +187,14 @@ def validate_paths(paths, kind: str | None = None, follow: bool = True) -> tuple
                     context.append(res.doc)
 
     # Launch files first, so the models they name are checked with the models loaded before them.
-    for f, tree in sorted(files, key=lambda ft: not _looks_like_launch(ft[0])):
+    for f, tree in sorted(files, key=lambda ft: not _looks_like_launch(*ft)):
         run(f, kind, tree=tree)
     return list(results.values()), problems
 
 
-def _looks_like_launch(path: Path) -> bool:
+def _looks_like_launch(path: Path, tree=None) -> bool:
     try:
-        with open(inputs.check_file(path), "rb") as fh:
+        with open(inputs.check_file(path, tree=tree), "rb") as fh:
             head = fh.read(65536).decode("utf-8", errors="replace")
     except (OSError, AdfError):
         return False

@@ -122,10 +122,12 @@ def _diagnostic(err, base: yaml.Node, file: str, context: str, at: yaml.Node | N
         hint = f"add '{missing}:'"
     elif err.validator in ("anyOf", "type", "pattern") and "title" in err.schema:
         shown = node.value if isinstance(node, yaml.ScalarNode) else ("a mapping" if isinstance(node, yaml.MappingNode) else "a list")
-        msg = f"{label}: expected {err.schema['title']}, found {shown!r}"
+        shown = repr(shown) if len(repr(shown)) <= 80 else repr(shown)[:75] + "...'"
+        msg = f"{label}: expected {err.schema['title']}, found {shown}"
         hint = "AMBF cannot convert this value and rejects the file"
-    else:
-        msg = f"{label}: {err.message}"
+    else:  # jsonschema's message can hold the whole value: the offending line at most
+        text = err.message if len(err.message) <= 200 else err.message[:195] + " ..."
+        msg = f"{label}: {text}"
         hint = None
     return Diagnostic(Severity.ERROR, rule, msg, where, hint)
 
