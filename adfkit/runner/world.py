@@ -293,6 +293,21 @@ class SimWorld:
     def _no_collision(self, a: SimBody, b: SimBody) -> None:
         pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, 0, physicsClientId=self.cid)
 
+    def set_collision(self, a: SimBody, b: SimBody, enabled: bool) -> None:
+        """Let two bodies collide or pass through each other (a task's choice, e.g. a needle
+        through a tissue whose collision shape is a convex hull over its holes)."""
+        pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, int(enabled), physicsClientId=self.cid)
+
+    def move_base(self, sb: SimBody, body_world: np.ndarray) -> None:
+        """Put the root of a multibody (e.g. a PSM's base, as its setup joints would) at a new
+        world pose of its ADF body frame; its links follow."""
+        pos, orn = matrix_to_pq(body_world @ sb.com_in_body)
+        pb.resetBasePositionAndOrientation(sb.uid, pos, orn, physicsClientId=self.cid)
+
+    def ghost_pose(self, g: SimGhost) -> np.ndarray:
+        """World pose (4x4) of a ghost, following its parent."""
+        return self._frame(g.parent) @ g.pose_in_parent if g.parent is not None else np.array(g.pose_in_parent)
+
     def _parent(self, ref: str | None, ns: str, obj):
         key, hit = self.registry.find(ref)
         if key is None and ref:
