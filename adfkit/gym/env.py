@@ -55,7 +55,7 @@ class SuturingEnv(gym.Env):
     def __init__(self, obs_mode: str = "state", reward_type: str = "dense", render_mode: str | None = None,
                  engine: str = "pybullet", scene=None, indices: str | None = None,
                  image_size: tuple = (128, 96), render_size: tuple = (320, 240), control_steps: int = 5,
-                 randomize: float = 0.004, settle_seconds: float = 1.0, setup_joints: bool = True) -> None:
+                 randomize: float = 0.008, randomize_needle: float = 0.0, settle_seconds: float = 1.0, setup_joints: bool = True) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode {obs_mode!r}: choose one of {', '.join(OBS_MODES)}")
         if reward_type not in REWARD_TYPES:
@@ -64,6 +64,7 @@ class SuturingEnv(gym.Env):
             raise ValueError(f"render_mode {render_mode!r}: only 'rgb_array' (or None)")
         self.obs_mode, self.reward_type, self.render_mode = obs_mode, reward_type, render_mode
         self.control_steps, self.randomize = int(control_steps), float(randomize)
+        self.randomize_needle = float(randomize_needle)
         self.built = b = scenes.build(scene, indices, engine, self.arms, obs_mode != "state" or render_mode is not None,
                                       setup_joints)
         self.world, self.psms, self.needle = b.world, b.psms, b.needle
@@ -82,6 +83,7 @@ class SuturingEnv(gym.Env):
         self._home = {n: p.setpoint_cp() for n, p in self.psms.items()}
         self._home_jaw = {n: p.measured_jaw() for n, p in self.psms.items()}
         self._snapshot = self.world.save_state()
+        self._rest = [(b, b.world_matrix()) for b in [self.needle] + b.carried]
         self.action_space = spaces.Box(-1.0, 1.0, (7 * len(self.arms),), np.float32)
         obs = {}
         for n in self.psms:
@@ -104,14 +106,27 @@ class SuturingEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
         self.world.restore_state(self._snapshot)
+        self._setpoint = {n: self._home[n].copy() for n in self.arms}
         if self.randomize > 0:
-            dx, dy = self.np_random.uniform(-self.randomize, self.randomize, size=2)
-            for body in [self.needle] + self.built.carried:
-                pose = body.world_matrix()
+            # the arms start at a seeded offset from their ready pose (teleported: nothing they
+            # touch moves, so a seeded reset is exact); the needle only with randomize_needle
+            for n in self.arms:
+                psm = self.psms[n]
+                base = psm.base_in_world()
+                ee = base @ self._home[n]
+                ee[:3, 3] += self.np_random.uniform(-self.randomize, self.randomize, size=3)
+                try:
+                    target = np.linalg.inv(base) @ ee
+                    psm.reset_jp(psm.kin.ik(target))
+                    self._setpoint[n] = target
+                except ValueError:
+                    pass
+        if self.randomize_needle > 0:
+            dx, dy = self.np_random.uniform(-self.randomize_needle, self.randomize_needle, size=2)
+            for body, rest in self._rest:
+                pose = rest.copy()
                 pose[:3, 3] += (dx, dy, 0.0)
                 self.world.place_body(body, pose)
-            self.world.step(2)
-        self._setpoint = {n: self._home[n].copy() for n in self.arms}
         self._closed = {n: False for n in self.arms}
         self._steps = 0
         self._task_reset()

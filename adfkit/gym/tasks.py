@@ -18,6 +18,13 @@ REACH_TOLERANCE = 0.003   # m
 LIFT = 0.01               # m
 
 
+def f32(x) -> np.ndarray:
+    """Rewards are computed from positions at the observation's precision (float32): a
+    restored world repeats a step to ~1e-12 m, not bit for bit, and a seeded reset plus the
+    same actions must give the same rewards (Gymnasium's determinism check)."""
+    return np.asarray(x, np.float32).astype(float)
+
+
 class NeedleReach(SuturingEnv):
     arms = ("psm1",)
 
@@ -25,7 +32,7 @@ class NeedleReach(SuturingEnv):
         return self.grasp_point()
 
     def _evaluate(self) -> dict:
-        d = float(np.linalg.norm(self.tool_position() - self.grasp_point()))
+        d = float(np.linalg.norm(f32(self.tool_position()) - f32(self.grasp_point())))
         return {"dense": -10.0 * d, "success": d < REACH_TOLERANCE, "distance": d}
 
 
@@ -33,7 +40,7 @@ class NeedlePick(SuturingEnv):
     arms = ("psm1",)
 
     def _task_reset(self) -> None:
-        self._rest_z = float(self.grasp_point()[2])
+        self._rest_z = float(f32(self.grasp_point())[2])
 
     def _goal(self) -> np.ndarray:
         g = self.grasp_point()
@@ -42,8 +49,8 @@ class NeedlePick(SuturingEnv):
         return g
 
     def _evaluate(self) -> dict:
-        g = self.grasp_point()
-        d = float(np.linalg.norm(self.tool_position() - g))
+        g = f32(self.grasp_point())
+        d = float(np.linalg.norm(f32(self.tool_position()) - g))
         held = self.holding()
         lift = float(g[2] - self._rest_z)
         dense = -10.0 * d + (1.0 + 100.0 * min(max(lift, 0.0), LIFT) if held else 0.0)
@@ -81,8 +88,8 @@ class SutureOnePair(SuturingEnv):
         if self.entered and inside_exit:
             self.passed = True
         held = self.holding("psm1") or self.holding("psm2")
-        d_needle = float(np.linalg.norm(self.grasp_point() - self._goal()))
-        d_tool = float(np.linalg.norm(self.tool_position("psm1") - self.grasp_point()))
+        d_needle = float(np.linalg.norm(f32(self.grasp_point()) - f32(self._goal())))
+        d_tool = float(np.linalg.norm(f32(self.tool_position("psm1")) - f32(self.grasp_point())))
         dense = (-10.0 * (d_tool if not held and not self.entered else d_needle)
                  + 1.0 * held + 2.0 * self.entered + 5.0 * self.passed)
         return {"dense": dense, "success": self.passed, "entered": self.entered, "held": held,

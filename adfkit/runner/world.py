@@ -113,7 +113,7 @@ class SimWorld:
         self.steps = 0
         self.sim_time = 0.0
         self.wall_time = 0.0
-        pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
+        pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
         self._build()
 
     # ---- building ------------------------------------------------------------------------
@@ -266,6 +266,7 @@ class SimWorld:
         set_dynamics(sb)
 
     def _collision_filters(self, records) -> None:
+        self._masks = {}
         groups = sorted({g for sb in self.bodies for g in (sb.body.collision_groups or []) if 0 <= g <= 999})
         bit = {g: 1 << (i % 30) for i, g in enumerate(groups)}
         if len(groups) > 30:
@@ -279,7 +280,9 @@ class SimWorld:
                     mask |= bit[g]
                 pb.setCollisionFilterGroupMask(sb.uid, sb.link, mask, mask, physicsClientId=self.cid)
             else:
+                mask = allbits
                 pb.setCollisionFilterGroupMask(sb.uid, sb.link, allbits, allbits, physicsClientId=self.cid)
+            self._masks[(sb.uid, sb.link)] = mask
         for j, kind, parent, child in records:
             if j.ignore_inter_collision is not False:
                 self._no_collision(parent, child)
@@ -297,6 +300,9 @@ class SimWorld:
         """Let two bodies collide or pass through each other (a task's choice, e.g. a needle
         through a tissue whose collision shape is a convex hull over its holes)."""
         pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, int(enabled), physicsClientId=self.cid)
+        pair = frozenset(((a.uid, a.link), (b.uid, b.link)))
+        self._pairs_off = getattr(self, "_pairs_off", set())
+        (self._pairs_off.discard if enabled else self._pairs_off.add)(pair)
 
     def move_base(self, sb: SimBody, body_world: np.ndarray) -> None:
         """Put the root of a multibody (e.g. a PSM's base, as its setup joints would) at a new
@@ -529,7 +535,11 @@ class SimWorld:
             ids.append(c)
         actuator.constraint, actuator.target = ids, target
         for link in self._links(actuator.parent):   # the closed jaws would push the held body out
-            pb.setCollisionFilterPair(actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid)
+            if not self._pair_off(actuator.parent.uid, link, target):
+                pb.setCollisionFilterPair(actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid)
+
+    def _pair_off(self, uid: int, link: int, b: SimBody) -> bool:
+        return frozenset(((uid, link), (b.uid, b.link))) in getattr(self, "_pairs_off", ())
 
     def _links(self, sb: SimBody):
         art = sb.articulation
@@ -577,7 +587,8 @@ class SimWorld:
                 pb.removeConstraint(c, physicsClientId=self.cid)
             t = actuator.target
             for link in self._links(actuator.parent):
-                pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
+                if not self._pair_off(actuator.parent.uid, link, t):   # set_collision's choice stays
+                    pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
         actuator.constraint, actuator.target = None, None
 
     # ---- snapshots and placement (fast resets for tasks and Gymnasium environments) -------
@@ -599,7 +610,8 @@ class SimWorld:
             states = pb.getJointStates(art.uid, list(range(n)), physicsClientId=cid) if n else []
             joints.append([(s[0], s[1]) for s in states])
         self._snapshots = getattr(self, "_snapshots", [])
-        self._snapshots.append((bases, joints, [list(a.targets) for a in self.articulations], self.steps))
+        bullet = pb.saveState(physicsClientId=cid)
+        self._snapshots.append((bases, joints, [list(a.targets) for a in self.articulations], self.steps, bullet))
         return len(self._snapshots) - 1
 
     def restore_state(self, sid: int) -> None:
@@ -608,7 +620,12 @@ class SimWorld:
         cid = self.cid
         for a in self.actuators:
             self.release(a)
-        bases, joints, targets, steps = self._snapshots[sid]
+        bases, joints, targets, steps, bullet = self._snapshots[sid]
+        try:   # exact, contact caches too, while no collision pair changed since the snapshot
+            pb.restoreState(stateId=bullet, physicsClientId=cid)
+            bases, joints, exact = [], [[] for _ in self.articulations], True
+        except pb.error:
+            exact = False
         for uid, p, q, v, w in bases:
             pb.resetBasePositionAndOrientation(uid, p, q, physicsClientId=cid)
             pb.resetBaseVelocity(uid, v, w, physicsClientId=cid)
