@@ -55,7 +55,7 @@ class SuturingEnv(gym.Env):
     def __init__(self, obs_mode: str = "state", reward_type: str = "dense", render_mode: str | None = None,
                  engine: str = "pybullet", scene=None, indices: str | None = None,
                  image_size: tuple = (128, 96), render_size: tuple = (320, 240), control_steps: int = 5,
-                 randomize: float = 0.008, randomize_needle: float = 0.0, settle_seconds: float = 1.0, setup_joints: bool = True) -> None:
+                 randomize: float = 0.008, randomize_needle: float = 0.0, settle_seconds: float = 0.5, setup_joints: bool = True) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode {obs_mode!r}: choose one of {', '.join(OBS_MODES)}")
         if reward_type not in REWARD_TYPES:
