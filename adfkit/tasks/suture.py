@@ -266,8 +266,11 @@ class SutureTask:
     def move(self, psm: PSM, goal: np.ndarray, seconds: float, settle: float = 0.15):
         """Free-space move: the IK at the goal, joints interpolated (the wrist never passes
         through an unreachable orientation on the way)."""
+        yield from self.move_jp(psm, psm.kin.ik(invert(psm.base_in_world()) @ goal), seconds, settle)
+
+    def move_jp(self, psm: PSM, q1, seconds: float, settle: float = 0.15):
         q0 = psm.setpoint_jp()
-        q1 = psm.kin.ik(invert(psm.base_in_world()) @ goal)
+        q1 = np.asarray(q1, dtype=float)
         n = self._steps(seconds)
         for i in range(1, n + 1):
             psm.servo_jp(q0 + (q1 - q0) * _smooth(i / n))
@@ -333,7 +336,7 @@ class SutureTask:
         names = sorted(self.psms, key=lambda n: float(np.dot(self.psms[n].base_in_world()[:3, 3], d)))
         return names[0], names[-1]
 
-    def setup_joints(self, reach: float = 0.19) -> dict:
+    def setup_joints(self, reach: float = 0.21) -> dict:
         """Where a PSM's remote centre of motion is farther from the holes than the tool reaches
         (the corpus set: 0.26 m against 0.24 m of insertion), slide its base toward them, as a
         surgeon places the arm on its setup joints. Returns {psm: metres moved}."""
@@ -398,13 +401,23 @@ class SutureTask:
                 if sb.model is m and sb.static and "phantom" in (sb.body.name or sb.body.identifier).lower()]
 
     def _soft_tissue_for_tools(self) -> None:
-        """The tools' jaws reach the wire lying on the tissue: they press into it rather than
-        push the arm off its set-point (the phantom is soft; its collision shape is a hull)."""
-        for t in self.tissue():
-            for psm in self.psms.values():
-                for sb in self.world.bodies:
-                    if sb.articulation is psm.art:
-                        self.world.set_collision(t, sb, False)
+        """The tools' jaws reach the wire lying on the tissue: they press into it (and the pad
+        under it) rather than push the arm off its set-point (the phantom is soft; its collision
+        shape is a hull). The two arms, brought closer on their setup joints, do not collide
+        with each other's links either (their links are coarse primitives)."""
+        m = self.needle.model
+        static = [sb for sb in self.world.bodies if sb.model is m and sb.static]
+        arms = {n: [sb for sb in self.world.bodies if sb.articulation is psm.art] for n, psm in self.psms.items()}
+        for links in arms.values():
+            for sb in links:
+                for t in static:
+                    self.world.set_collision(t, sb, False)
+        names = list(arms)
+        for i, a in enumerate(names):
+            for b in names[i + 1:]:
+                for x in arms[a]:
+                    for y in arms[b]:
+                        self.world.set_collision(x, y, False)
 
     def jitter(self, seconds: float = 0.05):
         """Seeded initial-pose jitter: a small random horizontal push on the needle."""
@@ -426,7 +439,7 @@ class SutureTask:
         yield from self.jitter()
         self.plan()
         d, p = self.psms[self.driver], self.psms[self.puller]
-        park = {n: self.setpoint_world(self.psms[n]) for n in self.psms}
+        park = {n: np.clip(self.psms[n].setpoint_jp(), self.psms[n].kin.lower_limits[:6], self.psms[n].kin.upper_limits[:6]) for n in self.psms}
         self._set_phase("pick up")
         yield from self.take(self.driver, self.drive_grasp)
         for k, pair in enumerate(self.pairs):
@@ -449,7 +462,7 @@ class SutureTask:
             self._set_phase(f"regrasp {pair.index}")
             yield from self.take(self.puller, self.pull_grasp)
             yield from self.let_go(self.driver)
-            yield from self.move(d, park[self.driver], 0.8, settle=0.0)
+            yield from self.move_jp(d, park[self.driver], 0.8, settle=0.0)
             self.holder = self.puller
             self._set_phase(f"pull {pair.index}")
             done = psi_x + self.geom.span + TAIL_CLEAR
@@ -463,6 +476,6 @@ class SutureTask:
                 self._set_phase(f"hand back {pair.index}")
                 yield from self.take(self.driver, self.drive_grasp)
                 yield from self.let_go(self.puller)
-                yield from self.move(p, park[self.puller], 0.8, settle=0.0)
+                yield from self.move_jp(p, park[self.puller], 0.8, settle=0.0)
                 self.holder = self.driver
         self._set_phase("done")
