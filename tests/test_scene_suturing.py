@@ -40,7 +40,7 @@ def world(built):
 def test_build_is_deterministic(built, tmp_path):
     BUILDERS["suturing"](tmp_path)
     assert _files(tmp_path) == _files(built)
-    assert len(_files(built)) == 27
+    assert len(_files(built)) == 28
 
 
 def test_bundled_copy_equals_a_fresh_build(built):
@@ -104,5 +104,15 @@ def test_a_short_play_is_stable(world):
     assert not rep["nan"] and not rep["exploded"] and not rep["fell_through_floor"]
     assert rep["max_constraint_error_m"] < 1e-3
     assert np.allclose(psm.measured_jp(), q0, atol=1e-4)   # the arm holds its home pose
-    z = world.body("Needle").com_position()[2]
-    assert layout.SLAB[2] < z < layout.SLAB[2] + 0.01          # resting on the slab
+    # the thread holds together: every pair of neighbouring elements still meets at its pivots
+    thread = {b.body.name: b for b in world.bodies if b.body.name and b.body.name.startswith("Thread")}
+    p = layout.THREAD_PITCH
+    for i in range(1, 40):
+        a = thread["Thread" if i == 1 else f"Thread_{i - 1:03d}"].world_matrix()
+        b = thread[f"Thread_{i:03d}"].world_matrix()
+        gap = (a @ [0, 0, -p / 2, 1])[:3] - (b @ [0, 0, p / 2, 1])[:3]
+        assert np.linalg.norm(gap) < 1e-3
+    # the needle lies still and flat where the layout put it (its thread does not lift it)
+    needle = world.body("Needle").world_matrix()
+    assert np.linalg.norm(needle[:3, 3] - layout.needle_start()[:3, 3]) < 1e-3
+    assert needle[2, 2] > np.cos(np.radians(2))

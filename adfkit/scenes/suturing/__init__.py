@@ -64,7 +64,9 @@ def write_suturing(out_dir: str | Path) -> Path:
     _write_bytes(meshes / "tissue_normal.png", textures.normal_png())
     _write_bytes(meshes / "Needle.OBJ", needle.needle_obj_text())
     _write_bytes(meshes / "Needle.mtl", needle.needle_mtl_text())
-    _write_bytes(meshes / "NeedleCollision.OBJ", needle.needle_hulls_text())
+    hulls_obj, hulls_mtl = needle.needle_hulls_text()
+    _write_bytes(meshes / "NeedleCollision.OBJ", hulls_obj)
+    _write_bytes(meshes / "NeedleCollision.mtl", hulls_mtl)
     write_file(InputDevices(present_lists={"input devices"}), out / "input_devices.yaml")
     from .needle import STEEL
     from .phantom import HOLE

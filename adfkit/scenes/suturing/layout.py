@@ -23,6 +23,9 @@ NEEDLE_ARC = 3 * math.pi / 4
 NEEDLE_WIRE = 0.0005            # wire radius
 NEEDLE_TIP_ANGLE = math.pi / 4  # in the needle's frame (arc in its xy plane, centre at the origin)
 NEEDLE_TAIL_ANGLE = math.pi     # the thread is fixed here
+#: PyBullet gives a convex-hull collision shape a margin of about 1 mm around the hull (the
+#: runner's contacts sit ~0.9 mm below the wire): the needle starts that far above the slab
+HULL_CLEARANCE = 0.001
 NEEDLE_GRASP_ANGLE = 5 * math.pi / 6   # where a PSM holds it (30 degrees from the tail)
 
 SLAB = (0.080, 0.176, 0.016)    # x, y, z full sizes; top at SLAB[2]
@@ -35,8 +38,8 @@ HOLE_HALF_GAP = 0.007           # entry at x = -7 mm, exit at +7 mm
 RIDGE_GAP = 0.0055              # width of the ridge's gap at each pair
 
 NEEDLE_GRASP_XY = (-0.026, 0.060)   # the slot's centre; the needle crosses it here
-SLOT_X = (-0.033, -0.019)
-SLOT_HALF_Y = 0.003
+SLOT_X = (-0.034, -0.018)
+SLOT_HALF_Y = 0.0035
 
 THREAD_ELEMENTS = 40
 THREAD_PITCH = 0.00244          # pivot-to-pivot length of an element (corpus)
@@ -69,13 +72,14 @@ def hole_poses(k: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def needle_start() -> np.ndarray:
-    """The needle lying flat on the slab, its wire crossing the slot at NEEDLE_GRASP_XY along
-    world +y (turned psi about z so that the tangent at the grasp angle is +y)."""
-    psi = math.pi - NEEDLE_GRASP_ANGLE
+    """The needle lying flat on the slab in its own orientation: the wire leaves the tail along
+    world +y, so the thread lies straight on along -y; the wire crosses the slot at
+    NEEDLE_GRASP_XY (30 degrees from y there), where the jaws close on it from above."""
     gx, gy = NEEDLE_GRASP_XY
-    a = NEEDLE_GRASP_ANGLE + psi
-    centre = (gx - NEEDLE_RADIUS * math.cos(a), gy - NEEDLE_RADIUS * math.sin(a), SLAB[2] + NEEDLE_WIRE + 0.0001)
-    return translation(*centre) @ rot_z(psi)
+    a = NEEDLE_GRASP_ANGLE
+    centre = (gx - NEEDLE_RADIUS * math.cos(a), gy - NEEDLE_RADIUS * math.sin(a),
+              SLAB[2] + NEEDLE_WIRE + HULL_CLEARANCE)
+    return translation(*centre)
 
 
 def needle_at_entry(k: int) -> np.ndarray:

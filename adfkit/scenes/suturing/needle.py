@@ -40,27 +40,27 @@ def needle_mtl_text() -> str:
     return "newmtl steel\nKa 0.2 0.2 0.2\nKd 0.800 0.800 0.820\nKs 0.9 0.9 0.9\nNs 200\nd 1\n"
 
 
-def needle_hulls_text(refresh: bool = False) -> str:
-    """The committed hull OBJ, or (``refresh``) a fresh CoACD decomposition of needle_mesh()."""
+def needle_hulls_text(refresh: bool = False) -> tuple[str, str]:
+    """(OBJ, MTL) text of the committed hulls, or (``refresh``) of a fresh CoACD decomposition
+    of needle_mesh(): one object and material per hull, the layout AMBF and the runner read as
+    one convex shape each (adfkit.geometry.decompose)."""
     if not refresh and HULLS_FILE.is_file():
-        return HULLS_FILE.read_text()
+        return HULLS_FILE.read_text(), HULLS_FILE.with_suffix(".mtl").read_text()
     import trimesh
 
     from ...geometry.decompose import DecompositionParams, decompose, hulls_obj_text
     v, f = needle_mesh()
     d = decompose(trimesh.Trimesh(v, f, process=False),
                   DecompositionParams(threshold=HULL_THRESHOLD, max_hulls=HULL_MAX, preprocess="off"))
-    obj, _ = hulls_obj_text(d.hulls, "NeedleCollision.mtl")
-    # keep the file to vertices and faces at fixed precision (deterministic, small)
+    obj, mtl = hulls_obj_text(d.hulls, "NeedleCollision.mtl")
+    # vertices at fixed precision: small, and the same text on every machine
     lines = []
     for line in obj.splitlines():
         if line.startswith("v "):
             x, y, z = (float(t) for t in line.split()[1:4])
             line = f"v {x:.7f} {y:.7f} {z:.7f}"
-        elif line.startswith(("mtllib", "usemtl")):
-            continue
         lines.append(line)
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n", mtl + "\n"
 
 
 def needle_body(world) -> Body:

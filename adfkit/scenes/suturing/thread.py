@@ -9,12 +9,12 @@ import math
 import numpy as np
 
 from ...model import (
-    RGBA, AxesGains, Body, Friction, Geometry, Inertia, Joint, JointLimits, Pose, Quat, Vec3, Vec3Range,
+    RGBA, AxesGains, Body, Friction, Geometry, Inertia, Joint, JointLimits, Pose, Vec3, Vec3Range,
     VelocityDamping,
 )
 from ...model.semantics import shortest_arc
 from . import layout as L
-from .frames import pose, r, rot_x, translation, vec
+from .frames import pose, r, rot_x, vec
 
 COLOUR = RGBA(r=0.25, g=0.2, b=0.85, a=1.0)
 STIFFNESS = 0.02
@@ -39,13 +39,34 @@ def fixed_axes(rel: np.ndarray, child_axis=(0.0, 0.0, 1.0)) -> tuple[Vec3, float
     return vec(a), r(off)
 
 
+def thread_path(tail: np.ndarray, rest_z: float) -> list[np.ndarray]:
+    """World pose of every element: from the needle's tail along world -y, the first element
+    level with the tail, the next two sloping down to ``rest_z`` (the needle's collision hull
+    holds the tail higher than a thread element lies; two joints of half the slope each stay
+    well inside the ±pi/6 limits), then lying on at rest_z. Element z points back toward the
+    needle, the next element is at -z."""
+    p = L.THREAD_PITCH
+    drop = max(0.0, tail[2] - rest_z)
+    slope = math.asin(min(1.0, drop / (2 * p)))
+    at = np.array(tail, float)
+    poses = []
+    for i in range(L.THREAD_ELEMENTS):
+        a = slope if i in (1, 2) else 0.0
+        d = np.array([0.0, -math.cos(a), -math.sin(a)])        # down the chain
+        m = rot_x(-math.pi / 2 + a)                              # z -> -d, x stays world x
+        m[:3, 3] = at + d * p / 2
+        poses.append(m)
+        at = at + d * p
+    return poses
+
+
 def thread_bodies_and_joints(needle_world: np.ndarray):
-    """Bodies and joints of the thread lying straight along world -y from the needle's tail."""
+    """Bodies and joints of the thread lying along world -y from the needle's tail."""
     p = L.THREAD_PITCH
     tail_local = np.array([L.NEEDLE_RADIUS * math.cos(L.NEEDLE_TAIL_ANGLE),
                            L.NEEDLE_RADIUS * math.sin(L.NEEDLE_TAIL_ANGLE), 0.0])
     tail = (needle_world @ np.append(tail_local, 1.0))[:3]
-    orient = rot_x(-math.pi / 2)             # element z -> world +y: the thread runs toward -y
+    path = thread_path(tail, L.SLAB[2] + L.THREAD_RADIUS + 0.00001)
     g = Geometry(radius=L.THREAD_RADIUS, height=0.00238, axis="z")
     m = L.THREAD_MASS
     i_perp = m * (3 * L.THREAD_RADIUS ** 2 + p * p) / 12
@@ -55,7 +76,7 @@ def thread_bodies_and_joints(needle_world: np.ndarray):
                          angular=Vec3Range(low=Vec3(-LIMIT, -LIMIT, -LIMIT), high=Vec3(LIMIT, LIMIT, LIMIT)))
     for i in range(L.THREAD_ELEMENTS):
         name = element_name(i)
-        world = translation(tail[0], tail[1] - (i + 0.5) * p, tail[2]) @ orient
+        world = path[i]
         bodies.append(Body(identifier=f"BODY {name}", name=name, mass=m, location=pose(world), inertia=inertia,
                            inertial_offset=Pose(), shape="Capsule", geometry=g, collision_shape="Capsule",
                            collision_geometry=g, collision_offset=Pose(), collision_margin=0.0001,
