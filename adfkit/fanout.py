@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from pathlib import Path
 from typing import Callable
 
@@ -56,8 +57,10 @@ def fan_out(fn: Callable, jobs: list, workers: int = 2, address: str | None = No
             if attempt <= RETRIES:
                 pending[remote.remote(jobs[i])] = (i, attempt + 1)
                 continue
+            cause = getattr(exc, "cause", None) or exc    # a RayTaskError wraps the task's own error
+            text = str(cause).strip().splitlines()
             out[i] = {"job": jobs[i], "ok": False, "attempts": attempt,
-                      "error": f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"}
+                      "error": f"{type(cause).__name__}: {text[-1] if text else ''}"}
         if progress is not None:
             progress(out[i])
     return out
@@ -83,5 +86,58 @@ def write_index(out_dir: Path, runs: list[dict], meta: dict) -> Path:
     return path
 
 
-def worker_pid() -> int:
-    return os.getpid()
+
+
+def _die_once(job: dict) -> None:
+    """The first worker to run a job with "kill_once" (a marker path) kills itself: the
+    fault-tolerance test's worker lost mid-run."""
+    import signal
+    kill = job.get("kill_once")
+    if kill and not Path(kill).exists():
+        Path(kill).write_text(str(os.getpid()))
+        os.kill(os.getpid(), signal.SIGKILL)
+
+
+def suture_job(job: dict) -> dict:
+    """One scripted suture (adfkit.tasks.episode.run_episode) in OUT/episode_<seed>."""
+    import time
+
+    from .tasks.episode import run_episode
+    _die_once(job)
+    t0 = time.perf_counter()
+    name = f"episode_{int(job['seed']):05d}"
+    m = run_episode(job["launch"], job["indices"], job["pairs"], int(job["seed"]), Path(job["out"]) / name,
+                    job.get("record", False), False, progress=False, every=job.get("every", 10))
+    return {"dir": name, "all_passed": bool(m.get("all_passed")),
+            "pairs_passed": [p["pair"] for p in m.get("pairs", []) if p.get("passed")],
+            "failure": m.get("failure"), "simulated_time_s": m.get("simulated_time_s"),
+            "wall_s": time.perf_counter() - t0, "pid": os.getpid()}
+
+
+def suture_episodes(launch, indices, pairs, seed: int, episodes: int, workers: int, address, out: Path,
+                    record: bool = False, every: int = 10, kill_once: str | None = None) -> int:
+    """`adfkit suture --episodes N --workers W`: exit 0 when every episode ran and passed every
+    pair, 1 otherwise (the index says which)."""
+    import time
+
+    from .report import Progress
+    out = Path(out).resolve()
+    jobs = [{"launch": str(Path(launch).resolve()), "indices": indices, "pairs": list(pairs), "seed": s,
+             "out": str(out), "record": record, "every": every} for s in range(seed, seed + episodes)]
+    if kill_once:
+        jobs[0]["kill_once"] = kill_once
+    t0 = time.perf_counter()
+    with Progress(len(jobs), "episodes") as bar:
+        runs = fan_out(suture_job, jobs, workers, address, progress=lambda r: bar.update(1))
+    wall = time.perf_counter() - t0
+    index = write_index(out, runs, {"command": "suture", "launch": jobs[0]["launch"], "indices": indices,
+                                    "pairs": list(pairs), "workers": workers, "address": address, "wall_s": wall})
+    done = [r for r in runs if r["ok"]]
+    passed = sum(1 for r in done if r["result"]["all_passed"])
+    print(f"{len(done)}/{len(runs)} episodes ran, {passed} passed every pair, in {wall:.1f} s "
+          f"({len(done) / wall:.3f} episodes/s); index: {index}")
+    for r in runs:
+        if r["attempts"] > 1 or not r["ok"]:
+            print(f"seed {r['job']['seed']}: {'retried, ' if r['attempts'] > 1 else ''}"
+                  f"{'ok' if r['ok'] else 'FAILED: ' + r['error']}", file=sys.stderr)
+    return 0 if len(done) == len(runs) and passed == len(runs) else 1

@@ -29,6 +29,10 @@ def add_arguments(p) -> None:
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--record", action="store_true", help="write the dataset (RGB, depth, segmentation, poses)")
     p.add_argument("--every", type=int, default=10, help="with --record: a frame every N control steps")
+    p.add_argument("--episodes", type=int, default=1,
+                   help="episodes (seeds SEED..SEED+N-1) as Ray tasks, each in OUT/episode_<seed>, merged in OUT/index.json")
+    p.add_argument("--workers", type=int, default=None, help="Ray workers on a local Ray (default 2 with --episodes)")
+    p.add_argument("--address", help="Ray cluster address (auto, ray://head:10001); default: a local Ray")
 
 
 def _pairs(text: str) -> list[int]:
@@ -70,8 +74,14 @@ def run(args) -> int:
     if any(d.severity >= Severity.ERROR for d in diags):
         print_diagnostics(diags, sys.stderr)
         return 2
-    from ..tasks.episode import run_episode
     out = Path(args.out)
+    if args.episodes > 1 or args.workers or args.address:
+        if args.episodes < 1 or (args.workers is not None and args.workers < 1):
+            raise AdfError(error("bad-option", "--episodes and --workers must be at least 1", None, "e.g. --episodes 4 --workers 2"))
+        from ..fanout import suture_episodes
+        return suture_episodes(launch, indices, pairs, args.seed, args.episodes, args.workers or 2, args.address, out,
+                               args.record, args.every)
+    from ..tasks.episode import run_episode
     m = run_episode(launch, indices, pairs, args.seed, out, args.record, args.gui, progress=True, every=args.every)
     if m.get("failure", "").startswith("setup:") if m.get("failure") else False:
         raise AdfError(error("suture-setup", m["failure"].removeprefix("setup: "), None,

@@ -8,7 +8,6 @@ is_success (T,); DIR/index.json (written by the caller) lists every episode.
 from __future__ import annotations
 
 import os
-import signal
 import time
 from pathlib import Path
 
@@ -30,10 +29,8 @@ def _env(env_id: str, kwargs: dict):
 def record_episode(job: dict) -> dict:
     """job: {"env", "seed", "out", "kwargs" (env keywords), "kill_once" (a marker path: the
     first worker to run this job kills itself, for the fault-tolerance test)}."""
-    kill = job.get("kill_once")
-    if kill and not Path(kill).exists():
-        Path(kill).write_text(str(os.getpid()))
-        os.kill(os.getpid(), signal.SIGKILL)
+    from ..fanout import _die_once
+    _die_once(job)
     from .experts import expert_for
     t0 = time.perf_counter()
     env = _env(job["env"], dict(job.get("kwargs", {})))
