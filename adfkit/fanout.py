@@ -141,3 +141,33 @@ def suture_episodes(launch, indices, pairs, seed: int, episodes: int, workers: i
             print(f"seed {r['job']['seed']}: {'retried, ' if r['attempts'] > 1 else ''}"
                   f"{'ok' if r['ok'] else 'FAILED: ' + r['error']}", file=sys.stderr)
     return 0 if len(done) == len(runs) and passed == len(runs) else 1
+
+
+def _validate_chunk(args) -> list:
+    from .validator import validate_paths
+    files, kind, follow = args
+    return validate_paths(files, kind, follow=follow)[0]
+
+
+def validate_parallel(paths, kind, follow: bool, workers: int, address=None) -> tuple[list, list]:
+    """validate_paths over a big tree as Ray tasks, same results in the same order: the files
+    in the engine's order (launch files first) cut into contiguous chunks, each chunk checked by
+    validate_paths (following launch files as it does), the chunks' results joined and a file
+    reached twice kept where it first appears, as the serial run keeps it."""
+    from .validator.engine import _looks_like_launch, expand
+    files, problems = expand(paths)
+    files = sorted(files, key=lambda f: not _looks_like_launch(f))
+    n = max(1, min(len(files), 4 * workers))
+    size = -(-len(files) // n) if files else 1
+    chunks = [files[i:i + size] for i in range(0, len(files), size)]
+    runs = fan_out(_validate_chunk, [(c, kind, follow) for c in chunks], workers, address)
+    results, seen = [], set()
+    for r in runs:
+        if not r["ok"]:
+            raise RuntimeError(f"a validation task failed twice: {r['error']}")
+        for res in r["result"]:
+            key = Path(res.path).resolve()
+            if key not in seen:
+                seen.add(key)
+                results.append(res)
+    return results, problems

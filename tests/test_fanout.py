@@ -71,3 +71,17 @@ def test_suture_episodes_4_on_2_workers_write_4_episodes_and_an_index(tmp_path):
     assert index["retried"] == [0]
     for e in index["episodes"]:
         assert (tmp_path / "su" / e["dir"] / "metrics.json").is_file()
+
+
+def test_validate_on_workers_prints_what_one_process_prints(capsys):
+    from conftest import ROOT
+
+    from adfkit.cli import main
+    tree = str(ROOT / "sample_scenes")
+    rc1 = main(["validate", tree, "-f", "json", "--fail-on", "warning"])
+    one = capsys.readouterr().out
+    rc2 = main(["validate", tree, "-f", "json", "--fail-on", "warning", "--workers", "2"])
+    two = capsys.readouterr().out
+    assert rc1 == rc2
+    assert json.loads(one) == json.loads(two) and one == two
+    assert json.loads(one)["files"] >= 10 and json.loads(one)["diagnostics"]
