@@ -23,6 +23,7 @@ from . import scenes
 
 MAX_STEP = 0.003      # m of set-point motion per env step at |action| = 1
 MAX_TURN = 0.05       # rad per env step
+GRASP_REACH = 0.004   # m from the point between the jaws to the needle's surface for a grasp
 READY_HEIGHT = 0.03   # m: the acting arms start this far above the needle's grasp point
 OBS_MODES = ("state", "rgb", "rgbd")
 REWARD_TYPES = ("dense", "sparse")
@@ -179,9 +180,9 @@ class SuturingEnv(gym.Env):
             refused = 1
         close = act[6] < 0.0
         if close and not self._closed[name]:
-            psm.grasp(True)
+            self._grasp(name)
         elif not close and self._closed[name]:
-            psm.grasp(False)
+            self.world.release(self._actuator(name))
         if not close:
             from ..runner.psm import JAW_OPEN
             psm.servo_jaw((act[6] + 1.0) / 2.0 * JAW_OPEN)
@@ -203,6 +204,19 @@ class SuturingEnv(gym.Env):
             except ValueError:
                 pass
             psm.servo_jaw(JAW_OPEN)
+
+    def _actuator(self, name: str):
+        return next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
+
+    def _grasp(self, name: str) -> bool:
+        """Close the jaws; the scene's constraint actuator holds the needle when its wire lies
+        within GRASP_REACH of the point between the jaws (only the needle: the environments'
+        grasps never take a thread element or another body)."""
+        self.psms[name].servo_jaw(0.0)
+        if self.world.nearest_point(self.needle, self.tool_position(name), GRASP_REACH) is None:
+            return False
+        self.world.actuate(self._actuator(name), self.needle)
+        return True
 
     def tool_position(self, name: str = "psm1") -> np.ndarray:
         """World position of the point between the arm's jaws (JAW_DEPTH along the end-effector's z)."""

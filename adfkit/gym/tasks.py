@@ -19,10 +19,11 @@ LIFT = 0.01               # m
 
 
 def f32(x) -> np.ndarray:
-    """Rewards are computed from positions at the observation's precision (float32): a
-    restored world repeats a step to ~1e-12 m, not bit for bit, and a seeded reset plus the
-    same actions must give the same rewards (Gymnasium's determinism check)."""
-    return np.asarray(x, np.float32).astype(float)
+    """Rewards are computed from positions rounded to the micrometre: a restored world repeats
+    a step to ~1e-9 m, not always bit for bit (Bullet keeps some solver state across a
+    restore), and a seeded reset plus the same actions must give the same rewards (Gymnasium's
+    determinism check)."""
+    return np.round(np.asarray(x, float), 6)
 
 
 class NeedleReach(SuturingEnv):
