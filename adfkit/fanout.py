@@ -20,8 +20,10 @@ RETRIES = 1
 def _ray():
     try:
         import ray
-    except ImportError as exc:
-        raise ImportError("fan-out needs Ray: pip install 'adfkit[ray]'") from exc
+    except ImportError:
+        from .diagnostics import AdfError, error
+        raise AdfError(error("missing-extra", "--workers/--episodes/--address run on Ray, which is not installed",
+                             None, "pip install 'adfkit[ray]'")) from None
     return ray
 
 

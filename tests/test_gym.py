@@ -160,3 +160,13 @@ def test_mujoco_engine_is_a_clear_error_or_works():
             gym.make("adfkit/NeedleReach-v0", engine="mujoco")
     with pytest.raises(ValueError, match="engine"):
         gym.make("adfkit/NeedleReach-v0", engine="ode")
+
+
+def test_dataset_command_refuses_bad_options(tmp_path, capsys):
+    from adfkit.cli import main
+    assert main(["dataset", "--env", "adfkit/SutureOnePair-v0", "--out", str(tmp_path)]) == 2
+    assert "no scripted expert" in capsys.readouterr().err
+    assert main(["dataset", "--episodes", "0", "--out", str(tmp_path)]) == 2
+    assert main(["dataset", "--scene", str(tmp_path / "none.yaml"), "--out", str(tmp_path)]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())

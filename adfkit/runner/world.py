@@ -24,6 +24,7 @@ from .joints import SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
 from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
 from .shapes import collision_parts, create_collision, create_visual
+from .world_state import WorldState
 
 GRASP_SPAN = 0.005   # m between the three point constraints of a grasp (SimWorld.actuate)
 SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
@@ -78,7 +79,7 @@ class SimSensor:
     sensed: list = field(default_factory=list)
 
 
-class SimWorld:
+class SimWorld(WorldState):
     def __init__(self, scene, options: Options | None = None, gui: bool = False) -> None:
         self.scene = scene
         self.opt = options or Options()
@@ -113,7 +114,7 @@ class SimWorld:
         self.steps = 0
         self.sim_time = 0.0
         self.wall_time = 0.0
-        pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
+        pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
         self._build()
 
     # ---- building ------------------------------------------------------------------------
@@ -266,7 +267,6 @@ class SimWorld:
         set_dynamics(sb)
 
     def _collision_filters(self, records) -> None:
-        self._masks = {}
         groups = sorted({g for sb in self.bodies for g in (sb.body.collision_groups or []) if 0 <= g <= 999})
         bit = {g: 1 << (i % 30) for i, g in enumerate(groups)}
         if len(groups) > 30:
@@ -280,9 +280,7 @@ class SimWorld:
                     mask |= bit[g]
                 pb.setCollisionFilterGroupMask(sb.uid, sb.link, mask, mask, physicsClientId=self.cid)
             else:
-                mask = allbits
                 pb.setCollisionFilterGroupMask(sb.uid, sb.link, allbits, allbits, physicsClientId=self.cid)
-            self._masks[(sb.uid, sb.link)] = mask
         for j, kind, parent, child in records:
             if j.ignore_inter_collision is not False:
                 self._no_collision(parent, child)
@@ -590,81 +588,6 @@ class SimWorld:
                 if not self._pair_off(actuator.parent.uid, link, t):   # set_collision's choice stays
                     pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
         actuator.constraint, actuator.target = None, None
-
-    # ---- snapshots and placement (fast resets for tasks and Gymnasium environments) -------
-    def save_state(self) -> int:
-        """Snapshot the simulation in memory: every free body's and multibody base's pose and
-        velocity, every joint's position, velocity and motor target, the clock. Returns an id
-        for restore_state. (Bullet's own saveState cannot be restored once a grasp has changed
-        a collision filter pair, so the snapshot is taken through the bodies.)"""
-        cid = self.cid
-        bases = []
-        for sb in self.bodies:
-            if sb.link < 0 and sb.uid is not None and sb.uid >= 0:
-                p, q = pb.getBasePositionAndOrientation(sb.uid, physicsClientId=cid)
-                v, w = pb.getBaseVelocity(sb.uid, physicsClientId=cid)
-                bases.append((sb.uid, p, q, v, w))
-        joints = []
-        for art in self.articulations:
-            n = len(art.records)
-            states = pb.getJointStates(art.uid, list(range(n)), physicsClientId=cid) if n else []
-            joints.append([(s[0], s[1]) for s in states])
-        self._snapshots = getattr(self, "_snapshots", [])
-        bullet = pb.saveState(physicsClientId=cid)
-        self._snapshots.append((bases, joints, [list(a.targets) for a in self.articulations], self.steps, bullet))
-        return len(self._snapshots) - 1
-
-    def restore_state(self, sid: int) -> None:
-        """Put the world back to snapshot ``sid``: every grasp released, bodies and joints at
-        their saved states, the joint motors at their saved targets, the clock at its time."""
-        cid = self.cid
-        for a in self.actuators:
-            self.release(a)
-        bases, joints, targets, steps, bullet = self._snapshots[sid]
-        try:   # exact, contact caches too, while no collision pair changed since the snapshot
-            pb.restoreState(stateId=bullet, physicsClientId=cid)
-            bases, joints, exact = [], [[] for _ in self.articulations], True
-        except pb.error:
-            exact = False
-        for uid, p, q, v, w in bases:
-            pb.resetBasePositionAndOrientation(uid, p, q, physicsClientId=cid)
-            pb.resetBaseVelocity(uid, v, w, physicsClientId=cid)
-        for art, states, t in zip(self.articulations, joints, targets):
-            for i, (q, v) in enumerate(states):
-                pb.resetJointState(art.uid, i, q, v, physicsClientId=cid)
-            art.targets[:] = t
-            art.drive()
-        self.steps, self.sim_time = steps, steps * self.dt
-
-    def place_body(self, sb: SimBody, pose: np.ndarray) -> None:
-        """Move a free body (its ADF body frame to the 4x4 world ``pose``), at rest; a
-        multibody's base moves with move_base."""
-        if sb.articulation is not None:
-            raise ValueError(f"{sb.key} is part of a multibody; only free bodies can be placed")
-        pos, orn = matrix_to_pq(pose @ sb.com_in_body)
-        pb.resetBasePositionAndOrientation(sb.uid, pos, orn, physicsClientId=self.cid)
-        if not sb.static:
-            pb.resetBaseVelocity(sb.uid, [0, 0, 0], [0, 0, 0], physicsClientId=self.cid)
-
-    def grasped(self, psm: str) -> SimBody | None:
-        """The body the constraint actuator of ``psm`` holds now, or None."""
-        act = next((a for a in self.actuators if psm in a.key or psm in a.parent.key), None)
-        return act.target if act is not None else None
-
-    def nearest_point(self, sb: SimBody, point, reach: float = 0.05):
-        """The point of ``sb``'s collision shape nearest ``point`` (world, m), or None when it
-        is farther than ``reach``."""
-        if getattr(self, "_probe", None) is None:
-            shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=1e-5, physicsClientId=self.cid)
-            self._probe = pb.createMultiBody(0, shape, -1, [0, 0, 0], useMaximalCoordinates=True,
-                                             physicsClientId=self.cid)
-            pb.setCollisionFilterGroupMask(self._probe, -1, 0, 0, physicsClientId=self.cid)
-        pb.resetBasePositionAndOrientation(self._probe, list(map(float, point)), [0, 0, 0, 1],
-                                           physicsClientId=self.cid)
-        hits = pb.getClosestPoints(self._probe, sb.uid, reach, -1, sb.link, physicsClientId=self.cid)
-        if not hits:
-            return None
-        return np.array(min(hits, key=lambda h: h[8])[6])
 
     # ---- measures -----------------------------------------------------------------------
     def constraint_error(self) -> float:
