@@ -123,6 +123,7 @@ class SutureObserver:
             "exploded": bool(rep["exploded"] or rep["nan"]),
             "exploded_bodies": rep["exploded"] + rep["nan"],
             "control_steps": self.n,
+            "clipped_setpoints": self.task.clipped,
         }
 
 
