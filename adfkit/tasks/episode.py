@@ -15,8 +15,8 @@ import numpy as np
 from .metrics import SutureObserver, finite
 from .suture import SutureError, SutureTask
 
-GIF_EVERY_S = 0.5      # simulated seconds between GIF frames
-GIF_WIDTH = 240        # pixels
+GIF_EVERY_S = 1.0      # simulated seconds between GIF frames
+GIF_WIDTH = 200        # pixels
 
 
 def _left_camera(world):
@@ -72,16 +72,22 @@ def play_task(world, task, out: Path | None = None, record: bool = False, every:
     bar = _Bar(progress)
     failure = None
     t0 = time.perf_counter()
+    clock = time.perf_counter
+    spent = {"observe_s": 0.0, "render_s": 0.0}
     n = 0
     try:
         for phase in task.steps():
             world.step(1)
+            a = clock()
             obs.observe()
+            b = clock()
+            spent["observe_s"] += b - a
             n += 1
             if writer is not None and n % every == 0:
                 writer.write(n, _poses(task), phase)
             if cam is not None and n % gif_every == 0:
                 frames.append(_small(cam.render(world)["rgb"]))
+            spent["render_s"] += clock() - b
             if n % 25 == 0:
                 rtf = world.sim_time / (time.perf_counter() - t0)
                 bar.update(f"{phase}  t={world.sim_time:5.2f} s  {rtf:.2f}x real time")
@@ -92,6 +98,9 @@ def play_task(world, task, out: Path | None = None, record: bool = False, every:
         if writer is not None:
             writer.close()
     metrics = obs.metrics(time.perf_counter() - t0, failure)
+    spent["physics_s"] = world.wall_time
+    spent["planning_and_servo_s"] = metrics["episode_wall_time_s"] - sum(spent.values())
+    metrics["where_the_time_goes"] = spent
     if writer is not None:
         metrics["dataset"] = {"dir": "dataset", "frames": writer.frames, "every_control_steps": every}
     return metrics, obs, frames

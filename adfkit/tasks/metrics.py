@@ -36,6 +36,7 @@ class SutureObserver:
         self.max_constraint_error = 0.0
         self.max_drift = 0.0
         self.drift_samples = 0
+        self.drift_by_phase: dict[str, float] = {}
         self.thread_seen: dict[int, set] = {p.index: set() for p in task.pairs}
         self.thread = [sb for sb in self.world.bodies
                        if sb.model is task.needle.model and "thread" in (sb.body.name or sb.body.identifier).lower()]
@@ -70,7 +71,10 @@ class SutureObserver:
             psm = self.task.psms[self.task.holder]
             ee = psm.base_in_world() @ psm.measured_cp()
             expected = ee @ invert(self.task.held_ee_in_needle)
-            self.max_drift = max(self.max_drift, float(np.linalg.norm(expected[:3, 3] - self.task.needle_pose()[:3, 3])))
+            drift = float(np.linalg.norm(expected[:3, 3] - self.task.needle_pose()[:3, 3]))
+            self.max_drift = max(self.max_drift, drift)
+            kind = self.task.phase.split()[0]
+            self.drift_by_phase[kind] = max(self.drift_by_phase.get(kind, 0.0), drift)
             self.drift_samples += 1
 
     def element_length(self) -> float:
@@ -114,6 +118,7 @@ class SutureObserver:
                                   "orientation": [float(v) for v in matrix_to_quat(n[:3, :3])]},
             "thread_length_through_tissue_m": through,
             "grasp_drift_max_m": self.max_drift if self.drift_samples else None,
+            "grasp_drift_by_phase_m": self.drift_by_phase,
             "max_constraint_error_m": max(self.max_constraint_error, rep["max_constraint_error_m"]),
             "simulated_time_s": self.world.sim_time,
             "physics_wall_time_s": self.world.wall_time,
@@ -123,6 +128,7 @@ class SutureObserver:
             "exploded": bool(rep["exploded"] or rep["nan"]),
             "exploded_bodies": rep["exploded"] + rep["nan"],
             "control_steps": self.n,
+            "clipped_setpoints": self.task.clipped,
         }
 
 

@@ -26,17 +26,20 @@ import numpy as np
 
 from ..adf.paths import collision_mesh_path
 from ..runner.psm import PSM
+from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert
 from .needle import NeedleGeometry, fit_needle, obj_vertices
 
 JAW_DEPTH = 0.01      # m from the end effector to the point between the jaws (LND: along z_E)
 BACK_OFF = 0.012      # m along -z_E before a grasp and after a release
 LIFT = 0.015          # m the needle is lifted when carried between the phantom and a hole
-APPROACH = math.radians(28)    # the tip starts this far before the entry on its arc
-BEYOND_EXIT = math.radians(60)  # ... and is driven this far beyond the exit
-TIP_GRASP = math.radians(28)   # the puller grasps this far behind the tip
-TAIL_GRASP = math.radians(22)  # the driver grasps this far ahead of the tail
+APPROACH = math.radians(15)    # the tip starts this far before the entry on its arc
+MAX_GRASP = math.radians(25)   # the grasps sit at most this far from the tip / the tail ...
+CLEAR = math.radians(10)       # ... and at least this far outside the tissue
+MAX_BITE = math.radians(65)    # the arc between entry and exit; wider bites aim inside the holes
+HOLE_MARGIN = 0.0008           # m kept from a hole ghost's side when aiming inside it
 TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
+CLIP_TOLERANCE = 0.15          # rad (m for the insertion) a set-point may pass a limit and be clipped
 JITTER_FORCE = 0.0  # N, the seeded push on the needle before the suture
 
 
@@ -87,6 +90,14 @@ def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
 
 def _smooth(s: float) -> float:
     return s * s * (3 - 2 * s)
+
+
+def _in_plane_room(ghost, direction) -> float:
+    """How far from its centre a hole ghost reaches along ``direction`` (in its plane)."""
+    geo = getattr(ghost.ghost, "geometry", None)
+    if geo is None or geo.x is None or geo.y is None:
+        return 0.0
+    return min(geo.x, geo.y) / 2 * (ghost.ghost.scale or 1.0)
 
 
 def hole_pairs(world) -> list[HolePair]:
@@ -153,12 +164,12 @@ class SutureTask:
         self.pairs = [all_pairs[k] for k in pairs]
         self.psms = {n: PSM(world, n) for n in psm_names}
         self.phase = "start"
+        self.clipped = 0                                # set-points clipped to the joint limits
         self.phase_log: list[tuple[str, float]] = []   # (phase, simulated start time)
         self.holder: str | None = None                  # the PSM holding the needle
         self.held_ee_in_needle: np.ndarray | None = None
         # seeded variation of the plan
-        self.tail_grasp = TAIL_GRASP + self.rng.uniform(-0.06, 0.06)
-        self.tip_grasp = TIP_GRASP + self.rng.uniform(-0.05, 0.05)
+        self.grasp_jitter = self.rng.uniform(-0.04, 0.04, 2)
         self.approach = APPROACH + self.rng.uniform(-0.05, 0.05)
 
     # ---- geometry ----------------------------------------------------------------------
@@ -169,21 +180,32 @@ class SutureTask:
         return (self.needle_pose() @ np.r_[self.geom.tip, 1.0])[:3]
 
     def arc_frame(self, pair: HolePair):
-        """Frame B at the circle's centre for this pair (x toward the entry, z the axis along
-        which the tip goes from entry to exit) and the exit's angle in it."""
+        """Frame B at the circle's centre for this pair (x toward the entry point, z the axis
+        about which the tip goes from entry to exit), the exit's angle in it, how far the tip
+        goes beyond the exit and how far from the ends the two grasps sit.
+
+        The needle's circle goes through an aim point in each hole: the hole's centre, or,
+        where the holes are farther apart than a bite of MAX_BITE, a point inside each hole
+        ghost toward the other one (the tip still passes through both ghosts)."""
         e = self.world.ghost_pose(pair.entry)
         x = self.world.ghost_pose(pair.exit)
         pe, px = e[:3, 3], x[:3, 3]
         up = e[:3, 2] + x[:3, 2]
         if up[2] < 0:
             up = -up
+        r = self.geom.radius
         d = px - pe
         dist = float(np.linalg.norm(d))
-        r = self.geom.radius
+        dn = d / dist
+        want = 2 * r * math.sin(MAX_BITE / 2)
+        if dist > want:
+            room = min(_in_plane_room(g, dn) for g in (pair.entry, pair.exit))
+            inset = min((dist - want) / 2, max(0.0, room - HOLE_MARGIN))
+            pe, px = pe + inset * dn, px - inset * dn
+            dist -= 2 * inset
         if dist >= 2 * r * 0.98:
             raise SutureError(f"entry and exit of pair {pair.index} are {dist * 1000:.1f} mm apart; "
                               f"the needle spans {2 * r * 1000:.1f} mm")
-        dn = d / dist
         w = up - np.dot(up, dn) * dn
         w /= np.linalg.norm(w)
         c = (pe + px) / 2 + math.sqrt(r * r - dist * dist / 4) * w
@@ -193,8 +215,15 @@ class SutureTask:
         b = np.eye(4)
         b[:3, :3] = np.c_[xa, np.cross(za, xa), za]
         b[:3, 3] = c
-        psi_exit = math.acos(float(np.clip(np.dot(xa, (px - c) / r), -1, 1)))
-        return b, psi_exit
+        psi_x = math.acos(float(np.clip(np.dot(xa, (px - c) / r), -1, 1)))
+        free = self.geom.span - psi_x          # arc outside the tissue when the bite is full
+        if free < 2 * CLEAR + math.radians(16):
+            raise SutureError(f"pair {pair.index}: the needle's arc ({math.degrees(self.geom.span):.0f}°) leaves "
+                              f"{math.degrees(free):.0f}° outside a {math.degrees(psi_x):.0f}° bite; too little to hold it")
+        g = min(MAX_GRASP, free / 2 - CLEAR - math.radians(2))
+        g_tip, g_tail = g + self.grasp_jitter[0] * g / MAX_GRASP, g + self.grasp_jitter[1] * g / MAX_GRASP
+        beyond = (g_tip + CLEAR + free - g_tail - CLEAR) / 2
+        return b, psi_x, beyond, g_tip, g_tail
 
     def needle_at(self, b: np.ndarray, psi: float) -> np.ndarray:
         """Needle body pose with its tip at angle psi in arc frame B."""
@@ -207,8 +236,10 @@ class SutureTask:
 
     # ---- grasp selection ---------------------------------------------------------------
     def grasp_candidates(self, phi: float):
-        """End-effector poses in the needle frame that hold the wire at arc angle phi across
-        the jaws (wire along x_E), around the wire in 15° steps, both ways."""
+        """End-effector poses in the needle frame that hold the wire at arc angle phi between
+        the jaws (the wire across the opening direction y_E): around the wire in 15° steps,
+        both ways, the wire square to the jaws or turned up to 45° about y_E. Each comes with
+        its turn (rad), which the choice penalises slightly."""
         g = self.geom
         a = g.arc_in_needle
         p = g.point(phi)
@@ -216,15 +247,17 @@ class SutureTask:
         radial = a[:3, :3] @ np.array([math.cos(phi), math.sin(phi), 0.0])
         n = a[:3, 2]
         out = []
-        for sign in (1.0, -1.0):
-            for beta in np.radians(np.arange(0, 360, 15)):
-                z = math.cos(beta) * -radial + math.sin(beta) * n
-                x = sign * t
-                y = np.cross(z, x)
-                m = np.eye(4)
-                m[:3, :3] = np.c_[x, y, z]
-                m[:3, 3] = p - JAW_DEPTH * z
-                out.append(m)
+        for turn in np.radians([0.0, 25.0, -25.0, 45.0, -45.0]):
+            for sign in (1.0, -1.0):
+                for beta in np.radians(np.arange(0, 360, 15)):
+                    z0 = math.cos(beta) * -radial + math.sin(beta) * n
+                    x0 = sign * t
+                    x = math.cos(turn) * x0 - math.sin(turn) * z0
+                    z = math.sin(turn) * x0 + math.cos(turn) * z0
+                    m = np.eye(4)
+                    m[:3, :3] = np.c_[x, np.cross(z, x), z]
+                    m[:3, 3] = p - JAW_DEPTH * z
+                    out.append((m, abs(float(turn))))
         return out
 
     def _margin(self, psm: PSM, ee_world: np.ndarray) -> float:
@@ -235,18 +268,24 @@ class SutureTask:
         lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
         return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo)))
 
-    def choose_grasp(self, psm: PSM, phi: float, needle_poses: list, down_at: np.ndarray | None = None) -> Grasp:
+    def choose_grasp(self, psm: PSM, phi: float, needle_poses: list, down_at: np.ndarray | None = None,
+                     what: str = "") -> Grasp:
         """The candidate grasp reachable at every needle pose with the widest joint margin
         (with ``down_at``: the jaws must point down at that needle pose, to come from above)."""
         best = None
-        for ee_in_n in self.grasp_candidates(phi):
+        for ee_in_n, turn in self.grasp_candidates(phi):
             if down_at is not None and (down_at @ ee_in_n)[2, 2] > -0.5:
                 continue
-            worst = min(self._margin(psm, pose @ ee_in_n) for pose in needle_poses)
-            if worst > 0 and (best is None or worst > best.margin):
-                best = Grasp(ee_in_n, worst)
+            worst = math.inf
+            for pose in needle_poses:
+                worst = min(worst, self._margin(psm, pose @ ee_in_n))
+                if worst <= 0:
+                    break
+            score = worst - 0.02 * turn
+            if worst > 0 and (best is None or score > best.margin):
+                best = Grasp(ee_in_n, score)
         if best is None:
-            raise SutureError(f"{psm.name}: no grasp of the needle reachable along the whole plan")
+            raise SutureError(f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})")
         return best
 
     # ---- motion primitives (generators: one yield per control step) ----------------------
@@ -258,7 +297,17 @@ class SutureTask:
         return max(1, int(round(seconds / self.speed / self.cdt)))
 
     def servo_world(self, psm: PSM, ee_world: np.ndarray) -> None:
-        psm.servo_cp(invert(psm.base_in_world()) @ ee_world)
+        """Cartesian set-point in the world; a pose a little past a joint limit (the grasp
+        as measured differs from the planned one by a few degrees) is servoed with the joints
+        clipped to their limits, and counted."""
+        try:
+            psm.servo_cp(invert(psm.base_in_world()) @ ee_world)
+        except JointLimitError as exc:
+            lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+            if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
+                raise
+            psm.servo_jp(np.clip(exc.q, lo, hi))
+            self.clipped += 1
 
     def setpoint_world(self, psm: PSM) -> np.ndarray:
         return psm.base_in_world() @ psm.setpoint_cp()
@@ -303,8 +352,8 @@ class SutureTask:
         psm.servo_jaw(0.8)
         yield from self.move(psm, above, 0.8)
         yield from self.move(psm, goal, 0.5, settle=0.2)
-        psm.servo_jaw(0.0)
-        yield from self.wait(0.25)
+        psm.servo_jaw(0.25)      # the jaws close on the wire ...
+        yield from self.wait(0.1)
         ee = psm.base_in_world() @ psm.measured_cp()
         jaw = ee[:3, 3] + JAW_DEPTH * ee[:3, 2]
         wire = (self.needle_pose() @ grasp.ee_in_needle)[:3, 3] + JAW_DEPTH * (self.needle_pose() @ grasp.ee_in_needle)[:3, 2]
@@ -312,9 +361,11 @@ class SutureTask:
         if miss > 0.004:
             raise SutureError(f"{name} missed the needle by {miss * 1000:.1f} mm ({self.phase})")
         act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
-        self.world.actuate(act, self.needle)
+        self.world.actuate(act, self.needle)   # ... the actuator holds it (and the jaws no longer push it) ...
         self.holder = name
         self.held_ee_in_needle = invert(self.needle_pose()) @ ee
+        psm.servo_jaw(0.0)                      # ... and they close fully
+        yield from self.wait(0.15)
 
     def let_go(self, name: str):
         psm = self.psms[name]
@@ -336,7 +387,7 @@ class SutureTask:
         names = sorted(self.psms, key=lambda n: float(np.dot(self.psms[n].base_in_world()[:3, 3], d)))
         return names[0], names[-1]
 
-    def setup_joints(self, reach: float = 0.21) -> dict:
+    def setup_joints(self, reach: float = 0.17) -> dict:
         """Where a PSM's remote centre of motion is farther from the holes than the tool reaches
         (the corpus set: 0.26 m against 0.24 m of insertion), slide its base toward them, as a
         surgeon places the arm on its setup joints. Returns {psm: metres moved}."""
@@ -357,27 +408,51 @@ class SutureTask:
         return moved
 
     def plan(self):
-        """Needle poses of the whole suture and the grasps that reach them."""
+        """Needle poses of the whole suture and, per pair, the grasps that reach them: the
+        driver's (from where it takes the needle, over the approach, along the insertion) and
+        the puller's (along the pull and the lift)."""
         n0 = self.needle_pose()
         self.driver, self.puller = self._sides()
-        frames = {p.index: self.arc_frame(p) for p in self.pairs}
-        drive_poses, pull_poses = [n0, self.lifted(n0, LIFT)], []
-        for p in self.pairs:
-            b, psi_x = frames[p.index]
-            psi_end = psi_x + BEYOND_EXIT
-            for psi in np.linspace(-self.approach, psi_end, 6):
-                drive_poses.append(self.needle_at(b, psi))
-            drive_poses.append(self.lifted(self.needle_at(b, -self.approach), LIFT))
+        self.frames = {p.index: self.arc_frame(p) for p in self.pairs}
+        self.drive_grasps, self.pull_grasps, self.out_poses, self.handbacks = [], [], [], []
+        for k, p in enumerate(self.pairs):
+            b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
+            psi_end = psi_x + beyond
+            insertion = [self.lifted(self.needle_at(b, -self.approach), LIFT)]
+            insertion += [self.needle_at(b, psi) for psi in np.linspace(-self.approach, psi_end, 7)]
+            if k == 0:
+                self.drive_grasps.append(self.choose_grasp(
+                    self.psms[self.driver], -self.geom.span + g_tail, [n0, self.lifted(n0, LIFT)] + insertion,
+                    down_at=n0, what=f"pair {p.index}, driving"))
+            else:
+                self.drive_grasps.append(self.hand_back(k, g_tail, insertion))
             done = psi_x + self.geom.span + TAIL_CLEAR
-            for psi in np.linspace(psi_end, done, 6):
-                pull_poses.append(self.needle_at(b, psi))
             out = self.lifted(self.needle_at(b, done), 2 * LIFT)
-            pull_poses.append(out)
-            drive_poses.append(out)
-        self.frames = frames
-        self.drive_grasp = self.choose_grasp(self.psms[self.driver], -self.geom.span + self.tail_grasp,
-                                             drive_poses, down_at=n0)
-        self.pull_grasp = self.choose_grasp(self.psms[self.puller], -self.tip_grasp, pull_poses)
+            pull = [self.needle_at(b, psi) for psi in np.linspace(psi_end, done, 7)] + [out]
+            self.pull_grasps.append(self.choose_grasp(self.psms[self.puller], -g_tip, pull,
+                                                      what=f"pair {p.index}, pulling"))
+            self.out_poses.append(out)
+
+    def hand_back(self, k: int, g_tail: float, insertion: list) -> Grasp:
+        """Where the puller, done with pair k-1, gives the needle back: over pair k, lifted,
+        turned in its plane as little as both arms allow (the driver's grasp must reach it and
+        the whole next insertion; the puller's grasp must reach it). Returns the driver's grasp
+        and records the pose in self.handbacks."""
+        b, _, _, _, _ = self.frames[self.pairs[k].index]
+        puller = self.psms[self.puller]
+        prev = self.pull_grasps[k - 1]
+        for psi in np.radians(np.arange(-15, 250, 15)) - self.approach:
+            h = self.lifted(self.needle_at(b, psi), 2 * LIFT)
+            if self._margin(puller, h @ prev.ee_in_needle) <= 0:
+                continue
+            try:
+                g = self.choose_grasp(self.psms[self.driver], -self.geom.span + g_tail, [h] + insertion)
+            except SutureError:
+                continue
+            self.handbacks.append(h)
+            return g
+        raise SutureError(f"{self.driver}/{self.puller}: no pose over pair {self.pairs[k].index} where both "
+                          "arms can hand the needle over")
 
     def _tissue_pass_through(self) -> None:
         """The needle passes through the phantom's bodies (its collision hull covers the holes;
@@ -441,9 +516,9 @@ class SutureTask:
         d, p = self.psms[self.driver], self.psms[self.puller]
         park = {n: np.clip(self.psms[n].setpoint_jp(), self.psms[n].kin.lower_limits[:6], self.psms[n].kin.upper_limits[:6]) for n in self.psms}
         self._set_phase("pick up")
-        yield from self.take(self.driver, self.drive_grasp)
+        yield from self.take(self.driver, self.drive_grasps[0])
         for k, pair in enumerate(self.pairs):
-            b, psi_x = self.frames[pair.index]
+            b, psi_x, beyond, _, _ = self.frames[pair.index]
             n_from = self.needle_pose()
             start = self.needle_at(b, -self.approach)
             self._set_phase(f"carry {pair.index}")
@@ -455,12 +530,12 @@ class SutureTask:
             yield from self.wait(0.2)
             self._set_phase(f"insert {pair.index}")
             self._tissue_pass_through()
-            psi_end = psi_x + BEYOND_EXIT
+            psi_end = psi_x + beyond
             a0 = -self.approach
             yield from self.carry(lambda s: self.needle_at(b, a0 + (psi_end - a0) * s), (psi_end - a0) / 0.5)
             yield from self.wait(0.2)
             self._set_phase(f"regrasp {pair.index}")
-            yield from self.take(self.puller, self.pull_grasp)
+            yield from self.take(self.puller, self.pull_grasps[k])
             yield from self.let_go(self.driver)
             yield from self.move_jp(d, park[self.driver], 0.8, settle=0.0)
             self.holder = self.puller
@@ -474,7 +549,9 @@ class SutureTask:
             yield from self.wait(0.2)
             if k + 1 < len(self.pairs):
                 self._set_phase(f"hand back {pair.index}")
-                yield from self.take(self.driver, self.drive_grasp)
+                yield from self.carry_to(self.handbacks[k], 1.2)
+                yield from self.wait(0.2)
+                yield from self.take(self.driver, self.drive_grasps[k + 1])
                 yield from self.let_go(self.puller)
                 yield from self.move_jp(p, park[self.puller], 0.8, settle=0.0)
                 self.holder = self.driver
