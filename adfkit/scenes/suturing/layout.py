@@ -128,23 +128,15 @@ def q_home() -> np.ndarray:
 
 def grasp_ee_pose(needle: np.ndarray, angle: float, tool_from_above=(0.0, 0.0, -1.0)) -> np.ndarray:
     """World end-effector pose of a PSM holding ``needle`` at ``angle`` (needle frame): the
-    wire runs between the fingers at the grasp point, the jaws point as close to
-    ``tool_from_above`` as that allows (perpendicular to the wire)."""
+    wire runs along the end effector's x between the fingers (they close along its y), the
+    jaws (its z) point as close to ``tool_from_above`` as that allows, and the grasp point
+    (the actuator, psm.grasp_offset()) sits on the wire."""
     from .psm import grasp_offset
     g = arc_point(needle, angle)
     t = arc_tangent(needle, angle)
-    # in the end-effector frame the wire runs along x (the fingers close along y), the jaws along z
-    f = look_frame(g, np.asarray(tool_from_above, float) - np.dot(tool_from_above, t) * t, t)
-    # f has its z along the jaws and x along the wire at the grasp point: the EE frame sits
-    # grasp_offset() back from it
-    return f @ np.linalg.inv(grasp_offset_aligned(grasp_offset()))
-
-
-def grasp_offset_aligned(off: np.ndarray) -> np.ndarray:
-    """grasp_offset() with the rotation of the grasp frame made EE-aligned (x wire, z jaws)."""
-    out = np.eye(4)
-    out[:3, 3] = off[:3, 3]
-    return out
+    jaws = np.asarray(tool_from_above, float)
+    at_grasp = look_frame(g, jaws - np.dot(jaws, t) * t, t)
+    return at_grasp @ translation(*(-grasp_offset()[:3, 3]))
 
 
 @dataclass

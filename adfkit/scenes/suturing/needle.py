@@ -7,11 +7,12 @@ re-runs the decomposition (``refresh=True``) when the mesh or the parameters cha
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
-from ...model import RGBA, Body, Friction, Inertia, Pose, VelocityDamping
+from ...model import RGBA, Body, Friction, Inertia, VelocityDamping
 from . import layout as L
-from .frames import pose, r, vec
+from .frames import pose, r, rot_z, translation
 from .meshes import arc_wire, obj_text
 
 DATA = Path(__file__).with_name("data")
@@ -65,7 +66,6 @@ def needle_hulls_text(refresh: bool = False) -> tuple[str, str]:
 
 def needle_body(world) -> Body:
     """The needle at pose ``world`` (4x4): mass and inertia of a thin ring arc about its COM."""
-    import math
     rad, arc = L.NEEDLE_RADIUS, L.NEEDLE_ARC
     mid = (L.NEEDLE_TAIL_ANGLE + L.NEEDLE_TIP_ANGLE) / 2
     # centroid of a circular arc: at r·sin(a/2)/(a/2) from the centre along the bisector
@@ -79,7 +79,6 @@ def needle_body(world) -> Body:
     i_x = i_bis
     i_y = i_perp - MASS * c * c
     i_z = MASS * rad * rad - MASS * c * c
-    from .frames import rot_z, translation
     return Body(identifier="BODY Needle", name="Needle", mass=MASS, location=pose(world),
                 inertia=Inertia(ix=r(i_x), iy=r(i_y), iz=r(i_z)),
                 inertial_offset=pose(translation(*com) @ rot_z(mid)),

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...model import (
-    RGBA, Body, Friction, Geometry, Ghost, ModelFile, Pose, ShapeEntry, Vec3, VelocityDamping,
+    RGBA, Body, Friction, Geometry, Ghost, ModelFile, Pose, ShapeEntry, Vec3,
 )
 from . import layout as L
 from .frames import look_frame, pose, r, vec
@@ -18,7 +18,7 @@ from .thread import thread_bodies_and_joints
 
 HOLE = RGBA(r=0.12, g=0.05, b=0.05, a=1.0)
 GHOST = RGBA(r=0.8, g=0.04, b=0.02, a=0.4)
-FRAME_HALF = 0.0025        # the hole's capsule square: centre lines 5 mm apart
+FRAME_HALF = 0.003         # the hole's capsule square: centre lines 6 mm apart
 CAPSULE_RADIUS = 0.0006
 GHOST_SIZE = (0.005, 0.005, 0.00045)
 TEXTURE_SCALE = 0.04       # metres per texture repeat

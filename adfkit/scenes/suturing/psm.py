@@ -42,6 +42,9 @@ JAW_LENGTH = 0.011                      # m, fingers along +y of the tool yaw li
 GRASP_POINT = 0.006                     # m along the jaws: the actuator and where a needle is held
 FINGER_GAP = 0.0002                     # m from the jaw plane to each finger's inner face (closed)
 FINGER_WIDTH = 0.001
+GHOST_REACH = 0.0024                    # m a finger ghost reaches past the jaw plane
+GHOST_LENGTH = 0.006                    # m of jaw the ghosts cover, centred at GRASP_POINT
+SENSOR_START = 0.0035                   # m along the jaws where the sensor's rays start
 
 ARM = RGBA(r=0.93, g=0.93, b=0.95, a=1.0)
 DARK = RGBA(r=0.15, g=0.15, b=0.17, a=1.0)
@@ -185,11 +188,14 @@ def build_psm_ghosts(name: str) -> ModelFile:
     """Finger ghosts, the grasp's constraint actuator and the proximity sensor of one PSM."""
     ns = f"/ambf/env/{name}/"
     m = ModelFile(namespace=f"/ambf/env/ghosts/{name}/", ignore_inter_collision=True)
-    g = Geometry(x=2 * FINGER_GAP + FINGER_WIDTH, y=JAW_LENGTH - 0.002, z=0.0016)
+    # Each ghost reaches from its finger's outer face GHOST_REACH across the jaw plane, over
+    # the middle of the jaws: it holds what lies between them whether they are closed or open
+    # (at 0.8 rad the fingers are 2.5 mm from the middle at the grasp point).
+    g = Geometry(x=FINGER_GAP + FINGER_WIDTH + GHOST_REACH, y=GHOST_LENGTH, z=0.002)
     for k, (side, finger) in enumerate((("right", FINGERS[0]), ("left", FINGERS[1]))):
         sign = 1.0 if k == 0 else -1.0
-        # each ghost covers the gap between the closed fingers (and half of its own finger)
-        at = Vec3(r(-sign * FINGER_WIDTH / 2), r(JAW_LENGTH / 2 + 0.001), 0.0)
+        outer = -sign * (FINGER_GAP + FINGER_WIDTH)
+        at = Vec3(r(outer + sign * g.x / 2), r(GRASP_POINT), 0.0)
         m.ghost_objects.append(Ghost(identifier=f"GHOST {side} finger", name=f"{side}_finger_ghost",
                                      parent=f"{ns}BODY {finger}", location=Pose(at), shape="Box", geometry=g,
                                      collision_shape="Box", collision_geometry=g, collision_margin=0.0001,
@@ -197,10 +203,12 @@ def build_psm_ghosts(name: str) -> ModelFile:
     m.actuators.append(Actuator(identifier="ACTUATOR Actuator0", name="Actuator0", type="Constraint",
                                 parent=f"{ns}BODY tool yaw link simple",
                                 location=Pose(Vec3(0.0, GRASP_POINT, 0.0)), visible=False, visible_size=0.00055))
-    rays = [Ray(offset=Vec3(0.0, 0.001, z), direction=Vec3(0.0, 1.0, 0.0)) for z in (-0.0006, 0.0, 0.0006)]
+    # rays along the middle of the jaws from where open fingers are clear of it (PyBullet's
+    # ray test reports only the first hit, so a ray must not start at a finger)
+    rays = [Ray(offset=Vec3(0.0, SENSOR_START, z), direction=Vec3(0.0, 1.0, 0.0)) for z in (-0.0004, 0.0, 0.0004)]
     m.sensors.append(Sensor(identifier="SENSOR Sensor0", name="Sensor0", type="Proximity",
                             parent=f"{ns}BODY tool yaw link simple", location=Pose(Vec3(0.0, 0.0, 0.0)),
-                            range=JAW_LENGTH - 0.001, array=rays, visible=False, visible_size=0.0003))
+                            range=r(JAW_LENGTH + 0.0005 - SENSOR_START), array=rays, visible=False, visible_size=0.0003))
     return m
 
 
