@@ -151,6 +151,12 @@ def test_expert_solves_90_percent_of_20_seeds(env_id):
     assert _solve(env_id, range(100, 120)) >= 18
 
 
+@pytest.mark.slow
+def test_suture_expert_passes_pair_1():
+    # the scripted suture's planner as actions: ~430 env steps (~9 s simulated) a seed
+    assert _solve("adfkit/SutureOnePair-v0", [0, 1]) == 2
+
+
 def test_mujoco_engine_is_a_clear_error_or_works():
     _need_scene()
     try:
@@ -164,7 +170,7 @@ def test_mujoco_engine_is_a_clear_error_or_works():
 
 def test_dataset_command_refuses_bad_options(tmp_path, capsys):
     from adfkit.cli import main
-    assert main(["dataset", "--env", "adfkit/SutureOnePair-v0", "--out", str(tmp_path)]) == 2
+    assert main(["dataset", "--env", "adfkit/NoSuchTask-v0", "--out", str(tmp_path)]) == 2
     assert "no scripted expert" in capsys.readouterr().err
     assert main(["dataset", "--episodes", "0", "--out", str(tmp_path)]) == 2
     assert main(["dataset", "--scene", str(tmp_path / "none.yaml"), "--out", str(tmp_path)]) == 2

@@ -11,7 +11,7 @@ HELP = "record expert demonstrations of an adfkit Gymnasium environment on Ray (
 
 def add_arguments(p) -> None:
     p.add_argument("--env", default="adfkit/NeedlePick-v0",
-                   help="environment id (adfkit/NeedleReach-v0, adfkit/NeedlePick-v0)")
+                   help="environment id (adfkit/NeedleReach-v0, adfkit/NeedlePick-v0, adfkit/SutureOnePair-v0)")
     p.add_argument("--episodes", type=int, default=4, help="number of episodes (seeds SEED..SEED+N-1)")
     p.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
     p.add_argument("--workers", type=int, default=2, help="Ray workers on a local Ray (default 2)")

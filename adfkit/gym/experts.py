@@ -77,7 +77,57 @@ class PickExpert:
         return a
 
 
-EXPERTS = {"NeedleReach": ReachExpert, "NeedlePick": PickExpert}
+class SutureExpert:
+    """The scripted suture's planner (adfkit.tasks.suture.SutureTask) turned into actions: each
+    env step advances the planner by the env's control steps and returns the action that takes
+    each arm's set-point where the planner put it (and the jaws). The planner reads the world
+    (ground truth) and fixes the needle with the actuator itself when it grasps; the actions
+    record what it did, so they can be replayed or learnt from."""
+
+    def __init__(self, env) -> None:
+        self.env = env.unwrapped
+
+    def reset(self) -> None:
+        from ..tasks.suture import SutureTask
+        env = self.env
+        self.task = SutureTask(env.world, [env.pair], seed=int(env.np_random.integers(1 << 30)),
+                               psm_names=env.arms)
+        self.task.psms = {n: env.psms[n] for n in env.arms}    # the env's arms, the env's set-points
+        self.plan = self.task.steps()
+        self.done = False
+
+    def __call__(self, obs) -> np.ndarray:
+        from ..runner.psm import JAW_OPEN
+        from .env import MAX_TURN
+        env = self.env
+        for _ in range(env.control_steps):
+            if self.done:
+                break
+            try:
+                next(self.plan)
+            except StopIteration:
+                self.done = True
+        a = np.zeros(7 * len(env.arms), np.float32)
+        for k, n in enumerate(env.arms):
+            psm = env.psms[n]
+            base = psm.base_in_world()
+            want = base @ psm.setpoint_cp()
+            have = base @ env._setpoint[n]
+            a[7 * k:7 * k + 3] = np.clip((want[:3, 3] - have[:3, 3]) / MAX_STEP, -1, 1)
+            a[7 * k + 3:7 * k + 6] = np.clip(_rotvec_of(want[:3, :3] @ have[:3, :3].T) / MAX_TURN, -1, 1)
+            jaw = sum(psm.art.targets[i] for i in psm.jaws)
+            a[7 * k + 6] = np.clip(2.0 * jaw / JAW_OPEN - 1.0, -1.0, 1.0)
+        return a
+
+
+def _rotvec_of(r: np.ndarray) -> np.ndarray:
+    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    s = 0.5 * np.linalg.norm(v)
+    ang = np.arctan2(s, 0.5 * (np.trace(r) - 1.0))
+    return v * (0.5 if s < 1e-12 else ang / (2.0 * s))
+
+
+EXPERTS = {"NeedleReach": ReachExpert, "NeedlePick": PickExpert, "SutureOnePair": SutureExpert}
 
 
 def expert_for(env):
@@ -85,4 +135,5 @@ def expert_for(env):
     name = type(env.unwrapped).__name__
     if name not in EXPERTS:
         raise KeyError(f"no scripted expert for {name} (experts: {', '.join(EXPERTS)})")
-    return EXPERTS[name]()
+    cls = EXPERTS[name]
+    return cls(env) if cls is SutureExpert else cls()

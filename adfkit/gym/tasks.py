@@ -2,8 +2,8 @@
 
 - NeedleReach: bring psm1's end-effector to the needle's grasp point (within REACH_TOLERANCE).
 - NeedlePick: grasp the needle with psm1 and lift it LIFT above where it lay.
-- SutureOnePair: drive the needle through entry hole 1 and then out of exit hole 1, detected as
-  the challenge does, through the holes' ghost objects (entry first, then exit).
+- SutureOnePair: drive the needle's tip through entry hole 1 and then out of exit hole 1, detected
+  as the challenge (and adfkit suture's metrics) do: the tip crossing each hole ghost, in order.
 
 Dense rewards are negative distances (m, x10) plus stage bonuses; sparse rewards are 0 on
 success and -1 otherwise (the SurRoL / Fetch convention).
@@ -58,40 +58,54 @@ class NeedlePick(SuturingEnv):
         return {"dense": dense, "success": bool(held and lift >= LIFT), "distance": d, "held": held, "lift": lift}
 
 
+class _TipWatch:
+    """What adfkit.tasks.metrics.SutureObserver reads of a task: the world, the hole pair, the
+    needle and its tip (the challenge's check: the tip through entry k, then out of exit k)."""
+
+    def __init__(self, world, pair: int) -> None:
+        from ..tasks.suture import find_needle, hole_pairs
+        self.world = world
+        self.needle, self.geom = find_needle(world)
+        self.pairs = [p for p in hole_pairs(world) if p.index == pair]
+        if not self.pairs:
+            raise ValueError(f"the scene has no entry/exit hole ghost pair {pair}")
+        self.holder = self.held_ee_in_needle = None
+        self.phase, self.phase_log = "env", []
+
+    def needle_pose(self) -> np.ndarray:
+        return self.needle.world_matrix()
+
+    def tip_world(self) -> np.ndarray:
+        return (self.needle_pose() @ np.r_[self.geom.tip, 1.0])[:3]
+
+
 class SutureOnePair(SuturingEnv):
     arms = ("psm1", "psm2")
     pair = 1
 
     def _task_setup(self) -> None:
-        self.entry = self._ghost("entry")
-        self.exit = self._ghost("exit")
-
-    def _ghost(self, word: str):
-        want = f"{word}{self.pair}"
-        hits = [g for g in self.world.ghosts if want in g.key.lower().replace(" ", "").replace("_", "")]
-        if len(hits) != 1:
-            raise ValueError(f"the scene has {len(hits)} ghost objects named like {want!r} "
-                             f"(ghosts: {', '.join(g.key for g in self.world.ghosts)})")
-        return hits[0]
+        self.watch = _TipWatch(self.world, self.pair)
+        p = self.watch.pairs[0]
+        self.entry, self.exit = p.entry, p.exit
 
     def _task_reset(self) -> None:
-        self.entered = False
-        self.passed = False
+        from ..tasks.metrics import SutureObserver
+        self.observer = SutureObserver(self.watch)
+        self.observer.observe()
 
     def _goal(self) -> np.ndarray:
-        return (self.world.ghost_pose(self.exit if self.entered else self.entry))[:3, 3]
+        r = self.observer.pair_results()[0]
+        return self.world.ghost_pose(self.exit if r["entry_passed_s"] is not None else self.entry)[:3, 3]
 
     def _evaluate(self) -> dict:
-        inside_entry = self.needle in self.world.overlapping(self.entry)
-        inside_exit = self.needle in self.world.overlapping(self.exit)
-        if inside_entry:
-            self.entered = True
-        if self.entered and inside_exit:
-            self.passed = True
+        if self.world.sim_time > self.observer.tip_path[-1][0]:
+            self.observer.observe()
+        r = self.observer.pair_results()[0]
+        entered = r["entry_passed_s"] is not None
         held = self.holding("psm1") or self.holding("psm2")
-        d_needle = float(np.linalg.norm(f32(self.grasp_point()) - f32(self._goal())))
+        d_tip = float(np.linalg.norm(f32(self.watch.tip_world()) - f32(self._goal())))
         d_tool = float(np.linalg.norm(f32(self.tool_position("psm1")) - f32(self.grasp_point())))
-        dense = (-10.0 * (d_tool if not held and not self.entered else d_needle)
-                 + 1.0 * held + 2.0 * self.entered + 5.0 * self.passed)
-        return {"dense": dense, "success": self.passed, "entered": self.entered, "held": held,
-                "distance": d_needle}
+        dense = (-10.0 * (d_tool if not held and not entered else d_tip)
+                 + 1.0 * held + 2.0 * entered + 5.0 * r["passed"])
+        return {"dense": dense, "success": bool(r["passed"]), "entered": entered, "held": held,
+                "distance": d_tip}
