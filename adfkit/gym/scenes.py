@@ -22,6 +22,11 @@ CORPUS_INDICES = "6-11"
 SETUP_DISTANCE = 0.17
 
 
+#: the world methods the environments use beyond stepping and reading bodies
+NEEDS = ("save_state", "restore_state", "place_body", "move_base", "set_collision", "nearest_point", "grasped",
+         "actuate", "release", "ghost_pose", "overlapping")
+
+
 class SceneUnavailable(FileNotFoundError):
     """No suturing scene to play: neither the bundled one nor the corpus."""
 
@@ -108,11 +113,15 @@ def _world(model, engine: str, visuals: bool):
     from ..runner.world import Options
     if engine == "mujoco":
         try:
-            from ..runner.mujoco_world import MujocoWorld   # built by the MuJoCo back end's branch
+            from ..runner.mj.world import MjWorld   # the MuJoCo back end (its own branch)
         except ImportError:
             raise NotImplementedError("engine='mujoco': this adfkit has no MuJoCo back end "
-                                      "(adfkit.runner.mujoco_world); use engine='pybullet'") from None
-        return MujocoWorld(model, Options(visuals=visuals))
+                                      "(adfkit.runner.mj); use engine='pybullet'") from None
+        missing = [m for m in NEEDS if not hasattr(MjWorld, m)]
+        if missing:
+            raise NotImplementedError("engine='mujoco': the MuJoCo back end lacks what the environments use: "
+                                      + ", ".join(missing) + "; use engine='pybullet'")
+        return MjWorld(model, Options(visuals=visuals))
     from ..runner.world import SimWorld
     return SimWorld(model, Options(visuals=visuals))
 
