@@ -40,7 +40,7 @@ MAX_BITE = math.radians(65)    # the arc between entry and exit; wider bites aim
 HOLE_MARGIN = 0.0008           # m kept from a hole ghost's side when aiming inside it
 TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
 CLIP_TOLERANCE = 0.15          # rad (m for the insertion) a set-point may pass a limit and be clipped
-JITTER_FORCE = 0.0  # N, the seeded push on the needle before the suture
+JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
 
 
 class SutureError(RuntimeError):
