@@ -53,7 +53,8 @@ def fit_needle(vertices: np.ndarray, tail_hint: np.ndarray | None = None) -> Nee
         raise ValueError("the needle mesh has too few vertices to fit a circle")
     mean = v.mean(axis=0)
     _, _, vt = np.linalg.svd(v - mean)
-    e1, e2, n = vt[0], vt[1], vt[2]
+    e1, e2 = vt[0], vt[1]
+    n = np.cross(e1, e2)          # right-handed: angles below run counter-clockwise about n
     xy = np.c_[(v - mean) @ e1, (v - mean) @ e2]
     a = np.c_[2 * xy, np.ones(len(xy))]
     sol = np.linalg.lstsq(a, (xy ** 2).sum(axis=1), rcond=None)[0]

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,7 +28,7 @@ from ..adf.paths import collision_mesh_path
 from ..runner.psm import PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert
-from .needle import NeedleGeometry, fit_needle, obj_vertices
+from .needle import fit_needle, obj_vertices
 
 JAW_DEPTH = 0.01      # m from the end effector to the point between the jaws (LND: along z_E)
 BACK_OFF = 0.012      # m along -z_E before a grasp and after a release
@@ -40,7 +40,7 @@ MAX_BITE = math.radians(65)    # the arc between entry and exit; wider bites aim
 HOLE_MARGIN = 0.0008           # m kept from a hole ghost's side when aiming inside it
 TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
 CLIP_TOLERANCE = 0.15          # rad (m for the insertion) a set-point may pass a limit and be clipped
-JITTER_FORCE = 0.0  # N, the seeded push on the needle before the suture
+JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
 
 
 class SutureError(RuntimeError):
@@ -138,12 +138,6 @@ class Grasp:
     """Where a PSM holds the needle: the end effector's pose in the needle frame."""
     ee_in_needle: np.ndarray
     margin: float
-
-
-@dataclass
-class Plan:
-    pairs: list
-    arc_frames: dict = field(default_factory=dict)   # pair index -> (B frame, psi_exit)
 
 
 class SutureTask:
