@@ -22,6 +22,9 @@ def add_arguments(p) -> None:
                    help="report only these rules (repeatable, comma-separated)")
     p.add_argument("--ignore", action="append", default=[], metavar="RULE",
                    help="do not report these rules (repeatable, comma-separated)")
+    p.add_argument("--workers", type=int, default=1,
+                   help="check on W Ray workers (big trees; same output, same order); default 1: in this process")
+    p.add_argument("--address", help="with --workers: a Ray cluster address (default: a local Ray)")
     p.add_argument("--no-follow", action="store_true", help="do not follow launch/world files to the files they name")
     p.add_argument("--skip-non-adf", action="store_true",
                    help="silently skip YAML files that are not ADF (unknown kind), e.g. in a pre-commit hook")
@@ -43,7 +46,11 @@ def run(args) -> int:
     if unknown:
         print(f"adfkit validate: unknown rule(s): {', '.join(unknown)} (the README lists the rules)", file=sys.stderr)
         return 2
-    results, problems = validate_paths(args.paths, args.kind, follow=not args.no_follow)
+    if args.workers > 1 or args.address:
+        from ..fanout import validate_parallel
+        results, problems = validate_parallel(args.paths, args.kind, not args.no_follow, args.workers, args.address)
+    else:
+        results, problems = validate_paths(args.paths, args.kind, follow=not args.no_follow)
     shown_min = Severity.parse(args.min_severity)
     diags = list(problems)
     texts = {}

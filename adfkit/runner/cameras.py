@@ -130,9 +130,7 @@ def save_frames(world, out_dir, size_limit: int | None = None) -> list[str]:
         Image.fromarray(frame["rgb"]).save(out / f"{stem}_rgb.png")
         np.save(out / f"{stem}_depth.npy", frame["depth"])
         np.save(out / f"{stem}_seg.npy", frame["segmentation"])
-        seg = frame["segmentation"]
-        vis = ((seg.astype(np.int64) * 2654435761) % 255).astype(np.uint8)
-        vis[seg < 0] = 0
-        Image.fromarray(vis).save(out / f"{stem}_seg.png")
+        from ..dataset.colors import colourise   # every body its own colour (was grey, nearly black)
+        Image.fromarray(colourise(frame["segmentation"])).save(out / f"{stem}_seg.png")
         written += [f"{stem}_rgb.png", f"{stem}_depth.npy", f"{stem}_seg.npy", f"{stem}_seg.png"]
     return written

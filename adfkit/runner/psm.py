@@ -139,6 +139,13 @@ class PSM:
             self.art.targets[i] = float(v)
         self.art.drive()
 
+    def reset_jp(self, q) -> None:
+        """Put q1..q6 at ``q`` at once, at rest, and hold them there (a reset, not a motion)."""
+        q = np.asarray(q, dtype=float)
+        for i, v in zip(self.arm, q):
+            pb.resetJointState(self.art.uid, i, float(v), 0.0, physicsClientId=self.world.cid)
+        self.servo_jp(q)
+
     # ---- Cartesian space ---------------------------------------------------------------
     def measured_cp(self) -> np.ndarray:
         """End-effector pose T_E^0 in the DH base frame, from the simulated bodies."""

@@ -25,6 +25,7 @@ from .names import Registry, merge_namespace
 from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
 from .shapes import collision_parts, create_collision, create_visual
 from .softbodies import SoftBodies, enable_deformable_world, in_scene as soft_in_scene
+from .world_state import WorldState
 
 GRASP_SPAN = 0.005   # m between the three point constraints of a grasp (SimWorld.actuate)
 SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
@@ -79,7 +80,7 @@ class SimSensor:
     sensed: list = field(default_factory=list)
 
 
-class SimWorld:
+class SimWorld(WorldState):
     def __init__(self, scene, options: Options | None = None, gui: bool = False) -> None:
         self.scene = scene
         self.opt = options or Options()
@@ -305,6 +306,24 @@ class SimWorld:
 
     def _no_collision(self, a: SimBody, b: SimBody) -> None:
         pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, 0, physicsClientId=self.cid)
+
+    def set_collision(self, a: SimBody, b: SimBody, enabled: bool) -> None:
+        """Let two bodies collide or pass through each other (a task's choice, e.g. a needle
+        through a tissue whose collision shape is a convex hull over its holes)."""
+        pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, int(enabled), physicsClientId=self.cid)
+        pair = frozenset(((a.uid, a.link), (b.uid, b.link)))
+        self._pairs_off = getattr(self, "_pairs_off", set())
+        (self._pairs_off.discard if enabled else self._pairs_off.add)(pair)
+
+    def move_base(self, sb: SimBody, body_world: np.ndarray) -> None:
+        """Put the root of a multibody (e.g. a PSM's base, as its setup joints would) at a new
+        world pose of its ADF body frame; its links follow."""
+        pos, orn = matrix_to_pq(body_world @ sb.com_in_body)
+        pb.resetBasePositionAndOrientation(sb.uid, pos, orn, physicsClientId=self.cid)
+
+    def ghost_pose(self, g: SimGhost) -> np.ndarray:
+        """World pose (4x4) of a ghost, following its parent."""
+        return self._frame(g.parent) @ g.pose_in_parent if g.parent is not None else np.array(g.pose_in_parent)
 
     def _parent(self, ref: str | None, ns: str, obj):
         key, hit = self.registry.find(ref)
@@ -538,7 +557,11 @@ class SimWorld:
             ids.append(c)
         actuator.constraint, actuator.target = ids, target
         for link in self._links(actuator.parent):   # the closed jaws would push the held body out
-            pb.setCollisionFilterPair(actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid)
+            if not self._pair_off(actuator.parent.uid, link, target):
+                pb.setCollisionFilterPair(actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid)
+
+    def _pair_off(self, uid: int, link: int, b: SimBody) -> bool:
+        return frozenset(((uid, link), (b.uid, b.link))) in getattr(self, "_pairs_off", ())
 
     def _links(self, sb: SimBody):
         art = sb.articulation
@@ -586,7 +609,8 @@ class SimWorld:
                 pb.removeConstraint(c, physicsClientId=self.cid)
             t = actuator.target
             for link in self._links(actuator.parent):
-                pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
+                if not self._pair_off(actuator.parent.uid, link, t):   # set_collision's choice stays
+                    pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
         actuator.constraint, actuator.target = None, None
 
     # ---- measures -----------------------------------------------------------------------

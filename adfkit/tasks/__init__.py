@@ -1,0 +1,4 @@
+"""Tasks played on a SimWorld: the scripted suture (suture.py), its metrics (metrics.py) and
+the episode runner that writes metrics, pictures and a dataset (episode.py).
+
+Task code talks to SimWorld's public methods and adfkit.runner.psm.PSM only (engine-neutral)."""

@@ -1,0 +1,206 @@
+"""One suture episode: build the world, drive the SutureTask step by step, observe it, and
+write metrics.json, trajectory.png, cameraL.gif and (with ``record``) the dataset.
+
+``run_episode`` is what `adfkit suture` runs and what a Ray fan-out or a Gymnasium wrapper calls.
+"""
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .metrics import SutureObserver, finite
+from .suture import SutureError, SutureTask
+
+GIF_EVERY_S = 1.0      # simulated seconds between GIF frames
+GIF_WIDTH = 200        # pixels
+
+
+def _left_camera(world):
+    cams = world.cameras
+    for c in cams:
+        n = c.name.lower()
+        if n.endswith("l") or n.endswith("_left") or "left" in n:
+            return c
+    return cams[0] if cams else None
+
+
+def _poses(task) -> dict:
+    out = {}
+    for name, psm in task.psms.items():
+        out[name] = {"T_world_ee": (psm.base_in_world() @ psm.measured_cp()).tolist(),
+                     "jp": [float(v) for v in psm.measured_jp()], "jaw": psm.measured_jaw()}
+    return {"needle": task.needle_pose(), "psms": out}
+
+
+class _Bar:
+    """rich progress on a terminal, nothing when piped."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.bar = None
+        if enabled and sys.stderr.isatty():
+            from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+            from rich.console import Console
+            self.bar = Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
+                                console=Console(file=sys.stderr), transient=True)
+            self.bar.start()
+            self.id = self.bar.add_task("suture")
+
+    def update(self, text: str) -> None:
+        if self.bar is not None:
+            self.bar.update(self.id, description=text)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
+def play_task(world, task, out: Path | None = None, record: bool = False, every: int = 10,
+              gif: bool = True, progress: bool = True) -> tuple[dict, SutureObserver, list]:
+    """Drive ``task`` on ``world`` to its end (or failure); returns (metrics, observer, GIF frames)."""
+    obs = SutureObserver(task)
+    writer = None
+    if record and out is not None:
+        from ..dataset.writer import DatasetWriter
+        writer = DatasetWriter(world, Path(out) / "dataset")
+    cam = _left_camera(world) if gif else None
+    gif_every = max(1, int(round(GIF_EVERY_S / (world.dt * world.opt.control_substeps))))
+    frames = []
+    bar = _Bar(progress)
+    failure = None
+    t0 = time.perf_counter()
+    clock = time.perf_counter
+    spent = {"observe_s": 0.0, "render_s": 0.0}
+    n = 0
+    try:
+        for phase in task.steps():
+            world.step(1)
+            a = clock()
+            obs.observe()
+            b = clock()
+            spent["observe_s"] += b - a
+            n += 1
+            if writer is not None and n % every == 0:
+                writer.write(n, _poses(task), phase)
+            if cam is not None and n % gif_every == 0:
+                frames.append(_small(cam.render(world)["rgb"]))
+            spent["render_s"] += clock() - b
+            if n % 25 == 0:
+                rtf = world.sim_time / (time.perf_counter() - t0)
+                bar.update(f"{phase}  t={world.sim_time:5.2f} s  {rtf:.2f}x real time")
+    except (SutureError, ValueError, KeyError) as exc:
+        failure = f"{task.phase}: {exc}"
+    finally:
+        bar.close()
+        if writer is not None:
+            writer.close()
+    metrics = obs.metrics(time.perf_counter() - t0, failure)
+    spent["physics_s"] = world.wall_time
+    spent["planning_and_servo_s"] = metrics["episode_wall_time_s"] - sum(spent.values())
+    metrics["where_the_time_goes"] = spent
+    if writer is not None:
+        metrics["dataset"] = {"dir": "dataset", "frames": writer.frames, "every_control_steps": every}
+    return metrics, obs, frames
+
+
+def _small(rgb: np.ndarray) -> np.ndarray:
+    from PIL import Image
+    h, w = rgb.shape[:2]
+    return np.asarray(Image.fromarray(rgb).resize((GIF_WIDTH, max(1, round(h * GIF_WIDTH / w)))))
+
+
+def tissue_outline(task):
+    """The tissue's collision-mesh vertices in the world (for the plot), or None."""
+    from ..adf.paths import collision_mesh_path
+    from .needle import obj_vertices
+    for sb in task.tissue():
+        path = collision_mesh_path(sb.model, sb.body)
+        if path is not None and path.is_file() and path.suffix.lower() == ".obj":
+            v = obj_vertices(path) * (sb.body.scale or 1.0)
+            t = sb.world_matrix()
+            return v @ t[:3, :3].T + t[:3, 3]
+    return None
+
+
+def plot_trajectory(obs: SutureObserver, task, path: Path) -> None:
+    """Tip trajectory over the phantom with the holes, top (x-y) and side (x-z) views."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    tip = np.array(obs.tip_path) if obs.tip_path else np.zeros((0, 4))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), dpi=90)
+    tissue = tissue_outline(task)
+    holes = [(p.index, task.world.ghost_pose(p.entry)[:3, 3], task.world.ghost_pose(p.exit)[:3, 3])
+             for p in task.pairs]
+    for ax, (i, j), title in ((axes[0], (0, 1), "top view"), (axes[1], (0, 2), "side view")):
+        if tissue is not None:
+            ax.scatter(tissue[:, i], tissue[:, j], s=1, c="#e8b4a8", label="phantom")
+        if len(tip):
+            sc = ax.scatter(tip[:, 1 + i], tip[:, 1 + j], s=2, c=tip[:, 0], cmap="viridis", label="needle tip")
+        for k, e, x in holes:
+            ax.plot(e[i], e[j], "o", mfc="none", mec="tab:blue", ms=9)
+            ax.plot(x[i], x[j], "s", mfc="none", mec="tab:red", ms=9)
+            ax.annotate(str(k), (e[i], e[j]), textcoords="offset points", xytext=(-12, 4), fontsize=8)
+        if holes:
+            pts = np.array([h[1] for h in holes] + [h[2] for h in holes])
+            lo, hi = pts.min(axis=0) - 0.03, pts.max(axis=0) + 0.03
+            if len(tip):
+                lo = np.minimum(lo, tip[:, 1:].min(axis=0) - 0.005)
+                hi = np.maximum(hi, tip[:, 1:].max(axis=0) + 0.005)
+            ax.set_xlim(lo[i], hi[i])
+            ax.set_ylim(lo[j], hi[j])
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)" if j == 1 else "z (m)")
+        ax.set_title(title + "  (o entry, \u25a1 exit)")
+    if len(tip):
+        fig.colorbar(sc, ax=axes, label="time (s)", shrink=0.8)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def write_outputs(out: Path, metrics: dict, obs, task, frames) -> list[str]:
+    from ..adf import atomic_write_text
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / "metrics.json", json.dumps(finite(metrics), indent=2, allow_nan=False))
+    written = ["metrics.json"]
+    plot_trajectory(obs, task, out / "trajectory.png")
+    written.append("trajectory.png")
+    if frames:
+        import imageio.v2 as imageio
+        imageio.mimsave(out / "cameraL.gif", frames, duration=GIF_EVERY_S, loop=0)
+        written.append("cameraL.gif")
+    return written
+
+
+def run_episode(launch, indices=None, pairs=(1,), seed: int = 0, out=None, record: bool = False,
+                gui: bool = False, progress: bool = True, every: int = 10, gif: bool = True,
+                options=None) -> dict:
+    """Play one scripted suture of hole ``pairs`` on the scene; returns the metrics (also written
+    with the pictures to ``out`` when given)."""
+    from ..adf import load_scene, parse_indices
+    from ..runner.world import Options, SimWorld
+    diags: list = []
+    scene = load_scene(Path(launch), parse_indices(indices) if isinstance(indices, str) else indices, diags)
+    world = SimWorld(scene, options or Options(), gui=gui)
+    try:
+        try:
+            task = SutureTask(world, list(pairs), seed=seed)
+        except (SutureError, KeyError, ValueError) as exc:
+            return {"pairs": [], "all_passed": False, "failure": f"setup: {exc}", "seed": seed}
+        metrics, obs, frames = play_task(world, task, Path(out) if out else None, record, every,
+                                         gif and out is not None, progress)
+        metrics.update({"seed": seed, "scene": str(launch), "indices": indices if isinstance(indices, str) else None,
+                        "setup_joint_moves_m": getattr(task, "base_moves", {}),
+                        "driver": getattr(task, "driver", None), "puller": getattr(task, "puller", None)})
+        if out is not None:
+            metrics["files"] = write_outputs(Path(out), metrics, obs, task, frames)
+            from ..adf import atomic_write_text
+            atomic_write_text(Path(out) / "metrics.json", json.dumps(finite(metrics), indent=2, allow_nan=False))
+        return finite(metrics)
+    finally:
+        world.close()

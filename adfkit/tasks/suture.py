@@ -1,0 +1,552 @@
+"""The scripted suture: phases and planner over the CRTK-style PSM API (adfkit.runner.psm.PSM)
+and the closed-form IK, engine-neutral (SimWorld's public methods only).
+
+One PSM (the driver, on the entry side) picks the needle up near its tail, carries it to
+entry hole k and drives the tip along the needle's own arc (a rotation about the needle's
+centre, planned in Cartesian space, servoed through the IK) through entry k and out of exit k.
+The other PSM (the puller) grasps the needle near its tip, the driver lets go, the puller turns
+the needle on along its arc until the tail is out and lifts it, pulling the thread through;
+the driver takes the needle back at its tail for the next pair.
+
+The needle pose comes from the simulation (ground truth). Every grasp fixes the needle to the
+tool where it lies (the scene's constraint actuator), so after a grasp the planner measures
+the needle in the tool frame and plans tool poses from needle poses.
+
+``SutureTask.steps()`` is a generator: it commands set-points and yields once per control
+step (the phase name); whoever drives it steps the world after each yield (run_episode,
+a Gymnasium env, an expert policy).
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..adf.paths import collision_mesh_path
+from ..runner.psm import PSM
+from ..runner.psm_kinematics import JointLimitError
+from ..runner.rotations import invert
+from .needle import fit_needle, obj_vertices
+
+JAW_DEPTH = 0.01      # m from the end effector to the point between the jaws (LND: along z_E)
+BACK_OFF = 0.012      # m along -z_E before a grasp and after a release
+LIFT = 0.015          # m the needle is lifted when carried between the phantom and a hole
+APPROACH = math.radians(15)    # the tip starts this far before the entry on its arc
+MAX_GRASP = math.radians(25)   # the grasps sit at most this far from the tip / the tail ...
+CLEAR = math.radians(10)       # ... and at least this far outside the tissue
+MAX_BITE = math.radians(65)    # the arc between entry and exit; wider bites aim inside the holes
+HOLE_MARGIN = 0.0008           # m kept from a hole ghost's side when aiming inside it
+TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
+CLIP_TOLERANCE = 0.15          # rad (m for the insertion) a set-point may pass a limit and be clipped
+JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
+
+
+class SutureError(RuntimeError):
+    """The planner cannot go on (no reachable grasp, a lost needle, ...)."""
+
+
+@dataclass
+class HolePair:
+    index: int
+    entry: object           # SimGhost
+    exit: object
+    entry_name: str
+    exit_name: str
+
+
+def _rot_z(a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    t = np.eye(4)
+    t[:2, :2] = [[c, -s], [s, c]]
+    return t
+
+
+def _axis_angle(r: np.ndarray) -> np.ndarray:
+    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    s = 0.5 * np.linalg.norm(v)
+    c = 0.5 * (np.trace(r) - 1.0)
+    a = math.atan2(s, c)
+    return v * (0.5 if s < 1e-12 else a / (2.0 * s))
+
+
+def _exp(v: np.ndarray) -> np.ndarray:
+    a = float(np.linalg.norm(v))
+    if a < 1e-12:
+        return np.eye(3)
+    k = v / a
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(a) * kx + (1 - math.cos(a)) * kx @ kx
+
+
+def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
+    """Pose between a and b: straight line, rotation about one axis."""
+    t = np.eye(4)
+    t[:3, :3] = a[:3, :3] @ _exp(s * _axis_angle(a[:3, :3].T @ b[:3, :3]))
+    t[:3, 3] = (1 - s) * a[:3, 3] + s * b[:3, 3]
+    return t
+
+
+def _smooth(s: float) -> float:
+    return s * s * (3 - 2 * s)
+
+
+def _in_plane_room(ghost, direction) -> float:
+    """How far from its centre a hole ghost reaches along ``direction`` (in its plane)."""
+    geo = getattr(ghost.ghost, "geometry", None)
+    if geo is None or geo.x is None or geo.y is None:
+        return 0.0
+    return min(geo.x, geo.y) / 2 * (ghost.ghost.scale or 1.0)
+
+
+def hole_pairs(world) -> list[HolePair]:
+    """Entry k / Exit k hole ghosts of the scene, by their number."""
+    found: dict[int, dict] = {}
+    for g in world.ghosts:
+        name = (g.ghost.name or g.ghost.identifier).lower()
+        m = re.search(r"(entry|exit)\D*(\d+)\s*$", name)
+        if m and g.friction:
+            found.setdefault(int(m.group(2)), {})[m.group(1)] = g
+    out = []
+    for k in sorted(found):
+        d = found[k]
+        if "entry" in d and "exit" in d:
+            out.append(HolePair(k, d["entry"], d["exit"], d["entry"].ghost.name or d["entry"].ghost.identifier,
+                                d["exit"].ghost.name or d["exit"].ghost.identifier))
+    return out
+
+
+def find_needle(world):
+    """The needle body and its measured geometry (tail: where the thread is attached)."""
+    needle = world.body("Needle")
+    b, m = needle.body, needle.model
+    path = collision_mesh_path(m, b)
+    if path is None or not path.is_file():
+        raise SutureError(f"{needle.key}: no collision mesh to measure the needle from")
+    v = obj_vertices(path) * (b.scale or 1.0)
+    hint = None
+    for j in m.joints:
+        if j.parent and j.parent.split()[-1] == b.identifier.split()[-1] and j.parent_pivot is not None:
+            hint = np.array([j.parent_pivot.x, j.parent_pivot.y, j.parent_pivot.z], float) * (b.scale or 1.0)
+            break
+    return needle, fit_needle(v, hint)
+
+
+@dataclass
+class Grasp:
+    """Where a PSM holds the needle: the end effector's pose in the needle frame."""
+    ee_in_needle: np.ndarray
+    margin: float
+
+
+class SutureTask:
+    """The scripted suture on a SimWorld with two PSMs (see the module docstring)."""
+
+    def __init__(self, world, pairs: list[int], seed: int = 0, psm_names=("psm1", "psm2"),
+                 speed: float = 1.0) -> None:
+        self.world = world
+        self.rng = np.random.default_rng(seed)
+        self.speed = speed
+        self.cdt = world.dt * world.opt.control_substeps
+        self.needle, self.geom = find_needle(world)
+        all_pairs = {p.index: p for p in hole_pairs(world)}
+        missing = [k for k in pairs if k not in all_pairs]
+        if missing:
+            have = ", ".join(str(k) for k in sorted(all_pairs)) or "none"
+            raise SutureError(f"the scene has no entry/exit hole pair {missing} (pairs: {have})")
+        self.pairs = [all_pairs[k] for k in pairs]
+        self.psms = {n: PSM(world, n) for n in psm_names}
+        self.phase = "start"
+        self.clipped = 0                                # set-points clipped to the joint limits
+        self.phase_log: list[tuple[str, float]] = []   # (phase, simulated start time)
+        self.holder: str | None = None                  # the PSM holding the needle
+        self.held_ee_in_needle: np.ndarray | None = None
+        # seeded variation of the plan
+        self.grasp_jitter = self.rng.uniform(-0.04, 0.04, 2)
+        self.approach = APPROACH + self.rng.uniform(-0.05, 0.05)
+
+    # ---- geometry ----------------------------------------------------------------------
+    def needle_pose(self) -> np.ndarray:
+        return self.needle.world_matrix()
+
+    def tip_world(self) -> np.ndarray:
+        return (self.needle_pose() @ np.r_[self.geom.tip, 1.0])[:3]
+
+    def arc_frame(self, pair: HolePair):
+        """Frame B at the circle's centre for this pair (x toward the entry point, z the axis
+        about which the tip goes from entry to exit), the exit's angle in it, how far the tip
+        goes beyond the exit and how far from the ends the two grasps sit.
+
+        The needle's circle goes through an aim point in each hole: the hole's centre, or,
+        where the holes are farther apart than a bite of MAX_BITE, a point inside each hole
+        ghost toward the other one (the tip still passes through both ghosts)."""
+        e = self.world.ghost_pose(pair.entry)
+        x = self.world.ghost_pose(pair.exit)
+        pe, px = e[:3, 3], x[:3, 3]
+        up = e[:3, 2] + x[:3, 2]
+        if up[2] < 0:
+            up = -up
+        r = self.geom.radius
+        d = px - pe
+        dist = float(np.linalg.norm(d))
+        dn = d / dist
+        want = 2 * r * math.sin(MAX_BITE / 2)
+        if dist > want:
+            room = min(_in_plane_room(g, dn) for g in (pair.entry, pair.exit))
+            inset = min((dist - want) / 2, max(0.0, room - HOLE_MARGIN))
+            pe, px = pe + inset * dn, px - inset * dn
+            dist -= 2 * inset
+        if dist >= 2 * r * 0.98:
+            raise SutureError(f"entry and exit of pair {pair.index} are {dist * 1000:.1f} mm apart; "
+                              f"the needle spans {2 * r * 1000:.1f} mm")
+        w = up - np.dot(up, dn) * dn
+        w /= np.linalg.norm(w)
+        c = (pe + px) / 2 + math.sqrt(r * r - dist * dist / 4) * w
+        xa = (pe - c) / np.linalg.norm(pe - c)
+        za = np.cross(pe - c, px - c)
+        za /= np.linalg.norm(za)
+        b = np.eye(4)
+        b[:3, :3] = np.c_[xa, np.cross(za, xa), za]
+        b[:3, 3] = c
+        psi_x = math.acos(float(np.clip(np.dot(xa, (px - c) / r), -1, 1)))
+        free = self.geom.span - psi_x          # arc outside the tissue when the bite is full
+        if free < 2 * CLEAR + math.radians(16):
+            raise SutureError(f"pair {pair.index}: the needle's arc ({math.degrees(self.geom.span):.0f}°) leaves "
+                              f"{math.degrees(free):.0f}° outside a {math.degrees(psi_x):.0f}° bite; too little to hold it")
+        g = min(MAX_GRASP, free / 2 - CLEAR - math.radians(2))
+        g_tip, g_tail = g + self.grasp_jitter[0] * g / MAX_GRASP, g + self.grasp_jitter[1] * g / MAX_GRASP
+        beyond = (g_tip + CLEAR + free - g_tail - CLEAR) / 2
+        return b, psi_x, beyond, g_tip, g_tail
+
+    def needle_at(self, b: np.ndarray, psi: float) -> np.ndarray:
+        """Needle body pose with its tip at angle psi in arc frame B."""
+        return b @ _rot_z(psi) @ invert(self.geom.arc_in_needle)
+
+    def lifted(self, pose: np.ndarray, dz: float) -> np.ndarray:
+        out = pose.copy()
+        out[2, 3] += dz
+        return out
+
+    # ---- grasp selection ---------------------------------------------------------------
+    def grasp_candidates(self, phi: float):
+        """End-effector poses in the needle frame that hold the wire at arc angle phi between
+        the jaws (the wire across the opening direction y_E): around the wire in 15° steps,
+        both ways, the wire square to the jaws or turned up to 45° about y_E. Each comes with
+        its turn (rad), which the choice penalises slightly."""
+        g = self.geom
+        a = g.arc_in_needle
+        p = g.point(phi)
+        t = a[:3, :3] @ np.array([-math.sin(phi), math.cos(phi), 0.0])
+        radial = a[:3, :3] @ np.array([math.cos(phi), math.sin(phi), 0.0])
+        n = a[:3, 2]
+        out = []
+        for turn in np.radians([0.0, 25.0, -25.0, 45.0, -45.0]):
+            for sign in (1.0, -1.0):
+                for beta in np.radians(np.arange(0, 360, 15)):
+                    z0 = math.cos(beta) * -radial + math.sin(beta) * n
+                    x0 = sign * t
+                    x = math.cos(turn) * x0 - math.sin(turn) * z0
+                    z = math.sin(turn) * x0 + math.cos(turn) * z0
+                    m = np.eye(4)
+                    m[:3, :3] = np.c_[x, np.cross(z, x), z]
+                    m[:3, 3] = p - JAW_DEPTH * z
+                    out.append((m, abs(float(turn))))
+        return out
+
+    def _margin(self, psm: PSM, ee_world: np.ndarray) -> float:
+        try:
+            q = psm.kin.ik(invert(psm.base_in_world()) @ ee_world)
+        except ValueError:
+            return -1.0
+        lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+        return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo)))
+
+    def choose_grasp(self, psm: PSM, phi: float, needle_poses: list, down_at: np.ndarray | None = None,
+                     what: str = "") -> Grasp:
+        """The candidate grasp reachable at every needle pose with the widest joint margin
+        (with ``down_at``: the jaws must point down at that needle pose, to come from above)."""
+        best = None
+        for ee_in_n, turn in self.grasp_candidates(phi):
+            if down_at is not None and (down_at @ ee_in_n)[2, 2] > -0.5:
+                continue
+            worst = math.inf
+            for pose in needle_poses:
+                worst = min(worst, self._margin(psm, pose @ ee_in_n))
+                if worst <= 0:
+                    break
+            score = worst - 0.02 * turn
+            if worst > 0 and (best is None or score > best.margin):
+                best = Grasp(ee_in_n, score)
+        if best is None:
+            raise SutureError(f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})")
+        return best
+
+    # ---- motion primitives (generators: one yield per control step) ----------------------
+    def _set_phase(self, name: str):
+        self.phase = name
+        self.phase_log.append((name, self.world.sim_time))
+
+    def _steps(self, seconds: float) -> int:
+        return max(1, int(round(seconds / self.speed / self.cdt)))
+
+    def servo_world(self, psm: PSM, ee_world: np.ndarray) -> None:
+        """Cartesian set-point in the world; a pose a little past a joint limit (the grasp
+        as measured differs from the planned one by a few degrees) is servoed with the joints
+        clipped to their limits, and counted."""
+        try:
+            psm.servo_cp(invert(psm.base_in_world()) @ ee_world)
+        except JointLimitError as exc:
+            lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+            if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
+                raise
+            psm.servo_jp(np.clip(exc.q, lo, hi))
+            self.clipped += 1
+
+    def setpoint_world(self, psm: PSM) -> np.ndarray:
+        return psm.base_in_world() @ psm.setpoint_cp()
+
+    def move(self, psm: PSM, goal: np.ndarray, seconds: float, settle: float = 0.15):
+        """Free-space move: the IK at the goal, joints interpolated (the wrist never passes
+        through an unreachable orientation on the way)."""
+        yield from self.move_jp(psm, psm.kin.ik(invert(psm.base_in_world()) @ goal), seconds, settle)
+
+    def move_jp(self, psm: PSM, q1, seconds: float, settle: float = 0.15):
+        q0 = psm.setpoint_jp()
+        q1 = np.asarray(q1, dtype=float)
+        n = self._steps(seconds)
+        for i in range(1, n + 1):
+            psm.servo_jp(q0 + (q1 - q0) * _smooth(i / n))
+            yield self.phase
+        yield from self.wait(settle)
+
+    def wait(self, seconds: float):
+        for _ in range(self._steps(seconds)):
+            yield self.phase
+
+    def carry(self, path, seconds: float):
+        """The holder moves the needle through needle poses path(s), s in [0, 1] (Cartesian)."""
+        psm = self.psms[self.holder]
+        n = self._steps(seconds)
+        for i in range(1, n + 1):
+            self.servo_world(psm, path(i / n) @ self.held_ee_in_needle)
+            yield self.phase
+
+    def carry_to(self, goal: np.ndarray, seconds: float):
+        """The holder takes the needle to a pose through joint space."""
+        yield from self.move(self.psms[self.holder], goal @ self.held_ee_in_needle, seconds, settle=0.0)
+
+    def take(self, name: str, grasp: Grasp):
+        """``name`` opens its jaws, comes down along its jaw axis onto the grasp (on the needle
+        where it is now) and holds the needle."""
+        psm = self.psms[name]
+        goal = self.needle_pose() @ grasp.ee_in_needle
+        above = goal.copy()
+        above[:3, 3] -= BACK_OFF * goal[:3, 2]
+        psm.servo_jaw(0.8)
+        yield from self.move(psm, above, 0.8)
+        yield from self.move(psm, goal, 0.5, settle=0.2)
+        psm.servo_jaw(0.25)      # the jaws close on the wire ...
+        yield from self.wait(0.1)
+        ee = psm.base_in_world() @ psm.measured_cp()
+        jaw = ee[:3, 3] + JAW_DEPTH * ee[:3, 2]
+        wire = (self.needle_pose() @ grasp.ee_in_needle)[:3, 3] + JAW_DEPTH * (self.needle_pose() @ grasp.ee_in_needle)[:3, 2]
+        miss = float(np.linalg.norm(jaw - wire))
+        if miss > 0.004:
+            raise SutureError(f"{name} missed the needle by {miss * 1000:.1f} mm ({self.phase})")
+        act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
+        self.world.actuate(act, self.needle)   # ... the actuator holds it (and the jaws no longer push it) ...
+        self.holder = name
+        self.held_ee_in_needle = invert(self.needle_pose()) @ ee
+        psm.servo_jaw(0.0)                      # ... and they close fully
+        yield from self.wait(0.15)
+
+    def let_go(self, name: str):
+        psm = self.psms[name]
+        act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
+        self.world.release(act)
+        psm.servo_jaw(0.8)
+        yield from self.wait(0.15)
+        here = self.setpoint_world(psm)
+        back = here.copy()
+        back[:3, 3] -= BACK_OFF * here[:3, 2]
+        back[2, 3] += 0.01
+        yield from self.move(psm, back, 0.5, settle=0.0)
+
+    # ---- the task ------------------------------------------------------------------------
+    def _sides(self):
+        """Driver: the PSM whose base lies on the entry side of the first pair."""
+        p = self.pairs[0]
+        d = self.world.ghost_pose(p.exit)[:3, 3] - self.world.ghost_pose(p.entry)[:3, 3]
+        names = sorted(self.psms, key=lambda n: float(np.dot(self.psms[n].base_in_world()[:3, 3], d)))
+        return names[0], names[-1]
+
+    def setup_joints(self, reach: float = 0.17) -> dict:
+        """Where a PSM's remote centre of motion is farther from the holes than the tool reaches
+        (the corpus set: 0.26 m against 0.24 m of insertion), slide its base toward them, as a
+        surgeon places the arm on its setup joints. Returns {psm: metres moved}."""
+        target = np.mean([self.world.ghost_pose(g)[:3, 3] for p in self.pairs for g in (p.entry, p.exit)]
+                         + [self.needle_pose()[:3, 3]], axis=0)
+        moved = {}
+        for name, psm in self.psms.items():
+            rcm = psm.base_in_world()[:3, 3]
+            d = float(np.linalg.norm(target - rcm))
+            if d <= reach + 1e-6:
+                moved[name] = 0.0
+                continue
+            shift = (target - rcm) * (1 - reach / d)
+            t = psm.base.world_matrix()
+            t[:3, 3] += shift
+            self.world.move_base(psm.base, t)
+            moved[name] = float(np.linalg.norm(shift))
+        return moved
+
+    def plan(self):
+        """Needle poses of the whole suture and, per pair, the grasps that reach them: the
+        driver's (from where it takes the needle, over the approach, along the insertion) and
+        the puller's (along the pull and the lift)."""
+        n0 = self.needle_pose()
+        self.driver, self.puller = self._sides()
+        self.frames = {p.index: self.arc_frame(p) for p in self.pairs}
+        self.drive_grasps, self.pull_grasps, self.out_poses, self.handbacks = [], [], [], []
+        for k, p in enumerate(self.pairs):
+            b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
+            psi_end = psi_x + beyond
+            insertion = [self.lifted(self.needle_at(b, -self.approach), LIFT)]
+            insertion += [self.needle_at(b, psi) for psi in np.linspace(-self.approach, psi_end, 7)]
+            if k == 0:
+                self.drive_grasps.append(self.choose_grasp(
+                    self.psms[self.driver], -self.geom.span + g_tail, [n0, self.lifted(n0, LIFT)] + insertion,
+                    down_at=n0, what=f"pair {p.index}, driving"))
+            else:
+                self.drive_grasps.append(self.hand_back(k, g_tail, insertion))
+            done = psi_x + self.geom.span + TAIL_CLEAR
+            out = self.lifted(self.needle_at(b, done), 2 * LIFT)
+            pull = [self.needle_at(b, psi) for psi in np.linspace(psi_end, done, 7)] + [out]
+            self.pull_grasps.append(self.choose_grasp(self.psms[self.puller], -g_tip, pull,
+                                                      what=f"pair {p.index}, pulling"))
+            self.out_poses.append(out)
+
+    def hand_back(self, k: int, g_tail: float, insertion: list) -> Grasp:
+        """Where the puller, done with pair k-1, gives the needle back: over pair k, lifted,
+        turned in its plane as little as both arms allow (the driver's grasp must reach it and
+        the whole next insertion; the puller's grasp must reach it). Returns the driver's grasp
+        and records the pose in self.handbacks."""
+        b, _, _, _, _ = self.frames[self.pairs[k].index]
+        puller = self.psms[self.puller]
+        prev = self.pull_grasps[k - 1]
+        for psi in np.radians(np.arange(-15, 250, 15)) - self.approach:
+            h = self.lifted(self.needle_at(b, psi), 2 * LIFT)
+            if self._margin(puller, h @ prev.ee_in_needle) <= 0:
+                continue
+            try:
+                g = self.choose_grasp(self.psms[self.driver], -self.geom.span + g_tail, [h] + insertion)
+            except SutureError:
+                continue
+            self.handbacks.append(h)
+            return g
+        raise SutureError(f"{self.driver}/{self.puller}: no pose over pair {self.pairs[k].index} where both "
+                          "arms can hand the needle over")
+
+    def _tissue_pass_through(self) -> None:
+        """The needle passes through the phantom's bodies (its collision hull covers the holes;
+        the hole ghosts' friction is what holds an inserted needle) and the thread through the
+        tissue body."""
+        m = self.needle.model
+        for sb in self.world.bodies:
+            name = (sb.body.name or sb.body.identifier).lower()
+            if sb is self.needle or sb.model is not m or not (
+                    "phantom" in name or re.search(r"(entry|exit)\s*\d+$", name)):
+                continue
+            self.world.set_collision(self.needle, sb, False)
+        for t in self.tissue():
+            for sb in self.world.bodies:
+                if sb.model is m and "thread" in (sb.body.name or sb.body.identifier).lower():
+                    self.world.set_collision(t, sb, False)
+
+    def tissue(self):
+        m = self.needle.model
+        return [sb for sb in self.world.bodies
+                if sb.model is m and sb.static and "phantom" in (sb.body.name or sb.body.identifier).lower()]
+
+    def _soft_tissue_for_tools(self) -> None:
+        """The tools' jaws reach the wire lying on the tissue: they press into it (and the pad
+        under it) rather than push the arm off its set-point (the phantom is soft; its collision
+        shape is a hull). The two arms, brought closer on their setup joints, do not collide
+        with each other's links either (their links are coarse primitives)."""
+        m = self.needle.model
+        static = [sb for sb in self.world.bodies if sb.model is m and sb.static]
+        arms = {n: [sb for sb in self.world.bodies if sb.articulation is psm.art] for n, psm in self.psms.items()}
+        for links in arms.values():
+            for sb in links:
+                for t in static:
+                    self.world.set_collision(t, sb, False)
+        names = list(arms)
+        for i, a in enumerate(names):
+            for b in names[i + 1:]:
+                for x in arms[a]:
+                    for y in arms[b]:
+                        self.world.set_collision(x, y, False)
+
+    def jitter(self, seconds: float = 0.05):
+        """Seeded initial-pose jitter: a small random horizontal push on the needle."""
+        f = self.rng.uniform(-1, 1, 2)
+        f = JITTER_FORCE * f / max(np.linalg.norm(f), 1e-9)
+        at = np.array(self.needle.com_position()) + self.rng.uniform(-0.004, 0.004, 3) * [1, 1, 0]
+        for _ in range(self._steps(seconds)):
+            self.needle.force([float(f[0]), float(f[1]), 0.0], at.tolist())
+            yield self.phase
+        yield from self.wait(0.4)
+
+    def steps(self):
+        """The whole suture, one yield per control step."""
+        self._set_phase("settle")
+        for name in self.psms:
+            self.psms[name].servo_jaw(0.8)
+        self.base_moves = self.setup_joints()
+        self._soft_tissue_for_tools()
+        yield from self.jitter()
+        self.plan()
+        d, p = self.psms[self.driver], self.psms[self.puller]
+        park = {n: np.clip(self.psms[n].setpoint_jp(), self.psms[n].kin.lower_limits[:6], self.psms[n].kin.upper_limits[:6]) for n in self.psms}
+        self._set_phase("pick up")
+        yield from self.take(self.driver, self.drive_grasps[0])
+        for k, pair in enumerate(self.pairs):
+            b, psi_x, beyond, _, _ = self.frames[pair.index]
+            n_from = self.needle_pose()
+            start = self.needle_at(b, -self.approach)
+            self._set_phase(f"carry {pair.index}")
+            up = self.lifted(n_from, LIFT)
+            yield from self.carry(lambda s: interpolate(n_from, up, _smooth(s)), 0.6)
+            yield from self.carry_to(self.lifted(start, LIFT), 1.2)
+            over = self.lifted(start, LIFT)
+            yield from self.carry(lambda s: interpolate(over, start, _smooth(s)), 0.8)
+            yield from self.wait(0.2)
+            self._set_phase(f"insert {pair.index}")
+            self._tissue_pass_through()
+            psi_end = psi_x + beyond
+            a0 = -self.approach
+            yield from self.carry(lambda s: self.needle_at(b, a0 + (psi_end - a0) * s), (psi_end - a0) / 0.5)
+            yield from self.wait(0.2)
+            self._set_phase(f"regrasp {pair.index}")
+            yield from self.take(self.puller, self.pull_grasps[k])
+            yield from self.let_go(self.driver)
+            yield from self.move_jp(d, park[self.driver], 0.8, settle=0.0)
+            self.holder = self.puller
+            self._set_phase(f"pull {pair.index}")
+            done = psi_x + self.geom.span + TAIL_CLEAR
+            yield from self.carry(lambda s: self.needle_at(b, psi_end + (done - psi_end) * s),
+                                  (done - psi_end) / 0.6)
+            out = self.needle_at(b, done)
+            high = self.lifted(out, 2 * LIFT)
+            yield from self.carry(lambda s: interpolate(out, high, _smooth(s)), 1.0)
+            yield from self.wait(0.2)
+            if k + 1 < len(self.pairs):
+                self._set_phase(f"hand back {pair.index}")
+                yield from self.carry_to(self.handbacks[k], 1.2)
+                yield from self.wait(0.2)
+                yield from self.take(self.driver, self.drive_grasps[k + 1])
+                yield from self.let_go(self.puller)
+                yield from self.move_jp(p, park[self.puller], 0.8, settle=0.0)
+                self.holder = self.driver
+        self._set_phase("done")

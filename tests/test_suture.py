@@ -1,0 +1,143 @@
+"""The scripted suture (adfkit/tasks): needle geometry, the grasp held and released, a one-pair
+suture on the project's own scene, its metrics and pictures, the corpus set, and four pairs on
+several seeds (slow)."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import CORPUS, ROOT, require_corpus
+
+from adfkit.tasks.needle import fit_needle
+
+BUNDLED = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
+
+
+def _arc(radius, start, span, n=400, tube=0.0004):
+    rng = np.random.default_rng(0)
+    phi = rng.uniform(start, start + span, n)
+    around = rng.uniform(0, 2 * np.pi, n)
+    r = radius + tube * np.cos(around)
+    return np.c_[r * np.cos(phi), r * np.sin(phi), tube * np.sin(around)]
+
+
+def test_needle_fit_finds_circle_tip_and_tail():
+    v = _arc(0.0102, math.radians(20), math.radians(150))
+    tail = np.array([0.0102 * math.cos(math.radians(20)), 0.0102 * math.sin(math.radians(20)), 0.0])
+    g = fit_needle(v, tail_hint=tail)
+    assert g.radius == pytest.approx(0.0102, abs=2e-4)
+    assert math.degrees(g.span) == pytest.approx(150, abs=3)
+    tip = 0.0102 * np.array([math.cos(math.radians(170)), math.sin(math.radians(170)), 0.0])
+    assert np.linalg.norm(g.tip - tip) < 5e-4 and np.linalg.norm(g.tail - tail) < 5e-4
+    # turning the arc frame by +a about its z moves the tip forward, away from the tail
+    a = g.arc_in_needle
+    ahead = (a @ np.array([g.radius * math.cos(0.1), g.radius * math.sin(0.1), 0, 1]))[:3]
+    assert np.linalg.norm(ahead - g.tail) > np.linalg.norm(g.tip - g.tail)
+
+
+def _strict(path: Path) -> dict:
+    def bad(x):
+        raise ValueError(f"non-finite {x} in strict JSON")
+    return json.loads(path.read_text(), parse_constant=bad)
+
+
+def _bundled():
+    if not BUNDLED.is_file():
+        pytest.skip("sample_scenes/suturing is not in this checkout")
+    return BUNDLED
+
+
+@pytest.fixture(scope="module")
+def one_pair(tmp_path_factory):
+    from adfkit.tasks.episode import run_episode
+    out = tmp_path_factory.mktemp("suture1")
+    return run_episode(_bundled(), None, [1], seed=0, out=out, progress=False), out
+
+
+@pytest.mark.slow
+def test_one_pair_on_the_project_scene(one_pair):
+    m, out = one_pair
+    assert m["failure"] is None
+    (p,) = m["pairs"]
+    assert p["passed"] and p["entry_passed_s"] < p["exit_passed_s"]
+    assert m["all_passed"] and not m["exploded"]
+
+
+@pytest.mark.slow
+def test_metrics_json_and_pictures(one_pair):
+    m, out = one_pair
+    j = _strict(out / "metrics.json")
+    assert j["pairs"] == m["pairs"]
+    names = [p["phase"] for p in j["phases"]]
+    assert names[:5] == ["settle", "pick up", "carry 1", "insert 1", "regrasp 1"] and names[-1] == "done"
+    assert sum(p["duration_s"] for p in j["phases"]) == pytest.approx(j["simulated_time_s"], abs=1e-6)
+    assert len(j["needle_final_pose"]["position"]) == 3
+    assert np.linalg.norm(j["needle_final_pose"]["orientation"]) == pytest.approx(1.0, abs=1e-6)
+    assert 0 <= j["max_constraint_error_m"] < 0.01 and j["real_time_factor"] > 0
+    assert j["thread_length_through_tissue_m"] >= 0 and j["exploded"] is False
+    from PIL import Image
+    assert Image.open(out / "trajectory.png").size[0] > 300
+    gif = Image.open(out / "cameraL.gif")
+    assert gif.n_frames > 5 and gif.size[0] <= 320
+
+
+@pytest.mark.slow
+def test_needle_held_while_carried_and_released_when_the_jaws_open():
+    from adfkit.adf import load_scene
+    from adfkit.runner.world import Options, SimWorld
+    from adfkit.tasks.suture import SutureTask
+    world = SimWorld(load_scene(_bundled()), Options())
+    try:
+        task = SutureTask(world, [1], seed=0)
+        run = lambda gen: [world.step(1) for _ in gen]   # noqa: E731
+        run(task.wait(0.3))
+        task._soft_tissue_for_tools()
+        task.plan()
+        run(task.take(task.driver, task.drive_grasps[0]))
+        psm = task.psms[task.driver]
+        start = task.needle_pose()
+        drift = []
+        for _ in task.carry(lambda s: task.lifted(start, 0.03 * s), 1.0):
+            world.step(1)
+            ee = psm.base_in_world() @ psm.measured_cp()
+            expected = ee @ np.linalg.inv(task.held_ee_in_needle)
+            drift.append(np.linalg.norm(expected[:3, 3] - task.needle_pose()[:3, 3]))
+        assert task.needle_pose()[2, 3] - start[2, 3] == pytest.approx(0.03, abs=2e-3)
+        assert max(drift) < 1e-3
+        held_z = task.needle_pose()[2, 3]
+        run(task.let_go(task.driver))
+        run(task.wait(0.5))
+        assert held_z - task.needle_pose()[2, 3] > 0.01      # it fell once the jaws opened
+        act = next(a for a in world.actuators if f"/{task.driver}/" in a.key or f"/{task.driver}/" in a.parent.key)
+        assert act.target is None
+    finally:
+        world.close()
+
+
+@pytest.mark.slow
+def test_corpus_set_pair_1(tmp_path):
+    require_corpus()
+    from adfkit.tasks.episode import run_episode
+    m = run_episode(CORPUS / "src" / "launch.yaml", "6-11", [1], seed=0, out=None, progress=False)
+    assert m["failure"] is None and m["pairs"][0]["passed"]
+
+
+@pytest.mark.slow
+def test_four_pairs_on_eight_of_ten_seeds():
+    from adfkit.tasks.episode import run_episode
+    scene = _bundled()
+    passed = [run_episode(scene, None, [1, 2, 3, 4], seed=s, out=None, progress=False)["all_passed"]
+              for s in range(10)]
+    assert sum(passed) >= 8, passed
+
+
+def test_cli_bad_input_is_exit_2(tmp_path, capsys):
+    from adfkit.cli import main
+    assert main(["suture", "--pairs", "0", "--out", str(tmp_path)]) == 2
+    assert main(["suture", "--pairs", "x", "--out", str(tmp_path)]) == 2
+    assert main(["suture", str(tmp_path / "none.yaml"), "--out", str(tmp_path)]) == 2
+    assert "bad-option" in capsys.readouterr().err
