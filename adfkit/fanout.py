@@ -146,19 +146,19 @@ def suture_episodes(launch, indices, pairs, seed: int, episodes: int, workers: i
 
 
 def _validate_chunk(args) -> list:
-    from .validator import validate_paths
+    from .validator.engine import validate_files
     files, kind, follow = args
-    return validate_paths(files, kind, follow=follow)[0]
+    return validate_files(files, kind, follow=follow)
 
 
 def validate_parallel(paths, kind, follow: bool, workers: int, address=None) -> tuple[list, list]:
-    """validate_paths over a big tree as Ray tasks, same results in the same order: the files
+    """validate_files over a big tree as Ray tasks, same results in the same order: the files
     in the engine's order (launch files first) cut into contiguous chunks, each chunk checked by
-    validate_paths (following launch files as it does), the chunks' results joined and a file
+    validate_files (following launch files as it does), the chunks' results joined and a file
     reached twice kept where it first appears, as the serial run keeps it."""
     from .validator.engine import _looks_like_launch, expand
     files, problems = expand(paths)
-    files = sorted(files, key=lambda f: not _looks_like_launch(f))
+    files = sorted(files, key=lambda ft: not _looks_like_launch(*ft))
     n = max(1, min(len(files), 4 * workers))
     size = -(-len(files) // n) if files else 1
     chunks = [files[i:i + size] for i in range(0, len(files), size)]

@@ -142,8 +142,7 @@ class PSM:
     def reset_jp(self, q) -> None:
         """Put q1..q6 at ``q`` at once, at rest, and hold them there (a reset, not a motion)."""
         q = np.asarray(q, dtype=float)
-        for i, v in zip(self.arm, q):
-            pb.resetJointState(self.art.uid, i, float(v), 0.0, physicsClientId=self.world.cid)
+        self.world.reset_joints(self.art, self.arm, q)
         self.servo_jp(q)
 
     # ---- Cartesian space ---------------------------------------------------------------

@@ -152,6 +152,11 @@ def expand(paths) -> tuple[list[tuple[Path, object]], list[Diagnostic]]:
 
 def validate_paths(paths, kind: str | None = None, follow: bool = True) -> tuple[list[FileResult], list[Diagnostic]]:
     files, problems = expand(paths)
+    return validate_files(files, kind, follow), problems
+
+
+def validate_files(files, kind: str | None = None, follow: bool = True) -> list[FileResult]:
+    """Check ``files``, (path, tree) pairs as :func:`expand` gives them, launch files first."""
     results: dict[Path, FileResult] = {}
 
     def run(path: Path, k: str | None, context=(), tree=None, referrer=None) -> FileResult:
@@ -189,7 +194,7 @@ def validate_paths(paths, kind: str | None = None, follow: bool = True) -> tuple
     # Launch files first, so the models they name are checked with the models loaded before them.
     for f, tree in sorted(files, key=lambda ft: not _looks_like_launch(*ft)):
         run(f, kind, tree=tree)
-    return list(results.values()), problems
+    return list(results.values())
 
 
 def _looks_like_launch(path: Path, tree=None) -> bool:
