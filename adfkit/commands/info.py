@@ -1,7 +1,7 @@
 """`adfkit info PATH`: a summary of a launch, world, input-devices or model file."""
 from __future__ import annotations
 
-import json
+from .. import jsonout
 import sys
 
 NAME = "info"
@@ -30,7 +30,7 @@ def run(args) -> int:
     print_diagnostics(diags, sys.stderr)
     summary = summarize(doc)
     if args.json:
-        json.dump(summary, sys.stdout, indent=2)
+        jsonout.dump(summary, sys.stdout, indent=2)
         sys.stdout.write("\n")
     else:
         print(format_summary(summary))

@@ -114,26 +114,49 @@ def _static_frame(cid: int, body):
     return st[0], st[1]  # constraint pivots are in the link's inertial frame
 
 
+class ConstraintRefused(Exception):
+    """PyBullet could not join the two bodies as asked (the world warns and skips the joint)."""
+
+
+_JTYPE_NAMES = {pb.JOINT_FIXED: "fixed", pb.JOINT_POINT2POINT: "point-to-point", pb.JOINT_PRISMATIC: "prismatic",
+                pb.JOINT_GEAR: "gear"}
+
+
 def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray,
                     max_force: float) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray | None]]:
     """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child
     frame, slide axis in the parent frame or None)]."""
     out = []
 
+    def create(a, b, jtype, axis, pa, pb_, oa, ob):
+        return pb.createConstraint(a.uid, a.link, b.uid, b.link, jtype,
+                                   list(map(float, axis)) if axis is not None else [0, 0, 0],
+                                   list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
+                                   physicsClientId=cid)
+
     def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1), axis=None):
+        # PyBullet joins a multibody link to a free (maximal-coordinate) body only with the link
+        # first (btMultiBodyPoint2Point/btMultiBodyFixedConstraint take the multibody as body A):
+        # such a joint is made with its ends swapped, which is the same joint
+        swap = (axis is None and getattr(parent, "articulation", None) is None
+                and getattr(child, "articulation", None) is not None)
         try:
-            c = pb.createConstraint(parent.uid, parent.link, child.uid, child.link, jtype,
-                                    list(map(float, axis)) if axis is not None else [0, 0, 0],
-                                    list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
-                                    physicsClientId=cid)
+            c = create(child, parent, jtype, None, pb_, pa, ob, oa) if swap else \
+                create(parent, child, jtype, axis, pa, pb_, oa, ob)
         except pb.error:
+            c = None
+        if c is None and getattr(parent, "static", False):
             # PyBullet refuses e.g. a fixed constraint from a static (mass 0) body to a multibody
             # base; a static parent never moves, so build it from the child to the world frame
-            if not getattr(parent, "static", False):
-                raise
             pw, ow = matrix_to_pq(pose_matrix(*_static_frame(cid, parent)) @ pose_matrix(pa, oa))
-            c = pb.createConstraint(child.uid, child.link, -1, -1, jtype, [0, 0, 0], list(map(float, pb_)),
-                                    list(map(float, pw)), list(ob), list(ow), physicsClientId=cid)
+            try:
+                c = pb.createConstraint(child.uid, child.link, -1, -1, jtype, [0, 0, 0], list(map(float, pb_)),
+                                        list(map(float, pw)), list(ob), list(ow), physicsClientId=cid)
+            except pb.error:
+                c = None
+        if c is None:
+            raise ConstraintRefused(f"PyBullet refused a {_JTYPE_NAMES.get(jtype, jtype)} constraint between "
+                                    f"{getattr(parent, 'key', 'the parent')} and {getattr(child, 'key', 'the child')}")
         pb.changeConstraint(c, maxForce=max_force, physicsClientId=cid)
         out.append((c, np.asarray(pa, float), np.asarray(pb_, float), None if axis is None else np.asarray(axis, float)))
 

@@ -2,7 +2,7 @@
 `adfkit demo` leave behind: report.json and each camera's frames."""
 from __future__ import annotations
 
-import json
+from .. import jsonout
 from pathlib import Path
 
 
@@ -24,7 +24,7 @@ def play(world, seconds: float, out: Path | None = None, frames: bool = True, sc
         out.mkdir(parents=True, exist_ok=True)
         if frames:
             report["frames"] = save_frames(world, out)
-        atomic_write_text(out / "report.json", json.dumps(report, indent=2))
+        atomic_write_text(out / "report.json", jsonout.dumps(report, indent=2))
     return report
 
 

@@ -17,6 +17,7 @@ import pybullet as pb
 from ..adf.paths import collision_mesh_path, visual_mesh_path
 from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, warning
+from ..geometry.meshcheck import mesh_problem
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import (
     CollisionMeshType, Primitive, ShapeKind, axis_vector, collision_mesh_type,
@@ -130,6 +131,11 @@ def collision_parts(model, obj, frame_in_body, scale: float,
                              "the body is skipped as AMBF does", obj.where("collision mesh") or obj.source,
                              "fix `collision mesh`/`mesh` or the resolution paths"))
         return None
+    if (problem := mesh_problem(path)) is not None:  # PyBullet crashes on some, reads garbage from others
+        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; "
+                             "the body is skipped as AMBF does",
+                             obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source, "re-export the mesh as a triangle mesh (STL or OBJ)"))
+        return None
     if path.suffix.lower() not in MESH_SUFFIXES:
         diags.append(warning("runner-mesh-format", f"{obj.identifier}: {path.suffix} meshes are not readable "
                              "by PyBullet; no collision shape", obj.source, "convert the mesh to OBJ or STL"))
@@ -145,8 +151,21 @@ def collision_parts(model, obj, frame_in_body, scale: float,
     return parts
 
 
-def create_collision(parts: ShapeParts, cid: int) -> int:
-    """Create the PyBullet collision shape; -1 for an empty one."""
+def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnostic] | None = None) -> int:
+    """Create the PyBullet collision shape; -1 for an empty one, or (with a warning located at
+    ``obj``) for one PyBullet refuses."""
+    try:
+        return _create_collision(parts, cid)
+    except pb.error as exc:
+        if diags is None:
+            raise
+        who = getattr(obj, "identifier", "an object")
+        diags.append(warning("runner-bad-shape", f"{who}: PyBullet refused its collision shape ({exc}); "
+                             "it has none", getattr(obj, "source", None), "check its meshes and shape sizes"))
+        return -1
+
+
+def _create_collision(parts: ShapeParts, cid: int) -> int:
     if parts.plane is not None and not parts.types:
         n, off = parts.plane
         return pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=n,
@@ -222,6 +241,10 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
                              obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
         return -1
     if path.suffix.lower() not in MESH_SUFFIXES:
+        return -1
+    if (problem := mesh_problem(path)) is not None:
+        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: {problem}",
+                             obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
         return -1
     kw = dict(base)
     if rgba(obj) is None:

@@ -20,7 +20,7 @@ from ..model.semantics import (
 )
 from . import articulation
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
-from .joints import SpringSet, make_constraint, spring_joint
+from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
 from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
 from .shapes import collision_parts, create_collision, create_visual
@@ -201,7 +201,12 @@ class SimWorld:
                 self._warn("runner-prismatic-loop", f"{j.identifier}: a prismatic joint closing a loop through "
                            "a maximal-coordinate body is not supported by PyBullet's constraints; built as fixed", j)
                 kind_c = JointKind.FIXED
-            for c, pa, pbv, axis in make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5):
+            try:
+                made = make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5)
+            except ConstraintRefused as exc:
+                self._warn("runner-constraint", f"{j.identifier}: {exc}; the joint is left out", j)
+                continue
+            for c, pa, pbv, axis in made:
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
         self.springs = SpringSet(springs, self.cid)
         for m in models:
@@ -212,8 +217,11 @@ class SimWorld:
         self.cameras = build_cameras(self)
         self._floor_z = self._floor()
         self.ground_z = None
-        if self.opt.ground and self.scene.world is None and self.scene.environment is None:
-            self._add_ground()
+        if self.scene.world is None and self.scene.environment is None:
+            if self.opt.ground:
+                self._add_ground()
+            else:  # --no-ground: nothing to fall through
+                self._floor_z = -math.inf
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
         self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
         self._gravity_overrides = self._group_gravity_overrides()
@@ -250,7 +258,7 @@ class SimWorld:
         b, m = sb.body, sb.model
         if frame_in_body is not sb.ref_in_body or sb._parts is None:
             sb._parts = collision_parts(m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics)
-        col = create_collision(sb._parts, self.cid) if sb._parts is not None else -1
+        col = create_collision(sb._parts, self.cid, b, self.diagnostics) if sb._parts is not None else -1
         vis = create_visual(m, b, frame_in_body, b.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
         return col, vis
 
@@ -313,7 +321,7 @@ class SimWorld:
             parent = self._parent(gh.parent, ns, gh) if gh.parent else None
             loc = pose_to_matrix(pose_or_identity(gh.location))
             rel = invert(parent.com_in_body) @ loc if parent is not None else loc
-            col = create_collision(parts, self.cid)
+            col = create_collision(parts, self.cid, gh, self.diagnostics)
             vis = create_visual(m, gh, np.eye(4), gh.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
             world = (self._frame(parent) @ rel) if parent is not None else rel
             pos, orn = matrix_to_pq(world)
@@ -594,7 +602,7 @@ class SimWorld:
                 # nothing to collide with: it falls freely under gravity, in AMBF too
                 shapeless.append(sb.key)
                 continue
-            if p[2] < self._floor_z - 0.1:
+            if math.isfinite(self._floor_z) and p[2] < self._floor_z - 0.1:
                 fell.append(sb.key)
             if np.linalg.norm(v) > 10.0:
                 fast.append(sb.key)
