@@ -441,8 +441,16 @@ class SimWorld:
         per nearby body, and the PSMs' finger ghosts are only read when grasping."""
         if self.gui:
             self.place_ghosts()
+        parents: dict[int, tuple] = {}   # hole ghosts share their parent (the phantom): read it once
+        cid = self.cid
         for g in self._friction_ghosts:
-            found = self.overlapping(g)
+            if g.moves:
+                pq = parents.get(id(g.parent))
+                if pq is None:
+                    pq = parents[id(g.parent)] = g.parent.state(velocity=False)[:2]
+                pos, orn = pb.multiplyTransforms(pq[0], pq[1], *g.pq_in_parent)
+                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=cid)
+            found = self._overlap(g)
             if found:
                 self._viscous(g, found)
 
@@ -460,8 +468,12 @@ class SimWorld:
     def overlapping(self, g: SimGhost) -> list[SimBody]:
         """The dynamic bodies inside ghost ``g`` now (moved to its parent first); also kept in
         ``g.overlapping``."""
-        cid = self.cid
         self._place(g)
+        return self._overlap(g)
+
+    def _overlap(self, g: SimGhost) -> list[SimBody]:
+        """``overlapping`` with the ghost already where its parent is."""
+        cid = self.cid
         lo, hi = pb.getAABB(g.uid, -1, physicsClientId=cid)
         found = []
         lookup = self._lookup
