@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..diagnostics import AdfError, SourceLocation, error
+from ..diagnostics import AdfError, error
 from ..model.common import RGBA, Geometry, ShapeEntry
 from ..model.files import ModelFile
 from ..model.objects import Body, Inertia, Joint, JointLimits
