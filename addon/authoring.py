@@ -27,15 +27,93 @@ def _link(obj, scene=None):
     return obj
 
 
+GEOMETRY_PACKAGES = "trimesh, manifold3d, coacd, scipy"
+
+
+def geometry(module: str):
+    """``adfkit.geometry.<module>``, or a readable AdfError when its packages are missing
+    (an extension built without the geometry wheels, a Blender with an older numpy)."""
+    import importlib
+    try:
+        return importlib.import_module(f"adfkit.geometry.{module}")
+    except ImportError as exc:
+        missing = getattr(exc, "name", None) or str(exc)
+        raise AdfError(error("geometry-unavailable", f"this needs the geometry package '{missing}', which is not "
+                             "installed in Blender's Python", None,
+                             f"install the adfkit extension built with its geometry wheels ({GEOMETRY_PACKAGES}; "
+                             "see the README, 'Blender add-on')")) from None
+
+
 def mark(obj, kind: str) -> None:
+    """Make ``obj`` an ADF object of ``kind`` with sensible first values: a body's mass
+    from its density and mesh volume, a light's shadow quality."""
     obj.adf.kind = kind
-    if kind == "BODY" and not obj.adf.body.use_mass:
-        obj.adf.body.use_mass = True
+    if kind in ("BODY", "SOFT_BODY"):
+        pg = obj.adf.body if kind == "BODY" else obj.adf.soft
+        if not pg.use_mass:
+            pg.use_mass = True
+            mass_from_density(obj)
+    if kind == "LIGHT" and not obj.adf.light.use_shadow_quality:
+        obj.adf.light.use_shadow_quality, obj.adf.light.shadow_quality = True, 5
+    if kind == "SOFT_BODY" and obj.type == "MESH" and obj.adf.soft.fixed_group not in obj.vertex_groups:
+        obj.vertex_groups.new(name=obj.adf.soft.fixed_group)
+
+
+def fix_selected_nodes(obj, replace: bool = True) -> list[int]:
+    """Put the mesh's selected vertices in the soft body's fixed-node vertex group (Edit Mode
+    selection; the object is switched to Object Mode to read it). Returns the vertex indices."""
+    if obj.type != "MESH":
+        _fail("no-mesh", f"'{obj.name}' is not a mesh", obj, "a soft body's nodes are its mesh's vertices")
+    if obj.mode == "EDIT":
+        obj.update_from_editmode()
+    name = obj.adf.soft.fixed_group
+    grp = obj.vertex_groups.get(name) or obj.vertex_groups.new(name=name)
+    picked = [v.index for v in obj.data.vertices if v.select]
+    if replace:
+        grp.remove(list(range(len(obj.data.vertices))))
+    if picked:
+        grp.add(picked, 1.0, "REPLACE")
+    return picked
+
+
+def mesh_volume(obj) -> tuple[float, bool]:
+    """(volume in m³ with the object's scale, closed?) of a mesh object; an open mesh gives
+    its convex hull's volume (bmesh, no geometry packages needed)."""
+    import bmesh
+    bm = bmesh.new()
+    try:
+        bm.from_mesh(obj.data)
+        bm.transform(Matrix.Diagonal((*obj.matrix_world.to_scale(), 1.0)))
+        closed = len(bm.faces) > 0 and all(e.is_manifold for e in bm.edges)
+        if not closed and len(bm.verts) >= 4:
+            bmesh.ops.convex_hull(bm, input=bm.verts[:], use_existing_faces=False)
+            for f in [f for f in bm.faces if not f.is_valid]:
+                bm.faces.remove(f)
+        return abs(bm.calc_volume()), closed
+    finally:
+        bm.free()
+
+
+def _mass_group(obj):
+    return obj.adf.soft if obj.adf.kind == "SOFT_BODY" else obj.adf.body
+
+
+def mass_from_density(obj) -> float | None:
+    """Set the mass of a body to density × mesh volume unless it was typed by hand."""
+    pg = _mass_group(obj)
+    if pg.mass_typed or obj.type != "MESH" or not len(obj.data.polygons):
+        return None
+    vol, _ = mesh_volume(obj)
+    if vol <= 0:
+        return None
+    pg.use_mass, pg.mass = True, float(obj.adf.density * vol)
+    pg.mass_typed = False
+    return pg.mass
 
 
 def _trimesh_of(obj):
     """The object's mesh as adfkit.geometry loads it (via a temporary OBJ)."""
-    from adfkit.geometry import load_mesh
+    load_mesh = geometry("meshio").load_mesh
     if obj.type != "MESH" or not len(obj.data.polygons):
         _fail("no-mesh", f"'{obj.name}' has no mesh faces", obj, "select a mesh object")
     with tempfile.TemporaryDirectory() as tmp:
@@ -47,15 +125,15 @@ def _trimesh_of(obj):
 
 def generate_collision(obj, threshold: float = 0.05, max_hulls: int = 16, repair: bool = False) -> list:
     """CoACD convex hulls of a body's mesh as COLLISION_MESH children (CONVEX_HULL)."""
-    from adfkit.geometry.decompose import DecompositionParams, decompose
+    dmod = geometry("decompose")
+    DecompositionParams, decompose = dmod.DecompositionParams, dmod.decompose
     mesh = _trimesh_of(obj)
     if not mesh.is_watertight:
         if not repair:
             _fail("mesh-not-manifold", f"'{obj.name}' is not a closed 2-manifold mesh "
                   f"({len(mesh.faces)} faces with open or non-manifold edges); convex decomposition needs a closed mesh",
                   obj, "close the mesh (Mesh > Clean Up > Fill Holes, 3D-Print toolbox) or use primitive collision")
-        from adfkit.geometry.repair import repair_mesh
-        mesh, _ = repair_mesh(mesh)
+        mesh, _ = geometry("repair").repair_mesh(mesh)
     dec = decompose(mesh, DecompositionParams(threshold=threshold, max_hulls=max_hulls))
     for c in [c for c in obj.children if c.adf.kind in ("COLLISION_MESH", "COLLISION_SHAPE")]:
         bpy.data.objects.remove(c, do_unlink=True)
@@ -77,35 +155,116 @@ def generate_collision(obj, threshold: float = 0.05, max_hulls: int = 16, repair
 
 
 def add_collision_primitive(obj, shape: str = "BOX", size=(0.1, 0.1, 0.1), radius=0.05, height=0.1,
-                            axis: str = "z", offset: Matrix | None = None):
-    e = _link(bpy.data.objects.new(f"{obj.name}.{shape.lower()}", None))
+                            axis: str = "z", offset: Matrix | None = None, name: str | None = None):
+    """A collision primitive of ``obj``: a wire mesh child whose outline follows its size."""
+    from .outline import update_outline
+    name = name or f"{obj.name}.{shape.lower()}"
+    e = _link(bpy.data.objects.new(name, bpy.data.meshes.new(name)))
+    e.display_type = "WIRE"
+    e.hide_render = True
     e.adf.kind = "COLLISION_SHAPE"
     s = e.adf.shape
     s.shape, s.size, s.radius, s.height, s.axis = shape, size, radius, height, axis
-    e.empty_display_type = "SPHERE" if shape == "SPHERE" else "CUBE"
-    e.empty_display_size = max(max(size) / 2 if shape == "BOX" else max(radius, height / 2), 1e-4)
+    update_outline(e)
     e.parent = obj
     e.matrix_parent_inverse = Matrix.Identity(4)
     e.matrix_basis = offset or Matrix.Identity(4)
     return e
 
 
+def _pose_matrix(pose) -> Matrix:
+    q = pose.orientation
+    m = Quaternion((q.w, q.x, q.y, q.z)).to_matrix().to_4x4()
+    m.translation = Vector(tuple(pose.position))
+    return m
+
+
+def fit_collision_primitive(obj, shape: str = "CAPSULE", replace: bool = True):
+    """Fit an oriented primitive around the body's mesh (adfkit.geometry.primitives; a cone
+    takes the fitted cylinder's axis, base at the wider end) and add it as the body's collision."""
+    prim = geometry("primitives")
+    mesh = _trimesh_of(obj)
+    kind = shape.upper()
+    if kind == "CONE":
+        entry = prim.fit_cylinder(mesh)
+        entry = _cone_from_cylinder(entry, mesh)
+    else:
+        entry = prim.FITTERS[kind.lower()](mesh)
+    if replace:
+        for c in [c for c in obj.children if c.adf.kind in ("COLLISION_SHAPE", "COLLISION_MESH")]:
+            bpy.data.objects.remove(c, do_unlink=True)
+    g = entry.geometry
+    size = (g.x, g.y, g.z) if kind == "BOX" else (0.1, 0.1, 0.1)
+    made = add_collision_primitive(obj, kind, size=size, radius=g.radius or 0.05, height=g.height or 0.1,
+                                   axis=g.axis or "z", offset=_pose_matrix(entry.offset))
+    bpy.context.view_layer.update()
+    return made
+
+
+def _cone_from_cylinder(entry, mesh):
+    """A cone on the cylinder's axis and extent, its base at the end where the mesh is wider
+    (Bullet's cone: apex at +height/2 along its axis)."""
+    import numpy as np
+    from adfkit.model.pose import Quat
+    pose = entry.offset
+    rot = np.array(Quat(*pose.orientation).matrix())
+    axis = rot[:, "xyz".index((entry.geometry.axis or "z").lower())]
+    rel = np.asarray(mesh.vertices) - np.array(tuple(pose.position))
+    t = rel @ axis
+    radial = np.linalg.norm(rel - np.outer(t, axis), axis=1)
+    low = radial[t < 0].max(initial=0.0)
+    high = radial[t >= 0].max(initial=0.0)
+    if high > low:   # wider at +axis: turn the cone over (half a turn about a perpendicular axis)
+        perp = rot[:, ("xyz".index((entry.geometry.axis or "z").lower()) + 1) % 3]
+        flip = Quat.from_axis_angle(tuple(map(float, perp)), math.pi)
+        entry.offset = type(pose)(pose.position, (flip * pose.orientation).normalized())
+    entry.shape = "cone"
+    return entry
+
+
 def estimate_inertia(obj, mass: float | None = None, density: float | None = None) -> None:
-    """Mass, principal inertia and inertial offset from the body's closed mesh."""
-    from adfkit.geometry.mass import mesh_mass_properties, to_adf
+    """Mass, principal inertia and inertial offset from the body's closed mesh: the mass is
+    kept when given (typed by hand), else density × volume."""
+    gmass = geometry("mass")
     mesh = _trimesh_of(obj)
     if not mesh.is_watertight:
         _fail("mesh-not-closed", f"'{obj.name}' is not closed; its volume and inertia are undefined", obj,
               "close the mesh, or give the inertia by hand")
     if mass is None and density is None:
         density = obj.adf.density
-    props = mesh_mass_properties(mesh, density=density, mass=mass)
-    inertia, offset = to_adf(props)
+    props = gmass.mesh_mass_properties(mesh, density=density, mass=mass)
+    inertia, offset = gmass.to_adf(props)
     b = obj.adf.body
+    typed = b.mass_typed
     b.use_mass, b.mass = True, float(props.mass)
+    b.mass_typed = typed and mass is not None
     b.use_inertia, b.inertia = True, (inertia.ix, inertia.iy, inertia.iz)
     b.use_inertial_offset = True
     b.inertial_offset = (*offset.position, *quat_to_rpy(offset.orientation))
+
+
+def estimate_body(obj) -> None:
+    """What the "Estimate inertia" button does: keep a mass typed by hand, else use density."""
+    b = obj.adf.body
+    typed = b.use_mass and b.mass_typed
+    estimate_inertia(obj, mass=b.mass if typed else None, density=None if typed else obj.adf.density)
+
+
+def estimate_all(scene) -> tuple[list, list[str]]:
+    """Estimate every ADF body with a closed mesh; returns (done, ["name: why not"])."""
+    done, skipped = [], []
+    for o in sorted(scene.objects, key=lambda o: o.name):
+        if o.adf.kind != "BODY" or o.type != "MESH":
+            continue
+        if o.adf.body.use_mass and o.adf.body.mass == 0.0:
+            skipped.append(f"{o.name}: static (mass 0)")
+            continue
+        try:
+            estimate_body(o)
+            done.append(o)
+        except AdfError as exc:
+            skipped.append(f"{o.name}: {exc.diagnostics[0].message}")
+    return done, skipped
 
 
 def add_joint(parent, child, joint_type: str = "revolute", frame: Matrix | None = None, name: str | None = None):
@@ -216,9 +375,8 @@ def add_ghost(name: str, radius: float = 0.005, parent=None, location=(0, 0, 0))
 
 def problems(scene) -> list[str]:
     """Readable findings for the UI (what export would refuse)."""
-    from .export import gather_model
-    return [f"{d.severity.name}: {d.message}" + (f" ({d.hint})" if d.hint else "")
-            for d in gather_model(scene).diagnostics]
+    from .export import check_scene
+    return [f"{d.severity.name}: {d.message}" + (f" ({d.hint})" if d.hint else "") for d in check_scene(scene)]
 
 
 __all__ = ["mark", "generate_collision", "add_collision_primitive", "estimate_inertia", "add_joint",

@@ -18,7 +18,7 @@ from adfkit.model.spec import adf_fields
 from adfkit.model.files import ObjectList
 
 from . import fields, gather, meshes
-from .properties import write_group
+from .properties import GROUP_OF, write_group
 
 RBC_TYPE = {JointKind.REVOLUTE: "HINGE", JointKind.PRISMATIC: "SLIDER", JointKind.FIXED: "FIXED",
             JointKind.P2P: "POINT", JointKind.CONE_TWIST: "GENERIC", JointKind.SIX_DOF: "GENERIC"}
@@ -84,35 +84,27 @@ def _snapshot(obj, x) -> None:
     obj.adf.snapshot = fields.snapshot_text(x)
     obj.adf.identifier = x.identifier
     table = fields.TABLES[obj.adf.kind][1]
-    pg = getattr(obj.adf, {"BODY": "body", "GHOST": "ghost", "JOINT": "joint", "SENSOR": "sensor",
-                           "ACTUATOR": "actuator", "CAMERA": "camera", "LIGHT": "light"}[obj.adf.kind])
+    pg = getattr(obj.adf, GROUP_OF[obj.adf.kind])
     write_group(pg, table, {f.prop: fields.get_value(x, f) for f in table})
 
 
 def _shape_child(body_obj, prim, i, scene):
-    e = _link(scene, bpy.data.objects.new(f"{body_obj.name}.collision{i}", None))
-    e.adf.kind = "COLLISION_SHAPE"
-    s, g = e.adf.shape, prim.geometry
-    s.shape = prim.kind.name if prim.kind.name in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE") else "BOX"
-    if g.x is not None:
-        s.size = (g.x, g.y or 0.0, g.z or 0.0)
-    if g.radius is not None:
-        s.radius = g.radius
-    if g.height is not None:
-        s.height = g.height
-    if g.axis:
-        s.axis = g.axis
-    e.empty_display_type = "SPHERE" if s.shape == "SPHERE" else "CUBE"
-    e.empty_display_size = max(max(s.size) / 2 if s.shape == "BOX" else max(s.radius, s.height / 2), 1e-4)
-    e.parent = body_obj
+    from .authoring import add_collision_primitive
+    g = prim.geometry
+    shape = prim.kind.name if prim.kind.name in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE") else "BOX"
+    size = (g.x, g.y or 0.0, g.z or 0.0) if g.x is not None else (0.1, 0.1, 0.1)
+    e = add_collision_primitive(body_obj, shape, size=size, radius=g.radius if g.radius is not None else 0.05,
+                                height=g.height if g.height is not None else 0.1,
+                                axis=g.axis if g.axis in tuple("xyzXYZ") else "z", name=f"{body_obj.name}.collision{i}")
     e.matrix_world = body_obj.matrix_world @ _matrix(prim.pose)
-    e.hide_render = True
     return e
 
 
 def _geometry(obj, x, doc, scene) -> None:
     vis = visual_mesh_path(doc, x) if x.mesh else None
-    prims = collision_primitives(x)
+    prims = collision_primitives(x) or []
+    if any(p.kind.name not in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE") for p in prims):
+        return  # a plane (or another shape the panel does not offer): kept exactly in the snapshot
     if prims:
         for i, p in enumerate(prims):
             _shape_child(obj, p, i, scene)
@@ -145,13 +137,56 @@ def _body(b, doc, scene, diags):
     return obj
 
 
+def _soft_mesh_object(name: str, path: Path | None, scene):
+    """A soft body's mesh built from the nodes AMBF makes of its file (vertex i = node i, so
+    `fixed nodes` index the Blender vertices); Blender's importer when that reader is missing."""
+    if path is None or not path.is_file():
+        return _mesh_object(name, path, scene)
+    try:
+        from adfkit.geometry.softmesh import load_soft_mesh
+        sm = load_soft_mesh(path)
+    except (ImportError, AdfError):
+        return _mesh_object(name, path, scene)
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(sm.nodes.tolist(), [], sm.triangles.tolist())
+    me.update()
+    return _link(scene, bpy.data.objects.new(name, me))
+
+
+def _soft_body(sb, doc, scene, diags):
+    path = collision_mesh_path(doc, sb) if sb.mesh else None
+    if path is not None and not path.is_file():
+        diags.append(warning("missing-mesh", f"mesh {path} of '{sb.identifier}' not found; imported as an empty",
+                             sb.where("mesh")))
+    obj = _soft_mesh_object(sb.name or sb.identifier, path, scene)
+    obj.adf.kind = "SOFT_BODY"
+    if obj.type == "MESH":
+        obj.adf.mesh_source = str(path)
+        grp = obj.vertex_groups.new(name=obj.adf.soft.fixed_group)
+        fixed = [i for i in (sb.config.fixed_nodes if sb.config is not None and sb.config.fixed_nodes else [])
+                 if 0 <= i < len(obj.data.vertices)]
+        if fixed:
+            grp.add(fixed, 1.0, "REPLACE")
+    _snapshot(obj, sb)
+    obj.matrix_world = _matrix(sb.location or Pose(), sb.scale if sb.scale is not None else 1.0)
+    return obj
+
+
 def _find(objs: dict, ref: str | None):
+    """The object a reference names: its identifier, a unique part of it, or a full name
+    with a namespace (`/ambf/env/BODY ExoRightFoot`, as AMBF resolves it)."""
     if not ref:
         return None
     if ref in objs:
         return objs[ref]
     hits = [k for k in objs if ref in k]
-    return objs[hits[0]] if len(hits) == 1 else None
+    if len(hits) == 1:
+        return objs[hits[0]]
+    tail = [k for k in objs if ref.endswith("/" + k)]
+    if len(tail) == 1:
+        return objs[tail[0]]
+    short = ref.rsplit("/", 1)[-1]
+    return objs.get(short) if short != ref else None
 
 
 def _attach(obj, parent, local: Matrix) -> None:
@@ -180,6 +215,10 @@ def _look_matrix(loc, look_at, up, forward_axis) -> Matrix:
 def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     scene = scene or bpy.context.scene
     doc, diags = read_file(Path(path), kind="model")
+    # the validator's severities: what AMBF loads anyway (duplicate keys, sb/cloth.yaml) is a warning
+    from dataclasses import replace
+    from adfkit.validator.engine import SEVERITY_OVERRIDES
+    diags = [replace(d, severity=SEVERITY_OVERRIDES.get(d.rule, d.severity)) for d in diags]
     errors = [d for d in diags if d.severity >= Severity.ERROR]
     if errors:
         raise AdfError(errors)
@@ -190,6 +229,12 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
             continue
         obj = _body(b, doc, scene, diags)
         bodies[b.identifier] = obj
+        made.append(obj)
+    for sb in doc.soft_bodies:
+        if sb.identifier in bodies or not sb.defined:
+            continue
+        obj = _soft_body(sb, doc, scene, diags)
+        bodies[sb.identifier] = obj
         made.append(obj)
     bpy.context.view_layer.update()
     for b in doc.bodies:
@@ -261,7 +306,7 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     bpy.context.view_layer.update()
     for o in made:
         o.adf.snapshot_matrix = gather.matrix_key(o)
-        if o.adf.kind in ("BODY", "GHOST") and o.type == "MESH":
+        if o.adf.kind in ("BODY", "GHOST", "SOFT_BODY") and o.type == "MESH":
             o.adf.mesh_hash = meshes.digest([meshes.mesh_arrays(o)])
         if o.adf.collision_source:
             parts = sorted((c for c in o.children if c.adf.kind == "COLLISION_MESH"), key=lambda c: c.name)
@@ -290,6 +335,9 @@ def _constraint(obj, j, p, c) -> None:
         rbc.use_limit_lin_x, rbc.limit_lin_x_lower, rbc.limit_lin_x_upper = True, lim.low, lim.high
 
 
+KEPT_LISTS = {"vehicles": "vehicles", "volumes": "volumes"}
+
+
 def _scene_snapshot(scene, doc: ModelFile) -> None:
     order = {}
     for f in adf_fields(doc):
@@ -303,8 +351,11 @@ def _scene_snapshot(scene, doc: ModelFile) -> None:
     import yaml
     from adfkit.adf.writer import _Dumper
     text = yaml.dump(file_to_plain(level), Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=100)
+    # sections the add-on does not edit (vehicles, volumes): carried through as written
+    kept = {key: [[o.identifier, fields.snapshot_text(o)] for o in getattr(doc, attr) if o.defined]
+            for key, attr in KEPT_LISTS.items() if getattr(doc, attr)}
     scene.adf.snapshot = json.dumps({"keys": text if text.strip() != "{}" else "", "order": order,
-                                     "present": sorted(doc.present_lists)})
+                                     "present": sorted(doc.present_lists), "kept": kept})
     scene.adf.use_namespace = doc.namespace is not None
     scene.adf.namespace = doc.namespace or ""
     scene.adf.use_ignore_inter_collision = doc.ignore_inter_collision is not None

@@ -1,8 +1,10 @@
 """Export the Blender scene as an ADF model: gather -> validate -> write (nothing on failure)."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -11,7 +13,7 @@ from adfkit.adf.writer import atomic_write_text
 from adfkit.diagnostics import Diagnostic, Severity, error
 from adfkit.model import ModelFile
 
-from . import gather, meshes
+from . import fields, gather, meshes
 
 HASH_FILE = ".adfkit-meshes.json"
 
@@ -36,6 +38,14 @@ def _model_level(scene) -> tuple[ModelFile, dict]:
     else:
         doc = ModelFile()
     doc.present_lists = set(snap.get("present", []))
+    from adfkit.model.objects import Vehicle, Volume
+    for key, cls in (("vehicles", Vehicle), ("volumes", Volume)):
+        items = []
+        for ident, text in snap.get("kept", {}).get(key, []):
+            o = fields.from_snapshot(cls, text, f"blender:{ident}")
+            o.identifier = ident
+            items.append(o)
+        setattr(doc, key, items)
     if scene.adf.use_namespace:
         doc.namespace = scene.adf.namespace
     if scene.adf.use_ignore_inter_collision:
@@ -62,9 +72,13 @@ def _ordered(objs, order: list[str]):
 def gather_model(scene, objects=None) -> gather.Gathered:
     doc, order = _model_level(scene)
     hi, lo = _mesh_paths(doc)
-    out = gather.Gathered(doc)
+    sp = scene.adf
+    out = gather.Gathered(doc, options=gather.Options(apply_modifiers=sp.apply_modifiers,
+                                                      low_res_ratio=sp.low_res_ratio))
+    fields.PRECISION["digits"] = sp.precision
     objs = sorted(objects if objects is not None else scene.objects, key=lambda o: o.name)
-    bodies, ghosts, joints, other = [], [], [], {k: [] for k in ("sensors", "actuators", "cameras", "lights")}
+    bodies, softs, ghosts, joints = [], [], [], []
+    other = {k: [] for k in ("sensors", "actuators", "cameras", "lights")}
     for o in objs:
         k = o.adf.kind
         if k == "BODY":
@@ -72,6 +86,9 @@ def gather_model(scene, objects=None) -> gather.Gathered:
             for b in bodies[-1:]:
                 for attr in ("high_resolution_path", "low_resolution_path"):
                     setattr(b, attr, None)  # per-body folders are folded into the model folders
+        elif k == "SOFT_BODY":
+            softs.append(gather.gather_soft_body(o, out, (hi, lo)))
+            softs[-1].high_resolution_path = softs[-1].low_resolution_path = None
         elif k == "GHOST":
             ghosts.append(gather.gather_ghost(o, out, (hi, lo)))
         elif k == "JOINT":
@@ -82,6 +99,7 @@ def gather_model(scene, objects=None) -> gather.Gathered:
             key, fn = gather.GATHER[k]
             other[key].append(fn(o, out))
     doc.bodies = _ordered(bodies, order.get("bodies", []))
+    doc.soft_bodies = _ordered(softs, order.get("soft bodies", []))
     doc.ghost_objects = _ordered(ghosts, order.get("ghost objects", []))
     doc.joints = _ordered(joints, order.get("joints", []))
     for key, items in other.items():
@@ -109,8 +127,32 @@ def validate(text: str, target: Path, pending: set[Path]) -> list[Diagnostic]:
     for d in res.diagnostics:
         if d.rule in ("missing-file", "missing-mesh") and any(p.name in d.message for p in pending):
             continue
+        if d.rule == "sensor-type" and d.severity >= Severity.ERROR:
+            # a type AMBF 2.0 does not know (CONTACT, used by newer AMBF): carried through, not refused
+            d = dataclasses.replace(d, severity=Severity.WARNING,
+                                    message=d.message.split(";")[0] + "; unknown to AMBF 2.0, carried through as written")
         keep.append(d)
     return keep
+
+
+def merge_findings(ours: list[Diagnostic], theirs: list[Diagnostic]) -> list[Diagnostic]:
+    """Gather findings, then the validator's, each (rule, object) said once: the validator's
+    wording wins where both report the same thing (a light without shadow quality)."""
+    def obj_of(d):
+        m = re.search(r"'([^']*)'", d.message)
+        name = m.group(1) if m else ""
+        return name.split(" ", 1)[-1] if name.split(" ", 1)[0].isupper() else name
+    said = {(d.rule, obj_of(d)) for d in theirs}
+    return [d for d in ours if (d.rule, obj_of(d)) not in said] + list(theirs)
+
+
+def check_scene(scene) -> list[Diagnostic]:
+    """What export would say, without writing anything (the Check operator)."""
+    g = gather_model(scene)
+    if any(d.severity >= Severity.ERROR for d in g.diagnostics):
+        return g.diagnostics
+    return merge_findings(list(g.diagnostics), validate(dumps(g.model), Path("model.yaml"),
+                                                        {Path(j.directory) / j.filename for j in g.jobs}))
 
 
 def export_scene(scene, out_dir: str | Path, name: str = "model", objects=None) -> ExportResult:
@@ -122,7 +164,7 @@ def export_scene(scene, out_dir: str | Path, name: str = "model", objects=None) 
         return result
     text = dumps(g.model)
     pending = {out_dir / j.directory / j.filename for j in g.jobs}
-    result.diagnostics += validate(text, target, pending)
+    result.diagnostics = merge_findings(result.diagnostics, validate(text, target, pending))
     if any(d.severity >= Severity.ERROR for d in result.diagnostics):
         return result
     _run_jobs(g.jobs, out_dir, result)

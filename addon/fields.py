@@ -15,6 +15,7 @@ import yaml
 from adfkit.adf.reader import Reader
 from adfkit.adf.writer import _Dumper, node_to_plain
 from adfkit.model import Actuator, Body, Camera, Ghost, Joint, Light, Pose, Sensor
+from adfkit.model.objects import SoftBody
 from adfkit.model.objects import Inertia
 from adfkit.model.pose import Vec3, quat_to_rpy, rpy_to_quat
 from adfkit.model.spec import FloatOr, Node, adf_fields
@@ -40,6 +41,11 @@ JOINT_TYPES = ("revolute", "hinge", "continuous", "prismatic", "slider", "fixed"
                "six dof spring")
 
 
+def _freq() -> list[Field]:
+    return [Field(f"publish_frequency_{k}", ("publish_frequency", k), "int", d, f"Publish frequency {k}", "Hz")
+            for k, d in (("low", 50), ("high", 1000))]
+
+
 def _pid(prefix: str, path: tuple[str, ...], label: str) -> list[Field]:
     return [Field(f"{prefix}_{g.lower()}", path + (g,), "float", d, f"{label} {g}") for g, d in
             (("P", 10.0), ("I", 0.0), ("D", 1.0))]
@@ -62,6 +68,11 @@ BODY = [
     *_pid("controller_angular", ("controller", "angular"), "Angular"),
     Field("controller_output_type", ("controller_output_type",), "enum", "FORCE", "Controller output", items=OUTPUT_TYPES),
     Field("passive", ("passive",), "bool", False, "Passive", "no ROS communication"),
+    Field("gravity", ("gravity",), "vec3", (0.0, 0.0, -9.8), "Gravity override", "m/s², this body only"),
+    Field("publish_children_names", ("publish_children_names",), "bool", False, "Publish children names"),
+    Field("publish_joint_names", ("publish_joint_names",), "bool", False, "Publish joint names"),
+    Field("publish_joint_positions", ("publish_joint_positions",), "bool", False, "Publish joint positions"),
+    *_freq(),
 ]
 
 GHOST = [
@@ -105,7 +116,18 @@ SENSOR = [
     Field("visible", ("visible",), "bool", False, "Visible"),
     Field("visible_size", ("visible_size",), "float", 0.02, "Visible size", min=0.0),
     Field("passive", ("passive",), "bool", False, "Passive"),
+    # resistance sensors (needle-tissue contact)
+    Field("friction_static", ("friction", "static"), "float", 0.5, "Resistance static friction", min=0.0),
+    Field("friction_dynamic", ("friction", "dynamic"), "float", 0.3, "Resistance dynamic friction", min=0.0),
+    Field("friction_damping", ("friction", "damping"), "float", 0.1, "Resistance friction damping", min=0.0),
+    Field("friction_variable", ("friction", "variable"), "bool", False, "Variable friction"),
+    Field("contact_area", ("contact_area",), "float", 0.001, "Contact area", "m", min=0.0),
+    Field("contact_stiffness", ("contact_stiffness",), "float", 1000.0, "Contact stiffness", "N/m", min=0.0),
+    Field("contact_damping", ("contact_damping",), "float", 10.0, "Contact damping", "N·s/m", min=0.0),
+    *_freq(),
 ]
+RESISTANCE_ONLY = {"friction_static", "friction_dynamic", "friction_damping", "friction_variable", "contact_area",
+                   "contact_stiffness", "contact_damping"}
 
 ACTUATOR = [
     Field("type", ("type",), "enum", "Constraint", "Actuator type", items=("Constraint", "constraint", "CONSTRAINT")),
@@ -121,6 +143,10 @@ CAMERA = [
     Field("publish_depth", ("publish_depth",), "bool", False, "Publish depth"),
     Field("image_width", ("publish_image_resolution", "width"), "float", 640.0, "Image width", min=1.0),
     Field("image_height", ("publish_image_resolution", "height"), "float", 480.0, "Image height", min=1.0),
+    Field("publish_image_interval", ("publish_image_interval",), "int", 1, "Publish image interval", "frames"),
+    Field("publish_depth_interval", ("publish_depth_interval",), "int", 1, "Publish depth interval", "frames"),
+    Field("depth_width", ("publish_depth_resolution", "width"), "float", 640.0, "Depth width", min=1.0),
+    Field("depth_height", ("publish_depth_resolution", "height"), "float", 480.0, "Depth height", min=1.0),
     Field("multipass", ("multipass",), "bool", False, "Multipass"),
     Field("passive", ("passive",), "bool", False, "Passive"),
 ]
@@ -134,9 +160,43 @@ LIGHT = [
     Field("passive", ("passive",), "bool", False, "Passive"),
 ]
 
-TABLES = {"BODY": (Body, BODY), "GHOST": (Ghost, GHOST), "JOINT": (Joint, JOINT), "SENSOR": (Sensor, SENSOR),
+_SOFT_FLOATS = ("kLST", "kAST", "kVST", "kVCF", "kDP", "kDG", "kLF", "kPR", "kVC", "kDF", "kMT", "kCHR", "kKHR",
+                "kSHR", "kAHR", "kSRHR_CL", "kSKHR_CL", "kSSHR_CL", "kSR_SPLT_CL", "kSK_SPLT_CL", "kSS_SPLT_CL",
+                "maxvolume", "timescale")
+_SOFT_INTS = ("viterations", "piterations", "diterations", "citerations", "flags", "bending_constraint", "clusters")
+SOFT_DESC = {"kLST": "linear stiffness 0-1", "kAST": "angular stiffness 0-1", "kVST": "volume stiffness 0-1",
+             "kVCF": "velocities correction factor", "kDP": "damping", "kDG": "drag", "kLF": "lift",
+             "kPR": "pressure", "kVC": "volume conservation", "kDF": "dynamic friction 0-1",
+             "kMT": "pose matching 0-1", "kCHR": "rigid contact hardness", "kKHR": "kinetic contact hardness",
+             "kSHR": "soft contact hardness", "kAHR": "anchor hardness", "piterations": "position solver iterations",
+             "viterations": "velocity solver iterations", "diterations": "drift solver iterations",
+             "citerations": "cluster solver iterations", "bending_constraint": "bending constraint distance",
+             "clusters": "cluster count (0: none)", "flags": "collision flags (bit set)"}
+
+# Bullet's btSoftBody defaults (what AMBF uses for a key not written)
+SOFT_DEFAULTS = {"kLST": 1.0, "kAST": 1.0, "kVST": 1.0, "kVCF": 1.0, "kDF": 0.2, "kCHR": 1.0, "kKHR": 0.1,
+                 "kSHR": 1.0, "kAHR": 0.7, "kSRHR_CL": 0.1, "kSKHR_CL": 1.0, "kSSHR_CL": 0.5, "kSR_SPLT_CL": 0.5,
+                 "kSK_SPLT_CL": 0.5, "kSS_SPLT_CL": 0.5, "maxvolume": 1.0, "timescale": 1.0, "piterations": 1,
+                 "viterations": 0, "diterations": 0, "citerations": 4, "flags": 1, "bending_constraint": 2,
+                 "clusters": 0}
+
+SOFT = [
+    Field("mass", ("mass",), "float", 1.0, "Mass", "kg, spread over the nodes", min=0.0),
+    Field("collision_margin", ("collision_margin",), "float", 0.001, "Collision margin", "m", min=0.0),
+    Field("collision_groups", ("collision_groups",), "groups", "", "Collision groups", "comma-separated ints 0-999"),
+    Field("gravity", ("gravity",), "vec3", (0.0, 0.0, -9.8), "Gravity override", "m/s², this body only"),
+    Field("randomize_constraints", ("randomize_constraints",), "bool", False, "Randomize constraints"),
+    *[Field(f"config_{k.lower()}", ("config", k), "float", SOFT_DEFAULTS.get(k, 0.0), k.replace("_", " "), SOFT_DESC.get(k, k), min=0.0)
+      for k in _SOFT_FLOATS],
+    *[Field(f"config_{k.lower()}", ("config", k), "int", SOFT_DEFAULTS.get(k, 0), k.replace("_", " "), SOFT_DESC.get(k, k), min=0)
+      for k in _SOFT_INTS],
+    Field("passive", ("passive",), "bool", False, "Passive"),
+    *_freq(),
+]
+
+TABLES = {"BODY": (Body, BODY), "SOFT_BODY": (SoftBody, SOFT), "GHOST": (Ghost, GHOST), "JOINT": (Joint, JOINT), "SENSOR": (Sensor, SENSOR),
           "ACTUATOR": (Actuator, ACTUATOR), "CAMERA": (Camera, CAMERA), "LIGHT": (Light, LIGHT)}
-PREFIX = {"BODY": "BODY ", "GHOST": "GHOST ", "JOINT": "JOINT ", "SENSOR": "SENSOR ", "ACTUATOR": "ACTUATOR ",
+PREFIX = {"BODY": "BODY ", "SOFT_BODY": "SOFT ", "GHOST": "GHOST ", "JOINT": "JOINT ", "SENSOR": "SENSOR ", "ACTUATOR": "ACTUATOR ",
           "CAMERA": "CAMERA ", "LIGHT": "LIGHT "}
 
 
@@ -176,6 +236,21 @@ def _field_class(parent: Node, name: str):
     raise KeyError(name)
 
 
+PRECISION = {"digits": 9}   # significant digits of floats the add-on computes (scene setting)
+
+
+def tidy(x: float) -> float:
+    """A float from Blender (single precision) as the shortest decimal that is the same
+    float32 (0.004999999888241291 -> 0.005), at most PRECISION significant digits."""
+    import numpy as np
+    x = float(x)
+    if x != x or x in (float("inf"), float("-inf")):
+        return x
+    if abs(x) < 3.4e38 and f32(x) == x:
+        x = float(np.format_float_positional(np.float32(x), unique=True, trim="-")) if x else 0.0
+    return float(f"{x:.{PRECISION['digits']}g}") + 0.0
+
+
 def set_value(obj: Node, f: Field, value) -> None:
     """Write a Blender-form value (or None to remove the key) into the model object."""
     parents = [obj]
@@ -193,20 +268,20 @@ def set_value(obj: Node, f: Field, value) -> None:
     if value is None:
         out = None
     elif f.kind == "inertia":
-        out = Inertia(ix=float(value[0]), iy=float(value[1]), iz=float(value[2]))
+        out = Inertia(ix=tidy(value[0]), iy=tidy(value[1]), iz=tidy(value[2]))
     elif f.kind == "conelimits":
         cur = getattr(v, leaf, None)
         cur = cur if isinstance(cur, Node) else _field_class(v, leaf)()
-        cur.x, cur.y, cur.z = (float(c) for c in value)
+        cur.x, cur.y, cur.z = (tidy(c) for c in value)
         out = cur
     elif f.kind == "pose":
-        out = Pose(Vec3(*map(float, value[:3])), rpy_to_quat(*map(float, value[3:])))
+        out = Pose(Vec3(*map(tidy, value[:3])), rpy_to_quat(*map(tidy, value[3:])))
     elif f.kind == "groups":
         out = parse_groups(value)
     elif f.kind == "vec3":
-        out = Vec3(*map(float, value))
+        out = Vec3(*map(tidy, value))
     elif f.kind == "float":
-        out = float(value)
+        out = tidy(value)
     elif f.kind == "int":
         out = int(value)
     else:

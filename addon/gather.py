@@ -15,7 +15,7 @@ import numpy as np
 from adfkit.diagnostics import Diagnostic, SourceLocation, error, warning
 from adfkit.model import Actuator, Body, Camera, Ghost, Joint, Light, ModelFile, Pose, Sensor
 from adfkit.model.common import Geometry, ShapeEntry
-from adfkit.model.objects import Ray
+from adfkit.model.objects import Ray, SoftBody
 from adfkit.model.pose import Quat, Vec3
 
 from . import fields, joint_frames, meshes
@@ -34,10 +34,17 @@ class MeshJob:
 
 
 @dataclass
+class Options:
+    apply_modifiers: bool = True     # export the evaluated mesh (depsgraph)
+    low_res_ratio: float = 1.0       # decimate collision meshes made from the visual one
+
+
+@dataclass
 class Gathered:
     model: ModelFile
     jobs: list[MeshJob] = field(default_factory=list)
     diagnostics: list[Diagnostic] = field(default_factory=list)
+    options: Options = field(default_factory=Options)
 
 
 def where(obj) -> SourceLocation:
@@ -59,7 +66,7 @@ def unchanged(obj) -> bool:
 
 def world_pose(obj) -> Pose:
     loc, rot, _ = obj.matrix_world.decompose()
-    return Pose(Vec3(*map(float, loc)), Quat(float(rot.x), float(rot.y), float(rot.z), float(rot.w)).normalized())
+    return Pose(Vec3(*map(fields.tidy, loc)), Quat(float(rot.x), float(rot.y), float(rot.z), float(rot.w)).normalized())
 
 
 def uniform_scale(obj) -> float:
@@ -68,7 +75,10 @@ def uniform_scale(obj) -> float:
 
 
 def relative_pose(obj, parent) -> Pose:
-    return world_pose(parent).inverse() * world_pose(obj) if parent is not None else world_pose(obj)
+    if parent is None:
+        return world_pose(obj)
+    p = world_pose(parent).inverse() * world_pose(obj)
+    return Pose(Vec3(*(round(c, 12) + 0.0 for c in p.position)), p.orientation)
 
 
 def adf_parent(obj):
@@ -87,8 +97,10 @@ def gather_body(obj, out: Gathered, paths: tuple[str, str]) -> Body:
         b.name = obj.name
     values = read_group(obj.adf.body, fields.BODY)
     if values.get("mass") is None:
-        out.diagnostics.append(error("body-mass", f"body '{obj.name}' has no mass", where(obj),
-                                     "tick 'Write Mass' in the ADF Body panel (0 makes it static)"))
+        # refused when authored here; a file imported without mass is carried through as AMBF loads it
+        out.diagnostics.append((warning if obj.adf.snapshot and b.mass is None else error)(
+            "body-mass", f"body '{obj.name}' has no mass", where(obj),
+            "tick 'Write Mass' in the ADF Body panel (0 makes it static)"))
     try:
         fields.merge(b, fields.BODY, values)
     except ValueError as exc:
@@ -126,9 +138,9 @@ def gather_ghost(obj, out: Gathered, paths: tuple[str, str]) -> Ghost:
 
 def _parent_ref(old: str | None, parent) -> str | None:
     if parent is None:
-        return None
+        return old  # a parent in another file (or not found at import) is carried through
     ident = identifier(parent)
-    return old if old and old in ident else ident
+    return old if old and (old in ident or old.endswith("/" + ident)) else ident
 
 
 def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
@@ -136,7 +148,8 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
     visual = None
     first_name = b.mesh
     if obj.type == "MESH" and len(obj.data.polygons):
-        arr = meshes.mesh_arrays(obj)
+        # a soft body's nodes are its own vertices (fixed nodes index them): no modifiers there
+        arr = meshes.mesh_arrays(obj, evaluated=out.options.apply_modifiers and not isinstance(b, SoftBody))
         digest = meshes.digest([arr])
         name = b.mesh if b.mesh else f"{obj.name}.OBJ"
         src = Path(obj.adf.mesh_source) if obj.adf.mesh_source else None
@@ -194,7 +207,7 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
         body_inv = np.array(obj.matrix_world.inverted(), dtype=np.float64)
         arrays = []
         for c in parts:
-            a = meshes.mesh_arrays(c)
+            a = meshes.mesh_arrays(c, evaluated=out.options.apply_modifiers)
             m = body_inv @ np.array(c.matrix_world, dtype=np.float64)
             if not np.allclose(m, np.eye(4), atol=1e-7):
                 co = a.co.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
@@ -218,6 +231,14 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
     if visual is not None and not (b.collision_shape or b.compound_collision_shape):
         # no collision of its own: AMBF looks the visual file name up in the low-res folder
         name = b.collision_mesh or visual.filename
+        ratio = out.options.low_res_ratio
+        if ratio < 1.0 and obj.type == "MESH" and b.collision_mesh is None and not isinstance(b, SoftBody):
+            low = meshes.decimated_arrays(obj, ratio)
+            if Path(name).suffix.lower() != ".obj":
+                name = Path(name).stem + ".OBJ"
+                b.collision_mesh = name
+            out.jobs.append(MeshJob(lo, name, meshes.digest([low]), parts=[low]))
+            return
         out.jobs.append(MeshJob(lo, name, visual.digest, parts=visual.parts, source=visual.source))
 
 
@@ -232,8 +253,18 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
     rbc = obj.rigid_body_constraint
     p = rbc.object1 if rbc is not None else None
     c = rbc.object2 if rbc is not None else None
+    if (p is None and j.parent) or (c is None and j.child):
+        # imported with a body that lives in another file: carried through as written
+        out.diagnostics.append(warning("joint-reference", f"joint '{obj.name}': "
+                                       f"{'parent' if p is None else 'child'} body is not in this scene; kept as written",
+                                       where(obj)))
+        if p is not None:
+            j.parent = _parent_ref(j.parent, p)
+        if c is not None:
+            j.child = _parent_ref(j.child, c)
+        return j
     for role, o in (("parent", p), ("child", c)):
-        if o is None or o.adf.kind != "BODY":
+        if o is None or o.adf.kind not in ("BODY", "SOFT_BODY"):
             what = "no object" if o is None else f"'{o.name}', which is not an ADF body"
             out.diagnostics.append(error("joint-reference", f"joint '{obj.name}': its {role} is {what}", where(obj),
                                          f"set the rigid body constraint's {'first' if role == 'parent' else 'second'}"
@@ -261,12 +292,21 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
 
 def _attached(obj, x, out: Gathered, what: str):
     parent = adf_parent(obj)
+    if parent is None and x.parent:
+        # imported with a parent in another file (or not found): carried through as written
+        out.diagnostics.append(warning(f"{what}-parent", f"{what} '{obj.name}': parent '{x.parent}' is not in this "
+                                       "scene; kept as written", where(obj)))
+        if not unchanged(obj):
+            x.location = world_pose(obj)
+            x.extras.pop("location", None)
+        return x
     if parent is None:
         out.diagnostics.append(error(f"{what}-parent", f"{what} '{obj.name}' is not parented to an ADF body", where(obj),
                                      "parent it to the body it is mounted on"))
     x.parent = _parent_ref(x.parent, parent)
-    if not (unchanged(obj) and x.location is not None):
+    if not unchanged(obj):   # unchanged: the location as the file wrote it (or left it out)
         x.location = relative_pose(obj, parent)
+        x.extras.pop("location", None)
     return x
 
 
@@ -279,7 +319,7 @@ def gather_sensor(obj, out: Gathered) -> Sensor:
     if rays and not fields.same32(old, [(*r.offset, *r.direction) for r in rays]):
         s.array = rays
     if not (s.array or s.mesh or s.parametric):
-        out.diagnostics.append(error("sensor-rays", f"sensor '{obj.name}' has no rays", where(obj),
+        out.diagnostics.append((warning if obj.adf.snapshot else error)("sensor-rays", f"sensor '{obj.name}' has no rays", where(obj),
                                      "add rays in the ADF Sensor panel; AMBF skips a sensor without them"))
     return _attached(obj, s, out, "sensor")
 
@@ -342,6 +382,48 @@ def gather_light(obj, out: Gathered) -> Light:
         out.diagnostics.append(warning("light-shadow", f"light '{obj.name}' has no shadow quality", where(obj),
                                        "AMBF leaves it uninitialised; set it (0-5)"))
     return li
+
+
+# --- soft bodies ----------------------------------------------------------------------------
+
+def fixed_nodes(obj) -> list[int] | None:
+    """Node indices of the vertices in the soft body's fixed-node vertex group (None: no group)."""
+    grp = obj.vertex_groups.get(obj.adf.soft.fixed_group) if obj.type == "MESH" else None
+    if grp is None:
+        return None
+    members = [v.index for v in obj.data.vertices if any(g.group == grp.index and g.weight > 0 for g in v.groups)]
+    if not members:
+        return []
+    from adfkit.geometry.softmesh import nodes_at, unique_nodes
+    co = np.empty(len(obj.data.vertices) * 3, np.float32)
+    obj.data.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3).astype(np.float64)
+    # AMBF's numbering: unique vertex positions in order of first appearance
+    return nodes_at(unique_nodes(co, np.zeros((0, 3), dtype=np.int64)), co[members])
+
+
+def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
+    from adfkit.model.objects import SoftBodyConfig
+    sb = fields.from_snapshot(SoftBody, obj.adf.snapshot, f"blender:{obj.name}")
+    sb.identifier = identifier(obj)
+    if sb.name is None:
+        sb.name = obj.name
+    try:
+        fields.merge(sb, fields.SOFT, read_group(obj.adf.soft, fields.SOFT))
+    except ValueError as exc:
+        out.diagnostics.append(error("body-value", f"soft body '{obj.name}': {exc}", where(obj)))
+    _pose_and_scale(obj, sb)
+    _gather_geometry(obj, sb, out, paths)
+    fixed = fixed_nodes(obj)
+    old = sb.config.fixed_nodes if sb.config is not None else None
+    if fixed is not None and sorted(set(old or [])) != fixed and not (fixed == [] and old is None):
+        if sb.config is None:
+            sb.config = SoftBodyConfig()
+        sb.config.fixed_nodes = fixed
+    if obj.type != "MESH" and not sb.mesh:
+        out.diagnostics.append(error("soft-body-mesh", f"soft body '{obj.name}' has no mesh", where(obj),
+                                     "a soft body's nodes are its mesh's vertices: make it a mesh object"))
+    return sb
 
 
 GATHER = {"SENSOR": ("sensors", gather_sensor), "ACTUATOR": ("actuators", gather_actuator),

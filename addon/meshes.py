@@ -33,9 +33,37 @@ class MaterialInfo:
     normal_map: str | None = None
 
 
-def mesh_arrays(obj, name: str | None = None) -> MeshArrays:
-    """Arrays of an object's own mesh data (no modifiers, object frame)."""
-    me = obj.data
+def mesh_arrays(obj, name: str | None = None, evaluated: bool = False) -> MeshArrays:
+    """Arrays of an object's mesh in its frame: its own data, or with ``evaluated`` the mesh
+    its modifiers make (Blender's depsgraph), as the viewport shows it."""
+    if evaluated and len(obj.modifiers):
+        import bpy
+        eo = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        me = eo.to_mesh()
+        try:
+            return _arrays(obj, me, name)
+        finally:
+            eo.to_mesh_clear()
+    return _arrays(obj, obj.data, name)
+
+
+def decimated_arrays(obj, ratio: float) -> MeshArrays:
+    """The object's evaluated mesh decimated (Blender's Decimate modifier, collapse, added
+    last for the moment) to ``ratio`` of its faces: a low-resolution collision mesh."""
+    import bpy
+    mod = obj.modifiers.new("adfkit-low-res", "DECIMATE")
+    try:
+        mod.ratio = float(ratio)
+        bpy.context.view_layer.update()
+        arr = mesh_arrays(obj, evaluated=True)
+    finally:
+        obj.modifiers.remove(mod)
+        bpy.context.view_layer.update()
+    arr.uv, arr.materials, arr.material_index = None, [], None
+    return arr
+
+
+def _arrays(obj, me, name: str | None) -> MeshArrays:
     n, m, f = len(me.vertices), len(me.loops), len(me.polygons)
     co = np.empty(n * 3, np.float32)
     me.vertices.foreach_get("co", co)

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from adfkit.diagnostics import AdfError
 
@@ -74,7 +74,7 @@ class _ActiveBody:
     @classmethod
     def poll(cls, context):
         o = context.active_object
-        return o is not None and o.adf.kind in ("BODY", "GHOST")
+        return o is not None and o.adf.kind in ("BODY", "GHOST", "SOFT_BODY")
 
 
 class ADF_OT_generate_collision(_ActiveBody, bpy.types.Operator):
@@ -108,13 +108,102 @@ class ADF_OT_estimate_inertia(_ActiveBody, bpy.types.Operator):
     bl_description = "Mass (from density, or keep the mass), inertia and inertial offset from the closed mesh"
 
     def execute(self, context):
-        o = context.active_object
-        b = o.adf.body
         try:
-            authoring.estimate_inertia(o, mass=b.mass if b.use_mass and b.mass > 0 else None,
-                                       density=None if b.use_mass and b.mass > 0 else o.adf.density)
+            authoring.estimate_body(context.active_object)
         except AdfError as exc:
             return _report(self, exc)
+        return {"FINISHED"}
+
+
+class ADF_OT_estimate_all(bpy.types.Operator):
+    bl_idname = "adf.estimate_all"
+    bl_label = "Estimate all bodies"
+    bl_description = "Mass (density × volume unless typed by hand), inertia and inertial offset of every ADF body"
+
+    def execute(self, context):
+        done, skipped = authoring.estimate_all(context.scene)
+        context.scene.adf.findings = "\n".join(f"INFO: not estimated: {s}" for s in skipped)
+        self.report({"INFO"}, f"{len(done)} bodies estimated, {len(skipped)} skipped")
+        return {"FINISHED"}
+
+
+class ADF_OT_fit_primitive(_ActiveBody, bpy.types.Operator):
+    bl_idname = "adf.fit_collision_primitive"
+    bl_label = "Fit collision primitive"
+    bl_description = "Replace the body's collision with an oriented primitive fitted around its mesh"
+    shape: EnumProperty(items=[(s, s.title(), s.title()) for s in SHAPES], default="CAPSULE")
+
+    def execute(self, context):
+        try:
+            authoring.fit_collision_primitive(context.active_object, self.shape)
+        except AdfError as exc:
+            return _report(self, exc)
+        return {"FINISHED"}
+
+
+class ADF_OT_fix_nodes(bpy.types.Operator):
+    bl_idname = "adf.fix_selected_nodes"
+    bl_label = "Fixed nodes = selected vertices"
+    bl_description = "The soft body's fixed nodes become the selected vertices (its fixed-node vertex group)"
+
+    @classmethod
+    def poll(cls, context):
+        o = context.active_object
+        return o is not None and o.adf.kind == "SOFT_BODY" and o.type == "MESH"
+
+    def execute(self, context):
+        picked = authoring.fix_selected_nodes(context.active_object)
+        self.report({"INFO"}, f"{len(picked)} fixed nodes")
+        return {"FINISHED"}
+
+
+class ADF_OT_estimate_gains(bpy.types.Operator):
+    bl_idname = "adf.estimate_gains"
+    bl_label = "Estimate joint controller gains"
+    bl_description = "P and D of each selected joint (all joints if none is selected) from what it moves"
+    frequency: FloatProperty(name="Frequency (Hz)", default=2.0, min=0.01)
+    damping_ratio: FloatProperty(name="Damping ratio", default=1.0, min=0.0)
+
+    def execute(self, context):
+        from .tuning import estimate_gains
+        joints = [o for o in context.selected_objects if o.adf.kind == "JOINT"] or \
+                 [o for o in context.scene.objects if o.adf.kind == "JOINT"]
+        done = estimate_gains(context.scene, joints, self.frequency, self.damping_ratio)
+        self.report({"INFO"}, f"gains of {len(done)} joints")
+        return {"FINISHED"}
+
+
+class ADF_OT_show_joints(bpy.types.Operator):
+    bl_idname = "adf.show_joints"
+    bl_label = "Show/hide joints"
+    show: BoolProperty(name="Show", default=True)
+
+    def execute(self, context):
+        from .tuning import show_joints
+        show_joints(context.scene, self.show)
+        return {"FINISHED"}
+
+
+class ADF_OT_cleanup(bpy.types.Operator):
+    bl_idname = "adf.cleanup"
+    bl_label = "Clean up ADF scene"
+    bl_description = "Remove joints without bodies and stray collision objects; clear ADF data of unmarked objects"
+
+    def execute(self, context):
+        from .tuning import cleanup
+        said = cleanup(context.scene)
+        context.scene.adf.findings = "\n".join(f"INFO: {s}" for s in said)
+        self.report({"INFO"}, f"{len(said)} clean-ups")
+        return {"FINISHED"}
+
+
+class ADF_OT_strip(bpy.types.Operator):
+    bl_idname = "adf.strip"
+    bl_label = "Remove ADF data from selected"
+
+    def execute(self, context):
+        from .tuning import strip
+        self.report({"INFO"}, f"{strip(context.selected_objects)} objects made plain")
         return {"FINISHED"}
 
 
@@ -181,7 +270,9 @@ class ADF_OT_check(bpy.types.Operator):
 
 
 CLASSES = (ADF_OT_export, ADF_OT_import, ADF_OT_mark, ADF_OT_generate_collision, ADF_OT_add_primitive,
-           ADF_OT_estimate_inertia, ADF_OT_add_joint, ADF_OT_rope, ADF_OT_grasp, ADF_OT_ghost, ADF_OT_check)
+           ADF_OT_estimate_inertia, ADF_OT_add_joint, ADF_OT_rope, ADF_OT_grasp, ADF_OT_ghost, ADF_OT_check,
+           ADF_OT_estimate_all, ADF_OT_fit_primitive, ADF_OT_estimate_gains, ADF_OT_show_joints, ADF_OT_cleanup,
+           ADF_OT_strip, ADF_OT_fix_nodes)
 
 
 def _menu_export(self, context):

@@ -12,6 +12,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 from . import fields
 
 KINDS = (("NONE", "None", "Not part of the ADF model"), ("BODY", "Body", "Rigid body"),
+         ("SOFT_BODY", "Soft body", "Bullet soft body (cloth, tissue): its nodes are the mesh's vertices"),
          ("GHOST", "Ghost", "Non-colliding trigger volume"), ("SENSOR", "Sensor", "Ray sensor"),
          ("ACTUATOR", "Actuator", "Constraint actuator"), ("CAMERA", "Camera", "ADF camera"),
          ("LIGHT", "Light", "ADF spot light"), ("JOINT", "Joint", "Joint (rigid body constraint on this object)"),
@@ -20,8 +21,10 @@ KINDS = (("NONE", "None", "Not part of the ADF model"), ("BODY", "Body", "Rigid 
 SHAPES = ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE")
 
 
-def _prop(f: fields.Field):
+def _prop(f: fields.Field, update=None):
     kw = {"name": f.label, "description": f.desc or f.label}
+    if update is not None:
+        kw["update"] = update
     if f.kind == "float":
         kw.update(default=f.default, precision=6)
         if f.min is not None:
@@ -40,12 +43,16 @@ def _prop(f: fields.Field):
     return StringProperty(default=str(f.default), **kw)
 
 
-def _make_group(name: str, table: list[fields.Field], extra: dict | None = None):
+def _make_group(name: str, table: list[fields.Field], extra: dict | None = None, updates: dict | None = None):
     ann = {}
+    updates = updates or {}
     for f in table:
-        ann[f.prop] = _prop(f)
+        up = updates.get(f.prop)
+        value_up, use_up = up if isinstance(up, tuple) else (up, up)
+        ann[f.prop] = _prop(f, value_up)
+        kw = {"update": use_up} if use_up is not None else {}
         ann["use_" + f.prop] = BoolProperty(name=f"Write {f.label}", default=False,
-                                            description=f"Write '{' '.join(f.path)}' (off: AMBF default)")
+                                            description=f"Write '{' '.join(f.path)}' (off: AMBF default)", **kw)
     ann.update(extra or {})
     return type(name, (bpy.types.PropertyGroup,), {"__annotations__": ann})
 
@@ -55,30 +62,60 @@ class AdfRay(bpy.types.PropertyGroup):
     direction: FloatVectorProperty(name="Direction", size=3, default=(1.0, 0.0, 0.0), precision=6)
 
 
+def _outline(self, context):
+    from .outline import update_outline
+    update_outline(self.id_data)
+
+
 class AdfShape(bpy.types.PropertyGroup):
-    shape: EnumProperty(name="Shape", items=[(s, s.title(), s.title()) for s in SHAPES], default="BOX")
+    shape: EnumProperty(name="Shape", items=[(s, s.title(), s.title()) for s in SHAPES], default="BOX",
+                        update=_outline)
     size: FloatVectorProperty(name="Box size", size=3, default=(0.1, 0.1, 0.1), min=0.0, precision=6,
-                              description="full edge lengths x, y, z (m)")
-    radius: FloatProperty(name="Radius", default=0.05, min=0.0, precision=6)
-    height: FloatProperty(name="Height", default=0.1, min=0.0, precision=6)
-    axis: EnumProperty(name="Axis", items=[(a, a, a) for a in "xyzXYZ"], default="z")
+                              description="full edge lengths x, y, z (m)", update=_outline)
+    radius: FloatProperty(name="Radius", default=0.05, min=0.0, precision=6, update=_outline)
+    height: FloatProperty(name="Height", default=0.1, min=0.0, precision=6, update=_outline)
+    axis: EnumProperty(name="Axis", items=[(a, a, a) for a in "xyzXYZ"], default="z", update=_outline)
 
 
-BodyProps = _make_group("AdfBodyProps", fields.BODY)
+def _mass_typed(self, context):
+    self.mass_typed = True
+
+
+def _joint_limits(self, context):
+    from .constraints import mirror_limits
+    mirror_limits(self.id_data)
+
+
+_LIMIT_PROPS = ("type", "limit_low", "limit_high", "cone_limits", "linear_low", "linear_high", "angular_low",
+                "angular_high")
+_TYPED = {"mass_typed": BoolProperty(name="Mass typed by hand", default=False,
+                                     description="off: mass follows density × mesh volume")}
+BodyProps = _make_group("AdfBodyProps", fields.BODY, dict(_TYPED), {"mass": (_mass_typed, None)})
+SoftProps = _make_group("AdfSoftProps", fields.SOFT, {
+    **_TYPED, "fixed_group": StringProperty(name="Fixed nodes group", default="fixed nodes",
+                                             description="vertex group whose vertices are the soft body's fixed nodes")},
+    {"mass": (_mass_typed, None)})
 GhostProps = _make_group("AdfGhostProps", fields.GHOST)
-JointProps = _make_group("AdfJointProps", fields.JOINT)
+JointProps = _make_group("AdfJointProps", fields.JOINT, None, {k: _joint_limits for k in _LIMIT_PROPS})
 SensorProps = _make_group("AdfSensorProps", fields.SENSOR, {"rays": CollectionProperty(type=AdfRay)})
 ActuatorProps = _make_group("AdfActuatorProps", fields.ACTUATOR)
 CameraProps = _make_group("AdfCameraProps", fields.CAMERA)
 LightProps = _make_group("AdfLightProps", fields.LIGHT)
-GROUP_OF = {"BODY": "body", "GHOST": "ghost", "JOINT": "joint", "SENSOR": "sensor", "ACTUATOR": "actuator",
+GROUP_OF = {"BODY": "body", "SOFT_BODY": "soft", "GHOST": "ghost", "JOINT": "joint", "SENSOR": "sensor", "ACTUATOR": "actuator",
             "CAMERA": "camera", "LIGHT": "light"}
+
+
+def _density(self, context):
+    if self.kind in ("BODY", "SOFT_BODY"):
+        from .authoring import mass_from_density
+        mass_from_density(self.id_data)
 
 
 class AdfObjectProps(bpy.types.PropertyGroup):
     kind: EnumProperty(name="ADF kind", items=KINDS, default="NONE")
     identifier: StringProperty(name="Identifier", description="ADF mapping key; empty: '<KIND> <object name>'")
     body: PointerProperty(type=BodyProps)
+    soft: PointerProperty(type=SoftProps)
     ghost: PointerProperty(type=GhostProps)
     joint: PointerProperty(type=JointProps)
     sensor: PointerProperty(type=SensorProps)
@@ -93,7 +130,8 @@ class AdfObjectProps(bpy.types.PropertyGroup):
     mesh_hash: StringProperty(options={"HIDDEN"})
     collision_source: StringProperty(name="Collision source", description="file the collision mesh came from")
     collision_hash: StringProperty(options={"HIDDEN"})
-    density: FloatProperty(name="Density", default=1000.0, min=0.0, description="kg/m³, for inertia estimation")
+    density: FloatProperty(name="Density", default=1000.0, min=0.0, update=_density,
+                           description="kg/m³: the mass is density × mesh volume unless typed by hand")
 
 
 class AdfSceneProps(bpy.types.PropertyGroup):
@@ -107,9 +145,17 @@ class AdfSceneProps(bpy.types.PropertyGroup):
     rope_length: FloatProperty(name="Length", default=0.2, min=0.001, precision=4)
     rope_radius: FloatProperty(name="Radius", default=0.001, min=0.0001, precision=5)
     rope_mass: FloatProperty(name="Total mass", default=0.002, min=0.0, precision=5)
+    precision: IntProperty(name="Float digits", default=9, min=3, max=17,
+                           description="significant digits of exported floats (values Blender stores in single "
+                                       "precision print as 0.005, not 0.004999999888241291)")
+    apply_modifiers: BoolProperty(name="Apply modifiers", default=True,
+                                  description="export the evaluated mesh (modifiers applied) of each body")
+    low_res_ratio: FloatProperty(name="Low-res ratio", default=1.0, min=0.01, max=1.0,
+                                 description="collision (low-res) meshes made from the visual one are decimated to "
+                                             "this share of its faces (1: same mesh)")
 
 
-CLASSES = (AdfRay, AdfShape, BodyProps, GhostProps, JointProps, SensorProps, ActuatorProps, CameraProps,
+CLASSES = (AdfRay, AdfShape, BodyProps, SoftProps, GhostProps, JointProps, SensorProps, ActuatorProps, CameraProps,
            LightProps, AdfObjectProps, AdfSceneProps)
 
 

@@ -9,6 +9,8 @@ from .properties import group
 
 
 def _visible(kind: str, pg, f: fields.Field) -> bool:
+    if kind == "SENSOR":
+        return f.prop not in fields.RESISTANCE_ONLY or (pg.use_type and pg.type.lower() == "resistance")
     if kind != "JOINT":
         return True
     t = pg.type
@@ -57,9 +59,20 @@ def draw_object(layout, obj) -> None:
         sub = row.row()
         sub.enabled = getattr(pg, "use_" + f.prop)
         sub.prop(pg, f.prop)
+    if adf.kind == "SOFT_BODY":
+        layout.prop(adf, "density")
+        if obj.type == "MESH":
+            layout.prop_search(pg, "fixed_group", obj, "vertex_groups", text="Fixed nodes")
+            layout.operator("adf.fix_selected_nodes")
+            if pg.fixed_group not in obj.vertex_groups:
+                layout.label(text="No such vertex group: no fixed nodes written", icon="INFO")
+        else:
+            layout.label(text="A soft body needs a mesh: its vertices are the nodes", icon="ERROR")
     if adf.kind == "BODY":
         if not pg.use_mass:
             layout.label(text="No mass: AMBF warns and uses 1 kg with an estimated inertia", icon="ERROR")
+        elif not pg.mass_typed:
+            layout.label(text="Mass from density × volume (type a mass to keep it)", icon="INFO")
         try:
             fields.parse_groups(pg.collision_groups)
         except ValueError as exc:
@@ -68,6 +81,7 @@ def draw_object(layout, obj) -> None:
         col = layout.column(align=True)
         col.operator("adf.estimate_inertia")
         col.operator("adf.generate_collision")
+        col.operator_menu_enum("adf.fit_collision_primitive", "shape")
         col.operator_menu_enum("adf.add_collision_primitive", "shape")
         col.operator("adf.add_grasp")
     if adf.kind == "JOINT":
@@ -112,6 +126,19 @@ class ADF_PT_sidebar(bpy.types.Panel):
         row = lay.row(align=True)
         row.prop(sc, "use_namespace", text="")
         row.prop(sc, "namespace")
+        box = lay.box()
+        box.label(text="Export")
+        box.prop(sc, "precision")
+        box.prop(sc, "apply_modifiers")
+        box.prop(sc, "low_res_ratio")
+        col = lay.column(align=True)
+        col.operator("adf.estimate_all")
+        col.operator("adf.estimate_gains")
+        row = col.row(align=True)
+        row.operator("adf.show_joints", text="Show joints").show = True
+        row.operator("adf.show_joints", text="Hide joints").show = False
+        col.operator("adf.cleanup")
+        col.operator("adf.strip")
         box = lay.box()
         box.label(text="Thread")
         box.prop(sc, "rope_count")

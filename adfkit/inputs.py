@@ -54,6 +54,8 @@ def shown(path: str | os.PathLike | bytes, limit: int = 240) -> str:
         text = os.fspath(path)
         if isinstance(text, bytes):  # pragma: no cover - fspath of a bytes path-like
             text = text.decode("utf-8", "backslashreplace")
+    if text.isprintable() and len(text) <= limit:  # the common case, checked in C
+        return text
     out = []
     for ch in text:
         code = ord(ch)

@@ -1,6 +1,8 @@
 """Counts that describe a launch, world or model file (what `adfkit info` prints)."""
 from __future__ import annotations
 
+import os
+
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -24,7 +26,7 @@ def model_summary(model: ModelFile) -> dict[str, Any]:
             c = collision_mesh_path(model, obj)
             if c is not None:
                 meshes.add(c)
-    missing = sorted(str(p) for p in meshes if not p.exists())
+    missing = sorted(str(p) for p in meshes if not os.path.lexists(p))  # lexists: never raises on odd names
     dynamic = [b for b in model.bodies if effective_mass(b) > 0]
     return {
         "kind": "model",

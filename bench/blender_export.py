@@ -15,7 +15,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT.parent / "shared" / "corpus"
 MODELS = {"psm": CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-psm.yaml",
-          "phantom": CORPUS / "src/ADF/Phantoms/Simple/phantom.yaml"}
+          "phantom": CORPUS / "src/ADF/Phantoms/Simple/phantom.yaml",
+          "cloth (soft body)": CORPUS / "ambf/ambf_models/descriptions/multi-bodies/sb/cloth.yaml",
+          "soft phantom (sample)": ROOT / "sample_scenes/soft_phantom/phantom.yaml"}
 
 
 def main() -> int:
@@ -37,10 +39,11 @@ def main() -> int:
             times = []
             for step in ("first", "unchanged", "one mesh edited"):
                 if step == "one mesh edited":
-                    o = next(o for o in bpy.context.scene.objects if o.adf.kind == "BODY" and o.type == "MESH")
+                    o = next(o for o in bpy.context.scene.objects
+                             if o.adf.kind in ("BODY", "SOFT_BODY") and o.type == "MESH")
                     o.data.vertices[0].co.x += 1e-4
                 t0 = time.perf_counter()
-                res = addon.export.export_scene(bpy.context.scene, tmp, name)
+                res = addon.export.export_scene(bpy.context.scene, tmp, name.split()[0])
                 times.append((step, time.perf_counter() - t0, len(res.written), len(res.skipped), res.ok))
             print(f"{name}: {len(made)} objects, import {t_import:.2f} s")
             for step, t, w, s, ok in times:

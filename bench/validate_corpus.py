@@ -33,7 +33,7 @@ def main() -> int:
     from adfkit.validator import validate_file
     from adfkit.validator.engine import expand
 
-    files, _ = expand([corpus])
+    files = [f for f, _tree in expand([corpus])[0]]
     n = len(files)
 
     # 1. adfkit CLI, start-up included (no following of launch files: each file once).

@@ -77,3 +77,22 @@ def test_extension_builds_with_blenders_tool_and_bundles_adfkit(tmp_path):
     assert any(n.startswith("wheels/adfkit-") and n.endswith(".whl") for n in names)
     assert "build_wheels.sh" not in names and not any("__pycache__" in n for n in names)
     assert _run("validate", str(zip_path)).returncode == 0
+
+
+def test_geometry_packages_are_bundled_at_the_tested_versions():
+    """build_wheels.sh downloads the geometry wheels at the versions this suite runs with,
+    and the manifest lists them for every platform (Generate convex collision in Blender)."""
+    import importlib.metadata
+    import re
+    script = (ADDON / "build_wheels.sh").read_text()
+    pins = dict(re.findall(r"([A-Za-z0-9_.-]+)==([0-9][^\s\"]*)", script.split("geometry_pins=", 1)[1].split("\n")[0]))
+    assert set(pins) == {"trimesh", "manifold3d", "coacd", "scipy", "networkx"}
+    for name, version in pins.items():
+        try:
+            assert importlib.metadata.version(name) == version, name
+        except importlib.metadata.PackageNotFoundError:
+            pytest.skip(f"{name} is not installed here")
+    manifest = (ADDON / "blender_manifest.toml").read_text()
+    for name in ("coacd", "manifold3d", "scipy"):   # binary: one wheel per platform
+        listed = re.findall(rf'"\./wheels/({name}-[^"]+)"', manifest)
+        assert len(listed) == 3 and any("win_amd64" in w for w in listed) and any("macosx" in w for w in listed)

@@ -81,7 +81,7 @@ def test_run_refuses_bad_options(box_model, capsys, args, said):
 
 def test_run_refuses_a_missing_file(tmp_path, capsys):
     assert main(["run", str(tmp_path / "nothing.yaml")]) == 2
-    assert "does not exist" in capsys.readouterr().err
+    assert f"{tmp_path / 'nothing.yaml'}: error[file-not-found]: no such ADF file" in capsys.readouterr().err
 
 
 def test_demo_plays_the_bundled_scene(tmp_path, capsys):

@@ -1,8 +1,9 @@
 """`adfkit demo`: what `make run` does — play the suturing scene headless for a few seconds in
 the PyBullet runner and write a report and camera images into run-output/.
 
-The scene is the corpus suturing set (launch indices 6-11) when ../shared/corpus is present,
-else the bundled primitive-only suturing-pad sample scene."""
+The scene is the project's own suturing scene, bundled in sample_scenes/suturing/ (two PSMs,
+the phantom, the needle and its thread; see `adfkit build-scene suturing`). The challenge's
+scene files play with ``--scene ../shared/corpus/src/launch.yaml -l 6-11``."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,9 +12,7 @@ NAME = "demo"
 HELP = "play the suturing scene headless for a few seconds and write a report and camera images"
 
 ROOT = Path(__file__).resolve().parents[2]
-BUNDLED = ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"
-CORPUS_LAUNCH = ROOT.parent / "shared" / "corpus" / "src" / "launch.yaml"
-CORPUS_INDICES = "6-11"
+BUNDLED = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
 
 
 def add_arguments(p) -> None:
@@ -34,13 +33,11 @@ def run(args) -> int:
 
     if args.scene:
         launch, indices = Path(args.scene), args.indices
-    elif CORPUS_LAUNCH.is_file():
-        launch, indices = CORPUS_LAUNCH, CORPUS_INDICES
     else:
         launch, indices = BUNDLED, None
         if not launch.exists():  # installed without the repository's sample_scenes/: author it now
-            from ..scenes import write_suturing_pad
-            launch = write_suturing_pad(Path(tempfile.mkdtemp(prefix="adfkit-demo-")))
+            from ..scenes import write_suturing
+            launch = write_suturing(Path(tempfile.mkdtemp(prefix="adfkit-demo-")))
     diags: list = []
     scene = load_scene(launch, parse_indices(indices) if indices else None, diags)
     print_diagnostics(diags, sys.stderr)

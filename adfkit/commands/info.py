@@ -27,8 +27,17 @@ def run(args) -> int:
         doc = load_scene(args.path, parse_indices(args.indices), diags)
     else:
         doc, diags = read_file(args.path, args.kind)
-    print_diagnostics(diags, sys.stderr)
     summary = summarize(doc)
+    try:  # a sum of huge masses can overflow: never print `total mass: inf` (or NaN) with exit 0
+        json.dumps(summary, allow_nan=False)
+    except ValueError:
+        from ..diagnostics import SourceLocation, error
+        where = getattr(doc, "source", None) or SourceLocation(str(args.path), 1, 1)
+        diags = [*diags, error("non-finite-number", "a total (mass) overflows to infinity or NaN", where,
+                               "check the bodies' masses; `adfkit validate` shows the implausible values")]
+        print_diagnostics(diags, sys.stderr)
+        return 2
+    print_diagnostics(diags, sys.stderr)
     if args.json:
         jsonout.dump(summary, sys.stdout, indent=2)
         sys.stdout.write("\n")

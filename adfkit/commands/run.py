@@ -36,8 +36,9 @@ def run(args) -> int:
     from ..runner.play import play, summary, unstable
     from ..runner.world import Options, SimWorld
 
-    if not Path(args.path).is_file():
-        raise AdfError(error("no-file", f"{args.path} does not exist", None, "give a launch, world or model file"))
+    from .. import inputs
+
+    inputs.check_file(args.path, what="ADF file")  # a regular file (adfkit.inputs), located errors
     if (args.seconds <= 0 or args.physics_hz <= 0 or args.control_substeps < 1 or args.solver_iterations < 1
             or (args.contact_threshold is not None and args.contact_threshold <= 0)):
         raise AdfError(error("bad-option", "--seconds, --physics-hz and --contact-threshold must be positive, "
@@ -53,6 +54,10 @@ def run(args) -> int:
                                  "e.g. --gravity 0,0,-9.81")) from None
     diags: list = []
     scene = load_scene(args.path, parse_indices(args.indices), diags)
+    # the validator's severities: what AMBF loads anyway (duplicate keys, sb/cloth.yaml) is a warning
+    from dataclasses import replace
+    from ..validator.engine import SEVERITY_OVERRIDES
+    diags = [replace(d, severity=SEVERITY_OVERRIDES.get(d.rule, d.severity)) for d in diags]
     print_diagnostics(diags, sys.stderr)
     if any(d.severity >= Severity.ERROR for d in diags):
         return 2

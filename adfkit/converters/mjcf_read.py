@@ -89,16 +89,19 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
         frames[b] = _visual_mesh_frame(m, b, meshes)
         world_pose[b] = _pose(d.xpos[b], d.xquat[b]) * frames[b]
     bodies: dict[int, Body] = {}
+    flex = _flex_vertex_bodies(m, losses)   # MuJoCo's bodies for flex vertices: not ADF bodies
     # the world body becomes a static ADF body when something is attached to it
     needs_world = any(m.geom_bodyid[g] == 0 for g in range(m.ngeom)) or any(
         m.body_parentid[b] == 0 and m.body_jntnum[b] > 0 and m.jnt_type[m.body_jntadr[b]] != FREE
-        for b in range(1, m.nbody))
+        for b in range(1, m.nbody) if b not in flex)
     if needs_world:
         names[0], frames[0], world_pose[0] = "world", Pose(), Pose()
         bodies[0] = Body(identifier="BODY world", name="world", location=Pose(), mass=0.0)
         _read_geoms(m, 0, bodies[0], meshes, losses, Pose())
         model.bodies.append(bodies[0])
     for b in range(1, m.nbody):
+        if b in flex:
+            continue
         who = f"BODY {names[b]}"
         body = Body(identifier=who, name=names[b], location=world_pose[b])
         body.mass = float(m.body_mass[b])
@@ -109,6 +112,8 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
         bodies[b] = body
         model.bodies.append(body)
     for b in range(1, m.nbody):
+        if b in flex:
+            continue
         _read_joint(m, b, names, bodies, world_pose, frames, model, losses)
     _read_equalities(m, names, bodies, world_pose, frames, model, losses)
     mujoco.mj_comPos(m, d)
@@ -122,6 +127,21 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
             losses.append(Loss(nm, label, "not converted to ADF"))
     model.present_lists.update({"bodies", "joints"} | {k for k in ("cameras", "lights") if getattr(model, k)})
     return model, sorted(set(losses))
+
+
+def _flex_vertex_bodies(m, losses) -> set[int]:
+    """Bodies MuJoCo made for flex vertices (flexcomp), each flex a named loss: an ADF soft
+    body needs a mesh file, which a reader does not write."""
+    import mujoco
+
+    out: set[int] = set()
+    for f in range(getattr(m, "nflex", 0)):
+        adr, num = int(m.flex_vertadr[f]), int(m.flex_vertnum[f])
+        out.update(int(b) for b in m.flex_vertbodyid[adr:adr + num] if int(b) > 0)
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_FLEX, f) or f"flex {f}"
+        losses.append(Loss(name, "flex", f"a MuJoCo flex ({num} vertices) is not read: "
+                           "an ADF soft body needs a mesh file; export the flex as OBJ and list it in 'soft bodies'"))
+    return out
 
 
 def _visual_mesh_frame(m, b: int, meshes) -> Pose:

@@ -27,6 +27,7 @@ from . import inertia as inertia_math
 from .engine_fit import MeshFiles, flat_box, joint_range, usable_scales
 from .losses import Loss
 from .mjcf_cameras import write_cameras_lights
+from .mjcf_soft import write_soft_bodies
 from .safexml import to_text
 from ..model.tree import Link, build_tree, motion
 from .urdf import INITIAL_VALUE_TOLERANCE, _AXIS_TO_Z, _BODY_ONLY, _link_name, _joint_name, _material, _num, _unique, _vec
@@ -40,7 +41,6 @@ MIN_MASS = 1e-6
 MIN_INERTIA = 1e-9
 
 _LOSSY_OBJECTS = (("ghost_objects", "ghost object"), ("sensors", "sensor"), ("actuators", "actuator"),
-                  ("soft_bodies", "soft body"),
                   ("vehicles", "vehicle"), ("volumes", "volume"))
 
 
@@ -217,8 +217,8 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None) -> tuple[s
     losses: list[Loss] = []
     model = usable_scales(model, losses)
     tree = build_tree(model)
-    if not tree.roots:
-        raise AdfError(error("convert-empty", "the model has no bodies; there is nothing to write as MJCF",
+    if not tree.roots and not any(sb.defined for sb in model.soft_bodies):
+        raise AdfError(error("convert-empty", "the model has no bodies or soft bodies; there is nothing to write as MJCF",
                              model.where(), "convert a model file with at least one body"))
     root = ET.Element("mujoco", model=name or model.name)
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
@@ -266,6 +266,7 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None) -> tuple[s
     if eq is not None:
         root.append(eq)
     write_cameras_lights(model, tree, elements, world, used, losses)
+    write_soft_bodies(model, world, used, losses)
     for j in tree.unresolved:
         losses.append(Loss(j.identifier, "joint", "unknown type or parent/child body not in this file"))
     for attr, label in _LOSSY_OBJECTS:

@@ -126,6 +126,11 @@ class SoftBodyConfig(Node):
 
 @dataclass(kw_only=True)
 class SoftBody(_Comm, _Collision, _Visual, _Ident):
+    """A soft body (§7.8): a btSoftBody whose nodes are the unique vertices of the collision
+    mesh. AMBF reads the keys declared here; `linear gain`, `angular gain` and
+    `config.cutting` are read into nodes but never used, and `config.margin` is not read at
+    all: those stay in ``extras`` (written back unchanged, reported as ignored keys)."""
+
     location: Pose | None = key("location", "pose")
     scale: float | None = key("scale", "float")
     mass: float | None = key("mass", "float")

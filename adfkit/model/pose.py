@@ -31,7 +31,7 @@ class Vec3(NamedTuple):
         return Vec3(self.y * o[2] - self.z * o[1], self.z * o[0] - self.x * o[2], self.x * o[1] - self.y * o[0])
 
     def norm(self) -> float:
-        return math.sqrt(self.dot(self))
+        return math.hypot(self.x, self.y, self.z)  # no overflow for components near 1e308
 
     def normalized(self) -> "Vec3":
         n = self.norm()

@@ -196,8 +196,8 @@ def collision_primitives(body) -> list[Primitive] | None:
 def normalized_or(v: Vec3 | None, fallback: Vec3) -> Vec3:
     if v is None:
         return fallback
-    n = math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2)
-    return Vec3(v[0] / n, v[1] / n, v[2] / n) if n > 0 else fallback
+    n = math.hypot(v[0], v[1], v[2])  # never overflows (1e308 ** 2 raises OverflowError)
+    return Vec3(v[0] / n, v[1] / n, v[2] / n) if 0.0 < n < math.inf else fallback
 
 
 def shortest_arc(u: Vec3, v: Vec3) -> Quat:

@@ -8,6 +8,7 @@ A field left ``None`` was not written by the user; effective defaults live in
 """
 from __future__ import annotations
 
+from functools import lru_cache
 from dataclasses import MISSING, dataclass, field, fields
 from typing import Any
 
@@ -61,10 +62,21 @@ class Obj(Node):
     defined: bool = True
 
 
+@lru_cache(maxsize=None)
+def _adf_fields_of(cls: type) -> tuple:
+    return tuple(f for f in fields(cls) if "adf_key" in f.metadata)
+
+
+@lru_cache(maxsize=None)
+def _adf_keys_of(cls: type) -> frozenset:
+    return frozenset(f.metadata["adf_key"] for f in _adf_fields_of(cls))
+
+
 def adf_fields(cls_or_obj) -> list:
-    """The dataclass fields of an element that mirror ADF keys, in declaration order."""
-    return [f for f in fields(cls_or_obj) if "adf_key" in f.metadata]
+    """The dataclass fields of an element that mirror ADF keys, in declaration order
+    (computed once per class: the reader and the validator ask for every element)."""
+    return list(_adf_fields_of(cls_or_obj if isinstance(cls_or_obj, type) else type(cls_or_obj)))
 
 
-def adf_keys(cls_or_obj) -> set[str]:
-    return {f.metadata["adf_key"] for f in adf_fields(cls_or_obj)}
+def adf_keys(cls_or_obj) -> frozenset[str]:
+    return _adf_keys_of(cls_or_obj if isinstance(cls_or_obj, type) else type(cls_or_obj))

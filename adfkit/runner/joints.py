@@ -24,6 +24,7 @@ import pybullet as pb
 from ..model.semantics import DEFAULT_SIX_DOF_LIMIT, DEFAULT_SIX_DOF_SPRING, JointKind
 from .rotations import euler_xyz, matrix_to_pq, pose_matrix, quat_to_matrix
 
+FIXED_SPAN = 0.005      # m between the three p2p pivots of a fixed joint outside a multibody
 HINGE_HALF_SPAN = 0.01  # m: the two p2p constraints of a loop-closing hinge sit ±this along the axis
 
 
@@ -161,9 +162,12 @@ def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarra
         out.append((c, np.asarray(pa, float), np.asarray(pb_, float), None if axis is None else np.asarray(axis, float)))
 
     if kind is JointKind.FIXED:
-        pa, oa = matrix_to_pq(frame_a)
-        pbp, ob = matrix_to_pq(frame_b)
-        add(pb.JOINT_FIXED, pa, pbp, oa, ob)
+        # Three point pivots at non-collinear points of the joint frame, not JOINT_FIXED:
+        # PyBullet's fixed constraint ignores both frame orientations and holds the two
+        # inertial frames parallel (measured: the corpus needle's thread turns 90 degrees off
+        # the needle in 0.1 s); point pivots keep the file's relative pose exactly.
+        for e in (np.zeros(3), np.array([FIXED_SPAN, 0.0, 0.0]), np.array([0.0, FIXED_SPAN, 0.0])):
+            add(pb.JOINT_POINT2POINT, frame_a[:3, :3] @ e + frame_a[:3, 3], frame_b[:3, :3] @ e + frame_b[:3, 3])
     elif kind is JointKind.PRISMATIC:
         # between multibody links only (the caller checks): btMultiBodySliderConstraint, its
         # axis given in the parent's link (COM) frame, along the joint's x axis as the

@@ -108,6 +108,53 @@ def mesh_refusal(model, path: Path) -> str | None:
     return None
 
 
+_STL_DIR: str | None = None
+_STL_CACHE: dict[tuple[str, int, int], tuple[str | None, str | None]] = {}
+
+
+def pybullet_mesh(model, path: Path) -> tuple[Path | None, str | None]:
+    """The file to hand PyBullet for a mesh, or (None, why not).
+
+    PyBullet reads only binary STL, and crashes (SIGSEGV) on an ASCII or malformed STL, or on
+    NaN vertices: an STL that is not a consistent binary STL with finite vertices is read with
+    trimesh (as AMBF's assimp would) and handed over as a temporary binary STL; one trimesh
+    cannot read either is refused like a missing mesh."""
+    refused = mesh_refusal(model, path)
+    if refused is not None:
+        return None, refused
+    if path.suffix.lower() != ".stl":
+        return path, None
+    st = path.stat()
+    key = (str(path), st.st_size, st.st_mtime_ns)
+    if key not in _STL_CACHE:
+        _STL_CACHE[key] = _checked_stl(path, st.st_size)
+    done, why = _STL_CACHE[key]
+    return (Path(done) if done else None), why
+
+
+def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
+    with open(path, "rb") as fh:
+        head = fh.read(84)
+        count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+        if count > 0 and size == 84 + 50 * count and not head.lstrip().startswith(b"solid"):
+            records = np.frombuffer(fh.read(), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", 9), ("a", "<u2")]))
+            if np.isfinite(records["v"]).all():
+                return str(path), None
+            return None, f"{inputs.shown(path)} has NaN or infinite vertices"
+    from ..geometry.meshio import load_mesh  # trimesh: only for meshes PyBullet cannot take as they are
+
+    try:
+        mesh = load_mesh(path)
+    except AdfError as exc:
+        return None, f"{inputs.shown(path)} is not a readable mesh ({exc.diagnostics[0].message})"
+    global _STL_DIR
+    if _STL_DIR is None:
+        _STL_DIR = tempfile.mkdtemp(prefix="adfkit-stl-")
+    out = os.path.join(_STL_DIR, f"mesh_{len(_STL_CACHE)}.stl")
+    mesh.export(out, file_type="stl")
+    return out, None
+
+
 def collision_parts(model, obj, frame_in_body, scale: float,
                     static: bool, diags: list[Diagnostic]) -> ShapeParts | None:
     """The collision shape of a body or ghost, or None when AMBF would skip the object."""
@@ -125,7 +172,7 @@ def collision_parts(model, obj, frame_in_body, scale: float,
     path = collision_mesh_path(model, obj)
     if path is None:
         return parts  # no collision geometry: an empty shape (AMBF prints an error)
-    refused = mesh_refusal(model, path)
+    path, refused = pybullet_mesh(model, path)
     if refused is not None:
         diags.append(warning("runner-missing-mesh", f"{obj.identifier}: collision mesh {refused}; "
                              "the body is skipped as AMBF does", obj.where("collision mesh") or obj.source,
@@ -235,12 +282,13 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
     path = visual_mesh_path(model, obj)
     if path is None:
         return -1
-    refused = mesh_refusal(model, path)
+    suffix = path.suffix.lower()
+    path, refused = pybullet_mesh(model, path) if suffix in MESH_SUFFIXES else (path, mesh_refusal(model, path))
     if refused is not None:
         diags.append(warning("runner-missing-mesh", f"{obj.identifier}: visual mesh {refused}",
                              obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
         return -1
-    if path.suffix.lower() not in MESH_SUFFIXES:
+    if suffix not in MESH_SUFFIXES:
         return -1
     if (problem := mesh_problem(path)) is not None:
         diags.append(warning("runner-bad-mesh", f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: {problem}",

@@ -24,6 +24,7 @@ from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
 from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
 from .shapes import collision_parts, create_collision, create_visual
+from .softbodies import SoftBodies, enable_deformable_world, in_scene as soft_in_scene
 
 GRASP_SPAN = 0.005   # m between the three point constraints of a grasp (SimWorld.actuate)
 SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
@@ -85,6 +86,9 @@ class SimWorld:
         self.diagnostics: list[Diagnostic] = []
         self.gui = gui
         self.cid = pb.connect(pb.GUI if gui else pb.DIRECT)
+        self.soft = SoftBodies(self) if soft_in_scene(scene) else None   # soft bodies: a deformable world
+        if self.soft is not None:
+            enable_deformable_world(self.cid)
         self.dt = 1.0 / self.opt.physics_hz
         w = scene.world
         g = self.opt.gravity or (tuple(w.gravity) if w is not None and w.gravity is not None else DEFAULT_GRAVITY)
@@ -124,7 +128,7 @@ class SimWorld:
         for m in models:
             ns = m.namespace or ""
             mine = []
-            for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles)):
+            for kind, objs in (("vehicle", m.vehicles),):
                 for o in objs:
                     self._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
                                "PyBullet runner; skipped", o, "play this object in AMBF itself")
@@ -144,6 +148,8 @@ class SimWorld:
             for sb in mine:
                 local.items[sb.key] = sb
             for j in m.joints:
+                if self.soft is not None and self.soft.claim(m, j):
+                    continue   # joins a soft body: anchors, made with the soft bodies
                 kind = joint_kind(j.type)
                 if kind is None:
                     self._warn("runner-joint-type", f"{j.identifier}: unknown joint type {j.type!r}; skipped", j)
@@ -179,6 +185,8 @@ class SimWorld:
             for sb in [root] + [r[3] for r in recs]:
                 set_dynamics(sb)
         self._collision_filters(records)
+        if self.soft is not None:
+            self.soft.build(models)
         springs = []
         for j, kind, parent, child in leftover:
             ps = parent.body.scale or 1.0
@@ -244,11 +252,16 @@ class SimWorld:
         """A model played without a world gets what AMBF's worlds give it: a floor, here a
         static plane 1 mm below the lowest point of every body."""
         lows = [pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2] for sb in self.bodies if sb.uid is not None]
+        if self.soft is not None and self.soft.items:
+            lows.append(self.soft.lowest_z())
         if not lows:
             return
         self.ground_z = min(lows) - 1e-3
-        shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=self.cid)
-        self.ground_uid = pb.createMultiBody(0.0, shape, -1, [0.0, 0.0, self.ground_z], physicsClientId=self.cid)
+        if self.soft is None:
+            shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=self.cid)
+            self.ground_uid = pb.createMultiBody(0.0, shape, -1, [0.0, 0.0, self.ground_z], physicsClientId=self.cid)
+        else:   # soft bodies stop centimetres above a static plane: a thick slab instead
+            self.ground_uid = self.soft.ground_slab(self.ground_z)
         self._floor_z = self.ground_z
 
     def _warn(self, rule, msg, obj, hint="") -> None:
@@ -618,8 +631,10 @@ class SimWorld:
                 fell.append(sb.key)
             if np.linalg.norm(v) > 10.0:
                 fast.append(sb.key)
+        soft = self.soft.report(self._floor_z) if self.soft is not None else ([], [], [], [])
+        nan, fast, fell = nan + soft[1], fast + soft[2], fell + soft[3]
         return {
-            "bodies": len(self.bodies), "skipped_bodies": self.skipped,
+            "bodies": len(self.bodies), "skipped_bodies": self.skipped, "soft_bodies": soft[0],
             "joints": len(self.joint_names), "multibodies": len(self.articulations),
             "constraints": len(self.constraints), "spring_joints": len(self.springs.joints),
             "ghosts": len(self.ghosts), "sensors": len(self.sensors), "actuators": len(self.actuators),
@@ -632,5 +647,7 @@ class SimWorld:
         }
 
     def close(self) -> None:
+        if self.soft is not None:
+            self.soft.close()
         if pb.isConnected(self.cid):
             pb.disconnect(self.cid)

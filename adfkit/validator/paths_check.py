@@ -12,6 +12,7 @@ from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..geometry.meshcheck import mesh_problem
 from ..model import InputDevices, Launch, ModelFile, World
+from . import softbody_rules
 from .rules import RULES
 
 TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")
@@ -223,7 +224,7 @@ def plugin_paths(doc) -> list[Diagnostic]:
 def check(doc) -> list[Diagnostic]:
     out = plugin_paths(doc) if hasattr(doc, "plugins") else []
     if isinstance(doc, ModelFile):
-        return out + model_paths(doc)
+        return out + model_paths(doc) + softbody_rules.mesh_rules(doc)
     if isinstance(doc, World):
         return out + world_paths(doc)
     if isinstance(doc, Launch):

@@ -124,6 +124,15 @@ _RULES = [
          "`look at` equal to `location`"),
     Rule("randomize-constraints", W, "`randomize constraints: false` turns randomisation on anyway",
          "`randomize constraints: false`"),
+    Rule("soft-body-mesh", W, "A soft body without a mesh (AMBF skips it) or with a collision primitive it does not use",
+         "`soft bodies: [S]` with `mesh: ''`"),
+    Rule("soft-body-mass", W, "A soft body without mass (AMBF uses 1 kg) or with mass <= 0", "`mass: 0` on a soft body"),
+    Rule("soft-body-fixed-nodes", E, "A fixed node index outside the nodes of the soft body's mesh (AMBF writes "
+         "past its node array)", "`fixed nodes: [400]` on the 386-node corpus cloth"),
+    Rule("soft-body-coefficient", W, "A soft-body stiffness, damping, friction or hardness outside Bullet's range "
+         "0..1 (or a negative drag, lift, volume or time scale)", "`kLST: 5`"),
+    Rule("soft-body-iterations", W, "Negative solver iterations or clusters, `piterations: 0`, or a bending "
+         "distance below 2 (no link added)", "`bending constraint: 1`"),
     Rule("missing-plugin", W, "A plugin with a `path` whose library file does not exist there",
          "`plugins: [{name: p, filename: libp.so, path: ./lib}]` without lib/libp.so"),
     Rule("light-shadow", W, "A light without `shadow quality` (uninitialised in AMBF) or above 5", "a light with no shadow quality"),

@@ -46,15 +46,20 @@ def _inline(node, defs: dict, depth: int = 0):
 
 
 @lru_cache(maxsize=None)
-def _validator(kind: str, definition: str | None):
-    from jsonschema import Draft202012Validator  # imported on first use: keeps `adfkit --help` fast
-
+def _inlined(kind: str, definition: str | None) -> dict:
     schema = load_schema(kind)
     defs = schema["$defs"]
     target = defs[definition] if definition is not None else schema
     inlined = _inline(target, defs)
     inlined["$schema"] = schema["$schema"]
-    return Draft202012Validator(inlined)
+    return inlined
+
+
+@lru_cache(maxsize=None)
+def _validator(kind: str, definition: str | None):
+    from jsonschema import Draft202012Validator  # imported on first use: only for files with findings
+
+    return Draft202012Validator(_inlined(kind, definition))
 
 
 @lru_cache(maxsize=None)
@@ -67,13 +72,17 @@ def _fast_validator(kind: str, definition: str | None):
         import jsonschema_rs
     except ImportError:  # pragma: no cover - optional accelerator
         return None
-    return jsonschema_rs.Draft202012Validator(_validator(kind, definition).schema)
+    return jsonschema_rs.Draft202012Validator(_inlined(kind, definition))
 
 
 def _errors(kind: str, definition: str | None, instance):
     fast = _fast_validator(kind, definition)
-    if fast is not None and fast.is_valid(instance):
-        return ()
+    if fast is not None:
+        try:
+            if fast.is_valid(instance):
+                return ()
+        except (ValueError, TypeError, OverflowError):  # a value it cannot take: jsonschema decides
+            pass
     return _validator(kind, definition).iter_errors(instance)
 
 

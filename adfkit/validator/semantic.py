@@ -15,6 +15,7 @@ from ..model.spec import Node
 from ..model.spec import adf_fields as _adf_fields
 from ..model.spec import adf_keys as _adf_keys
 from .references import Registry, body_registry, merge_namespace
+from . import softbody_rules
 from .rules import RULES
 
 @lru_cache(maxsize=None)
@@ -93,18 +94,30 @@ class Checker:
 
     # --- numbers (NaN, inf, absurd magnitudes) --------------------------------------------
     def numbers(self, node: Node) -> None:
-        for f in adf_fields(node):
-            key = f.metadata["adf_key"]
-            value = getattr(node, f.name)
-            self._number(key, value, node.where(key))
-            if isinstance(value, Node):
-                self.numbers(value)
-            elif isinstance(value, list):
-                for item in value:
-                    if isinstance(item, Node):
-                        self.numbers(item)
-                    else:
-                        self._number(key, item, node.where(key))
+        """Non-finite and absurd numbers anywhere in the element (an explicit stack; plain
+        floats, the common case, are checked without building lists)."""
+        stack = [node]
+        while stack:
+            n = stack.pop()
+            for f in adf_fields(n):
+                value = getattr(n, f.name)
+                if value is None:
+                    continue
+                cls = value.__class__
+                key = f.metadata["adf_key"]
+                if cls is float:
+                    if value - value != 0.0 or (abs(value) > ABSURD and key not in UNBOUNDED_KEYS):
+                        self._number(key, value, n.where(key))
+                elif isinstance(value, Node):
+                    stack.append(value)
+                elif cls is list:
+                    for item in value:
+                        if isinstance(item, Node):
+                            stack.append(item)
+                        else:
+                            self._number(key, item, n.where(key))
+                else:
+                    self._number(key, value, n.where(key))
 
     def _number(self, key: str, value, loc) -> None:
         if isinstance(value, bool):
@@ -195,6 +208,7 @@ class Checker:
             self.light(light)
         for c in m.cameras:
             self.camera(c)
+        self.out += softbody_rules.check(m)
         for sb in m.soft_bodies:
             if sb.randomize_constraints is False:
                 self.emit("randomize-constraints", f"soft body '{sb.identifier}': 'randomize constraints: false' "

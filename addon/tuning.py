@@ -1,0 +1,120 @@
+"""Joint controller gains, joint visibility and clean-up (what the original AMBF add-on
+offered beside export): Blender-level walks over the scene, arithmetic in plain functions."""
+from __future__ import annotations
+
+import math
+
+import bpy
+
+
+def pd_gains(inertia: float, frequency_hz: float = 2.0, damping_ratio: float = 1.0) -> tuple[float, float]:
+    """(P, D) that make a load of ``inertia`` (kg·m², or kg for a prismatic joint) a second-
+    order system of natural frequency ``frequency_hz`` and damping ratio ``damping_ratio``:
+    P = I·ω², D = 2·ζ·I·ω."""
+    w = 2.0 * math.pi * frequency_hz
+    return inertia * w * w, 2.0 * damping_ratio * inertia * w
+
+
+def _joint_bodies(scene):
+    """{parent body: [(joint object, child body)]} from the ADF joints' constraints."""
+    out: dict = {}
+    for o in scene.objects:
+        rbc = o.rigid_body_constraint if o.adf.kind == "JOINT" else None
+        if rbc is not None and rbc.object1 is not None and rbc.object2 is not None:
+            out.setdefault(rbc.object1, []).append((o, rbc.object2))
+    return out
+
+
+def subtree(scene, child) -> list:
+    """The child body and every body jointed below it (no body twice)."""
+    tree, seen, stack = _joint_bodies(scene), [], [child]
+    while stack:
+        b = stack.pop()
+        if b in seen:
+            continue
+        seen.append(b)
+        stack.extend(c for _, c in tree.get(b, []))
+    return seen
+
+
+def load_about_joint(scene, joint) -> float:
+    """What the joint moves: for a prismatic joint the subtree's mass (kg); otherwise its
+    inertia about the joint axis (kg·m²): each body's mass times its squared distance from
+    the axis plus its largest principal moment (an upper bound of its own term)."""
+    from adfkit.model.semantics import JointKind, joint_kind
+    rbc = joint.rigid_body_constraint
+    p = joint.adf.joint
+    kind = joint_kind(p.type) if p.use_type else JointKind.REVOLUTE
+    bodies = subtree(scene, rbc.object2)
+    masses = [(b, b.adf.body.mass if b.adf.body.use_mass else 1.0) for b in bodies]
+    if kind in (JointKind.PRISMATIC, JointKind.LINEAR_SPRING):
+        return sum(m for _, m in masses)
+    origin = joint.matrix_world.translation
+    axis = (joint.matrix_world.to_3x3() @ __import__("mathutils").Vector((0, 0, 1))).normalized()
+    total = 0.0
+    for b, m in masses:
+        r = b.matrix_world.translation - origin
+        d2 = (r - axis * r.dot(axis)).length_squared
+        own = max(b.adf.body.inertia) if b.adf.body.use_inertia else 0.0
+        total += m * d2 + own
+    return total
+
+
+def estimate_gains(scene, joints, frequency_hz: float = 2.0, damping_ratio: float = 1.0) -> dict:
+    """Set the PID controller (P, I = 0, D) of each joint; returns {joint name: (P, D)}."""
+    done = {}
+    for j in joints:
+        rbc = j.rigid_body_constraint
+        if j.adf.kind != "JOINT" or rbc is None or rbc.object2 is None:
+            continue
+        pgain, dgain = pd_gains(max(load_about_joint(scene, j), 1e-9), frequency_hz, damping_ratio)
+        p = j.adf.joint
+        p.use_controller_p, p.controller_p = True, pgain
+        p.use_controller_i, p.controller_i = True, 0.0
+        p.use_controller_d, p.controller_d = True, dgain
+        done[j.name] = (pgain, dgain)
+    return done
+
+
+def show_joints(scene, show: bool) -> int:
+    """Hide or show every ADF joint (and its constraint empty) in the viewport."""
+    n = 0
+    for o in scene.objects:
+        if o.adf.kind == "JOINT":
+            o.hide_set(not show)
+            n += 1
+    return n
+
+
+def cleanup(scene) -> list[str]:
+    """Remove what no longer makes an ADF element: joints whose constraint lost a body,
+    collision children whose parent is not a body or ghost, and empty ADF snapshots of
+    objects marked None. Returns what was removed or cleared, one line each."""
+    said = []
+    for o in list(scene.objects):
+        k = o.adf.kind
+        if k == "JOINT":
+            rbc = o.rigid_body_constraint
+            ok = rbc is not None and all(b is not None and b.adf.kind in ("BODY", "SOFT_BODY")
+                                         for b in (rbc.object1, rbc.object2))
+            if not ok and not o.adf.snapshot:
+                said.append(f"removed joint {o.name} (no parent or child body)")
+                bpy.data.objects.remove(o, do_unlink=True)
+        elif k in ("COLLISION_SHAPE", "COLLISION_MESH"):
+            if o.parent is None or o.parent.adf.kind not in ("BODY", "GHOST", "SOFT_BODY"):
+                said.append(f"removed collision {o.name} (not under a body)")
+                bpy.data.objects.remove(o, do_unlink=True)
+        elif k == "NONE" and (o.adf.snapshot or o.adf.identifier):
+            o.adf.snapshot = o.adf.snapshot_matrix = o.adf.identifier = ""
+            said.append(f"cleared ADF data of {o.name}")
+    return said
+
+
+def strip(objs) -> int:
+    """Make objects plain Blender objects again (kind None, no ADF snapshot)."""
+    n = 0
+    for o in objs:
+        o.adf.kind = "NONE"
+        o.adf.snapshot = o.adf.snapshot_matrix = o.adf.identifier = ""
+        n += 1
+    return n

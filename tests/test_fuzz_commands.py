@@ -1,0 +1,209 @@
+"""Issue 14: the fuzz suite. Mutated scenes (tests/fuzzkit.py) through validate (all formats),
+info (-l, --json), convert (every direction), run (a few steps) and blend-import, in process.
+
+Whatever the input: exit 0, 1 or 2; no traceback; a located ``error[rule]`` for exit 2;
+strict JSON; nothing opened outside the scene's tree (ADFKIT_INPUT_ROOT is the scene's
+folder here; an audit hook records every open) unless the command line names it; no
+content of the planted secret or of /etc/passwd in any output; no hang (a timer per case).
+
+Default: a few hundred cases (seeded, the same every run). ``-m slow``: >= 100,000 cases,
+the count printed.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from pathlib import Path
+
+import pytest
+
+import fuzzkit
+from conftest import CORPUS
+
+# Known crashes in code another branch owns (issue 14's converter and runner items, branch
+# `robust`), by the exact site: (module, function, exception type) of the innermost adfkit
+# frame. A case whose only problem is one of these is counted as known, not hidden: the tests
+# xfail with the list, and a known site that no longer occurs anywhere is not an excuse for
+# any other failure.
+KNOWN_SITES: dict[tuple[str, str, str], str] = {
+    ("adfkit/converters/mjcf_write.py", "mesh", "ValueError"):
+        "MJCF writer resolves a mesh path holding a NUL byte",
+    ("adfkit/converters/urdf.py", "_mesh_ref", "ValueError"):
+        "URDF writer resolves a mesh path holding a NUL byte",
+    ("adfkit/converters/mjcf_write.py", "mesh", "OSError"):
+        "MJCF writer resolves a mesh path over 255 bytes",
+    ("adfkit/converters/urdf.py", "_mesh_ref", "OSError"):
+        "URDF writer resolves a mesh path over 255 bytes",
+    ("adfkit/runner/shapes.py", "_primitive", "TypeError"):
+        "runner: a primitive whose geometry lacks a dimension (None) after a bad value",
+    ("adfkit/converters/mjcf_write.py", "_write_body", "RecursionError"):
+        "MJCF writer recurses over the body tree (a chain of 1,000 bodies)",
+}
+KNOWN: dict[str, str] = {}  # exact case ids (none today)
+
+
+def _known(outcome, bad) -> str | None:
+    if (outcome.error or "").startswith("timeout") and any(b"<include" in v for v in outcome.case.files.values()):
+        return "MJCF <include> followed by MuJoCo's compiler, which blocks opening a FIFO (mjcf_read.py)"
+    site = fuzzkit.crash_site(outcome)
+    if site in KNOWN_SITES and len(bad) == 1:
+        return f"{KNOWN_SITES[site]} ({site[0]}:{site[1]} {site[2]})"
+    return None
+
+
+def _seeds(with_corpus: bool):
+    seeds = fuzzkit.builtin_seeds() + fuzzkit.sample_scene_seeds()
+    if with_corpus:
+        seeds += fuzzkit.corpus_seeds(CORPUS)
+    return seeds
+
+
+def _check(case, tmp_path: Path):
+    outcome = fuzzkit.run_case(case, tmp_path / "case")
+    bad = fuzzkit.problems(outcome)
+    shutil.rmtree(tmp_path / "case", ignore_errors=True)
+    return outcome, bad
+
+
+def _assert_clean(case, outcome, bad):
+    if case.id in KNOWN:
+        assert bad, f"{case.id} passes now: drop it from KNOWN ({KNOWN[case.id]})"
+        pytest.xfail(KNOWN[case.id])
+    known = _known(outcome, bad) if bad else None
+    if known:
+        pytest.xfail(known)
+    assert not bad, f"{case.id}: {bad}"
+
+
+# --- default: a few hundred cases ------------------------------------------------------------
+
+DEFAULT_CASES = 64  # per group below; 4 groups + the named-file cases ~ 300 cases
+
+def _group(name: str, seeds, n: int, with_run: bool):
+    return [fuzzkit.make_case(seeds[i % len(seeds)], i // len(seeds), with_run) for i in range(n)]
+
+
+@pytest.mark.parametrize("group", ["builtin", "sample", "corpus", "xml"])
+def test_fuzz_group(group, tmp_path):
+    """64 seeded cases per group; every guarantee checked on each."""
+    builtin = fuzzkit.builtin_seeds()
+    if group == "builtin":
+        seeds = [s for s in builtin if s.kind in ("model", "launch")]
+    elif group == "xml":
+        seeds = [s for s in builtin if s.kind in ("urdf", "mjcf")]
+    elif group == "sample":
+        seeds = fuzzkit.sample_scene_seeds()
+        if not seeds:
+            pytest.skip("sample_scenes/suturing_pad is not in this checkout")
+    else:
+        seeds = [s for s in fuzzkit.corpus_seeds(CORPUS) if s.small] or [
+            s for s in builtin if s.kind in ("model", "launch")]  # no corpus: more builtin cases
+    cases = _group(group, seeds, DEFAULT_CASES, with_run=group in ("builtin", "corpus"))
+    failures, known = [], []
+    for i, case in enumerate(cases):
+        outcome, bad = _check(case, tmp_path / str(i))
+        if not bad:
+            continue
+        why = KNOWN.get(case.id) or _known(outcome, bad)
+        (known if why else failures).append(f"{case.id}: {why or bad[0][:400]}")
+    assert not failures, "\n".join(failures)
+    if known:
+        pytest.xfail("known crashes in the robust branch's code: " + "; ".join(known))
+
+
+@pytest.mark.parametrize("case", fuzzkit.explicit_cases(), ids=lambda c: f"{c.command}:{c.argv[-1][-40:]!r}")
+def test_named_hostile_files(case, tmp_path):
+    """Devices, FIFOs, folders, NUL bytes, over-long names named on the command line: a clean,
+    located exit 2 at once (never a read of a device, never a hang)."""
+    start = time.monotonic()
+    outcome, bad = _check(case, tmp_path)
+    _assert_clean(case, outcome, bad)
+    target = case.argv[-1] if case.command != "convert" else case.argv[1]
+    folder_ok = case.command.startswith("validate") and target.endswith("folder")  # validate walks folders
+    if (target.startswith("/dev/") or "fifo" in target or "folder" in target or "\0" in target) and not folder_ok:
+        assert outcome.rc == 2, (outcome.rc, outcome.out, outcome.err)
+        assert time.monotonic() - start < 30  # returns; not a wall-clock assertion on speed
+
+
+def test_devices_exit_2_within_a_second(tmp_path, capsys):
+    """Issue 14 acceptance: /dev/zero and /dev/stdin give a clean exit 2 within 1 s (timed by
+    the per-case timer, which raises in the command if it is exceeded)."""
+    from adfkit.cli import main
+
+    for device in ("/dev/zero", "/dev/stdin"):
+        for argv in (["info", device], ["validate", device], ["run", device]):
+            case = fuzzkit.Case("device", 0, "named", argv[0], {}, argv, explicit=True)
+            outcome = fuzzkit.run_case(case, tmp_path / device.strip("/").replace("/", "-") / argv[0], timeout=1.0)
+            assert outcome.error is None, outcome.error
+            assert outcome.rc == 2 and f"{device}: error[not-a-regular-file]" in outcome.err + outcome.out, outcome
+
+
+def test_mutations_are_seeded():
+    seed = fuzzkit.builtin_seeds()[0]
+    a, b = fuzzkit.make_case(seed, 7), fuzzkit.make_case(seed, 7)
+    assert (a.op, a.command, a.files) == (b.op, b.command, b.files)
+    assert {fuzzkit.make_case(seed, i).op.split("+")[0] for i in range(80)} == set(fuzzkit.YAML_OPS)
+
+
+def test_the_checks_catch_what_they_claim(tmp_path):
+    """The oracle itself: a traceback, an unlocated exit 2, NaN in JSON and the secret in the
+    output are each reported."""
+    case = fuzzkit.Case("x", 0, "none", "validate-json", {}, ["validate", "-f", "json", "{dir}/m.yaml"])
+    scene, outside = tmp_path / "s", tmp_path / "o"
+    scene.mkdir()
+    mk = lambda rc, out="", err="", error=None, opened=(): fuzzkit.Outcome(case, rc, out, err, error, list(opened),
+                                                                          scene, outside)
+    assert fuzzkit.problems(mk(0, '{"files": 1, "diagnostics": []}')) == []
+    assert "stdout is not strict JSON" in fuzzkit.problems(mk(0, '{"x": NaN}'))[0]
+    assert fuzzkit.problems(mk(2, "", "usage: adfkit\n")) == ["exit 2 without a located error[rule] diagnostic"]
+    assert fuzzkit.problems(mk(2, "", "m.yaml:3:4: error[bad-type]: x\n")) == []
+    assert fuzzkit.problems(mk(1, "", "Traceback (most recent call last):\n")) == ["a traceback in the output"]
+    assert "the secret outside the scene's tree reached the output" in fuzzkit.problems(mk(0, "", fuzzkit.SECRET))
+    assert fuzzkit.problems(mk(0, "", "", None, [str(outside / "secret.yaml")]))[0].startswith("opened ")
+    assert fuzzkit.problems(mk(0, "", "", None, ["/dev/zero"])) == ["opened /dev/zero outside the scene's tree",
+                                                                  "opened a device or FIFO: /dev/zero"]
+    assert fuzzkit.problems(mk(None, error="timeout after 1 s")) == ["escaped: timeout after 1 s"]
+
+
+# --- slow: >= 100,000 cases --------------------------------------------------------------------
+
+SLOW_CASES = int(os.environ.get("ADFKIT_FUZZ_CASES", "100000"))
+
+
+@pytest.mark.slow
+def test_fuzz_many(tmp_path, capsys):
+    """>= 100,000 seeded cases over every seed (corpus included when present); the count and
+    the tally are printed. `run` and `convert` on the small seeds, cheap commands elsewhere."""
+    seeds = _seeds(with_corpus=True)
+    small = [s for s in seeds if s.small]
+    large = [s for s in seeds if not s.small]
+    failures: list[str] = []
+    known: dict[str, int] = {}
+    counts = {"cases": 0, "exit 0": 0, "exit 1": 0, "exit 2": 0}
+    start = time.monotonic()
+    for i in range(SLOW_CASES):
+        pool = large if large and i % 100 == 99 else small  # large seeds (suturing pad, big corpus files) 1 in 100
+        seed = pool[(i // 100 if pool is large else i) % len(pool)]
+        case = fuzzkit.make_case(seed, 10_000 + i // len(pool), with_run=(i % 50 == 0))
+        outcome, bad = _check(case, tmp_path / "c")
+        counts["cases"] += 1
+        if outcome.rc in (0, 1, 2):
+            counts[f"exit {outcome.rc}"] += 1
+        if bad:
+            why = KNOWN.get(case.id) or _known(outcome, bad)
+            if why:
+                known[why] = known.get(why, 0) + 1
+            else:
+                failures.append(f"{case.id}: {bad[0][:300]}")
+    wall = time.monotonic() - start
+    with capsys.disabled():
+        print(f"\nfuzz: {counts['cases']:,} cases in {wall:.0f} s ({counts['cases'] / wall:.0f}/s); "
+              f"exit 0 {counts['exit 0']:,}, exit 1 {counts['exit 1']:,}, exit 2 {counts['exit 2']:,}; "
+              f"broken guarantees {len(failures)}; known crashes elsewhere {sum(known.values())}")
+        for why, n in sorted(known.items()):
+            print(f"  known: {n} x {why}")
+    assert counts["cases"] >= min(SLOW_CASES, 100_000)
+    assert not failures, "\n".join(failures[:50])
+    if known:
+        pytest.xfail(f"{sum(known.values())} known crashes in the robust branch's code: {sorted(known)}")
