@@ -26,26 +26,11 @@ from conftest import CORPUS
 # frame. A case whose only problem is one of these is counted as known, not hidden: the tests
 # xfail with the list, and a known site that no longer occurs anywhere is not an excuse for
 # any other failure.
-KNOWN_SITES: dict[tuple[str, str, str], str] = {
-    ("adfkit/converters/mjcf_write.py", "mesh", "ValueError"):
-        "MJCF writer resolves a mesh path holding a NUL byte",
-    ("adfkit/converters/urdf.py", "_mesh_ref", "ValueError"):
-        "URDF writer resolves a mesh path holding a NUL byte",
-    ("adfkit/converters/mjcf_write.py", "mesh", "OSError"):
-        "MJCF writer resolves a mesh path over 255 bytes",
-    ("adfkit/converters/urdf.py", "_mesh_ref", "OSError"):
-        "URDF writer resolves a mesh path over 255 bytes",
-    ("adfkit/runner/shapes.py", "_primitive", "TypeError"):
-        "runner: a primitive whose geometry lacks a dimension (None) after a bad value",
-    ("adfkit/converters/mjcf_write.py", "_write_body", "RecursionError"):
-        "MJCF writer recurses over the body tree (a chain of 1,000 bodies)",
-}
+KNOWN_SITES: dict[tuple[str, str, str], str] = {}  # none since the robust branch's fixes
 KNOWN: dict[str, str] = {}  # exact case ids (none today)
 
 
 def _known(outcome, bad) -> str | None:
-    if (outcome.error or "").startswith("timeout") and any(b"<include" in v for v in outcome.case.files.values()):
-        return "MJCF <include> followed by MuJoCo's compiler, which blocks opening a FIFO (mjcf_read.py)"
     site = fuzzkit.crash_site(outcome)
     if site in KNOWN_SITES and len(bad) == 1:
         return f"{KNOWN_SITES[site]} ({site[0]}:{site[1]} {site[2]})"

@@ -1,8 +1,10 @@
 """`adfkit info PATH`: a summary of a launch, world, input-devices or model file."""
 from __future__ import annotations
 
-from .. import jsonout
+import json
 import sys
+
+from .. import jsonout
 
 NAME = "info"
 HELP = "summarise a launch, world, input-devices or model file"

@@ -20,6 +20,8 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
+from .. import inputs
+from ..diagnostics import AdfError
 from .losses import Loss
 
 #: Mesh file suffixes each engine reads itself.
@@ -78,8 +80,9 @@ class MeshFiles:
     """Engine-readable mesh files for one output file; converted copies go to
     ``<output stem>_meshes/`` beside it. ``fit`` answers (path or None, flat?)."""
 
-    def __init__(self, engine: str, out_dir: Path, stem: str):
+    def __init__(self, engine: str, out_dir: Path, stem: str, tree=None):
         self.engine = engine
+        self.tree = tree   # the model's input tree (adfkit.inputs): meshes are read only inside it
         self.folder = out_dir / f"{stem}_meshes"
         self._done: dict[str, tuple[Path | None, bool, object]] = {}
 
@@ -87,7 +90,7 @@ class MeshFiles:
         from ..diagnostics import AdfError
         try:
             from ..geometry.meshio import load_mesh
-            return load_mesh(path), None
+            return load_mesh(path, tree=self.tree), None
         except AdfError as exc:
             return None, exc.diagnostics[0].message
         except ImportError:
@@ -97,6 +100,12 @@ class MeshFiles:
         """(file the engine reads, or None; the mesh when it is flat and ``check_flat``, else None)."""
         key = str(path)
         if key not in self._done:
+            try:  # a NUL byte or an over-long name is no file name at all
+                inputs.check_path_text(path)
+            except AdfError as exc:
+                losses.append(Loss(who, "mesh", f"{exc.diagnostics[0].message}: left out"))
+                self._done[key] = (None, False, None)
+                return None, None
             readable = path.suffix.lower() in ENGINE_SUFFIXES[self.engine]
             mesh = None
             if not readable or check_flat:

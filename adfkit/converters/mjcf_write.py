@@ -53,12 +53,12 @@ def _place(el: ET.Element, pose: Pose) -> None:
 
 
 class _Assets:
-    def __init__(self, root: ET.Element, out_dir: Path, stem: str):
+    def __init__(self, root: ET.Element, out_dir: Path, stem: str, tree=None):
         self.el = ET.SubElement(root, "asset")
         self.out_dir = out_dir
         self.names: dict[tuple[str, float], str] = {}
         self.used: set[str] = set()
-        self.files = MeshFiles("mjcf", out_dir, stem)
+        self.files = MeshFiles("mjcf", out_dir, stem, tree)
 
     def fit(self, path: Path, who: str, losses: list[Loss]):
         """(a file MuJoCo reads or None, the mesh when it is flat): engine_fit.MeshFiles."""
@@ -222,7 +222,7 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None) -> tuple[s
                              model.where(), "convert a model file with at least one body"))
     root = ET.Element("mujoco", model=name or model.name)
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
-    assets = _Assets(root, out_dir, name or model.name)
+    assets = _Assets(root, out_dir, name or model.name, getattr(model, "tree", None))
     world = ET.SubElement(root, "worldbody")
     # MuJoCo keeps one namespace per element type; "world" is the world body's name
     used: dict[str, set[str]] = {"body": {"world"}, "joint": set(), "geom": set(), "equality": set()}

@@ -256,7 +256,7 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     Meshes PyBullet cannot read are converted to STL in ``<robot name>_meshes/`` there."""
     losses: list[Loss] = []
     model = usable_scales(model, losses)
-    files = MeshFiles("urdf", out_dir, robot_name or model.name)
+    files = MeshFiles("urdf", out_dir, robot_name or model.name, getattr(model, "tree", None))
     tree = build_tree(model)
     name = robot_name or model.name
     robot = ET.Element("robot", name=name)

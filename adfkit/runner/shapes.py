@@ -97,6 +97,19 @@ def _primitive(parts: ShapeParts, prim: Primitive, pose_in_com: np.ndarray, marg
         parts.plane = (list(map(float, n)), float(g.offset or 0.0))
 
 
+_DIMENSIONS = {ShapeKind.BOX: ("x", "y", "z"), ShapeKind.SPHERE: ("radius",), ShapeKind.CYLINDER: ("radius", "height"),
+               ShapeKind.CAPSULE: ("radius", "height"), ShapeKind.CONE: ("radius", "height")}
+
+
+def _missing_dimension(prim: Primitive) -> str | None:
+    """The first dimension a primitive needs that is absent, not a number, negative or not finite."""
+    for name in _DIMENSIONS.get(prim.kind, ()):
+        v = getattr(prim.geometry, name, None)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+            return name
+    return None
+
+
 def mesh_refusal(model, path: Path) -> str | None:
     """Why the input policy (adfkit.inputs) keeps PyBullet from reading this mesh, or None:
     missing, not a regular file, over the size cap, outside the model's tree."""
@@ -167,6 +180,12 @@ def collision_parts(model, obj, frame_in_body, scale: float,
             diags.append(warning("runner-no-collision", f"{obj.identifier}: no usable collision primitive",
                                  obj.source, "check `collision shape` and `collision geometry`"))
         for prim in prims:
+            missing = _missing_dimension(prim)
+            if missing:
+                diags.append(warning("runner-no-collision", f"{obj.identifier}: collision {prim.kind.value} has no "
+                                     f"usable {missing}; that shape is left out", obj.where("collision geometry")
+                                     or obj.source, "give every dimension as a finite number ≥ 0"))
+                continue
             _primitive(parts, prim, body_to_com @ pose_to_matrix(prim.pose), margin)
         return parts
     path = collision_mesh_path(model, obj)
