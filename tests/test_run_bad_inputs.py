@@ -134,3 +134,13 @@ def test_json_output_is_strict_and_explains_its_nulls():
     assert _strict(text) == {"a": None, "b": [1.0, None, {"c": None}], "d": "x",
                              "non_finite": ["a", "b[1]", "b[2].c"]}
     assert _strict(jsonout.dumps({"ok": 1.5})) == {"ok": 1.5}
+
+
+def test_collision_primitive_missing_a_dimension_is_a_located_warning(tmp_path, capsys):
+    f = tmp_path / "m.yaml"
+    f.write_text("bodies: [BODY a]\n" + _body("a", z=0.5, shape="  collision shape: BOX\n"
+                                                             "  collision geometry: {x: 0.1, y: 0.1}\n"))
+    rc = main(["run", str(f), "--seconds", "0.02", "--no-frames"])
+    err = capsys.readouterr().err
+    assert rc in (0, 1) and "Traceback" not in err
+    assert f"{f}:8:23: warning[runner-no-collision]: BODY a: collision box has no usable z" in err
