@@ -191,16 +191,18 @@ def collision_parts(model, obj, frame_in_body, scale: float,
     path = collision_mesh_path(model, obj)
     if path is None:
         return parts  # no collision geometry: an empty shape (AMBF prints an error)
+    if mesh_refusal(model, path) is None and (problem := mesh_problem(path)) is not None:
+        # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some, reads garbage from others
+        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: "
+                             f"{problem}; the body is skipped as AMBF does",
+                             obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
+                             "re-export the mesh as a triangle mesh (STL or OBJ)"))
+        return None
     path, refused = pybullet_mesh(model, path)
     if refused is not None:
         diags.append(warning("runner-missing-mesh", f"{obj.identifier}: collision mesh {refused}; "
                              "the body is skipped as AMBF does", obj.where("collision mesh") or obj.source,
                              "fix `collision mesh`/`mesh` or the resolution paths"))
-        return None
-    if (problem := mesh_problem(path)) is not None:  # PyBullet crashes on some, reads garbage from others
-        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; "
-                             "the body is skipped as AMBF does",
-                             obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source, "re-export the mesh as a triangle mesh (STL or OBJ)"))
         return None
     if path.suffix.lower() not in MESH_SUFFIXES:
         diags.append(warning("runner-mesh-format", f"{obj.identifier}: {path.suffix} meshes are not readable "
@@ -302,16 +304,16 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
     if path is None:
         return -1
     suffix = path.suffix.lower()
+    if suffix in MESH_SUFFIXES and mesh_refusal(model, path) is None and (problem := mesh_problem(path)) is not None:
+        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: {problem}",
+                             obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
+        return -1
     path, refused = pybullet_mesh(model, path) if suffix in MESH_SUFFIXES else (path, mesh_refusal(model, path))
     if refused is not None:
         diags.append(warning("runner-missing-mesh", f"{obj.identifier}: visual mesh {refused}",
                              obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
         return -1
     if suffix not in MESH_SUFFIXES:
-        return -1
-    if (problem := mesh_problem(path)) is not None:
-        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: {problem}",
-                             obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
         return -1
     kw = dict(base)
     if rgba(obj) is None:
