@@ -242,8 +242,9 @@ def _world(path, seconds: float, **opt):
     return world
 
 
-def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path):
+def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path, monkeypatch):
     """cloth.yaml (386 nodes, hung from node 0) over a 0.4 m box whose top is 0.1 m below it."""
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")   # the launch in tmp names the corpus file by path
     cloth = _cloth("cloth.yaml")
     (tmp_path / "box.yaml").write_text(BOX_UNDER_CLOTH)
     (tmp_path / "launch.yaml").write_text(f"multibody configs:\n  - {cloth}\n  - box.yaml\n")
@@ -273,7 +274,8 @@ def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", CLOTHS)
-def test_corpus_cloth_plays_5_seconds_on_a_box(name, tmp_path):
+def test_corpus_cloth_plays_5_seconds_on_a_box(name, tmp_path, monkeypatch):
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")   # the launch in tmp names the corpus file by path
     cloth = _cloth(name)
     y = {"cloth.yaml": 2.0, "cloth2.yaml": -0.5}[name]
     (tmp_path / "box.yaml").write_text(BOX_UNDER_CLOTH.replace("y: 2.0", f"y: {y}"))

@@ -1,27 +1,30 @@
-"""`adfkit run PATH`: play an ADF scene in the PyBullet reference runner, headless by default,
-and write report.json plus each camera's RGB/depth/segmentation frames."""
+"""`adfkit run PATH`: play an ADF scene in the PyBullet reference runner (or MuJoCo with
+--engine mujoco), headless by default, and write report.json plus each camera's
+RGB/depth/segmentation frames."""
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
 NAME = "run"
-HELP = "play a launch, world or model file in PyBullet and write a report and camera frames"
+HELP = "play a launch, world or model file in PyBullet or MuJoCo and write a report and camera frames"
 
 
 def add_arguments(p) -> None:
     p.add_argument("path", help="launch, world or model ADF file")
     p.add_argument("-l", "--indices", help="launch file: multibody configs to load, e.g. 6,7,8,9,10,11 or 6-11")
     p.add_argument("--seconds", type=float, default=5.0, help="simulated time (default 5)")
+    p.add_argument("--engine", choices=("pybullet", "mujoco"), default="pybullet",
+                   help="physics engine (default pybullet; mujoco: the scene through the MJCF writer, headless)")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--out", help="folder for report.json and camera frames")
     p.add_argument("--physics-hz", type=float, default=1000.0, help="physics rate (AMBF: 1000)")
     p.add_argument("--control-substeps", type=int, default=4,
                    help="physics steps per control step (springs, ghosts, gravity overrides); default 4")
     p.add_argument("--solver-iterations", type=int, default=10,
-                   help="Bullet solver iterations (default 10: Bullet's, as AMBF; PyBullet's own is 50)")
+                   help="solver iterations (default 10: Bullet's, as AMBF; PyBullet's own is 50; MuJoCo: Newton iterations)")
     p.add_argument("--contact-threshold", type=float,
-                   help="Bullet contact breaking threshold, m (default Bullet's 0.02; 0.001 plays small scenes faster)")
+                   help="Bullet contact breaking threshold, m (default Bullet's 0.02; 0.001 plays small scenes faster; PyBullet only)")
     p.add_argument("--gravity", help="override the world gravity, e.g. 0,0,-9.81")
     p.add_argument("--hole-friction", type=float, default=2.0, help="K of F = -K·v inside hole ghosts, N·s/m")
     p.add_argument("--no-frames", action="store_true", help="do not render camera frames")
@@ -44,6 +47,9 @@ def run(args) -> int:
         raise AdfError(error("bad-option", "--seconds, --physics-hz and --contact-threshold must be positive, "
                              "--control-substeps and --solver-iterations ≥ 1",
                              None, "e.g. --seconds 5 --physics-hz 1000 --solver-iterations 10"))
+    if args.gui and args.engine == "mujoco":
+        raise AdfError(error("bad-option", "--gui opens the PyBullet window; the MuJoCo engine plays headless", None,
+                             "drop --gui or use --engine pybullet"))
     gravity = None
     if args.gravity:
         try:
@@ -65,7 +71,11 @@ def run(args) -> int:
                   solver_iterations=args.solver_iterations, contact_threshold=args.contact_threshold,
                   gravity=gravity, hole_friction=args.hole_friction,
                   ground=not args.no_ground)
-    world = SimWorld(scene, opt, gui=args.gui)
+    if args.engine == "mujoco":
+        from ..runner.mj.world import MjWorld
+        world = MjWorld(scene, opt)
+    else:
+        world = SimWorld(scene, opt, gui=args.gui)
     try:
         print_diagnostics(world.diagnostics, sys.stderr)
         report = play(world, args.seconds, Path(args.out) if args.out else None, not args.no_frames, str(args.path))

@@ -213,10 +213,15 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
         el.append(geom)
 
 
-def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None) -> tuple[str, list[Loss]]:
+def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None, *, tree_kinds=None,
+            names_out: dict | None = None) -> tuple[str, list[Loss]]:
+    """MJCF text and losses. ``tree_kinds``: joint kinds that join the tree (default revolute,
+    prismatic, fixed); a link joined by another kind is written welded to its parent, for the
+    caller to add its joints (the MuJoCo runner's six-dof springs). ``names_out`` receives
+    {body identifier: (MJCF body name, tree Link)}; the key "" holds the KinematicTree."""
     losses: list[Loss] = []
     model = usable_scales(model, losses)
-    tree = build_tree(model)
+    tree = build_tree(model) if tree_kinds is None else build_tree(model, tree_kinds)
     if not tree.roots and not any(sb.defined for sb in model.soft_bodies):
         raise AdfError(error("convert-empty", "the model has no bodies or soft bodies; there is nothing to write as MJCF",
                              model.where(), "convert a model file with at least one body"))
@@ -246,6 +251,10 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None) -> tuple[s
         if lk.parent is not None and lk.kind is JointKind.FIXED and lk.joint.damping is not None:
             losses.append(Loss(lk.joint.identifier, "damping", "a fixed joint has nothing to damp"))
     by_body = {lk.body.identifier: lk for lk in tree.ordered()}
+    if names_out is not None:
+        names_out[""] = tree
+        for lk in tree.ordered():
+            names_out[lk.body.identifier] = ("world" if elements[id(lk)] is world else names[id(lk)], lk)
     eq = None
     for j, kind, parent, child in tree.loops:
         if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):

@@ -17,13 +17,20 @@ def play(world, seconds: float, out: Path | None = None, frames: bool = True, sc
     with Progress(steps, "simulating") as bar:
         world.run(seconds, bar)
     report = world.report()
+    report.setdefault("engine", getattr(world, "engine", "pybullet"))
     report["scene"] = scene_label
     report["diagnostics"] = [f"{d.rule}: {d.message}" for d in world.diagnostics]
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         if frames:
-            report["frames"] = save_frames(world, out)
+            try:
+                report["frames"] = save_frames(world, out)
+            except RuntimeError as e:   # the MuJoCo engine without a headless OpenGL (CameraUnavailable)
+                if type(e).__name__ != "CameraUnavailable":
+                    raise
+                report["frames"] = []
+                report["camera_problem"] = str(e)
         atomic_write_text(out / "report.json", jsonout.dumps(report, indent=2))
     return report
 

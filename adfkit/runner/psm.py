@@ -16,7 +16,6 @@ not follow the DH kinematics, ``PSM`` refuses it with the residual it measured.
 from __future__ import annotations
 
 import numpy as np
-import pybullet as pb
 
 from .psm_kinematics import PSMKinematics, default, pose_error
 from .rotations import invert
@@ -95,8 +94,7 @@ class PSM:
     def _calibrate(self, samples: int, seed: int):
         """Constant frames between the model's bodies and the DH frames, from the model's own
         joint motion; the joints are put back where they were."""
-        cid, uid = self.world.cid, self.art.uid
-        saved = [pb.getJointState(uid, i, physicsClientId=cid)[:2] for i in self.arm]
+        saved = self.world.joint_state(self.art, self.arm)
         rng = np.random.default_rng(seed)
         lo, hi = self.kin.lower_limits[:6], self.kin.upper_limits[:6]
         mid = (lo + hi) / 2
@@ -104,13 +102,11 @@ class PSM:
         world_poses, model_poses = [], []
         try:
             for q in qs:
-                for i, v in zip(self.arm, q):
-                    pb.resetJointState(uid, i, float(v), physicsClientId=cid)
+                self.world.reset_joints(self.art, self.arm, q)
                 world_poses.append(self._tool_in_base())
                 model_poses.append(self.kin.fk(q))
         finally:
-            for i, (p, v) in zip(self.arm, saved):
-                pb.resetJointState(uid, i, p, v, physicsClientId=cid)
+            self.world.reset_joints(self.art, self.arm, *saved)
         b, y = hand_eye(world_poses, model_poses)
         err = max(pose_error(b @ f @ y, w) for w, f in zip(world_poses, model_poses))
         if err > CALIBRATION_TOLERANCE:
@@ -127,7 +123,7 @@ class PSM:
     # ---- joint space -------------------------------------------------------------------
     def measured_jp(self) -> np.ndarray:
         """q1..q6 as the simulation has them."""
-        return np.array([pb.getJointState(self.art.uid, i, physicsClientId=self.world.cid)[0] for i in self.arm])
+        return self.world.joint_state(self.art, self.arm)[0]
 
     def setpoint_jp(self) -> np.ndarray:
         return np.array([self.art.targets[i] for i in self.arm])
@@ -176,7 +172,7 @@ class PSM:
     # ---- jaw and grasp -------------------------------------------------------------------
     def measured_jaw(self) -> float:
         """Angle between the two fingers, rad."""
-        return float(sum(pb.getJointState(self.art.uid, i, physicsClientId=self.world.cid)[0] for i in self.jaws))
+        return float(sum(self.world.joint_state(self.art, self.jaws)[0]))
 
     def servo_jaw(self, angle: float) -> None:
         """Open the fingers ``angle`` rad apart (each finger takes half)."""

@@ -400,6 +400,17 @@ class SimWorld:
             raise KeyError(f"no unique body matches {text!r}")
         return hit
 
+    def joint_state(self, art, idxs) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities of joints ``idxs`` (record indices) of an articulation."""
+        st = pb.getJointStates(art.uid, list(idxs), physicsClientId=self.cid)
+        return np.array([s[0] for s in st]), np.array([s[1] for s in st])
+
+    def reset_joints(self, art, idxs, positions, velocities=None) -> None:
+        """Put joints ``idxs`` of an articulation at ``positions`` (and ``velocities``, default 0) now."""
+        vel = velocities if velocities is not None else [0.0] * len(idxs)
+        for i, p, v in zip(idxs, positions, vel):
+            pb.resetJointState(art.uid, i, float(p), float(v), physicsClientId=self.cid)
+
     def by_uid(self):
         """{(PyBullet uid, link): SimBody}"""
         return self._lookup

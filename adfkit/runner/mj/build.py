@@ -1,0 +1,384 @@
+"""An ADF scene as one MuJoCo model: every model file through the project's MJCF writer
+(bodies, joints, loops as equalities, lights), attached under its own prefix, plus what the
+runner adds (the README, "MuJoCo engine"):
+
+- six-dof-family joints (the thread, the phantom's hole bodies) join the kinematic tree and
+  get one slide per free linear axis and one hinge per free angular axis, with the ADF
+  stiffness, damping, equilibrium and limits as MuJoCo joint stiffness/damping/springref/range;
+- a position actuator on every revolute/prismatic tree joint (AMBF's joint motors, held at
+  the file's initial value);
+- ghost objects as contact-free geoms (contype = conaffinity = 0, group 4, never drawn);
+- one inactive weld equality per constraint actuator (the grasp), re-targeted when grasping;
+- collision groups as contype/conaffinity bits, `ignore inter collision` as excluded pairs.
+"""
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from ...converters.mjcf_write import to_mjcf
+from ...converters.urdf import _material
+from ...model.semantics import JointKind, collision_primitives, joint_frames, pose_or_identity
+from ...model.tree import ONE_DOF
+from ..rotations import matrix_to_quat, pose_to_matrix
+
+SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
+                JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING)
+TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
+GHOST_GROUP = 4
+WELD_SOLREF = (0.004, 1.0)    # s, damping ratio: a stiff grasp weld at a 1 ms step (timeconst ≥ 2 dt)
+
+
+@dataclass
+class BodyPlan:
+    key: str                      # namespace + identifier, as SimWorld keys it
+    body: object                  # ADF Body
+    model: object                 # ADF ModelFile
+    mjname: str                   # MJCF body name ("world" for ADF's world stand-in)
+    link: object                  # model.tree.Link
+    spring: tuple | None = None   # (joint, kind) of a six-dof-family joint to its parent
+
+
+@dataclass
+class GhostPlan:
+    key: str
+    ghost: object
+    parent: BodyPlan | None
+    geoms: list[str] = field(default_factory=list)
+    friction: bool = False
+
+
+@dataclass
+class Plan:
+    spec: object
+    bodies: list[BodyPlan]
+    ghosts: list[GhostPlan]
+    actuators: list[tuple]        # (key, ADF actuator, parent BodyPlan, weld name)
+    joints: list[tuple]           # (ADF joint, kind, parent BodyPlan, child BodyPlan, MJCF joint names)
+    loops: list[tuple]            # (ADF joint, kind, parent BodyPlan, child BodyPlan, pivot in parent link, pivot in child link)
+    springs: int = 0
+    losses: list = field(default_factory=list)
+    tmp: object = None
+    sensors: list = field(default_factory=list)   # (key, ADF sensor, parent BodyPlan)
+
+
+def _spring_axes(joint, kind):
+    """[(slide|hinge, axis index, low, high, stiffness, damping, equilibrium)] of a six-dof-family joint."""
+    from ..joints import spring_joint
+    sj = spring_joint(joint, kind, None, None, np.eye(4), np.eye(4))
+    out = []
+    for tag, lo, hi, k, c, eq in (("slide", sj.lin_low, sj.lin_high, sj.k_lin, sj.c_lin, sj.eq_lin),
+                                  ("hinge", sj.ang_low, sj.ang_high, sj.k_ang, sj.c_ang, sj.eq_ang)):
+        for i in range(3):
+            if hi[i] - lo[i] > 1e-12:
+                out.append((tag, i, float(lo[i]), float(hi[i]), float(k[i]), float(c[i]), float(eq[i])))
+    return out
+
+
+def _ghost_geoms(body_el, gh, pose_in_link: np.ndarray, name: str, warn) -> list[str]:
+    prims = collision_primitives(gh)
+    if not prims:
+        warn("runner-ghost", f"{gh.identifier}: only primitive ghost shapes are played by the MuJoCo engine; skipped", gh)
+        return []
+    from ...model.semantics import ShapeKind
+    out = []
+    for n, p in enumerate(prims):
+        t = pose_in_link @ pose_to_matrix(p.pose)
+        g = p.geometry
+        kw = dict(contype=0, conaffinity=0, group=GHOST_GROUP, pos=t[:3, 3], rgba=[0, 1, 0, 0.2],
+                  name=f"{name}#{n}")
+        if p.kind is ShapeKind.BOX:
+            kw.update(type=mujoco.mjtGeom.mjGEOM_BOX, size=[(g.x or 0) / 2, (g.y or 0) / 2, (g.z or 0) / 2])
+        elif p.kind is ShapeKind.SPHERE:
+            kw.update(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[g.radius or 0.0, 0, 0])
+        elif p.kind in (ShapeKind.CYLINDER, ShapeKind.CAPSULE):
+            ax = (g.axis or "z").lower()
+            turn = {"x": np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]]), "y": np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]])}
+            r = t[:3, :3] @ turn[ax].T if ax in turn else t[:3, :3]
+            t = t.copy()
+            t[:3, :3] = r
+            half = (g.height or 0) / 2 if p.kind is ShapeKind.CYLINDER else max((g.height or 0) / 2 - (g.radius or 0), 0)
+            kw.update(type=mujoco.mjtGeom.mjGEOM_CYLINDER if p.kind is ShapeKind.CYLINDER
+                      else mujoco.mjtGeom.mjGEOM_CAPSULE, size=[g.radius or 0.0, half, 0])
+        else:
+            warn("runner-ghost", f"{gh.identifier}: ghost shape {p.kind.value} not played by the MuJoCo engine", gh)
+            continue
+        q = matrix_to_quat(t[:3, :3])
+        kw["quat"] = [q[3], q[0], q[1], q[2]]
+        body_el.add_geom(**kw)
+        out.append(kw["name"])
+    return out
+
+
+def build_plan(world) -> Plan:
+    """The MjSpec of ``world.scene`` (not compiled) and the tables the MuJoCo world reads."""
+    from ..names import Registry, merge_namespace
+    scene, opt = world.scene, world.opt
+    tmp = tempfile.TemporaryDirectory(prefix="adfkit-mj-")
+    out_dir = Path(tmp.name)
+    spec = mujoco.MjSpec()
+    spec.compiler.degree = False
+    bodies: list[BodyPlan] = []
+    registry: Registry = world.registry
+    plans_by_model = []
+    losses = []
+    for i, m in enumerate(scene.all_models()):
+        ns = m.namespace or ""
+        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles)):
+            for o in objs:
+                world._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
+                            "MuJoCo engine; skipped", o, "play it with --engine pybullet")
+        mine = {}
+        if m.bodies:
+            names: dict = {}
+            text, ls = to_mjcf(m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names)
+            losses += ls
+            child = mujoco.MjSpec.from_string(text)
+            _resolve_meshes(world, child, out_dir, m)
+            prefix = f"m{i}/"
+            spec.attach(child, frame=spec.worldbody.add_frame(), prefix=prefix)
+            tree = names.pop("")
+            for b in m.bodies:
+                if b.identifier not in names:
+                    continue
+                mjname, link = names[b.identifier]
+                key = registry.add(merge_namespace(ns, b.namespace) + b.identifier, None)
+                bp = BodyPlan(key, b, m, mjname if mjname == "world" else prefix + mjname, link)
+                registry.items[key] = bp
+                if link.parent is not None and link.kind in SPRING_KINDS:
+                    bp.spring = (link.joint, link.kind)
+                mine[b.identifier] = bp
+                bodies.append(bp)
+            plans_by_model.append((m, mine, tree))
+        else:
+            plans_by_model.append((m, mine, None))
+    joints, loops, springs = [], [], 0
+    for m, mine, tree in plans_by_model:
+        if tree is None:
+            continue
+        for lk in tree.ordered():
+            if lk.parent is None:
+                continue
+            child, parent = mine[lk.body.identifier], mine[lk.parent.body.identifier]
+            jn = []
+            if lk.kind in ONE_DOF:
+                mj = spec.body(child.mjname)
+                jn = [j.name for j in mj.joints]
+            elif lk.kind in SPRING_KINDS:
+                springs += 1
+                mj = spec.body(child.mjname)
+                for n, (tag, ax, lo, hi, k, c, eq) in enumerate(_spring_axes(lk.joint, lk.kind)):
+                    axis = [0.0, 0.0, 0.0]
+                    axis[ax] = 1.0
+                    j = mj.add_joint(type=mujoco.mjtJoint.mjJNT_SLIDE if tag == "slide" else mujoco.mjtJoint.mjJNT_HINGE,
+                                     axis=axis, name=f"{child.mjname}#{tag}{'xyz'[ax]}", stiffness=k, damping=c,
+                                     springref=eq)
+                    if np.isfinite(lo) and np.isfinite(hi) and (tag == "slide" or hi - lo < 2 * np.pi):
+                        j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+                        j.range = [lo, hi]
+                    jn.append(j.name)
+            joints.append((lk.joint, lk.kind, parent, child, jn))
+        for j, kind, pb_, cb in tree.loops:
+            parent, child = mine[pb_.identifier], mine[cb.identifier]
+            if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
+                a, b = joint_frames(j, pb_.scale or 1.0, cb.scale or 1.0)
+                pa = np.array(parent.link.in_link(a).position, float)
+                pbv = np.array(child.link.in_link(b).position, float)
+                loops.append((j, kind, parent, child, pa, pbv))
+            else:
+                world._warn("runner-loop", f"{j.identifier}: a {kind.value} joint closing a loop is not played by the "
+                            "MuJoCo engine; skipped", j)
+    _world_lights(world, spec)
+    _collision_filters(world, spec, bodies, joints, plans_by_model)
+    ghosts, actuators, sensors = [], [], []
+    for m, mine, tree in plans_by_model:
+        ns = m.namespace or ""
+        for gh in m.ghost_objects:
+            parent = _parent(world, gh.parent, ns, gh) if gh.parent else None
+            loc = pose_to_matrix(pose_or_identity(gh.location))
+            if parent is not None:
+                loc = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body)) @ loc
+            key = registry.add(merge_namespace(ns, gh.namespace) + gh.identifier, None)
+            body_el = spec.worldbody if parent is None or parent.mjname == "world" else spec.body(parent.mjname)
+            name = (gh.name or gh.identifier).lower()
+            gp = GhostPlan(key, gh, parent, _ghost_geoms(body_el, gh, loc, f"ghost:{key}", world._warn),
+                           any(w in name for w in opt.hole_ghost_words))
+            if gp.geoms:
+                ghosts.append(gp)
+        from ...model.semantics import ACTUATOR_TYPES, SENSOR_TYPES
+        for sn in m.sensors:
+            if SENSOR_TYPES.get(sn.type) != "proximity" or not sn.array:
+                world._warn("runner-sensor", f"{sn.identifier}: only proximity sensors with an `array` of rays "
+                            "are played; skipped", sn)
+                continue
+            parent = _parent(world, sn.parent, ns, sn)
+            if parent is not None:
+                sensors.append((merge_namespace(ns, sn.namespace) + sn.identifier, sn, parent))
+        for a in m.actuators:
+            if ACTUATOR_TYPES.get(a.type) != "constraint":
+                world._warn("runner-actuator", f"{a.identifier}: actuator type {a.type!r} not supported; skipped", a)
+                continue
+            parent = _parent(world, a.parent, ns, a)
+            if parent is None:
+                continue
+            key = merge_namespace(ns, a.namespace) + a.identifier
+            weld = f"grasp:{key}"
+            spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name=weld, name1=parent.mjname, name2="world",
+                              objtype=mujoco.mjtObj.mjOBJ_BODY, active=False, solref=list(WELD_SOLREF))
+            actuators.append((key, a, parent, weld))
+    for j, kind, parent, child, jn in joints:
+        if kind in ONE_DOF and jn:
+            act = spec.add_actuator(name=f"motor:{jn[0]}", target=jn[0], trntype=mujoco.mjtTrn.mjTRN_JOINT)
+            act.set_to_position(kp=1.0, kv=0.0)   # gains are set per joint once the model is compiled
+    return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors)
+
+
+def _resolve_meshes(world, child, out_dir: Path, model) -> None:
+    """Absolute mesh paths; a mesh file that is not there drops its geoms, with a warning."""
+    missing, missing_paths = {}, {}
+    for mesh in list(child.meshes):
+        path = (out_dir / mesh.file).resolve()
+        if path.is_file():
+            mesh.file = str(path)
+            # inertials are explicit; shell inertia lets flat meshes (a floor, a backdrop) compile
+            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+        else:
+            missing[mesh.name] = mesh
+            missing_paths[mesh.name] = path
+    if not missing:
+        return
+    for g in list(child.geoms):
+        if g.meshname in missing:
+            child.delete(g)
+    for name, mesh in missing.items():
+        world._warn("runner-mesh", f"{model.name}: mesh file {missing_paths[name]} not found; its shapes are left out", model)
+        child.delete(mesh)
+
+
+def _world_lights(world, spec) -> None:
+    """The world file's spot lights (the writer handles model files' lights), without shadows:
+    a shadow map is a render pass per light per camera."""
+    import math
+    from ...converters.mjcf_cameras import ADF_CUTOFF, ADF_SPOT_EXPONENT
+    w = world.scene.world
+    for light in (w.lights if w is not None else []):
+        el, to_link = spec.worldbody, np.eye(4)
+        if light.parent:
+            parent = _parent(world, light.parent, w.namespace or "", light)
+            if parent is None:
+                continue
+            to_link = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body))
+            if parent.mjname != "world":
+                el = spec.body(parent.mjname)
+        d = np.array(light.direction if light.direction is not None else (1.0, 0.0, 0.0), float)
+        if np.linalg.norm(d) == 0:
+            d = np.array([1.0, 0.0, 0.0])
+        pos = to_link[:3, :3] @ np.array(light.location or (0.0, 0.0, 0.0), float) + to_link[:3, 3]
+        el.add_light(pos=list(pos), dir=list(to_link[:3, :3] @ (d / np.linalg.norm(d))),
+                     cutoff=math.degrees(light.cutoff_angle if light.cutoff_angle is not None else ADF_CUTOFF),
+                     exponent=light.spot_exponent if light.spot_exponent is not None else ADF_SPOT_EXPONENT,
+                     castshadow=False)
+
+
+def _parent(world, ref, ns, obj):
+    key, hit = world.registry.find(ref)
+    if key is None and ref:
+        key, hit = world.registry.find(ns + ref)
+    if key is None or not isinstance(hit, BodyPlan):
+        world._warn("runner-parent", f"{obj.identifier}: parent {ref!r} not found"
+                    + (f" (matches: {', '.join(hit)})" if hit else ""), obj)
+        return None
+    return hit
+
+
+def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
+    """ADF collision groups as contype/conaffinity bits (bodies collide when they share a
+    group, as in the PyBullet runner); joints and models that ignore inter-collision as
+    excluded body pairs."""
+    groups = sorted({g for bp in bodies for g in (bp.body.collision_groups or []) if 0 <= g <= 999})
+    bit = {g: 1 << (i % 31) for i, g in enumerate(groups)}
+    allbits = (1 << 31) - 1
+    for bp in bodies:
+        if bp.mjname == "world":
+            continue
+        gs = [g for g in (bp.body.collision_groups or []) if 0 <= g <= 999]
+        mask = 0
+        for g in gs:
+            mask |= bit[g]
+        fr = bp.body.friction
+        geoms = spec.body(bp.mjname).geoms
+        drawn = any(g.group == 1 for g in geoms)
+        rgba = _material(bp.body)
+        for g in geoms:
+            if not drawn and g.group == 3:
+                g.group = 0     # no visual shape written: the camera sees the collision shape
+                if rgba is not None:
+                    g.rgba = rgba
+
+            if g.contype == 0 and g.conaffinity == 0:
+                continue
+            g.contype = g.conaffinity = mask or allbits
+            if fr is not None and fr.static is not None:
+                g.friction = [fr.static, g.friction[1], fr.rolling if fr.rolling is not None else g.friction[2]]
+    pairs = set()
+    for j, kind, parent, child, jn in joints:
+        if j.ignore_inter_collision is not False:
+            pairs.add((parent.mjname, child.mjname))
+    for m, mine, tree in plans_by_model:
+        if m.ignore_inter_collision:
+            bs = list(mine.values())
+            for i, a in enumerate(bs):
+                for b in bs[i + 1:]:
+                    pairs.add((a.mjname, b.mjname))
+    for a, b in sorted(pairs):
+        if a != b and "world" not in (a, b):
+            spec.add_exclude(bodyname1=a, bodyname2=b)
+
+
+def compile_spec(world, spec):
+    """spec.compile(), replacing a collision mesh MuJoCo cannot hull (flat: coplanar vertices)
+    by a box around its vertices (at least 1 mm thick), with a warning."""
+    import re
+    for _ in range(100):
+        try:
+            return spec.compile()
+        except ValueError as e:
+            hit = re.search(r"mesh '([^']+)' has coplanar vertices", str(e))
+            if hit is None:
+                raise
+            mesh = spec.mesh(hit.group(1))
+            lo, hi = _obj_bounds(Path(mesh.file), np.array(mesh.scale, float))
+            for g in list(spec.geoms):
+                if g.meshname != mesh.name:
+                    continue
+                body = g.parent
+                box = body.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=np.maximum((hi - lo) / 2, 5e-4),
+                                    contype=g.contype, conaffinity=g.conaffinity, group=g.group, friction=g.friction,
+                                    rgba=g.rgba, name=(g.name or "") + "#box")
+                r = _quat_matrix(np.array(g.quat, float))
+                box.pos = np.array(g.pos, float) + r @ ((lo + hi) / 2)
+                box.quat = g.quat
+                spec.delete(g)
+            world._warn("runner-flat-mesh", f"{Path(mesh.file).name}: a flat mesh has no convex hull for MuJoCo; "
+                        "it collides as its bounding box", None)
+            spec.delete(mesh)
+    return spec.compile()
+
+
+def _obj_bounds(path: Path, scale: np.ndarray):
+    vs = []
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            if line.startswith("v "):
+                vs.append([float(x) for x in line.split()[1:4]])
+    v = np.array(vs) * scale if vs else np.zeros((1, 3))
+    return v.min(axis=0), v.max(axis=0)
+
+
+def _quat_matrix(q: np.ndarray) -> np.ndarray:
+    from ..rotations import quat_to_matrix
+    return quat_to_matrix(np.array([q[1], q[2], q[3], q[0]]))
