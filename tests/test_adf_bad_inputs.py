@@ -165,11 +165,7 @@ def test_odd_mesh_names_are_findings_not_crashes(tmp_path, capsys, name):
 
 @pytest.mark.parametrize("to", ["urdf", "xml", "yaml"])
 @pytest.mark.parametrize("name", ["x" * 300 + ".stl", "a\\0b.stl", ("d" * 200 + "/") * 25 + "m.stl"])
-def test_convert_with_odd_mesh_names(tmp_path, capsys, name, to, request):
-    if "\\0" in name and to in ("urdf", "xml"):
-        request.applymarker(pytest.mark.xfail(
-            raises=ValueError, strict=True, reason="the URDF/MJCF writers resolve a mesh path holding a NUL byte "
-            "(ValueError: embedded null byte); converter code, issue 14's robust branch"))
+def test_convert_with_odd_mesh_names(tmp_path, capsys, name, to):
     f = tmp_path / "m.yaml"
     f.write_text(f'bodies: [BODY a]\nBODY a:\n  name: a\n  mass: 1.0\n  mesh: "{name}"\n')
     assert main(["convert", str(f), str(tmp_path / f"out.{to}")]) in (0, 1, 2)

@@ -1,7 +1,7 @@
 """`adfkit convert IN OUT`: ADF ⇄ URDF ⇄ MJCF through the scene model; prints what was dropped."""
 from __future__ import annotations
 
-import json
+from .. import jsonout
 import sys
 
 NAME = "convert"
@@ -35,7 +35,7 @@ def run(args) -> int:
     write_losses = write(model, dst, fout)
     losses = [("read", l) for l in read_losses] + [("write", l) for l in write_losses]
     if args.json:
-        json.dump({"input": str(src), "output": str(dst), "from": fin, "to": fout,
+        jsonout.dump({"input": str(src), "output": str(dst), "from": fin, "to": fout,
                    "losses": [{"stage": s, "element": l.element, "feature": l.feature, "reason": l.reason}
                               for s, l in losses]}, sys.stdout, indent=2)
         sys.stdout.write("\n")

@@ -1,7 +1,7 @@
 """`adfkit decompose MESH`: convex decomposition (CoACD) into a hull OBJ for ADF collision."""
 from __future__ import annotations
 
-import json
+from .. import jsonout
 import sys
 
 NAME = "decompose"
@@ -58,7 +58,7 @@ def run(args) -> int:
         "adf": {"collision mesh": out.name, "collision mesh type": "CONVEX_HULL"},
     }
     if args.json:
-        json.dump(summary, sys.stdout, indent=2)
+        jsonout.dump(summary, sys.stdout, indent=2)
         sys.stdout.write("\n")
         return 0
     print(f"{src.name}: {report.summary()}")

@@ -1,7 +1,7 @@
 """`adfkit inertia MESH --mass M | --density D`: volume, COM and principal inertia."""
 from __future__ import annotations
 
-import json
+from .. import jsonout
 import sys
 
 NAME = "inertia"
@@ -43,7 +43,7 @@ def run(args) -> int:
                                     "orientation": dict(zip(("r", "p", "y"), rpy))}},
     }
     if args.json:
-        json.dump(out, sys.stdout, indent=2)
+        jsonout.dump(out, sys.stdout, indent=2)
         sys.stdout.write("\n")
         return 0
     f = lambda v: " ".join(f"{x: .6g}" for x in v)  # noqa: E731

@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 import sys
 
+from .. import jsonout
+
 NAME = "info"
 HELP = "summarise a launch, world, input-devices or model file"
 
@@ -39,7 +41,7 @@ def run(args) -> int:
         return 2
     print_diagnostics(diags, sys.stderr)
     if args.json:
-        json.dump(summary, sys.stdout, indent=2)
+        jsonout.dump(summary, sys.stdout, indent=2)
         sys.stdout.write("\n")
     else:
         print(format_summary(summary))

@@ -10,10 +10,9 @@ directly, hinge/slide joints become revolute/prismatic joints whose ADF value eq
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
-from ..diagnostics import AdfError, SourceLocation, error
+from ..diagnostics import AdfError, error
 from ..model.common import RGBA, Geometry, ShapeEntry
 from ..model.files import ModelFile
 from ..model.objects import Body, Inertia, Joint, JointLimits
@@ -22,7 +21,7 @@ from ..model.semantics import shortest_arc
 from .losses import Loss
 from .urdf import _unique
 from .mjcf_cameras import read_cameras, read_lights
-from .safexml import parse_xml
+from .mjcf_source import Source, load
 
 # mjtGeom / mjtJoint values (MuJoCo's enums, stable across 2.x-4.x)
 PLANE, HFIELD, SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = range(8)
@@ -35,19 +34,19 @@ def _pose(pos, quat_wxyz) -> Pose:
     return Pose(Vec3(*(float(v) for v in pos)), Quat(x, y, z, w).normalized())
 
 
-def _compile(path: Path):
+def _compile(source: Source, path: Path):
     import mujoco
 
     try:
-        spec = mujoco.MjSpec.from_file(str(path))
+        # the merged text when the file has includes (resolved by mjcf_source), else the file
+        spec = mujoco.MjSpec.from_string(source.text) if source.text is not None else mujoco.MjSpec.from_file(str(path))
         model = spec.compile()
-    except (ValueError, mujoco.FatalError) as exc:  # MuJoCo reports "XML Error: ... line N, column M"
+    except (ValueError, mujoco.FatalError) as exc:  # "XML Error: ...\nElement 'geom', line N"
         text = str(exc).strip()
-        m = re.search(r"[Ll]ine\s*=?\s*(\d+)(?:.*?[Cc]olumn\s*=?\s*(\d+))?", text)
-        line = int(m.group(1)) if m else None
-        col = int(m.group(2)) if m and m.group(2) else None
-        raise AdfError(error("mjcf-compile", f"MuJoCo cannot load the file: {text.splitlines()[0] if text else exc}",
-                             SourceLocation(str(path), line, col),
+        first = text.splitlines()[0] if text else type(exc).__name__
+        if "XML_ELEMENT_DEPTH_EXCEEDED" in text:
+            first = "elements nested too deep for MuJoCo's XML parser (at most 499 levels)"
+        raise AdfError(error("mjcf-compile", f"MuJoCo cannot load the file: {first}", source.locate(text),
                              "fix what MuJoCo names; `python -m mujoco.viewer` shows the same message")) from None
     return mujoco, spec, model
 
@@ -69,11 +68,12 @@ def _mesh_files(spec, path: Path) -> list[tuple[str | None, float | None]]:
 
 def read(path: Path) -> tuple[ModelFile, list[Loss]]:
     path = Path(path)
-    doc = parse_xml(path)
+    source = load(path)  # safe XML, includes resolved inside the model's folder tree
+    doc = source.doc
     if doc.root.tag != "mujoco":
         raise AdfError(error("mjcf-root", f"the root element is <{doc.root.tag}>, not <mujoco>", doc.where(doc.root),
                              "an MJCF file holds one <mujoco> element"))
-    mujoco, spec, m = _compile(path)
+    mujoco, spec, m = _compile(source, path)
     d = mujoco.MjData(m)
     d.qpos[:] = m.qpos0
     mujoco.mj_kinematics(m, d)

@@ -24,11 +24,17 @@ from ..model.semantics import (
     JointKind, ShapeKind, collision_primitives, effective_mass, inertial_offset, joint_frames,
 )
 from . import inertia as inertia_math
+from .engine_fit import MeshFiles, flat_box, joint_range, usable_scales
 from .losses import Loss
 from .mjcf_cameras import write_cameras_lights
 from .mjcf_soft import write_soft_bodies
+from .safexml import to_text
 from ..model.tree import Link, build_tree, motion
 from .urdf import INITIAL_VALUE_TOLERANCE, _AXIS_TO_Z, _BODY_ONLY, _link_name, _joint_name, _material, _num, _unique, _vec
+
+# MuJoCo's XML parser (tinyxml2) refuses elements nested deeper than ~500: <mujoco>,
+# <worldbody>, the bodies, and a body's own geoms and joints.
+MAX_BODY_DEPTH = 496
 
 # Moving bodies need mass and inertia above MuJoCo's mjMINVAL; massless ADF links get this.
 MIN_MASS = 1e-6
@@ -47,13 +53,18 @@ def _place(el: ET.Element, pose: Pose) -> None:
 
 
 class _Assets:
-    def __init__(self, root: ET.Element, out_dir: Path):
+    def __init__(self, root: ET.Element, out_dir: Path, stem: str, tree=None):
         self.el = ET.SubElement(root, "asset")
         self.out_dir = out_dir
         self.names: dict[tuple[str, float], str] = {}
         self.used: set[str] = set()
+        self.files = MeshFiles("mjcf", out_dir, stem, tree)
 
-    def mesh(self, path: Path, scale: float) -> str:
+    def fit(self, path: Path, who: str, losses: list[Loss]):
+        """(a file MuJoCo reads or None, the mesh when it is flat): engine_fit.MeshFiles."""
+        return self.files.fit(path, who, losses, check_flat=True)
+
+    def mesh(self, path: Path, scale: float, flat: bool = False) -> str:
         key = (str(path.resolve()), scale)
         if key not in self.names:
             name = _unique(path.stem.replace(" ", "_"), self.used)
@@ -61,6 +72,8 @@ class _Assets:
                               file=Path(os.path.relpath(path.resolve(), self.out_dir.resolve())).as_posix())
             if scale != 1.0:
                 m.set("scale", _vec((scale,) * 3))
+            if flat:  # zero volume: MuJoCo computes its (unused) inertia as a shell
+                m.set("inertia", "shell")
             self.names[key] = name
         return self.names[key]
 
@@ -103,10 +116,10 @@ def _write_body(parent_el: ET.Element, model: ModelFile, link: Link, names: dict
                             axis=_vec(link.axis))
         if q0:
             jel.set("ref", _num(q0))
-        lim = j.joint_limits
-        if lim is not None and lim.low is not None and lim.high is not None:
+        lim = joint_range(j, losses)
+        if lim is not None:
             jel.set("limited", "true")
-            jel.set("range", _vec((lim.low, lim.high)))
+            jel.set("range", _vec(lim))
         if isinstance(j.damping, float):
             jel.set("damping", _num(j.damping))
         for attr, key in (("controller", "controller"), ("max_motor_impulse", "max motor impulse")):
@@ -154,9 +167,12 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
     scale = body.scale if body.scale is not None else 1.0
     to_link = link.frame_in_body.inverse()
     mesh = visual_mesh_path(model, body)
+    flat = None
+    if mesh is not None:
+        mesh, flat = assets.fit(mesh, who, losses)
     if mesh is not None:
         g = ET.SubElement(el, "geom", name=_unique(f"{name}_visual", used["geom"]), type="mesh",
-                          mesh=assets.mesh(mesh, scale), contype="0", conaffinity="0", group="1")
+                          mesh=assets.mesh(mesh, scale, flat is not None), contype="0", conaffinity="0", group="1")
         _place(g, to_link)
         rgba = _material(body)
         if rgba is not None:
@@ -164,7 +180,17 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
     prims = collision_primitives(body)
     if prims is None:
         cmesh = collision_mesh_path(model, body)
+        flat = None
         if cmesh is not None:
+            cmesh, flat = assets.fit(cmesh, who, losses)
+        if cmesh is not None and flat is not None:  # MuJoCo cannot hull a flat mesh: a thin box
+            centre, rot, sizes = flat_box(flat, scale)
+            g = ET.SubElement(el, "geom", name=_unique(f"{name}_collision", used["geom"]), type="box",
+                              size=_vec(sizes / 2), group="3")
+            _place(g, to_link * Pose(Vec3(*centre), Quat.from_matrix(rot.tolist())))
+            losses.append(Loss(who, "collision mesh", f"{cmesh.name} is flat (no volume): MuJoCo cannot take its "
+                                                      "convex hull, so it collides as a thin box around it"))
+        elif cmesh is not None:
             g = ET.SubElement(el, "geom", name=_unique(f"{name}_collision", used["geom"]), type="mesh",
                               mesh=assets.mesh(cmesh, scale), group="3")
             _place(g, to_link)
@@ -194,20 +220,27 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None, *, tree_ki
     caller to add its joints (the MuJoCo runner's six-dof springs). ``names_out`` receives
     {body identifier: (MJCF body name, tree Link)}; the key "" holds the KinematicTree."""
     losses: list[Loss] = []
+    model = usable_scales(model, losses)
     tree = build_tree(model) if tree_kinds is None else build_tree(model, tree_kinds)
     if not tree.roots and not any(sb.defined for sb in model.soft_bodies):
         raise AdfError(error("convert-empty", "the model has no bodies or soft bodies; there is nothing to write as MJCF",
                              model.where(), "convert a model file with at least one body"))
     root = ET.Element("mujoco", model=name or model.name)
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
-    assets = _Assets(root, out_dir)
+    assets = _Assets(root, out_dir, name or model.name, getattr(model, "tree", None))
     world = ET.SubElement(root, "worldbody")
     # MuJoCo keeps one namespace per element type; "world" is the world body's name
     used: dict[str, set[str]] = {"body": {"world"}, "joint": set(), "geom": set(), "equality": set()}
     names: dict[int, str] = {}
     elements: dict[int, ET.Element] = {}
+    depth: dict[int, int] = {}
     for lk in tree.ordered():
         names[id(lk)] = _unique(_link_name(lk.body), used["body"])
+        depth[id(lk)] = 1 if lk.parent is None else depth[id(lk.parent)] + 1
+        if depth[id(lk)] == MAX_BODY_DEPTH + 1:
+            losses.append(Loss(lk.body.identifier, "body nesting", f"MJCF nests each child body in its parent and "
+                               f"MuJoCo's XML parser refuses more than {MAX_BODY_DEPTH} levels: the file will not "
+                               "load in MuJoCo"))
     for lk in tree.ordered():
         parent_el = world if lk.parent is None else elements[id(lk.parent)]
         if _is_world(lk):  # ADF's stand-in for the world: its geoms and children go in <worldbody>
@@ -250,8 +283,7 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None, *, tree_ki
             losses.append(Loss(obj.identifier, label, "not written to MJCF"))
     if not len(assets.el):
         root.remove(assets.el)
-    ET.indent(root, "  ")
-    return ET.tostring(root, encoding="unicode") + "\n", sorted(set(losses))
+    return to_text(root) + "\n", sorted(set(losses))
 
 
 def write(model: ModelFile, path: Path) -> list[Loss]:

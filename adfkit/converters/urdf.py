@@ -28,8 +28,9 @@ from ..model.semantics import (
     JointKind, ShapeKind, collision_primitives, effective_mass, inertial_offset, shortest_arc,
 )
 from . import inertia as inertia_math
+from .engine_fit import MeshFiles, joint_range, usable_scales
 from .losses import Loss
-from .safexml import XmlDocument, parse_xml
+from .safexml import XmlDocument, parse_xml, to_text
 from ..model.tree import Link, build_tree
 
 # --- writing ------------------------------------------------------------------------------
@@ -143,7 +144,8 @@ def _mesh_element(link_el: ET.Element, tag: str, pose: Pose, mesh: Path, scale: 
     return el
 
 
-def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_dir: Path, losses: list[Loss]) -> None:
+def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_dir: Path, losses: list[Loss],
+                files: MeshFiles) -> None:
     body = link.body
     el = ET.SubElement(robot, "link", name=name)
     who = body.identifier
@@ -165,6 +167,8 @@ def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_
     to_link = link.frame_in_body.inverse()
     mesh = visual_mesh_path(model, body)
     if mesh is not None:
+        mesh = files.fit(mesh, who, losses)[0]
+    if mesh is not None:
         vis = _mesh_element(el, "visual", to_link, mesh, scale, out_dir)
         rgba = _material(body)
         if rgba is not None:
@@ -175,6 +179,8 @@ def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_
     prims = collision_primitives(body)
     if prims is None:
         cmesh = collision_mesh_path(model, body)
+        if cmesh is not None:
+            cmesh = files.fit(cmesh, who, losses)[0]
         if cmesh is not None:
             _mesh_element(el, "collision", to_link, cmesh, scale, out_dir)
             if body.collision_mesh_type is not None:
@@ -212,8 +218,8 @@ def _is_bare(model: ModelFile, body: Body) -> bool:
 
 def _write_joint(robot: ET.Element, link: Link, name: str, parent: str, child: str, losses: list[Loss]) -> None:
     j = link.joint
-    limits = j.joint_limits
-    has_limits = limits is not None and limits.low is not None and limits.high is not None
+    limits = joint_range(j, losses) if link.kind in (JointKind.REVOLUTE, JointKind.PRISMATIC) else None
+    has_limits = limits is not None
     if link.kind is JointKind.REVOLUTE:
         jtype = "revolute" if has_limits else "continuous"
     elif link.kind is JointKind.PRISMATIC:
@@ -229,7 +235,7 @@ def _write_joint(robot: ET.Element, link: Link, name: str, parent: str, child: s
     if jtype != "fixed":
         ET.SubElement(el, "axis", xyz=_vec(link.axis))
     if jtype in ("revolute", "prismatic"):
-        low, high = (limits.low, limits.high) if has_limits else (-1e3, 1e3)
+        low, high = limits if has_limits else (-1e3, 1e3)
         ET.SubElement(el, "limit", lower=_num(low), upper=_num(high), effort="0.0", velocity="0.0")
     if isinstance(j.damping, float) and jtype != "fixed":
         ET.SubElement(el, "dynamics", damping=_num(j.damping))
@@ -246,8 +252,11 @@ def _write_joint(robot: ET.Element, link: Link, name: str, parent: str, child: s
 
 
 def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> tuple[str, list[Loss]]:
-    """The URDF text for ``model`` (mesh paths relative to ``out_dir``) and the losses."""
+    """The URDF text for ``model`` (mesh paths relative to ``out_dir``) and the losses.
+    Meshes PyBullet cannot read are converted to STL in ``<robot name>_meshes/`` there."""
     losses: list[Loss] = []
+    model = usable_scales(model, losses)
+    files = MeshFiles("urdf", out_dir, robot_name or model.name, getattr(model, "tree", None))
     tree = build_tree(model)
     name = robot_name or model.name
     robot = ET.Element("robot", name=name)
@@ -285,7 +294,7 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
             ET.SubElement(robot, "link", name=names[id(lk)])
             _body_only_losses(lk.body, losses)
         else:
-            _write_link(robot, model, lk, names[id(lk)], out_dir, losses)
+            _write_link(robot, model, lk, names[id(lk)], out_dir, losses, files)
     if static_root:
         el = ET.SubElement(robot, "joint", name=_unique(f"world_to_{names[id(main)]}", used), type="fixed")
         _origin(el, main.origin)
@@ -303,8 +312,7 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     for attr, label in _LOSSY_OBJECTS:
         for obj in getattr(model, attr):
             losses.append(Loss(obj.identifier, label, "URDF has no element for it"))
-    ET.indent(robot, "  ")
-    text = '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
+    text = '<?xml version="1.0"?>\n' + to_text(robot) + "\n"
     return text, sorted(set(losses))
 
 
@@ -473,14 +481,15 @@ def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
     # world pose of every link frame at joint value 0
     world: dict[str, Pose] = {}
 
-    def link_world(name: str) -> Pose:
-        if name not in world:
-            if name in parent_of:
-                pname, j = parent_of[name]
-                world[name] = link_world(pname) * _pose_of(doc, j)
-            else:
-                world[name] = Pose()
-        return world[name]
+    def link_world(name: str) -> Pose:  # up the chain to a known pose, then down: no recursion
+        path = []
+        while name not in world and name in parent_of:
+            path.append(name)
+            name = parent_of[name][0]
+        world.setdefault(name, Pose())
+        for kid in reversed(path):
+            world[kid] = world[parent_of[kid][0]] * _pose_of(doc, parent_of[kid][1])
+        return world[path[0]] if path else world[name]
 
     # an empty root whose joints are all fixed is the world frame: its children are welded to
     # the world (static ADF bodies); an empty root with moving joints stays, as a static body
@@ -681,14 +690,14 @@ def _read_joint(doc, j, links, ground, bodies, frame_in_link, world, model: Mode
         low = _floats(doc, lim, "lower", 1, (0.0,))[0]
         high = _floats(doc, lim, "upper", 1, (0.0,))[0]
         joint.joint_limits = JointLimits(low=low, high=high)
-    if lim is not None and any(float(lim.get(k, "0") or 0) != 0.0 for k in ("effort", "velocity")):
+    if lim is not None and any(_floats(doc, lim, k, 1, (0.0,))[0] != 0.0 for k in ("effort", "velocity")):
         losses.append(Loss(who, "effort/velocity limit", "ADF has no joint effort or velocity limit"))
     dyn = j.find("dynamics")
     if dyn is not None:
         d = _floats(doc, dyn, "damping", 1, (0.0,))[0]
         if d != 0.0:
             joint.damping = d
-        if float(dyn.get("friction", "0") or 0) != 0.0:
+        if _floats(doc, dyn, "friction", 1, (0.0,))[0] != 0.0:
             losses.append(Loss(who, "friction", "ADF joints have no Coulomb friction"))
     for tag in ("mimic", "safety_controller", "calibration"):
         if j.find(tag) is not None:

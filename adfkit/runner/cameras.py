@@ -62,16 +62,38 @@ class SimCamera:
         depth = (f * n / (f - (f - n) * z)).astype(np.float32)   # linearised z-buffer
         depth[z >= 1.0] = np.inf
         seg = np.reshape(np.asarray(seg, dtype=np.int64), (self.height, self.width))
-        labels = np.full(seg.shape, -1, dtype=np.int32)
-        valid = seg >= 0
-        uid = seg & ((1 << 24) - 1)
-        link = (seg >> 24) - 1
-        index = {(sb.uid, sb.link): i for i, sb in enumerate(world.bodies)}
-        for u, l in set(zip(uid[valid].tolist(), link[valid].tolist())):
-            i = index.get((u, l))
-            if i is not None:
-                labels[(uid == u) & (link == l) & valid] = i
-        return {"rgb": rgb, "depth": depth, "segmentation": labels}
+        return {"rgb": rgb, "depth": depth, "segmentation": label_image(world, seg)}
+
+
+def label_table(world) -> np.ndarray:
+    """[uid, link + 1] -> index of the body in ``world.bodies`` (-1: none), built once per body
+    count: a segmentation image is then labelled by one numpy lookup."""
+    bodies = world.bodies
+    cached = getattr(world, "_seg_label_table", None)
+    if cached is not None and cached[0] == len(bodies):
+        return cached[1]
+    ids = [(sb.uid, sb.link, i) for i, sb in enumerate(bodies) if sb.uid is not None and sb.uid >= 0]
+    if ids:
+        uids, links, index = (np.array(c) for c in zip(*ids))
+        table = np.full((uids.max() + 1, links.max() + 2), -1, dtype=np.int32)
+        table[uids, links + 1] = index   # as a dict would: the last body of a (uid, link) wins
+    else:
+        table = np.full((1, 1), -1, dtype=np.int32)
+    world._seg_label_table = (len(bodies), table)
+    return table
+
+
+def label_image(world, seg: np.ndarray) -> np.ndarray:
+    """PyBullet's object-and-link segmentation (uid + (link + 1) << 24, -1 for none) as body
+    indices (-1 for the background, ghosts and anything that is not a body)."""
+    table = label_table(world)
+    valid = seg >= 0
+    uid = np.where(valid, seg & ((1 << 24) - 1), 0)
+    link1 = np.where(valid, seg >> 24, 0)
+    inside = valid & (uid < table.shape[0]) & (link1 < table.shape[1])
+    labels = np.full(seg.shape, -1, dtype=np.int32)
+    labels[inside] = table[uid[inside], link1[inside]]
+    return labels
 
 
 def _camera(world, cam, ns: str) -> list[SimCamera]:

@@ -115,26 +115,49 @@ def _static_frame(cid: int, body):
     return st[0], st[1]  # constraint pivots are in the link's inertial frame
 
 
+class ConstraintRefused(Exception):
+    """PyBullet could not join the two bodies as asked (the world warns and skips the joint)."""
+
+
+_JTYPE_NAMES = {pb.JOINT_FIXED: "fixed", pb.JOINT_POINT2POINT: "point-to-point", pb.JOINT_PRISMATIC: "prismatic",
+                pb.JOINT_GEAR: "gear"}
+
+
 def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray,
                     max_force: float) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray | None]]:
     """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child
     frame, slide axis in the parent frame or None)]."""
     out = []
 
+    def create(a, b, jtype, axis, pa, pb_, oa, ob):
+        return pb.createConstraint(a.uid, a.link, b.uid, b.link, jtype,
+                                   list(map(float, axis)) if axis is not None else [0, 0, 0],
+                                   list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
+                                   physicsClientId=cid)
+
     def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1), axis=None):
+        # PyBullet joins a multibody link to a free (maximal-coordinate) body only with the link
+        # first (btMultiBodyPoint2Point/btMultiBodyFixedConstraint take the multibody as body A):
+        # such a joint is made with its ends swapped, which is the same joint
+        swap = (axis is None and getattr(parent, "articulation", None) is None
+                and getattr(child, "articulation", None) is not None)
         try:
-            c = pb.createConstraint(parent.uid, parent.link, child.uid, child.link, jtype,
-                                    list(map(float, axis)) if axis is not None else [0, 0, 0],
-                                    list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
-                                    physicsClientId=cid)
+            c = create(child, parent, jtype, None, pb_, pa, ob, oa) if swap else \
+                create(parent, child, jtype, axis, pa, pb_, oa, ob)
         except pb.error:
+            c = None
+        if c is None and getattr(parent, "static", False):
             # PyBullet refuses e.g. a fixed constraint from a static (mass 0) body to a multibody
             # base; a static parent never moves, so build it from the child to the world frame
-            if not getattr(parent, "static", False):
-                raise
             pw, ow = matrix_to_pq(pose_matrix(*_static_frame(cid, parent)) @ pose_matrix(pa, oa))
-            c = pb.createConstraint(child.uid, child.link, -1, -1, jtype, [0, 0, 0], list(map(float, pb_)),
-                                    list(map(float, pw)), list(ob), list(ow), physicsClientId=cid)
+            try:
+                c = pb.createConstraint(child.uid, child.link, -1, -1, jtype, [0, 0, 0], list(map(float, pb_)),
+                                        list(map(float, pw)), list(ob), list(ow), physicsClientId=cid)
+            except pb.error:
+                c = None
+        if c is None:
+            raise ConstraintRefused(f"PyBullet refused a {_JTYPE_NAMES.get(jtype, jtype)} constraint between "
+                                    f"{getattr(parent, 'key', 'the parent')} and {getattr(child, 'key', 'the child')}")
         pb.changeConstraint(c, maxForce=max_force, physicsClientId=cid)
         out.append((c, np.asarray(pa, float), np.asarray(pb_, float), None if axis is None else np.asarray(axis, float)))
 
@@ -157,6 +180,16 @@ def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarra
             add(pb.JOINT_POINT2POINT, frame_a[:3, 3] + s * frame_a[:3, 2], frame_b[:3, 3] + s * frame_b[:3, 2])
     else:
         add(pb.JOINT_POINT2POINT, frame_a[:3, 3], frame_b[:3, 3])
+    return out
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product of (n, 3) arrays: np.cross's products in np.cross's order,
+    without its axis bookkeeping (a third of the cost at this size)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     return out
 
 
@@ -217,12 +250,38 @@ class SpringSet:
             self._gains_dt = dt
         return self._k_ang, self._c_ang, self._k_lin, self._c_lin
 
+    def _read_plan(self):
+        """How to read every body's COM state with the fewest PyBullet calls: free bodies and
+        multibody bases one by one (PyBullet has no batch call for them), the links of each
+        multibody with one getLinkStates. Built on first use (bodies have their uids then)."""
+        bases, links = [], {}
+        for i, b in enumerate(self.bodies):
+            if b.link < 0:
+                bases.append((i, b.uid))
+            else:
+                links.setdefault(b.uid, []).append((i, b.link))
+        order = [i for i, _ in bases] + [i for group in links.values() for i, _ in group]
+        self._bases = [uid for _, uid in bases]
+        self._links = [(uid, [k for _, k in group]) for uid, group in links.items()]
+        self._order = np.argsort(np.array(order, dtype=int))   # read order -> body order
+        self._apply_ids = [(i, self.bodies[i].uid, self.bodies[i].link, bool(self.pushed[i])) for i in self.dynamic]
+
     def states(self):
+        """(positions, rotation matrices, linear and angular velocities) of every body's COM."""
+        if getattr(self, "_order", None) is None:
+            self._read_plan()
+        cid = self.cid
+        get_pose, get_vel, get_links = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getLinkStates
         pos, orn, lv, av = [], [], [], []
-        for b in self.bodies:
-            p, q, v, w = b.state()
+        for uid in self._bases:
+            p, q = get_pose(uid, physicsClientId=cid)
+            v, w = get_vel(uid, physicsClientId=cid)
             pos.append(p); orn.append(q); lv.append(v); av.append(w)
-        return np.array(pos), quat_to_matrix(np.array(orn)), np.array(lv), np.array(av)
+        for uid, ks in self._links:
+            for s in get_links(uid, ks, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=cid):
+                pos.append(s[0]); orn.append(s[1]); lv.append(s[6]); av.append(s[7])
+        o = self._order
+        return (np.array(pos)[o], quat_to_matrix(np.array(orn)[o]), np.array(lv)[o], np.array(av)[o])
 
     def apply(self, dt: float, erp: float = 0.2) -> None:
         if not self.joints:
@@ -253,16 +312,17 @@ class SpringSet:
             f += self._limit(d, v_rel, self.lin_low[fl], self.lin_high[fl], self.m_eff[fl][:, None], dt, erp)
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
             force = self.net[:, fl] @ f_w
-            torque += (self.to_child[fl].T @ np.cross(pbw - pos[ic[fl]], f_w)
-                       - self.to_parent[fl].T @ np.cross(pbw - pos[ip[fl]], f_w))
+            torque += (self.to_child[fl].T @ _cross(pbw - pos[ic[fl]], f_w)
+                       - self.to_parent[fl].T @ _cross(pbw - pos[ip[fl]], f_w))
         torque = torque.tolist()
         if force is not None:
             force, pos = force.tolist(), pos.tolist()
-        for i in self.dynamic:
-            b = self.bodies[i]
-            b.torque(torque[i])
-            if self.pushed[i]:
-                b.force(force[i], pos[i])
+        cid, frame = self.cid, pb.WORLD_FRAME
+        apply_torque, apply_force = pb.applyExternalTorque, pb.applyExternalForce
+        for i, uid, link, pushed in self._apply_ids:
+            apply_torque(uid, link, torque[i], frame, physicsClientId=cid)
+            if pushed:
+                apply_force(uid, link, force[i], pos[i], frame, physicsClientId=cid)
 
     @staticmethod
     def _limit(x, v, low, high, inertia, dt, erp):

@@ -2,7 +2,7 @@
 `adfkit demo` leave behind: report.json and each camera's frames."""
 from __future__ import annotations
 
-import json
+from .. import jsonout
 from pathlib import Path
 
 
@@ -31,7 +31,7 @@ def play(world, seconds: float, out: Path | None = None, frames: bool = True, sc
                     raise
                 report["frames"] = []
                 report["camera_problem"] = str(e)
-        atomic_write_text(out / "report.json", json.dumps(report, indent=2))
+        atomic_write_text(out / "report.json", jsonout.dumps(report, indent=2))
     return report
 
 

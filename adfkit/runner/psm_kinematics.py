@@ -228,10 +228,11 @@ class PSMKinematics:
         for palm_sign in (1.0, -1.0):
             p_pitch0 = p_yaw0 + palm_sign * self.l_pitch2yaw * palm_dir
             for behind_rcm in (False, True):
-                q = self._solve_from_pitch_point(R, p_yaw0, p_pitch0, behind_rcm)
-                if q is None:
+                solved = self._solve_from_pitch_point(R, p_yaw0, p_pitch0, behind_rcm)
+                if solved is None:
                     continue
-                err = pose_error(self.fk(q), T)
+                q, end = solved   # the solve's own frames finish the FK: one FK per candidate
+                err = pose_error(end, T)
                 candidates.append((err, q))
                 if err <= tol and not self.violations(q, LIMIT_SLACK):
                     # a solution at a limit may land a rounding error outside it
@@ -267,7 +268,9 @@ class PSMKinematics:
         q5 = signed_angle(palm, T40[:3, 2], -T40[:3, 1])
         T50 = T40 @ self.links[4].transform(q5)
         q6 = signed_angle(R[:, 2], T50[:3, 0], -T50[:3, 1])
-        return np.array([q1, q2, q3, q4, q5, q6])
+        # the end effector at q, multiplied in fk_all's order (so it equals fk(q) exactly)
+        end = (T50 @ self.links[5].transform(q6)) @ self.links[6].transform(0.0)
+        return np.array([q1, q2, q3, q4, q5, q6]), end
 
 
 def pose_error(A: np.ndarray, B: np.ndarray) -> float:

@@ -7,13 +7,20 @@ import numpy as np
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
     """(..., 4) quaternions → (..., 3, 3) rotation matrices."""
     q = np.asarray(q, dtype=float)
-    x, y, z, w = np.moveaxis(q, -1, 0)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     xx, yy, zz = x * x, y * y, z * z
     xy, xz, yz, xw, yw, zw = x * y, x * z, y * z, x * w, y * w, z * w
-    m = np.stack([1 - 2 * (yy + zz), 2 * (xy - zw), 2 * (xz + yw),
-                  2 * (xy + zw), 1 - 2 * (xx + zz), 2 * (yz - xw),
-                  2 * (xz - yw), 2 * (yz + xw), 1 - 2 * (xx + yy)], axis=-1)
-    return m.reshape(q.shape[:-1] + (3, 3))
+    m = np.empty(q.shape[:-1] + (3, 3))
+    m[..., 0, 0] = 1 - 2 * (yy + zz)
+    m[..., 0, 1] = 2 * (xy - zw)
+    m[..., 0, 2] = 2 * (xz + yw)
+    m[..., 1, 0] = 2 * (xy + zw)
+    m[..., 1, 1] = 1 - 2 * (xx + zz)
+    m[..., 1, 2] = 2 * (yz - xw)
+    m[..., 2, 0] = 2 * (xz - yw)
+    m[..., 2, 1] = 2 * (yz + xw)
+    m[..., 2, 2] = 1 - 2 * (xx + yy)
+    return m
 
 
 def matrix_to_quat(m: np.ndarray) -> np.ndarray:

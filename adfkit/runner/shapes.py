@@ -17,6 +17,7 @@ import pybullet as pb
 from ..adf.paths import collision_mesh_path, visual_mesh_path
 from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, warning
+from ..geometry.meshcheck import mesh_problem
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import (
     CollisionMeshType, Primitive, ShapeKind, axis_vector, collision_mesh_type,
@@ -96,6 +97,19 @@ def _primitive(parts: ShapeParts, prim: Primitive, pose_in_com: np.ndarray, marg
         parts.plane = (list(map(float, n)), float(g.offset or 0.0))
 
 
+_DIMENSIONS = {ShapeKind.BOX: ("x", "y", "z"), ShapeKind.SPHERE: ("radius",), ShapeKind.CYLINDER: ("radius", "height"),
+               ShapeKind.CAPSULE: ("radius", "height"), ShapeKind.CONE: ("radius", "height")}
+
+
+def _missing_dimension(prim: Primitive) -> str | None:
+    """The first dimension a primitive needs that is absent, not a number, negative or not finite."""
+    for name in _DIMENSIONS.get(prim.kind, ()):
+        v = getattr(prim.geometry, name, None)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+            return name
+    return None
+
+
 def mesh_refusal(model, path: Path) -> str | None:
     """Why the input policy (adfkit.inputs) keeps PyBullet from reading this mesh, or None:
     missing, not a regular file, over the size cap, outside the model's tree."""
@@ -166,11 +180,24 @@ def collision_parts(model, obj, frame_in_body, scale: float,
             diags.append(warning("runner-no-collision", f"{obj.identifier}: no usable collision primitive",
                                  obj.source, "check `collision shape` and `collision geometry`"))
         for prim in prims:
+            missing = _missing_dimension(prim)
+            if missing:
+                diags.append(warning("runner-no-collision", f"{obj.identifier}: collision {prim.kind.value} has no "
+                                     f"usable {missing}; that shape is left out", obj.where("collision geometry")
+                                     or obj.source, "give every dimension as a finite number ≥ 0"))
+                continue
             _primitive(parts, prim, body_to_com @ pose_to_matrix(prim.pose), margin)
         return parts
     path = collision_mesh_path(model, obj)
     if path is None:
         return parts  # no collision geometry: an empty shape (AMBF prints an error)
+    if mesh_refusal(model, path) is None and (problem := mesh_problem(path)) is not None:
+        # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some, reads garbage from others
+        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: "
+                             f"{problem}; the body is skipped as AMBF does",
+                             obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
+                             "re-export the mesh as a triangle mesh (STL or OBJ)"))
+        return None
     path, refused = pybullet_mesh(model, path)
     if refused is not None:
         diags.append(warning("runner-missing-mesh", f"{obj.identifier}: collision mesh {refused}; "
@@ -192,8 +219,21 @@ def collision_parts(model, obj, frame_in_body, scale: float,
     return parts
 
 
-def create_collision(parts: ShapeParts, cid: int) -> int:
-    """Create the PyBullet collision shape; -1 for an empty one."""
+def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnostic] | None = None) -> int:
+    """Create the PyBullet collision shape; -1 for an empty one, or (with a warning located at
+    ``obj``) for one PyBullet refuses."""
+    try:
+        return _create_collision(parts, cid)
+    except pb.error as exc:
+        if diags is None:
+            raise
+        who = getattr(obj, "identifier", "an object")
+        diags.append(warning("runner-bad-shape", f"{who}: PyBullet refused its collision shape ({exc}); "
+                             "it has none", getattr(obj, "source", None), "check its meshes and shape sizes"))
+        return -1
+
+
+def _create_collision(parts: ShapeParts, cid: int) -> int:
     if parts.plane is not None and not parts.types:
         n, off = parts.plane
         return pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=n,
@@ -264,6 +304,10 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
     if path is None:
         return -1
     suffix = path.suffix.lower()
+    if suffix in MESH_SUFFIXES and mesh_refusal(model, path) is None and (problem := mesh_problem(path)) is not None:
+        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: {problem}",
+                             obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
+        return -1
     path, refused = pybullet_mesh(model, path) if suffix in MESH_SUFFIXES else (path, mesh_refusal(model, path))
     if refused is not None:
         diags.append(warning("runner-missing-mesh", f"{obj.identifier}: visual mesh {refused}",

@@ -20,7 +20,7 @@ from ..model.semantics import (
 )
 from . import articulation
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
-from .joints import SpringSet, make_constraint, spring_joint
+from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
 from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
 from .shapes import collision_parts, create_collision, create_visual
@@ -210,7 +210,12 @@ class SimWorld(WorldState):
                 self._warn("runner-prismatic-loop", f"{j.identifier}: a prismatic joint closing a loop through "
                            "a maximal-coordinate body is not supported by PyBullet's constraints; built as fixed", j)
                 kind_c = JointKind.FIXED
-            for c, pa, pbv, axis in make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5):
+            try:
+                made = make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5)
+            except ConstraintRefused as exc:
+                self._warn("runner-constraint", f"{j.identifier}: {exc}; the joint is left out", j)
+                continue
+            for c, pa, pbv, axis in made:
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
         self.springs = SpringSet(springs, self.cid)
         for m in models:
@@ -221,8 +226,11 @@ class SimWorld(WorldState):
         self.cameras = build_cameras(self)
         self._floor_z = self._floor()
         self.ground_z = None
-        if self.opt.ground and self.scene.world is None and self.scene.environment is None:
-            self._add_ground()
+        if self.scene.world is None and self.scene.environment is None:
+            if self.opt.ground:
+                self._add_ground()
+            else:  # --no-ground: nothing to fall through
+                self._floor_z = -math.inf
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
         self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
         self._gravity_overrides = self._group_gravity_overrides()
@@ -264,7 +272,7 @@ class SimWorld(WorldState):
         b, m = sb.body, sb.model
         if frame_in_body is not sb.ref_in_body or sb._parts is None:
             sb._parts = collision_parts(m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics)
-        col = create_collision(sb._parts, self.cid) if sb._parts is not None else -1
+        col = create_collision(sb._parts, self.cid, b, self.diagnostics) if sb._parts is not None else -1
         vis = create_visual(m, b, frame_in_body, b.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
         return col, vis
 
@@ -345,7 +353,7 @@ class SimWorld(WorldState):
             parent = self._parent(gh.parent, ns, gh) if gh.parent else None
             loc = pose_to_matrix(pose_or_identity(gh.location))
             rel = invert(parent.com_in_body) @ loc if parent is not None else loc
-            col = create_collision(parts, self.cid)
+            col = create_collision(parts, self.cid, gh, self.diagnostics)
             vis = create_visual(m, gh, np.eye(4), gh.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
             world = (self._frame(parent) @ rel) if parent is not None else rel
             pos, orn = matrix_to_pq(world)
@@ -476,8 +484,16 @@ class SimWorld(WorldState):
         per nearby body, and the PSMs' finger ghosts are only read when grasping."""
         if self.gui:
             self.place_ghosts()
+        parents: dict[int, tuple] = {}   # hole ghosts share their parent (the phantom): read it once
+        cid = self.cid
         for g in self._friction_ghosts:
-            found = self.overlapping(g)
+            if g.moves:
+                pq = parents.get(id(g.parent))
+                if pq is None:
+                    pq = parents[id(g.parent)] = g.parent.state(velocity=False)[:2]
+                pos, orn = pb.multiplyTransforms(pq[0], pq[1], *g.pq_in_parent)
+                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=cid)
+            found = self._overlap(g)
             if found:
                 self._viscous(g, found)
 
@@ -495,8 +511,12 @@ class SimWorld(WorldState):
     def overlapping(self, g: SimGhost) -> list[SimBody]:
         """The dynamic bodies inside ghost ``g`` now (moved to its parent first); also kept in
         ``g.overlapping``."""
-        cid = self.cid
         self._place(g)
+        return self._overlap(g)
+
+    def _overlap(self, g: SimGhost) -> list[SimBody]:
+        """``overlapping`` with the ghost already where its parent is."""
+        cid = self.cid
         lo, hi = pb.getAABB(g.uid, -1, physicsClientId=cid)
         found = []
         lookup = self._lookup
@@ -642,7 +662,7 @@ class SimWorld(WorldState):
                 # nothing to collide with: it falls freely under gravity, in AMBF too
                 shapeless.append(sb.key)
                 continue
-            if p[2] < self._floor_z - 0.1:
+            if math.isfinite(self._floor_z) and p[2] < self._floor_z - 0.1:
                 fell.append(sb.key)
             if np.linalg.norm(v) > 10.0:
                 fast.append(sb.key)

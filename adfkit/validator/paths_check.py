@@ -10,6 +10,7 @@ from pathlib import Path
 from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
 from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
+from ..geometry.meshcheck import mesh_problem
 from ..model import InputDevices, Launch, ModelFile, World
 from . import softbody_rules
 from .rules import RULES
@@ -123,6 +124,9 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
                               "paths, then the model file's directory"))
             elif (refused := _policy(path, m, "mesh", obj.where(key), f"mesh of '{obj.identifier}'")) is not None:
                 out.append(refused)
+            elif (problem := mesh_problem(path)) is not None:
+                out.append(_d("mesh-unreadable", f"mesh {inputs.shown(path.name)} of '{obj.identifier}': {problem}",
+                              obj.where(key), "re-export the mesh as a triangle mesh (STL or OBJ)"))
             elif path.suffix.lower() == ".obj":
                 for what in obj_material_problems(str(path)):
                     out.append(_d("missing-texture", f"{what} of mesh {path.name} ('{obj.identifier}') not found",

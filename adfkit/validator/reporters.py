@@ -2,7 +2,7 @@
 github (workflow annotations) and sarif (2.1.0)."""
 from __future__ import annotations
 
-import json
+from .. import jsonout
 from pathlib import Path
 from typing import IO
 
@@ -57,7 +57,7 @@ def _dict(d: Diagnostic) -> dict:
 
 
 def write_json(diags: list[Diagnostic], stream: IO[str], files: int = 0) -> None:
-    json.dump({"files": files, "diagnostics": [_dict(d) for d in diags]}, stream, indent=2)
+    jsonout.dump({"files": files, "diagnostics": [_dict(d) for d in diags]}, stream, indent=2)
     stream.write("\n")
 
 
@@ -124,5 +124,5 @@ def sarif(diags: list[Diagnostic]) -> dict:
 
 
 def write_sarif(diags: list[Diagnostic], stream: IO[str]) -> None:
-    json.dump(sarif(diags), stream, indent=2)
+    jsonout.dump(sarif(diags), stream, indent=2)
     stream.write("\n")

@@ -87,6 +87,8 @@ _RULES = [
          "`- sb/magic_box.yaml` that is not there"),
     Rule("missing-mesh", W, "A mesh file is not found after §6.2 resolution (AMBF skips the body)",
          "`mesh: link1.STL` with no such file"),
+    Rule("mesh-unreadable", W, "An STL/OBJ mesh holds no triangles or is not a valid file (AMBF skips the body)",
+         "`mesh: part.stl` that is 300 random bytes, or an OBJ with no `f` lines"),
     Rule("missing-texture", W, "A material library or texture named by an OBJ/MTL is not found",
          "`map_Kd wood.png` missing"),
     Rule("missing-shader", W, "A shader, skybox or sensor mesh file is not found", "`vertex: shader.vs` missing"),

@@ -137,6 +137,9 @@ def build_plan(world) -> Plan:
             names: dict = {}
             text, ls = to_mjcf(m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names)
             losses += ls
+            for loss in ls:  # the MJCF writer already made a flat collision mesh a thin box (engine_fit)
+                if loss.feature == "collision mesh" and "flat" in loss.reason:
+                    world._warn("runner-flat-mesh", f"{loss.element}: {loss.reason}", m.body(loss.element))
             child = mujoco.MjSpec.from_string(text)
             _resolve_meshes(world, child, out_dir, m)
             prefix = f"m{i}/"

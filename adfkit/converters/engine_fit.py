@@ -1,0 +1,175 @@
+"""What the target engines accept, checked before a URDF or MJCF file is written.
+
+A converted file must load in its engine (PyBullet for URDF, MuJoCo for MJCF), or a loss says
+why a part of it was changed or left out:
+
+- a body ``scale`` that is not a positive finite number, or so large that coordinates
+  overflow, is written as 1 (the engines would read inf/NaN);
+- joint limits with ``low > high`` (Bullet, so AMBF, then applies no limit; MuJoCo refuses
+  such a ``range``) or non-finite limits are written as no limit;
+- a mesh in a format the engine does not read (.3DS, .DAE, .PLY, ...) is converted to STL
+  with trimesh beside the output file, or left out when trimesh cannot read it either;
+- (MJCF) a flat mesh, which MuJoCo cannot take as a collision hull, collides as a thin box
+  around it; as a visual mesh it gets ``inertia="shell"`` (its volume is zero).
+"""
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
+from .. import inputs
+from ..diagnostics import AdfError
+from .losses import Loss
+
+#: Mesh file suffixes each engine reads itself.
+ENGINE_SUFFIXES = {"urdf": (".stl", ".obj"), "mjcf": (".stl", ".obj", ".msh")}
+#: Largest usable body scale (coordinates beyond ~1e6 m overflow float32 contact math).
+MAX_SCALE = 1e6
+#: Thickness of the box a flat collision mesh becomes, relative to its largest side.
+FLAT_THICKNESS = 1e-3
+
+
+def usable_scales(model, losses: list[Loss]):
+    """``model`` itself, or a copy whose bodies with an unusable ``scale`` have scale 1."""
+    bad = [b for b in model.bodies if b.scale is not None
+           and not (math.isfinite(b.scale) and 0.0 < b.scale <= MAX_SCALE)]
+    if not bad:
+        return model
+    for b in bad:
+        losses.append(Loss(b.identifier, "scale", f"{b.scale!r} is not a positive finite scale up to {MAX_SCALE:g} "
+                                                  "(the engine's coordinates would overflow): written as 1"))
+    swap = {id(b): replace(b, scale=None) for b in bad}
+    return replace(model, bodies=[swap.get(id(b), b) for b in model.bodies])
+
+
+def _write_bytes(path: Path, data: bytes) -> None:
+    """Atomic: a temporary file beside the target, then a rename."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def joint_range(joint, losses: list[Loss]) -> tuple[float, float] | None:
+    """The joint's (low, high) when both are set, finite and ordered; else None (with a loss
+    for limits that are set but unusable)."""
+    lim = joint.joint_limits
+    if lim is None or lim.low is None or lim.high is None:
+        return None
+    low, high = lim.low, lim.high
+    if not (math.isfinite(low) and math.isfinite(high)):
+        losses.append(Loss(joint.identifier, "joint limits", f"not finite ({low!r}, {high!r}): written as no limit"))
+        return None
+    if low > high:
+        losses.append(Loss(joint.identifier, "joint limits", f"low {low!r} > high {high!r}: Bullet (and so AMBF) "
+                                                             "applies no limit then; written as no limit"))
+        return None
+    return low, high
+
+
+class MeshFiles:
+    """Engine-readable mesh files for one output file; converted copies go to
+    ``<output stem>_meshes/`` beside it. ``fit`` answers (path or None, flat?)."""
+
+    def __init__(self, engine: str, out_dir: Path, stem: str, tree=None):
+        self.engine = engine
+        self.tree = tree   # the model's input tree (adfkit.inputs): meshes are read only inside it
+        self.folder = out_dir / f"{stem}_meshes"
+        self._done: dict[str, tuple[Path | None, bool, object]] = {}
+
+    def _load(self, path: Path):
+        from ..diagnostics import AdfError
+        try:
+            from ..geometry.meshio import load_mesh
+            return load_mesh(path, tree=self.tree), None
+        except AdfError as exc:
+            return None, exc.diagnostics[0].message
+        except ImportError:
+            return None, "trimesh is not installed"
+
+    def fit(self, path: Path, who: str, losses: list[Loss], check_flat: bool = False) -> tuple[Path | None, object]:
+        """(file the engine reads, or None; the mesh when it is flat and ``check_flat``, else None)."""
+        key = str(path)
+        if key not in self._done:
+            try:  # a NUL byte or an over-long name is no file name at all
+                inputs.check_path_text(path)
+            except AdfError as exc:
+                losses.append(Loss(who, "mesh", f"{exc.diagnostics[0].message}: left out"))
+                self._done[key] = (None, False, None)
+                return None, None
+            readable = path.suffix.lower() in ENGINE_SUFFIXES[self.engine]
+            mesh = None
+            if not readable or check_flat:
+                if path.is_file():
+                    mesh, why = self._load(path)
+                else:
+                    why = "file not found"
+            out: Path | None = path
+            if not readable:
+                if mesh is None:
+                    losses.append(Loss(who, "mesh", f"{path.name}: {path.suffix or 'this'} format is not read by "
+                                                    f"{'PyBullet' if self.engine == 'urdf' else 'MuJoCo'} and could "
+                                                    f"not be converted ({why}): left out"))
+                    out = None
+                else:
+                    out = self.folder / (path.stem + ".stl")
+                    n = 1
+                    while any(v[0] == out for v in self._done.values()):
+                        n += 1
+                        out = self.folder / f"{path.stem}_{n}.stl"
+                    self.folder.mkdir(parents=True, exist_ok=True)
+                    _write_bytes(out, mesh.export(file_type="stl"))
+                    losses.append(Loss(who, "mesh", f"{path.name}: {path.suffix} is not read by the engine: converted "
+                                                    f"to {out.parent.name}/{out.name} (normals, UVs and materials dropped)"))
+            flat = mesh if (mesh is not None and _is_flat(mesh)) else None
+            self._done[key] = (out, flat is not None, flat)
+        out, is_flat, flat = self._done[key]
+        return out, flat if (check_flat and is_flat) else None
+
+
+def _is_flat(mesh) -> bool:
+    """True when the mesh spans (almost) no volume: all its vertices on one plane."""
+    import numpy as np
+
+    v = np.asarray(mesh.vertices, dtype=float)
+    if len(v) < 4:
+        return True
+    c = v - v.mean(axis=0)
+    s = np.linalg.svd(c, compute_uv=False)
+    return bool(s[0] == 0.0 or s[2] <= 1e-9 * s[0])
+
+
+def flat_box(mesh, scale: float):
+    """(centre, rotation matrix, full sizes) of the thin box that stands in for a flat mesh:
+    the smallest rectangle around it in its plane, ``FLAT_THICKNESS`` of its size thick."""
+    import numpy as np
+    from trimesh.bounds import oriented_bounds_2D
+
+    v = np.asarray(mesh.vertices, dtype=float) * scale
+    mean = v.mean(axis=0)
+    _u, _s, vt = np.linalg.svd(v - mean, full_matrices=False)
+    e1, e2 = vt[0], vt[1]
+    normal = np.cross(e1, e2)
+    flat2d = np.column_stack(((v - mean) @ e1, (v - mean) @ e2))
+    to_rect, extents = oriented_bounds_2D(flat2d)   # 3x3 homogeneous: points -> rectangle frame
+    back = np.linalg.inv(to_rect)
+    c2 = back[:2, 2]
+    a2 = back[:2, 0]
+    u = a2[0] * e1 + a2[1] * e2
+    u /= np.linalg.norm(u)
+    w = np.cross(normal, u)
+    rot = np.column_stack((u, w, normal))
+    centre = mean + c2[0] * e1 + c2[1] * e2
+    thick = (v - mean) @ normal
+    centre = centre + normal * (thick.max() + thick.min()) / 2
+    sizes = np.array([extents[0], extents[1], max(thick.max() - thick.min(), FLAT_THICKNESS * max(extents.max(), 1e-6))])
+    return centre, rot, sizes

@@ -1,0 +1,72 @@
+"""A cheap structural read of the mesh files physics engines take (STL, OBJ): does the file
+hold triangles at all? Used by the validator (before a run) and by the runner (before
+PyBullet, which crashes on an OBJ without faces and reads random bytes as an STL).
+
+No trimesh here: the validator imports this, and it must stay fast. A binary STL is its
+80-byte header, a triangle count and 50 bytes per triangle; an ASCII STL has ``facet`` and
+``vertex`` lines; an OBJ has ``v`` and ``f`` lines. Other formats get no opinion (None).
+"""
+from __future__ import annotations
+
+import os
+import re
+import struct
+from functools import lru_cache
+
+from .. import inputs
+from ..diagnostics import AdfError
+
+_OBJ_FACE = re.compile(rb"^[ \t]*f[ \t]", re.M)
+_OBJ_VERTEX = re.compile(rb"^[ \t]*v[ \t]", re.M)
+
+
+def mesh_problem(path: str | os.PathLike) -> str | None:
+    """Why the STL/OBJ file at ``path`` holds no usable triangles, or None (also None for other
+    formats and for files the input policy refuses: that is reported on its own)."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return _problem(os.fspath(path), st.st_size, st.st_mtime_ns)
+
+
+@lru_cache(maxsize=4096)
+def _problem(path: str, size: int, _mtime: int) -> str | None:
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix not in (".stl", ".obj"):
+        return None
+    try:
+        data = inputs.read_bytes(path, "mesh", what="mesh file")
+    except AdfError:
+        return None
+    if suffix == ".stl":
+        return _stl_problem(data)
+    return _obj_problem(data)
+
+
+def _stl_problem(data: bytes) -> str | None:
+    if len(data) >= 84:
+        (n,) = struct.unpack_from("<I", data, 80)
+        if len(data) == 84 + 50 * n:
+            return None if n else "the STL file holds no triangles"
+    head = data[:512].lstrip().lower()
+    if head.startswith(b"solid"):
+        facets, vertices = data.count(b"facet"), data.count(b"vertex")
+        if facets == 0 or vertices < 3:
+            return "the ASCII STL file holds no triangles"
+        return None
+    if len(data) < 84:
+        return f"not an STL file ({len(data)} bytes; a binary STL has at least 84)"
+    (n,) = struct.unpack_from("<I", data, 80)
+    if n and len(data) >= 84 + 50 * n:  # some exporters pad the end
+        return None
+    return (f"not a valid STL file: a binary STL with {n} triangles has {84 + 50 * n} bytes, this one "
+            f"{len(data)} (and it does not start with 'solid')")
+
+
+def _obj_problem(data: bytes) -> str | None:
+    if _OBJ_VERTEX.search(data) is None:
+        return "the OBJ file has no vertices ('v' lines)"
+    if _OBJ_FACE.search(data) is None:
+        return "the OBJ file has no faces ('f' lines)"
+    return None

@@ -1,0 +1,146 @@
+"""`adfkit run` and `validate` on odd input (issue 14): garbage and empty meshes are located
+warnings (never a pybullet.error), a spring joint from a free body to a multibody link is built
+(PyBullet's `createConstraint failed`), `--no-ground` has no floor to fall through, and every
+JSON output is strict."""
+from __future__ import annotations
+
+import json
+import math
+import textwrap
+
+import pytest
+
+from adfkit import jsonout
+from adfkit.diagnostics import Severity
+from adfkit.validator import validate_file
+
+pytest.importorskip("pybullet")
+
+from adfkit.cli import main  # noqa: E402
+
+BODY = """\
+BODY {name}:
+  name: {name}
+  mass: {mass}
+  inertia: {{ix: 1.0e-3, iy: 1.0e-3, iz: 1.0e-3}}
+  location: {{position: {{x: {x}, y: 0.0, z: {z}}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+{shape}"""
+SPHERE = "  collision shape: SPHERE\n  collision geometry: {radius: 0.05}\n"
+
+
+def _body(name, mass=1.0, x=0.0, z=0.0, shape=SPHERE):
+    return BODY.format(name=name, mass=mass, x=x, z=z, shape=shape)
+
+
+def _strict(text: str):
+    def refuse(const):
+        raise ValueError(f"bare {const} in JSON")
+    return json.loads(text, parse_constant=refuse)
+
+
+BAD_MESHES = {
+    "empty.stl": (b"solid x\nendsolid x\n", "holds no triangles"),
+    "garbage.stl": (bytes(range(256)) + b"\x07" * 44, "not a valid STL file"),
+    "nofaces.obj": (b"v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no faces"),
+    "nothing.obj": (b"# nothing\n", "no vertices"),
+}
+
+
+@pytest.mark.parametrize("mesh", sorted(BAD_MESHES))
+def test_run_and_validate_on_a_mesh_without_triangles(tmp_path, capsys, mesh):
+    data, why = BAD_MESHES[mesh]
+    (tmp_path / mesh).write_bytes(data)
+    f = tmp_path / "m.yaml"
+    f.write_text("bodies: [BODY a]\n" + _body("a", z=0.5, shape=f"  mesh: {mesh}\n"))
+    found = [d for d in validate_file(f).diagnostics if d.rule == "mesh-unreadable"]
+    assert len(found) == 1 and why in found[0].message
+    assert (found[0].location.line, found[0].location.column, found[0].severity) == (7, 9, Severity.WARNING)
+    rc = main(["run", str(f), "--seconds", "0.02", "--no-frames", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert rc == 0 and "Traceback" not in err
+    assert f"{f}:7:9: warning[runner-bad-mesh]" in err and why in err
+    assert _strict((tmp_path / "out" / "report.json").read_text())["bodies"] == 0
+
+
+def test_sound_meshes_pass_the_mesh_check(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    from adfkit.geometry.meshcheck import mesh_problem
+    box = trimesh.creation.box((1, 1, 1))
+    box.export(tmp_path / "b.stl")
+    (tmp_path / "a.stl").write_text(trimesh.exchange.stl.export_stl_ascii(box))
+    box.export(tmp_path / "b.obj")
+    for name in ("a.stl", "b.stl", "b.obj"):
+        assert mesh_problem(tmp_path / name) is None, name
+
+
+SPRING_MODEL = "bodies: [BODY free, BODY base, BODY link]\njoints: [JOINT hinge, JOINT spring]\n" + \
+    _body("free", 0.5, x=0.0, z=1.0) + _body("base", 0.0, z=0.0) + _body("link", 0.5, z=0.5) + textwrap.dedent("""\
+    JOINT hinge:
+      name: hinge
+      parent: BODY base
+      child: BODY link
+      type: revolute
+      parent pivot: {x: 0, y: 0, z: 0.25}
+      parent axis: {x: 1, y: 0, z: 0}
+      child pivot: {x: 0, y: 0, z: -0.25}
+      child axis: {x: 1, y: 0, z: 0}
+    JOINT spring:
+      name: spring
+      parent: BODY free
+      child: BODY link
+      type: torsion spring
+      parent pivot: {x: 0, y: 0, z: -0.25}
+      parent axis: {x: 0, y: 0, z: 1}
+      child pivot: {x: 0, y: 0, z: 0.25}
+      child axis: {x: 0, y: 0, z: 1}
+      joint limits: {low: -0.5, high: 0.5}
+      stiffness: 1.0
+      damping: 0.01
+    """)
+
+
+def test_spring_from_a_free_body_to_a_multibody_link_is_built(tmp_path):
+    """The class behind `createConstraint failed` on the springy PSM/ECM/MTM models: PyBullet
+    joins a multibody link and a maximal-coordinate body only with the link as body A."""
+    from adfkit.adf.scene import load_scene
+    from adfkit.runner.world import Options, SimWorld
+
+    f = tmp_path / "springy.yaml"
+    f.write_text(SPRING_MODEL)
+    world = SimWorld(load_scene(f, None, []), Options())
+    try:
+        names = [c[0] for c in world.constraints]
+        assert names == ["JOINT spring"]
+        parent, child = world.constraints[0][2], world.constraints[0][3]
+        assert parent.articulation is None and child.articulation is not None
+        world.run(0.3)
+        assert world.constraint_error() < 1e-3   # the pivots stay together
+        assert not [d for d in world.diagnostics if d.rule == "runner-constraint"]
+    finally:
+        world.close()
+
+
+def test_no_ground_reports_nothing_fell_through_a_floor(tmp_path):
+    f = tmp_path / "m.yaml"
+    f.write_text("bodies: [BODY base, BODY ball]\n" + _body("base", 0.0, z=0.0) + _body("ball", 1.0, x=1.0, z=0.0))
+    out = tmp_path / "out"
+    assert main(["run", str(f), "--seconds", "0.5", "--no-frames", "--no-ground", "--out", str(out)]) == 0
+    rep = _strict((out / "report.json").read_text())
+    assert rep["fell_through_floor"] == [] and rep["ground_plane_z"] is None
+
+
+def test_json_output_is_strict_and_explains_its_nulls():
+    text = jsonout.dumps({"a": math.nan, "b": [1.0, math.inf, {"c": -math.inf}], "d": "x"})
+    assert _strict(text) == {"a": None, "b": [1.0, None, {"c": None}], "d": "x",
+                             "non_finite": ["a", "b[1]", "b[2].c"]}
+    assert _strict(jsonout.dumps({"ok": 1.5})) == {"ok": 1.5}
+
+
+def test_collision_primitive_missing_a_dimension_is_a_located_warning(tmp_path, capsys):
+    f = tmp_path / "m.yaml"
+    f.write_text("bodies: [BODY a]\n" + _body("a", z=0.5, shape="  collision shape: BOX\n"
+                                                             "  collision geometry: {x: 0.1, y: 0.1}\n"))
+    rc = main(["run", str(f), "--seconds", "0.02", "--no-frames"])
+    err = capsys.readouterr().err
+    assert rc in (0, 1) and "Traceback" not in err
+    assert f"{f}:8:23: warning[runner-no-collision]: BODY a: collision box has no usable z" in err
