@@ -309,7 +309,15 @@ class SutureTask:
     def move(self, psm: PSM, goal: np.ndarray, seconds: float, settle: float = 0.15):
         """Free-space move: the IK at the goal, joints interpolated (the wrist never passes
         through an unreachable orientation on the way)."""
-        yield from self.move_jp(psm, psm.kin.ik(invert(psm.base_in_world()) @ goal), seconds, settle)
+        try:
+            q = psm.kin.ik(invert(psm.base_in_world()) @ goal)
+        except JointLimitError as exc:   # a little past a limit: go as near as the joints allow
+            lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+            if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
+                raise
+            q = np.clip(exc.q, lo, hi)
+            self.clipped += 1
+        yield from self.move_jp(psm, q, seconds, settle)
 
     def move_jp(self, psm: PSM, q1, seconds: float, settle: float = 0.15):
         q0 = psm.setpoint_jp()
