@@ -10,7 +10,8 @@ from mathutils import Matrix, Quaternion, Vector
 
 from adfkit.adf import collision_mesh_path, read_file, visual_mesh_path
 from adfkit.adf.writer import file_to_plain
-from adfkit.diagnostics import AdfError, Diagnostic, Severity, warning
+from adfkit.diagnostics import AdfError, Diagnostic, Severity, SourceLocation, warning
+from adfkit.inputs import shown
 from adfkit.model import ModelFile, Pose
 from adfkit.model.pose import Vec3
 from adfkit.model.semantics import collision_primitives, joint_frames, joint_kind, JointKind, shape_kind
@@ -41,17 +42,26 @@ def ensure_rigidbody_world(scene) -> None:
         bpy.ops.rigidbody.world_add()
 
 
+#: meshes Blender's importers refused during the current import_model (drained into its diagnostics)
+_UNREADABLE: list[Diagnostic] = []
+_IMPORTERS = {".obj": "obj_import", ".stl": "stl_import", ".ply": "ply_import"}
+
+
 def _import_file(path: Path, scene) -> list:
-    """Objects created by Blender's own importer for ``path``, axes left as in the file."""
+    """Objects created by Blender's own importer for ``path``, axes left as in the file. A file
+    the importer refuses (garbage, truncated) gives no object and a warning, never an exception."""
     before = set(scene.objects)
-    suffix = path.suffix.lower()
-    if suffix == ".obj":
-        bpy.ops.wm.obj_import(filepath=str(path), forward_axis="Y", up_axis="Z")
-    elif suffix == ".stl":
-        bpy.ops.wm.stl_import(filepath=str(path), forward_axis="Y", up_axis="Z")
-    elif suffix == ".ply":
-        bpy.ops.wm.ply_import(filepath=str(path), forward_axis="Y", up_axis="Z")
-    else:
+    op = _IMPORTERS.get(path.suffix.lower())
+    if op is None:
+        return []
+    try:
+        getattr(bpy.ops.wm, op)(filepath=str(path), forward_axis="Y", up_axis="Z")
+    except RuntimeError as exc:   # Blender's operators report a failed read this way
+        for o in [o for o in scene.objects if o not in before]:
+            bpy.data.objects.remove(o, do_unlink=True)
+        reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else "unreadable"
+        _UNREADABLE.append(warning("mesh-unreadable", f"Blender could not import the mesh {path.name}: {reason}; "
+                                   "imported without it", SourceLocation(shown(path)), "check the mesh file (adfkit validate says why)"))
         return []
     return sorted((o for o in scene.objects if o not in before), key=lambda o: o.name)
 
@@ -222,6 +232,7 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     errors = [d for d in diags if d.severity >= Severity.ERROR]
     if errors:
         raise AdfError(errors)
+    _UNREADABLE.clear()
     bodies: dict[str, object] = {}
     made = []
     for b in doc.bodies:
@@ -312,6 +323,8 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
             parts = sorted((c for c in o.children if c.adf.kind == "COLLISION_MESH"), key=lambda c: c.name)
             o.adf.collision_hash = meshes.digest([meshes.mesh_arrays(c) for c in parts])
     _scene_snapshot(scene, doc)
+    diags.extend(_UNREADABLE)
+    _UNREADABLE.clear()
     return made, diags
 
 

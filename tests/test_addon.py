@@ -308,3 +308,16 @@ def test_rope_chain_of_six_dof_springs(addon, scene, tmp_path):
     assert j0.child_pivot == pytest.approx((0.0, 0.0, -0.01), abs=1e-7)
     assert tuple(j0.stiffness.angular) == pytest.approx((0.5, 0.5, 0.5))
     assert doc.bodies[0].mass == pytest.approx(0.001)
+
+
+def test_garbage_mesh_imports_without_it_and_says_so(addon, scene, tmp_path):
+    """Blender's STL importer raises on an empty STL: the body still imports, empty,
+    with a located mesh-unreadable warning (was a RuntimeError traceback from blend-import)."""
+    (tmp_path / "bad.stl").write_bytes(b"")   # an empty file
+    (tmp_path / "m.yaml").write_text(
+        "bodies: [BODY a]\nBODY a:\n  name: a\n  mass: 1.0\n  mesh: bad.stl\n"
+        "  location: {position: {x: 0, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 0}}\n")
+    made, diags = addon.build.import_model(tmp_path / "m.yaml")
+    assert [o.name for o in made] == ["a"] and made[0].type == "EMPTY"
+    (d,) = [d for d in diags if d.rule == "mesh-unreadable"]
+    assert d.severity == Severity.WARNING and "bad.stl" in d.message and "bad.stl" in str(d.location)

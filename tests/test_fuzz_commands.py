@@ -26,11 +26,7 @@ from conftest import CORPUS
 # frame. A case whose only problem is one of these is counted as known, not hidden: the tests
 # xfail with the list, and a known site that no longer occurs anywhere is not an excuse for
 # any other failure.
-KNOWN_SITES: dict[tuple[str, str, str], str] = {
-    # the converter and runner sites once listed here are fixed; the add-on's remains
-    ("addon/build.py", "_import_file", "RuntimeError"):
-        "add-on: Blender's STL importer raises on a garbage mesh file (blend-import)",
-}
+KNOWN_SITES: dict[tuple[str, str, str], str] = {}  # none: the converter, runner and add-on sites are fixed
 KNOWN: dict[str, str] = {}  # exact case ids (none today)
 
 
