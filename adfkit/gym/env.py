@@ -18,6 +18,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from ..runner.rotations import rotation_exp
 from ..tasks.suture import JAW_DEPTH
 from . import scenes
 
@@ -36,15 +37,6 @@ def _pose7(t: np.ndarray) -> np.ndarray:
     if q[3] < 0:
         q = -q
     return np.concatenate([t[:3, 3], q]).astype(np.float32)
-
-
-def _rotvec(v: np.ndarray) -> np.ndarray:
-    a = float(np.linalg.norm(v))
-    if a < 1e-12:
-        return np.eye(3)
-    k = v / a
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(a) * kx + (1 - np.cos(a)) * kx @ kx
 
 
 class SuturingEnv(gym.Env):
@@ -170,7 +162,7 @@ class SuturingEnv(gym.Env):
         world_sp = base @ self._setpoint[name]
         goal = world_sp.copy()
         goal[:3, 3] += act[:3] * MAX_STEP
-        goal[:3, :3] = _rotvec(act[3:6] * MAX_TURN) @ world_sp[:3, :3]
+        goal[:3, :3] = rotation_exp(act[3:6] * MAX_TURN) @ world_sp[:3, :3]
         target = np.linalg.inv(base) @ goal
         refused = 0
         try:

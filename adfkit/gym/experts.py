@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..runner.rotations import quat_to_matrix
+from ..runner.rotations import quat_to_matrix, rotation_log
 from ..tasks.suture import JAW_DEPTH
 from .env import MAX_STEP
 
@@ -114,17 +114,10 @@ class SutureExpert:
             want = base @ psm.setpoint_cp()
             have = base @ env._setpoint[n]
             a[7 * k:7 * k + 3] = np.clip((want[:3, 3] - have[:3, 3]) / MAX_STEP, -1, 1)
-            a[7 * k + 3:7 * k + 6] = np.clip(_rotvec_of(want[:3, :3] @ have[:3, :3].T) / MAX_TURN, -1, 1)
+            a[7 * k + 3:7 * k + 6] = np.clip(rotation_log(want[:3, :3] @ have[:3, :3].T) / MAX_TURN, -1, 1)
             jaw = sum(psm.art.targets[i] for i in psm.jaws)
             a[7 * k + 6] = np.clip(2.0 * jaw / JAW_OPEN - 1.0, -1.0, 1.0)
         return a
-
-
-def _rotvec_of(r: np.ndarray) -> np.ndarray:
-    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    s = 0.5 * np.linalg.norm(v)
-    ang = np.arctan2(s, 0.5 * (np.trace(r) - 1.0))
-    return v * (0.5 if s < 1e-12 else ang / (2.0 * s))
 
 
 EXPERTS = {"NeedleReach": ReachExpert, "NeedlePick": PickExpert, "SutureOnePair": SutureExpert}

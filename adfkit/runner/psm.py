@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .psm_kinematics import PSMKinematics, default, pose_error
-from .rotations import invert
+from .rotations import invert, rotation_exp, rotation_log
 
 #: ADF joint names of the arm (dVRK order q1..q6) and of the two jaw fingers, as in the
 #: suturing challenge's PSM files (LND 400006)
@@ -34,15 +34,6 @@ class PSMModelError(ValueError):
     """The played model is not a PSM the DH kinematics describe."""
 
 
-def _log(r: np.ndarray) -> np.ndarray:
-    """Rotation vector of a 3x3 rotation."""
-    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    s = 0.5 * np.linalg.norm(v)
-    c = 0.5 * (np.trace(r) - 1.0)
-    a = np.arctan2(s, c)
-    return v * (0.5 if s < 1e-12 else a / (2.0 * s))
-
-
 def hand_eye(world_poses, model_poses) -> tuple[np.ndarray, np.ndarray]:
     """B and Y with world_poses[i] = B · model_poses[i] · Y for every i (Park & Martin's
     closed form on the motions relative to the first pose). Needs motions about at least two
@@ -50,8 +41,8 @@ def hand_eye(world_poses, model_poses) -> tuple[np.ndarray, np.ndarray]:
     w0, f0 = world_poses[0], model_poses[0]
     a = [w @ invert(w0) for w in world_poses[1:]]
     c = [f @ invert(f0) for f in model_poses[1:]]
-    alpha = np.array([_log(x[:3, :3]) for x in a])
-    beta = np.array([_log(x[:3, :3]) for x in c])
+    alpha = np.array([rotation_log(x[:3, :3]) for x in a])
+    beta = np.array([rotation_log(x[:3, :3]) for x in c])
     u, _s, vt = np.linalg.svd(beta.T @ alpha)
     d = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
     rb = vt.T @ d @ u.T
@@ -166,11 +157,11 @@ class PSM:
         start = self.setpoint_cp()
         goal = np.asarray(pose, dtype=float)
         steps = max(1, int(round(seconds / (self.world.dt * self.world.opt.control_substeps))))
-        axis_angle = _log(start[:3, :3].T @ goal[:3, :3])
+        axis_angle = rotation_log(start[:3, :3].T @ goal[:3, :3])
         for n in range(1, steps + 1):
             s = n / steps
             t = np.eye(4)
-            t[:3, :3] = start[:3, :3] @ _exp(s * axis_angle)
+            t[:3, :3] = start[:3, :3] @ rotation_exp(s * axis_angle)
             t[:3, 3] = (1 - s) * start[:3, 3] + s * goal[:3, 3]
             self.servo_cp(t)
             self.world.step(1)
@@ -192,12 +183,3 @@ class PSM:
         got = self.world.grasp(self.name, on)
         self.servo_jaw(0.0 if on else JAW_OPEN)
         return got
-
-
-def _exp(v: np.ndarray) -> np.ndarray:
-    a = float(np.linalg.norm(v))
-    if a < 1e-12:
-        return np.eye(3)
-    k = v / a
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(a) * kx + (1 - np.cos(a)) * kx @ kx

@@ -61,3 +61,22 @@ def invert(t: np.ndarray) -> np.ndarray:
     out[:3, :3] = r
     out[:3, 3] = -r @ t[:3, 3]
     return out
+
+
+def rotation_log(r: np.ndarray) -> np.ndarray:
+    """Rotation vector (axis × angle) of a 3x3 rotation."""
+    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    s = 0.5 * np.linalg.norm(v)
+    c = 0.5 * (np.trace(r) - 1.0)
+    a = np.arctan2(s, c)
+    return v * (0.5 if s < 1e-12 else a / (2.0 * s))
+
+
+def rotation_exp(v: np.ndarray) -> np.ndarray:
+    """3x3 rotation of a rotation vector (Rodrigues)."""
+    a = float(np.linalg.norm(v))
+    if a < 1e-12:
+        return np.eye(3)
+    k = v / a
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(a) * kx + (1 - np.cos(a)) * kx @ kx

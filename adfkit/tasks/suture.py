@@ -27,7 +27,7 @@ import numpy as np
 from ..adf.paths import collision_mesh_path
 from ..runner.psm import PSM
 from ..runner.psm_kinematics import JointLimitError
-from ..runner.rotations import invert
+from ..runner.rotations import invert, rotation_exp, rotation_log
 from .needle import fit_needle, obj_vertices
 
 JAW_DEPTH = 0.01      # m from the end effector to the point between the jaws (LND: along z_E)
@@ -63,27 +63,10 @@ def _rot_z(a: float) -> np.ndarray:
     return t
 
 
-def _axis_angle(r: np.ndarray) -> np.ndarray:
-    v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    s = 0.5 * np.linalg.norm(v)
-    c = 0.5 * (np.trace(r) - 1.0)
-    a = math.atan2(s, c)
-    return v * (0.5 if s < 1e-12 else a / (2.0 * s))
-
-
-def _exp(v: np.ndarray) -> np.ndarray:
-    a = float(np.linalg.norm(v))
-    if a < 1e-12:
-        return np.eye(3)
-    k = v / a
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(a) * kx + (1 - math.cos(a)) * kx @ kx
-
-
 def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
     """Pose between a and b: straight line, rotation about one axis."""
     t = np.eye(4)
-    t[:3, :3] = a[:3, :3] @ _exp(s * _axis_angle(a[:3, :3].T @ b[:3, :3]))
+    t[:3, :3] = a[:3, :3] @ rotation_exp(s * rotation_log(a[:3, :3].T @ b[:3, :3]))
     t[:3, 3] = (1 - s) * a[:3, 3] + s * b[:3, 3]
     return t
 
