@@ -19,6 +19,7 @@ from ..model.semantics import (
     SENSOR_TYPES, joint_frames, joint_kind, pose_or_identity,
 )
 from . import articulation
+from .grasping import grasp
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
@@ -591,37 +592,7 @@ class SimWorld(WorldState):
         """What the suturing scene does: close the jaws of ``psm`` and fix the body the finger
         ghosts (or a sensor) detect to the tool with its constraint actuator; ``on=False``
         releases it and opens the jaws. Returns the grasped body."""
-        act = next((a for a in self.actuators if psm in a.key or psm in a.parent.key), None)
-        if act is None:
-            raise KeyError(f"no constraint actuator for {psm!r}")
-        art = act.parent.articulation
-        jaws = [i for i, n in enumerate(art.joint_names) if "gripper" in n] if art is not None else []
-        if not on:
-            self.release(act)
-            for i in jaws:
-                art.targets[i] = 0.5
-            if art is not None:
-                art.drive()
-            return None
-        for i in jaws:
-            art.targets[i] = 0.0
-        if art is not None:
-            art.drive()
-        found = [b for g in self.ghosts if psm in g.key for b in self.overlapping(g)]
-        found += [b for s in self.sensors if psm in s.key for b in s.sensed]
-        own = {id(b) for b in self.bodies if b.articulation is not None and b.articulation is art}
-        found = [b for b in found if id(b) not in own]
-        if not found:
-            at = (act.parent.world_matrix() @ act.location)[:3, 3]
-            free = [b for b in self.bodies if not b.static and id(b) not in own]
-            if not free:
-                return None
-            near = min(free, key=lambda b: np.linalg.norm(np.array(b.com_position()) - at))
-            if np.linalg.norm(np.array(near.com_position()) - at) > 0.02:
-                return None
-            found = [near]
-        self.actuate(act, found[0])
-        return found[0]
+        return grasp(self, psm, on)
 
     def release(self, actuator: SimActuator) -> None:
         if actuator.constraint is not None:

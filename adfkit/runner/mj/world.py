@@ -18,6 +18,7 @@ from ...model.semantics import (
     inertial_offset,
 )
 from ...model.tree import ONE_DOF
+from ..grasping import grasp
 from ..names import Registry
 from ..rotations import invert, matrix_to_quat, pose_matrix, pose_to_matrix
 from .build import build_plan, compile_spec
@@ -422,37 +423,7 @@ class MjWorld:
     def grasp(self, psm: str, on: bool):
         """Close the jaws of ``psm`` and weld the body its finger ghosts find to the tool
         (the constraint actuator's weld equality), or release it and open them."""
-        act = next((a for a in self.actuators if psm in a.key or psm in a.parent.key), None)
-        if act is None:
-            raise KeyError(f"no constraint actuator for {psm!r}")
-        art = act.parent.articulation
-        jaws = [i for i, n in enumerate(art.joint_names) if "gripper" in n] if art is not None else []
-        if not on:
-            self.release(act)
-            for i in jaws:
-                art.targets[i] = 0.5
-            if art is not None:
-                art.drive()
-            return None
-        for i in jaws:
-            art.targets[i] = 0.0
-        if art is not None:
-            art.drive()
-        found = [b for g in self.ghosts if psm in g.key for b in self.overlapping(g)]
-        found += [b for s in self.sensors if psm in s.key for b in s.sensed]
-        own = {id(b) for b in self.bodies if b.articulation is not None and b.articulation is art}
-        found = [b for b in found if id(b) not in own]
-        if not found:
-            at = (act.parent.world_matrix() @ act.location)[:3, 3]
-            free = [b for b in self.bodies if not b.static and id(b) not in own]
-            if not free:
-                return None
-            near = min(free, key=lambda b: np.linalg.norm(np.array(b.com_position()) - at))
-            if np.linalg.norm(np.array(near.com_position()) - at) > 0.02:
-                return None
-            found = [near]
-        self.actuate(act, found[0])
-        return found[0]
+        return grasp(self, psm, on)
 
     def actuate(self, actuator: MjActuator, target: MjBody) -> None:
         """Weld ``target`` to the actuator's parent at their current relative pose; the jaws'
