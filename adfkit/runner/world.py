@@ -19,7 +19,7 @@ from ..model.semantics import (
     SENSOR_TYPES, joint_frames, joint_kind, pose_or_identity,
 )
 from . import articulation
-from .grasping import grasp
+from .neutral import EngineNeutral
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
@@ -81,7 +81,7 @@ class SimSensor:
     sensed: list = field(default_factory=list)
 
 
-class SimWorld(WorldState):
+class SimWorld(EngineNeutral, WorldState):
     def __init__(self, scene, options: Options | None = None, gui: bool = False) -> None:
         self.scene = scene
         self.opt = options or Options()
@@ -465,19 +465,6 @@ class SimWorld(WorldState):
         self.sim_time = self.steps * self.dt
         self.wall_time += time.perf_counter() - t0
 
-    def run(self, seconds: float, progress=None) -> None:
-        per = self.dt * self.opt.control_substeps
-        total = int(round(seconds / per))
-        chunk = max(1, int(0.05 / per))
-        done = 0
-        while done < total:
-            k = min(chunk, total - done)
-            self.step(k)
-            done += k
-            if progress is not None:
-                rtf = self.sim_time / self.wall_time if self.wall_time else 0.0
-                progress.update(k, suffix=f"{rtf:.2f}x real time")
-
     # ---- ghosts, sensors, actuators -------------------------------------------------------
     def _update_ghosts(self) -> None:
         """Hole ghosts (the ones with viscous friction) sense every control step; the others
@@ -588,11 +575,6 @@ class SimWorld(WorldState):
         art = sb.articulation
         return range(-1, len(art.records)) if art is not None else [sb.link]
 
-    def grasp(self, psm: str, on: bool) -> SimBody | None:
-        """What the suturing scene does: close the jaws of ``psm`` and fix the body the finger
-        ghosts (or a sensor) detect to the tool with its constraint actuator; ``on=False``
-        releases it and opens the jaws. Returns the grasped body."""
-        return grasp(self, psm, on)
 
     def release(self, actuator: SimActuator) -> None:
         if actuator.constraint is not None:

@@ -18,7 +18,7 @@ from ...model.semantics import (
     inertial_offset,
 )
 from ...model.tree import ONE_DOF
-from ..grasping import grasp
+from ..neutral import EngineNeutral
 from ..names import Registry
 from ..rotations import invert, matrix_to_quat, pose_matrix, pose_to_matrix
 from .build import build_plan, compile_spec
@@ -33,7 +33,7 @@ SLEEP_TOLERANCE = 3e-4
 SPRING_LIMIT = 0.25       # k ≤ SPRING_LIMIT·M_ii/dt²: the PyBullet runner's clamp for explicit springs
 
 
-class MjWorld:
+class MjWorld(EngineNeutral):
     engine = "mujoco"
 
     def __init__(self, scene, options=None, gui: bool = False, sleep: bool = True) -> None:
@@ -362,19 +362,6 @@ class MjWorld:
         self.sim_time = self.steps * self.dt
         self.wall_time += time.perf_counter() - t0
 
-    def run(self, seconds: float, progress=None) -> None:
-        per = self.dt * self.opt.control_substeps
-        total = int(round(seconds / per))
-        chunk = max(1, int(0.05 / per))
-        done = 0
-        while done < total:
-            k = min(chunk, total - done)
-            self.step(k)
-            done += k
-            if progress is not None:
-                rtf = self.sim_time / self.wall_time if self.wall_time else 0.0
-                progress.update(k, suffix=f"{rtf:.2f}x real time")
-
     # ---- ghosts and grasps ----------------------------------------------------------------
     def place_ghosts(self) -> None:
         """Ghost geoms ride on their parent bodies: nothing to move."""
@@ -420,10 +407,6 @@ class MjWorld:
         mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, sb.id, v, 0)
         return v[3:].copy()
 
-    def grasp(self, psm: str, on: bool):
-        """Close the jaws of ``psm`` and weld the body its finger ghosts find to the tool
-        (the constraint actuator's weld equality), or release it and open them."""
-        return grasp(self, psm, on)
 
     def actuate(self, actuator: MjActuator, target: MjBody) -> None:
         """Weld ``target`` to the actuator's parent at their current relative pose; the jaws'
