@@ -7,6 +7,7 @@ Exit status: 0 success, 1 findings/failure the user asked to fail on, 2 usage or
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import pkgutil
 import sys
@@ -16,7 +17,10 @@ from .diagnostics import AdfError
 from .report import print_diagnostics
 
 
+@functools.lru_cache(maxsize=1)
 def build_parser() -> argparse.ArgumentParser:
+    """The parser, built once per process (parse_args leaves it unchanged; in-process callers
+    such as the fuzz suite and the Gymnasium fan-out call main() many times)."""
     from . import commands
 
     parser = argparse.ArgumentParser(prog="adfkit", description="Author, validate, convert and play AMBF ADF scenes.")
