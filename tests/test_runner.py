@@ -84,9 +84,20 @@ def _model(tmp_path, text: str):
 BOX_CAMERA = box_camera_model()
 
 
-def test_camera_depth_segmentation_rgb(tmp_path):
-    world = SimWorld(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0)))
+def _renderer(name: str) -> str:
+    if name == "egl":
+        from adfkit.runner import egl
+        ok, why = egl.available()
+        if not ok:
+            pytest.skip(f"PyBullet's EGL renderer does not work here: {why}")
+    return name
+
+
+@pytest.mark.parametrize("renderer", ["tiny", "egl"])
+def test_camera_depth_segmentation_rgb(tmp_path, renderer):
+    world = SimWorld(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0), renderer=_renderer(renderer)))
     try:
+        assert world.renderer == renderer and world.report()["renderer"] == renderer
         cam = world.cameras[0]
         k = cam.intrinsics()
         assert k[1, 1] == pytest.approx(24 / math.tan(0.35)) and k[0, 2] == 32 and k[1, 2] == 24

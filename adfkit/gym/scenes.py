@@ -123,7 +123,8 @@ def _world(model, engine: str, visuals: bool):
                                       + ", ".join(missing) + "; use engine='pybullet'")
         return MjWorld(model, Options(visuals=visuals))
     from ..runner.world import SimWorld
-    return SimWorld(model, Options(visuals=visuals))
+    # image observations: a frame every step, so PyBullet's EGL renderer where it works (runner/egl.py)
+    return SimWorld(model, Options(visuals=visuals, renderer="auto" if visuals else "tiny"))
 
 
 def _unique(world, text: str) -> bool:

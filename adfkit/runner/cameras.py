@@ -1,7 +1,9 @@
 """Cameras (adf-format.md §9): RGB, depth in metres along the optical axis, per-body
-segmentation, pinhole intrinsics, rendered headless with TinyRenderer."""
+segmentation, pinhole intrinsics, rendered headless through PyBullet's EGL plugin where it works
+(runner/egl.py), else with TinyRenderer."""
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass
 
@@ -9,6 +11,7 @@ import numpy as np
 import pybullet as pb
 
 from ..model.semantics import DEFAULT_CAMERA_FAR, DEFAULT_CAMERA_FOV, DEFAULT_CAMERA_NEAR, DEFAULT_IMAGE_SIZE
+from . import egl
 from .names import merge_namespace
 
 
@@ -53,9 +56,11 @@ class SimCamera:
         vm = pb.computeViewMatrix(eye, target, up, physicsClientId=world.cid)
         pm = pb.computeProjectionMatrixFOV(math.degrees(self.fov), self.width / self.height, self.near, self.far,
                                            physicsClientId=world.cid)
-        _, _, rgba, zbuf, seg = pb.getCameraImage(self.width, self.height, vm, pm, renderer=pb.ER_TINY_RENDERER,
-                                                  flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,
-                                                  physicsClientId=world.cid)
+        renderer = getattr(world, "renderer", "tiny")
+        with egl.quiet_stdout() if renderer == "egl" else contextlib.nullcontext():
+            _, _, rgba, zbuf, seg = pb.getCameraImage(self.width, self.height, vm, pm, renderer=egl.flag(renderer),
+                                                      flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,
+                                                      shadow=0, physicsClientId=world.cid)
         rgb = np.reshape(np.asarray(rgba, dtype=np.uint8), (self.height, self.width, 4))[:, :, :3]
         z = np.reshape(np.asarray(zbuf, dtype=np.float64), (self.height, self.width))
         n, f = self.near, self.far

@@ -186,7 +186,9 @@ def run_episode(launch, indices=None, pairs=(1,), seed: int = 0, out=None, recor
     from ..runner.world import Options, SimWorld
     diags: list = []
     scene = load_scene(Path(launch), parse_indices(indices) if isinstance(indices, str) else indices, diags)
-    world = SimWorld(scene, options or Options(), gui=gui)
+    # many frames (the dataset, the GIF): PyBullet's EGL renderer where it works (runner/egl.py)
+    world = SimWorld(scene, options or Options(renderer="auto" if record or (gif and out is not None) else "tiny"),
+                     gui=gui)
     try:
         try:
             task = SutureTask(world, list(pairs), seed=seed)
