@@ -156,20 +156,11 @@ def validate_parallel(paths, kind, follow: bool, workers: int, address=None) -> 
     in the engine's order (launch files first) cut into contiguous chunks, each chunk checked by
     validate_files (following launch files as it does), the chunks' results joined and a file
     reached twice kept where it first appears, as the serial run keeps it."""
-    from .validator.engine import _looks_like_launch, expand
+    from .validator.engine import chunked, expand, merge_chunks
     files, problems = expand(paths)
-    files = sorted(files, key=lambda ft: not _looks_like_launch(*ft))
-    n = max(1, min(len(files), 4 * workers))
-    size = -(-len(files) // n) if files else 1
-    chunks = [files[i:i + size] for i in range(0, len(files), size)]
-    runs = fan_out(_validate_chunk, [(c, kind, follow) for c in chunks], workers, address)
-    results, seen = [], set()
+    runs = fan_out(_validate_chunk, [(c, kind, follow) for c in chunked(files, 4 * workers)], workers, address)
     for r in runs:
         if not r["ok"]:
             raise RuntimeError(f"a validation task failed twice: {r['error']}")
-        for res in r["result"]:
-            key = Path(res.path).resolve()
-            if key not in seen:
-                seen.add(key)
-                results.append(res)
+    results = merge_chunks(r["result"] for r in runs)
     return results, problems

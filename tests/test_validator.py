@@ -332,3 +332,26 @@ def test_reporters_accept_empty_input():
     reporters.write_text([], buf, files=3)
     assert buf.getvalue() == "3 file(s) checked: 0 error(s), 0 warning(s), 0 info\n"
     assert reporters.sarif([])["runs"][0]["results"] == []
+
+
+@pytest.mark.parametrize("fmt", ["text", "json", "sarif"])
+def test_validate_on_two_local_processes_prints_what_one_prints(capsys, fmt):
+    """--jobs 2 forks two workers over chunks of the tree; the report is the same text, in the
+    same order, as one process gives (the corpus too when it is beside the project)."""
+    from conftest import ROOT
+    trees = [str(ROOT / "sample_scenes")] + ([str(CORPUS)] if CORPUS.is_dir() else [])
+    rc1 = main(["validate", *trees, "-f", fmt, "-j", "1"])
+    one = capsys.readouterr().out
+    rc2 = main(["validate", *trees, "-f", fmt, "-j", "2"])
+    two = capsys.readouterr().out
+    assert rc1 == rc2 and one == two
+    assert len(one) > 200
+
+
+def test_auto_jobs_starts_processes_only_for_big_trees():
+    from adfkit.validator.engine import auto_jobs, chunked
+    assert auto_jobs(1) == 1 and auto_jobs(47) == 1
+    assert auto_jobs(10_000) >= 1
+    files = [(Path(f"/x/{i}.yaml"), None) for i in range(10)]
+    chunks = chunked(files, 4)
+    assert [len(c) for c in chunks] == [3, 3, 3, 1] and sum(chunks, []) == files

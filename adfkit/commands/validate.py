@@ -22,6 +22,9 @@ def add_arguments(p) -> None:
                    help="report only these rules (repeatable, comma-separated)")
     p.add_argument("--ignore", action="append", default=[], metavar="RULE",
                    help="do not report these rules (repeatable, comma-separated)")
+    p.add_argument("--jobs", "-j", type=int, default=0, metavar="N",
+                   help="check on N local processes (default 0: one per CPU for trees of 48 files and more, "
+                        "else this process alone; 1: this process)")
     p.add_argument("--workers", type=int, default=1,
                    help="check on W Ray workers (big trees; same output, same order); default 1: in this process")
     p.add_argument("--address", help="with --workers: a Ray cluster address (default: a local Ray)")
@@ -38,7 +41,7 @@ def _rules(values: list[str]) -> set[str]:
 
 def run(args) -> int:
     from ..diagnostics import Severity
-    from ..validator import RULES, validate_paths
+    from ..validator import RULES
     from ..validator import reporters
 
     select, ignore = _rules(args.select), _rules(args.ignore)
@@ -50,7 +53,9 @@ def run(args) -> int:
         from ..fanout import validate_parallel
         results, problems = validate_parallel(args.paths, args.kind, not args.no_follow, args.workers, args.address)
     else:
-        results, problems = validate_paths(args.paths, args.kind, follow=not args.no_follow)
+        from ..validator.engine import expand, validate_files_jobs
+        files, problems = expand(args.paths)
+        results = validate_files_jobs(files, args.kind, not args.no_follow, args.jobs)
     shown_min = Severity.parse(args.min_severity)
     diags = list(problems)
     texts = {}

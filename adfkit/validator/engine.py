@@ -197,6 +197,63 @@ def validate_files(files, kind: str | None = None, follow: bool = True) -> list[
     return list(results.values())
 
 
+def in_engine_order(files) -> list:
+    """``files`` in the order validate_files checks them: launch files first."""
+    return sorted(files, key=lambda ft: not _looks_like_launch(*ft))
+
+
+def chunked(files, parts: int) -> list[list]:
+    """The files in the engine's order cut into ``parts`` contiguous chunks (fewer when there
+    are fewer files)."""
+    files = in_engine_order(files)
+    n = max(1, min(len(files), parts))
+    size = -(-len(files) // n) if files else 1
+    return [files[i:i + size] for i in range(0, len(files), size)]
+
+
+def merge_chunks(runs) -> list[FileResult]:
+    """Chunks' results joined in order; a file reached twice is kept where it first appears,
+    as the serial run keeps it."""
+    results, seen = [], set()
+    for chunk in runs:
+        for res in chunk:
+            key = Path(os.path.realpath(res.path))
+            if key not in seen:
+                seen.add(key)
+                results.append(res)
+    return results
+
+
+def _chunk_without_docs(args) -> list[FileResult]:
+    files, kind, follow = args
+    out = validate_files(files, kind, follow)
+    for res in out:
+        res.doc = None          # the model stays in the worker: only findings and text travel back
+    return out
+
+
+def auto_jobs(n_files: int) -> int:
+    """Processes worth starting for ``n_files``: one per CPU, but at least ~24 files each."""
+    return max(1, min(os.cpu_count() or 1, n_files // 24))
+
+
+def validate_files_jobs(files, kind: str | None = None, follow: bool = True, jobs: int = 0) -> list[FileResult]:
+    """validate_files on ``jobs`` local processes (0: :func:`auto_jobs`), the same findings in
+    the same order; the results carry no ``doc``. Forked workers start with everything already
+    imported; where fork is not available it runs in this process."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    files = list(files)
+    jobs = auto_jobs(len(files)) if jobs <= 0 else jobs
+    if jobs <= 1 or len(files) < 2 or "fork" not in multiprocessing.get_all_start_methods():
+        return validate_files(files, kind, follow)
+    chunks = chunked(files, 4 * jobs)
+    with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+        runs = list(pool.map(_chunk_without_docs, [(c, kind, follow) for c in chunks]))
+    return merge_chunks(runs)
+
+
 def _looks_like_launch(path: Path, tree=None) -> bool:
     try:
         with open(inputs.check_file(path, tree=tree), "rb") as fh:
