@@ -297,3 +297,20 @@ def test_urdf_output_with_odd_meshes_and_inverted_limits_loads_in_pybullet(odd_m
         assert info[b"j1"][8:10] == (0.0, -1.0)  # continuous: no limit
     finally:
         pybullet.disconnect(cid)
+
+
+@pytest.mark.parametrize("points", [[(0, 0, 0)], [(0, 0, 0), (1, 0, 0)], [(0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0)]])
+def test_flat_box_of_a_point_or_a_line_is_its_bounds(points):
+    """A garbage collision mesh (one vertex, or all on a line) stands in as a box around it
+    instead of an IndexError/QhullError in the MJCF writer (found by the fuzz run)."""
+    import numpy as np
+    import trimesh
+
+    from adfkit.converters.engine_fit import FLAT_THICKNESS, flat_box
+    mesh = trimesh.Trimesh(vertices=np.array(points, float), faces=np.zeros((0, 3), int), process=False)
+    centre, rot, sizes = flat_box(mesh, 2.0)
+    span = 2.0 * (len(points) - 1)
+    assert np.allclose(rot @ rot.T, np.eye(3), atol=1e-9)
+    assert np.allclose(centre, [span / 2, 0, 0], atol=1e-9)
+    assert sorted(np.round(sizes[:2], 9).tolist()) == [0.0, span]
+    assert sizes[2] == pytest.approx(FLAT_THICKNESS * max(span, 1e-6))

@@ -90,10 +90,15 @@ def _renderer(name: str) -> str:
         ok, why = egl.available()
         if not ok:
             pytest.skip(f"PyBullet's EGL renderer does not work here: {why}")
+    if name == "mujoco":
+        from adfkit.runner.mj.render import _gl_context_class
+        cls, why = _gl_context_class()
+        if cls is None:
+            pytest.skip(f"MuJoCo has no headless OpenGL here: {why}")
     return name
 
 
-@pytest.mark.parametrize("renderer", ["tiny", "egl"])
+@pytest.mark.parametrize("renderer", ["tiny", "egl", "mujoco"])
 def test_camera_depth_segmentation_rgb(tmp_path, renderer):
     world = SimWorld(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0), renderer=_renderer(renderer)))
     try:

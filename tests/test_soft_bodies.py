@@ -2,6 +2,7 @@
 runner and MJCF. Corpus tests (sb/cloth.yaml, cloth2.yaml) skip when the corpus is absent."""
 from __future__ import annotations
 
+import shutil
 import struct
 
 import jsonschema
@@ -209,7 +210,8 @@ def test_soft_body_rules(tmp_path, change, expected):
 
 def test_fixed_nodes_rule_on_the_corpus_cloth(tmp_path):
     text = _cloth("cloth2.yaml").read_text().replace("fixed nodes: [0]", "fixed nodes: [0, 385, 386]")
-    (tmp_path / "low_res").symlink_to(_cloth("cloth2.yaml").parent / "low_res")
+    # a copy, not a symlink: a link out of the scene's tree is not followed (adfkit.inputs)
+    shutil.copytree(_cloth("cloth2.yaml").parent / "low_res", tmp_path / "low_res")
     f = tmp_path / "cloth.yaml"
     f.write_text(text)
     hits = [d for d in validate_file(f).diagnostics if d.rule == "soft-body-fixed-nodes"]
@@ -529,3 +531,32 @@ def test_urdf_names_the_soft_body_loss(tmp_path):
     m.soft_bodies.append(SoftBody(identifier="SOFT s", name="s", mesh="sq.obj", mass=0.4))
     losses = write(m, tmp_path / "m.urdf", "urdf")
     assert ("SOFT s", "soft body") in {(l.element, l.feature) for l in losses}
+
+
+@pytest.mark.parametrize("where", ["outside", "long-name"])
+def test_soft_body_mesh_outside_the_tree_or_unnameable_is_not_read(tmp_path, monkeypatch, where):
+    """The fixed-nodes rule and the MJCF soft writer read the mesh through the input policy:
+    a mesh outside the scene's tree is never opened (found by the 100,000-case fuzz run: the
+    validator and `convert` read /etc/passwd there), and a name over 255 bytes is a located
+    finding, not an OSError."""
+    from adfkit.cli import main
+    scene = tmp_path / "scene"
+    scene.mkdir()
+    secret = tmp_path / "secret.3ds"
+    _tiny_3ds(secret, [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 1, 2), (0, 2, 3)])
+    mesh = str(secret) if where == "outside" else "d" * 300 + "/m.3ds"
+    f = scene / "soft.yaml"
+    f.write_text(SOFT.format(mesh=mesh, mass="0.1", klst="0.5", pit="4", bend="2", fixed="[0, 9]"))
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", str(scene))
+    import fuzzkit   # its audit hook records every open (one hook for the whole session)
+    fuzzkit._install_hook()
+    fuzzkit._OPENED = []
+    try:
+        rules = [d.rule for d in validate_file(f).diagnostics]
+        assert rules and "soft-body-fixed-nodes" not in rules          # the mesh was not counted
+        assert ({"outside-tree"} if where == "outside" else {"missing-mesh", "bad-path"}) & set(rules)
+        assert main(["convert", str(f), str(scene / "out.xml")]) in (0, 1, 2)
+        opened = [str(p) for p in fuzzkit._OPENED]
+    finally:
+        fuzzkit._OPENED = None
+    assert not [p for p in opened if "secret" in p]

@@ -156,14 +156,20 @@ def flat_box(mesh, scale: float):
 
     v = np.asarray(mesh.vertices, dtype=float) * scale
     mean = v.mean(axis=0)
-    _u, _s, vt = np.linalg.svd(v - mean, full_matrices=False)
+    _u, _s, vt = np.linalg.svd(v - mean, full_matrices=True)   # 3x3: a plane even for < 3 vertices
     e1, e2 = vt[0], vt[1]
     normal = np.cross(e1, e2)
     flat2d = np.column_stack(((v - mean) @ e1, (v - mean) @ e2))
-    to_rect, extents = oriented_bounds_2D(flat2d)   # 3x3 homogeneous: points -> rectangle frame
-    back = np.linalg.inv(to_rect)
-    c2 = back[:2, 2]
-    a2 = back[:2, 0]
+    spread = np.linalg.svd(flat2d - flat2d.mean(axis=0), compute_uv=False) if len(flat2d) > 1 else np.zeros(2)
+    if len(flat2d) < 3 or spread[-1] <= 1e-12 * max(spread[0], 1e-300):
+        # a point or a line (a garbage mesh): its bounds in the plane, no rectangle to fit
+        lo, hi = flat2d.min(axis=0), flat2d.max(axis=0)
+        c2, a2, extents = (lo + hi) / 2, np.array([1.0, 0.0]), hi - lo
+    else:
+        to_rect, extents = oriented_bounds_2D(flat2d)   # 3x3 homogeneous: points -> rectangle frame
+        back = np.linalg.inv(to_rect)
+        c2 = back[:2, 2]
+        a2 = back[:2, 0]
     u = a2[0] * e1 + a2[1] * e2
     u /= np.linalg.norm(u)
     w = np.cross(normal, u)

@@ -123,13 +123,19 @@ def nodes_at(mesh: SoftMesh, points, tol: float = 1e-6) -> list[int]:
     return sorted(out)
 
 
-def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0) -> SoftMesh:
+def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0, tree=None) -> SoftMesh:
     """The soft body AMBF makes of a collision mesh file: unique nodes (times ``scale``) and
-    triangles. Raises AdfError (mesh-not-found, mesh-unreadable, mesh-empty)."""
+    triangles. Raises AdfError (mesh-not-found, mesh-unreadable, mesh-empty, or an input-policy
+    rule of adfkit.inputs: bad-path, not-a-regular-file, file-too-large, outside-tree when
+    ``tree``, the naming ADF file's tree, is given)."""
+    from .. import inputs  # noqa: PLC0415
+
+    inputs.check_path_text(path)
     p = Path(path)
-    if not p.is_file():
-        raise AdfError(error("mesh-not-found", f"mesh file not found: {p}", SourceLocation(str(p)),
+    if not os.path.lexists(p):
+        raise AdfError(error("mesh-not-found", f"mesh file not found: {inputs.shown(p)}", SourceLocation(inputs.shown(p)),
                              "check the path (ADF resolves mesh paths as in adf-format.md §6.2)"))
+    inputs.check_file(p, "mesh", tree=tree, what="mesh file")
     v, f = _raw_triangles(p)
     if len(v) == 0 or len(f) == 0:
         raise AdfError(error("mesh-empty", "the mesh has no triangles", SourceLocation(str(p)),
@@ -150,7 +156,7 @@ def placed_soft_mesh(model, sb) -> SoftMesh:
     if path is None:
         raise AdfError(error("mesh-not-found", f"soft body '{sb.identifier}' names no mesh", sb.where(),
                              "AMBF builds soft bodies from their collision mesh; name one with `mesh`"))
-    mesh = load_soft_mesh(path, sb.scale or 1.0)
+    mesh = load_soft_mesh(path, sb.scale or 1.0, tree=getattr(model, "tree", None))
     if sb.location is not None:
         rot = np.array(sb.location.orientation.matrix())
         mesh.nodes = mesh.nodes @ rot.T + np.array([*sb.location.position])

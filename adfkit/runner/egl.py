@@ -22,7 +22,6 @@ import sys
 
 import pybullet as pb
 
-RENDERERS = ("auto", "egl", "tiny")
 
 _PROBE = r"""
 import pybullet as pb, sys
@@ -67,24 +66,17 @@ def available() -> tuple[bool, str]:
     return _answer
 
 
-def choose(wanted: str, cid: int, has_cameras: bool, soft: bool, gui: bool) -> tuple[str, str]:
-    """Load the plugin into client ``cid`` when it is wanted and works: ("egl" | "tiny", note).
-    ``auto`` asks for it only for a scene with cameras, without soft bodies (the plugin does
-    not draw deformables) and headless; ``egl`` asks regardless of cameras."""
-    if wanted == "tiny" or gui:
-        return "tiny", ""
-    if soft:
-        return "tiny", "soft bodies are drawn by TinyRenderer only"
-    if wanted == "auto" and not has_cameras:
-        return "tiny", ""
+def load(cid: int) -> tuple[bool, str]:
+    """Load the plugin into client ``cid`` (before its first body) when it works here:
+    (loaded, why not)."""
     ok, why = available()
     if not ok:
-        return "tiny", why
+        return False, why
     with quiet_stdout():
         loaded = pb.loadPlugin(plugin_path(), "_eglRendererPlugin", physicsClientId=cid)
     if loaded < 0:
-        return "tiny", "PyBullet refused to load the eglRenderer plugin"
-    return "egl", ""
+        return False, "PyBullet refused to load the eglRenderer plugin"
+    return True, ""
 
 
 @contextlib.contextmanager

@@ -21,6 +21,7 @@ from ..model.semantics import (
 )
 from . import articulation, egl
 from .neutral import EngineNeutral
+from .cameras import choose_renderer
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
@@ -45,8 +46,9 @@ class Options:
     hole_friction: float = 2.0            # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
     ground: bool = True                   # a model played without a world gets a floor under it
-    # cameras: "tiny" (TinyRenderer, CPU; no set-up cost, best for a frame or two), "egl" (PyBullet's
-    # EGL plugin: ~0.3 s and ~400 MiB to set up, then 2-4x faster frames), "auto" (egl where it works)
+    # cameras (cameras.choose_renderer): "tiny" (TinyRenderer, CPU; nothing to set up, best for a
+    # frame or two), "mujoco" (MuJoCo's renderer on a mirror of the scene: ~1 s to build, then
+    # ~15x faster frames), "egl" (PyBullet's EGL plugin), "auto" (mujoco, else egl, else tiny)
     renderer: str = "tiny"
 
 
@@ -96,8 +98,9 @@ class SimWorld(EngineNeutral, WorldState):
         if self.soft is not None:
             enable_deformable_world(self.cid)
         has_cameras = bool(scene.world is not None and scene.world.cameras) or any(m.cameras for m in scene.all_models())
-        self.renderer, self.renderer_note = egl.choose(self.opt.renderer, self.cid, has_cameras,
-                                                       self.soft is not None, gui)
+        self._mj_view = None
+        self.renderer, self.renderer_note = choose_renderer(self.opt.renderer, self.cid, has_cameras,
+                                                            self.soft is not None, gui)
         self.dt = 1.0 / self.opt.physics_hz
         w = scene.world
         g = self.opt.gravity or (tuple(w.gravity) if w is not None and w.gravity is not None else DEFAULT_GRAVITY)
@@ -651,7 +654,24 @@ class SimWorld(EngineNeutral, WorldState):
             "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
         }
 
+    def mj_view(self):
+        """The MuJoCo mirror that draws the cameras with ``renderer="mujoco"`` (runner/mjview.py),
+        built on the first picture."""
+        if self._mj_view is None:
+            from .mjview import MjView
+            self._mj_view = MjView(self)
+        return self._mj_view
+
+    def fall_back_to_tiny(self, why: str) -> None:
+        """The renderer chosen could not start (MuJoCo could not build or open the scene):
+        TinyRenderer from now on, the reason in the report and a warning."""
+        self._warn("runner-renderer", f"{self.renderer} renderer unavailable ({why}); TinyRenderer instead", None)
+        self.renderer, self.renderer_note = "tiny", why
+
     def close(self) -> None:
+        if self._mj_view is not None:
+            self._mj_view.close()
+            self._mj_view = None
         if self.soft is not None:
             self.soft.close()
         if pb.isConnected(self.cid):

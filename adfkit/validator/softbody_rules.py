@@ -86,14 +86,14 @@ def mesh_rules(m: ModelFile) -> list[Diagnostic]:
         if not sb.defined or cfg is None or not cfg.fixed_nodes or not sb.mesh:
             continue
         path = collision_mesh_path(m, sb)
-        if path is None or not path.is_file():
+        if path is None:
             continue   # missing-mesh says so
         from ..geometry.softmesh import load_soft_mesh  # noqa: PLC0415 - only when fixed nodes need counting
 
-        try:
-            n = load_soft_mesh(path, sb.scale or 1.0).node_count
+        try:   # through the input policy: a mesh outside the tree, a device or a bad name is not read
+            n = load_soft_mesh(path, sb.scale or 1.0, tree=getattr(m, "tree", None)).node_count
         except AdfError:
-            continue
+            continue   # the path rules report why it cannot be read
         bad = [i for i in cfg.fixed_nodes if not 0 <= i < n]
         if bad:
             out.append(_d("soft-body-fixed-nodes", f"soft body '{sb.identifier}': fixed node(s) "
