@@ -123,6 +123,8 @@ def test_sparse_reward_and_image_observations():
     obs, r, *_ = env.step(np.zeros(7, np.float32))
     assert r == -1.0
     assert env.render().ndim == 3
+    world = env.unwrapped.world   # the resized cameras drew with the renderer chosen, no fall-back
+    assert not [d for d in world.diagnostics if d.rule == "runner-renderer"]
 
 
 def _solve(env_id, seeds):

@@ -99,3 +99,22 @@ def test_renderer_agrees_with_tinyrenderer_on_the_suturing_pad(renderer):
         both = np.isfinite(a["depth"]) & np.isfinite(b["depth"])
         assert (np.isfinite(a["depth"]) == np.isfinite(b["depth"])).mean() > 0.97
         assert np.median(np.abs(a["depth"][both] - b["depth"][both])) < 1e-3
+
+
+def test_mujoco_renderer_draws_a_resized_copy_of_a_camera():
+    """The Gymnasium environments render copies of the scene's cameras at their own size."""
+    from dataclasses import replace
+    _usable("mujoco")
+    world = SimWorld(load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"), Options(renderer="mujoco"))
+    try:
+        full = world.cameras[0].render(world)
+        small = replace(world.cameras[0], width=64, height=48).render(world)
+        assert world.renderer == "mujoco" and not [d for d in world.diagnostics if d.rule == "runner-renderer"]
+        assert small["rgb"].shape == (48, 64, 3) and full["rgb"].shape[:2] == (world.cameras[0].height,
+                                                                              world.cameras[0].width)
+        # the same view: the centre pixel sees the same body at the same depth
+        h, w = full["segmentation"].shape
+        assert small["segmentation"][24, 32] == full["segmentation"][h // 2, w // 2]
+        assert abs(float(small["depth"][24, 32]) - float(full["depth"][h // 2, w // 2])) < 5e-3
+    finally:
+        world.close()

@@ -53,7 +53,7 @@ class SimCamera:
         """{'rgb': H×W×3 uint8, 'depth': H×W float32 m, 'segmentation': H×W int32 (body index, -1 none)}."""
         if getattr(world, "renderer", "tiny") == "mujoco":
             try:
-                return world.mj_view().render(world.cameras.index(self))
+                return world.mj_view().render(self)
             except Exception as exc:  # noqa: BLE001 - another engine's build: whatever stops it, PyBullet's own renderer draws
                 # MuJoCo could not build the scene or open a GL context: the frame from TinyRenderer
                 world.fall_back_to_tiny(f"{type(exc).__name__}: {exc}")

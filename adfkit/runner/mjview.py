@@ -77,10 +77,28 @@ class MjView:
             d.light_xpos[:] = xpos[lb] + np.einsum("nij,nj->ni", xmat[lb], self._light_pos)
             d.light_xdir[:] = np.einsum("nij,nj->ni", xmat[lb], self._light_dir)
 
-    def render(self, index: int) -> dict:
-        """Camera ``index`` (the PyBullet world's camera order) now."""
+    def render(self, camera) -> dict:
+        """The PyBullet world's ``camera`` now: one of ``world.cameras`` or a copy of one with
+        another image size (the Gymnasium environments resize them)."""
+        import copy
+
+        sims = self.world.cameras
+        index = next((i for i, c in enumerate(sims) if c is camera), None)
+        if index is None:
+            index = next((i for i, c in enumerate(sims) if (c.key, c.name, c.eye_offset) ==
+                          (camera.key, camera.name, camera.eye_offset)), None)
+        if index is None:
+            raise ValueError(f"camera {camera.name!r} is not one of the scene's")
+        cam = self.cameras[index]
+        if (cam.width, cam.height) != (camera.width, camera.height):
+            g = self.mj.model.vis.global_
+            if camera.width > g.offwidth or camera.height > g.offheight:
+                raise ValueError(f"{camera.width}x{camera.height} is larger than the offscreen buffer "
+                                 f"({g.offwidth}x{g.offheight})")
+            cam = copy.copy(cam)
+            cam.width, cam.height = camera.width, camera.height
         self._sync()
-        return self.mj._renderer().render(self.cameras[index])
+        return self.mj._renderer().render(cam)
 
     def close(self) -> None:
         self.mj.close()
