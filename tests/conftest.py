@@ -35,6 +35,23 @@ def require_corpus() -> None:
         pytest.skip(SKIP_CORPUS)
 
 
+def require_renderer(name: str) -> str:
+    """Skip, with the reason, when renderer ``name`` of the PyBullet world's cameras
+    (runner/cameras.choose_renderer) cannot start here; returns the name."""
+    import pytest
+    if name == "egl":
+        from adfkit.runner import egl
+        ok, why = egl.available()
+        if not ok:
+            pytest.skip(f"PyBullet's EGL renderer does not work here: {why}")
+    if name == "mujoco":
+        from adfkit.runner.mj.render import _gl_context_class
+        cls, why = _gl_context_class()
+        if cls is None:
+            pytest.skip(f"MuJoCo has no headless OpenGL here: {why}")
+    return name
+
+
 def box_camera_model(mass: float = 0.0, z: float = 0.0, rgb=(0.9, 0.2, 0.1)) -> str:
     """A 0.2 m box at height ``z`` and a 64x48 camera 1 m away on +x looking at its centre."""
     r, g, b = rgb

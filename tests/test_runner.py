@@ -7,7 +7,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from conftest import CORPUS, box_camera_model, require_corpus
+from conftest import CORPUS, box_camera_model, require_corpus, require_renderer
 
 pb = pytest.importorskip("pybullet")
 
@@ -84,23 +84,9 @@ def _model(tmp_path, text: str):
 BOX_CAMERA = box_camera_model()
 
 
-def _renderer(name: str) -> str:
-    if name == "egl":
-        from adfkit.runner import egl
-        ok, why = egl.available()
-        if not ok:
-            pytest.skip(f"PyBullet's EGL renderer does not work here: {why}")
-    if name == "mujoco":
-        from adfkit.runner.mj.render import _gl_context_class
-        cls, why = _gl_context_class()
-        if cls is None:
-            pytest.skip(f"MuJoCo has no headless OpenGL here: {why}")
-    return name
-
-
 @pytest.mark.parametrize("renderer", ["tiny", "egl", "mujoco"])
 def test_camera_depth_segmentation_rgb(tmp_path, renderer):
-    world = SimWorld(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0), renderer=_renderer(renderer)))
+    world = SimWorld(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0), renderer=require_renderer(renderer)))
     try:
         assert world.renderer == renderer and world.report()["renderer"] == renderer
         cam = world.cameras[0]

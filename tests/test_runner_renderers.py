@@ -14,20 +14,11 @@ import numpy as np
 import pytest
 
 from adfkit.adf import load_scene
-from adfkit.runner import egl
 from adfkit.runner.world import Options, SimWorld
+from conftest import require_renderer
 
 ROOT = Path(__file__).resolve().parent.parent
 
-
-def _usable(renderer: str) -> None:
-    if renderer == "egl" and not egl.available()[0]:
-        pytest.skip(f"PyBullet's EGL renderer does not work here: {egl.available()[1]}")
-    if renderer == "mujoco":
-        from adfkit.runner.mj.render import _gl_context_class
-        cls, why = _gl_context_class()
-        if cls is None:
-            pytest.skip(f"MuJoCo has no headless OpenGL here: {why}")
 
 PLANE_AND_CAMERA = """
 bodies: [BODY floor, BODY box]
@@ -60,7 +51,7 @@ CAMERA cam:
 def test_lone_plane_without_visual_renders_and_stdout_stays_clean(tmp_path, renderer):
     """A PLANE-only body with no visual segfaults PyBullet 3.2.7's EGL plugin; the runner gives
     it a slab visual. Run in a child process: a crash must fail this test, not end the run."""
-    _usable(renderer)
+    require_renderer(renderer)
     model = tmp_path / "model.yaml"
     model.write_text(textwrap.dedent(PLANE_AND_CAMERA))
     out = tmp_path / "run"
@@ -80,7 +71,7 @@ def test_lone_plane_without_visual_renders_and_stdout_stays_clean(tmp_path, rend
 
 @pytest.mark.parametrize("renderer", ["egl", "mujoco"])
 def test_renderer_agrees_with_tinyrenderer_on_the_suturing_pad(renderer):
-    _usable(renderer)
+    require_renderer(renderer)
     scene = load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml")
     frames = {}
     for renderer in (renderer, "tiny"):
@@ -104,7 +95,7 @@ def test_renderer_agrees_with_tinyrenderer_on_the_suturing_pad(renderer):
 def test_mujoco_renderer_draws_a_resized_copy_of_a_camera():
     """The Gymnasium environments render copies of the scene's cameras at their own size."""
     from dataclasses import replace
-    _usable("mujoco")
+    require_renderer("mujoco")
     world = SimWorld(load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"), Options(renderer="mujoco"))
     try:
         full = world.cameras[0].render(world)
