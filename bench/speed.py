@@ -1,0 +1,149 @@
+"""Every speed figure of issue 17 in one run, each beside its floor or its goal, as a table.
+
+    .venv/bin/python bench/speed.py [--seconds S] [--rounds R] [--frames N]
+
+- PyBullet loop (suturing set, 1 kHz physics, no frames) against the bare ``stepSimulation``
+  floor of the same loaded scene, alternated ``--rounds`` times (medians);
+- MuJoCo engine on the same scene: the first S seconds (the thread settling, every tree
+  awake) and the next S (resting trees asleep), against the bare ``mj_step`` floor from there;
+- a stereo frame (both cameras, RGB + depth + segmentation) with each renderer of the PyBullet
+  world (TinyRenderer, PyBullet's EGL plugin, MuJoCo's renderer on a mirror) and with the
+  MuJoCo engine's own cameras: medians of N frames after a first one;
+- ``adfkit validate`` of the whole corpus and ``adfkit --help``: fresh processes, start-up
+  included, medians of 5.
+
+The suturing set is the corpus's (launch indices 6-11) when ``../shared/corpus`` is there, else
+the project's bundled suturing scene. Asserts nothing; prints figures.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CORPUS = ROOT.parent / "shared" / "corpus"
+
+
+def scene_and_label():
+    from adfkit.adf import load_scene
+    launch = CORPUS / "src" / "launch.yaml"
+    if launch.is_file():
+        return load_scene(launch, [6, 7, 8, 9, 10, 11]), "corpus suturing set (launch -l 6-11)"
+    return load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml"), "bundled suturing scene"
+
+
+def pybullet_loop(scene, seconds: float, rounds: int) -> tuple[float, float]:
+    import pybullet as pb
+
+    from adfkit.runner.world import Options, SimWorld
+    full, bare = [], []
+    for _ in range(rounds):
+        for kind in ("full", "bare"):
+            world = SimWorld(scene, Options(visuals=False))
+            try:
+                world.run(0.05)
+                n = int(round(seconds / (world.dt * world.opt.control_substeps)))
+                t = time.perf_counter()
+                if kind == "full":
+                    world.step(n)
+                else:
+                    for _ in range(n):
+                        pb.stepSimulation(physicsClientId=world.cid)
+                (full if kind == "full" else bare).append(seconds / (time.perf_counter() - t))
+            finally:
+                world.close()
+    return statistics.median(full), statistics.median(bare)
+
+
+def mujoco_loop(scene, seconds: float) -> tuple[float, float, float]:
+    import mujoco
+
+    from adfkit.runner.mj.world import MjWorld
+    from adfkit.runner.world import Options
+    world = MjWorld(scene, Options())
+    try:
+        world.run(seconds)
+        first = world.sim_time / world.wall_time
+        w0, s0 = world.wall_time, world.sim_time
+        world.run(seconds)
+        settled = (world.sim_time - s0) / (world.wall_time - w0)
+        n = int(round(seconds * world.opt.physics_hz))
+        t = time.perf_counter()
+        mujoco.mj_step(world.model, world.data, n)
+        floor = seconds / (time.perf_counter() - t)
+    finally:
+        world.close()
+    return first, settled, floor
+
+
+def stereo_ms(make_world, frames: int) -> float | str:
+    try:
+        world = make_world()
+    except Exception as exc:  # noqa: BLE001 - a renderer that cannot start here is a table cell, not a crash
+        return f"n/a ({type(exc).__name__})"
+    try:
+        world.run(0.1)
+        cams = world.cameras
+        for c in cams:
+            c.render(world)
+        times = []
+        for _ in range(frames):
+            t = time.perf_counter()
+            for c in cams:
+                c.render(world)
+            times.append(time.perf_counter() - t)
+        used = getattr(world, "renderer", "mujoco engine")
+        return f"{1e3 * statistics.median(times):.1f} ms ({used}, {len(cams)} x {cams[0].width}x{cams[0].height})"
+    finally:
+        world.close()
+
+
+def cli_ms(args: list[str], runs: int = 5) -> float:
+    times = []
+    for _ in range(runs):
+        t = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "adfkit", *args], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        times.append(time.perf_counter() - t)
+    return 1e3 * statistics.median(times)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--seconds", type=float, default=3.0)
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--frames", type=int, default=10)
+    args = ap.parse_args()
+    from adfkit.runner.mj.world import MjWorld
+    from adfkit.runner.world import Options, SimWorld
+    scene, label = scene_and_label()
+    print(f"scene: {label}; {args.seconds:g} s windows, {args.rounds} rounds, {args.frames} frames")
+    rows = []
+    loop, floor = pybullet_loop(scene, args.seconds, args.rounds)
+    rows.append(("PyBullet loop / bare stepSimulation floor", f"{loop:.2f}x / {floor:.2f}x real time, "
+                 f"ratio {loop / floor:.3f}", ">= 2.2x, ratio >= 0.9"))
+    first, settled, mfloor = mujoco_loop(scene, args.seconds)
+    rows.append(("MuJoCo engine, first window (thread settling)", f"{first:.2f}x real time", ">= 10x"))
+    rows.append(("MuJoCo engine, next window / bare mj_step floor", f"{settled:.2f}x / {mfloor:.2f}x, ratio "
+                 f"{settled / mfloor:.2f}", ">= 10x"))
+    for renderer in ("tiny", "egl", "mujoco"):
+        rows.append((f"stereo frame, PyBullet world, renderer={renderer}",
+                     stereo_ms(lambda: SimWorld(scene, Options(renderer=renderer)), args.frames), "<= 60 ms"))
+    rows.append(("stereo frame, MuJoCo engine", stereo_ms(lambda: MjWorld(scene, Options()), args.frames), "<= 15 ms"))
+    if CORPUS.is_dir():
+        rows.append(("adfkit validate corpus/ (CLI, start-up included)",
+                     f"{cli_ms(['validate', str(CORPUS), '-f', 'json']):.0f} ms", "< 1000 ms"))
+        rows.append(("adfkit validate corpus/ -j 1 (one process)",
+                     f"{cli_ms(['validate', str(CORPUS), '-f', 'json', '-j', '1']):.0f} ms", ""))
+    rows.append(("adfkit --help", f"{cli_ms(['--help'], 9):.0f} ms", "< 80 ms"))
+    width = max(len(r[0]) for r in rows)
+    for name, value, goal in rows:
+        print(f"{name:<{width}}  {value:<58}  {goal}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
