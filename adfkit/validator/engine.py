@@ -248,10 +248,48 @@ def validate_files_jobs(files, kind: str | None = None, follow: bool = True, job
     jobs = auto_jobs(len(files)) if jobs <= 0 else jobs
     if jobs <= 1 or len(files) < 2 or "fork" not in multiprocessing.get_all_start_methods():
         return validate_files(files, kind, follow)
-    chunks = chunked(files, 4 * jobs)
+    units = _work_units(files, follow, 4 * jobs)
     with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork")) as pool:
-        runs = list(pool.map(_chunk_without_docs, [(c, kind, follow) for c in chunks]))
+        runs = list(pool.map(_chunk_without_docs, [(c, kind, follow) for c in units]))
     return merge_chunks(runs)
+
+
+def _work_units(files, follow: bool, parts: int) -> list[list]:
+    """Each launch file alone (it checks the files it reaches), then the other files in
+    contiguous chunks, less those a launch file reaches: the serial run checks those once, in
+    the launch file's context, and so does this (no file is checked twice)."""
+    if not follow:
+        return chunked(files, parts)
+    files = in_engine_order(files)
+    launches = [ft for ft in files if _looks_like_launch(*ft)]
+    reached: set[str] = set()
+    for path, tree in launches:
+        reached |= _reached_from_launch(path, tree)
+    rest = [ft for ft in files if ft not in launches and os.path.realpath(ft[0]) not in reached]
+    return [[ft] for ft in launches] + (chunked(rest, max(1, parts - len(launches))) if rest else [])
+
+
+def _reached_from_launch(path: Path, tree) -> set[str]:
+    """Real paths of the files validate_files follows from launch file ``path`` (its world and
+    the world's environment, input devices, colours and models); empty when it cannot be read."""
+    try:
+        launch, _ = read_file(path, "launch", tree=tree)
+    except AdfError:
+        return set()
+    if not isinstance(launch, Launch):
+        return set()
+    out: set[str] = set()
+    for slot, paths in paths_check.launch_targets(launch).items():
+        for p in paths:
+            out.add(os.path.realpath(p))
+            if slot == "world config" and os.path.lexists(p):
+                try:
+                    world, _ = read_file(p, "world", tree=launch.tree)
+                except AdfError:
+                    continue
+                if isinstance(world, World) and world.environment:
+                    out.add(os.path.realpath(paths_check.relative_to_file(world.path, world.environment)))
+    return out
 
 
 def _looks_like_launch(path: Path, tree=None) -> bool:
