@@ -109,7 +109,8 @@ def suture_job(job: dict) -> dict:
     t0 = time.perf_counter()
     name = f"episode_{int(job['seed']):05d}"
     m = run_episode(job["launch"], job["indices"], job["pairs"], int(job["seed"]), Path(job["out"]) / name,
-                    job.get("record", False), False, progress=False, every=job.get("every", 10))
+                    job.get("record", False), False, progress=False, every=job.get("every", 10),
+                    engine=job.get("engine", "pybullet"))
     return {"dir": name, "all_passed": bool(m.get("all_passed")),
             "pairs_passed": [p["pair"] for p in m.get("pairs", []) if p.get("passed")],
             "failure": m.get("failure"), "simulated_time_s": m.get("simulated_time_s"),
@@ -117,7 +118,8 @@ def suture_job(job: dict) -> dict:
 
 
 def suture_episodes(launch, indices, pairs, seed: int, episodes: int, workers: int, address, out: Path,
-                    record: bool = False, every: int = 10, kill_once: str | None = None) -> int:
+                    record: bool = False, every: int = 10, kill_once: str | None = None,
+                    engine: str = "pybullet") -> int:
     """`adfkit suture --episodes N --workers W`: exit 0 when every episode ran and passed every
     pair, 1 otherwise (the index says which)."""
     import time
@@ -125,7 +127,7 @@ def suture_episodes(launch, indices, pairs, seed: int, episodes: int, workers: i
     from .report import Progress
     out = Path(out).resolve()
     jobs = [{"launch": str(Path(launch).resolve()), "indices": indices, "pairs": list(pairs), "seed": s,
-             "out": str(out), "record": record, "every": every} for s in range(seed, seed + episodes)]
+             "out": str(out), "record": record, "every": every, "engine": engine} for s in range(seed, seed + episodes)]
     if kill_once:
         jobs[0]["kill_once"] = kill_once
     t0 = time.perf_counter()

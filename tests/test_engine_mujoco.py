@@ -523,3 +523,69 @@ BODY box:
         assert z == pytest.approx(0.01 + 5e-4, abs=1e-3)   # on the floor's 1 mm box, not through it
     finally:
         world.close()
+
+
+BOX_ON_FLOOR = """
+bodies: [BODY floor, BODY box, BODY post]
+ghost objects: [GHOST hole]
+BODY floor:
+  name: floor
+  mass: 0.0
+  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 1.0, y: 1.0, z: 0.1}
+BODY box:
+  name: box
+  mass: 0.5
+  inertia: {ix: 0.001, iy: 0.001, iz: 0.001}
+  location: {position: {x: 0.0, y: 0.0, z: 0.2}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.1, y: 0.1, z: 0.1}
+BODY post:
+  name: post
+  mass: 0.0
+  location: {position: {x: 0.3, y: 0.0, z: 0.3}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: SPHERE
+  collision geometry: {radius: 0.02}
+GHOST hole:
+  name: hole
+  parent: BODY post
+  location: {position: {x: 0.0, y: 0.01, z: 0.02}, orientation: {r: 0.3, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.01, y: 0.01, z: 0.01}
+"""
+
+
+@pytest.mark.parametrize("engine", ENGINES, ids=lambda e: e.__name__)
+def test_task_api_set_collision_move_base_ghost_pose(tmp_path, engine):
+    """What the suture asks of a world, the same in both engines: a body pair turned off falls
+    through, turned on again it rests; a static body moved by move_base is where it was put,
+    its ghost with it (ghost_pose)."""
+    world = engine(_model(tmp_path, BOX_ON_FLOOR), Options())
+    try:
+        floor, box, post = world.body("floor"), world.body("box"), world.body("post")
+        world.set_collision(floor, box, False)
+        world.run(0.25)
+        assert box.world_matrix()[2, 3] < 0.0                 # through the floor's top face (0.05)
+        world.set_collision(floor, box, True)
+        top = post.world_matrix()
+        top[:3, 3] = [0.5, -0.2, 0.4]
+        world.move_base(post, top)
+        assert np.allclose(post.world_matrix()[:3, 3], [0.5, -0.2, 0.4], atol=1e-9)
+        g = world.ghost_pose(world.ghosts[0])
+        assert np.allclose(g[:3, 3], [0.5, -0.19, 0.42], atol=1e-6)
+        assert math.isclose(math.atan2(g[2, 1], g[2, 2]), 0.3, abs_tol=1e-6)
+    finally:
+        world.close()
+
+
+def test_set_collision_turned_on_again_collides(tmp_path):
+    world = MjWorld(_model(tmp_path, BOX_ON_FLOOR), Options())
+    try:
+        floor, box = world.body("floor"), world.body("box")
+        world.set_collision(floor, box, False)
+        world.set_collision(floor, box, True)
+        world.run(0.5)
+        assert abs(box.world_matrix()[2, 3] - 0.1) < 2e-3    # resting on the floor's top face
+    finally:
+        world.close()

@@ -27,6 +27,8 @@ def add_arguments(p) -> None:
     p.add_argument("--out", default="suture-output", help="output folder (default suture-output)")
     p.add_argument("--seed", type=int, default=0, help="seed of the plan's small randomisation")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
+    p.add_argument("--engine", choices=("pybullet", "mujoco"), default="pybullet",
+                   help="physics engine (default pybullet; the README says how the suture fares in MuJoCo)")
     p.add_argument("--record", action="store_true", help="write the dataset (RGB, depth, segmentation, poses)")
     p.add_argument("--every", type=int, default=10, help="with --record: a frame every N control steps")
     p.add_argument("--episodes", type=int, default=1,
@@ -80,9 +82,13 @@ def run(args) -> int:
             raise AdfError(error("bad-option", "--episodes and --workers must be at least 1", None, "e.g. --episodes 4 --workers 2"))
         from ..fanout import suture_episodes
         return suture_episodes(launch, indices, pairs, args.seed, args.episodes, args.workers or 2, args.address, out,
-                               args.record, args.every)
+                               args.record, args.every, engine=args.engine)
     from ..tasks.episode import run_episode
-    m = run_episode(launch, indices, pairs, args.seed, out, args.record, args.gui, progress=True, every=args.every)
+    if args.gui and args.engine == "mujoco":
+        raise AdfError(error("bad-option", "--gui opens PyBullet's window; the MuJoCo engine plays headless", None,
+                             "drop --gui, or use --engine pybullet"))
+    m = run_episode(launch, indices, pairs, args.seed, out, args.record, args.gui, progress=True, every=args.every,
+                    engine=args.engine)
     if m.get("failure", "").startswith("setup:") if m.get("failure") else False:
         raise AdfError(error("suture-setup", m["failure"].removeprefix("setup: "), None,
                              "the scene needs a Needle, Entry k/Exit k hole ghosts and two PSMs"))

@@ -179,16 +179,20 @@ def write_outputs(out: Path, metrics: dict, obs, task, frames) -> list[str]:
 
 def run_episode(launch, indices=None, pairs=(1,), seed: int = 0, out=None, record: bool = False,
                 gui: bool = False, progress: bool = True, every: int = 10, gif: bool = True,
-                options=None) -> dict:
+                options=None, engine: str = "pybullet") -> dict:
     """Play one scripted suture of hole ``pairs`` on the scene; returns the metrics (also written
     with the pictures to ``out`` when given)."""
     from ..adf import load_scene, parse_indices
     from ..runner.world import Options, SimWorld
     diags: list = []
     scene = load_scene(Path(launch), parse_indices(indices) if isinstance(indices, str) else indices, diags)
-    # many frames (the dataset, the GIF): PyBullet's EGL renderer where it works (runner/egl.py)
-    world = SimWorld(scene, options or Options(renderer="auto" if record or (gif and out is not None) else "tiny"),
-                     gui=gui)
+    # many frames (the dataset, the GIF): the fastest renderer that works here (cameras.choose_renderer)
+    options = options or Options(renderer="auto" if record or (gif and out is not None) else "tiny")
+    if engine == "mujoco":
+        from ..runner.mj.world import MjWorld
+        world = MjWorld(scene, options, gui=gui)
+    else:
+        world = SimWorld(scene, options, gui=gui)
     try:
         try:
             task = SutureTask(world, list(pairs), seed=seed)

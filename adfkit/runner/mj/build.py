@@ -43,6 +43,9 @@ class BodyPlan:
     spring: tuple | None = None   # (joint, kind) of a six-dof-family joint to its parent
 
 
+EXCLUDE_SPARE = 512   # run-time excluded pairs (MjWorld.set_collision); the suture turns off ~300
+
+
 @dataclass
 class GhostPlan:
     key: str
@@ -50,6 +53,7 @@ class GhostPlan:
     parent: BodyPlan | None
     geoms: list[str] = field(default_factory=list)
     friction: bool = False
+    location: np.ndarray | None = None   # the ghost's frame in its parent's ADF body frame (or the world)
 
 
 @dataclass
@@ -202,14 +206,14 @@ def build_plan(world) -> Plan:
         ns = m.namespace or ""
         for gh in m.ghost_objects:
             parent = _parent(world, gh.parent, ns, gh) if gh.parent else None
-            loc = pose_to_matrix(pose_or_identity(gh.location))
+            loc = location = pose_to_matrix(pose_or_identity(gh.location))
             if parent is not None:
                 loc = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body)) @ loc
             key = registry.add(merge_namespace(ns, gh.namespace) + gh.identifier, None)
             body_el = spec.worldbody if parent is None or parent.mjname == "world" else spec.body(parent.mjname)
             name = (gh.name or gh.identifier).lower()
             gp = GhostPlan(key, gh, parent, _ghost_geoms(body_el, gh, loc, f"ghost:{key}", world._warn),
-                           any(w in name for w in opt.hole_ghost_words))
+                           any(w in name for w in opt.hole_ghost_words), location)
             if gp.geoms:
                 ghosts.append(gp)
         from ...model.semantics import ACTUATOR_TYPES, SENSOR_TYPES
@@ -340,6 +344,10 @@ def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
     for a, b in sorted(pairs):
         if a != b and "world" not in (a, b):
             spec.add_exclude(bodyname1=a, bodyname2=b)
+    # spare slots for MjWorld.set_collision: MuJoCo's excluded pairs are compiled in, so a task
+    # that turns a pair off at run time fills a world-world placeholder (a pair that never collides)
+    for _ in range(EXCLUDE_SPARE):
+        spec.add_exclude(bodyname1="world", bodyname2="world")
 
 
 def compile_spec(world, spec):

@@ -102,6 +102,7 @@ class MjGhost:
     geoms: np.ndarray
     friction: bool = False
     overlapping: list = field(default_factory=list)
+    pose_in_parent: np.ndarray | None = None   # the ghost's frame in its parent's ADF body frame (or the world)
 
 
 @dataclass(eq=False)

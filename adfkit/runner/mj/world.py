@@ -21,7 +21,7 @@ from ...model.tree import ONE_DOF
 from ..neutral import EngineNeutral
 from ..names import Registry
 from ..rotations import invert, matrix_to_quat, pose_matrix, pose_to_matrix
-from .build import build_plan, compile_spec
+from .build import EXCLUDE_SPARE, build_plan, compile_spec
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 
 DRIVE_BANDWIDTH = 0.25    # ω·dt of the joint position servos (explicit stiffness is stable below 2)
@@ -58,6 +58,7 @@ class MjWorld(EngineNeutral):
         self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")   # MuJoCo 4's island sleeping
         self._render = None
         self._vel6 = np.zeros(6)
+        self._runtime_excludes: set[int] = set()
         self.camera_problem = ""
         self._build()
 
@@ -124,7 +125,7 @@ class MjWorld(EngineNeutral):
         for gp in plan.ghosts:
             ids = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in gp.geoms])
             parent = by_plan.get(id(gp.parent)) if gp.parent is not None else None
-            self.ghosts.append(MjGhost(gp.key, gp.ghost, parent, ids, gp.friction))
+            self.ghosts.append(MjGhost(gp.key, gp.ghost, parent, ids, gp.friction, pose_in_parent=gp.location))
             self.registry.items[gp.key] = None
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
         self._friction_geoms = np.array([gid for g in self._friction_ghosts for gid in g.geoms], dtype=int)
@@ -441,6 +442,55 @@ class MjWorld(EngineNeutral):
         for gid, _, _ in actuator.constraint:   # only the links near the held body matter; all is simplest
             if np.linalg.norm(d.geom_xpos[gid] - d.xpos[b]) < 0.05:
                 m.geom_contype[gid] = m.geom_conaffinity[gid] = 0
+
+    def ghost_pose(self, g: MjGhost) -> np.ndarray:
+        """World pose (4x4) of a ghost's frame, following its parent."""
+        loc = g.pose_in_parent if g.pose_in_parent is not None else np.eye(4)
+        return g.parent.world_matrix() @ loc if g.parent is not None else np.array(loc)
+
+    def set_collision(self, a: MjBody, b: MjBody, enabled: bool) -> None:
+        """Let two bodies collide or pass through each other, as SimWorld.set_collision: an
+        excluded body pair written into one of the spare slots the build reserved."""
+        m = self.model
+        lo, hi = sorted((int(a.id), int(b.id)))
+        sig = (lo << 16) + hi
+        sigs = np.array(m.exclude_signature[:m.nexclude])
+        if enabled:
+            if sig not in self._runtime_excludes:
+                return
+            self._runtime_excludes.discard(sig)
+            sigs[np.flatnonzero(sigs == sig)[0]] = 0
+        else:
+            if sig in sigs or lo == hi:
+                return
+            free = np.flatnonzero(sigs == 0)
+            if not free.size:
+                self._warn("runner-collision-pairs", f"more than {EXCLUDE_SPARE} body pairs turned off at run "
+                           f"time; {a.key} and {b.key} keep colliding", None)
+                return
+            sigs[free[0]] = sig
+            self._runtime_excludes.add(sig)
+        m.exclude_signature[:m.nexclude] = np.sort(sigs)
+
+    def move_base(self, sb: MjBody, body_world: np.ndarray) -> None:
+        """Put a body without joints (a PSM's base, as its setup joints would) at a new world
+        pose of its ADF body frame; what hangs from it follows."""
+        m, d = self.model, self.data
+        parent = int(m.body_parentid[sb.id])
+        tp = np.eye(4)
+        tp[:3, :3], tp[:3, 3] = d.xmat[parent].reshape(3, 3), d.xpos[parent]
+        local = invert(tp) @ body_world @ sb.link_in_body
+        q = matrix_to_quat(local[:3, :3])
+        m.body_pos[sb.id] = local[:3, 3]
+        m.body_quat[sb.id] = (q[3], q[0], q[1], q[2])
+        # with island sleeping on, MuJoCo computes the frames of bodies welded to the world once;
+        # one forward pass without it puts them (and what hangs from them) where they now are
+        flags = m.opt.enableflags
+        m.opt.enableflags = flags & ~int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
+        try:
+            mujoco.mj_forward(m, d)
+        finally:
+            m.opt.enableflags = flags
 
     def wake(self, sb: MjBody) -> None:
         """Wake the sleeping tree of ``sb`` (MuJoCo wakes a tree a force is applied to: a
