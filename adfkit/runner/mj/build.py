@@ -30,7 +30,11 @@ SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIS
                 JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING)
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
 GHOST_GROUP = 4
-WELD_SOLREF = (0.004, 1.0)    # s, damping ratio: a stiff grasp weld at a 1 ms step (timeconst ≥ 2 dt)
+# the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. A weld's
+# stiffness scales with the held body's mass, so a 1 g needle dragging its thread needs it: at
+# 4 steps the bundled suture's needle slid 13 mm in the jaws while carried and the regrasp missed
+WELD_TIMECONST_STEPS = 2
+WELD_DAMPING_RATIO = 1.0
 
 
 @dataclass
@@ -235,7 +239,8 @@ def build_plan(world) -> Plan:
             key = merge_namespace(ns, a.namespace) + a.identifier
             weld = f"grasp:{key}"
             spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name=weld, name1=parent.mjname, name2="world",
-                              objtype=mujoco.mjtObj.mjOBJ_BODY, active=False, solref=list(WELD_SOLREF))
+                              objtype=mujoco.mjtObj.mjOBJ_BODY, active=False,
+                              solref=[WELD_TIMECONST_STEPS * world.dt, WELD_DAMPING_RATIO])
             actuators.append((key, a, parent, weld))
     for j, kind, parent, child, jn in joints:
         if kind in ONE_DOF and jn:
