@@ -44,10 +44,16 @@ def _play(rel: str, seconds: float) -> dict:
         world.close()
 
 
+# puzzle6 holds 42 fixed joints, each three point pivots (runner/joints.py), solved with Bullet's
+# 10 iterations: its error swings between 0.7 and 1.03 mm once it has settled (measured every
+# 0.5 s over 5 s), so 1 mm sits inside its steady band; 1.5 mm still catches a joint coming apart
+CONSTRAINT_TOLERANCE = {f"{MB}/puzzles/puzzle6.yaml": 1.5e-3}
+
+
 def _check(rep: dict, rel: str) -> None:
     assert rep["nan"] == [], rel
     assert rep["exploded"] == [], rel
-    assert rep["max_constraint_error_m"] < 1e-3, (rel, rep["max_constraint_error_m"])
+    assert rep["max_constraint_error_m"] < CONSTRAINT_TOLERANCE.get(rel, 1e-3), (rel, rep["max_constraint_error_m"])
 
 
 @pytest.mark.parametrize("rel", FAST, ids=lambda r: r.rsplit("/", 1)[-1])
@@ -59,8 +65,21 @@ def test_corpus_model_plays_briefly(rel):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("rel", WITH_MESHES, ids=lambda r: str(r).rsplit("/", 1)[-1])
-def test_corpus_model_plays_5_seconds(rel):
-    _check(_play(rel, 5.0), rel)
+def test_corpus_model_plays_5_seconds(rel, tmp_path):
+    """Each model in a process of its own, as `adfkit run` plays it: PyBullet 3.2.7 carries
+    something over from one world to the next in a process (parallel_structure.yaml played after
+    puzzle5.yaml or blender-psm.yaml in one process sometimes segfaults in stepSimulation or
+    ends 17 mm to 500 m apart, and plays to 0.08 mm on its own; README, runner)."""
+    import json
+    import subprocess
+    import sys
+    require_corpus()
+    r = subprocess.run([sys.executable, "-m", "adfkit", "run", str(CORPUS / rel), "--seconds", "5", "--no-frames",
+                        "--out", str(tmp_path)], capture_output=True, text=True, timeout=600)
+    assert r.returncode in (0, 1), r.stderr[-2000:]
+    rep = json.loads((tmp_path / "report.json").read_text())
+    assert rep["skipped_bodies"] == [], rep["skipped_bodies"]
+    _check(rep, rel)
 
 
 @pytest.mark.parametrize("rel", SOFT, ids=lambda r: r.rsplit("/", 1)[-1])
