@@ -1,6 +1,7 @@
 """PyBullet's EGL renderer plugin: the cameras' pictures through OpenGL (a GPU, or Mesa's
 multi-threaded llvmpipe) instead of the single-threaded TinyRenderer — a 640×480 RGB + depth +
-segmentation frame of the suturing set in ~13 ms instead of ~250 ms on the 2-core box.
+segmentation frame of the suturing set in ~65 ms instead of ~220 ms on the 2-core box (MuJoCo's
+renderer on a mirror of the scene, runner/mjview.py, is faster still).
 
 The plugin must be loaded before the first body is created (it converts each visual shape as
 the body is made) and, when it cannot open an EGL display, it ends the whole process instead of
@@ -8,8 +9,8 @@ failing the call. So whether it works is asked once per process in a child proce
 (:func:`available`), and the world loads it only when the answer is yes.
 
 Known plugin crash (PyBullet 3.2.7), avoided by the world: a body whose only collision shape is
-a PLANE and that has no visual shape segfaults when it is converted; such bodies get a plane
-visual of their own (:func:`plane_visual`).
+a PLANE and that has no visual shape segfaults when it is converted (and the plugin has no visual
+plane either); such bodies get a thin slab visual of their own (:func:`plane_visual`).
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ import pybullet as pb
 
 
 _PROBE = r"""
-import pybullet as pb, sys
+import numpy as np, pybullet as pb, sys
 cid = pb.connect(pb.DIRECT)
 if pb.loadPlugin(sys.argv[1], "_eglRendererPlugin", physicsClientId=cid) < 0:
     sys.exit(3)
@@ -33,7 +34,7 @@ pb.createMultiBody(0, c, -1, [0, 0, 0], physicsClientId=cid)
 vm = pb.computeViewMatrix([1, 1, 1], [0, 0, 0], [0, 0, 1])
 pm = pb.computeProjectionMatrixFOV(60, 1, 0.01, 10)
 img = pb.getCameraImage(64, 64, vm, pm, renderer=pb.ER_BULLET_HARDWARE_OPENGL, physicsClientId=cid)
-sys.exit(0 if (img[4] == 0).any() else 4)
+sys.exit(0 if (np.asarray(img[4]).ravel() == 0).any() else 4)
 """
 
 _answer: tuple[bool, str] | None = None
