@@ -165,6 +165,24 @@ def check_file(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None 
     return p
 
 
+def check_mesh(path: str | os.PathLike, *, tree: Tree | None = None,
+               referrer: SourceLocation | None = None) -> Path:
+    """:func:`check_file` for a mesh file, with ``mesh-not-found`` (located at the mesh's path,
+    with a hint when only the letter case differs) for a mesh that is not there."""
+    check_path_text(path, referrer)
+    p = Path(path)
+    if not os.path.lexists(p):
+        hint = "check the path (ADF resolves mesh paths as in adf-format.md §6.2)"
+        if p.parent.is_dir():
+            stem = p.name.lower()
+            near = [q.name for q in p.parent.iterdir() if q.name.lower() == stem]
+            if near:
+                hint = f"file names are case-sensitive: did you mean '{near[0]}'?"
+        raise AdfError(error("mesh-not-found", f"mesh file not found: {shown(p)}", SourceLocation(shown(p)), hint))
+    # a regular file under the mesh size cap, inside ``tree`` when another file named it
+    return check_file(p, "mesh", tree=tree, referrer=referrer, what="mesh file")
+
+
 def read_bytes(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None = None,
                referrer: SourceLocation | None = None, what: str = "file") -> bytes:
     """The file's bytes, after :func:`check_file`; reads at most the kind's cap."""

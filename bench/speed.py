@@ -37,26 +37,10 @@ def scene_and_label():
 
 
 def pybullet_loop(scene, seconds: float, rounds: int) -> tuple[float, float]:
-    import pybullet as pb
-
-    from adfkit.runner.world import Options, SimWorld
-    full, bare = [], []
-    for _ in range(rounds):
-        for kind in ("full", "bare"):
-            world = SimWorld(scene, Options(visuals=False))
-            try:
-                world.run(0.05)
-                n = int(round(seconds / (world.dt * world.opt.control_substeps)))
-                t = time.perf_counter()
-                if kind == "full":
-                    world.step(n)
-                else:
-                    for _ in range(n):
-                        pb.stepSimulation(physicsClientId=world.cid)
-                (full if kind == "full" else bare).append(seconds / (time.perf_counter() - t))
-            finally:
-                world.close()
-    return statistics.median(full), statistics.median(bare)
+    """(loop, bare floor) in wall-time real-time factors: bench/run_suturing.py's alternated rounds."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    from run_suturing import measure
+    return measure(scene, {}, seconds, rounds)["wall"]
 
 
 def mujoco_loop(scene, seconds: float) -> tuple[float, float, float]:

@@ -56,18 +56,7 @@ def load_mesh(path: str | os.PathLike, scale: float = 1.0, tree: inputs.Tree | N
     ``bad-path``, ``not-a-regular-file``, ``file-too-large``, ``outside-tree`` when ``tree``
     is given: the tree of the ADF file that names the mesh).
     """
-    inputs.check_path_text(path, referrer)
-    p = Path(path)
-    if not os.path.lexists(p):
-        hint = "check the path (ADF resolves mesh paths as in adf-format.md §6.2)"
-        if p.parent.is_dir():
-            stem = p.name.lower()
-            near = [q.name for q in p.parent.iterdir() if q.name.lower() == stem]
-            if near:
-                hint = f"file names are case-sensitive: did you mean '{near[0]}'?"
-        raise _fail("mesh-not-found", f"mesh file not found: {inputs.shown(p)}", p, hint)
-    # A regular file under the mesh size cap, inside ``tree`` when another file named it.
-    inputs.check_file(p, "mesh", tree=tree, referrer=referrer, what="mesh file")
+    p = inputs.check_mesh(path, tree=tree, referrer=referrer)
     if not np.isfinite(scale) or scale <= 0:
         raise _fail("mesh-bad-scale", f"scale must be a positive finite number, got {scale!r}", p,
                     "ADF 'scale' is a positive factor (default 1.0)")

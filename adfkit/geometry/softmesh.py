@@ -130,12 +130,7 @@ def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0, tree=None) -> So
     ``tree``, the naming ADF file's tree, is given)."""
     from .. import inputs  # noqa: PLC0415
 
-    inputs.check_path_text(path)
-    p = Path(path)
-    if not os.path.lexists(p):
-        raise AdfError(error("mesh-not-found", f"mesh file not found: {inputs.shown(p)}", SourceLocation(inputs.shown(p)),
-                             "check the path (ADF resolves mesh paths as in adf-format.md §6.2)"))
-    inputs.check_file(p, "mesh", tree=tree, what="mesh file")
+    p = inputs.check_mesh(path, tree=tree)
     v, f = _raw_triangles(p)
     if len(v) == 0 or len(f) == 0:
         raise AdfError(error("mesh-empty", "the mesh has no triangles", SourceLocation(str(p)),

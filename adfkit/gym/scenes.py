@@ -123,7 +123,7 @@ def _world(model, engine: str, visuals: bool):
                                       + ", ".join(missing) + "; use engine='pybullet'")
         return MjWorld(model, Options(visuals=visuals))
     from ..runner.world import SimWorld
-    # image observations: a frame every step, so PyBullet's EGL renderer where it works (runner/egl.py)
+    # image observations: a frame every step, so the fastest renderer that works (cameras.choose_renderer)
     return SimWorld(model, Options(visuals=visuals, renderer="auto" if visuals else "tiny"))
 
 

@@ -1,6 +1,7 @@
 """Cameras (adf-format.md §9): RGB, depth in metres along the optical axis, per-body
-segmentation, pinhole intrinsics, rendered headless through PyBullet's EGL plugin where it works
-(runner/egl.py), else with TinyRenderer."""
+segmentation, pinhole intrinsics, rendered headless by the renderer the world chose
+(:func:`choose_renderer`): TinyRenderer, PyBullet's EGL plugin (runner/egl.py) or MuJoCo's
+renderer on a mirror of the scene (runner/mjview.py)."""
 from __future__ import annotations
 
 import contextlib
@@ -51,7 +52,7 @@ class SimCamera:
 
     def render(self, world) -> dict:
         """{'rgb': H×W×3 uint8, 'depth': H×W float32 m, 'segmentation': H×W int32 (body index, -1 none)}."""
-        if getattr(world, "renderer", "tiny") == "mujoco":
+        if world.renderer == "mujoco":
             try:
                 return world.mj_view().render(self)
             except Exception as exc:  # noqa: BLE001 - another engine's build: whatever stops it, PyBullet's own renderer draws
@@ -62,9 +63,9 @@ class SimCamera:
         vm = pb.computeViewMatrix(eye, target, up, physicsClientId=world.cid)
         pm = pb.computeProjectionMatrixFOV(math.degrees(self.fov), self.width / self.height, self.near, self.far,
                                            physicsClientId=world.cid)
-        renderer = getattr(world, "renderer", "tiny")
-        with egl.quiet_stdout() if renderer == "egl" else contextlib.nullcontext():
-            _, _, rgba, zbuf, seg = pb.getCameraImage(self.width, self.height, vm, pm, renderer=egl.flag(renderer),
+        with egl.quiet_stdout() if world.renderer == "egl" else contextlib.nullcontext():
+            _, _, rgba, zbuf, seg = pb.getCameraImage(self.width, self.height, vm, pm,
+                                                      renderer=egl.flag(world.renderer),
                                                       flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,
                                                       shadow=0, physicsClientId=world.cid)
         rgb = np.reshape(np.asarray(rgba, dtype=np.uint8), (self.height, self.width, 4))[:, :, :3]
@@ -88,6 +89,8 @@ def choose_renderer(wanted: str, cid: int, has_cameras: bool, soft: bool, gui: b
     (runner/egl.py; loaded now, before the first body). ``auto``: for a scene with cameras,
     mujoco where MuJoCo has a headless OpenGL, else egl where it works, else tiny.
     Soft bodies are drawn by TinyRenderer only (neither other renderer draws deformables)."""
+    if wanted not in RENDERERS:
+        raise ValueError(f"renderer {wanted!r} is not one of {', '.join(RENDERERS)}")
     if wanted == "tiny" or gui:
         return "tiny", ""
     if soft:

@@ -31,13 +31,10 @@ class MjView:
         self.mj = mj = MjWorld(world.scene, opt, sleep=False)
         m = mj.model
         sim_index = {sb.key: i for i, sb in enumerate(world.bodies)}
-        # MuJoCo body id -> (PyBullet SimBody, MuJoCo link frame in the ADF body frame)
-        self.pairs = [(mb.id, world.bodies[sim_index[mb.key]], mb.link_in_body)
-                      for mb in mj.bodies if mb.id > 0 and mb.key in sim_index]
-        label = np.full(m.ngeom, -1, dtype=np.int32)
-        for mb in mj.bodies:
-            if mb.id > 0 and mb.key in sim_index:
-                label[m.geom_bodyid == mb.id] = sim_index[mb.key]
+        matched = [(mb, sim_index[mb.key]) for mb in mj.bodies if mb.id > 0 and mb.key in sim_index]
+        label = np.full(m.ngeom, -1, dtype=np.int32)   # segmentation labels: PyBullet's body indices
+        for mb, i in matched:
+            label[m.geom_bodyid == mb.id] = i
         mj._geom_label = label
         self._geom_body = np.array(m.geom_bodyid, dtype=int)
         self._geom_pos = np.array(m.geom_pos)
@@ -52,9 +49,10 @@ class MjView:
         if [c.name for c in self.cameras] != [c.name for c in world.cameras]:
             raise ValueError("MuJoCo's build placed other cameras than PyBullet's "
                              f"({[c.name for c in self.cameras]} against {[c.name for c in world.cameras]})")
-        # a body's pose is read from PyBullet only when something of it is drawn
+        # MuJoCo body id -> (PyBullet SimBody, MuJoCo link frame in the ADF body frame), for the
+        # bodies something is drawn on (only their poses are read from PyBullet)
         drawn = set(self._geom_body.tolist()) | set(self._cam_body.tolist()) | set(self._light_body.tolist())
-        self.pairs = [p for p in self.pairs if p[0] in drawn]
+        self.pairs = [(mb.id, world.bodies[i], mb.link_in_body) for mb, i in matched if mb.id in drawn]
 
     def _sync(self) -> None:
         """MuJoCo's drawn frames from PyBullet's bodies."""
@@ -65,17 +63,18 @@ class MjView:
             xpos[bid], xmat[bid] = t[:3, 3], t[:3, :3]
         d.xpos[:] = xpos
         d.xmat[:] = xmat.reshape(-1, 9)
-        gb = self._geom_body
-        d.geom_xpos[:] = xpos[gb] + np.einsum("nij,nj->ni", xmat[gb], self._geom_pos)
+        def on(bodies, local):   # points (or directions) fixed on their bodies, in the world
+            return np.einsum("nij,nj->ni", xmat[bodies], local)
+
+        gb, cb, lb = self._geom_body, self._cam_body, self._light_body
+        d.geom_xpos[:] = xpos[gb] + on(gb, self._geom_pos)
         d.geom_xmat[:] = (xmat[gb] @ self._geom_rot).reshape(-1, 9)
-        if self._cam_body.size:
-            cb = self._cam_body
-            d.cam_xpos[:] = xpos[cb] + np.einsum("nij,nj->ni", xmat[cb], self._cam_pos)
+        if cb.size:
+            d.cam_xpos[:] = xpos[cb] + on(cb, self._cam_pos)
             d.cam_xmat[:] = (xmat[cb] @ self._cam_rot).reshape(-1, 9)
-        if self._light_body.size:
-            lb = self._light_body
-            d.light_xpos[:] = xpos[lb] + np.einsum("nij,nj->ni", xmat[lb], self._light_pos)
-            d.light_xdir[:] = np.einsum("nij,nj->ni", xmat[lb], self._light_dir)
+        if lb.size:
+            d.light_xpos[:] = xpos[lb] + on(lb, self._light_pos)
+            d.light_xdir[:] = on(lb, self._light_dir)
 
     def render(self, camera) -> dict:
         """The PyBullet world's ``camera`` now: one of ``world.cameras`` or a copy of one with

@@ -205,7 +205,10 @@ def in_engine_order(files) -> list:
 def chunked(files, parts: int) -> list[list]:
     """The files in the engine's order cut into ``parts`` contiguous chunks (fewer when there
     are fewer files)."""
-    files = in_engine_order(files)
+    return _cut(in_engine_order(files), parts)
+
+
+def _cut(files: list, parts: int) -> list[list]:
     n = max(1, min(len(files), parts))
     size = -(-len(files) // n) if files else 1
     return [files[i:i + size] for i in range(0, len(files), size)]
@@ -260,13 +263,14 @@ def _work_units(files, follow: bool, parts: int) -> list[list]:
     the launch file's context, and so does this (no file is checked twice)."""
     if not follow:
         return chunked(files, parts)
-    files = in_engine_order(files)
-    launches = [ft for ft in files if _looks_like_launch(*ft)]
+    launch_flags = [_looks_like_launch(*ft) for ft in files]   # each file opened once to sniff it
+    launches = [ft for ft, is_launch in zip(files, launch_flags) if is_launch]
     reached: set[str] = set()
     for path, tree in launches:
         reached |= _reached_from_launch(path, tree)
-    rest = [ft for ft in files if ft not in launches and os.path.realpath(ft[0]) not in reached]
-    return [[ft] for ft in launches] + (chunked(rest, max(1, parts - len(launches))) if rest else [])
+    rest = [ft for ft, is_launch in zip(files, launch_flags)
+            if not is_launch and os.path.realpath(ft[0]) not in reached]
+    return [[ft] for ft in launches] + (_cut(rest, max(1, parts - len(launches))) if rest else [])
 
 
 def _reached_from_launch(path: Path, tree) -> set[str]:
