@@ -1,16 +1,41 @@
 # Two commands: `make run` plays the bundled sample scene, `make test` runs the tests.
-# Both build .venv from nothing the first time (and again when pyproject.toml changes).
+# Both build .venv from nothing the first time, from requirements.lock (exact versions and
+# hashes, installed by uv), and again whenever the lock changes.
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 PY     := $(VENV)/bin/python
+UV     := $(VENV)/bin/uv
 STAMP  := $(VENV)/.installed
+LOCK   := requirements.lock
+# uv at the version the lock names (the lock installs it too; this is only the bootstrap)
+UV_VERSION := $(shell sed -n 's/^uv==\([^ ]*\).*/\1/p' $(LOCK))
+# The platform the lock is for: CPython 3.11 on Linux x86-64 (glibc 2.28 or newer)
+LOCK_TARGET := --python-version 3.11 --python-platform x86_64-manylinux_2_28
+LATEST := .venv-latest
 
-.PHONY: run test test-all bench clean
+# Prints each package whose newest release differs from the lock (what test-latest tries).
+define LOCK_DRIFT
+import importlib.metadata as md, re, sys
+pins = re.findall(r"^([A-Za-z0-9._-]+)==(\S+)", open(sys.argv[1]).read(), re.M)
+for name, pinned in pins:
+    try:
+        now = md.version(name)
+    except md.PackageNotFoundError:
+        continue
+    if now != pinned:
+        print(f"  newer than the lock: {name} {pinned} -> {now}")
+endef
+export LOCK_DRIFT
 
-$(STAMP): pyproject.toml
+.PHONY: run test test-all test-latest bench lock clean
+
+$(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[all,test]'
+	$(PY) -m pip install --quiet --disable-pip-version-check "uv==$(UV_VERSION)"
+
+$(STAMP): $(LOCK) | $(UV)
+	$(UV) pip sync --quiet --python $(PY) --require-hashes $(LOCK)
+	$(UV) pip install --quiet --python $(PY) --no-deps --no-build-isolation -e .
 	@touch $(STAMP)
 
 run: $(STAMP)
@@ -22,8 +47,22 @@ test: $(STAMP)
 test-all: $(STAMP)
 	$(PY) -m pytest -q -m ''
 
+# The same suite against the newest releases pyproject.toml allows, in a venv of its own:
+# drift in a dependency shows here on purpose before a user meets it.
+test-latest: | $(UV)
+	rm -rf $(LATEST)
+	$(UV) venv --quiet --python $(PYTHON) $(LATEST)
+	$(UV) pip install --quiet --python $(LATEST)/bin/python --refresh --upgrade -e '.[all,test]'
+	@$(LATEST)/bin/python -c "$$LOCK_DRIFT" $(LOCK)
+	$(LATEST)/bin/python -m pytest -q
+
+# Re-resolve the lock to the newest releases pyproject.toml allows (then run `make test`).
+lock: | $(UV)
+	$(UV) pip compile pyproject.toml --extra all --extra test $(LOCK_TARGET) --generate-hashes --upgrade \
+		--quiet -o $(LOCK)
+
 bench: $(STAMP)
 	@for b in bench/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) build dist *.egg-info .pytest_cache
+	rm -rf $(VENV) $(LATEST) build dist *.egg-info .pytest_cache

@@ -7,6 +7,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from . import inputs
 from .adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
 from .model import InputDevices, Launch, ModelFile, Scene, World
 from .model.semantics import effective_mass, joint_kind
@@ -62,6 +63,14 @@ def world_summary(world: World, environment: ModelFile | None = None) -> dict[st
     }
 
 
+def _config_exists(launch: Launch, named: str) -> bool:
+    """Whether a multibody config exists; a name the file system cannot look up (over-long, a
+    NUL byte) is a located ``bad-path`` error, as everywhere else."""
+    path = relative_to_file(launch.path, named)
+    inputs.check_path_text(path, launch.where("multibody configs") or launch.source)
+    return os.path.exists(path)
+
+
 def launch_summary(launch: Launch) -> dict[str, Any]:
     configs = launch.multibody_configs or []
     return {
@@ -70,7 +79,7 @@ def launch_summary(launch: Launch) -> dict[str, Any]:
         "world config": launch.world_config,
         "input devices config": launch.input_devices_config,
         "multibody configs": [
-            {"index": i, "path": p, "exists": relative_to_file(launch.path, p).exists()} for i, p in enumerate(configs)
+            {"index": i, "path": p, "exists": _config_exists(launch, p)} for i, p in enumerate(configs)
         ],
     }
 

@@ -95,23 +95,36 @@ def _depth_bound(text: str) -> int:
 
 
 def _check_depth(text: str, file: str) -> None:
-    """Refuse nesting deeper than MAX_DEPTH from the parser's events (iterative, no node built)."""
+    """Refuse nesting deeper than MAX_DEPTH from the parser's events (iterative, no node built).
+
+    libyaml first; when it stops with an error of its own, the pure-Python parser, which has no
+    nesting limit: libyaml 0.2.6 (PyYAML 6.0.4) refuses 1,000 levels itself, while it still
+    looks ahead for a simple key, before emitting the event at level 101. Which parser stops
+    first must not decide the diagnostic: too deep is ``yaml-too-deep`` at level 101 with any
+    release."""
+    try:
+        _scan_depth(text, file, _Loader)
+    except yaml.YAMLError:
+        try:
+            _scan_depth(text, file, yaml.SafeLoader)
+        except yaml.YAMLError:
+            return  # a syntax error within the first MAX_DEPTH levels: the composer reports it, located
+
+
+def _scan_depth(text: str, file: str, loader) -> None:
     depth = 0
     starts = (yaml.MappingStartEvent, yaml.SequenceStartEvent)
     ends = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
-    try:
-        for ev in yaml.parse(text, Loader=_Loader):
-            if isinstance(ev, starts):
-                depth += 1
-                if depth > MAX_DEPTH:
-                    m = ev.start_mark
-                    raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
-                                         SourceLocation(file, m.line + 1, m.column + 1),
-                                         "an ADF file nests a few levels; flatten the data"))
-            elif isinstance(ev, ends):
-                depth -= 1
-    except yaml.YAMLError:
-        return  # the composer reports it, located
+    for ev in yaml.parse(text, Loader=loader):
+        if isinstance(ev, starts):
+            depth += 1
+            if depth > MAX_DEPTH:
+                m = ev.start_mark
+                raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
+                                     SourceLocation(file, m.line + 1, m.column + 1),
+                                     "an ADF file nests a few levels; flatten the data"))
+        elif isinstance(ev, ends):
+            depth -= 1
 
 
 def compose(text: str, file: str, diagnostics: list[Diagnostic] | None = None) -> yaml.Node | None:
@@ -125,6 +138,8 @@ def compose(text: str, file: str, diagnostics: list[Diagnostic] | None = None) -
     try:
         root = yaml.compose(text, Loader=_Loader)
     except yaml.YAMLError as exc:
+        if _depth_bound(text) > MAX_DEPTH:  # a parser's own nesting limit is still yaml-too-deep, at level 101
+            _check_depth(text, file)
         raise _syntax_error(exc, file, text) from None
     if root is not None:
         found = check_tree(root, file, check_tags="!" in text, aliases="*" in text)

@@ -8,11 +8,31 @@ from ..model.pose import Quat
 
 
 def adf_principal(body) -> tuple[float, float, float]:
-    """The principal moments written in the file (0 where missing)."""
+    """The principal moments written in the file (0 where missing), rounding noise removed
+    (:func:`without_noise`)."""
     i = body.inertia
     if i is None:
         return (0.0, 0.0, 0.0)
-    return (i.ix or 0.0, i.iy or 0.0, i.iz or 0.0)
+    return without_noise((i.ix or 0.0, i.iy or 0.0, i.iz or 0.0))
+
+
+def without_noise(moments, rel: float = 1e-9) -> tuple[float, float, float]:
+    """Principal moments with floating-point noise taken out, so that engines accept them.
+
+    An eigen-solver's last bits differ from one BLAS build or processor to another: the
+    principal moments of a rod-like tensor come out as (5.6e-17, 0.21499999999999989, 0.215)
+    on one machine and exactly on the triangle inequality on another, and PyBullet and MuJoCo
+    zero or refuse a tensor that breaks it by a single ulp. A moment below ``rel`` times the
+    largest is 0, and one that exceeds the sum of the other two by no more than that is lowered
+    to the sum. Real violations (larger than the noise) are kept for the caller to report."""
+    m = [float(x) for x in moments]
+    tol = rel * max(abs(x) for x in m)
+    m = [0.0 if abs(x) <= tol else x for x in m]
+    for k in range(3):
+        rest = m[(k + 1) % 3] + m[(k + 2) % 3]
+        if rest < m[k] <= rest + tol:
+            m[k] = rest
+    return (m[0], m[1], m[2])
 
 
 def principal(tensor) -> tuple[tuple[float, float, float], Quat]:
@@ -25,7 +45,7 @@ def principal(tensor) -> tuple[tuple[float, float, float], Quat]:
     moments, axes = np.linalg.eigh(t)
     if np.linalg.det(axes) < 0:
         axes[:, 2] = -axes[:, 2]
-    return (float(moments[0]), float(moments[1]), float(moments[2])), Quat.from_matrix(axes.tolist())
+    return without_noise(moments), Quat.from_matrix(axes.tolist())
 
 
 def physical_problem(moments, rel: float = 1e-9) -> str | None:
