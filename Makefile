@@ -27,7 +27,7 @@ for name, pinned in pins:
 endef
 export LOCK_DRIFT
 
-.PHONY: run test test-all test-latest bench lock clean
+.PHONY: run test test-all test-latest bench lock docs clean
 
 $(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -52,17 +52,22 @@ test-all: $(STAMP)
 test-latest: | $(UV)
 	rm -rf $(LATEST)
 	$(UV) venv --quiet --python $(PYTHON) $(LATEST)
-	$(UV) pip install --quiet --python $(LATEST)/bin/python --refresh --upgrade -e '.[all,test]'
+	$(UV) pip install --quiet --python $(LATEST)/bin/python --refresh --upgrade -e '.[all,test,dev]'
 	@$(LATEST)/bin/python -c "$$LOCK_DRIFT" $(LOCK)
 	$(LATEST)/bin/python -m pytest -q
 
 # Re-resolve the lock to the newest releases pyproject.toml allows (then run `make test`).
 lock: | $(UV)
-	$(UV) pip compile pyproject.toml --extra all --extra test $(LOCK_TARGET) --generate-hashes --upgrade \
+	$(UV) pip compile pyproject.toml --extra all --extra test --extra dev $(LOCK_TARGET) --generate-hashes --upgrade \
 		--quiet -o $(LOCK)
+
+# The documentation site (docs/, API reference from the docstrings) in site/; strict: a broken
+# link, anchor or reference fails.
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 
 bench: $(STAMP)
 	@for b in bench/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) $(LATEST) build dist *.egg-info .pytest_cache
+	rm -rf $(VENV) $(LATEST) site build dist *.egg-info .pytest_cache

@@ -4,7 +4,7 @@ that fails (an exception, or its worker process killed) is retried once on a fre
 reported; none is lost: the index lists every seed with its outcome.
 
 Local Ray by default (``num_cpus=workers``); ``address="ray://host:10001"`` or ``"auto"`` joins
-a cluster (README: "Gymnasium and Ray").
+a cluster (docs/gym-ray.md).
 """
 from __future__ import annotations
 

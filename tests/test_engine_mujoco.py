@@ -179,7 +179,7 @@ def test_thread_hangs_to_its_static_equilibrium():
     the chain falls asleep once slower than the sleep tolerance, 0.6 mm short). PyBullet
     (springs as explicit per-step torques) keeps its pivots together (< 1 mm) and the chain in
     its plane, but does not settle on this chain (it still swings 40-75 mm about after 8 s;
-    see the README, "MuJoCo engine"), so only that is asserted for it."""
+    see docs/mujoco.md), so only that is asserted for it."""
     import tempfile
     from pathlib import Path
     expected = thread_equilibrium()

@@ -69,7 +69,7 @@ def test_corpus_model_plays_5_seconds(rel, tmp_path):
     """Each model in a process of its own, as `adfkit run` plays it: PyBullet 3.2.7 carries
     something over from one world to the next in a process (parallel_structure.yaml played after
     puzzle5.yaml or blender-psm.yaml in one process sometimes segfaults in stepSimulation or
-    ends 17 mm to 500 m apart, and plays to 0.08 mm on its own; README, runner)."""
+    ends 17 mm to 500 m apart, and plays to 0.08 mm on its own; docs/runner.md)."""
     import json
     import subprocess
     import sys

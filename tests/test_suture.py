@@ -150,7 +150,7 @@ def test_cli_bad_input_is_exit_2(tmp_path, capsys):
 @pytest.mark.slow
 def test_the_suture_runs_on_the_mujoco_engine(tmp_path):
     """Issue 17: the same suture script on MuJoCo. It carries the needle through the first
-    entry and exit holes; the README says where it stops (the regrasp) and why."""
+    entry and exit holes; docs/suturing.md says where it stops (the regrasp) and why."""
     from adfkit.cli import main
     rc = main(["suture", "--engine", "mujoco", "--pairs", "1", "--out", str(tmp_path / "mj")])
     assert rc in (0, 1)

@@ -28,7 +28,7 @@ def add_arguments(p) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the plan's small randomisation")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--engine", choices=("pybullet", "mujoco"), default="pybullet",
-                   help="physics engine (default pybullet; the README says how the suture fares in MuJoCo)")
+                   help="physics engine (default pybullet; docs/mujoco.md says how the suture fares in MuJoCo)")
     p.add_argument("--record", action="store_true", help="write the dataset (RGB, depth, segmentation, poses)")
     p.add_argument("--every", type=int, default=10, help="with --record: a frame every N control steps")
     p.add_argument("--episodes", type=int, default=1,

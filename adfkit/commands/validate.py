@@ -47,7 +47,7 @@ def run(args) -> int:
     select, ignore = _rules(args.select), _rules(args.ignore)
     unknown = sorted((select | ignore) - set(RULES))
     if unknown:
-        print(f"adfkit validate: unknown rule(s): {', '.join(unknown)} (the README lists the rules)", file=sys.stderr)
+        print(f"adfkit validate: unknown rule(s): {', '.join(unknown)} (docs/validate.md lists the rules)", file=sys.stderr)
         return 2
     if args.workers > 1 or args.address:
         from ..fanout import validate_parallel

@@ -1,4 +1,4 @@
-"""ADF soft bodies → MuJoCo ``flexcomp`` (format-mapping.md; README "Soft bodies").
+"""ADF soft bodies → MuJoCo ``flexcomp`` (format-mapping.md; docs/soft-bodies.md).
 
 A soft body becomes a 2-D flex (``type="direct"``, ``dim="2"``) on the nodes AMBF makes of
 its collision mesh (unique vertices, placed by `location` and `scale`) and its triangles, in
@@ -87,7 +87,7 @@ def write_soft_bodies(model: ModelFile, world: ET.Element, used: dict, losses: l
         if sb.mass is None:
             losses.append(Loss(who, "mass", "not in the ADF file: MuJoCo's default flex mass is written (AMBF: 1 kg)"))
         losses.append(Loss(who, "soft body", "Bullet's position-based links become a MuJoCo flex membrane "
-                                             "(elasticity from kLST and piterations; README 'Soft bodies')"))
+                                             "(elasticity from kLST and piterations; docs/soft-bodies.md)"))
         written += 1
     return written
 

@@ -5,7 +5,7 @@ AMBF (afSoftBody::cleanupMesh) loads the collision mesh with CHAI3D and merges r
 vertices before creating the soft body, so a soft body's nodes are the mesh's *unique*
 vertex positions; `fixed nodes` index them. We keep them in order of first appearance
 (AMBF's sequential variant; its block-sorted variant may number them differently, see
-the README's "Soft bodies" section). numpy only: the validator calls this too.
+docs/soft-bodies.md). numpy only: the validator calls this too.
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ JOINT_POINT2POINT and JOINT_GEAR. So:
 - `fixed` → JOINT_FIXED; `p2p` → JOINT_POINT2POINT at the pivots;
 - `six dof`/`six dof spring`/`cone twist`/springs whose linear range is locked → a
   JOINT_POINT2POINT at the pivot plus angular spring-damper and limit torques applied each
-  control step (the 6-DOF spring approximation, see the README, "PyBullet reference runner");
+  control step (the 6-DOF spring approximation, see docs/runner.md);
 - the same types with a free linear range → no constraint at all; linear and angular
   springs and limits are all applied as forces;
 - a revolute joint that closes a loop → two JOINT_POINT2POINT constraints along the axis.

@@ -3,7 +3,7 @@
 AMBF makes a btSoftBody (position-based links, Bullet's classic soft-body solver) from the
 collision mesh. PyBullet's deformable world (``RESET_USE_DEFORMABLE_WORLD``) is a different
 solver: implicit mass-spring on the same nodes and triangles. We map the ADF settings onto
-it as follows (README "Soft bodies" gives the reasoning):
+it as follows (docs/soft-bodies.md gives the reasoning):
 
 - nodes: the unique collision-mesh vertices (``adfkit.geometry.softmesh``), placed by
   `location` and `scale`, written to a temporary OBJ that ``loadSoftBody`` reads;
@@ -166,7 +166,7 @@ class SoftBodies:
         if made.unmapped:
             w._warn("runner-soft-body-approx", f"{sb.identifier}: {', '.join(made.unmapped)} not played "
                     "(no counterpart in PyBullet's deformable world)", sb,
-                    "see the README section 'Soft bodies' for what is mapped")
+                    "see docs/soft-bodies.md for what is mapped")
         return made
 
     def parameters(self, sb, nodes: int) -> dict:
@@ -180,7 +180,7 @@ class SoftBodies:
         bending = cfg is not None and cfg.bending_constraint is not None and cfg.bending_constraint >= 2
         margin = sb.collision_margin if sb.collision_margin is not None else DEFAULT_MARGIN
         # PyBullet's mass-spring solver diverges above about these stiffnesses (measured on a
-        # 21 x 21 grid, 0.1 mm nodes: README "Soft bodies"); stiffer links are capped there
+        # 21 x 21 grid, 0.1 mm nodes: docs/soft-bodies.md); stiffer links are capped there
         k_bend = min(k, BENDING_CAP * m_node / dt ** 2)
         k = min(k, ELASTIC_CAP * m_node / dt ** 2)
         return dict(mass=float(mass), useMassSpring=1, useBendingSprings=int(bending),

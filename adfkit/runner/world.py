@@ -2,7 +2,7 @@
 
 Bodies joined by revolute/prismatic trees become multibodies (exact joints, native limits and
 position motors); every other body is a maximal-coordinate rigid body and every other joint a
-createConstraint plus per-step forces (joints.py). The README ("PyBullet reference runner") says why.
+createConstraint plus per-step forces (joints.py). docs/runner.md says why.
 """
 from __future__ import annotations
 

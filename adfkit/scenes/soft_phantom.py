@@ -6,7 +6,7 @@ tests/test_soft_bodies.py measures the indentation. The world has a floor, a cam
 along the skin and a light.
 
 The skin's settings are Bullet soft-body keys (config: kLST, piterations, kDP, kDF, fixed
-nodes) as AMBF reads them; the PyBullet runner maps them as the README ("Soft bodies")
+nodes) as AMBF reads them; the PyBullet runner maps them as docs/soft-bodies.md
 says. The mesh is written beside the model file as skin.obj.
 """
 from __future__ import annotations

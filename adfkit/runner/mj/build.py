@@ -1,6 +1,6 @@
 """An ADF scene as one MuJoCo model: every model file through the project's MJCF writer
 (bodies, joints, loops as equalities, lights), attached under its own prefix, plus what the
-runner adds (the README, "MuJoCo engine"):
+runner adds (docs/mujoco.md):
 
 - six-dof-family joints (the thread, the phantom's hole bodies) join the kinematic tree and
   get one slide per free linear axis and one hinge per free angular axis, with the ADF

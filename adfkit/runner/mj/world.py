@@ -1,8 +1,8 @@
 """MjWorld: an ADF scene played in MuJoCo behind the same public API as SimWorld (PyBullet):
 step, run, body(name) with world_matrix/com_position/state/force/torque, grasp, overlapping,
 place_ghosts, ghosts/actuators/sensors/cameras/articulations, joint_state/reset_joints,
-report, constraint_error, close. The model comes from build.py; the README ("MuJoCo
-engine") says what is approximated.
+report, constraint_error, close. The model comes from build.py; docs/mujoco.md says
+what is approximated.
 """
 from __future__ import annotations
 
