@@ -32,6 +32,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT.parent / "shared" / "corpus"
 JOINTS = ["revolute", "prismatic", "fixed", "p2p", "six dof spring"]
+BUDGET_S = 60.0   # a chain size whose run would take longer than this (by the growth seen) is not run
 
 
 def exponent(sizes, costs) -> float:
@@ -66,10 +67,11 @@ def chain_model(n: int, joint: str) -> str:
 
 def _table(title: str, unit: str, rows: list[tuple[str, list[int], list[float]]]) -> list[dict]:
     print(f"\n{title}")
-    print(f"  {'case':34s} " + "  ".join(f"{'size':>6s} {'cost':>9s}" for _ in rows[0][1]) + "   exponent")
+    width = max(len(r[1]) for r in rows)
+    print(f"  {'case':34s} " + "  ".join(f"{'size':>6s} {'cost':>9s}" for _ in range(width)) + "   exponent")
     found = []
     for label, sizes, costs in rows:
-        cells = "  ".join(f"{s:6d} {c:9.4f}" for s, c in zip(sizes, costs))
+        cells = "  ".join(f"{s:6d} {c:9.4f}" for s, c in zip(sizes, costs)) + " " * 18 * (width - len(sizes))
         k = exponent(sizes, costs)
         flag = "" if k <= 1.1 else "  <- above 1.1"
         print(f"  {label:34s} {cells}   {k:5.2f}{flag}")
@@ -114,6 +116,7 @@ def _world(engine: str, path: Path):
 
 
 def bench_run(quick: bool, tmp: Path) -> list[dict]:
+    from adfkit.diagnostics import AdfError
     sizes = [10, 100] if quick else [10, 100, 1000]
     found, notes = [], []
     for engine in ("pybullet", "mujoco"):
@@ -122,12 +125,21 @@ def bench_run(quick: bool, tmp: Path) -> list[dict]:
         _world(engine, warm).close()             # imports and first-build caches apart
         rows, builds = [], []
         for joint in JOINTS:
-            costs, build_costs = [], []
+            costs, build_costs, done = [], [], []
             for n in sizes:
+                if costs and costs[-1] * (n / done[-1]) ** 3 * 0.1 > BUDGET_S:
+                    notes.append(f"  {joint:16s} N={n:5d}: not run (at the cubic growth seen, 0.1 s would take "
+                                 f"{costs[-1] * (n / done[-1]) ** 3 * 0.1:,.0f} s)")
+                    continue
                 path = tmp / f"chain_{joint.replace(' ', '_')}_{n}.yaml"
                 path.write_text(chain_model(n, joint))
                 t = time.perf_counter()
-                world = _world(engine, path)
+                try:
+                    world = _world(engine, path)
+                except AdfError as exc:
+                    notes.append(f"  {joint:16s} N={n:5d}: cannot be built: {exc.diagnostics[0].message}")
+                    continue
+                done.append(n)
                 build_costs.append(time.perf_counter() - t)
                 try:
                     sim = 0.1 if n >= 1000 else 0.5
@@ -140,8 +152,8 @@ def bench_run(quick: bool, tmp: Path) -> list[dict]:
                                  f"{floor:9.4f} s/s ({floor / costs[-1]:.0%} of the loop){facts}")
                 finally:
                     world.close()
-            rows.append((joint, sizes, costs))
-            builds.append((joint, sizes, build_costs))
+            rows.append((joint, done, costs))
+            builds.append((joint, done, build_costs))
         found += _table(f"adfkit run, {engine}: chain of N bodies (wall s per simulated s)", "s/s", rows)
         print("  where the time goes (the engine's own step on the same loaded world, called bare):")
         print("\n".join(notes))

@@ -21,6 +21,7 @@ import mujoco
 import numpy as np
 
 from ...converters.mjcf_write import to_mjcf
+from ...diagnostics import AdfError, SourceLocation, error
 from ...converters.urdf import _material
 from ...model.semantics import JointKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
@@ -148,7 +149,7 @@ def build_plan(world) -> Plan:
             for loss in ls:  # the MJCF writer already made a flat collision mesh a thin box (engine_fit)
                 if loss.feature == "collision mesh" and "flat" in loss.reason:
                     world._warn("runner-flat-mesh", f"{loss.element}: {loss.reason}", m.body(loss.element))
-            child = mujoco.MjSpec.from_string(text)
+            child = _parse_spec(text, m)
             _resolve_meshes(world, child, out_dir, m)
             prefix = f"m{i}/"
             spec.attach(child, frame=spec.worldbody.add_frame(), prefix=prefix)
@@ -398,3 +399,19 @@ def _obj_bounds(path: Path, scale: np.ndarray):
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
     from ..rotations import quat_to_matrix
     return quat_to_matrix(np.array([q[1], q[2], q[3], q[0]]))
+
+
+def _parse_spec(text: str, model) -> mujoco.MjSpec:
+    """MuJoCo's spec of one model's MJCF. MuJoCo parses MJCF with tinyxml2, which stops at 500
+    nested elements: a chain of about 500 bodies joined by revolute or prismatic joints (each
+    a <body> inside its parent's) cannot be loaded; that is a located error, not a traceback."""
+    try:
+        return mujoco.MjSpec.from_string(text)
+    except ValueError as exc:
+        if "DEPTH" not in str(exc).upper():
+            raise
+        where = model.source or SourceLocation(str(model.path) if model.path else "<model>", 1, 1)
+        raise AdfError(error("mujoco-tree-too-deep",
+                             "MuJoCo cannot load this model: its kinematic tree nests bodies deeper than "
+                             "MuJoCo's MJCF parser allows (about 500 levels)", where,
+                             "play it with --engine pybullet, or split the chain with p2p joints")) from None
