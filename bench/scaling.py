@@ -235,6 +235,8 @@ def bench_record(quick: bool) -> list[dict]:
     world = SimWorld(scene, Options(renderer="auto"))
     try:
         cams = list(world.cameras)
+        for cam in cams:                         # the renderer's start-up (GL context, mirror) apart
+            cam.render(world)
         sizes, costs = [], []
         for frames in ((5, 10) if quick else (10, 20, 40)):
             t = time.perf_counter()

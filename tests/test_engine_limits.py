@@ -37,3 +37,24 @@ def test_a_chain_within_the_limit_plays_in_mujoco(tmp_path, capsys):
     f = tmp_path / "chain.yaml"
     f.write_text(_chain(120))
     assert main(["run", str(f), "--engine", "mujoco", "--seconds", "0.01", "--no-frames"]) == 0, capsys.readouterr().err
+
+
+def test_constraint_algebra_follows_the_inertia_matrix(tmp_path):
+    """Dense for a serial chain (every dof coupled), sparse for many free bodies joined by p2p."""
+    import mujoco
+
+    from adfkit.adf import load_scene
+    from adfkit.runner.mj.world import MjWorld
+    from adfkit.runner.world import Options
+    hinged = tmp_path / "hinged.yaml"
+    hinged.write_text(_chain(80))
+    p2p = tmp_path / "p2p.yaml"
+    p2p.write_text(_chain(80).replace("type: revolute", "type: p2p"))
+    worlds = [MjWorld(load_scene(f), Options(ground=False)) for f in (hinged, p2p)]
+    try:
+        assert [w.model.opt.jacobian for w in worlds] == [mujoco.mjtJacobian.mjJAC_DENSE,
+                                                           mujoco.mjtJacobian.mjJAC_SPARSE]
+        assert worlds[1].model.nv == 6 * 79      # free bodies: the matrix is block-diagonal
+    finally:
+        for w in worlds:
+            w.close()

@@ -72,10 +72,8 @@ class MjWorld(EngineNeutral):
         spec.option.timestep = self.dt
         spec.option.gravity = self.gravity
         spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-        # a 40-element thread is a 120-dof chain: its mass matrix and contact Jacobians are dense,
-        # and dense algebra is faster for it than MuJoCo's sparse default (above 60 dofs);
-        # Newton stops at a 1e-6 relative improvement (MuJoCo's 1e-8 costs 1.8x the time here)
-        spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
+        # Newton stops at a 1e-6 relative improvement (MuJoCo's 1e-8 costs 1.8x the time here);
+        # dense or sparse algebra: jacobian_for, once the model is compiled
         spec.option.tolerance = SOLVER_TOLERANCE
         # elliptic friction cones (Coulomb's, as Bullet's friction): Newton converges in fewer
         # iterations on the thread lying on the phantom than with the pyramidal default, so the
@@ -90,6 +88,7 @@ class MjWorld(EngineNeutral):
         cams = prepare_cameras(self, plan)
         ground = self.opt.ground and self.scene.world is None and self.scene.environment is None
         self.model = compile_spec(self, spec)
+        self.model.opt.jacobian = jacobian_for(self.model)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self.ground_z = None
@@ -571,3 +570,17 @@ class MjWorld(EngineNeutral):
 
 def _xyzw(wxyz) -> np.ndarray:
     return np.array([wxyz[1], wxyz[2], wxyz[3], wxyz[0]])
+
+
+def jacobian_for(model) -> int:
+    """Dense or sparse constraint algebra, from how full the joint-space inertia matrix is.
+
+    A 40-element thread is a 120-dof chain: its mass matrix and contact Jacobians are dense,
+    and dense algebra is faster for it than MuJoCo's sparse default above 60 dofs (the bundled
+    suturing scene: 139 dofs, the matrix 79 % filled). Many shallow trees (free bodies joined
+    by p2p joints) leave it nearly empty, and dense algebra there grows with the square of the
+    size: a chain of 300 p2p-joined bodies steps 19x faster sparse (bench/scaling.py)."""
+    full = model.nv * (model.nv + 1) // 2
+    if model.nv < 60 or model.nM >= 0.5 * full:
+        return mujoco.mjtJacobian.mjJAC_DENSE
+    return mujoco.mjtJacobian.mjJAC_SPARSE
