@@ -19,6 +19,7 @@ Asserts nothing.
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import shutil
 import subprocess
@@ -261,19 +262,23 @@ def plot(found: list[dict], path: Path) -> None:
     groups = {}
     for f in found:
         groups.setdefault(f["figure"], []).append(f)
-    fig, axes = plt.subplots(1, len(groups), figsize=(4.2 * len(groups), 3.6), squeeze=False)
-    for ax, (title, rows) in zip(axes[0], groups.items()):
+    ncols = min(3, len(groups))
+    nrows = -(-len(groups) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols, 3.8 * nrows), squeeze=False)
+    for ax in axes.flat[len(groups):]:
+        ax.set_visible(False)
+    for ax, (title, rows) in zip(axes.flat, groups.items()):
         for r in rows:
             ax.loglog(r["sizes"], r["costs"], "o-", label=f"{r['case']} ({r['exponent']:.2f})")
         s = np.array(rows[0]["sizes"], dtype=float)
         c0 = rows[0]["costs"][0]
         ax.loglog(s, c0 * s / s[0], "k:", label="linear")
-        ax.set_title(title.split("(")[0].strip(), fontsize=8)
+        ax.set_title(title.split("(")[0].split(":")[0].strip(), fontsize=9)
         ax.set_xlabel("size")
         ax.set_ylabel(rows[0]["unit"])
         ax.legend(fontsize=5)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=80)
     print(f"\nplot: {path}")
 
 
@@ -282,7 +287,12 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smaller sizes; no suture episodes")
     ap.add_argument("--only", default="validate,run,convert,suture,record")
     ap.add_argument("--plot", type=Path, help="write the log-log plot here (PNG)")
+    ap.add_argument("--save", type=Path, help="write the figures here (JSON), for --replot")
+    ap.add_argument("--replot", type=Path, help="plot figures saved with --save; measure nothing")
     args = ap.parse_args()
+    if args.replot:
+        plot(json.loads(args.replot.read_text()), args.plot or args.replot.with_suffix(".png"))
+        return
     only = set(args.only.split(","))
     found: list[dict] = []
     with tempfile.TemporaryDirectory() as tmp_name:
@@ -300,6 +310,8 @@ def main() -> None:
     over = [f for f in found if f["exponent"] > 1.1]
     print(f"\n{len(found)} curves; {len(over)} with an exponent above 1.1"
           + "".join(f"\n  {f['figure']}: {f['case']} {f['exponent']:.2f}" for f in over))
+    if args.save:
+        args.save.write_text(json.dumps(found, indent=1))
     if args.plot:
         plot(found, args.plot)
 
