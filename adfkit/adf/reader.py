@@ -173,7 +173,7 @@ class Reader:
             return self.struct(kind, node)
         raise TypeError(f"unknown field kind {kind!r}")  # pragma: no cover
 
-    def fill(self, obj: Node, node: yaml.MappingNode, skip: set[str] = frozenset()) -> None:
+    def fill(self, obj: Node, node: yaml.MappingNode, skip: frozenset[str] | set[str] = frozenset()) -> None:
         """Set obj's declared fields from a mapping node; unknown keys go to extras."""
         by_key = {f.metadata["adf_key"]: f for f in adf_fields(obj) if not isinstance(f.metadata["kind"], ObjectList)}
         obj.source = self.loc(node)
@@ -260,6 +260,7 @@ def read_file(path: str | Path, kind: str | None = None, text: str | None = None
         raise AdfError(error("wrong-kind", f"this looks like a {detected} file, not a {kind} file",
                              location(shown, root), f"pass --kind {detected}, or the file meant for this slot"))
     cls = FILE_KINDS[kind]
+    obj: AdfFile
     if cls is Colors:
         obj = _read_colors(reader, root)
     else:
@@ -301,8 +302,9 @@ def _read_with_objects(reader: Reader, cls, root: yaml.MappingNode) -> AdfFile:
                 continue
             ident = entry.value
             item = kind.kind(identifier=ident)
-            if ident in items and isinstance(items[ident][1], yaml.MappingNode):
-                reader.fill(item, items[ident][1])
+            mapping = items[ident][1] if ident in items else None
+            if isinstance(mapping, yaml.MappingNode):
+                reader.fill(item, mapping)
                 consumed.add(ident)
             else:
                 item.defined = False

@@ -3,7 +3,7 @@ like AMBF's ``--launch_file ... -l 6,7,8``."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, cast
 
 from ..diagnostics import AdfError, Diagnostic, SourceLocation, error
 from ..model import InputDevices, Launch, ModelFile, Scene, World
@@ -54,7 +54,7 @@ def load_scene(path: str | Path, indices: Iterable[int] | None = None,
         world, found = read_file(relative_to_file(doc.path, doc.world_config), "world",
                                  tree=doc.tree, referrer=doc.where("world config"))
         diags.extend(found)
-        _attach_world(scene, world, diags)
+        _attach_world(scene, cast(World, world), diags)
     configs = doc.multibody_configs or []
     chosen = range(len(configs)) if indices is None else list(indices)
     for i in chosen:
@@ -65,7 +65,7 @@ def load_scene(path: str | Path, indices: Iterable[int] | None = None,
         model, found = read_file(relative_to_file(doc.path, configs[i]), "model",
                                  tree=doc.tree, referrer=doc.where("multibody configs"))
         diags.extend(found)
-        scene.models.append(model)
+        scene.models.append(cast(ModelFile, model))
     return scene
 
 
@@ -75,7 +75,7 @@ def _attach_world(scene: Scene, world: World, diags: list[Diagnostic]) -> None:
         env_path = relative_to_file(world.path, world.environment)
         env, found = read_file(env_path, "model", tree=world.tree, referrer=world.where("environment"))
         diags.extend(found)
-        scene.environment = env
+        scene.environment = cast(ModelFile, env)
 
 
 def load_input_devices(launch: Launch) -> InputDevices | None:

@@ -22,7 +22,10 @@ class _Flow(dict):
     """A small mapping written on one line: {x: 0.0, y: 0.0, z: 0.0}."""
 
 
-class _Dumper(getattr(yaml, "CSafeDumper", yaml.SafeDumper)):  # libyaml's emitter when built in: ~5x faster
+_BaseDumper: Any = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's emitter when built in: ~5x faster
+
+
+class _Dumper(_BaseDumper):
     def ignore_aliases(self, data):  # readable output: never emit anchors
         return True
 
@@ -106,13 +109,14 @@ def node_to_plain(obj: Node) -> dict:
 
 def file_to_plain(doc: AdfFile) -> dict:
     """The whole file as plain data: object lists, file-level keys, extras, then objects."""
+    out: dict[str, Any]
     if isinstance(doc, Colors):
         out = {name: node_to_plain(c) for name, c in doc.colors.items()}
         out.update((k, v) for k, v in doc.extras.items() if k not in out)
         return out
-    out: dict[str, Any] = {}
+    out = {}
     objects: dict[str, dict] = {}
-    present = getattr(doc, "present_lists", set())
+    present: set[str] = getattr(doc, "present_lists", set())
     for f in adf_fields(doc):
         kind = f.metadata["kind"]
         if not isinstance(kind, ObjectList):

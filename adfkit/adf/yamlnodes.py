@@ -13,6 +13,7 @@ import yaml
 from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, SourceLocation, error, warning
 
+_BaseLoader: Any
 try:  # libyaml is much faster and keeps marks
     _BaseLoader = yaml.CSafeLoader
 except AttributeError:  # pragma: no cover - depends on the PyYAML build
@@ -22,7 +23,7 @@ _PLAIN = (True, False)
 _RESOLVED: dict[str, str] = {}
 
 
-class _Loader(_BaseLoader):  # type: ignore[misc, valid-type]
+class _Loader(_BaseLoader):
     """The safe loader with plain-scalar tags resolved once per distinct text.
 
     The C composer asks Python's regex resolver for every scalar (174,000 calls over the
@@ -120,6 +121,7 @@ def _scan_depth(text: str, file: str, loader) -> None:
             depth += 1
             if depth > MAX_DEPTH:
                 m = ev.start_mark
+                assert m is not None  # parsers always mark their events
                 raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
                                      SourceLocation(file, m.line + 1, m.column + 1),
                                      "an ADF file nests a few levels; flatten the data"))
@@ -243,7 +245,7 @@ def _check_alias_free(root: yaml.Node, file: str, check_tags: bool, diags: list[
                 elif check_tags and v.tag in _SCALAR_TAGS_CHECKED:
                     _check_scalar_tag(v, file, diags)
         elif check_tags and node.tag in _SCALAR_TAGS_CHECKED:
-            _check_scalar_tag(node, file, diags)
+            _check_scalar_tag(node, file, diags)  # type: ignore[arg-type]  # neither collection: a scalar
 
 
 
@@ -303,9 +305,9 @@ def plain(node: yaml.Node) -> Any:
     if node.__class__ is yaml.ScalarNode:
         return _cached_value(node)
     made: dict[int, Any] = {}
-    root_out = [] if isinstance(node, yaml.SequenceNode) else {}
+    root_out: Any = [] if isinstance(node, yaml.SequenceNode) else {}
     made[id(node)] = root_out
-    stack = [(node, root_out)]
+    stack: list[tuple[yaml.Node, Any]] = [(node, root_out)]
     while stack:
         src, out = stack.pop()
         if src.__class__ is yaml.SequenceNode:
@@ -325,7 +327,7 @@ def _plain_child(node, made: dict, stack: list):
     done = made.get(id(node))
     if done is not None:
         return done
-    out = [] if node.__class__ is yaml.SequenceNode else {}
+    out: Any = [] if node.__class__ is yaml.SequenceNode else {}
     made[id(node)] = out
     stack.append((node, out))
     return out
@@ -333,7 +335,8 @@ def _plain_child(node, made: dict, stack: list):
 
 def _key_text(node: yaml.Node) -> str:
     """A collection used as a key, as one line of text (yaml-cpp compares keys as text)."""
-    parts, stack = [], [node]
+    parts: list[str] = []
+    stack = [node]
     while stack and len(parts) < 200:
         n = stack.pop()
         if isinstance(n, yaml.ScalarNode):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .common import RGBA, CartesianController, Plugin, Shaders
 from .objects import (
@@ -11,6 +12,9 @@ from .objects import (
 )
 from .pose import Pose, Quat, Vec3
 from .spec import ListOf, Node, Obj, key
+
+if TYPE_CHECKING:  # the model does no I/O: the input policy's Tree is only named here
+    from ..inputs import Tree
 
 
 @dataclass(frozen=True)
@@ -30,7 +34,7 @@ class AdfFile(Node):
 
     path: Path | None = field(default=None, compare=False, repr=False)
     # The folder the files this one names must lie in (adfkit.inputs.Tree); None: no limit.
-    tree: object = field(default=None, compare=False, repr=False)
+    tree: Tree | None = field(default=None, compare=False, repr=False)
     adf_version: str | None = key("adf version", "str")
 
     @property

@@ -15,7 +15,7 @@ class Vec3(NamedTuple):
     y: float = 0.0
     z: float = 0.0
 
-    def __add__(self, o):  # type: ignore[override]
+    def __add__(self, o):
         return Vec3(self.x + o[0], self.y + o[1], self.z + o[2])
 
     def __sub__(self, o):
@@ -61,7 +61,9 @@ class Quat(NamedTuple):
     def conjugate(self) -> "Quat":
         return Quat(-self.x, -self.y, -self.z, self.w)
 
-    inverse = conjugate
+    def inverse(self) -> "Quat":
+        """The inverse rotation (the conjugate of a unit quaternion)."""
+        return Quat(-self.x, -self.y, -self.z, self.w)
 
     def normalized(self) -> "Quat":
         n = math.sqrt(sum(c * c for c in self))

@@ -76,7 +76,7 @@ class KinematicTree:
         world: dict[str, Pose] = {}
         link_world: dict[int, Pose] = {}
         for link in self.ordered():
-            if link.parent is None:
+            if link.parent is None or link.joint is None:
                 lw = link.origin
             else:
                 value = q.get(link.joint.identifier, link.q0)

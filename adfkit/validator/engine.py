@@ -126,11 +126,12 @@ def _unique(diags: list[Diagnostic]) -> list[Diagnostic]:
     return sorted(out, key=lambda d: (d.location.line if d.location else 0, d.location.column if d.location else 0))
 
 
-def expand(paths) -> tuple[list[tuple[Path, object]], list[Diagnostic]]:
+def expand(paths) -> tuple[list[tuple[Path, inputs.Tree | None]], list[Diagnostic]]:
     """Files to check from command-line paths, each with the tree it must lie in: None for a
     file named on the command line, the folder's tree for files found in a named folder
     (searched recursively; a symlink found there that leads out of the folder is refused)."""
-    files, problems = [], []
+    files: list[tuple[Path, inputs.Tree | None]] = []
+    problems: list[Diagnostic] = []
     for p in map(Path, paths):
         try:
             inputs.check_path_text(p)

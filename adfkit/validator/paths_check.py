@@ -12,6 +12,7 @@ from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..geometry.meshcheck import mesh_problem
 from ..model import InputDevices, Launch, ModelFile, World
+from ..model.objects import Body, Ghost, SoftBody
 from . import softbody_rules
 from .rules import RULES
 
@@ -77,8 +78,8 @@ def obj_material_problems(obj_path: str) -> tuple[str, ...]:
             missing.append(f"material library {inputs.shown(lib, 80)}")
             continue
         try:
-            lines = inputs.read_bytes(mtl, "text", tree=inputs.Tree(Path(os.path.realpath(base))))
-            lines = lines.decode("utf-8", errors="replace").splitlines()
+            data = inputs.read_bytes(mtl, "text", tree=inputs.Tree(Path(os.path.realpath(base))))
+            lines = data.decode("utf-8", errors="replace").splitlines()
         except AdfError:
             missing.append(f"material library {inputs.shown(lib, 80)} (outside the mesh's folder or not readable)")
             continue
@@ -92,7 +93,7 @@ def obj_material_problems(obj_path: str) -> tuple[str, ...]:
 
 
 def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:
-    out = []
+    out: list[Diagnostic] = []
     if shaders is None or shaders.path is None:
         return out
     base = relative_to_file(doc_path, shaders.path)
@@ -105,7 +106,8 @@ def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:
 
 def model_paths(m: ModelFile) -> list[Diagnostic]:
     out: list[Diagnostic] = []
-    for obj in [*m.bodies, *m.soft_bodies, *m.ghost_objects]:
+    objs: list[Body | SoftBody | Ghost] = [*m.bodies, *m.soft_bodies, *m.ghost_objects]
+    for obj in objs:
         if not obj.defined:
             continue
         seen = set()

@@ -37,7 +37,7 @@ def write_text(diags: list[Diagnostic], stream: IO[str], texts: dict[str, str | 
         where = f"{d.location}: " if d.location else ""
         stream.write(f"{where}{d.severity}[{d.rule}]: {one_line(d.message)}\n")
         line = _source_line(texts, d)
-        if line is not None:
+        if line is not None and d.location is not None:
             col = max(1, d.location.column)
             stream.write(f"  {d.location.line:>5} | {line}\n")
             stream.write(f"        | {' ' * (col - 1)}^\n")

@@ -29,7 +29,7 @@ _BOOL_WORDS = [w for base in ("true", "false", "yes", "no", "on", "off", "y", "n
                for w in dict.fromkeys((base, base.capitalize(), base.upper()))]
 NUMBER_PATTERN = r"^\s*[-+]?(([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?|\.(inf|Inf|INF|nan|NaN|NAN))\s*$"
 
-SCALARS = {
+SCALARS: dict[str, dict] = {
     "float": {"title": "a number", "anyOf": [{"type": "number"}, {"type": "string", "pattern": NUMBER_PATTERN}]},
     "bool": {"title": "true or false",
              "anyOf": [{"type": "boolean"}, {"type": "string", "pattern": "^\\s*(" + "|".join(_BOOL_WORDS) + ")\\s*$"}]},

@@ -2,6 +2,8 @@
 references, names, numbers and keys. File-existence rules live in :mod:`.paths_check`."""
 from __future__ import annotations
 
+from typing import Any
+
 import difflib
 import math
 from functools import lru_cache
@@ -19,21 +21,23 @@ from . import softbody_rules
 from .rules import RULES
 
 @lru_cache(maxsize=None)
-def _fields_of(cls) -> tuple:
+def _fields_of(cls: type) -> tuple:
     return tuple(_adf_fields(cls))
 
 
 @lru_cache(maxsize=None)
-def _keys_of(cls) -> frozenset:
+def _keys_of(cls: type) -> frozenset:
     return frozenset(_adf_keys(cls))
 
 
-def adf_fields(node) -> tuple:
-    return _fields_of(type(node))
+def adf_fields(node: object) -> tuple:
+    cls: Any = type(node)  # a class is hashable; mypy's view of type[object] is not
+    return _fields_of(cls)
 
 
-def adf_keys(node) -> frozenset:
-    return _keys_of(type(node))
+def adf_keys(node: object) -> frozenset:
+    cls: Any = type(node)
+    return _keys_of(cls)
 
 
 SPRINGS = {JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING}
@@ -230,7 +234,7 @@ class Checker:
     def name_collisions(self, m: ModelFile) -> None:
         for group in (m.bodies, m.joints, m.soft_bodies, m.ghost_objects, m.sensors, m.actuators,
                       m.cameras, m.lights, m.vehicles, m.volumes):
-            seen: dict[str, object] = {}
+            seen: dict[str, Any] = {}
             for obj in group:
                 if not obj.name or not obj.defined:
                     continue
@@ -355,7 +359,7 @@ class Checker:
         tree = build_tree(m)
         for link in tree.ordered():
             j, parent = link.joint, link.parent
-            if link.kind not in TREE_ONE_DOF or j is None or not j.defined:
+            if link.kind not in TREE_ONE_DOF or j is None or parent is None or not j.defined:
                 continue
             if link.body.location is None or parent.body.location is None:
                 continue
