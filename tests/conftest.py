@@ -45,8 +45,8 @@ def require_renderer(name: str) -> str:
         if not ok:
             pytest.skip(f"PyBullet's EGL renderer does not work here: {why}")
     if name == "mujoco":
-        from adfkit.runner.mj.render import _gl_context_class
-        cls, why = _gl_context_class()
+        from adfkit.runner.glcontext import gl_context_class
+        cls, why = gl_context_class()
         if cls is None:
             pytest.skip(f"MuJoCo has no headless OpenGL here: {why}")
     return name

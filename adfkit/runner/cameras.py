@@ -99,8 +99,8 @@ def choose_renderer(wanted: str, cid: int, has_cameras: bool, soft: bool, gui: b
         return "tiny", ""
     notes = []
     if wanted in ("mujoco", "auto"):
-        from .mj.render import _gl_context_class
-        cls, why = _gl_context_class()
+        from .glcontext import gl_context_class
+        cls, why = gl_context_class()
         if cls is not None:
             return "mujoco", ""
         notes.append(f"MuJoCo's renderer: no headless OpenGL ({why})")

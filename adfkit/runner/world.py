@@ -28,28 +28,12 @@ from .names import Registry, merge_namespace
 from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
 from .shapes import collision_parts, create_collision, create_visual
 from .softbodies import SoftBodies, enable_deformable_world, in_scene as soft_in_scene
+from .options import Options  # noqa: F401 - the world's options, imported from here by callers
 from .world_state import WorldState
 
 GRASP_SPAN = 0.005   # m between the three point constraints of a grasp (SimWorld.actuate)
 SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
                 JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING)
-
-
-@dataclass
-class Options:
-    physics_hz: float = 1000.0           # internal Bullet step (AMBF: fixed 1 ms)
-    control_substeps: int = 4            # physics steps per control step (springs, ghosts, drives held between)
-    solver_iterations: int | None = 10    # Bullet's own default, which AMBF runs with (PyBullet raises it to 50)
-    contact_threshold: float | None = None  # Bullet's contact breaking threshold; None: its default 0.02
-    gravity: tuple | None = None          # override the world's
-    visuals: bool = True
-    hole_friction: float = 2.0            # K of F = -K·v_rel inside hole ghosts, N·s/m
-    hole_ghost_words: tuple = ("entry", "exit", "hole")
-    ground: bool = True                   # a model played without a world gets a floor under it
-    # cameras (cameras.choose_renderer): "tiny" (TinyRenderer, CPU; nothing to set up, best for a
-    # frame or two), "mujoco" (MuJoCo's renderer on a mirror of the scene: ~1 s to build, then
-    # ~15x faster frames), "egl" (PyBullet's EGL plugin), "auto" (mujoco, else egl, else tiny)
-    renderer: str = "tiny"
 
 
 @dataclass(eq=False)

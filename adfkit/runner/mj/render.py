@@ -9,35 +9,16 @@ are listed but render() raises CameraUnavailable with the reason (world.camera_p
 from __future__ import annotations
 
 import math
-import os
 
 import mujoco
 import numpy as np
 
+from ..glcontext import gl_context_class as _gl_context_class
 from ..rotations import invert, matrix_to_quat, pose_to_matrix
 
 
 class CameraUnavailable(RuntimeError):
     """No headless OpenGL context could be made for MuJoCo's renderer."""
-
-
-def _gl_context_class():
-    """The first headless GL context class that imports; (class, None) or (None, reason)."""
-    tried = []
-    want = os.environ.get("MUJOCO_GL", "").lower().strip()
-    names = [want] if want else ["egl", "osmesa"]
-    for name in names:
-        try:
-            if name == "egl":
-                from mujoco.egl import GLContext
-            elif name == "osmesa":
-                from mujoco.osmesa import GLContext
-            else:
-                from mujoco.rendering.classic.gl_context import GLContext
-            return GLContext, None
-        except Exception as e:   # a missing libEGL/libOSMesa surfaces as ImportError, OSError or AttributeError
-            tried.append(f"{name}: {type(e).__name__}: {e}")
-    return None, "; ".join(tried)
 
 
 class MjCamera:

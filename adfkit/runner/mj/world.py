@@ -39,7 +39,7 @@ class MjWorld(EngineNeutral):
     def __init__(self, scene, options=None, gui: bool = False, sleep: bool = True) -> None:
         """``sleep``: MuJoCo's island sleeping (resting trees are not integrated until a contact,
         a force or a constraint with an awake tree wakes them; driven trees never sleep)."""
-        from ..world import Options
+        from ..options import Options
         if gui:
             raise ValueError("the MuJoCo engine plays headless only (use --engine pybullet for --gui)")
         self.scene = scene

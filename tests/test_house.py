@@ -1,0 +1,106 @@
+"""The house drawn from its own imports: no import circles, and the core never imports the edges."""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _modules(pkg: str) -> dict[str, Path]:
+    out = {}
+    for f in (ROOT / pkg).rglob("*.py"):
+        parts = f.relative_to(ROOT).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        out[name] = f
+    return out
+
+
+def _edges(mods: dict[str, Path]) -> dict[str, set[str]]:
+    """Every import (module level or inside a function) of one module of the house by another;
+    importing a package's own parent package is not an edge (Python runs it first anyway)."""
+    edges: dict[str, set[str]] = {m: set() for m in mods}
+    for m, f in mods.items():
+        is_pkg = f.name == "__init__.py"
+        for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+            names: list[str] = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = m.split(".") if is_pkg else m.split(".")[:-1]
+                if node.level:
+                    base = base[: len(base) - (node.level - 1)]
+                    mod = ".".join(base) + (f".{node.module}" if node.module else "")
+                else:
+                    mod = node.module or ""
+                names = [mod] + [f"{mod}.{a.name}" for a in node.names]
+            for t in names:
+                if t in mods and t != m and not m.startswith(t + "."):
+                    edges[m].add(t)
+    return edges
+
+
+def _cycles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (iterative Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    found = []
+    for start in edges:
+        if start in index:
+            continue
+        work = [(start, iter(sorted(edges[start])))]
+        index[start] = low[start] = len(index)
+        stack.append(start)
+        on.add(start)
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(edges[w]))))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    x = stack.pop()
+                    on.discard(x)
+                    comp.append(x)
+                    if x == v:
+                        break
+                if len(comp) > 1:
+                    found.append(sorted(comp))
+    return found
+
+
+def test_the_cycle_finder_finds_a_circle():
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
+@pytest.mark.parametrize("pkg", ["adfkit"])
+def test_no_import_circles(pkg):
+    assert _cycles(_edges(_modules(pkg))) == []
+
+
+# the core (model, ADF I/O, validator) never reaches up into the edges
+CORE = ("adfkit.model", "adfkit.adf", "adfkit.validator")
+EDGES = ("adfkit.runner", "adfkit.tasks", "adfkit.gym", "adfkit.converters", "adfkit.commands", "adfkit.scenes",
+         "adfkit.dataset")
+
+
+def test_the_core_does_not_import_the_edges():
+    edges = _edges(_modules("adfkit"))
+    up = sorted(f"{m} -> {t}" for m, ts in edges.items() if m.startswith(CORE) for t in ts if t.startswith(EDGES))
+    assert up == []
