@@ -1,4 +1,4 @@
-"""Episodes per second on Ray with 1 and 2 workers (issue 18): expert demonstrations of
+"""Episodes per second on Ray with 1 and 2 workers : expert demonstrations of
 adfkit/NeedlePick-v0 recorded as Ray tasks (adfkit.fanout, the `adfkit dataset` path), one
 seed per episode, on a local Ray. Each worker builds its environment once and resets it per
 episode, so the figure counts steady-state episodes: a warm-up round (one episode per worker)

@@ -1,5 +1,5 @@
 """Closed-form PSM IK (adfkit.runner.psm_kinematics): microseconds per call over random
-reachable poses, and how many of them reproduce the pose (issue 17: one FK per candidate)."""
+reachable poses, and how many of them reproduce the pose (one FK per candidate)."""
 from __future__ import annotations
 
 import sys

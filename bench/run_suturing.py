@@ -1,6 +1,6 @@
 """Real-time factor of the suturing set (launch indices 6–11) headless at 1 kHz physics, side by
 side with its floor: the same loaded scene stepping ``stepSimulation`` alone, measured in the
-same run (issue 17). Printed for wall time and for this process's CPU time (the CPU figures
+same run. Printed for wall time and for this process's CPU time (the CPU figures
 hold on a shared, loaded machine; wall time does not), with the ratio loop/floor (goal ≥ 0.9)
 and the cost of one control step and its parts.
 
