@@ -27,7 +27,7 @@ for name, pinned in pins:
 endef
 export LOCK_DRIFT
 
-.PHONY: run test test-all test-latest bench lock docs clean
+.PHONY: run test test-all test-latest bench lock docs lint clean
 
 $(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -65,6 +65,12 @@ lock: | $(UV)
 # link, anchor or reference fails.
 docs: $(STAMP)
 	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+
+# The project's habits, as CI checks them: ruff's lint rules and its format, the type check.
+lint: $(STAMP)
+	$(VENV)/bin/ruff check --quiet .
+	$(VENV)/bin/ruff format --check --quiet .
+	$(VENV)/bin/mypy
 
 bench: $(STAMP)
 	@for b in bench/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done
