@@ -26,7 +26,19 @@ class Frame:
         return np.asarray(Image.open(self.root / self.paths["rgb"]).convert("RGB"))
 
     def depth(self) -> np.ndarray:
-        return np.load(self.root / self.paths["depth"])
+        """float32 H×W metres along the optical axis, inf where nothing (whichever way the frame
+        stored it: 16-bit PNG in 0.1 mm, deflated npz, or the float32 npy of older datasets)."""
+        path = self.root / self.paths["depth"]
+        if path.suffix == ".png":
+            from PIL import Image
+
+            from .writer import DEPTH_UNIT_M
+            counts = np.asarray(Image.open(path)).astype(np.float64)
+            return np.where(counts > 0, counts * DEPTH_UNIT_M, np.inf).astype(np.float32)
+        if path.suffix == ".npz":
+            with np.load(path) as data:
+                return data["depth"]
+        return np.load(path)
 
     def labels(self) -> np.ndarray:
         """int32 H×W: body index of labels.json, -1 nothing."""

@@ -4,7 +4,9 @@
     DIR/cameras.json                {camera: {"width", "height", "K" 3x3, "near", "far"}}
     DIR/index.jsonl                 one JSON line per frame (below)
     DIR/<camera>/<step>_rgb.png     RGB, 8 bit
-    DIR/<camera>/<step>_depth.npy   float32 H×W, metres along the optical axis (inf: nothing)
+    DIR/<camera>/<step>_depth.png   uint16 H×W, depth along the optical axis in 0.1 mm (0: nothing),
+                                    lossless at that quantum; a frame with depths beyond 6.5534 m is
+                                    <step>_depth.npz instead (float32 metres, inf: nothing, deflated)
     DIR/<camera>/<step>_seg.png     uint16 labels: 0 nothing, k+1 body k of labels.json
     DIR/<camera>/<step>_seg_color.png  the labels colourised for a person
 
@@ -37,6 +39,21 @@ def camera_to_world(eye, target, up) -> np.ndarray:
     return t
 
 
+#: Depth PNGs count in this unit (0.1 mm): 16 bits reach 6.5534 m, 0 is "nothing".
+DEPTH_UNIT_M = 1e-4
+
+
+def depth_to_png16(depth: np.ndarray) -> np.ndarray | None:
+    """Depth in metres (inf or NaN where nothing) as uint16 counts of DEPTH_UNIT_M, 0 where
+    nothing; a hit nearer than half a unit still counts 1. None when a finite depth is beyond
+    what 16 bits hold (the caller keeps float32 then)."""
+    hit = np.isfinite(depth)
+    counts = np.rint(np.where(hit, depth, 0.0) / DEPTH_UNIT_M)
+    if hit.any() and (counts[hit].max() > 65535 or depth[hit].min() < 0):
+        return None
+    return np.where(hit, np.maximum(counts, 1), 0).astype(np.uint16)
+
+
 class DatasetWriter:
     def __init__(self, world, root, cameras=None) -> None:
         self.world, self.root = world, Path(root)
@@ -59,10 +76,16 @@ class DatasetWriter:
             d = self.root / cam.name
             d.mkdir(exist_ok=True)
             stem = f"{step:07d}"
+            depth = np.asarray(frame["depth"], dtype=np.float32)
+            quantised = depth_to_png16(depth)
             names = {k: f"{cam.name}/{stem}_{k}{ext}" for k, ext in
-                     (("rgb", ".png"), ("depth", ".npy"), ("seg", ".png"), ("seg_color", ".png"))}
+                     (("rgb", ".png"), ("depth", ".png" if quantised is not None else ".npz"), ("seg", ".png"),
+                      ("seg_color", ".png"))}
             Image.fromarray(frame["rgb"]).save(self.root / names["rgb"])
-            np.save(self.root / names["depth"], frame["depth"].astype(np.float32))
+            if quantised is not None:
+                Image.fromarray(quantised).save(self.root / names["depth"])
+            else:
+                np.savez_compressed(self.root / names["depth"], depth=depth)
             seg = frame["segmentation"]
             Image.fromarray((seg.astype(np.int64) + 1).clip(0, 65535).astype(np.uint16)).save(self.root / names["seg"])
             Image.fromarray(colourise(seg)).save(self.root / names["seg_color"])
