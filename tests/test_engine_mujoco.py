@@ -461,7 +461,7 @@ def test_suturing_set_grasp_in_mujoco():
 
 def test_both_engines_answer_the_same_public_api(tmp_path):
     """What PSM, `adfkit run` and tasks use exists on both worlds, and MuJoCo's report has
-    every key PyBullet's has (plus its engine and sleeping trees)."""
+    every key PyBullet's has (plus its engine, sleeping trees and its other warnings)."""
     scene = _model(tmp_path, box_camera_model(mass=1.0, z=0.5))
     reports = {}
     for engine in ENGINES:
@@ -480,7 +480,8 @@ def test_both_engines_answer_the_same_public_api(tmp_path):
         finally:
             world.close()
     assert set(reports["SimWorld"]) <= set(reports["MjWorld"])
-    assert set(reports["MjWorld"]) - set(reports["SimWorld"]) == {"engine", "awake_trees", "trees"}
+    assert set(reports["MjWorld"]) - set(reports["SimWorld"]) == {"engine", "awake_trees", "trees", "engine_warnings"}
+    assert reports["MjWorld"]["instabilities"] == reports["SimWorld"]["instabilities"] == []
     p_mj, p_pb = reports["MjWorld"]["ground_plane_z"], reports["SimWorld"]["ground_plane_z"]
     assert p_mj == pytest.approx(p_pb, abs=1e-6)      # the same floor 1 mm under the box
 

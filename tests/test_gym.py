@@ -181,3 +181,20 @@ def test_dataset_command_refuses_bad_options(tmp_path, capsys):
     assert main(["dataset", "--scene", str(tmp_path / "none.yaml"), "--out", str(tmp_path)]) == 2
     assert "does not exist" in capsys.readouterr().err
     assert not list(tmp_path.iterdir())
+
+
+def test_an_engine_instability_terminates_the_episode_with_its_reason():
+    """What the world's stability watch met during a step (runner/stability.py) ends the episode,
+    with the event in ``info``; the next episode starts clean."""
+    from adfkit.runner.stability import Instability
+    env = make("adfkit/NeedleReach-v0")
+    env.reset(seed=1)
+    zero = np.zeros(env.action_space.shape, dtype=np.float32)
+    _, _, term, _, info = env.step(zero)
+    assert not term and "unstable" not in info
+    env.unwrapped.world.watch.add(Instability(0.1, "BODY Needle", "state-reset", "MuJoCo reset the state"))
+    _, _, term, _, info = env.step(zero)
+    assert term and info["unstable"] == ["t = 0.100 s (BODY Needle): MuJoCo reset the state"]
+    env.reset(seed=2)
+    _, _, term, _, info = env.step(zero)
+    assert not term and "unstable" not in info

@@ -92,5 +92,7 @@ def run(args) -> int:
     if unstable(report):
         print(f"unstable: nan {report['nan']}, exploded {report['exploded']}, "
               f"fell {report['fell_through_floor']}", file=sys.stderr)
+        for e in report.get("instabilities", []):
+            print(f"  t = {e['time_s']:.3f} s, {e['body'] or 'the scene'}: {e['message']}", file=sys.stderr)
         return 1
     return 0

@@ -103,4 +103,6 @@ def run(args) -> int:
           f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm, max constraint error "
           f"{(m.get('max_constraint_error_m') or 0) * 1000:.2f} mm" + (", EXPLODED" if m.get("exploded") else ""))
     print(f"metrics: {(out / 'metrics.json').resolve()}")
-    return 0 if m.get("all_passed") else 1
+    for e in m.get("instabilities", []):
+        print(f"  unstable at t = {e['time_s']:.3f} s, {e['body'] or 'the scene'}: {e['message']}")
+    return 0 if m.get("all_passed") and not m.get("exploded") else 1

@@ -122,6 +122,7 @@ class SuturingEnv(gym.Env):
                 self.world.place_body(body, pose)
         self._closed = {n: False for n in self.arms}
         self._steps = 0
+        self._events_seen = len(self.world.watch.events)   # instabilities of earlier episodes are theirs
         self._task_reset()
         obs = self._observe()
         return obs, self._info(self._evaluate())
@@ -139,8 +140,10 @@ class SuturingEnv(gym.Env):
         bad = not all(np.all(np.isfinite(v)) for k, v in obs.items() if not k.endswith("_depth"))
         info = self._info(ev)
         info["unreachable_setpoints"] = unreachable
-        if bad:
-            info["unstable"] = True
+        events = self.world.watch.events[self._events_seen:]   # the engine blew up (runner/stability.py)
+        if bad or events:
+            bad = True
+            info["unstable"] = [str(e) for e in events] or ["the observation holds NaN or Inf"]
         return obs, reward, bool(ev["success"] or bad), False, info
 
     def render(self):

@@ -36,8 +36,12 @@ def play(world, seconds: float, out: Path | None = None, frames: bool = True, sc
 
 
 def unstable(report: dict) -> list[str]:
-    """Bodies that became NaN, exploded (> 10 m/s) or fell through the floor."""
-    return report["nan"] + report["exploded"] + report["fell_through_floor"]
+    """Bodies that became NaN, exploded (> 10 m/s) or fell through the floor at the end, and
+    every instability the engine met on the way (runner/stability.py: a state reset, a singular
+    inertia, NaN, a flung body), with its time."""
+    events = [f"{e['body'] or 'the scene'}: {e['kind']} at t = {e['time_s']:.3f} s"
+              for e in report.get("instabilities", [])]
+    return report["nan"] + report["exploded"] + report["fell_through_floor"] + events
 
 
 def summary(report: dict) -> str:

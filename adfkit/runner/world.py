@@ -19,7 +19,7 @@ from ..model.semantics import (
     ACTUATOR_TYPES, DEFAULT_ACTUATOR_MAX_IMPULSE, DEFAULT_GRAVITY, DEFAULT_SENSOR_RANGE, JointKind,
     SENSOR_TYPES, joint_frames, joint_kind, pose_or_identity,
 )
-from . import articulation, egl
+from . import articulation, egl, stability
 from .neutral import EngineNeutral
 from .cameras import choose_renderer
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
@@ -113,6 +113,8 @@ class SimWorld(EngineNeutral, WorldState):
         self.steps = 0
         self.sim_time = 0.0
         self.wall_time = 0.0
+        self.watch = stability.Watch()
+        self._next_stability_check = 0.0
         pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
         self._build()
 
@@ -466,6 +468,9 @@ class SimWorld(EngineNeutral, WorldState):
             pb.stepSimulation(physicsClientId=self.cid)
         self.steps += n * sub
         self.sim_time = self.steps * self.dt
+        if self.sim_time >= self._next_stability_check:   # NaN or a flung body, caught as it happens
+            self._next_stability_check = self.sim_time + stability.CHECK_EVERY_S
+            stability.check_pybullet(self, self.watch)
         self.wall_time += time.perf_counter() - t0
 
     # ---- ghosts, sensors, actuators -------------------------------------------------------
@@ -636,6 +641,7 @@ class SimWorld(EngineNeutral, WorldState):
             "real_time_factor": self.sim_time / self.wall_time if self.wall_time else None,
             "max_constraint_error_m": self.constraint_error(), "ground_plane_z": self.ground_z,
             "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
+            **self.watch.report(),
         }
 
     def mj_view(self):

@@ -111,7 +111,8 @@ class SutureObserver:
         through = sum(p["thread_elements_through"] for p in pairs) * self.element_length()
         return {
             "pairs": pairs,
-            "all_passed": bool(pairs) and all(p["passed"] for p in pairs) and failure is None,
+            "all_passed": (bool(pairs) and all(p["passed"] for p in pairs) and failure is None
+                           and not rep.get("instabilities")),   # an engine that blew up passes nothing
             "failure": failure,
             "phases": self.phases(),
             "needle_final_pose": {"position": [float(v) for v in n[:3, 3]],
@@ -125,8 +126,10 @@ class SutureObserver:
             "episode_wall_time_s": wall_s,
             "real_time_factor": self.world.sim_time / wall_s if wall_s > 0 else None,
             "physics_real_time_factor": (self.world.sim_time / self.world.wall_time) if self.world.wall_time else None,
-            "exploded": bool(rep["exploded"] or rep["nan"]),
-            "exploded_bodies": rep["exploded"] + rep["nan"],
+            "exploded": bool(rep["exploded"] or rep["nan"] or rep.get("instabilities")),
+            "exploded_bodies": rep["exploded"] + rep["nan"] + [e["body"] for e in rep.get("instabilities", [])
+                                                                if e["body"]],
+            "instabilities": rep.get("instabilities", []),   # runner/stability.py: time, body, kind, message
             "control_steps": self.n,
             "clipped_setpoints": self.task.clipped,
         }

@@ -18,6 +18,7 @@ from ...model.semantics import (
     inertial_offset,
 )
 from ...model.tree import ONE_DOF
+from .. import stability
 from ..neutral import EngineNeutral
 from ..names import Registry
 from ..rotations import invert, matrix_to_quat, pose_matrix, pose_to_matrix
@@ -54,6 +55,9 @@ class MjWorld(EngineNeutral):
         self.steps = 0
         self.sim_time = 0.0
         self.wall_time = 0.0
+        self.watch = stability.Watch()
+        self.engine_warnings: list[str] = []     # MuJoCo's other warnings, with their time
+        stability.install_mujoco_handler()
         self.skipped: list[str] = []
         self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")   # MuJoCo 4's island sleeping
         self._render = None
@@ -358,10 +362,13 @@ class MjWorld(EngineNeutral):
         sub = self.opt.control_substeps
         m, d = self.model, self.data
         base = self._base_xfrc
-        for _ in range(n):
+        for k in range(n):
             self.control()
             mujoco.mj_step(m, d, sub)
             d.xfrc_applied[:] = base
+            if stability.mujoco_pending():     # a warning: NaN and a state reset, a singular inertia...
+                self.sim_time = (self.steps + (k + 1) * sub) * self.dt
+                stability.drain_mujoco(self, self.watch)
         self.steps += n * sub
         self.sim_time = self.steps * self.dt
         self.wall_time += time.perf_counter() - t0
@@ -546,6 +553,7 @@ class MjWorld(EngineNeutral):
             "max_constraint_error_m": self.constraint_error(), "ground_plane_z": self.ground_z,
             "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
             "soft_bodies": [],   # not played by this engine (a runner-soft-body warning names each)
+            **self.watch.report(), "engine_warnings": self.engine_warnings,
         }
 
     def _renderer(self):
