@@ -235,3 +235,23 @@ def read_text(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None =
 
 __all__ = ["MAX_BYTES", "ROOT_ENV", "TREE_LEVELS", "Tree", "check_file", "check_path_text", "decode_utf8", "is_regular",
            "read_bytes", "read_text", "shown", "tree_of"]
+
+
+def scene_file(path: str | os.PathLike) -> Path:
+    """The ADF file a command plays or summarises when the user names ``path``: the path itself,
+    or a folder's ``launch.yaml`` (as AMBF's launcher reads a folder). A folder without one is a
+    located ``not-a-regular-file`` error that names the YAML files it holds."""
+    p = Path(path)
+    check_path_text(p)
+    if not p.is_dir():
+        return p
+    launch = p / "launch.yaml"
+    if launch.is_file():
+        return launch
+    try:
+        yamls = sorted(x.name for x in p.iterdir() if x.suffix.lower() in (".yaml", ".yml") and x.is_file())
+    except OSError:
+        yamls = []
+    listed = ", ".join(yamls[:8]) + (" ..." if len(yamls) > 8 else "")
+    raise _fail("not-a-regular-file", f"{shown(p)} is a folder without a launch.yaml", p, None,
+                f"name the ADF file to use: one of {listed}" if yamls else "name an ADF file (launch, world or model)")

@@ -32,7 +32,8 @@ def run(args) -> int:
     from ..summary import format_summary, scene_summary
 
     if args.scene:
-        launch, indices = Path(args.scene), args.indices
+        from .. import inputs
+        launch, indices = inputs.scene_file(args.scene), args.indices   # a folder: its launch.yaml
     else:
         launch, indices = BUNDLED, None
         if not launch.exists():  # installed without the repository's sample_scenes/: author it now

@@ -24,6 +24,8 @@ def run(args) -> int:
     from ..report import print_diagnostics
     from ..summary import format_summary, summarize
 
+    from .. import inputs
+    args.path = inputs.scene_file(args.path)        # a folder: its launch.yaml
     if args.indices:
         diags: list = []
         doc = load_scene(args.path, parse_indices(args.indices), diags)

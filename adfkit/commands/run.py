@@ -46,6 +46,7 @@ def run(args) -> int:
 
     from .. import inputs
 
+    args.path = inputs.scene_file(args.path)        # a folder: its launch.yaml
     inputs.check_file(args.path, what="ADF file")  # a regular file (adfkit.inputs), located errors
     if (args.seconds <= 0 or args.physics_hz <= 0 or args.control_substeps < 1 or args.solver_iterations < 1
             or (args.contact_threshold is not None and args.contact_threshold <= 0)):

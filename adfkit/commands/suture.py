@@ -58,7 +58,8 @@ def run(args) -> int:
     if args.every < 1:
         raise AdfError(error("bad-option", "--every must be ≥ 1", None, "e.g. --every 10"))
     if args.scene:
-        launch, indices = Path(args.scene), args.indices
+        from .. import inputs
+        launch, indices = inputs.scene_file(args.scene), args.indices   # a folder: its launch.yaml
         if not launch.is_file():
             raise AdfError(error("no-file", f"{launch} does not exist", None, "give a launch file"))
     elif BUNDLED.is_file():
