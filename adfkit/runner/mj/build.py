@@ -32,7 +32,7 @@ SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIS
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
 GHOST_GROUP = 4
 # the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. A weld's
-# stiffness scales with the held body's mass, so a 1 g needle dragging its thread needs it: at
+# stiffness scales with the held body's mass, so a light needle dragging its thread needs it: at
 # 4 steps the bundled suture's needle slid 13 mm in the jaws while carried and the regrasp missed
 WELD_TIMECONST_STEPS = 2
 WELD_DAMPING_RATIO = 1.0
