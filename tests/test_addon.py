@@ -321,3 +321,36 @@ def test_garbage_mesh_imports_without_it_and_says_so(addon, scene, tmp_path):
     assert [o.name for o in made] == ["a"] and made[0].type == "EMPTY"
     (d,) = [d for d in diags if d.rule == "mesh-unreadable"]
     assert d.severity == Severity.WARNING and "bad.stl" in d.message and "bad.stl" in str(d.location)
+
+
+DEGENERATE = {  # (vertices, faces) of the meshes a modeller meets: each operator says why, never a traceback
+    "empty": ([], []),
+    "single face": ([(0, 0, 0), (0.01, 0, 0), (0, 0.01, 0)], [(0, 1, 2)]),
+    "flat grid": ([(x * 0.01, y * 0.01, 0) for y in range(4) for x in range(4)],
+                  [(y * 4 + x, y * 4 + x + 1, y * 4 + x + 5, y * 4 + x + 4) for y in range(3) for x in range(3)]),
+    "open box": ([(x, y, z) for x in (0, 0.01) for y in (0, 0.02) for z in (0, 0.03)],
+                 [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6)]),          # two sides missing
+    "non-manifold": ([(0, 0, 0), (0.01, 0, 0), (0, 0.01, 0), (0, 0, 0.01), (0, -0.01, 0), (0, 0, -0.01)],
+                     [(0, 1, 2), (0, 1, 3), (0, 1, 4), (0, 1, 5)]),                 # four faces on one edge
+}
+
+
+@pytest.mark.parametrize("name", list(DEGENERATE))
+def test_every_geometry_operator_on_a_degenerate_mesh_finishes_or_says_why(addon, scene, name):
+    verts, faces = DEGENERATE[name]
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(verts, [], faces)
+    me.update()
+    o = bpy.data.objects.new(name, me)
+    scene.collection.objects.link(o)
+    bpy.context.view_layer.objects.active = o
+    o.select_set(True)
+    addon.authoring.mark(o, "BODY")
+    calls = [("fit_collision_primitive", {"shape": s}) for s in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE")]
+    calls += [("estimate_inertia", {}), ("generate_collision", {"max_hulls": 2})]
+    for op, kw in calls:
+        try:
+            assert getattr(bpy.ops.adf, op)(**kw) == {"FINISHED"}, (op, kw)
+        except RuntimeError as exc:   # bpy raises an operator's ERROR report; an exception it let out is a traceback
+            text = str(exc)
+            assert text.startswith("Error: ") and "Traceback" not in text and " — " in text, (op, kw, text)

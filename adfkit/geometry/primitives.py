@@ -14,9 +14,13 @@ import manifold3d
 import numpy as np
 import trimesh
 
+from ..diagnostics import AdfError, SourceLocation, error
 from ..model import Geometry, ShapeEntry
 from ..model.pose import Pose, Quat, Vec3
 from .repair import to_manifold
+
+#: Spread below this share of the largest one counts as none (a flat or straight point set).
+_FLAT = 1e-9
 
 
 @dataclass
@@ -67,8 +71,54 @@ def entry_manifold(entry: ShapeEntry, segments: int = 64) -> manifold3d.Manifold
     return solid.transform(affine)
 
 
+def _refuse(rule: str, message: str, hint: str) -> AdfError:
+    return AdfError(error(rule, message, SourceLocation("<mesh>"), hint))
+
+
+def _points(mesh: trimesh.Trimesh) -> np.ndarray:
+    """The vertices the triangles use (what a primitive must enclose); a mesh without a
+    triangle is refused with a message, not a numpy error."""
+    faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    verts = np.asarray(mesh.vertices, dtype=np.float64).reshape(-1, 3)
+    if len(faces) == 0 or len(verts) == 0:
+        raise _refuse("mesh-empty", "the mesh has no triangles to fit a shape around",
+                      "give the object a mesh with faces (or add a primitive by hand)")
+    pts = verts[np.unique(faces)]
+    if not np.all(np.isfinite(pts)):
+        raise _refuse("mesh-unreadable", "the mesh has NaN or infinite vertex coordinates", "fix or re-export the mesh")
+    return pts
+
+
+def spread(points: np.ndarray) -> int:
+    """How many directions the points extend in: 0 (one point), 1 (a line), 2 (flat), 3 (a solid)."""
+    centred = points - points.mean(axis=0)
+    s = np.linalg.svd(centred, compute_uv=False) if len(points) > 1 else np.zeros(3)
+    if len(s) == 0 or s[0] <= 0.0:
+        return 0
+    return int(np.sum(s > _FLAT * s[0]))
+
+
+def _principal_frame(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Axes of the points' spread (columns, largest first) and their centroid."""
+    c = points.mean(axis=0)
+    _, _, vt = np.linalg.svd(points - c, full_matrices=True)
+    return vt.T, c
+
+
 def fit_error(mesh: trimesh.Trimesh, entry: ShapeEntry) -> tuple[float, float]:
-    solid, prim = to_manifold(mesh), entry_manifold(entry)
+    """1 - IoU of the primitive and the mesh solid, and the primitive's volume. An open or
+    non-manifold mesh is measured as the convex hull of its vertices; a flat one has no
+    volume, so nothing overlaps it (error 1)."""
+    prim = entry_manifold(entry)
+    try:
+        solid = to_manifold(mesh)
+        if solid.status() != manifold3d.Error.NoError or solid.volume() <= 0.0:
+            raise ValueError("not a closed solid")
+    except Exception:  # noqa: BLE001 - manifold3d refuses open or non-manifold input in several ways
+        pts = _points(mesh)
+        if spread(pts) < 3:
+            return 1.0, prim.volume()
+        solid = to_manifold(trimesh.convex.convex_hull(pts))
     inter = (solid ^ prim).volume()
     union = (solid + prim).volume()
     return 1.0 - inter / union, prim.volume()
@@ -82,27 +132,54 @@ def _axial_extent(pts: np.ndarray, center: np.ndarray, axis: np.ndarray):
 
 
 def fit_box(mesh: trimesh.Trimesh) -> ShapeEntry:
-    transform, extents = trimesh.bounds.oriented_bounds(mesh)
+    pts = _points(mesh)
+    if spread(pts) < 3:
+        raise _refuse("mesh-flat", "the mesh is flat (its vertices lie in one plane or on one line): a box "
+                      "around it would have no thickness",
+                      "give it thickness (a Solidify modifier), or fit a capsule or a sphere around it")
+    transform, extents = trimesh.bounds.oriented_bounds(pts)
     inv = np.linalg.inv(transform)  # box frame in mesh frame
     return ShapeEntry(shape="box", geometry=Geometry(x=float(extents[0]), y=float(extents[1]), z=float(extents[2])),
                       offset=_pose(inv[:3, :3], inv[:3, 3]))
 
 
 def fit_sphere(mesh: trimesh.Trimesh) -> ShapeEntry:
-    center, radius = trimesh.nsphere.minimum_nsphere(mesh)
+    pts = _points(mesh)
+    dims = spread(pts)
+    if dims == 0:
+        raise _refuse("mesh-degenerate", "every vertex of the mesh is at one point: no sphere can enclose it",
+                      "give the object a mesh with extent")
+    if dims == 3:
+        center, radius = trimesh.nsphere.minimum_nsphere(pts)
+    else:   # flat or straight: the sphere about the bounding box's centre (encloses; not the smallest)
+        center = (pts.min(axis=0) + pts.max(axis=0)) / 2
+        radius = float(np.linalg.norm(pts - center, axis=1).max())
     return ShapeEntry(shape="sphere", geometry=Geometry(radius=float(radius)), offset=_pose(np.eye(3), center))
 
 
-def _principal_axis(mesh: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray]:
-    """Long axis of the hull's inertia (smallest moment) and the hull centroid."""
-    hull = mesh.convex_hull
+def _principal_axis(mesh: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Long axis of the hull's inertia (smallest moment) and the hull centroid, and the points;
+    for a flat or straight mesh (no hull volume) the points' direction of largest spread and
+    their centroid. A single point is refused."""
+    pts = _points(mesh)
+    dims = spread(pts)
+    if dims == 0:
+        raise _refuse("mesh-degenerate", "every vertex of the mesh is at one point: nothing to fit around",
+                      "give the object a mesh with extent")
+    if dims < 3:
+        axes, c = _principal_frame(pts)
+        return axes[:, 0], c, pts
+    hull = trimesh.convex.convex_hull(pts)
     moments, axes = np.linalg.eigh(hull.moment_inertia)
-    return axes[:, 0], np.asarray(hull.center_mass)
+    return axes[:, 0], np.asarray(hull.center_mass), pts
 
 
 def fit_cylinder(mesh: trimesh.Trimesh) -> ShapeEntry:
-    axis, center = _principal_axis(mesh)
-    t, radial = _axial_extent(mesh.vertices, center, axis)
+    axis, center, pts = _principal_axis(mesh)
+    t, radial = _axial_extent(pts, center, axis)
+    if radial.max() <= _FLAT * max(1e-300, float(t.max() - t.min())):
+        raise _refuse("mesh-degenerate", "the mesh is a straight line: a cylinder around it has no radius",
+                      "fit a capsule, or give the object a mesh with width")
     center = center + axis * (t.max() + t.min()) / 2
     name, rot = _axis_frame(axis)
     return ShapeEntry(shape="cylinder", geometry=Geometry(radius=float(radial.max()), height=float(t.max() - t.min()), axis=name),
@@ -122,8 +199,11 @@ def capsule_around(points: np.ndarray, center: np.ndarray, axis: np.ndarray) -> 
 
 
 def fit_capsule(mesh: trimesh.Trimesh) -> ShapeEntry:
-    axis, center = _principal_axis(mesh)
-    r, height, c = capsule_around(np.asarray(mesh.vertices), center, axis)
+    axis, center, pts = _principal_axis(mesh)
+    r, height, c = capsule_around(pts, center, axis)
+    if r <= 0.0:
+        raise _refuse("mesh-degenerate", "the mesh is a straight line: a capsule around it has no radius",
+                      "give the object a mesh with width")
     name, rot = _axis_frame(axis)
     return ShapeEntry(shape="capsule", geometry=Geometry(radius=r, height=height, axis=name), offset=_pose(rot, c))
 
