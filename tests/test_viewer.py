@@ -1,0 +1,170 @@
+"""`adfkit view` driven in a real headless browser (the system's Chromium through Playwright):
+the bundled suturing scene is drawn (not a blank canvas), a joint slider moves the picture, a
+recorded episode replays on its timeline; and bad input is a clear error."""
+from __future__ import annotations
+
+import json
+import shutil
+import socket
+
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+from adfkit.cli import main
+
+pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
+pytest.importorskip("viser", reason="viser (view extra) is not installed")
+
+BUNDLED = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
+CHROMIUM = next((p for p in (shutil.which("chromium"), shutil.which("chromium-browser")) if p), None)
+# software WebGL in headless Chromium (design.md)
+FLAGS = ["--headless=new", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def browser():
+    if CHROMIUM is None:
+        pytest.skip("no Chromium here (apt-get install chromium; .ci/run installs it)")
+    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=FLAGS)
+        yield b
+        b.close()
+
+
+def _canvas(page) -> np.ndarray:
+    """The 3-D view's pixels (the left of the page; the panel is on the right)."""
+    from io import BytesIO
+
+    from PIL import Image
+    png = page.screenshot(clip={"x": 0, "y": 160, "width": 900, "height": 600})
+    return np.asarray(Image.open(BytesIO(png)).convert("RGB")).astype(np.int16)
+
+
+def _serve(episode=None):
+    from adfkit.viewer.server import Viewer
+    v = Viewer(BUNDLED, None, "pybullet", "127.0.0.1", _free_port(), episode)
+    v.load()
+    return v, v.start()
+
+
+def _open(browser, address):
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    page.goto(address)
+    page.wait_for_selector("canvas", timeout=30_000)
+    page.wait_for_timeout(4000)       # the scene's meshes arrive over the websocket
+    return page
+
+
+def _to_end(slider) -> None:
+    """Press End on a slider until the page shows it at its maximum (a folder just opened may
+    still be animating), then let the new picture arrive."""
+    for _ in range(10):
+        slider.page.wait_for_timeout(500)
+        slider.press("End")
+        if slider.get_attribute("aria-valuenow") == slider.get_attribute("aria-valuemax"):
+            break
+    slider.page.wait_for_timeout(2500)
+
+
+def _expand(page, *titles) -> None:
+    for t in titles:
+        page.get_by_text(t, exact=True).first.click()
+        page.wait_for_timeout(300)
+
+
+def test_the_scene_is_drawn_and_a_joint_slider_moves_it(browser):
+    v, address = _serve()
+    try:
+        assert v.world is not None and len(v.body_nodes) == len(v.world.bodies) > 50
+        page = _open(browser, address)
+        before = _canvas(page)
+        # not a blank canvas: many colours and real contrast where the bodies are
+        assert len(np.unique(before.reshape(-1, 3), axis=0)) > 200 and before.std() > 10
+        _expand(page, "Joints", "psm1/base link simple")
+        _to_end(page.locator("[role=slider]").first)   # the first joint (the arm's yaw) to its upper limit
+        arm = v.world.articulations[0]
+        assert v.world.joint_state(arm, [0])[0][0] == pytest.approx(arm.records[0][0].joint_limits.high, abs=1e-6)
+        after = _canvas(page)
+        moved = np.abs(after - before).max(axis=2) > 40
+        assert moved.mean() > 0.002, moved.mean()      # the arm swung: its pixels changed
+        page.close()
+    finally:
+        v.close()
+
+
+def _record_episode(folder):
+    """A short episode in the format `adfkit suture --record` writes: frames of the live world
+    while psm1 turns its yaw, and a metrics.json with one verdict."""
+    from adfkit.adf import load_scene
+    from adfkit.dataset.writer import DatasetWriter
+    from adfkit.runner.psm import PSM
+    from adfkit.runner.world import Options, SimWorld
+    world = SimWorld(load_scene(BUNDLED), Options())
+    try:
+        psm = PSM(world, "psm1")
+        writer = DatasetWriter(world, folder / "dataset", cameras=[world.cameras[0].name])
+        q0 = psm.measured_jp()
+        for k in range(4):
+            q = q0.copy()
+            q[0] += 0.25 * k
+            psm.reset_jp(q)
+            world.step(2)
+            writer.write(k, {"needle": world.body("Needle").world_matrix(),
+                             "psms": {"psm1": {"jp": [float(x) for x in psm.measured_jp()], "jaw": 0.5}}},
+                         f"phase {k}")
+        writer.close()
+    finally:
+        world.close()
+    (folder / "metrics.json").write_text(json.dumps({"pairs": [{"pair": 1, "passed": False,
+                                                                "reason": "blocked at entry 1"}]}))
+
+
+def test_a_recorded_episode_replays_on_its_timeline(browser, tmp_path):
+    _record_episode(tmp_path)
+    v, address = _serve(tmp_path)
+    try:
+        assert v.episode is not None and len(v.episode.frames) == 4
+        page = _open(browser, address)
+        assert page.get_by_text("blocked at entry 1").count() >= 1     # the verdicts are listed
+        first = _canvas(page)
+        _to_end(page.locator("[role=slider]").last)                  # the timeline (the last panel) to the last frame
+        assert page.get_by_text("phase 3", exact=False).count() >= 1
+        last = _canvas(page)
+        assert (np.abs(last - first).max(axis=2) > 40).mean() > 0.002
+        page.close()
+    finally:
+        v.close()
+
+
+def test_a_scene_with_errors_opens_with_them_listed(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("bodies: [BODY a]\nBODY a:\n  mass: heavy\n")
+    from adfkit.viewer.server import Viewer
+    v = Viewer(bad, None, "pybullet", "127.0.0.1", _free_port())
+    v.load()
+    try:
+        assert v.world is None
+        assert any(d.rule == "bad-type" and d.location.line == 3 for d in v.findings)
+    finally:
+        v.close()
+
+
+def test_bad_input_is_a_clear_error(tmp_path, capsys):
+    assert main(["view", str(tmp_path / "absent.yaml")]) == 2
+    assert "error[file-not-found]" in capsys.readouterr().err
+    with socket.socket() as s:             # a port in use
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        assert main(["view", str(BUNDLED), "--port", str(port)]) == 2
+    err = capsys.readouterr().err
+    assert "error[port-in-use]" in err and f"127.0.0.1:{port}" in err and "Traceback" not in err
