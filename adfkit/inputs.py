@@ -35,6 +35,7 @@ MAX_BYTES = {
     "xml": 64 * 1024 * 1024,     # URDF / MJCF
     "mesh": 512 * 1024 * 1024,   # STL / OBJ / PLY / DAE ...
     "text": 16 * 1024 * 1024,    # MTL and other small side files
+    "image": 256 * 1024 * 1024,  # a volume slice or a texture
 }
 MAX_PATH_BYTES = 4096
 MAX_NAME_BYTES = 255

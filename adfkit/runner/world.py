@@ -115,6 +115,8 @@ class SimWorld(EngineNeutral, WorldState):
         self.wall_time = 0.0
         self.watch = stability.Watch()
         self._next_stability_check = 0.0
+        self.volumes: list[dict] = []        # volumes played as iso-surface bodies (runner/volumes.py)
+        self.not_played: list[dict] = []     # every part of the scene not played, with why
         pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
         self._build()
 
@@ -215,6 +217,8 @@ class SimWorld(EngineNeutral, WorldState):
             for c, pa, pbv, axis in made:
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
         self.springs = SpringSet(springs, self.cid)
+        from .volumes import build_volumes
+        build_volumes(self, models)
         for m in models:
             self._build_ghosts(m)
             self._build_actuators(m)
@@ -641,7 +645,7 @@ class SimWorld(EngineNeutral, WorldState):
             "real_time_factor": self.sim_time / self.wall_time if self.wall_time else None,
             "max_constraint_error_m": self.constraint_error(), "ground_plane_z": self.ground_z,
             "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
-            **self.watch.report(),
+            **self.watch.report(), "volumes": self.volumes, "not_played": self.not_played,
         }
 
     def mj_view(self):

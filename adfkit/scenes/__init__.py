@@ -19,11 +19,12 @@ BUILDERS = {
     "suturing": _lazy("suturing", "write_suturing"),
     "suturing-pad": _lazy("suturing_pad", "write_suturing_pad"),
     "soft-phantom": _lazy("soft_phantom", "write_soft_phantom"),
+    "drilling": _lazy("drilling", "write_drilling"),
 }
 
 _EXPORTS = {
     "SuturingPadParams": "suturing_pad", "build_suturing_pad": "suturing_pad", "write_suturing_pad": "suturing_pad",
-    "write_suturing": "suturing", "write_soft_phantom": "soft_phantom",
+    "write_suturing": "suturing", "write_soft_phantom": "soft_phantom", "write_drilling": "drilling",
 }
 
 

@@ -13,7 +13,7 @@ from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..geometry.meshcheck import mesh_problem
 from ..model import InputDevices, Launch, ModelFile, World
 from ..model.objects import Body, Ghost, SoftBody
-from . import softbody_rules
+from . import softbody_rules, volume_rules
 from .rules import RULES
 
 TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")
@@ -226,7 +226,7 @@ def plugin_paths(doc) -> list[Diagnostic]:
 def check(doc) -> list[Diagnostic]:
     out = plugin_paths(doc) if hasattr(doc, "plugins") else []
     if isinstance(doc, ModelFile):
-        return out + model_paths(doc) + softbody_rules.mesh_rules(doc)
+        return out + model_paths(doc) + softbody_rules.mesh_rules(doc) + volume_rules.check(doc)
     if isinstance(doc, World):
         return out + world_paths(doc)
     if isinstance(doc, Launch):

@@ -127,6 +127,16 @@ _RULES = [
     Rule("soft-body-mesh", W, "A soft body without a mesh (AMBF skips it) or with a collision primitive it does not use",
          "`soft bodies: [S]` with `mesh: ''`"),
     Rule("soft-body-mass", W, "A soft body without mass (AMBF uses 1 kg) or with mass <= 0", "`mass: 0` on a soft body"),
+    Rule("volume-images", E, "A volume's `images` lacks path, prefix, format or count, or counts no slice or more "
+         "than 4096 (AMBF skips the volume)", "`images: {path: slices/, prefix: s_, format: png}` with no count"),
+    Rule("volume-slice-missing", E, "A slice file of a volume (path + prefix + index + format) is missing, outside "
+         "the scene's tree or not a regular file", "`count: 64` with slices 0..62 on disk"),
+    Rule("volume-slice-unreadable", E, "A slice of a volume is not an image Pillow reads, or not a single-channel one",
+         "`bone_3.png` that holds text"),
+    Rule("volume-slice-size", E, "The slices of a volume are not all the same size", "a 64x64 slice among 128x128 ones"),
+    Rule("volume-too-large", E, "A volume of more than 512^3 voxels", "`count: 2000` slices of 2048x2048"),
+    Rule("volume-dimensions", E, "A volume's `dimensions` (times its scale) are not all positive",
+         "`dimensions: {x: 0.04, y: 0, z: 0.04}`"),
     Rule("soft-body-fixed-nodes", E, "A fixed node index outside the nodes of the soft body's mesh (AMBF writes "
          "past its node array)", "`fixed nodes: [400]` on the 386-node corpus cloth"),
     Rule("soft-body-coefficient", W, "A soft-body stiffness, damping, friction or hardness outside Bullet's range "

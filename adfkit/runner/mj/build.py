@@ -137,10 +137,12 @@ def build_plan(world) -> Plan:
     losses = []
     for i, m in enumerate(scene.all_models()):
         ns = m.namespace or ""
-        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles)):
+        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles), ("volume", m.volumes)):
             for o in objs:
                 world._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
                             "MuJoCo engine; skipped", o, "play it with --engine pybullet")
+                world.not_played.append({"object": o.identifier, "what": kind,
+                                         "why": f"{kind}s are not played by the MuJoCo engine"})
         mine = {}
         if m.bodies:
             names: dict = {}

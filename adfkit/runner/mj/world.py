@@ -57,6 +57,8 @@ class MjWorld(EngineNeutral):
         self.wall_time = 0.0
         self.watch = stability.Watch()
         self.engine_warnings: list[str] = []     # MuJoCo's other warnings, with their time
+        self.volumes: list[dict] = []            # (volumes are played by the PyBullet world only)
+        self.not_played: list[dict] = []         # every part of the scene not played, with why
         stability.install_mujoco_handler()
         self.skipped: list[str] = []
         self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")   # MuJoCo 4's island sleeping
@@ -554,6 +556,7 @@ class MjWorld(EngineNeutral):
             "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
             "soft_bodies": [],   # not played by this engine (a runner-soft-body warning names each)
             **self.watch.report(), "engine_warnings": self.engine_warnings,
+            "volumes": self.volumes, "not_played": self.not_played,
         }
 
     def _renderer(self):
