@@ -168,3 +168,25 @@ def test_bad_input_is_a_clear_error(tmp_path, capsys):
         assert main(["view", str(BUNDLED), "--port", str(port)]) == 2
     err = capsys.readouterr().err
     assert "error[port-in-use]" in err and f"127.0.0.1:{port}" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("scene, soft, volume", [("soft_phantom", 1, False), ("drilling", 0, True)])
+def test_soft_bodies_deform_and_volumes_show_in_the_page(scene, soft, volume):
+    from adfkit.viewer.server import Viewer
+    v = Viewer(ROOT / "sample_scenes" / scene / "launch.yaml", None, "pybullet", "127.0.0.1", _free_port())
+    v.load()
+    v.start()
+    try:
+        assert len(v.soft_nodes) == soft
+        for s, h in v.soft_nodes:
+            before = np.array(h.vertices)
+            with v.lock:
+                v.world.run(0.3)          # the probe presses into the skin
+            v.update_poses()
+            assert np.abs(np.array(h.vertices) - before).max() > 1e-4
+        drawn = [sb for sb, _ in v.body_nodes if getattr(sb, "surface", None) is not None]
+        assert bool(drawn) == volume
+        if volume:
+            assert drawn[0].key.endswith("VOLUME Bone") and len(drawn[0].surface[1]) > 1000
+    finally:
+        v.close()

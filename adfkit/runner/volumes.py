@@ -73,6 +73,8 @@ def build_volumes(world, models) -> None:
             sb.ref_in_body = np.eye(4)
             sb.body_world_matrix = pose
             sb._parts = None          # no ADF collision parts: the iso-surface mesh is its collision
+            sb.surface = (np.asarray(verts, dtype=np.float32), np.asarray(faces, dtype=np.uint32),
+                          tuple(rgba(vol) or BONE))   # what a viewer draws of it (its own frame)
             world.bodies.append(sb)
             world.volumes.append({"object": vol.identifier, "key": sb.key, "voxels": list(data.voxels.shape[::-1]),
                                   "dimensions_m": data.dimensions.tolist(), "triangles": int(len(faces)),

@@ -54,6 +54,7 @@ class Viewer:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self.body_nodes: list = []          # (sim body, frame handle)
+        self.soft_nodes: list = []          # (soft body, mesh handle): vertices resent each frame
         self.ghost_nodes: list = []         # (sim ghost, frame handle)
         self.toggled: dict[str, list] = {"collision": [], "ghosts": [], "joints": [], "frustums": []}
         self.contacts = None
@@ -144,7 +145,9 @@ class Viewer:
         from . import panels
         for i, sb in enumerate(w.bodies):
             frame = scene.add_frame(f"/bodies/b{i}", show_axes=False)
-            for k, part in enumerate(geometry.visual_parts(sb.model, sb.body)):
+            surface = getattr(sb, "surface", None)      # a volume's iso-surface (runner/volumes.py)
+            parts = [geometry.Part(*surface)] if surface is not None else geometry.visual_parts(sb.model, sb.body)
+            for k, part in enumerate(parts):
                 h = scene.add_mesh_simple(f"/bodies/b{i}/visual{k}", part.vertices, part.faces,
                                           color=tuple(part.colour[:3]), opacity=part.colour[3] if part.colour[3] < 1 else None)
                 h.on_click(lambda _e, sb=sb: panels.show_body(self, sb))
@@ -154,6 +157,7 @@ class Viewer:
                                           visible=False)
                 self.toggled["collision"].append(h)
             self.body_nodes.append((sb, frame))
+        self._draw_soft_bodies()
         models = list(self.scene.all_models())
         for j, g in enumerate(w.ghosts):
             model = next((m for m in models if any(x is g.ghost for x in m.ghost_objects)), None)
@@ -169,6 +173,23 @@ class Viewer:
         self._draw_joint_frames()
         self._draw_cameras()
         self.update_poses()
+
+    def _draw_soft_bodies(self) -> None:
+        """Soft bodies as their simulation meshes, the nodes sent again with every frame."""
+        soft = getattr(self.world, "soft", None)
+        if soft is None:
+            return
+        from ..geometry.softmesh import placed_soft_mesh
+        from ..runner.shapes import rgba
+        for n, s in enumerate(soft.items):
+            try:
+                tris = np.asarray(placed_soft_mesh(s.model, s.soft).triangles, dtype=np.uint32)
+            except (AdfError, ValueError):
+                continue
+            colour = rgba(s.soft) or (0.85, 0.55, 0.5, 1.0)
+            h = self.server.scene.add_mesh_simple(f"/soft/s{n}", s.nodes(self.world.cid).astype(np.float32), tris,
+                                                  color=tuple(colour[:3]), side="double")
+            self.soft_nodes.append((s, h))
 
     def _draw_joint_frames(self) -> None:
         from ..model.semantics import joint_frames
@@ -207,6 +228,8 @@ class Viewer:
                 m = sb.world_matrix()
                 if np.all(np.isfinite(m)):
                     frame.position, frame.wxyz = tuple(m[:3, 3]), _wxyz(m)
+            for s, h in self.soft_nodes:
+                h.vertices = s.nodes(w.cid).astype(np.float32)
             for g, frame in self.ghost_nodes:
                 if frame.visible:
                     m = w.ghost_pose(g)
