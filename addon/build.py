@@ -341,6 +341,9 @@ def _constraint(obj, j, p, c) -> None:
     bpy.ops.rigidbody.constraint_add(type=RBC_TYPE.get(kind, "GENERIC_SPRING"))
     rbc = obj.rigid_body_constraint
     rbc.object1, rbc.object2 = p, c
+    # which ends live in another file (kept as written on export); an end that was here and is
+    # cleared later is the modeller's doing, and export refuses it
+    obj["adf_external_ends"] = ",".join(r for r, o in (("parent", p), ("child", c)) if o is None)
     lim = j.joint_limits
     if kind == JointKind.REVOLUTE and lim is not None and lim.low is not None and lim.high is not None:
         rbc.use_limit_ang_z, rbc.limit_ang_z_lower, rbc.limit_ang_z_upper = True, lim.low, lim.high

@@ -253,6 +253,16 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
     rbc = obj.rigid_body_constraint
     p = rbc.object1 if rbc is not None else None
     c = rbc.object2 if rbc is not None else None
+    external = set(str(obj.get("adf_external_ends", "")).split(","))
+    cleared = [r for r, o, ref in (("parent", p, j.parent), ("child", c, j.child))
+               if o is None and ref and r not in external]
+    if cleared:
+        # the end was a body of this scene at import (or set by hand), and has been cleared since
+        out.diagnostics.append(error("joint-reference", f"joint '{obj.name}': its {cleared[0]} was cleared (it was "
+                                     f"'{getattr(j, cleared[0])}')", where(obj),
+                                     f"set the rigid body constraint's {'first' if cleared[0] == 'parent' else 'second'}"
+                                     " object to an ADF body, or delete the joint"))
+        return None
     if (p is None and j.parent) or (c is None and j.child):
         # imported with a body that lives in another file: carried through as written
         out.diagnostics.append(warning("joint-reference", f"joint '{obj.name}': "

@@ -87,7 +87,14 @@ def draw_object(layout, obj) -> None:
     if adf.kind == "JOINT":
         rbc = obj.rigid_body_constraint
         if rbc is None or rbc.object1 is None or rbc.object2 is None:
-            layout.label(text="Set the constraint's parent (Object 1) and child (Object 2) bodies", icon="ERROR")
+            external = [e for e in str(obj.get("adf_external_ends", "")).split(",") if e]
+            missing = [r for r, o in (("parent", rbc and rbc.object1), ("child", rbc and rbc.object2)) if o is None]
+            if missing and set(missing) <= set(external):
+                layout.label(text=f"The {' and '.join(missing)} body is in another file: exported as written",
+                             icon="INFO")
+            else:
+                layout.label(text="Set the constraint's parent (Object 1) and child (Object 2) bodies: "
+                             "export refuses the joint until then", icon="ERROR")
     if adf.kind == "SENSOR":
         layout.label(text=f"{len(pg.rays)} rays")
         for r in pg.rays:

@@ -354,3 +354,31 @@ def test_every_geometry_operator_on_a_degenerate_mesh_finishes_or_says_why(addon
         except RuntimeError as exc:   # bpy raises an operator's ERROR report; an exception it let out is a traceback
             text = str(exc)
             assert text.startswith("Error: ") and "Traceback" not in text and " — " in text, (op, kw, text)
+
+
+def test_an_imported_joint_whose_child_is_cleared_is_refused_and_an_external_one_kept(addon, scene, tmp_path):
+    a, b = _cube("A"), _cube("B", location=(0, 0, 0.1))
+    for o in (a, b):
+        addon.authoring.mark(o, "BODY")
+    addon.authoring.add_joint(a, b, "revolute", name="J")
+    first = _export(addon, scene, tmp_path / "first", "m")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon.build.import_model(first.path)
+    j = bpy.data.objects["J"]
+    assert j.get("adf_external_ends") == ""
+    j.rigid_body_constraint.object2 = None          # the modeller clears the child
+    res = addon.export.export_scene(bpy.context.scene, tmp_path / "second", "m")
+    assert not res.ok
+    (d,) = [d for d in res.diagnostics if d.rule == "joint-reference"]
+    assert d.message == "joint 'J': its child was cleared (it was 'BODY B')" and "delete the joint" in d.hint
+    # a joint to a body in another file (imported without it) is carried through as written
+    text = first.path.read_text().replace("- BODY B\n", "", 1)
+    start, end = text.index("\nBODY B:\n") + 1, text.index("\nJOINT J:\n") + 1   # B's mapping, written before J's
+    alone = tmp_path / "alone.yaml"
+    alone.write_text(text[:start] + text[end:])
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon.build.import_model(alone)
+    assert bpy.data.objects["J"].get("adf_external_ends") == "child"
+    res = addon.export.export_scene(bpy.context.scene, tmp_path / "third", "m")
+    assert res.ok and [d.message for d in res.diagnostics if d.rule == "joint-reference"] == [
+        "joint 'J': child body is not in this scene; kept as written"]
