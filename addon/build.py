@@ -371,7 +371,9 @@ def _scene_snapshot(scene, doc: ModelFile) -> None:
     kept = {key: [[o.identifier, fields.snapshot_text(o)] for o in getattr(doc, attr) if o.defined]
             for key, attr in KEPT_LISTS.items() if getattr(doc, attr)}
     scene.adf.snapshot = json.dumps({"keys": text if text.strip() != "{}" else "", "order": order,
-                                     "present": sorted(doc.present_lists), "kept": kept})
+                                     "present": sorted(doc.present_lists), "kept": kept,
+                                     # the folder relative paths (shaders, volume slices) were written against
+                                     "source_dir": str(Path(doc.path).resolve().parent) if doc.path else None})
     scene.adf.use_namespace = doc.namespace is not None
     scene.adf.namespace = doc.namespace or ""
     scene.adf.use_ignore_inter_collision = doc.ignore_inter_collision is not None

@@ -5,6 +5,7 @@ import dataclasses
 import json
 import os
 import re
+import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -162,16 +163,71 @@ def export_scene(scene, out_dir: str | Path, name: str = "model", objects=None) 
     result = ExportResult(None, list(g.diagnostics))
     if any(d.severity >= Severity.ERROR for d in result.diagnostics):
         return result
+    source = json.loads(scene.adf.snapshot).get("source_dir") if scene.adf.snapshot else None
+    copies = rebase_paths(g.model, Path(source), out_dir) if source else []
     text = dumps(g.model)
     pending = {out_dir / j.directory / j.filename for j in g.jobs}
+    # the folder exists while the text is validated (paths through it, such as ../x, resolve);
+    # a folder made for a refused export is taken away again
+    made = next((p for p in reversed([out_dir, *out_dir.parents]) if not p.exists()), None)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    copied = []
+    for src, dst in copies:          # shader and slice files the new file names (rebase_paths)
+        if not dst.exists():
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(src, dst)
+            copied.append(dst)
     result.diagnostics = merge_findings(result.diagnostics, validate(text, target, pending))
     if any(d.severity >= Severity.ERROR for d in result.diagnostics):
+        for f in copied:
+            f.unlink(missing_ok=True)
+        if made is not None:
+            shutil.rmtree(made, ignore_errors=True)
         return result
+    result.written.extend(copied)
     _run_jobs(g.jobs, out_dir, result)
     atomic_write_text(target, text)
     result.path = target
     result.written.append(target)
     return result
+
+
+def rebase_paths(model: ModelFile, source_dir: Path, out_dir: Path) -> list[tuple[Path, Path]]:
+    """Paths to folders of files the add-on does not edit (shaders, volume slices), written
+    relative to the imported file, made to resolve from the exported one: relative to the new
+    file when the folder stays inside its scene tree (adfkit.inputs), else the files are copied
+    into the output folder under the same folder name. Absolute paths stay as they are.
+    Returns the (source, destination) copies to make."""
+    from adfkit import inputs
+    tree = inputs.tree_of(out_dir / "model.yaml")
+    copies: list[tuple[Path, Path]] = []
+
+    def rebase(text: str | None, names: list[str]) -> str | None:
+        if not text or os.path.isabs(text):
+            return text
+        folder = (source_dir / text).resolve()
+        if tree.contains(folder / (names[0] if names else ".")):
+            new = os.path.relpath(folder, out_dir.resolve())
+            return new + ("/" if text.endswith("/") and not new.endswith("/") else "")
+        local = Path(*[p for p in Path(text).parts if p not in ("..", ".")]) if Path(text).parts else Path(".")
+        copies.extend((folder / n, out_dir / local / n) for n in names if (folder / n).is_file())
+        return local.as_posix() + ("/" if text.endswith("/") else "")
+
+    def shader_files(sh) -> list[str]:
+        return [n for n in (sh.vertex, sh.fragment) if n]
+
+    for obj in model.all_objects():
+        for attr in ("shaders", "preprocessing_shaders", "depth_compute_shaders"):
+            sh = getattr(obj, attr, None)
+            if sh is not None:
+                sh.path = rebase(sh.path, shader_files(sh))
+        im = getattr(obj, "images", None)
+        if im is not None and im.count and im.prefix is not None and im.format:
+            names = [f"{im.prefix}{i}.{str(im.format).lstrip('.')}" for i in range(min(int(im.count), 4096))]
+            im.path = rebase(im.path, names)
+    if getattr(model, "shaders", None) is not None:
+        model.shaders.path = rebase(model.shaders.path, shader_files(model.shaders))
+    return copies
 
 
 def _run_jobs(jobs, out_dir: Path, result: ExportResult) -> None:

@@ -382,3 +382,49 @@ def test_an_imported_joint_whose_child_is_cleared_is_refused_and_an_external_one
     res = addon.export.export_scene(bpy.context.scene, tmp_path / "third", "m")
     assert res.ok and [d.message for d in res.diagnostics if d.rule == "joint-reference"] == [
         "joint 'J': child body is not in this scene; kept as written"]
+
+
+def test_export_to_a_new_folder_keeps_shader_and_volume_slice_paths_resolving(addon, scene, tmp_path):
+    """Shader folders and volume slice folders are not copied: export rewrites them relative to
+    the new file, and the validator (which reads every slice and checks every shader) passes."""
+    pytest.importorskip("skimage")
+    from adfkit.scenes.drilling import write_drilling
+    from adfkit.validator.engine import validate_file
+    src = write_drilling(tmp_path / "a" / "scene").parent
+    (src / "shaders").mkdir()
+    for f in ("bone.vs", "bone.fs"):
+        (src / "shaders" / f).write_text("// shader\n")
+    drill = src / "drill.yaml"
+    drill.write_text(drill.read_text().replace("  iso-surface value: 0.5\n",
+                     "  iso-surface value: 0.5\n  shaders: {path: shaders/, vertex: bone.vs, fragment: bone.fs}\n"))
+    addon.build.import_model(drill)
+    res = _export(addon, scene, tmp_path / "b" / "out", "drill")
+    back, _ = read_file(res.path)
+    (vol,) = back.volumes
+    assert vol.images.path == "../../a/scene/slices/" and vol.shaders.path == "../../a/scene/shaders/"
+    assert [d for d in validate_file(res.path).diagnostics if d.severity >= Severity.WARNING] == []
+    # written as they were, the same paths would point nowhere: the validator says so
+    stale = res.path.read_text().replace("../../a/scene/", "")
+    res.path.write_text(stale)
+    rules = sorted({d.rule for d in validate_file(res.path).diagnostics if d.severity >= Severity.WARNING})
+    assert rules == ["missing-shader", "volume-slice-missing"]
+
+
+def test_export_far_away_copies_the_slices_and_shaders_it_names(addon, scene, tmp_path):
+    """A folder the new file could only reach outside its scene tree is copied into the output."""
+    pytest.importorskip("skimage")
+    import shutil
+    import tempfile
+    from adfkit.scenes.drilling import write_drilling
+    from adfkit.validator.engine import validate_file
+    src = write_drilling(tmp_path / "scene").parent
+    addon.build.import_model(src / "drill.yaml")
+    far = Path(tempfile.mkdtemp(dir="/var/tmp")) / "a" / "b" / "c" / "out"
+    try:
+        res = _export(addon, scene, far, "drill")
+        back, _ = read_file(res.path)
+        assert back.volumes[0].images.path == "slices/"
+        assert sorted(p.name for p in (far / "slices").iterdir()) == sorted(p.name for p in (src / "slices").iterdir())
+        assert [d for d in validate_file(res.path).diagnostics if d.severity >= Severity.WARNING] == []
+    finally:
+        shutil.rmtree(far.parents[3], ignore_errors=True)

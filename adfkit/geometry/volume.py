@@ -68,7 +68,7 @@ def load_volume(model, vol) -> VolumeData:
     where = _where(vol, "images")
     slices, size, peak = [], None, 1.0
     for i, f in enumerate(files):
-        inputs.check_file(f, "image", tree=tree, referrer=where, what=f"slice {i} of volume '{vol.identifier}'")
+        inputs.check_file(f, "image", tree=tree, referrer=where, what=f"slice {i}")
         try:
             with Image.open(f) as img:
                 img.load()
