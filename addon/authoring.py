@@ -76,13 +76,17 @@ def fix_selected_nodes(obj, replace: bool = True) -> list[int]:
     return picked
 
 
-def mesh_volume(obj) -> tuple[float, bool]:
-    """(volume in m³ with the object's scale, closed?) of a mesh object; an open mesh gives
-    its convex hull's volume (bmesh, no geometry packages needed)."""
+def mesh_volume(obj, evaluated: bool = False) -> tuple[float, bool]:
+    """(volume in m³ with the object's scale, closed?) of a mesh object, its modifiers applied
+    when ``evaluated`` (a Solidify gives a sheet its thickness); an open mesh gives its convex
+    hull's volume (bmesh, no geometry packages needed)."""
     import bmesh
     bm = bmesh.new()
     try:
-        bm.from_mesh(obj.data)
+        if evaluated and len(obj.modifiers):
+            bm.from_object(obj, bpy.context.evaluated_depsgraph_get())
+        else:
+            bm.from_mesh(obj.data)
         bm.transform(Matrix.Diagonal((*obj.matrix_world.to_scale(), 1.0)))
         closed = len(bm.faces) > 0 and all(e.is_manifold for e in bm.edges)
         if not closed and len(bm.verts) >= 4:
@@ -99,11 +103,20 @@ def _mass_group(obj):
 
 
 def mass_from_density(obj) -> float | None:
-    """Set the mass of a body to density × mesh volume unless it was typed by hand."""
+    """Set the mass of a body to density × mesh volume unless it was typed by hand. A soft body
+    takes the volume of its evaluated mesh (what export writes) and must be closed: a sheet has
+    no volume, and the reason is kept in ``obj.adf.soft.mass_note`` for the panel."""
     pg = _mass_group(obj)
+    soft = obj.adf.kind == "SOFT_BODY"
     if pg.mass_typed or obj.type != "MESH" or not len(obj.data.polygons):
         return None
-    vol, _ = mesh_volume(obj)
+    vol, closed = mesh_volume(obj, evaluated=soft)
+    if soft:
+        pg.mass_note = "" if closed and vol > 0 else (
+            "no mass from density: the mesh (modifiers applied) is not closed, so it has no volume; "
+            "give it thickness (Solidify) or type the mass")
+        if pg.mass_note:
+            return None
     if vol <= 0:
         return None
     pg.use_mass, pg.mass = True, float(obj.adf.density * vol)
@@ -244,7 +257,16 @@ def estimate_inertia(obj, mass: float | None = None, density: float | None = Non
 
 
 def estimate_body(obj) -> None:
-    """What the "Estimate inertia" button does: keep a mass typed by hand, else use density."""
+    """What the "Estimate inertia" button does: keep a mass typed by hand, else use density. A
+    soft body has no rigid inertia: its mass from density over its evaluated, closed volume."""
+    if obj.adf.kind == "SOFT_BODY":
+        pg = obj.adf.soft
+        if pg.mass_typed:
+            return
+        if mass_from_density(obj) is None:
+            _fail("mesh-not-closed", f"soft body '{obj.name}': {pg.mass_note or 'no volume to take a mass from'}",
+                  obj, "give the sheet thickness with a Solidify modifier, or type the mass")
+        return
     b = obj.adf.body
     typed = b.use_mass and b.mass_typed
     estimate_inertia(obj, mass=b.mass if typed else None, density=None if typed else obj.adf.density)

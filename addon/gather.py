@@ -148,8 +148,8 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
     visual = None
     first_name = b.mesh
     if obj.type == "MESH" and len(obj.data.polygons):
-        # a soft body's nodes are its own vertices (fixed nodes index them): no modifiers there
-        arr = meshes.mesh_arrays(obj, evaluated=out.options.apply_modifiers and not isinstance(b, SoftBody))
+        # a soft body's nodes are the vertices written (its fixed nodes index the same mesh)
+        arr = meshes.mesh_arrays(obj, evaluated=out.options.apply_modifiers)
         digest = meshes.digest([arr])
         name = b.mesh if b.mesh else f"{obj.name}.OBJ"
         src = Path(obj.adf.mesh_source) if obj.adf.mesh_source else None
@@ -396,20 +396,32 @@ def gather_light(obj, out: Gathered) -> Light:
 
 # --- soft bodies ----------------------------------------------------------------------------
 
-def fixed_nodes(obj) -> list[int] | None:
-    """Node indices of the vertices in the soft body's fixed-node vertex group (None: no group)."""
+def fixed_nodes(obj, evaluated: bool = False) -> list[int] | None:
+    """Node indices of the vertices in the soft body's fixed-node vertex group (None: no group),
+    counted on the mesh export writes: with ``evaluated``, the one its modifiers make (a
+    Solidify copies the group to the new shell's vertices, so both faces of a fixed rim stay)."""
     grp = obj.vertex_groups.get(obj.adf.soft.fixed_group) if obj.type == "MESH" else None
     if grp is None:
         return None
-    members = [v.index for v in obj.data.vertices if any(g.group == grp.index and g.weight > 0 for g in v.groups)]
-    if not members:
-        return []
-    from adfkit.geometry.softmesh import nodes_at, unique_nodes
-    co = np.empty(len(obj.data.vertices) * 3, np.float32)
-    obj.data.vertices.foreach_get("co", co)
-    co = co.reshape(-1, 3).astype(np.float64)
-    # AMBF's numbering: unique vertex positions in order of first appearance
-    return nodes_at(unique_nodes(co, np.zeros((0, 3), dtype=np.int64)), co[members])
+    eo = me = None
+    if evaluated and len(obj.modifiers):
+        import bpy
+        eo = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        me = eo.to_mesh()
+    try:
+        data = me if me is not None else obj.data
+        members = [v.index for v in data.vertices if any(g.group == grp.index and g.weight > 0 for g in v.groups)]
+        if not members:
+            return []
+        from adfkit.geometry.softmesh import nodes_at, unique_nodes
+        co = np.empty(len(data.vertices) * 3, np.float32)
+        data.vertices.foreach_get("co", co)
+        co = co.reshape(-1, 3).astype(np.float64)
+        # AMBF's numbering: unique vertex positions in order of first appearance
+        return nodes_at(unique_nodes(co, np.zeros((0, 3), dtype=np.int64)), co[members])
+    finally:
+        if eo is not None:
+            eo.to_mesh_clear()
 
 
 def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
@@ -424,7 +436,7 @@ def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
         out.diagnostics.append(error("body-value", f"soft body '{obj.name}': {exc}", where(obj)))
     _pose_and_scale(obj, sb)
     _gather_geometry(obj, sb, out, paths)
-    fixed = fixed_nodes(obj)
+    fixed = fixed_nodes(obj, evaluated=out.options.apply_modifiers)
     old = sb.config.fixed_nodes if sb.config is not None else None
     if fixed is not None and sorted(set(old or [])) != fixed and not (fixed == [] and old is None):
         if sb.config is None:

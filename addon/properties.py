@@ -93,7 +93,9 @@ _TYPED = {"mass_typed": BoolProperty(name="Mass typed by hand", default=False,
 BodyProps = _make_group("AdfBodyProps", fields.BODY, dict(_TYPED), {"mass": (_mass_typed, None)})
 SoftProps = _make_group("AdfSoftProps", fields.SOFT, {
     **_TYPED, "fixed_group": StringProperty(name="Fixed nodes group", default="fixed nodes",
-                                             description="vertex group whose vertices are the soft body's fixed nodes")},
+                                             description="vertex group whose vertices are the soft body's fixed nodes"),
+    "mass_note": StringProperty(name="Mass note", options={"HIDDEN"},
+                                description="why the mass could not be taken from density × volume")},
     {"mass": (_mass_typed, None)})
 GhostProps = _make_group("AdfGhostProps", fields.GHOST)
 JointProps = _make_group("AdfJointProps", fields.JOINT, None, {k: _joint_limits for k in _LIMIT_PROPS})

@@ -61,6 +61,10 @@ def draw_object(layout, obj) -> None:
         sub.prop(pg, f.prop)
     if adf.kind == "SOFT_BODY":
         layout.prop(adf, "density")
+        if pg.mass_note and not pg.mass_typed:
+            layout.label(text=pg.mass_note, icon="ERROR")
+        elif pg.use_mass and not pg.mass_typed:
+            layout.label(text="Mass from density × volume of the mesh with its modifiers", icon="INFO")
         if obj.type == "MESH":
             layout.prop_search(pg, "fixed_group", obj, "vertex_groups", text="Fixed nodes")
             layout.operator("adf.fix_selected_nodes")

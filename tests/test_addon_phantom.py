@@ -477,3 +477,41 @@ def test_operators_run_from_blender(addon, scene, tmp_path):
     doc, _ = read_file(tmp_path / "ops.yaml")
     assert [b.identifier for b in doc.bodies] == ["BODY Rod"] and len(doc.soft_bodies) == 1
     assert len(doc.soft_bodies[0].config.fixed_nodes) == len(pad.data.vertices)   # all were selected
+
+
+def test_a_tissue_pad_with_thickness_exports_its_shell_and_its_mass(addon, scene, tmp_path):
+    """Grid + Solidify as a soft body, border nodes fixed, through the operators: the exported
+    mesh is the solid shell (both faces), the mass is density × its volume, the estimate acts on
+    the soft body (not on rigid-body settings), and a flat sheet says why it has no mass."""
+    import numpy as np
+    from adfkit.geometry.softmesh import load_soft_mesh
+    n, size, thick = 9, 0.1, 0.004
+    pad = _grid("Pad", n, size)
+    solid = pad.modifiers.new("Solidify", "SOLIDIFY")
+    solid.thickness = thick
+    pad.adf.density = 1000.0
+    bpy.context.view_layer.objects.active = pad
+    pad.select_set(True)
+    assert bpy.ops.adf.mark(kind="SOFT_BODY") == {"FINISHED"}
+    s = pad.adf.soft
+    assert s.use_mass and s.mass == pytest.approx(1000.0 * size * size * thick, rel=1e-4) and s.mass_note == ""
+    border = [v.index for v in pad.data.vertices if max(abs(v.co.x), abs(v.co.y)) > size / 2 - 1e-6]
+    for v in pad.data.vertices:
+        v.select = v.index in border
+    assert bpy.ops.adf.fix_selected_nodes() == {"FINISHED"}
+    assert bpy.ops.adf.estimate_inertia() == {"FINISHED"}          # acts on the soft body's mass
+    assert pad.adf.body.use_inertia is False
+    res = _export(addon, scene, tmp_path / "out")
+    doc, _ = read_file(res.path)
+    (sb,) = doc.soft_bodies
+    nodes = load_soft_mesh(tmp_path / "out" / doc.low_resolution_path / sb.mesh).nodes
+    assert len(nodes) == 2 * len(pad.data.vertices)                  # both faces of the shell
+    assert np.ptp(nodes[:, 2]) == pytest.approx(thick, rel=1e-3)
+    assert len(sb.config.fixed_nodes) == 2 * len(border)              # the rim fixed on both faces
+    assert sb.mass == pytest.approx(1000.0 * size * size * thick, rel=1e-4)
+    # a flat sheet says why it has no mass from density, and the estimate says so too
+    pad.modifiers.remove(solid)
+    addon.authoring.mass_from_density(pad)
+    assert "not closed" in s.mass_note
+    with pytest.raises(RuntimeError, match="Solidify"):
+        bpy.ops.adf.estimate_inertia()
