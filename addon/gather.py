@@ -168,12 +168,13 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
 def _shape_entry(child, body_obj) -> ShapeEntry:
     s = child.adf.shape
     geo = Geometry()
+    tidy = fields.tidy     # Blender keeps these in single precision: the shortest decimal, not 0.0099999997...
     if s.shape == "BOX":
-        geo.x, geo.y, geo.z = (float(v) for v in s.size)
+        geo.x, geo.y, geo.z = (tidy(v) for v in s.size)
     elif s.shape == "SPHERE":
-        geo.radius = float(s.radius)
+        geo.radius = tidy(s.radius)
     else:
-        geo.radius, geo.height, geo.axis = float(s.radius), float(s.height), s.axis
+        geo.radius, geo.height, geo.axis = tidy(s.radius), tidy(s.height), s.axis
     return ShapeEntry(shape=s.shape.title(), geometry=geo, offset=relative_pose(child, body_obj))
 
 
@@ -324,7 +325,8 @@ def gather_sensor(obj, out: Gathered) -> Sensor:
     s = fields.from_snapshot(Sensor, obj.adf.snapshot, f"blender:{obj.name}")
     s.identifier, s.name = identifier(obj), s.name or obj.name
     fields.merge(s, fields.SENSOR, read_group(obj.adf.sensor, fields.SENSOR))
-    rays = [Ray(offset=Vec3(*map(float, r.offset)), direction=Vec3(*map(float, r.direction))) for r in obj.adf.sensor.rays]
+    rays = [Ray(offset=Vec3(*map(fields.tidy, r.offset)), direction=Vec3(*map(fields.tidy, r.direction)))
+            for r in obj.adf.sensor.rays]
     old = [(*r.offset, *r.direction) for r in (s.array or []) if r.offset is not None and r.direction is not None]
     if rays and not fields.same32(old, [(*r.offset, *r.direction) for r in rays]):
         s.array = rays
@@ -347,7 +349,7 @@ def _vec_in_parent(obj, local, point: bool):
     if parent is not None:
         inv = parent.matrix_world.inverted()
         v = inv @ v if point else inv.to_3x3() @ v
-    return Vec3(*(round(float(c), 9) + 0.0 for c in v))
+    return Vec3(*(round(fields.tidy(c), 9) + 0.0 for c in v))
 
 
 def gather_camera(obj, out: Gathered) -> Camera:
@@ -367,11 +369,11 @@ def gather_camera(obj, out: Gathered) -> Camera:
     if obj.type == "CAMERA":
         cam = obj.data
         if not fields.same32(c.field_view_angle, cam.angle_y):
-            c.field_view_angle = float(cam.angle_y)
+            c.field_view_angle = fields.tidy(cam.angle_y)
         from adfkit.model.objects import ClippingPlane
         cp = c.clipping_plane or ClippingPlane()
         if not fields.same32((cp.near, cp.far), (cam.clip_start, cam.clip_end)):
-            c.clipping_plane = ClippingPlane(near=float(cam.clip_start), far=float(cam.clip_end))
+            c.clipping_plane = ClippingPlane(near=fields.tidy(cam.clip_start), far=fields.tidy(cam.clip_end))
     return c
 
 
@@ -387,7 +389,7 @@ def gather_light(obj, out: Gathered) -> Light:
         li.direction = _vec_in_parent(obj, Vector((0, 0, -1)), False)
     if obj.type == "LIGHT" and obj.data.type == "SPOT":
         if not fields.same32(li.cutoff_angle, obj.data.spot_size / 2.0):
-            li.cutoff_angle = float(obj.data.spot_size) / 2.0
+            li.cutoff_angle = fields.tidy(obj.data.spot_size) / 2.0
     if li.shadow_quality is None:
         out.diagnostics.append(warning("light-shadow", f"light '{obj.name}' has no shadow quality", where(obj),
                                        "AMBF leaves it uninitialised; set it (0-5)"))

@@ -428,3 +428,27 @@ def test_export_far_away_copies_the_slices_and_shaders_it_names(addon, scene, tm
         assert [d for d in validate_file(res.path).diagnostics if d.severity >= Severity.WARNING] == []
     finally:
         shutil.rmtree(far.parents[3], ignore_errors=True)
+
+
+def _float32_noise(text: str) -> list[str]:
+    """Numbers written as a float32's full expansion (0.009999999776482582 for 0.01): twelve
+    digits or more where the float32's shortest decimal is the same number."""
+    import re
+
+    import numpy as np
+    noisy = []
+    for m in re.findall(r"(?<![\w.])-?\d+\.\d{12,}(?:e-?\d+)?", text):
+        x = float(m)
+        short = float(np.format_float_positional(np.float32(x), unique=True, trim="-"))
+        if np.float32(short) == np.float32(x) and short != x:
+            noisy.append(m)
+    return noisy
+
+
+def test_values_the_add_on_writes_carry_no_float32_noise(addon, scene, tmp_path):
+    """Primitive sizes, camera and light keys, poses: the shortest decimal of Blender's float32."""
+    build_everything(addon, tmp_path)
+    fitted = addon.authoring.fit_collision_primitive(bpy.data.objects["Ring"], "CAPSULE")
+    assert fitted is not None
+    res = _export(addon, scene, tmp_path / "out")
+    assert _float32_noise(res.path.read_text()) == []
