@@ -375,6 +375,9 @@ def _scene_snapshot(scene, doc: ModelFile) -> None:
                                      # the folder relative paths (shaders, volume slices) were written against
                                      "source_dir": str(Path(doc.path).resolve().parent) if doc.path else None})
     scene.adf.use_namespace = doc.namespace is not None
+    scene.adf.use_gravity = doc.gravity is not None
+    if doc.gravity is not None:
+        scene.adf.gravity = tuple(doc.gravity)
     scene.adf.namespace = doc.namespace or ""
     scene.adf.use_ignore_inter_collision = doc.ignore_inter_collision is not None
     scene.adf.ignore_inter_collision = bool(doc.ignore_inter_collision)

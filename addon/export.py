@@ -51,6 +51,9 @@ def _model_level(scene) -> tuple[ModelFile, dict]:
         doc.namespace = scene.adf.namespace
     if scene.adf.use_ignore_inter_collision:
         doc.ignore_inter_collision = scene.adf.ignore_inter_collision
+    if scene.adf.use_gravity:
+        from adfkit.model.pose import Vec3
+        doc.gravity = Vec3(*(fields.tidy(g) for g in scene.adf.gravity))
     return doc, snap.get("order", {})
 
 

@@ -22,6 +22,8 @@ class ADF_OT_export(bpy.types.Operator):
     bl_description = "Validate and write the scene's ADF objects as MODEL.yaml plus meshes"
     directory: StringProperty(subtype="DIR_PATH")
     model_name: StringProperty(name="Model name", default="model")
+    use_selection: BoolProperty(name="Selected only", default=False,
+                                description="export the selected ADF objects only (joints need both bodies selected)")
 
     def invoke(self, context, event):
         context.window_manager.fileselect_add(self)
@@ -29,7 +31,8 @@ class ADF_OT_export(bpy.types.Operator):
 
     def execute(self, context):
         from .export import export_scene
-        res = export_scene(context.scene, self.directory, self.model_name)
+        objects = list(context.selected_objects) if self.use_selection else None
+        res = export_scene(context.scene, self.directory, self.model_name, objects)
         context.scene.adf.findings = "\n".join(f"{d.severity.name}: {d.message}" for d in res.diagnostics)
         if not res.ok:
             self.report({"ERROR"}, "Export refused, nothing written: " + "; ".join(
@@ -177,10 +180,33 @@ class ADF_OT_show_joints(bpy.types.Operator):
     bl_idname = "adf.show_joints"
     bl_label = "Show/hide joints"
     show: BoolProperty(name="Show", default=True)
+    passive_only: BoolProperty(name="Passive joints only", default=False)
 
     def execute(self, context):
         from .tuning import show_joints
-        show_joints(context.scene, self.show)
+        show_joints(context.scene, self.show, self.passive_only)
+        return {"FINISHED"}
+
+
+class ADF_OT_show_collision(bpy.types.Operator):
+    bl_idname = "adf.show_collision"
+    bl_label = "Show/hide collision shapes"
+    show: BoolProperty(name="Show", default=False)
+
+    def execute(self, context):
+        from .tuning import show_collision
+        self.report({"INFO"}, f"{show_collision(context.scene, self.show)} collision objects")
+        return {"FINISHED"}
+
+
+class ADF_OT_rename_joints(bpy.types.Operator):
+    bl_idname = "adf.rename_joints"
+    bl_label = "Name joints after their bodies"
+    bl_description = "Rename every joint 'parent-child' from its constraint's bodies"
+
+    def execute(self, context):
+        from .tuning import rename_joints
+        self.report({"INFO"}, f"{len(rename_joints(context.scene))} joints named")
         return {"FINISHED"}
 
 
@@ -272,7 +298,7 @@ class ADF_OT_check(bpy.types.Operator):
 CLASSES = (ADF_OT_export, ADF_OT_import, ADF_OT_mark, ADF_OT_generate_collision, ADF_OT_add_primitive,
            ADF_OT_estimate_inertia, ADF_OT_add_joint, ADF_OT_rope, ADF_OT_grasp, ADF_OT_ghost, ADF_OT_check,
            ADF_OT_estimate_all, ADF_OT_fit_primitive, ADF_OT_estimate_gains, ADF_OT_show_joints, ADF_OT_cleanup,
-           ADF_OT_strip, ADF_OT_fix_nodes)
+           ADF_OT_strip, ADF_OT_fix_nodes, ADF_OT_show_collision, ADF_OT_rename_joints)
 
 
 def _menu_export(self, context):

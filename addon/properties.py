@@ -141,6 +141,9 @@ class AdfSceneProps(bpy.types.PropertyGroup):
     namespace: StringProperty(name="Namespace", default="")
     use_namespace: BoolProperty(name="Write namespace", default=False)
     ignore_inter_collision: BoolProperty(name="Ignore inter-collision", default=False)
+    use_gravity: BoolProperty(name="Model gravity", default=False,
+                              description="write the model's own gravity (bodies without one of their own use it)")
+    gravity: FloatVectorProperty(name="Gravity", default=(0.0, 0.0, -9.81), size=3, subtype="ACCELERATION")
     use_ignore_inter_collision: BoolProperty(name="Write ignore inter-collision", default=False)
     findings: StringProperty(name="Findings", description="last export's validation findings")
     rope_count: IntProperty(name="Elements", default=20, min=2, max=500)

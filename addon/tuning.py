@@ -76,14 +76,45 @@ def estimate_gains(scene, joints, frequency_hz: float = 2.0, damping_ratio: floa
     return done
 
 
-def show_joints(scene, show: bool) -> int:
-    """Hide or show every ADF joint (and its constraint empty) in the viewport."""
+def show_joints(scene, show: bool, passive_only: bool = False) -> int:
+    """Hide or show every ADF joint (and its constraint empty) in the viewport; with
+    ``passive_only`` only the joints marked passive (AMBF's add-on: "hide passive joints")."""
     n = 0
     for o in scene.objects:
-        if o.adf.kind == "JOINT":
+        if o.adf.kind == "JOINT" and (not passive_only or _passive(o)):
             o.hide_set(not show)
             n += 1
     return n
+
+
+def _passive(joint_obj) -> bool:
+    j = joint_obj.adf.joint
+    return bool(getattr(j, "use_passive", False) and getattr(j, "passive", False))
+
+
+def show_collision(scene, show: bool) -> int:
+    """Hide or show every collision shape and collision mesh of every body and ghost."""
+    n = 0
+    for o in scene.objects:
+        if o.adf.kind in ("COLLISION_SHAPE", "COLLISION_MESH"):
+            o.hide_set(not show)
+            n += 1
+    return n
+
+
+def rename_joints(scene) -> list[str]:
+    """Name every joint after its bodies, 'parent-child' (AMBF's add-on convention), keeping
+    names unique; returns the new names."""
+    done = []
+    for o in sorted((o for o in scene.objects if o.adf.kind == "JOINT"), key=lambda o: o.name):
+        rbc = o.rigid_body_constraint
+        if rbc is None or rbc.object1 is None or rbc.object2 is None:
+            continue
+        want = f"{rbc.object1.name}-{rbc.object2.name}"
+        if o.name != want:
+            o.name = want          # Blender appends .001 when the name is taken
+        done.append(o.name)
+    return done
 
 
 def cleanup(scene) -> list[str]:

@@ -137,6 +137,11 @@ class ADF_PT_sidebar(bpy.types.Panel):
         row = lay.row(align=True)
         row.prop(sc, "use_namespace", text="")
         row.prop(sc, "namespace")
+        row = lay.row(align=True)
+        row.prop(sc, "use_gravity", text="")
+        sub = row.row()
+        sub.enabled = sc.use_gravity
+        sub.prop(sc, "gravity")
         box = lay.box()
         box.label(text="Export")
         box.prop(sc, "precision")
@@ -148,6 +153,12 @@ class ADF_PT_sidebar(bpy.types.Panel):
         row = col.row(align=True)
         row.operator("adf.show_joints", text="Show joints").show = True
         row.operator("adf.show_joints", text="Hide joints").show = False
+        op = row.operator("adf.show_joints", text="Hide passive")
+        op.show, op.passive_only = False, True
+        row = col.row(align=True)
+        row.operator("adf.show_collision", text="Show collision").show = True
+        row.operator("adf.show_collision", text="Hide collision").show = False
+        col.operator("adf.rename_joints")
         col.operator("adf.cleanup")
         col.operator("adf.strip")
         box = lay.box()

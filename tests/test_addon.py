@@ -452,3 +452,34 @@ def test_values_the_add_on_writes_carry_no_float32_noise(addon, scene, tmp_path)
     assert fitted is not None
     res = _export(addon, scene, tmp_path / "out")
     assert _float32_noise(res.path.read_text()) == []
+
+
+def test_what_ambfs_own_add_on_had(addon, scene, tmp_path):
+    """Show/hide every collision shape, hide passive joints, name joints after their bodies,
+    a model-level gravity, export of the selection only."""
+    parts = build_everything(addon, tmp_path)
+    collision = [o for o in scene.objects if o.adf.kind in ("COLLISION_SHAPE", "COLLISION_MESH")]
+    assert collision
+    assert bpy.ops.adf.show_collision(show=False) == {"FINISHED"}
+    assert all(o.hide_get() for o in collision)
+    assert bpy.ops.adf.show_collision(show=True) == {"FINISHED"}
+    assert not any(o.hide_get() for o in collision)
+    joints = [o for o in scene.objects if o.adf.kind == "JOINT"]
+    passive = joints[0]
+    passive.adf.joint.use_passive, passive.adf.joint.passive = True, True
+    assert bpy.ops.adf.show_joints(show=False, passive_only=True) == {"FINISHED"}
+    assert [o.name for o in joints if o.hide_get()] == [passive.name]
+    assert bpy.ops.adf.rename_joints() == {"FINISHED"}
+    rbc = passive.rigid_body_constraint
+    assert passive.name.startswith(f"{rbc.object1.name}-{rbc.object2.name}")
+    scene.adf.use_gravity, scene.adf.gravity = True, (0.0, 0.0, -3.71)        # Mars
+    res = _export(addon, scene, tmp_path / "all")
+    doc, _ = read_file(res.path)
+    assert tuple(doc.gravity) == (0.0, 0.0, -3.71)
+    # only the selection: the base body and the camera, nothing else
+    for o in scene.objects:
+        o.select_set(o in (parts["base"], bpy.data.objects["Endoscope"]))
+    assert bpy.ops.adf.export_model(directory=str(tmp_path / "sel"), model_name="m", use_selection=True) == {"FINISHED"}
+    part, _ = read_file(tmp_path / "sel" / "m.yaml")
+    assert [b.name for b in part.bodies] == [parts["base"].name] and [c.name for c in part.cameras] == ["Endoscope"]
+    assert part.joints == [] and part.sensors == []
