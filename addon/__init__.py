@@ -3,11 +3,13 @@
 Blender-level code lives in this package; the ADF model, reader, writer and validator
 come from the ``adfkit`` package (bundled as a wheel, see the README, "Blender add-on").
 """
+
 from __future__ import annotations
 
 
 def register() -> None:
     from . import operators, properties, ui
+
     properties.register()
     operators.register()
     ui.register()
@@ -15,6 +17,7 @@ def register() -> None:
 
 def unregister() -> None:
     from . import operators, properties, ui
+
     ui.unregister()
     operators.unregister()
     properties.unregister()

@@ -3,6 +3,7 @@
 Each function raises :class:`adfkit.diagnostics.AdfError` with a readable message for bad
 input, so operators and scripts report the same thing.
 """
+
 from __future__ import annotations
 
 import math
@@ -34,14 +35,20 @@ def geometry(module: str):
     """``adfkit.geometry.<module>``, or a readable AdfError when its packages are missing
     (an extension built without the geometry wheels, a Blender with an older numpy)."""
     import importlib
+
     try:
         return importlib.import_module(f"adfkit.geometry.{module}")
     except ImportError as exc:
         missing = getattr(exc, "name", None) or str(exc)
-        raise AdfError(error("geometry-unavailable", f"this needs the geometry package '{missing}', which is not "
-                             "installed in Blender's Python", None,
-                             f"install the adfkit extension built with its geometry wheels ({GEOMETRY_PACKAGES}; "
-                             "see the README, 'Blender add-on')")) from None
+        raise AdfError(
+            error(
+                "geometry-unavailable",
+                f"this needs the geometry package '{missing}', which is not installed in Blender's Python",
+                None,
+                f"install the adfkit extension built with its geometry wheels ({GEOMETRY_PACKAGES}; "
+                "see the README, 'Blender add-on')",
+            )
+        ) from None
 
 
 def mark(obj, kind: str) -> None:
@@ -81,6 +88,7 @@ def mesh_volume(obj, evaluated: bool = False) -> tuple[float, bool]:
     when ``evaluated`` (a Solidify gives a sheet its thickness); an open mesh gives its convex
     hull's volume (bmesh, no geometry packages needed)."""
     import bmesh
+
     bm = bmesh.new()
     try:
         if evaluated and len(obj.modifiers):
@@ -112,9 +120,14 @@ def mass_from_density(obj) -> float | None:
         return None
     vol, closed = mesh_volume(obj, evaluated=soft)
     if soft:
-        pg.mass_note = "" if closed and vol > 0 else (
-            "no mass from density: the mesh (modifiers applied) is not closed, so it has no volume; "
-            "give it thickness (Solidify) or type the mass")
+        pg.mass_note = (
+            ""
+            if closed and vol > 0
+            else (
+                "no mass from density: the mesh (modifiers applied) is not closed, so it has no volume; "
+                "give it thickness (Solidify) or type the mass"
+            )
+        )
         if pg.mass_note:
             return None
     if vol <= 0:
@@ -143,9 +156,13 @@ def generate_collision(obj, threshold: float = 0.05, max_hulls: int = 16, repair
     mesh = _trimesh_of(obj)
     if not mesh.is_watertight:
         if not repair:
-            _fail("mesh-not-manifold", f"'{obj.name}' is not a closed 2-manifold mesh "
-                  f"({len(mesh.faces)} faces with open or non-manifold edges); convex decomposition needs a closed mesh",
-                  obj, "close the mesh (Mesh > Clean Up > Fill Holes, 3D-Print toolbox) or use primitive collision")
+            _fail(
+                "mesh-not-manifold",
+                f"'{obj.name}' is not a closed 2-manifold mesh "
+                f"({len(mesh.faces)} faces with open or non-manifold edges); convex decomposition needs a closed mesh",
+                obj,
+                "close the mesh (Mesh > Clean Up > Fill Holes, 3D-Print toolbox) or use primitive collision",
+            )
         mesh, _ = geometry("repair").repair_mesh(mesh)
     dec = decompose(mesh, DecompositionParams(threshold=threshold, max_hulls=max_hulls))
     for c in [c for c in obj.children if c.adf.kind in ("COLLISION_MESH", "COLLISION_SHAPE")]:
@@ -167,10 +184,19 @@ def generate_collision(obj, threshold: float = 0.05, max_hulls: int = 16, repair
     return made
 
 
-def add_collision_primitive(obj, shape: str = "BOX", size=(0.1, 0.1, 0.1), radius=0.05, height=0.1,
-                            axis: str = "z", offset: Matrix | None = None, name: str | None = None):
+def add_collision_primitive(
+    obj,
+    shape: str = "BOX",
+    size=(0.1, 0.1, 0.1),
+    radius=0.05,
+    height=0.1,
+    axis: str = "z",
+    offset: Matrix | None = None,
+    name: str | None = None,
+):
     """A collision primitive of ``obj``: a wire mesh child whose outline follows its size."""
     from .outline import update_outline
+
     name = name or f"{obj.name}.{shape.lower()}"
     e = _link(bpy.data.objects.new(name, bpy.data.meshes.new(name)))
     e.display_type = "WIRE"
@@ -208,8 +234,15 @@ def fit_collision_primitive(obj, shape: str = "CAPSULE", replace: bool = True):
             bpy.data.objects.remove(c, do_unlink=True)
     g = entry.geometry
     size = (g.x, g.y, g.z) if kind == "BOX" else (0.1, 0.1, 0.1)
-    made = add_collision_primitive(obj, kind, size=size, radius=g.radius or 0.05, height=g.height or 0.1,
-                                   axis=g.axis or "z", offset=_pose_matrix(entry.offset))
+    made = add_collision_primitive(
+        obj,
+        kind,
+        size=size,
+        radius=g.radius or 0.05,
+        height=g.height or 0.1,
+        axis=g.axis or "z",
+        offset=_pose_matrix(entry.offset),
+    )
     bpy.context.view_layer.update()
     return made
 
@@ -218,7 +251,9 @@ def _cone_from_cylinder(entry, mesh):
     """A cone on the cylinder's axis and extent, its base at the end where the mesh is wider
     (Bullet's cone: apex at +height/2 along its axis)."""
     import numpy as np
+
     from adfkit.model.pose import Quat
+
     pose = entry.offset
     rot = np.array(Quat(*pose.orientation).matrix())
     axis = rot[:, "xyz".index((entry.geometry.axis or "z").lower())]
@@ -227,7 +262,7 @@ def _cone_from_cylinder(entry, mesh):
     radial = np.linalg.norm(rel - np.outer(t, axis), axis=1)
     low = radial[t < 0].max(initial=0.0)
     high = radial[t >= 0].max(initial=0.0)
-    if high > low:   # wider at +axis: turn the cone over (half a turn about a perpendicular axis)
+    if high > low:  # wider at +axis: turn the cone over (half a turn about a perpendicular axis)
         perp = rot[:, ("xyz".index((entry.geometry.axis or "z").lower()) + 1) % 3]
         flip = Quat.from_axis_angle(tuple(map(float, perp)), math.pi)
         entry.offset = type(pose)(pose.position, (flip * pose.orientation).normalized())
@@ -241,8 +276,12 @@ def estimate_inertia(obj, mass: float | None = None, density: float | None = Non
     gmass = geometry("mass")
     mesh = _trimesh_of(obj)
     if not mesh.is_watertight:
-        _fail("mesh-not-closed", f"'{obj.name}' is not closed; its volume and inertia are undefined", obj,
-              "close the mesh, or give the inertia by hand")
+        _fail(
+            "mesh-not-closed",
+            f"'{obj.name}' is not closed; its volume and inertia are undefined",
+            obj,
+            "close the mesh, or give the inertia by hand",
+        )
     if mass is None and density is None:
         density = obj.adf.density
     props = gmass.mesh_mass_properties(mesh, density=density, mass=mass)
@@ -264,8 +303,12 @@ def estimate_body(obj) -> None:
         if pg.mass_typed:
             return
         if mass_from_density(obj) is None:
-            _fail("mesh-not-closed", f"soft body '{obj.name}': {pg.mass_note or 'no volume to take a mass from'}",
-                  obj, "give the sheet thickness with a Solidify modifier, or type the mass")
+            _fail(
+                "mesh-not-closed",
+                f"soft body '{obj.name}': {pg.mass_note or 'no volume to take a mass from'}",
+                obj,
+                "give the sheet thickness with a Solidify modifier, or type the mass",
+            )
         return
     b = obj.adf.body
     typed = b.use_mass and b.mass_typed
@@ -292,8 +335,10 @@ def estimate_all(scene) -> tuple[list, list[str]]:
 def add_joint(parent, child, joint_type: str = "revolute", frame: Matrix | None = None, name: str | None = None):
     """An Empty with a rigid body constraint between two bodies; the Empty is the joint frame
     (Z: axis of hinge/spring joints, X: axis of prismatic joints)."""
-    from .build import RBC_TYPE, ensure_rigidbody_world
     from adfkit.model.semantics import joint_kind
+
+    from .build import RBC_TYPE, ensure_rigidbody_world
+
     scene = bpy.context.scene
     ensure_rigidbody_world(scene)
     e = _link(bpy.data.objects.new(name or f"{parent.name}-{child.name}", None))
@@ -327,8 +372,16 @@ def _cylinder(name: str, radius: float, length: float, segments: int = 8):
     return me
 
 
-def create_rope(name: str, count: int, length: float, radius: float, mass: float, origin=(0, 0, 0),
-                stiffness: float = 0.5, damping: float = 0.05) -> tuple[list, list]:
+def create_rope(
+    name: str,
+    count: int,
+    length: float,
+    radius: float,
+    mass: float,
+    origin=(0, 0, 0),
+    stiffness: float = 0.5,
+    damping: float = 0.05,
+) -> tuple[list, list]:
     """A thread of ``count`` capsule bodies along +X joined by six-dof springs."""
     seg = length / count
     bodies, joints = [], []
@@ -341,8 +394,8 @@ def create_rope(name: str, count: int, length: float, radius: float, mass: float
         b.mass = mass / count
         b.use_inertia = True
         m = mass / count
-        ia = m * (3 * radius ** 2 + seg ** 2) / 12
-        b.inertia = (ia, ia, m * radius ** 2 / 2)
+        ia = m * (3 * radius**2 + seg**2) / 12
+        b.inertia = (ia, ia, m * radius**2 / 2)
         add_collision_primitive(o, "CAPSULE", radius=radius, height=seg + 2 * radius * 0.5, axis="z")
         bodies.append(o)
     bpy.context.view_layer.update()
@@ -350,11 +403,18 @@ def create_rope(name: str, count: int, length: float, radius: float, mass: float
         frame = Matrix.Translation(Vector(origin) + Vector(((i + 1) * seg, 0, 0))) @ rot
         j = add_joint(bodies[i], bodies[i + 1], "six dof spring", frame, f"{name}_{i:03d}-{i + 1:03d}")
         p = j.adf.joint
-        for attr, val in (("linear_low", (0.0,) * 3), ("linear_high", (0.0,) * 3), ("angular_low", (-0.6,) * 3),
-                          ("angular_high", (0.6,) * 3), ("stiffness_linear", (0.0,) * 3),
-                          ("stiffness_angular", (stiffness,) * 3), ("damping_linear", (0.0,) * 3),
-                          ("damping_angular", (damping,) * 3), ("equilibrium_linear", (0.0,) * 3),
-                          ("equilibrium_angular", (0.0,) * 3)):
+        for attr, val in (
+            ("linear_low", (0.0,) * 3),
+            ("linear_high", (0.0,) * 3),
+            ("angular_low", (-0.6,) * 3),
+            ("angular_high", (0.6,) * 3),
+            ("stiffness_linear", (0.0,) * 3),
+            ("stiffness_angular", (stiffness,) * 3),
+            ("damping_linear", (0.0,) * 3),
+            ("damping_angular", (damping,) * 3),
+            ("equilibrium_linear", (0.0,) * 3),
+            ("equilibrium_angular", (0.0,) * 3),
+        ):
             setattr(p, "use_" + attr, True)
             setattr(p, attr, val)
         joints.append(j)
@@ -398,8 +458,19 @@ def add_ghost(name: str, radius: float = 0.005, parent=None, location=(0, 0, 0))
 def problems(scene) -> list[str]:
     """Readable findings for the UI (what export would refuse)."""
     from .export import check_scene
+
     return [f"{d.severity.name}: {d.message}" + (f" ({d.hint})" if d.hint else "") for d in check_scene(scene)]
 
 
-__all__ = ["mark", "generate_collision", "add_collision_primitive", "estimate_inertia", "add_joint",
-           "create_rope", "add_grasp", "add_ghost", "problems", "gather"]
+__all__ = [
+    "mark",
+    "generate_collision",
+    "add_collision_primitive",
+    "estimate_inertia",
+    "add_joint",
+    "create_rope",
+    "add_grasp",
+    "add_ghost",
+    "problems",
+    "gather",
+]

@@ -1,5 +1,6 @@
 """adfkit model -> Blender scene (import). Each object keeps its exact ADF text (snapshot)
 so an unchanged scene exports back to the same file."""
+
 from __future__ import annotations
 
 import json
@@ -13,16 +14,21 @@ from adfkit.adf.writer import file_to_plain
 from adfkit.diagnostics import AdfError, Diagnostic, Severity, SourceLocation, warning
 from adfkit.inputs import shown
 from adfkit.model import ModelFile, Pose
-from adfkit.model.pose import Vec3
-from adfkit.model.semantics import collision_primitives, joint_frames, joint_kind, JointKind, shape_kind
-from adfkit.model.spec import adf_fields
 from adfkit.model.files import ObjectList
+from adfkit.model.semantics import JointKind, collision_primitives, joint_frames, joint_kind
+from adfkit.model.spec import adf_fields
 
 from . import fields, gather, meshes
 from .properties import GROUP_OF, write_group
 
-RBC_TYPE = {JointKind.REVOLUTE: "HINGE", JointKind.PRISMATIC: "SLIDER", JointKind.FIXED: "FIXED",
-            JointKind.P2P: "POINT", JointKind.CONE_TWIST: "GENERIC", JointKind.SIX_DOF: "GENERIC"}
+RBC_TYPE = {
+    JointKind.REVOLUTE: "HINGE",
+    JointKind.PRISMATIC: "SLIDER",
+    JointKind.FIXED: "FIXED",
+    JointKind.P2P: "POINT",
+    JointKind.CONE_TWIST: "GENERIC",
+    JointKind.SIX_DOF: "GENERIC",
+}
 
 
 def _matrix(p: Pose, scale: float = 1.0) -> Matrix:
@@ -56,12 +62,18 @@ def _import_file(path: Path, scene) -> list:
         return []
     try:
         getattr(bpy.ops.wm, op)(filepath=str(path), forward_axis="Y", up_axis="Z")
-    except RuntimeError as exc:   # Blender's operators report a failed read this way
+    except RuntimeError as exc:  # Blender's operators report a failed read this way
         for o in [o for o in scene.objects if o not in before]:
             bpy.data.objects.remove(o, do_unlink=True)
         reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else "unreadable"
-        _UNREADABLE.append(warning("mesh-unreadable", f"Blender could not import the mesh {path.name}: {reason}; "
-                                   "imported without it", SourceLocation(shown(path)), "check the mesh file (adfkit validate says why)"))
+        _UNREADABLE.append(
+            warning(
+                "mesh-unreadable",
+                f"Blender could not import the mesh {path.name}: {reason}; imported without it",
+                SourceLocation(shown(path)),
+                "check the mesh file (adfkit validate says why)",
+            )
+        )
         return []
     return sorted((o for o in scene.objects if o not in before), key=lambda o: o.name)
 
@@ -100,12 +112,19 @@ def _snapshot(obj, x) -> None:
 
 def _shape_child(body_obj, prim, i, scene):
     from .authoring import add_collision_primitive
+
     g = prim.geometry
     shape = prim.kind.name if prim.kind.name in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE") else "BOX"
     size = (g.x, g.y or 0.0, g.z or 0.0) if g.x is not None else (0.1, 0.1, 0.1)
-    e = add_collision_primitive(body_obj, shape, size=size, radius=g.radius if g.radius is not None else 0.05,
-                                height=g.height if g.height is not None else 0.1,
-                                axis=g.axis if g.axis in tuple("xyzXYZ") else "z", name=f"{body_obj.name}.collision{i}")
+    e = add_collision_primitive(
+        body_obj,
+        shape,
+        size=size,
+        radius=g.radius if g.radius is not None else 0.05,
+        height=g.height if g.height is not None else 0.1,
+        axis=g.axis if g.axis in tuple("xyzXYZ") else "z",
+        name=f"{body_obj.name}.collision{i}",
+    )
     e.matrix_world = body_obj.matrix_world @ _matrix(prim.pose)
     return e
 
@@ -137,7 +156,9 @@ def _geometry(obj, x, doc, scene) -> None:
 def _body(b, doc, scene, diags):
     vis = visual_mesh_path(doc, b) if b.mesh else None
     if vis is not None and not vis.is_file():
-        diags.append(warning("missing-mesh", f"mesh {vis} of '{b.identifier}' not found; imported as an empty", b.where("mesh")))
+        diags.append(
+            warning("missing-mesh", f"mesh {vis} of '{b.identifier}' not found; imported as an empty", b.where("mesh"))
+        )
     obj = _mesh_object(b.name or b.identifier, vis, scene)
     obj.adf.kind = "BODY"
     if obj.type == "MESH":
@@ -154,6 +175,7 @@ def _soft_mesh_object(name: str, path: Path | None, scene):
         return _mesh_object(name, path, scene)
     try:
         from adfkit.geometry.softmesh import load_soft_mesh
+
         sm = load_soft_mesh(path)
     except (ImportError, AdfError):
         return _mesh_object(name, path, scene)
@@ -166,15 +188,21 @@ def _soft_mesh_object(name: str, path: Path | None, scene):
 def _soft_body(sb, doc, scene, diags):
     path = collision_mesh_path(doc, sb) if sb.mesh else None
     if path is not None and not path.is_file():
-        diags.append(warning("missing-mesh", f"mesh {path} of '{sb.identifier}' not found; imported as an empty",
-                             sb.where("mesh")))
+        diags.append(
+            warning(
+                "missing-mesh", f"mesh {path} of '{sb.identifier}' not found; imported as an empty", sb.where("mesh")
+            )
+        )
     obj = _soft_mesh_object(sb.name or sb.identifier, path, scene)
     obj.adf.kind = "SOFT_BODY"
     if obj.type == "MESH":
         obj.adf.mesh_source = str(path)
         grp = obj.vertex_groups.new(name=obj.adf.soft.fixed_group)
-        fixed = [i for i in (sb.config.fixed_nodes if sb.config is not None and sb.config.fixed_nodes else [])
-                 if 0 <= i < len(obj.data.vertices)]
+        fixed = [
+            i
+            for i in (sb.config.fixed_nodes if sb.config is not None and sb.config.fixed_nodes else [])
+            if 0 <= i < len(obj.data.vertices)
+        ]
         if fixed:
             grp.add(fixed, 1.0, "REPLACE")
     _snapshot(obj, sb)
@@ -227,7 +255,9 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     doc, diags = read_file(Path(path), kind="model")
     # the validator's severities: what AMBF loads anyway (duplicate keys, sb/cloth.yaml) is a warning
     from dataclasses import replace
+
     from adfkit.validator.engine import SEVERITY_OVERRIDES
+
     diags = [replace(d, severity=SEVERITY_OVERRIDES.get(d.rule, d.severity)) for d in diags]
     errors = [d for d in diags if d.severity >= Severity.ERROR]
     if errors:
@@ -361,19 +391,31 @@ def _scene_snapshot(scene, doc: ModelFile) -> None:
             items = getattr(doc, f.name)
             if items:
                 order[f.metadata["adf_key"]] = [o.identifier for o in items]
-    level = ModelFile(**{f.name: getattr(doc, f.name) for f in adf_fields(doc)
-                         if not isinstance(f.metadata["kind"], ObjectList)})
+    level = ModelFile(
+        **{f.name: getattr(doc, f.name) for f in adf_fields(doc) if not isinstance(f.metadata["kind"], ObjectList)}
+    )
     level.extras = dict(doc.extras)
     import yaml
+
     from adfkit.adf.writer import _Dumper
+
     text = yaml.dump(file_to_plain(level), Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=100)
     # sections the add-on does not edit (vehicles, volumes): carried through as written
-    kept = {key: [[o.identifier, fields.snapshot_text(o)] for o in getattr(doc, attr) if o.defined]
-            for key, attr in KEPT_LISTS.items() if getattr(doc, attr)}
-    scene.adf.snapshot = json.dumps({"keys": text if text.strip() != "{}" else "", "order": order,
-                                     "present": sorted(doc.present_lists), "kept": kept,
-                                     # the folder relative paths (shaders, volume slices) were written against
-                                     "source_dir": str(Path(doc.path).resolve().parent) if doc.path else None})
+    kept = {
+        key: [[o.identifier, fields.snapshot_text(o)] for o in getattr(doc, attr) if o.defined]
+        for key, attr in KEPT_LISTS.items()
+        if getattr(doc, attr)
+    }
+    scene.adf.snapshot = json.dumps(
+        {
+            "keys": text if text.strip() != "{}" else "",
+            "order": order,
+            "present": sorted(doc.present_lists),
+            "kept": kept,
+            # the folder relative paths (shaders, volume slices) were written against
+            "source_dir": str(Path(doc.path).resolve().parent) if doc.path else None,
+        }
+    )
     scene.adf.use_namespace = doc.namespace is not None
     scene.adf.use_gravity = doc.gravity is not None
     if doc.gravity is not None:

@@ -1,5 +1,6 @@
 """Blender's rigid body constraint kept in step with the ADF joint panel: limits typed in
 the panel are mirrored onto the constraint (hinge Z, slider X, generic six-dof axes)."""
+
 from __future__ import annotations
 
 from adfkit.model.semantics import JointKind, joint_kind

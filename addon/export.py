@@ -1,4 +1,5 @@
 """Export the Blender scene as an ADF model: gather -> validate -> write (nothing on failure)."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -40,6 +41,7 @@ def _model_level(scene) -> tuple[ModelFile, dict]:
         doc = ModelFile()
     doc.present_lists = set(snap.get("present", []))
     from adfkit.model.objects import Vehicle, Volume
+
     for key, cls in (("vehicles", Vehicle), ("volumes", Volume)):
         items = []
         for ident, text in snap.get("kept", {}).get(key, []):
@@ -53,6 +55,7 @@ def _model_level(scene) -> tuple[ModelFile, dict]:
         doc.ignore_inter_collision = scene.adf.ignore_inter_collision
     if scene.adf.use_gravity:
         from adfkit.model.pose import Vec3
+
         doc.gravity = Vec3(*(fields.tidy(g) for g in scene.adf.gravity))
     return doc, snap.get("order", {})
 
@@ -77,8 +80,9 @@ def gather_model(scene, objects=None) -> gather.Gathered:
     doc, order = _model_level(scene)
     hi, lo = _mesh_paths(doc)
     sp = scene.adf
-    out = gather.Gathered(doc, options=gather.Options(apply_modifiers=sp.apply_modifiers,
-                                                      low_res_ratio=sp.low_res_ratio))
+    out = gather.Gathered(
+        doc, options=gather.Options(apply_modifiers=sp.apply_modifiers, low_res_ratio=sp.low_res_ratio)
+    )
     fields.PRECISION["digits"] = sp.precision
     objs = sorted(objects if objects is not None else scene.objects, key=lambda o: o.name)
     bodies, softs, ghosts, joints = [], [], [], []
@@ -112,8 +116,14 @@ def gather_model(scene, objects=None) -> gather.Gathered:
     for job in out.jobs:
         rel = job.directory + job.filename
         if seen.get(rel, job.digest) != job.digest:
-            out.diagnostics.append(error("mesh-name-clash", f"two different meshes would be written as {rel}", None,
-                                         "rename one of the objects"))
+            out.diagnostics.append(
+                error(
+                    "mesh-name-clash",
+                    f"two different meshes would be written as {rel}",
+                    None,
+                    "rename one of the objects",
+                )
+            )
         seen[rel] = job.digest
     return out
 
@@ -133,8 +143,11 @@ def validate(text: str, target: Path, pending: set[Path]) -> list[Diagnostic]:
             continue
         if d.rule == "sensor-type" and d.severity >= Severity.ERROR:
             # a type AMBF 2.0 does not know (CONTACT, used by newer AMBF): carried through, not refused
-            d = dataclasses.replace(d, severity=Severity.WARNING,
-                                    message=d.message.split(";")[0] + "; unknown to AMBF 2.0, carried through as written")
+            d = dataclasses.replace(
+                d,
+                severity=Severity.WARNING,
+                message=d.message.split(";")[0] + "; unknown to AMBF 2.0, carried through as written",
+            )
         keep.append(d)
     return keep
 
@@ -142,10 +155,12 @@ def validate(text: str, target: Path, pending: set[Path]) -> list[Diagnostic]:
 def merge_findings(ours: list[Diagnostic], theirs: list[Diagnostic]) -> list[Diagnostic]:
     """Gather findings, then the validator's, each (rule, object) said once: the validator's
     wording wins where both report the same thing (a light without shadow quality)."""
+
     def obj_of(d):
         m = re.search(r"'([^']*)'", d.message)
         name = m.group(1) if m else ""
         return name.split(" ", 1)[-1] if name.split(" ", 1)[0].isupper() else name
+
     said = {(d.rule, obj_of(d)) for d in theirs}
     return [d for d in ours if (d.rule, obj_of(d)) not in said] + list(theirs)
 
@@ -155,8 +170,10 @@ def check_scene(scene) -> list[Diagnostic]:
     g = gather_model(scene)
     if any(d.severity >= Severity.ERROR for d in g.diagnostics):
         return g.diagnostics
-    return merge_findings(list(g.diagnostics), validate(dumps(g.model), Path("model.yaml"),
-                                                        {Path(j.directory) / j.filename for j in g.jobs}))
+    return merge_findings(
+        list(g.diagnostics),
+        validate(dumps(g.model), Path("model.yaml"), {Path(j.directory) / j.filename for j in g.jobs}),
+    )
 
 
 def export_scene(scene, out_dir: str | Path, name: str = "model", objects=None) -> ExportResult:
@@ -175,7 +192,7 @@ def export_scene(scene, out_dir: str | Path, name: str = "model", objects=None) 
     made = next((p for p in reversed([out_dir, *out_dir.parents]) if not p.exists()), None)
     out_dir.mkdir(parents=True, exist_ok=True)
     copied = []
-    for src, dst in copies:          # shader and slice files the new file names (rebase_paths)
+    for src, dst in copies:  # shader and slice files the new file names (rebase_paths)
         if not dst.exists():
             dst.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(src, dst)
@@ -202,6 +219,7 @@ def rebase_paths(model: ModelFile, source_dir: Path, out_dir: Path) -> list[tupl
     into the output folder under the same folder name. Absolute paths stay as they are.
     Returns the (source, destination) copies to make."""
     from adfkit import inputs
+
     tree = inputs.tree_of(out_dir / "model.yaml")
     copies: list[tuple[Path, Path]] = []
 

@@ -5,27 +5,28 @@ them on import and reads them on export. Blender stores floats in single precisi
 each object also keeps a *snapshot* (the exact ADF text it was imported or exported
 as); on export a value whose float32 image is unchanged keeps its exact snapshot value.
 """
+
 from __future__ import annotations
 
 import struct
-from dataclasses import dataclass, fields as dc_fields
+from dataclasses import dataclass
+from dataclasses import fields as dc_fields
 
 import yaml
 
 from adfkit.adf.reader import Reader
 from adfkit.adf.writer import _Dumper, node_to_plain
 from adfkit.model import Actuator, Body, Camera, Ghost, Joint, Light, Pose, Sensor
-from adfkit.model.objects import SoftBody
-from adfkit.model.objects import Inertia
+from adfkit.model.objects import Inertia, SoftBody
 from adfkit.model.pose import Vec3, quat_to_rpy, rpy_to_quat
 from adfkit.model.spec import FloatOr, Node, adf_fields
 
 
 @dataclass(frozen=True)
 class Field:
-    prop: str                 # Blender property name
-    path: tuple[str, ...]     # attribute path in the adfkit model object
-    kind: str                 # float | int | bool | str | vec3 | enum | groups | inertia | pose
+    prop: str  # Blender property name
+    path: tuple[str, ...]  # attribute path in the adfkit model object
+    kind: str  # float | int | bool | str | vec3 | enum | groups | inertia | pose
     default: object
     label: str
     desc: str = ""
@@ -34,28 +35,62 @@ class Field:
 
 
 OUTPUT_TYPES = ("FORCE", "VELOCITY", "POSITION", "EFFORT", "force", "velocity", "position", "effort")
-MESH_TYPES = ("CONCAVE_MESH", "CONVEX_HULL", "CONVEX_MESH", "POINT_CLOUD", "convex_hull", "hull",
-              "convex_mesh", "TRIMESH", "trimesh", "point_cloud")
-JOINT_TYPES = ("revolute", "hinge", "continuous", "prismatic", "slider", "fixed", "linear spring", "spring",
-               "torsion spring", "torsional spring", "angular spring", "p2p", "cone twist", "six dof",
-               "six dof spring")
+MESH_TYPES = (
+    "CONCAVE_MESH",
+    "CONVEX_HULL",
+    "CONVEX_MESH",
+    "POINT_CLOUD",
+    "convex_hull",
+    "hull",
+    "convex_mesh",
+    "TRIMESH",
+    "trimesh",
+    "point_cloud",
+)
+JOINT_TYPES = (
+    "revolute",
+    "hinge",
+    "continuous",
+    "prismatic",
+    "slider",
+    "fixed",
+    "linear spring",
+    "spring",
+    "torsion spring",
+    "torsional spring",
+    "angular spring",
+    "p2p",
+    "cone twist",
+    "six dof",
+    "six dof spring",
+)
 
 
 def _freq() -> list[Field]:
-    return [Field(f"publish_frequency_{k}", ("publish_frequency", k), "int", d, f"Publish frequency {k}", "Hz")
-            for k, d in (("low", 50), ("high", 1000))]
+    return [
+        Field(f"publish_frequency_{k}", ("publish_frequency", k), "int", d, f"Publish frequency {k}", "Hz")
+        for k, d in (("low", 50), ("high", 1000))
+    ]
 
 
 def _pid(prefix: str, path: tuple[str, ...], label: str) -> list[Field]:
-    return [Field(f"{prefix}_{g.lower()}", path + (g,), "float", d, f"{label} {g}") for g, d in
-            (("P", 10.0), ("I", 0.0), ("D", 1.0))]
+    return [
+        Field(f"{prefix}_{g.lower()}", path + (g,), "float", d, f"{label} {g}")
+        for g, d in (("P", 10.0), ("I", 0.0), ("D", 1.0))
+    ]
 
 
 BODY = [
     Field("mass", ("mass",), "float", 1.0, "Mass", "kg; 0 makes the body static", min=0.0),
     Field("inertia", ("inertia",), "inertia", (0.001, 0.001, 0.001), "Inertia", "principal moments ix, iy, iz (kg·m²)"),
-    Field("inertial_offset", ("inertial_offset",), "pose", (0.0,) * 6, "Inertial offset",
-          "COM frame in the body frame: x, y, z (m), roll, pitch, yaw (rad)"),
+    Field(
+        "inertial_offset",
+        ("inertial_offset",),
+        "pose",
+        (0.0,) * 6,
+        "Inertial offset",
+        "COM frame in the body frame: x, y, z (m), roll, pitch, yaw (rad)",
+    ),
     Field("friction_static", ("friction", "static"), "float", 0.5, "Static friction", min=0.0),
     Field("friction_rolling", ("friction", "rolling"), "float", 0.01, "Rolling friction", min=0.0),
     Field("restitution", ("restitution",), "float", 0.1, "Restitution", min=0.0),
@@ -63,10 +98,14 @@ BODY = [
     Field("damping_angular", ("damping", "angular"), "float", 0.1, "Angular damping", min=0.0),
     Field("collision_margin", ("collision_margin",), "float", 0.001, "Collision margin", "m", min=0.0),
     Field("collision_groups", ("collision_groups",), "groups", "", "Collision groups", "comma-separated ints 0-999"),
-    Field("collision_mesh_type", ("collision_mesh_type",), "enum", "CONCAVE_MESH", "Collision mesh type", items=MESH_TYPES),
+    Field(
+        "collision_mesh_type", ("collision_mesh_type",), "enum", "CONCAVE_MESH", "Collision mesh type", items=MESH_TYPES
+    ),
     *_pid("controller_linear", ("controller", "linear"), "Linear"),
     *_pid("controller_angular", ("controller", "angular"), "Angular"),
-    Field("controller_output_type", ("controller_output_type",), "enum", "FORCE", "Controller output", items=OUTPUT_TYPES),
+    Field(
+        "controller_output_type", ("controller_output_type",), "enum", "FORCE", "Controller output", items=OUTPUT_TYPES
+    ),
     Field("passive", ("passive",), "bool", False, "Passive", "no ROS communication"),
     Field("gravity", ("gravity",), "vec3", (0.0, 0.0, -9.8), "Gravity override", "m/s², this body only"),
     Field("publish_children_names", ("publish_children_names",), "bool", False, "Publish children names"),
@@ -77,7 +116,9 @@ BODY = [
 
 GHOST = [
     Field("collision_margin", ("collision_margin",), "float", 0.001, "Collision margin", min=0.0),
-    Field("collision_mesh_type", ("collision_mesh_type",), "enum", "CONCAVE_MESH", "Collision mesh type", items=MESH_TYPES),
+    Field(
+        "collision_mesh_type", ("collision_mesh_type",), "enum", "CONCAVE_MESH", "Collision mesh type", items=MESH_TYPES
+    ),
     Field("passive", ("passive",), "bool", False, "Passive"),
 ]
 
@@ -97,11 +138,27 @@ JOINT = [
     Field("damping_angular", ("damping", "angular"), "vec3", (0.7,) * 3, "Damping angular", "six-dof spring"),
     Field("stiffness_linear", ("stiffness", "linear"), "vec3", (1.0,) * 3, "Stiffness linear", "six-dof spring"),
     Field("stiffness_angular", ("stiffness", "angular"), "vec3", (1.0,) * 3, "Stiffness angular", "six-dof spring"),
-    Field("equilibrium_linear", ("equilibrium_point", "linear"), "vec3", (0.0,) * 3, "Equilibrium linear", "six-dof spring"),
-    Field("equilibrium_angular", ("equilibrium_point", "angular"), "vec3", (0.0,) * 3, "Equilibrium angular", "six-dof spring"),
+    Field(
+        "equilibrium_linear",
+        ("equilibrium_point", "linear"),
+        "vec3",
+        (0.0,) * 3,
+        "Equilibrium linear",
+        "six-dof spring",
+    ),
+    Field(
+        "equilibrium_angular",
+        ("equilibrium_point", "angular"),
+        "vec3",
+        (0.0,) * 3,
+        "Equilibrium angular",
+        "six-dof spring",
+    ),
     Field("max_motor_impulse", ("max_motor_impulse",), "float", 0.1, "Max motor impulse", min=0.0),
     *_pid("controller", ("controller",), "Controller"),
-    Field("controller_output_type", ("controller_output_type",), "enum", "FORCE", "Controller output", items=OUTPUT_TYPES),
+    Field(
+        "controller_output_type", ("controller_output_type",), "enum", "FORCE", "Controller output", items=OUTPUT_TYPES
+    ),
     Field("enable_feedback", ("enable_feedback",), "bool", False, "Enable feedback"),
     Field("ignore_inter_collision", ("ignore_inter_collision",), "bool", True, "Ignore inter-collision"),
     Field("joint_erp", ("joint_erp",), "float", 0.1, "ERP"),
@@ -110,8 +167,14 @@ JOINT = [
 ]
 
 SENSOR = [
-    Field("type", ("type",), "enum", "Proximity", "Sensor type",
-          items=("Proximity", "proximity", "PROXIMITY", "Resistance", "resistance", "RESISTANCE")),
+    Field(
+        "type",
+        ("type",),
+        "enum",
+        "Proximity",
+        "Sensor type",
+        items=("Proximity", "proximity", "PROXIMITY", "Resistance", "resistance", "RESISTANCE"),
+    ),
     Field("range", ("range",), "float", 0.5, "Range", "m", min=0.0),
     Field("visible", ("visible",), "bool", False, "Visible"),
     Field("visible_size", ("visible_size",), "float", 0.02, "Visible size", min=0.0),
@@ -126,8 +189,15 @@ SENSOR = [
     Field("contact_damping", ("contact_damping",), "float", 10.0, "Contact damping", "N·s/m", min=0.0),
     *_freq(),
 ]
-RESISTANCE_ONLY = {"friction_static", "friction_dynamic", "friction_damping", "friction_variable", "contact_area",
-                   "contact_stiffness", "contact_damping"}
+RESISTANCE_ONLY = {
+    "friction_static",
+    "friction_dynamic",
+    "friction_damping",
+    "friction_variable",
+    "contact_area",
+    "contact_stiffness",
+    "contact_damping",
+}
 
 ACTUATOR = [
     Field("type", ("type",), "enum", "Constraint", "Actuator type", items=("Constraint", "constraint", "CONSTRAINT")),
@@ -160,25 +230,84 @@ LIGHT = [
     Field("passive", ("passive",), "bool", False, "Passive"),
 ]
 
-_SOFT_FLOATS = ("kLST", "kAST", "kVST", "kVCF", "kDP", "kDG", "kLF", "kPR", "kVC", "kDF", "kMT", "kCHR", "kKHR",
-                "kSHR", "kAHR", "kSRHR_CL", "kSKHR_CL", "kSSHR_CL", "kSR_SPLT_CL", "kSK_SPLT_CL", "kSS_SPLT_CL",
-                "maxvolume", "timescale")
+_SOFT_FLOATS = (
+    "kLST",
+    "kAST",
+    "kVST",
+    "kVCF",
+    "kDP",
+    "kDG",
+    "kLF",
+    "kPR",
+    "kVC",
+    "kDF",
+    "kMT",
+    "kCHR",
+    "kKHR",
+    "kSHR",
+    "kAHR",
+    "kSRHR_CL",
+    "kSKHR_CL",
+    "kSSHR_CL",
+    "kSR_SPLT_CL",
+    "kSK_SPLT_CL",
+    "kSS_SPLT_CL",
+    "maxvolume",
+    "timescale",
+)
 _SOFT_INTS = ("viterations", "piterations", "diterations", "citerations", "flags", "bending_constraint", "clusters")
-SOFT_DESC = {"kLST": "linear stiffness 0-1", "kAST": "angular stiffness 0-1", "kVST": "volume stiffness 0-1",
-             "kVCF": "velocities correction factor", "kDP": "damping", "kDG": "drag", "kLF": "lift",
-             "kPR": "pressure", "kVC": "volume conservation", "kDF": "dynamic friction 0-1",
-             "kMT": "pose matching 0-1", "kCHR": "rigid contact hardness", "kKHR": "kinetic contact hardness",
-             "kSHR": "soft contact hardness", "kAHR": "anchor hardness", "piterations": "position solver iterations",
-             "viterations": "velocity solver iterations", "diterations": "drift solver iterations",
-             "citerations": "cluster solver iterations", "bending_constraint": "bending constraint distance",
-             "clusters": "cluster count (0: none)", "flags": "collision flags (bit set)"}
+SOFT_DESC = {
+    "kLST": "linear stiffness 0-1",
+    "kAST": "angular stiffness 0-1",
+    "kVST": "volume stiffness 0-1",
+    "kVCF": "velocities correction factor",
+    "kDP": "damping",
+    "kDG": "drag",
+    "kLF": "lift",
+    "kPR": "pressure",
+    "kVC": "volume conservation",
+    "kDF": "dynamic friction 0-1",
+    "kMT": "pose matching 0-1",
+    "kCHR": "rigid contact hardness",
+    "kKHR": "kinetic contact hardness",
+    "kSHR": "soft contact hardness",
+    "kAHR": "anchor hardness",
+    "piterations": "position solver iterations",
+    "viterations": "velocity solver iterations",
+    "diterations": "drift solver iterations",
+    "citerations": "cluster solver iterations",
+    "bending_constraint": "bending constraint distance",
+    "clusters": "cluster count (0: none)",
+    "flags": "collision flags (bit set)",
+}
 
 # Bullet's btSoftBody defaults (what AMBF uses for a key not written)
-SOFT_DEFAULTS = {"kLST": 1.0, "kAST": 1.0, "kVST": 1.0, "kVCF": 1.0, "kDF": 0.2, "kCHR": 1.0, "kKHR": 0.1,
-                 "kSHR": 1.0, "kAHR": 0.7, "kSRHR_CL": 0.1, "kSKHR_CL": 1.0, "kSSHR_CL": 0.5, "kSR_SPLT_CL": 0.5,
-                 "kSK_SPLT_CL": 0.5, "kSS_SPLT_CL": 0.5, "maxvolume": 1.0, "timescale": 1.0, "piterations": 1,
-                 "viterations": 0, "diterations": 0, "citerations": 4, "flags": 1, "bending_constraint": 2,
-                 "clusters": 0}
+SOFT_DEFAULTS = {
+    "kLST": 1.0,
+    "kAST": 1.0,
+    "kVST": 1.0,
+    "kVCF": 1.0,
+    "kDF": 0.2,
+    "kCHR": 1.0,
+    "kKHR": 0.1,
+    "kSHR": 1.0,
+    "kAHR": 0.7,
+    "kSRHR_CL": 0.1,
+    "kSKHR_CL": 1.0,
+    "kSSHR_CL": 0.5,
+    "kSR_SPLT_CL": 0.5,
+    "kSK_SPLT_CL": 0.5,
+    "kSS_SPLT_CL": 0.5,
+    "maxvolume": 1.0,
+    "timescale": 1.0,
+    "piterations": 1,
+    "viterations": 0,
+    "diterations": 0,
+    "citerations": 4,
+    "flags": 1,
+    "bending_constraint": 2,
+    "clusters": 0,
+}
 
 SOFT = [
     Field("mass", ("mass",), "float", 1.0, "Mass", "kg, spread over the nodes", min=0.0),
@@ -186,21 +315,58 @@ SOFT = [
     Field("collision_groups", ("collision_groups",), "groups", "", "Collision groups", "comma-separated ints 0-999"),
     Field("gravity", ("gravity",), "vec3", (0.0, 0.0, -9.8), "Gravity override", "m/s², this body only"),
     Field("randomize_constraints", ("randomize_constraints",), "bool", False, "Randomize constraints"),
-    *[Field(f"config_{k.lower()}", ("config", k), "float", SOFT_DEFAULTS.get(k, 0.0), k.replace("_", " "), SOFT_DESC.get(k, k), min=0.0)
-      for k in _SOFT_FLOATS],
-    *[Field(f"config_{k.lower()}", ("config", k), "int", SOFT_DEFAULTS.get(k, 0), k.replace("_", " "), SOFT_DESC.get(k, k), min=0)
-      for k in _SOFT_INTS],
+    *[
+        Field(
+            f"config_{k.lower()}",
+            ("config", k),
+            "float",
+            SOFT_DEFAULTS.get(k, 0.0),
+            k.replace("_", " "),
+            SOFT_DESC.get(k, k),
+            min=0.0,
+        )
+        for k in _SOFT_FLOATS
+    ],
+    *[
+        Field(
+            f"config_{k.lower()}",
+            ("config", k),
+            "int",
+            SOFT_DEFAULTS.get(k, 0),
+            k.replace("_", " "),
+            SOFT_DESC.get(k, k),
+            min=0,
+        )
+        for k in _SOFT_INTS
+    ],
     Field("passive", ("passive",), "bool", False, "Passive"),
     *_freq(),
 ]
 
-TABLES = {"BODY": (Body, BODY), "SOFT_BODY": (SoftBody, SOFT), "GHOST": (Ghost, GHOST), "JOINT": (Joint, JOINT), "SENSOR": (Sensor, SENSOR),
-          "ACTUATOR": (Actuator, ACTUATOR), "CAMERA": (Camera, CAMERA), "LIGHT": (Light, LIGHT)}
-PREFIX = {"BODY": "BODY ", "SOFT_BODY": "SOFT ", "GHOST": "GHOST ", "JOINT": "JOINT ", "SENSOR": "SENSOR ", "ACTUATOR": "ACTUATOR ",
-          "CAMERA": "CAMERA ", "LIGHT": "LIGHT "}
+TABLES = {
+    "BODY": (Body, BODY),
+    "SOFT_BODY": (SoftBody, SOFT),
+    "GHOST": (Ghost, GHOST),
+    "JOINT": (Joint, JOINT),
+    "SENSOR": (Sensor, SENSOR),
+    "ACTUATOR": (Actuator, ACTUATOR),
+    "CAMERA": (Camera, CAMERA),
+    "LIGHT": (Light, LIGHT),
+}
+PREFIX = {
+    "BODY": "BODY ",
+    "SOFT_BODY": "SOFT ",
+    "GHOST": "GHOST ",
+    "JOINT": "JOINT ",
+    "SENSOR": "SENSOR ",
+    "ACTUATOR": "ACTUATOR ",
+    "CAMERA": "CAMERA ",
+    "LIGHT": "LIGHT ",
+}
 
 
 # --- values on model objects ----------------------------------------------------------
+
 
 def get_value(obj: Node, f: Field):
     """The field's value on a model object, in Blender form, or None when not written."""
@@ -236,13 +402,14 @@ def _field_class(parent: Node, name: str):
     raise KeyError(name)
 
 
-PRECISION = {"digits": 9}   # significant digits of floats the add-on computes (scene setting)
+PRECISION = {"digits": 9}  # significant digits of floats the add-on computes (scene setting)
 
 
 def tidy(x: float) -> float:
     """A float from Blender (single precision) as the shortest decimal that is the same
     float32 (0.004999999888241291 -> 0.005), at most PRECISION significant digits."""
     import numpy as np
+
     x = float(x)
     if x != x or x in (float("inf"), float("-inf")):
         return x
@@ -360,6 +527,7 @@ def merge(obj: Node, table: list[Field], values: dict) -> None:
 
 
 # --- snapshots: the exact ADF text of one object ----------------------------------------
+
 
 def snapshot_text(obj: Node) -> str:
     return yaml.dump(node_to_plain(obj), Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=100)

@@ -4,6 +4,7 @@ Blender-level code only reads Blender data here; ADF semantics come from adfkit 
 :mod:`.fields`. Mesh files are not written here: gatherers return *mesh jobs* that the
 exporter runs only after the model has been validated.
 """
+
 from __future__ import annotations
 
 import json
@@ -26,7 +27,7 @@ MESH_DIRS = ("meshes/high_res/", "meshes/low_res/")
 
 @dataclass
 class MeshJob:
-    directory: str            # relative to the output directory
+    directory: str  # relative to the output directory
     filename: str
     digest: str
     parts: list | None = None  # MeshArrays to write, or None to copy ``source``
@@ -35,8 +36,8 @@ class MeshJob:
 
 @dataclass
 class Options:
-    apply_modifiers: bool = True     # export the evaluated mesh (depsgraph)
-    low_res_ratio: float = 1.0       # decimate collision meshes made from the visual one
+    apply_modifiers: bool = True  # export the evaluated mesh (depsgraph)
+    low_res_ratio: float = 1.0  # decimate collision meshes made from the visual one
 
 
 @dataclass
@@ -90,6 +91,7 @@ def adf_parent(obj):
 
 # --- bodies and ghosts ---------------------------------------------------------------------
 
+
 def gather_body(obj, out: Gathered, paths: tuple[str, str]) -> Body:
     b = fields.from_snapshot(Body, obj.adf.snapshot, f"blender:{obj.name}")
     b.identifier = identifier(obj)
@@ -98,9 +100,14 @@ def gather_body(obj, out: Gathered, paths: tuple[str, str]) -> Body:
     values = read_group(obj.adf.body, fields.BODY)
     if values.get("mass") is None:
         # refused when authored here; a file imported without mass is carried through as AMBF loads it
-        out.diagnostics.append((warning if obj.adf.snapshot and b.mass is None else error)(
-            "body-mass", f"body '{obj.name}' has no mass", where(obj),
-            "tick 'Write Mass' in the ADF Body panel (0 makes it static)"))
+        out.diagnostics.append(
+            (warning if obj.adf.snapshot and b.mass is None else error)(
+                "body-mass",
+                f"body '{obj.name}' has no mass",
+                where(obj),
+                "tick 'Write Mass' in the ADF Body panel (0 makes it static)",
+            )
+        )
     try:
         fields.merge(b, fields.BODY, values)
     except ValueError as exc:
@@ -131,8 +138,14 @@ def gather_ghost(obj, out: Gathered, paths: tuple[str, str]) -> Ghost:
         g.location = relative_pose(obj, parent)
     _gather_geometry(obj, g, out, paths)
     if not (g.collision_shape or g.compound_collision_shape or g.collision_mesh or g.mesh):
-        out.diagnostics.append(error("ghost-collision", f"ghost '{obj.name}' has no collision geometry", where(obj),
-                                     "add a collision primitive or mesh; AMBF skips a ghost without one"))
+        out.diagnostics.append(
+            error(
+                "ghost-collision",
+                f"ghost '{obj.name}' has no collision geometry",
+                where(obj),
+                "add a collision primitive or mesh; AMBF skips a ghost without one",
+            )
+        )
     return g
 
 
@@ -168,7 +181,7 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
 def _shape_entry(child, body_obj) -> ShapeEntry:
     s = child.adf.shape
     geo = Geometry()
-    tidy = fields.tidy     # Blender keeps these in single precision: the shortest decimal, not 0.0099999997...
+    tidy = fields.tidy  # Blender keeps these in single precision: the shortest decimal, not 0.0099999997...
     if s.shape == "BOX":
         geo.x, geo.y, geo.z = (tidy(v) for v in s.size)
     elif s.shape == "SPHERE":
@@ -198,8 +211,9 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
                 b.collision_offset = entries[0].offset
         else:
             old = b.compound_collision_shape or []
-            same = len(old) == len(entries) and all(fields.close(_entry_key(x), _entry_key(y))
-                                                   for x, y in zip(old, entries))
+            same = len(old) == len(entries) and all(
+                fields.close(_entry_key(x), _entry_key(y)) for x, y in zip(old, entries)
+            )
             if not same:
                 b.collision_shape = b.collision_geometry = b.collision_offset = None
                 b.compound_collision_shape = entries
@@ -215,8 +229,9 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
                 a.co = co.astype(np.float32)
             arrays.append(a)
         digest = meshes.digest(arrays)
-        name = b.collision_mesh or (first_name if first_name and obj.adf.collision_source
-                                    else f"{obj.name}_collision.OBJ")
+        name = b.collision_mesh or (
+            first_name if first_name and obj.adf.collision_source else f"{obj.name}_collision.OBJ"
+        )
         src = Path(obj.adf.collision_source) if obj.adf.collision_source else None
         if digest == obj.adf.collision_hash and src is not None and src.is_file():
             out.jobs.append(MeshJob(lo, name, digest, source=src))
@@ -245,6 +260,7 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
 
 # --- joints --------------------------------------------------------------------------------
 
+
 def gather_joint(obj, out: Gathered) -> Joint | None:
     j = fields.from_snapshot(Joint, obj.adf.snapshot, f"blender:{obj.name}")
     j.identifier = identifier(obj)
@@ -255,20 +271,30 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
     p = rbc.object1 if rbc is not None else None
     c = rbc.object2 if rbc is not None else None
     external = set(str(obj.get("adf_external_ends", "")).split(","))
-    cleared = [r for r, o, ref in (("parent", p, j.parent), ("child", c, j.child))
-               if o is None and ref and r not in external]
+    cleared = [
+        r for r, o, ref in (("parent", p, j.parent), ("child", c, j.child)) if o is None and ref and r not in external
+    ]
     if cleared:
         # the end was a body of this scene at import (or set by hand), and has been cleared since
-        out.diagnostics.append(error("joint-reference", f"joint '{obj.name}': its {cleared[0]} was cleared (it was "
-                                     f"'{getattr(j, cleared[0])}')", where(obj),
-                                     f"set the rigid body constraint's {'first' if cleared[0] == 'parent' else 'second'}"
-                                     " object to an ADF body, or delete the joint"))
+        out.diagnostics.append(
+            error(
+                "joint-reference",
+                f"joint '{obj.name}': its {cleared[0]} was cleared (it was '{getattr(j, cleared[0])}')",
+                where(obj),
+                f"set the rigid body constraint's {'first' if cleared[0] == 'parent' else 'second'}"
+                " object to an ADF body, or delete the joint",
+            )
+        )
         return None
     if (p is None and j.parent) or (c is None and j.child):
         # imported with a body that lives in another file: carried through as written
-        out.diagnostics.append(warning("joint-reference", f"joint '{obj.name}': "
-                                       f"{'parent' if p is None else 'child'} body is not in this scene; kept as written",
-                                       where(obj)))
+        out.diagnostics.append(
+            warning(
+                "joint-reference",
+                f"joint '{obj.name}': {'parent' if p is None else 'child'} body is not in this scene; kept as written",
+                where(obj),
+            )
+        )
         if p is not None:
             j.parent = _parent_ref(j.parent, p)
         if c is not None:
@@ -277,9 +303,15 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
     for role, o in (("parent", p), ("child", c)):
         if o is None or o.adf.kind not in ("BODY", "SOFT_BODY"):
             what = "no object" if o is None else f"'{o.name}', which is not an ADF body"
-            out.diagnostics.append(error("joint-reference", f"joint '{obj.name}': its {role} is {what}", where(obj),
-                                         f"set the rigid body constraint's {'first' if role == 'parent' else 'second'}"
-                                         " object to an ADF body"))
+            out.diagnostics.append(
+                error(
+                    "joint-reference",
+                    f"joint '{obj.name}': its {role} is {what}",
+                    where(obj),
+                    f"set the rigid body constraint's {'first' if role == 'parent' else 'second'}"
+                    " object to an ADF body",
+                )
+            )
             return None
     if p == c:
         out.diagnostics.append(error("joint-reference", f"joint '{obj.name}' joins '{p.name}' to itself", where(obj)))
@@ -288,8 +320,9 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
     j.child = _parent_ref(j.child, c)
     keep = unchanged(obj) and unchanged(p) and unchanged(c) and j.parent_pivot is not None
     if not keep:
-        d = joint_frames.derive(j.type, world_pose(p), world_pose(c), world_pose(obj),
-                                uniform_scale(p), uniform_scale(c))
+        d = joint_frames.derive(
+            j.type, world_pose(p), world_pose(c), world_pose(obj), uniform_scale(p), uniform_scale(c)
+        )
         for k, v in d.items():
             if k in ("offset", "joint_offset") and v == 0.0 and getattr(j, k) is None:
                 continue
@@ -301,21 +334,33 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
 
 # --- sensors, actuators, cameras, lights ---------------------------------------------------
 
+
 def _attached(obj, x, out: Gathered, what: str):
     parent = adf_parent(obj)
     if parent is None and x.parent:
         # imported with a parent in another file (or not found): carried through as written
-        out.diagnostics.append(warning(f"{what}-parent", f"{what} '{obj.name}': parent '{x.parent}' is not in this "
-                                       "scene; kept as written", where(obj)))
+        out.diagnostics.append(
+            warning(
+                f"{what}-parent",
+                f"{what} '{obj.name}': parent '{x.parent}' is not in this scene; kept as written",
+                where(obj),
+            )
+        )
         if not unchanged(obj):
             x.location = world_pose(obj)
             x.extras.pop("location", None)
         return x
     if parent is None:
-        out.diagnostics.append(error(f"{what}-parent", f"{what} '{obj.name}' is not parented to an ADF body", where(obj),
-                                     "parent it to the body it is mounted on"))
+        out.diagnostics.append(
+            error(
+                f"{what}-parent",
+                f"{what} '{obj.name}' is not parented to an ADF body",
+                where(obj),
+                "parent it to the body it is mounted on",
+            )
+        )
     x.parent = _parent_ref(x.parent, parent)
-    if not unchanged(obj):   # unchanged: the location as the file wrote it (or left it out)
+    if not unchanged(obj):  # unchanged: the location as the file wrote it (or left it out)
         x.location = relative_pose(obj, parent)
         x.extras.pop("location", None)
     return x
@@ -325,14 +370,22 @@ def gather_sensor(obj, out: Gathered) -> Sensor:
     s = fields.from_snapshot(Sensor, obj.adf.snapshot, f"blender:{obj.name}")
     s.identifier, s.name = identifier(obj), s.name or obj.name
     fields.merge(s, fields.SENSOR, read_group(obj.adf.sensor, fields.SENSOR))
-    rays = [Ray(offset=Vec3(*map(fields.tidy, r.offset)), direction=Vec3(*map(fields.tidy, r.direction)))
-            for r in obj.adf.sensor.rays]
+    rays = [
+        Ray(offset=Vec3(*map(fields.tidy, r.offset)), direction=Vec3(*map(fields.tidy, r.direction)))
+        for r in obj.adf.sensor.rays
+    ]
     old = [(*r.offset, *r.direction) for r in (s.array or []) if r.offset is not None and r.direction is not None]
     if rays and not fields.same32(old, [(*r.offset, *r.direction) for r in rays]):
         s.array = rays
     if not (s.array or s.mesh or s.parametric):
-        out.diagnostics.append((warning if obj.adf.snapshot else error)("sensor-rays", f"sensor '{obj.name}' has no rays", where(obj),
-                                     "add rays in the ADF Sensor panel; AMBF skips a sensor without them"))
+        out.diagnostics.append(
+            (warning if obj.adf.snapshot else error)(
+                "sensor-rays",
+                f"sensor '{obj.name}' has no rays",
+                where(obj),
+                "add rays in the ADF Sensor panel; AMBF skips a sensor without them",
+            )
+        )
     return _attached(obj, s, out, "sensor")
 
 
@@ -354,6 +407,7 @@ def _vec_in_parent(obj, local, point: bool):
 
 def gather_camera(obj, out: Gathered) -> Camera:
     from mathutils import Vector
+
     c = fields.from_snapshot(Camera, obj.adf.snapshot, f"blender:{obj.name}")
     c.identifier, c.name = identifier(obj), c.name or obj.name
     fields.merge(c, fields.CAMERA, read_group(obj.adf.camera, fields.CAMERA))
@@ -371,6 +425,7 @@ def gather_camera(obj, out: Gathered) -> Camera:
         if not fields.same32(c.field_view_angle, cam.angle_y):
             c.field_view_angle = fields.tidy(cam.angle_y)
         from adfkit.model.objects import ClippingPlane
+
         cp = c.clipping_plane or ClippingPlane()
         if not fields.same32((cp.near, cp.far), (cam.clip_start, cam.clip_end)):
             c.clipping_plane = ClippingPlane(near=fields.tidy(cam.clip_start), far=fields.tidy(cam.clip_end))
@@ -379,6 +434,7 @@ def gather_camera(obj, out: Gathered) -> Camera:
 
 def gather_light(obj, out: Gathered) -> Light:
     from mathutils import Vector
+
     li = fields.from_snapshot(Light, obj.adf.snapshot, f"blender:{obj.name}")
     li.identifier, li.name = identifier(obj), li.name or obj.name
     fields.merge(li, fields.LIGHT, read_group(obj.adf.light, fields.LIGHT))
@@ -391,12 +447,19 @@ def gather_light(obj, out: Gathered) -> Light:
         if not fields.same32(li.cutoff_angle, obj.data.spot_size / 2.0):
             li.cutoff_angle = fields.tidy(obj.data.spot_size) / 2.0
     if li.shadow_quality is None:
-        out.diagnostics.append(warning("light-shadow", f"light '{obj.name}' has no shadow quality", where(obj),
-                                       "AMBF leaves it uninitialised; set it (0-5)"))
+        out.diagnostics.append(
+            warning(
+                "light-shadow",
+                f"light '{obj.name}' has no shadow quality",
+                where(obj),
+                "AMBF leaves it uninitialised; set it (0-5)",
+            )
+        )
     return li
 
 
 # --- soft bodies ----------------------------------------------------------------------------
+
 
 def fixed_nodes(obj, evaluated: bool = False) -> list[int] | None:
     """Node indices of the vertices in the soft body's fixed-node vertex group (None: no group),
@@ -408,6 +471,7 @@ def fixed_nodes(obj, evaluated: bool = False) -> list[int] | None:
     eo = me = None
     if evaluated and len(obj.modifiers):
         import bpy
+
         eo = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
         me = eo.to_mesh()
     try:
@@ -416,6 +480,7 @@ def fixed_nodes(obj, evaluated: bool = False) -> list[int] | None:
         if not members:
             return []
         from adfkit.geometry.softmesh import nodes_at, unique_nodes
+
         co = np.empty(len(data.vertices) * 3, np.float32)
         data.vertices.foreach_get("co", co)
         co = co.reshape(-1, 3).astype(np.float64)
@@ -428,6 +493,7 @@ def fixed_nodes(obj, evaluated: bool = False) -> list[int] | None:
 
 def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
     from adfkit.model.objects import SoftBodyConfig
+
     sb = fields.from_snapshot(SoftBody, obj.adf.snapshot, f"blender:{obj.name}")
     sb.identifier = identifier(obj)
     if sb.name is None:
@@ -445,10 +511,20 @@ def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
             sb.config = SoftBodyConfig()
         sb.config.fixed_nodes = fixed
     if obj.type != "MESH" and not sb.mesh:
-        out.diagnostics.append(error("soft-body-mesh", f"soft body '{obj.name}' has no mesh", where(obj),
-                                     "a soft body's nodes are its mesh's vertices: make it a mesh object"))
+        out.diagnostics.append(
+            error(
+                "soft-body-mesh",
+                f"soft body '{obj.name}' has no mesh",
+                where(obj),
+                "a soft body's nodes are its mesh's vertices: make it a mesh object",
+            )
+        )
     return sb
 
 
-GATHER = {"SENSOR": ("sensors", gather_sensor), "ACTUATOR": ("actuators", gather_actuator),
-          "CAMERA": ("cameras", gather_camera), "LIGHT": ("lights", gather_light)}
+GATHER = {
+    "SENSOR": ("sensors", gather_sensor),
+    "ACTUATOR": ("actuators", gather_actuator),
+    "CAMERA": ("cameras", gather_camera),
+    "LIGHT": ("lights", gather_light),
+}

@@ -1,4 +1,5 @@
 """Headless entry points used by `adfkit blend-import` / `blend-export` (bpy stays in addon/)."""
+
 from __future__ import annotations
 
 from pathlib import Path

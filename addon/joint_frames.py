@@ -5,6 +5,7 @@ parent body, the child body and the joint frame (the constraint empty; its Z is 
 X for prismatic joints), return the ADF keys that make AMBF's frames A and B coincide
 there at joint value zero.
 """
+
 from __future__ import annotations
 
 import math
@@ -28,8 +29,9 @@ def _vec(v) -> Vec3:
     return Vec3(*(_clean(c) for c in v))
 
 
-def derive(joint_type: str | None, parent: Pose, child: Pose, frame: Pose,
-           parent_scale: float = 1.0, child_scale: float = 1.0) -> dict:
+def derive(
+    joint_type: str | None, parent: Pose, child: Pose, frame: Pose, parent_scale: float = 1.0, child_scale: float = 1.0
+) -> dict:
     kind = joint_kind(joint_type) or JointKind.REVOLUTE
     d = reference_axis(kind)
     a_frame = parent.inverse() * frame
@@ -42,6 +44,8 @@ def derive(joint_type: str | None, parent: Pose, child: Pose, frame: Pose,
     return {
         "parent_pivot": _vec(a_frame.position.scaled(1.0 / parent_scale)),
         "child_pivot": _vec(b_frame.position.scaled(1.0 / child_scale)),
-        "parent_axis": _vec(a), "child_axis": _vec(b),
-        "offset": _clean(offset), "joint_offset": _clean(joint_offset),
+        "parent_axis": _vec(a),
+        "child_axis": _vec(b),
+        "offset": _clean(offset),
+        "joint_offset": _clean(joint_offset),
     }

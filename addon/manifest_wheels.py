@@ -2,6 +2,7 @@
 
 Blender needs every bundled wheel listed by exact file name; run by build_wheels.sh after it
 downloads them, so the manifest never names a wheel that is not there."""
+
 from __future__ import annotations
 
 import re
@@ -24,7 +25,9 @@ def rewrite(addon_dir: Path) -> str:
     text = manifest.read_text(encoding="utf-8")
     block = "wheels = [\n" + "".join(f'  "./wheels/{w}",\n' for w in wheels) + "]"
     text = re.sub(r"(?ms)^wheels = \[.*?^\]", lambda _m: block, text)
-    text = re.sub(r"(?m)^platforms = \[.*\]$", lambda _m: "platforms = [" + ", ".join(f'"{p}"' for p in platforms) + "]", text)
+    text = re.sub(
+        r"(?m)^platforms = \[.*\]$", lambda _m: "platforms = [" + ", ".join(f'"{p}"' for p in platforms) + "]", text
+    )
     manifest.write_text(text, encoding="utf-8")
     return text
 

@@ -3,6 +3,7 @@
 ``mesh_arrays`` is the only Blender-level function; the OBJ/MTL text writers are plain
 Python over NumPy arrays, so exports of unchanged meshes can be skipped by hash.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -16,20 +17,20 @@ import numpy as np
 @dataclass
 class MeshArrays:
     name: str
-    co: np.ndarray                    # (n, 3) float32 vertex positions in the object frame
-    loops: np.ndarray                 # (m,) int32 vertex index per face corner
-    loop_start: np.ndarray            # (f,) int32
-    loop_total: np.ndarray            # (f,) int32
-    uv: np.ndarray | None = None      # (m, 2) float32 per corner
+    co: np.ndarray  # (n, 3) float32 vertex positions in the object frame
+    loops: np.ndarray  # (m,) int32 vertex index per face corner
+    loop_start: np.ndarray  # (f,) int32
+    loop_total: np.ndarray  # (f,) int32
+    uv: np.ndarray | None = None  # (m, 2) float32 per corner
     material_index: np.ndarray | None = None
-    materials: list = field(default_factory=list)   # [MaterialInfo]
+    materials: list = field(default_factory=list)  # [MaterialInfo]
 
 
 @dataclass
 class MaterialInfo:
     name: str
     base_color: tuple = (0.8, 0.8, 0.8, 1.0)
-    texture: str | None = None        # image file path
+    texture: str | None = None  # image file path
     normal_map: str | None = None
 
 
@@ -38,6 +39,7 @@ def mesh_arrays(obj, name: str | None = None, evaluated: bool = False) -> MeshAr
     its modifiers make (Blender's depsgraph), as the viewport shows it."""
     if evaluated and len(obj.modifiers):
         import bpy
+
         eo = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
         me = eo.to_mesh()
         try:
@@ -51,6 +53,7 @@ def decimated_arrays(obj, ratio: float) -> MeshArrays:
     """The object's evaluated mesh decimated (Blender's Decimate modifier, collapse, added
     last for the moment) to ``ratio`` of its faces: a low-resolution collision mesh."""
     import bpy
+
     mod = obj.modifiers.new("adfkit-low-res", "DECIMATE")
     try:
         mod.ratio = float(ratio)
@@ -112,6 +115,7 @@ def _linked_image(socket):
 
 def _image_file(img) -> str | None:
     import bpy
+
     path = bpy.path.abspath(img.filepath) if img.filepath else ""
     return path if path and Path(path).is_file() else None
 
@@ -207,7 +211,11 @@ def copy_mesh_file(src: Path, directory: Path, filename: str) -> list[Path]:
                     out.append(directory / mtl.name)
                     for ml in mtl.read_text(encoding="utf-8", errors="replace").splitlines():
                         parts = ml.strip().split()
-                        if parts and parts[0].lower() in ("map_kd", "map_bump", "bump", "norm", "map_ks") and len(parts) > 1:
+                        if (
+                            parts
+                            and parts[0].lower() in ("map_kd", "map_bump", "bump", "norm", "map_ks")
+                            and len(parts) > 1
+                        ):
                             img = src.parent / parts[-1]
                             if img.is_file():
                                 shutil.copyfile(img, directory / img.name)

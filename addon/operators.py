@@ -1,4 +1,5 @@
 """Operators: thin wrappers that report findings in the UI; the work is in authoring/export/build."""
+
 from __future__ import annotations
 
 import bpy
@@ -22,8 +23,11 @@ class ADF_OT_export(bpy.types.Operator):
     bl_description = "Validate and write the scene's ADF objects as MODEL.yaml plus meshes"
     directory: StringProperty(subtype="DIR_PATH")
     model_name: StringProperty(name="Model name", default="model")
-    use_selection: BoolProperty(name="Selected only", default=False,
-                                description="export the selected ADF objects only (joints need both bodies selected)")
+    use_selection: BoolProperty(
+        name="Selected only",
+        default=False,
+        description="export the selected ADF objects only (joints need both bodies selected)",
+    )
 
     def invoke(self, context, event):
         context.window_manager.fileselect_add(self)
@@ -31,12 +35,15 @@ class ADF_OT_export(bpy.types.Operator):
 
     def execute(self, context):
         from .export import export_scene
+
         objects = list(context.selected_objects) if self.use_selection else None
         res = export_scene(context.scene, self.directory, self.model_name, objects)
         context.scene.adf.findings = "\n".join(f"{d.severity.name}: {d.message}" for d in res.diagnostics)
         if not res.ok:
-            self.report({"ERROR"}, "Export refused, nothing written: " + "; ".join(
-                d.message for d in res.diagnostics if d.severity >= 2))
+            self.report(
+                {"ERROR"},
+                "Export refused, nothing written: " + "; ".join(d.message for d in res.diagnostics if d.severity >= 2),
+            )
             return {"CANCELLED"}
         self.report({"INFO"}, f"Wrote {res.path} ({len(res.skipped)} unchanged meshes kept)")
         return {"FINISHED"}
@@ -54,6 +61,7 @@ class ADF_OT_import(bpy.types.Operator):
 
     def execute(self, context):
         from .build import import_model
+
         try:
             made, diags = import_model(self.filepath, context.scene)
         except AdfError as exc:
@@ -169,8 +177,10 @@ class ADF_OT_estimate_gains(bpy.types.Operator):
 
     def execute(self, context):
         from .tuning import estimate_gains
-        joints = [o for o in context.selected_objects if o.adf.kind == "JOINT"] or \
-                 [o for o in context.scene.objects if o.adf.kind == "JOINT"]
+
+        joints = [o for o in context.selected_objects if o.adf.kind == "JOINT"] or [
+            o for o in context.scene.objects if o.adf.kind == "JOINT"
+        ]
         done = estimate_gains(context.scene, joints, self.frequency, self.damping_ratio)
         self.report({"INFO"}, f"gains of {len(done)} joints")
         return {"FINISHED"}
@@ -184,6 +194,7 @@ class ADF_OT_show_joints(bpy.types.Operator):
 
     def execute(self, context):
         from .tuning import show_joints
+
         show_joints(context.scene, self.show, self.passive_only)
         return {"FINISHED"}
 
@@ -195,6 +206,7 @@ class ADF_OT_show_collision(bpy.types.Operator):
 
     def execute(self, context):
         from .tuning import show_collision
+
         self.report({"INFO"}, f"{show_collision(context.scene, self.show)} collision objects")
         return {"FINISHED"}
 
@@ -206,6 +218,7 @@ class ADF_OT_rename_joints(bpy.types.Operator):
 
     def execute(self, context):
         from .tuning import rename_joints
+
         self.report({"INFO"}, f"{len(rename_joints(context.scene))} joints named")
         return {"FINISHED"}
 
@@ -217,6 +230,7 @@ class ADF_OT_cleanup(bpy.types.Operator):
 
     def execute(self, context):
         from .tuning import cleanup
+
         said = cleanup(context.scene)
         context.scene.adf.findings = "\n".join(f"INFO: {s}" for s in said)
         self.report({"INFO"}, f"{len(said)} clean-ups")
@@ -229,6 +243,7 @@ class ADF_OT_strip(bpy.types.Operator):
 
     def execute(self, context):
         from .tuning import strip
+
         self.report({"INFO"}, f"{strip(context.selected_objects)} objects made plain")
         return {"FINISHED"}
 
@@ -236,9 +251,22 @@ class ADF_OT_strip(bpy.types.Operator):
 class ADF_OT_add_joint(bpy.types.Operator):
     bl_idname = "adf.add_joint"
     bl_label = "Add joint (active = child)"
-    joint_type: EnumProperty(items=[(t, t, t) for t in ("revolute", "prismatic", "fixed", "six dof spring",
-                                                          "linear spring", "torsion spring", "p2p", "six dof",
-                                                          "cone twist")])
+    joint_type: EnumProperty(
+        items=[
+            (t, t, t)
+            for t in (
+                "revolute",
+                "prismatic",
+                "fixed",
+                "six dof spring",
+                "linear spring",
+                "torsion spring",
+                "p2p",
+                "six dof",
+                "cone twist",
+            )
+        ]
+    )
 
     def execute(self, context):
         child = context.active_object
@@ -257,8 +285,9 @@ class ADF_OT_rope(bpy.types.Operator):
 
     def execute(self, context):
         p = context.scene.adf
-        authoring.create_rope("Thread", p.rope_count, p.rope_length, p.rope_radius, p.rope_mass,
-                              tuple(context.scene.cursor.location))
+        authoring.create_rope(
+            "Thread", p.rope_count, p.rope_length, p.rope_radius, p.rope_mass, tuple(context.scene.cursor.location)
+        )
         return {"FINISHED"}
 
 
@@ -295,10 +324,28 @@ class ADF_OT_check(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (ADF_OT_export, ADF_OT_import, ADF_OT_mark, ADF_OT_generate_collision, ADF_OT_add_primitive,
-           ADF_OT_estimate_inertia, ADF_OT_add_joint, ADF_OT_rope, ADF_OT_grasp, ADF_OT_ghost, ADF_OT_check,
-           ADF_OT_estimate_all, ADF_OT_fit_primitive, ADF_OT_estimate_gains, ADF_OT_show_joints, ADF_OT_cleanup,
-           ADF_OT_strip, ADF_OT_fix_nodes, ADF_OT_show_collision, ADF_OT_rename_joints)
+CLASSES = (
+    ADF_OT_export,
+    ADF_OT_import,
+    ADF_OT_mark,
+    ADF_OT_generate_collision,
+    ADF_OT_add_primitive,
+    ADF_OT_estimate_inertia,
+    ADF_OT_add_joint,
+    ADF_OT_rope,
+    ADF_OT_grasp,
+    ADF_OT_ghost,
+    ADF_OT_check,
+    ADF_OT_estimate_all,
+    ADF_OT_fit_primitive,
+    ADF_OT_estimate_gains,
+    ADF_OT_show_joints,
+    ADF_OT_cleanup,
+    ADF_OT_strip,
+    ADF_OT_fix_nodes,
+    ADF_OT_show_collision,
+    ADF_OT_rename_joints,
+)
 
 
 def _menu_export(self, context):

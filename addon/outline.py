@@ -1,6 +1,7 @@
 """Wire outlines of collision primitives: a COLLISION_SHAPE object is a mesh shown as a wire
 whose vertices are rebuilt from its ADF shape, size, radius, height and axis whenever one of
 them changes (the properties' update callback), so what the user sees is what AMBF collides."""
+
 from __future__ import annotations
 
 import math
@@ -48,13 +49,13 @@ def shape_geometry(shape: str, size, radius: float, height: float) -> tuple[list
     rings = []
     lat = 8
     for k in range(1, lat):
-        phi = math.pi * k / lat - math.pi / 2     # -90°..90° exclusive of the poles
+        phi = math.pi * k / lat - math.pi / 2  # -90°..90° exclusive of the poles
         z = radius * math.sin(phi)
         z += half if phi > 0 else (-half if phi < 0 else 0.0)
         rings.append(_ring(radius * math.cos(phi), z))
     if shape == "CAPSULE" and half > 0:
         mid = lat // 2 - 1
-        rings = rings[:mid] + [_ring(radius, -half), _ring(radius, half)] + rings[mid + 1:]
+        rings = rings[:mid] + [_ring(radius, -half), _ring(radius, half)] + rings[mid + 1 :]
     verts, faces = _tube(rings, caps=False)
     n = SEGMENTS
     bottom, top = len(verts), len(verts) + 1

@@ -3,21 +3,36 @@
 Every optional ADF key gets a ``use_<name>`` switch: off means "not written" (AMBF uses
 its default), which is not the same as writing the default value.
 """
+
 from __future__ import annotations
 
 import bpy
-from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
-                       IntProperty, PointerProperty, StringProperty)
+from bpy.props import (
+    BoolProperty,
+    CollectionProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    PointerProperty,
+    StringProperty,
+)
 
 from . import fields
 
-KINDS = (("NONE", "None", "Not part of the ADF model"), ("BODY", "Body", "Rigid body"),
-         ("SOFT_BODY", "Soft body", "Bullet soft body (cloth, tissue): its nodes are the mesh's vertices"),
-         ("GHOST", "Ghost", "Non-colliding trigger volume"), ("SENSOR", "Sensor", "Ray sensor"),
-         ("ACTUATOR", "Actuator", "Constraint actuator"), ("CAMERA", "Camera", "ADF camera"),
-         ("LIGHT", "Light", "ADF spot light"), ("JOINT", "Joint", "Joint (rigid body constraint on this object)"),
-         ("COLLISION_SHAPE", "Collision primitive", "A primitive of its parent body's collision"),
-         ("COLLISION_MESH", "Collision mesh", "A (convex) collision mesh part of its parent body"))
+KINDS = (
+    ("NONE", "None", "Not part of the ADF model"),
+    ("BODY", "Body", "Rigid body"),
+    ("SOFT_BODY", "Soft body", "Bullet soft body (cloth, tissue): its nodes are the mesh's vertices"),
+    ("GHOST", "Ghost", "Non-colliding trigger volume"),
+    ("SENSOR", "Sensor", "Ray sensor"),
+    ("ACTUATOR", "Actuator", "Constraint actuator"),
+    ("CAMERA", "Camera", "ADF camera"),
+    ("LIGHT", "Light", "ADF spot light"),
+    ("JOINT", "Joint", "Joint (rigid body constraint on this object)"),
+    ("COLLISION_SHAPE", "Collision primitive", "A primitive of its parent body's collision"),
+    ("COLLISION_MESH", "Collision mesh", "A (convex) collision mesh part of its parent body"),
+)
 SHAPES = ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE")
 
 
@@ -51,8 +66,9 @@ def _make_group(name: str, table: list[fields.Field], extra: dict | None = None,
         value_up, use_up = up if isinstance(up, tuple) else (up, up)
         ann[f.prop] = _prop(f, value_up)
         kw = {"update": use_up} if use_up is not None else {}
-        ann["use_" + f.prop] = BoolProperty(name=f"Write {f.label}", default=False,
-                                            description=f"Write '{' '.join(f.path)}' (off: AMBF default)", **kw)
+        ann["use_" + f.prop] = BoolProperty(
+            name=f"Write {f.label}", default=False, description=f"Write '{' '.join(f.path)}' (off: AMBF default)", **kw
+        )
     ann.update(extra or {})
     return type(name, (bpy.types.PropertyGroup,), {"__annotations__": ann})
 
@@ -64,14 +80,21 @@ class AdfRay(bpy.types.PropertyGroup):
 
 def _outline(self, context):
     from .outline import update_outline
+
     update_outline(self.id_data)
 
 
 class AdfShape(bpy.types.PropertyGroup):
-    shape: EnumProperty(name="Shape", items=[(s, s.title(), s.title()) for s in SHAPES], default="BOX",
-                        update=_outline)
-    size: FloatVectorProperty(name="Box size", size=3, default=(0.1, 0.1, 0.1), min=0.0, precision=6,
-                              description="full edge lengths x, y, z (m)", update=_outline)
+    shape: EnumProperty(name="Shape", items=[(s, s.title(), s.title()) for s in SHAPES], default="BOX", update=_outline)
+    size: FloatVectorProperty(
+        name="Box size",
+        size=3,
+        default=(0.1, 0.1, 0.1),
+        min=0.0,
+        precision=6,
+        description="full edge lengths x, y, z (m)",
+        update=_outline,
+    )
     radius: FloatProperty(name="Radius", default=0.05, min=0.0, precision=6, update=_outline)
     height: FloatProperty(name="Height", default=0.1, min=0.0, precision=6, update=_outline)
     axis: EnumProperty(name="Axis", items=[(a, a, a) for a in "xyzXYZ"], default="z", update=_outline)
@@ -83,33 +106,64 @@ def _mass_typed(self, context):
 
 def _joint_limits(self, context):
     from .constraints import mirror_limits
+
     mirror_limits(self.id_data)
 
 
-_LIMIT_PROPS = ("type", "limit_low", "limit_high", "cone_limits", "linear_low", "linear_high", "angular_low",
-                "angular_high")
-_TYPED = {"mass_typed": BoolProperty(name="Mass typed by hand", default=False,
-                                     description="off: mass follows density × mesh volume")}
+_LIMIT_PROPS = (
+    "type",
+    "limit_low",
+    "limit_high",
+    "cone_limits",
+    "linear_low",
+    "linear_high",
+    "angular_low",
+    "angular_high",
+)
+_TYPED = {
+    "mass_typed": BoolProperty(
+        name="Mass typed by hand", default=False, description="off: mass follows density × mesh volume"
+    )
+}
 BodyProps = _make_group("AdfBodyProps", fields.BODY, dict(_TYPED), {"mass": (_mass_typed, None)})
-SoftProps = _make_group("AdfSoftProps", fields.SOFT, {
-    **_TYPED, "fixed_group": StringProperty(name="Fixed nodes group", default="fixed nodes",
-                                             description="vertex group whose vertices are the soft body's fixed nodes"),
-    "mass_note": StringProperty(name="Mass note", options={"HIDDEN"},
-                                description="why the mass could not be taken from density × volume")},
-    {"mass": (_mass_typed, None)})
+SoftProps = _make_group(
+    "AdfSoftProps",
+    fields.SOFT,
+    {
+        **_TYPED,
+        "fixed_group": StringProperty(
+            name="Fixed nodes group",
+            default="fixed nodes",
+            description="vertex group whose vertices are the soft body's fixed nodes",
+        ),
+        "mass_note": StringProperty(
+            name="Mass note", options={"HIDDEN"}, description="why the mass could not be taken from density × volume"
+        ),
+    },
+    {"mass": (_mass_typed, None)},
+)
 GhostProps = _make_group("AdfGhostProps", fields.GHOST)
 JointProps = _make_group("AdfJointProps", fields.JOINT, None, {k: _joint_limits for k in _LIMIT_PROPS})
 SensorProps = _make_group("AdfSensorProps", fields.SENSOR, {"rays": CollectionProperty(type=AdfRay)})
 ActuatorProps = _make_group("AdfActuatorProps", fields.ACTUATOR)
 CameraProps = _make_group("AdfCameraProps", fields.CAMERA)
 LightProps = _make_group("AdfLightProps", fields.LIGHT)
-GROUP_OF = {"BODY": "body", "SOFT_BODY": "soft", "GHOST": "ghost", "JOINT": "joint", "SENSOR": "sensor", "ACTUATOR": "actuator",
-            "CAMERA": "camera", "LIGHT": "light"}
+GROUP_OF = {
+    "BODY": "body",
+    "SOFT_BODY": "soft",
+    "GHOST": "ghost",
+    "JOINT": "joint",
+    "SENSOR": "sensor",
+    "ACTUATOR": "actuator",
+    "CAMERA": "camera",
+    "LIGHT": "light",
+}
 
 
 def _density(self, context):
     if self.kind in ("BODY", "SOFT_BODY"):
         from .authoring import mass_from_density
+
         mass_from_density(self.id_data)
 
 
@@ -132,8 +186,13 @@ class AdfObjectProps(bpy.types.PropertyGroup):
     mesh_hash: StringProperty(options={"HIDDEN"})
     collision_source: StringProperty(name="Collision source", description="file the collision mesh came from")
     collision_hash: StringProperty(options={"HIDDEN"})
-    density: FloatProperty(name="Density", default=1000.0, min=0.0, update=_density,
-                           description="kg/m³: the mass is density × mesh volume unless typed by hand")
+    density: FloatProperty(
+        name="Density",
+        default=1000.0,
+        min=0.0,
+        update=_density,
+        description="kg/m³: the mass is density × mesh volume unless typed by hand",
+    )
 
 
 class AdfSceneProps(bpy.types.PropertyGroup):
@@ -141,8 +200,11 @@ class AdfSceneProps(bpy.types.PropertyGroup):
     namespace: StringProperty(name="Namespace", default="")
     use_namespace: BoolProperty(name="Write namespace", default=False)
     ignore_inter_collision: BoolProperty(name="Ignore inter-collision", default=False)
-    use_gravity: BoolProperty(name="Model gravity", default=False,
-                              description="write the model's own gravity (bodies without one of their own use it)")
+    use_gravity: BoolProperty(
+        name="Model gravity",
+        default=False,
+        description="write the model's own gravity (bodies without one of their own use it)",
+    )
     gravity: FloatVectorProperty(name="Gravity", default=(0.0, 0.0, -9.81), size=3, subtype="ACCELERATION")
     use_ignore_inter_collision: BoolProperty(name="Write ignore inter-collision", default=False)
     findings: StringProperty(name="Findings", description="last export's validation findings")
@@ -150,18 +212,41 @@ class AdfSceneProps(bpy.types.PropertyGroup):
     rope_length: FloatProperty(name="Length", default=0.2, min=0.001, precision=4)
     rope_radius: FloatProperty(name="Radius", default=0.001, min=0.0001, precision=5)
     rope_mass: FloatProperty(name="Total mass", default=0.002, min=0.0, precision=5)
-    precision: IntProperty(name="Float digits", default=9, min=3, max=17,
-                           description="significant digits of exported floats (values Blender stores in single "
-                                       "precision print as 0.005, not 0.004999999888241291)")
-    apply_modifiers: BoolProperty(name="Apply modifiers", default=True,
-                                  description="export the evaluated mesh (modifiers applied) of each body")
-    low_res_ratio: FloatProperty(name="Low-res ratio", default=1.0, min=0.01, max=1.0,
-                                 description="collision (low-res) meshes made from the visual one are decimated to "
-                                             "this share of its faces (1: same mesh)")
+    precision: IntProperty(
+        name="Float digits",
+        default=9,
+        min=3,
+        max=17,
+        description="significant digits of exported floats (values Blender stores in single "
+        "precision print as 0.005, not 0.004999999888241291)",
+    )
+    apply_modifiers: BoolProperty(
+        name="Apply modifiers", default=True, description="export the evaluated mesh (modifiers applied) of each body"
+    )
+    low_res_ratio: FloatProperty(
+        name="Low-res ratio",
+        default=1.0,
+        min=0.01,
+        max=1.0,
+        description="collision (low-res) meshes made from the visual one are decimated to "
+        "this share of its faces (1: same mesh)",
+    )
 
 
-CLASSES = (AdfRay, AdfShape, BodyProps, SoftProps, GhostProps, JointProps, SensorProps, ActuatorProps, CameraProps,
-           LightProps, AdfObjectProps, AdfSceneProps)
+CLASSES = (
+    AdfRay,
+    AdfShape,
+    BodyProps,
+    SoftProps,
+    GhostProps,
+    JointProps,
+    SensorProps,
+    ActuatorProps,
+    CameraProps,
+    LightProps,
+    AdfObjectProps,
+    AdfSceneProps,
+)
 
 
 def register() -> None:

@@ -1,4 +1,5 @@
 """Headless Workbench thumbnail of the ADF objects in a scene (for READMEs and reviews)."""
+
 from __future__ import annotations
 
 from pathlib import Path

@@ -1,5 +1,6 @@
 """Joint controller gains, joint visibility and clean-up (what the original AMBF add-on
 offered beside export): Blender-level walks over the scene, arithmetic in plain functions."""
+
 from __future__ import annotations
 
 import math
@@ -42,6 +43,7 @@ def load_about_joint(scene, joint) -> float:
     inertia about the joint axis (kg·m²): each body's mass times its squared distance from
     the axis plus its largest principal moment (an upper bound of its own term)."""
     from adfkit.model.semantics import JointKind, joint_kind
+
     rbc = joint.rigid_body_constraint
     p = joint.adf.joint
     kind = joint_kind(p.type) if p.use_type else JointKind.REVOLUTE
@@ -112,7 +114,7 @@ def rename_joints(scene) -> list[str]:
             continue
         want = f"{rbc.object1.name}-{rbc.object2.name}"
         if o.name != want:
-            o.name = want          # Blender appends .001 when the name is taken
+            o.name = want  # Blender appends .001 when the name is taken
         done.append(o.name)
     return done
 
@@ -126,8 +128,9 @@ def cleanup(scene) -> list[str]:
         k = o.adf.kind
         if k == "JOINT":
             rbc = o.rigid_body_constraint
-            ok = rbc is not None and all(b is not None and b.adf.kind in ("BODY", "SOFT_BODY")
-                                         for b in (rbc.object1, rbc.object2))
+            ok = rbc is not None and all(
+                b is not None and b.adf.kind in ("BODY", "SOFT_BODY") for b in (rbc.object1, rbc.object2)
+            )
             if not ok and not o.adf.snapshot:
                 said.append(f"removed joint {o.name} (no parent or child body)")
                 bpy.data.objects.remove(o, do_unlink=True)

@@ -1,11 +1,11 @@
 """Panels: Properties editor (Object tab) and the 3D view N-panel, drawn from the field tables."""
+
 from __future__ import annotations
 
 import bpy
 
 from . import fields
 from .properties import group
-
 
 
 def _visible(kind: str, pg, f: fields.Field) -> bool:
@@ -15,8 +15,14 @@ def _visible(kind: str, pg, f: fields.Field) -> bool:
         return True
     t = pg.type
     six = t in ("six dof", "six dof spring")
-    spring_axes = ("damping_linear", "damping_angular", "stiffness_linear", "stiffness_angular",
-                   "equilibrium_linear", "equilibrium_angular")
+    spring_axes = (
+        "damping_linear",
+        "damping_angular",
+        "stiffness_linear",
+        "stiffness_angular",
+        "equilibrium_linear",
+        "equilibrium_angular",
+    )
     if f.prop in ("linear_low", "linear_high", "angular_low", "angular_high"):
         return six
     if f.prop in spring_axes:
@@ -94,11 +100,15 @@ def draw_object(layout, obj) -> None:
             external = [e for e in str(obj.get("adf_external_ends", "")).split(",") if e]
             missing = [r for r, o in (("parent", rbc and rbc.object1), ("child", rbc and rbc.object2)) if o is None]
             if missing and set(missing) <= set(external):
-                layout.label(text=f"The {' and '.join(missing)} body is in another file: exported as written",
-                             icon="INFO")
+                layout.label(
+                    text=f"The {' and '.join(missing)} body is in another file: exported as written", icon="INFO"
+                )
             else:
-                layout.label(text="Set the constraint's parent (Object 1) and child (Object 2) bodies: "
-                             "export refuses the joint until then", icon="ERROR")
+                layout.label(
+                    text="Set the constraint's parent (Object 1) and child (Object 2) bodies: "
+                    "export refuses the joint until then",
+                    icon="ERROR",
+                )
     if adf.kind == "SENSOR":
         layout.label(text=f"{len(pg.rays)} rays")
         for r in pg.rays:

@@ -4,6 +4,7 @@ happen inside ``run`` so ``adfkit --help`` stays fast.
 
 Exit status: 0 success, 1 findings/failure the user asked to fail on, 2 usage or input error.
 """
+
 from __future__ import annotations
 
 import argparse

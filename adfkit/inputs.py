@@ -20,6 +20,7 @@ Every refusal is an :class:`AdfError` whose diagnostic is located at the key tha
 file (``referrer``) or, for a file named on the command line, at that file; its message
 names the path (control characters escaped) and never quotes the file's content.
 """
+
 from __future__ import annotations
 
 import os
@@ -31,10 +32,10 @@ from .diagnostics import AdfError, SourceLocation, error
 
 #: Largest file read per kind, in bytes.
 MAX_BYTES = {
-    "adf": 16 * 1024 * 1024,     # the largest public ADF file is ~300 KB
-    "xml": 64 * 1024 * 1024,     # URDF / MJCF
-    "mesh": 512 * 1024 * 1024,   # STL / OBJ / PLY / DAE ...
-    "text": 16 * 1024 * 1024,    # MTL and other small side files
+    "adf": 16 * 1024 * 1024,  # the largest public ADF file is ~300 KB
+    "xml": 64 * 1024 * 1024,  # URDF / MJCF
+    "mesh": 512 * 1024 * 1024,  # STL / OBJ / PLY / DAE ...
+    "text": 16 * 1024 * 1024,  # MTL and other small side files
     "image": 256 * 1024 * 1024,  # a volume slice or a texture
 }
 MAX_PATH_BYTES = 4096
@@ -43,8 +44,10 @@ MAX_NAME_BYTES = 255
 TREE_LEVELS = 3
 ROOT_ENV = "ADFKIT_INPUT_ROOT"
 
-_HINT_TREE = ("files an ADF names must lie in the scene's folder tree; name the file on the command line "
-              f"to read it anyway, or set {ROOT_ENV} to a wider folder")
+_HINT_TREE = (
+    "files an ADF names must lie in the scene's folder tree; name the file on the command line "
+    f"to read it anyway, or set {ROOT_ENV} to a wider folder"
+)
 
 
 def shown(path: str | os.PathLike | bytes, limit: int = 240) -> str:
@@ -66,7 +69,7 @@ def shown(path: str | os.PathLike | bytes, limit: int = 240) -> str:
             out.append(ch)
     text = "".join(out)
     if len(text) > limit:
-        text = text[: limit // 2] + "..." + text[-(limit // 2):]
+        text = text[: limit // 2] + "..." + text[-(limit // 2) :]
     return text
 
 
@@ -113,22 +116,48 @@ def check_path_text(path: str | os.PathLike, referrer: SourceLocation | None = N
     try:
         raw = os.fsencode(path)
     except (TypeError, ValueError, UnicodeError):
-        raise _fail("bad-path", f"the path {shown(str(path))} cannot be encoded for the file system",
-                    str(path), referrer, "use a plain UTF-8 file name") from None
+        raise _fail(
+            "bad-path",
+            f"the path {shown(str(path))} cannot be encoded for the file system",
+            str(path),
+            referrer,
+            "use a plain UTF-8 file name",
+        ) from None
     if b"\0" in raw:
-        raise _fail("bad-path", f"the path {shown(raw)} holds a NUL byte", raw, referrer,
-                    "a file name cannot contain a NUL byte; fix the path")
+        raise _fail(
+            "bad-path",
+            f"the path {shown(raw)} holds a NUL byte",
+            raw,
+            referrer,
+            "a file name cannot contain a NUL byte; fix the path",
+        )
     if len(raw) > MAX_PATH_BYTES:
-        raise _fail("bad-path", f"the path is {len(raw)} bytes long (the limit is {MAX_PATH_BYTES})", raw,
-                    referrer, "shorten the path")
+        raise _fail(
+            "bad-path",
+            f"the path is {len(raw)} bytes long (the limit is {MAX_PATH_BYTES})",
+            raw,
+            referrer,
+            "shorten the path",
+        )
     longest = max((len(part) for part in raw.split(b"/")), default=0)
     if longest > MAX_NAME_BYTES:
-        raise _fail("bad-path", f"a name in the path {shown(raw)} is {longest} bytes long "
-                    f"(the limit is {MAX_NAME_BYTES})", raw, referrer, "shorten the file or folder name")
+        raise _fail(
+            "bad-path",
+            f"a name in the path {shown(raw)} is {longest} bytes long (the limit is {MAX_NAME_BYTES})",
+            raw,
+            referrer,
+            "shorten the file or folder name",
+        )
 
 
-def check_file(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None = None,
-               referrer: SourceLocation | None = None, what: str = "file") -> Path:
+def check_file(
+    path: str | os.PathLike,
+    kind: str = "adf",
+    *,
+    tree: Tree | None = None,
+    referrer: SourceLocation | None = None,
+    what: str = "file",
+) -> Path:
     """Check ``path`` against the policy without opening it; returns it as a Path.
 
     ``tree`` None means the user named the file (no tree check); ``referrer`` locates the
@@ -138,36 +167,74 @@ def check_file(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None 
     try:
         st = os.stat(p)
     except FileNotFoundError:
-        raise _fail("file-not-found", f"no such {what}: {shown(p)}", p, referrer,
-                    "check the path; relative paths resolve against the naming file's folder "
-                    "(the current folder on the command line)") from None
+        raise _fail(
+            "file-not-found",
+            f"no such {what}: {shown(p)}",
+            p,
+            referrer,
+            "check the path; relative paths resolve against the naming file's folder "
+            "(the current folder on the command line)",
+        ) from None
     except NotADirectoryError:
-        raise _fail("file-not-found", f"no such {what}: {shown(p)} (a folder in the path is a file)", p, referrer,
-                    "check the path") from None
+        raise _fail(
+            "file-not-found",
+            f"no such {what}: {shown(p)} (a folder in the path is a file)",
+            p,
+            referrer,
+            "check the path",
+        ) from None
     except PermissionError:
-        raise _fail("file-unreadable", f"cannot read {shown(p)}: permission denied", p, referrer,
-                    "check the file's permissions") from None
+        raise _fail(
+            "file-unreadable", f"cannot read {shown(p)}: permission denied", p, referrer, "check the file's permissions"
+        ) from None
     except OSError as exc:
-        raise _fail("file-unreadable", f"cannot read {shown(p)}: {exc.strerror or type(exc).__name__}", p, referrer,
-                    "check the path") from None
+        raise _fail(
+            "file-unreadable",
+            f"cannot read {shown(p)}: {exc.strerror or type(exc).__name__}",
+            p,
+            referrer,
+            "check the path",
+        ) from None
     if not stat.S_ISREG(st.st_mode):
-        kind_word = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
-                     else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode)
-                     else "a socket" if stat.S_ISSOCK(st.st_mode) else "not a regular file")
-        raise _fail("not-a-regular-file", f"{shown(p)} is {kind_word}, not a regular file", p, referrer,
-                    f"name a regular {what}; adfkit never reads devices, FIFOs or folders as files")
+        kind_word = (
+            "a folder"
+            if stat.S_ISDIR(st.st_mode)
+            else "a FIFO"
+            if stat.S_ISFIFO(st.st_mode)
+            else "a device"
+            if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode)
+            else "a socket"
+            if stat.S_ISSOCK(st.st_mode)
+            else "not a regular file"
+        )
+        raise _fail(
+            "not-a-regular-file",
+            f"{shown(p)} is {kind_word}, not a regular file",
+            p,
+            referrer,
+            f"name a regular {what}; adfkit never reads devices, FIFOs or folders as files",
+        )
     if tree is not None and not tree.contains(p):
-        raise _fail("outside-tree", f"{shown(p)} lies outside the scene's folder tree ({shown(tree.root)}); not read",
-                    p, referrer, _HINT_TREE)
+        raise _fail(
+            "outside-tree",
+            f"{shown(p)} lies outside the scene's folder tree ({shown(tree.root)}); not read",
+            p,
+            referrer,
+            _HINT_TREE,
+        )
     cap = MAX_BYTES.get(kind, MAX_BYTES["adf"])
     if st.st_size > cap:
-        raise _fail("file-too-large", f"{shown(p)} is {st.st_size:,} bytes; the limit for a {kind} file "
-                    f"is {cap:,}", p, referrer, "split the file, or check that this is the file you meant")
+        raise _fail(
+            "file-too-large",
+            f"{shown(p)} is {st.st_size:,} bytes; the limit for a {kind} file is {cap:,}",
+            p,
+            referrer,
+            "split the file, or check that this is the file you meant",
+        )
     return p
 
 
-def check_mesh(path: str | os.PathLike, *, tree: Tree | None = None,
-               referrer: SourceLocation | None = None) -> Path:
+def check_mesh(path: str | os.PathLike, *, tree: Tree | None = None, referrer: SourceLocation | None = None) -> Path:
     """:func:`check_file` for a mesh file, with ``mesh-not-found`` (located at the mesh's path,
     with a hint when only the letter case differs) for a mesh that is not there."""
     check_path_text(path, referrer)
@@ -184,20 +251,32 @@ def check_mesh(path: str | os.PathLike, *, tree: Tree | None = None,
     return check_file(p, "mesh", tree=tree, referrer=referrer, what="mesh file")
 
 
-def read_bytes(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None = None,
-               referrer: SourceLocation | None = None, what: str = "file") -> bytes:
+def read_bytes(
+    path: str | os.PathLike,
+    kind: str = "adf",
+    *,
+    tree: Tree | None = None,
+    referrer: SourceLocation | None = None,
+    what: str = "file",
+) -> bytes:
     """The file's bytes, after :func:`check_file`; reads at most the kind's cap."""
     p = check_file(path, kind, tree=tree, referrer=referrer, what=what)
     cap = MAX_BYTES.get(kind, MAX_BYTES["adf"])
     try:
         fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except OSError as exc:
-        raise _fail("file-unreadable", f"cannot read {shown(p)}: {exc.strerror or type(exc).__name__}", p, referrer,
-                    "check the path and permissions") from None
+        raise _fail(
+            "file-unreadable",
+            f"cannot read {shown(p)}: {exc.strerror or type(exc).__name__}",
+            p,
+            referrer,
+            "check the path and permissions",
+        ) from None
     try:
         if not stat.S_ISREG(os.fstat(fd).st_mode):  # swapped between stat and open
-            raise _fail("not-a-regular-file", f"{shown(p)} is not a regular file", p, referrer,
-                        f"name a regular {what}")
+            raise _fail(
+                "not-a-regular-file", f"{shown(p)} is not a regular file", p, referrer, f"name a regular {what}"
+            )
         chunks, total = [], 0
         while True:
             chunk = os.read(fd, min(1 << 20, cap + 1 - total))
@@ -206,12 +285,22 @@ def read_bytes(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None 
             chunks.append(chunk)
             total += len(chunk)
             if total > cap:
-                raise _fail("file-too-large", f"{shown(p)} holds more than {cap:,} bytes", p, referrer,
-                            "split the file, or check that this is the file you meant")
+                raise _fail(
+                    "file-too-large",
+                    f"{shown(p)} holds more than {cap:,} bytes",
+                    p,
+                    referrer,
+                    "split the file, or check that this is the file you meant",
+                )
         return b"".join(chunks)
     except OSError as exc:
-        raise _fail("file-unreadable", f"cannot read {shown(p)}: {exc.strerror or type(exc).__name__}", p, referrer,
-                    "check the file") from None
+        raise _fail(
+            "file-unreadable",
+            f"cannot read {shown(p)}: {exc.strerror or type(exc).__name__}",
+            p,
+            referrer,
+            "check the file",
+        ) from None
     finally:
         os.close(fd)
 
@@ -224,18 +313,42 @@ def decode_utf8(data: bytes, path: str | os.PathLike) -> str:
         before = data[: exc.start]
         line = before.count(b"\n") + 1
         col = exc.start - (before.rfind(b"\n") + 1) + 1
-        raise AdfError(error("yaml-encoding", f"invalid UTF-8 byte 0x{data[exc.start]:02x}",
-                             SourceLocation(shown(path), line, col), "save the file as UTF-8")) from None
+        raise AdfError(
+            error(
+                "yaml-encoding",
+                f"invalid UTF-8 byte 0x{data[exc.start]:02x}",
+                SourceLocation(shown(path), line, col),
+                "save the file as UTF-8",
+            )
+        ) from None
 
 
-def read_text(path: str | os.PathLike, kind: str = "adf", *, tree: Tree | None = None,
-              referrer: SourceLocation | None = None, what: str = "file") -> str:
+def read_text(
+    path: str | os.PathLike,
+    kind: str = "adf",
+    *,
+    tree: Tree | None = None,
+    referrer: SourceLocation | None = None,
+    what: str = "file",
+) -> str:
     """The file as UTF-8 text, after :func:`read_bytes`."""
     return decode_utf8(read_bytes(path, kind, tree=tree, referrer=referrer, what=what), path)
 
 
-__all__ = ["MAX_BYTES", "ROOT_ENV", "TREE_LEVELS", "Tree", "check_file", "check_path_text", "decode_utf8", "is_regular",
-           "read_bytes", "read_text", "shown", "tree_of"]
+__all__ = [
+    "MAX_BYTES",
+    "ROOT_ENV",
+    "TREE_LEVELS",
+    "Tree",
+    "check_file",
+    "check_path_text",
+    "decode_utf8",
+    "is_regular",
+    "read_bytes",
+    "read_text",
+    "shown",
+    "tree_of",
+]
 
 
 def scene_file(path: str | os.PathLike) -> Path:
@@ -254,5 +367,10 @@ def scene_file(path: str | os.PathLike) -> Path:
     except OSError:
         yamls = []
     listed = ", ".join(yamls[:8]) + (" ..." if len(yamls) > 8 else "")
-    raise _fail("not-a-regular-file", f"{shown(p)} is a folder without a launch.yaml", p, None,
-                f"name the ADF file to use: one of {listed}" if yamls else "name an ADF file (launch, world or model)")
+    raise _fail(
+        "not-a-regular-file",
+        f"{shown(p)} is a folder without a launch.yaml",
+        p,
+        None,
+        f"name the ADF file to use: one of {listed}" if yamls else "name an ADF file (launch, world or model)",
+    )

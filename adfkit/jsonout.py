@@ -1,6 +1,7 @@
 """Strict JSON for everything adfkit prints or writes: no bare NaN or Infinity (invalid JSON
 that most parsers refuse). A non-finite number becomes ``null`` and, in an object at the top,
 its path is listed under ``"non_finite"`` so that the null is explained, not silent."""
+
 from __future__ import annotations
 
 import json

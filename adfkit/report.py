@@ -1,9 +1,11 @@
 """Printing diagnostics and progress for people: text on a terminal, quiet when piped."""
+
 from __future__ import annotations
 
 import sys
 import time
-from typing import IO, Iterable, Iterator, TypeVar
+from collections.abc import Iterable, Iterator
+from typing import IO, TypeVar
 
 from .diagnostics import Diagnostic
 
@@ -22,8 +24,14 @@ class Progress:
     ``extra`` is a callable returning text shown after the counts (e.g. a real-time factor).
     """
 
-    def __init__(self, total: int | None, label: str = "", stream: IO[str] | None = None,
-                 enabled: bool | None = None, min_interval: float = 0.1):
+    def __init__(
+        self,
+        total: int | None,
+        label: str = "",
+        stream: IO[str] | None = None,
+        enabled: bool | None = None,
+        min_interval: float = 0.1,
+    ):
         self.total, self.label = total, label
         self.stream = stream or sys.stderr
         self.enabled = self.stream.isatty() if enabled is None else enabled
@@ -59,7 +67,7 @@ class Progress:
             self.stream.write("\n")
             self.stream.flush()
 
-    def __enter__(self) -> "Progress":
+    def __enter__(self) -> Progress:
         return self
 
     def __exit__(self, *exc) -> None:

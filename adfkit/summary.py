@@ -1,8 +1,8 @@
 """Counts that describe a launch, world or model file (what `adfkit info` prints)."""
+
 from __future__ import annotations
 
 import os
-
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -88,8 +88,9 @@ def input_devices_summary(devs: InputDevices) -> dict[str, Any]:
     return {
         "kind": "input_devices",
         "file": str(devs.path) if devs.path else None,
-        "devices": [{"name": d.identifier, "hardware": d.hardware_name, "root link": d.root_link}
-                    for d in devs.input_devices],
+        "devices": [
+            {"name": d.identifier, "hardware": d.hardware_name, "root link": d.root_link} for d in devs.input_devices
+        ],
     }
 
 
@@ -134,8 +135,9 @@ def format_summary(s: dict[str, Any], indent: str = "") -> str:
         elif isinstance(v, list) and v and isinstance(v[0], dict):
             lines.append(f"{indent}{k}:")
             for item in v:
-                lines.append(f"{indent}  - " + ", ".join(f"{a}: {b}" for a, b in item.items()
-                                                          if not isinstance(b, (dict, list))))
+                lines.append(
+                    f"{indent}  - " + ", ".join(f"{a}: {b}" for a, b in item.items() if not isinstance(b, (dict, list)))
+                )
         elif isinstance(v, list):
             lines.append(f"{indent}{k}: " + ", ".join(map(str, v)))
         else:

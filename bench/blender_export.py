@@ -4,6 +4,7 @@ Prints, per model: import time, first export (meshes copied/written), export aga
 meshes unchanged (skipped by content hash), export after editing one mesh. Goal: < 2 s,
 and < 1 s when meshes are unchanged.   Usage: python bench/blender_export.py [--thumbnail PNG]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -14,10 +15,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT.parent / "shared" / "corpus"
-MODELS = {"psm": CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-psm.yaml",
-          "phantom": CORPUS / "src/ADF/Phantoms/Simple/phantom.yaml",
-          "cloth (soft body)": CORPUS / "ambf/ambf_models/descriptions/multi-bodies/sb/cloth.yaml",
-          "soft phantom (sample)": ROOT / "sample_scenes/soft_phantom/phantom.yaml"}
+MODELS = {
+    "psm": CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-psm.yaml",
+    "phantom": CORPUS / "src/ADF/Phantoms/Simple/phantom.yaml",
+    "cloth (soft body)": CORPUS / "ambf/ambf_models/descriptions/multi-bodies/sb/cloth.yaml",
+    "soft phantom (sample)": ROOT / "sample_scenes/soft_phantom/phantom.yaml",
+}
 
 
 def main() -> int:
@@ -26,6 +29,7 @@ def main() -> int:
     args = ap.parse_args()
     sys.path.insert(0, str(ROOT))
     from adfkit.commands.blend_import import load_addon
+
     bpy, addon = load_addon()
     for name, path in MODELS.items():
         if not path.is_file():
@@ -39,8 +43,9 @@ def main() -> int:
             times = []
             for step in ("first", "unchanged", "one mesh edited"):
                 if step == "one mesh edited":
-                    o = next(o for o in bpy.context.scene.objects
-                             if o.adf.kind in ("BODY", "SOFT_BODY") and o.type == "MESH")
+                    o = next(
+                        o for o in bpy.context.scene.objects if o.adf.kind in ("BODY", "SOFT_BODY") and o.type == "MESH"
+                    )
                     o.data.vertices[0].co.x += 1e-4
                 t0 = time.perf_counter()
                 res = addon.export.export_scene(bpy.context.scene, tmp, name.split()[0])

@@ -11,6 +11,7 @@ URDFs, dm_control models). For URDF → MJCF on the same files in the same run:
 - urdf2mjcf (`pip install urdf2mjcf`; skipped with a note when not installed).
 Each time is the best of --repeat runs in this process.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -61,6 +62,7 @@ def main() -> int:
         print(f"{rel:34s} {'URDF → ADF':14s} {t * 1e3:8.2f}")
     try:
         import dm_control
+
         suite = Path(dm_control.__file__).parent / "suite"
         for name in ("cartpole.xml", "acrobot.xml", "cheetah.xml", "humanoid.xml"):
             t = best(lambda: mjcf.read(suite / name), args.repeat)
@@ -72,6 +74,7 @@ def main() -> int:
         import logging
 
         from urdf2mjcf.convert import convert_urdf_to_mjcf
+
         logging.disable(logging.WARNING)  # urdf2mjcf logs every fallback it takes
     except ImportError:
         convert_urdf_to_mjcf = None

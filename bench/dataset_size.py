@@ -5,6 +5,7 @@ the goal of 0.5 MB, on the bundled suturing scene at its cameras' own size.
 
 Asserts nothing; prints figures.
 """
+
 from __future__ import annotations
 
 import sys
@@ -22,6 +23,7 @@ def main() -> int:
     from adfkit.dataset.writer import DatasetWriter
     from adfkit.runner.options import Options
     from adfkit.runner.world import SimWorld
+
     world = SimWorld(load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml"), Options(renderer="auto"))
     with tempfile.TemporaryDirectory() as tmp:
         try:
@@ -38,13 +40,17 @@ def main() -> int:
         kinds = ("rgb", "depth", "seg", "seg_color")
         size = {k: sum((Path(tmp) / "ds" / f.paths[k]).stat().st_size for f in loaded) / len(loaded) for k in kinds}
         cam = world.cameras[0]
-        print(f"{len(loaded)} camera frames ({len(world.cameras)} cameras, {cam.width}x{cam.height}), "
-              f"renderer {world.renderer}, {len(loaded) / elapsed:.1f} camera frames a second written")
+        print(
+            f"{len(loaded)} camera frames ({len(world.cameras)} cameras, {cam.width}x{cam.height}), "
+            f"renderer {world.renderer}, {len(loaded) / elapsed:.1f} camera frames a second written"
+        )
         for k in kinds:
             print(f"  {k:10s} {size[k] / 1e3:8.1f} kB")
         total = sum(size.values())
-        print(f"  {'total':10s} {total / 1e3:8.1f} kB a camera frame   goal <= 500 kB   "
-              f"(float32 .npy depth alone was {cam.width * cam.height * 4 / 1e3:.0f} kB)")
+        print(
+            f"  {'total':10s} {total / 1e3:8.1f} kB a camera frame   goal <= 500 kB   "
+            f"(float32 .npy depth alone was {cam.width * cam.height * 4 / 1e3:.0f} kB)"
+        )
     return 0
 
 

@@ -3,6 +3,7 @@ cache-hit time (goal < 50 ms). Prints figures; asserts nothing.
 
     .venv/bin/python bench/decompose.py [--max-hulls 8] [--seed 0]
 """
+
 from __future__ import annotations
 
 import argparse

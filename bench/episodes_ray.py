@@ -6,6 +6,7 @@ runs first and is not timed.
 
     python bench/episodes_ray.py [--episodes 8] [--env adfkit/NeedlePick-v0] [--address A]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -42,8 +43,11 @@ def main() -> int:
         steps = sum(r["result"]["steps"] for r in ok)
         pids = len({r["result"]["pid"] for r in ok})
         rows.append((workers, len(ok), wall, len(ok) / wall, steps / wall, pids))
-        print(f"{workers} worker(s): {len(ok)} episodes in {wall:.1f} s = {len(ok) / wall:.3f} episodes/s, "
-              f"{steps / wall:.1f} env steps/s ({pids} worker processes)", flush=True)
+        print(
+            f"{workers} worker(s): {len(ok)} episodes in {wall:.1f} s = {len(ok) / wall:.3f} episodes/s, "
+            f"{steps / wall:.1f} env steps/s ({pids} worker processes)",
+            flush=True,
+        )
         ray.shutdown()
     if len(rows) == 2:
         print(f"speed-up 2 vs 1 worker: {rows[1][3] / rows[0][3]:.2f}x")

@@ -3,6 +3,7 @@ the tally by exit status, and every case that broke a guarantee. Asserts nothing
 
     .venv/bin/python bench/fuzz.py [N] [--no-run] [--blender] [--corpus DIR] [--seed-filter TEXT]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,8 +34,10 @@ def main() -> int:
 
     seeds = fuzzkit.builtin_seeds() + fuzzkit.sample_scene_seeds() + fuzzkit.corpus_seeds(Path(args.corpus))
     seeds = [s for s in seeds if args.seed_filter in s.name]
-    cases = [fuzzkit.make_case(seeds[i % len(seeds)], args.start + i // len(seeds), not args.no_run, args.blender)
-             for i in range(args.n)]
+    cases = [
+        fuzzkit.make_case(seeds[i % len(seeds)], args.start + i // len(seeds), not args.no_run, args.blender)
+        for i in range(args.n)
+    ]
     if args.explicit:
         cases = fuzzkit.explicit_cases() + cases
     by_status: collections.Counter = collections.Counter()

@@ -1,5 +1,6 @@
 """Closed-form PSM IK (adfkit.runner.psm_kinematics): microseconds per call over random
 reachable poses, and how many of them reproduce the pose (one FK per candidate)."""
+
 from __future__ import annotations
 
 import sys
@@ -22,18 +23,20 @@ def main() -> int:
     t0 = time.process_time()
     for T in poses:
         try:
-            q = k.ik(T)
+            k.ik(T)
         except ValueError:
             continue
         ok += 1
     per_ik = (time.process_time() - t0) / len(poses)
     t0 = time.process_time()
-    for T in poses[:500]:
+    for _pose in poses[:500]:
         k.fk(np.zeros(6))
     per_fk = (time.process_time() - t0) / 500
     worst = max(pose_error(k.fk(k.ik(T, check_limits=False)), T) for T in poses[:200])
-    print(f"ik: {per_ik * 1e6:.0f} us a call (CPU), {ok}/{len(poses)} random in-limit poses solved, "
-          f"worst error {worst:.2g}; fk: {per_fk * 1e6:.0f} us a call")
+    print(
+        f"ik: {per_ik * 1e6:.0f} us a call (CPU), {ok}/{len(poses)} random in-limit poses solved, "
+        f"worst error {worst:.2g}; fk: {per_fk * 1e6:.0f} us a call"
+    )
     return 0
 
 

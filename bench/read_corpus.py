@@ -2,6 +2,7 @@
 
 Prints figures; asserts nothing. Target: core import (model + ADF I/O) < 150 ms.
 """
+
 from __future__ import annotations
 
 import re
@@ -16,8 +17,9 @@ CORPUS = ROOT.parent / "shared" / "corpus"
 
 def import_time(module: str) -> float:
     """Cumulative import time of ``module`` in a fresh interpreter, from -X importtime (ms)."""
-    proc = subprocess.run([sys.executable, "-X", "importtime", "-c", f"import {module}"],
-                          capture_output=True, text=True, check=True)
+    proc = subprocess.run(
+        [sys.executable, "-X", "importtime", "-c", f"import {module}"], capture_output=True, text=True, check=True
+    )
     total = 0
     for line in proc.stderr.splitlines():
         m = re.match(r"import time:\s+\d+ \|\s+(\d+) \| (\s*)(\S+)", line)
@@ -67,7 +69,9 @@ def main() -> None:
         dumps(d)
     write_s = time.perf_counter() - t
     print(f"corpus: {len(files)} files, {size / 1e6:.2f} MB; read {len(docs)} into the model")
-    print(f"read  whole corpus: {read_s * 1000:7.1f} ms ({len(files) / read_s:6.0f} files/s, {size / 1e6 / read_s:5.1f} MB/s)")
+    print(
+        f"read  whole corpus: {read_s * 1000:7.1f} ms ({len(files) / read_s:6.0f} files/s, {size / 1e6 / read_s:5.1f} MB/s)"
+    )
     print(f"write whole corpus: {write_s * 1000:7.1f} ms ({len(docs) / write_s:6.0f} files/s)")
 
 

@@ -7,6 +7,7 @@ and the cost of one control step and its parts.
 Each figure is the median of ``--rounds`` alternations of (full loop, bare floor) on freshly
 built worlds, so both see the same machine load.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -42,7 +43,7 @@ def measure(scene, kw: dict, seconds: float, rounds: int) -> dict:
         for kind in ("full", "bare"):
             world = SimWorld(scene, Options(visuals=False, **kw))
             try:
-                world.run(0.05)   # settle: the first steps wake everything up
+                world.run(0.05)  # settle: the first steps wake everything up
                 n = int(round(seconds / (world.dt * world.opt.control_substeps)))
                 if kind == "full":
                     full.append(_timed(lambda: world.step(n)))
@@ -56,14 +57,23 @@ def measure(scene, kw: dict, seconds: float, rounds: int) -> dict:
     try:
         world.run(0.05)
         cdt = world.dt * world.opt.control_substeps
-        parts = {name: timeit.timeit(fn, number=300, timer=time.process_time) / 300 for name, fn in (
-            ("springs", lambda: world.springs.apply(cdt)), ("hole ghosts", world._update_ghosts),
-            ("control step", world.control))}
+        parts = {
+            name: timeit.timeit(fn, number=300, timer=time.process_time) / 300
+            for name, fn in (
+                ("springs", lambda: world.springs.apply(cdt)),
+                ("hole ghosts", world._update_ghosts),
+                ("control step", world.control),
+            )
+        }
     finally:
         world.close()
     med = lambda xs, i: statistics.median(x[i] for x in xs)  # noqa: E731
-    return {"wall": (seconds / med(full, 0), seconds / med(bare, 0)),
-            "cpu": (seconds / med(full, 1), seconds / med(bare, 1)), "report": r, "parts": parts}
+    return {
+        "wall": (seconds / med(full, 0), seconds / med(bare, 0)),
+        "cpu": (seconds / med(full, 1), seconds / med(bare, 1)),
+        "report": r,
+        "parts": parts,
+    }
 
 
 def main() -> int:
@@ -72,6 +82,7 @@ def main() -> int:
     ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args()
     from adfkit.adf import load_scene
+
     launch = CORPUS / "src" / "launch.yaml"
     if not launch.is_file():
         print(f"corpus not found at {launch}", file=sys.stderr)
@@ -83,11 +94,15 @@ def main() -> int:
         print(f"{label}:")
         for clock in ("wall", "cpu"):
             loop, floor = m[clock]
-            print(f"  {clock:4s}: loop {loop:.2f}x real time, bare stepSimulation floor {floor:.2f}x, "
-                  f"loop/floor {loop / floor:.3f} (goal 0.9)")
+            print(
+                f"  {clock:4s}: loop {loop:.2f}x real time, bare stepSimulation floor {floor:.2f}x, "
+                f"loop/floor {loop / floor:.3f} (goal 0.9)"
+            )
         print("  per control step (CPU): " + ", ".join(f"{k} {v * 1e6:.0f} us" for k, v in m["parts"].items()))
-        print(f"  max constraint error {r['max_constraint_error_m'] * 1e3:.4f} mm, unstable bodies "
-              f"{len(r['nan']) + len(r['exploded']) + len(r['fell_through_floor'])}")
+        print(
+            f"  max constraint error {r['max_constraint_error_m'] * 1e3:.4f} mm, unstable bodies "
+            f"{len(r['nan']) + len(r['exploded']) + len(r['fell_through_floor'])}"
+        )
     print(f"peak memory {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
     return 0
 

@@ -2,6 +2,7 @@
 real-time factor of MjWorld.run, the bare mj_step floor of the same compiled model from the
 same state, where the time goes (MuJoCo's own timers), and the stereo frame time (cameraL +
 cameraR, each RGB + depth + segmentation) with MuJoCo's renderer. Figures only, no asserts."""
+
 from __future__ import annotations
 
 import argparse
@@ -26,6 +27,7 @@ def main() -> int:
     from adfkit.runner.mj.render import CameraUnavailable
     from adfkit.runner.mj.world import MjWorld
     from adfkit.runner.world import Options
+
     launch = CORPUS / "src" / "launch.yaml"
     if not launch.is_file():
         print(f"corpus not found at {launch}", file=sys.stderr)
@@ -35,18 +37,21 @@ def main() -> int:
     world = MjWorld(scene, Options())
     build = time.perf_counter() - t0
     m, d = world.model, world.data
-    print(f"model: {m.nbody} bodies, {m.nv} dofs, {m.ngeom} geoms, {m.nu} servos, {m.neq} equalities; "
-          f"build {build:.2f} s")
-    world.run(args.seconds)                          # the thread settles onto the phantom
+    print(
+        f"model: {m.nbody} bodies, {m.nv} dofs, {m.ngeom} geoms, {m.nu} servos, {m.neq} equalities; build {build:.2f} s"
+    )
+    world.run(args.seconds)  # the thread settles onto the phantom
     r = world.report()
     first = world.sim_time / world.wall_time
     w0, s0 = world.wall_time, world.sim_time
     world.run(args.seconds)
     r = world.report()
     rtf = (world.sim_time - s0) / (world.wall_time - w0)
-    print(f"MjWorld.run: {first:.2f}x real time over the first {args.seconds:g} s (the thread settling, "
-          f"awake), {rtf:.2f}x over the next {args.seconds:g} s ({r['awake_trees']} of {r['trees']} trees awake); "
-          f"unstable bodies {len(r['nan']) + len(r['exploded']) + len(r['fell_through_floor'])}")
+    print(
+        f"MjWorld.run: {first:.2f}x real time over the first {args.seconds:g} s (the thread settling, "
+        f"awake), {rtf:.2f}x over the next {args.seconds:g} s ({r['awake_trees']} of {r['trees']} trees awake); "
+        f"unstable bodies {len(r['nan']) + len(r['exploded']) + len(r['fell_through_floor'])}"
+    )
     # the floor: the same model and state, mj_step only
     for t in d.timer:
         t.duration, t.number = 0.0, 0
@@ -54,8 +59,10 @@ def main() -> int:
     t1 = time.perf_counter()
     mujoco.mj_step(m, d, n)
     floor = args.seconds / (time.perf_counter() - t1)
-    print(f"bare mj_step floor from there {floor:.2f}x (ratio {rtf / floor:.2f}); contacts {d.ncon}, "
-          f"constraint rows {d.nefc}")
+    print(
+        f"bare mj_step floor from there {floor:.2f}x (ratio {rtf / floor:.2f}); contacts {d.ncon}, "
+        f"constraint rows {d.nefc}"
+    )
     asleep = MjWorld(scene, Options(), sleep=False)
     asleep.run(args.seconds)
     w1, s1 = asleep.wall_time, asleep.sim_time
@@ -72,12 +79,14 @@ def main() -> int:
     t2 = time.perf_counter()
     for _ in range(200):
         world.control()
-    print(f"control step (hole ghosts' friction) {(time.perf_counter() - t2) / 200 * 1e3:.3f} ms "
-          f"per {world.opt.control_substeps} physics steps")
+    print(
+        f"control step (hole ghosts' friction) {(time.perf_counter() - t2) / 200 * 1e3:.3f} ms "
+        f"per {world.opt.control_substeps} physics steps"
+    )
     cams = world.cameras
     try:
         for c in cams:
-            c.render(world)                          # first frame: context and shaders
+            c.render(world)  # first frame: context and shaders
         times = []
         for _ in range(args.frames):
             t3 = time.perf_counter()
@@ -85,8 +94,10 @@ def main() -> int:
                 c.render(world)
             times.append(time.perf_counter() - t3)
         w, h = cams[0].width, cams[0].height
-        print(f"stereo frame ({len(cams)} cameras {w}x{h}, RGB + depth + segmentation): median "
-              f"{np.median(times) * 1e3:.1f} ms, best {min(times) * 1e3:.1f} ms (goal 15 ms)")
+        print(
+            f"stereo frame ({len(cams)} cameras {w}x{h}, RGB + depth + segmentation): median "
+            f"{np.median(times) * 1e3:.1f} ms, best {min(times) * 1e3:.1f} ms (goal 15 ms)"
+        )
     except CameraUnavailable as e:
         print(f"cameras unavailable: {e}")
     world.close()

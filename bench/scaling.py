@@ -16,6 +16,7 @@ exponent of cost against size (log-log least squares; 1.0 is linear).
 Prints a table: size, cost, cost per unit, exponent. ``--plot`` writes the log-log plot.
 Asserts nothing.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,7 +34,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT.parent / "shared" / "corpus"
 JOINTS = ["revolute", "prismatic", "fixed", "p2p", "six dof spring"]
-BUDGET_S = 60.0   # a chain size whose run would take longer than this (by the growth seen) is not run
+BUDGET_S = 60.0  # a chain size whose run would take longer than this (by the growth seen) is not run
 
 
 def exponent(sizes, costs) -> float:
@@ -49,18 +50,32 @@ def chain_model(n: int, joint: str) -> str:
     out = ["bodies:"] + [f"- BODY {b}" for b in names] + ["joints:"]
     out += [f"- JOINT J{i}" for i in range(1, n)]
     for i, b in enumerate(names):
-        out += [f"BODY {b}:", f"  name: {b}", "  mass: " + ("0.0" if i == 0 else "0.01"),
-                "  inertia: {ix: 1.0e-6, iy: 1.0e-6, iz: 1.0e-6}",
-                "  collision shape: Box", "  collision geometry: {x: 0.02, y: 0.01, z: 0.01}",
-                f"  collision groups: [{i % 1000}]",   # a group of its own: no self-contact, joints alone
-                "  shape: Box", "  geometry: {x: 0.02, y: 0.01, z: 0.01}",
-                "  location:", f"    position: {{x: {0.02 * i:.4f}, y: 0.0, z: 1.0}}",
-                "    orientation: {r: 0.0, p: 0.0, y: 0.0}"]
+        out += [
+            f"BODY {b}:",
+            f"  name: {b}",
+            "  mass: " + ("0.0" if i == 0 else "0.01"),
+            "  inertia: {ix: 1.0e-6, iy: 1.0e-6, iz: 1.0e-6}",
+            "  collision shape: Box",
+            "  collision geometry: {x: 0.02, y: 0.01, z: 0.01}",
+            f"  collision groups: [{i % 1000}]",  # a group of its own: no self-contact, joints alone
+            "  shape: Box",
+            "  geometry: {x: 0.02, y: 0.01, z: 0.01}",
+            "  location:",
+            f"    position: {{x: {0.02 * i:.4f}, y: 0.0, z: 1.0}}",
+            "    orientation: {r: 0.0, p: 0.0, y: 0.0}",
+        ]
     for i in range(1, n):
-        out += [f"JOINT J{i}:", f"  name: J{i}", f"  parent: BODY L{i - 1}", f"  child: BODY L{i}",
-                f"  type: {joint}", "  parent pivot: {x: 0.01, y: 0.0, z: 0.0}",
-                "  child pivot: {x: -0.01, y: 0.0, z: 0.0}", "  parent axis: {x: 0.0, y: 1.0, z: 0.0}",
-                "  child axis: {x: 0.0, y: 1.0, z: 0.0}"]
+        out += [
+            f"JOINT J{i}:",
+            f"  name: J{i}",
+            f"  parent: BODY L{i - 1}",
+            f"  child: BODY L{i}",
+            f"  type: {joint}",
+            "  parent pivot: {x: 0.01, y: 0.0, z: 0.0}",
+            "  child pivot: {x: -0.01, y: 0.0, z: 0.0}",
+            "  parent axis: {x: 0.0, y: 1.0, z: 0.0}",
+            "  child axis: {x: 0.0, y: 1.0, z: 0.0}",
+        ]
         if joint == "six dof spring":
             out += ["  stiffness: 10.0", "  damping: 0.1"]
     return "\n".join(out) + "\n"
@@ -84,7 +99,7 @@ def bench_validate(quick: bool) -> list[dict]:
     src = CORPUS if CORPUS.is_dir() else ROOT / "sample_scenes"
     files = [p for p in src.rglob("*.yaml")] + [p for p in src.rglob("*.yml")]
     sizes, costs = [], []
-    for copies in ((1, 4) if quick else (1, 4, 16)):
+    for copies in (1, 4) if quick else (1, 4, 16):
         with tempfile.TemporaryDirectory() as tmp:
             for c in range(copies):
                 for p in files:
@@ -94,43 +109,54 @@ def bench_validate(quick: bool) -> list[dict]:
             best = math.inf
             for _ in range(3):
                 t = time.perf_counter()
-                subprocess.run([sys.executable, "-m", "adfkit", "validate", tmp, "-f", "json"],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                subprocess.run(
+                    [sys.executable, "-m", "adfkit", "validate", tmp, "-f", "json"],
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL,
+                )
                 best = min(best, time.perf_counter() - t)
         sizes.append(copies * len(files))
         costs.append(best)
-    return _table(f"adfkit validate ({'corpus' if src == CORPUS else 'sample scenes'}; files -> s, CLI, best of 3)",
-                  "s", [("validate -f json", sizes, costs)])
+    return _table(
+        f"adfkit validate ({'corpus' if src == CORPUS else 'sample scenes'}; files -> s, CLI, best of 3)",
+        "s",
+        [("validate -f json", sizes, costs)],
+    )
 
 
 def _world(engine: str, path: Path):
     from adfkit.adf import load_scene
     from adfkit.runner.world import Options, SimWorld
+
     scene = load_scene(path)
     # no gravity and no sleeping: the chain holds still, so every size does the same work per
     # body (a falling chain whips, and its cost would follow the motion, not the size)
     opt = Options(ground=False, gravity=(0.0, 0.0, 0.0))
     if engine == "mujoco":
         from adfkit.runner.mj.world import MjWorld
+
         return MjWorld(scene, opt, sleep=False)
     return SimWorld(scene, opt)
 
 
 def bench_run(quick: bool, tmp: Path) -> list[dict]:
     from adfkit.diagnostics import AdfError
+
     sizes = [10, 100] if quick else [10, 100, 1000]
     found, notes = [], []
     for engine in ("pybullet", "mujoco"):
         warm = tmp / "warm.yaml"
         warm.write_text(chain_model(3, "revolute"))
-        _world(engine, warm).close()             # imports and first-build caches apart
+        _world(engine, warm).close()  # imports and first-build caches apart
         rows, builds = [], []
         for joint in JOINTS:
             costs, build_costs, done = [], [], []
             for n in sizes:
                 if costs and costs[-1] * (n / done[-1]) ** 3 * 0.1 > BUDGET_S:
-                    notes.append(f"  {joint:16s} N={n:5d}: not run (at the cubic growth seen, 0.1 s would take "
-                                 f"{costs[-1] * (n / done[-1]) ** 3 * 0.1:,.0f} s)")
+                    notes.append(
+                        f"  {joint:16s} N={n:5d}: not run (at the cubic growth seen, 0.1 s would take "
+                        f"{costs[-1] * (n / done[-1]) ** 3 * 0.1:,.0f} s)"
+                    )
                     continue
                 path = tmp / f"chain_{joint.replace(' ', '_')}_{n}.yaml"
                 path.write_text(chain_model(n, joint))
@@ -144,13 +170,15 @@ def bench_run(quick: bool, tmp: Path) -> list[dict]:
                 build_costs.append(time.perf_counter() - t)
                 try:
                     sim = 0.1 if n >= 1000 else 0.5
-                    world.run(0.05)                  # first steps (caches, contact pairs) apart
+                    world.run(0.05)  # first steps (caches, contact pairs) apart
                     t = time.perf_counter()
                     world.run(sim)
                     costs.append((time.perf_counter() - t) / sim)
                     floor, facts = engine_floor(engine, world, sim)
-                    notes.append(f"  {joint:16s} N={n:5d}: loop {costs[-1]:9.4f} s/s, bare engine step "
-                                 f"{floor:9.4f} s/s ({floor / costs[-1]:.0%} of the loop){facts}")
+                    notes.append(
+                        f"  {joint:16s} N={n:5d}: loop {costs[-1]:9.4f} s/s, bare engine step "
+                        f"{floor:9.4f} s/s ({floor / costs[-1]:.0%} of the loop){facts}"
+                    )
                 finally:
                     world.close()
             rows.append((joint, done, costs))
@@ -171,6 +199,7 @@ def engine_floor(engine: str, world, sim: float) -> tuple[float, str]:
     steps = max(1, int(round(sim / world.dt)))
     if engine == "mujoco":
         import mujoco
+
         m, d = world.model, world.data
         t = time.perf_counter()
         mujoco.mj_step(m, d, steps)
@@ -184,7 +213,8 @@ def engine_floor(engine: str, world, sim: float) -> tuple[float, str]:
         filled = m.nM / max(1, m.nv * (m.nv + 1) // 2)
         return floor, f"; nv {m.nv}, tree depth {depth}, inertia matrix {filled:.0%} filled, constraints {d.nefc}"
     import pybullet as pb
-    steps = max(1, steps // world.opt.control_substeps)   # each call advances control_substeps physics steps
+
+    steps = max(1, steps // world.opt.control_substeps)  # each call advances control_substeps physics steps
     t = time.perf_counter()
     for _ in range(steps):
         pb.stepSimulation(physicsClientId=world.cid)
@@ -194,6 +224,7 @@ def engine_floor(engine: str, world, sim: float) -> tuple[float, str]:
 
 def bench_convert(quick: bool, tmp: Path) -> list[dict]:
     from adfkit.converters import read, write
+
     sizes = [10, 100] if quick else [10, 100, 1000]
     rows = []
     for fmt in ("urdf", "mjcf"):
@@ -217,9 +248,24 @@ def bench_suture(tmp: Path) -> list[dict]:
         sizes, costs = [], []
         for episodes in (2, 4):
             t = time.perf_counter()
-            subprocess.run([sys.executable, "-m", "adfkit", "suture", "--pairs", "1", "--episodes", str(episodes),
-                            "--workers", str(workers), "--out", str(out / str(episodes))],
-                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            subprocess.run(
+                [
+                    sys.executable,
+                    "-m",
+                    "adfkit",
+                    "suture",
+                    "--pairs",
+                    "1",
+                    "--episodes",
+                    str(episodes),
+                    "--workers",
+                    str(workers),
+                    "--out",
+                    str(out / str(episodes)),
+                ],
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
             sizes.append(episodes)
             costs.append(time.perf_counter() - t)
         rows.append((f"suture --episodes N --workers {workers}", sizes, costs))
@@ -232,14 +278,15 @@ def bench_suture(tmp: Path) -> list[dict]:
 def bench_record(quick: bool) -> list[dict]:
     from adfkit.adf import load_scene
     from adfkit.runner.world import Options, SimWorld
+
     scene = load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml")
     world = SimWorld(scene, Options(renderer="auto"))
     try:
         cams = list(world.cameras)
-        for cam in cams:                         # the renderer's start-up (GL context, mirror) apart
+        for cam in cams:  # the renderer's start-up (GL context, mirror) apart
             cam.render(world)
         sizes, costs = [], []
-        for frames in ((5, 10) if quick else (10, 20, 40)):
+        for frames in (5, 10) if quick else (10, 20, 40):
             t = time.perf_counter()
             for _ in range(frames):
                 world.run(1 / 30)
@@ -249,23 +296,29 @@ def bench_record(quick: bool) -> list[dict]:
             costs.append(time.perf_counter() - t)
     finally:
         world.close()
-    found = _table(f"recording: stereo RGB + depth + segmentation, {len(cams)} cameras at their own size, "
-                   "1/30 s of physics between frames (s)", "s", [("frames", sizes, costs)])
+    found = _table(
+        f"recording: stereo RGB + depth + segmentation, {len(cams)} cameras at their own size, "
+        "1/30 s of physics between frames (s)",
+        "s",
+        [("frames", sizes, costs)],
+    )
     print(f"  {sizes[-1] / costs[-1]:.1f} frames per second")
     return found
 
 
 def plot(found: list[dict], path: Path) -> None:
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     groups = {}
     for f in found:
         groups.setdefault(f["figure"], []).append(f)
     ncols = min(3, len(groups))
     nrows = -(-len(groups) // ncols)
     fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols, 3.8 * nrows), squeeze=False)
-    for ax in axes.flat[len(groups):]:
+    for ax in axes.flat[len(groups) :]:
         ax.set_visible(False)
     for ax, (title, rows) in zip(axes.flat, groups.items()):
         for r in rows:
@@ -308,8 +361,10 @@ def main() -> None:
         if "record" in only:
             found += bench_record(args.quick)
     over = [f for f in found if f["exponent"] > 1.1]
-    print(f"\n{len(found)} curves; {len(over)} with an exponent above 1.1"
-          + "".join(f"\n  {f['figure']}: {f['case']} {f['exponent']:.2f}" for f in over))
+    print(
+        f"\n{len(found)} curves; {len(over)} with an exponent above 1.1"
+        + "".join(f"\n  {f['figure']}: {f['case']} {f['exponent']:.2f}" for f in over)
+    )
     if args.save:
         args.save.write_text(json.dumps(found, indent=1))
     if args.plot:

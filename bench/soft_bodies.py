@@ -1,6 +1,7 @@
 """Soft bodies in the PyBullet runner: real-time factor of the corpus cloth alone (hanging
 from its pinned corner), the cloth draped over a box, and the soft phantom with the needle and with the probe;
 node counts, and the phantom's indentation. Prints figures, asserts nothing."""
+
 from __future__ import annotations
 
 import argparse
@@ -60,17 +61,21 @@ def main() -> int:
             rows.append((f"soft phantom, {tool}", *play(write_soft_phantom(tmp / tool, p), args.seconds)))
             tools[tool] = rows[-1][3]
         alone = play(write_soft_phantom(tmp / "alone", SoftPhantomParams(with_probe=False)), args.seconds)[2]
-    for label, rep, build, nodes in rows:
+    for label, rep, build, _nodes in rows:
         sb = rep["soft_bodies"][0]
-        print(f"{label:36s} {sb['nodes']:4d} nodes  build {build:5.2f} s  "
-              f"{rep['simulated_time_s']:.1f} s in {rep['wall_time_s']:6.2f} s = {rep['real_time_factor']:.2f}x real time")
+        print(
+            f"{label:36s} {sb['nodes']:4d} nodes  build {build:5.2f} s  "
+            f"{rep['simulated_time_s']:.1f} s in {rep['wall_time_s']:6.2f} s = {rep['real_time_factor']:.2f}x real time"
+        )
     h = SoftPhantomParams().height
     sag = h - alone[np.linalg.norm(alone[:, :2], axis=1) < 0.006, 2].min()
     for tool, nodes in tools.items():
         under = np.linalg.norm(nodes[:, :2], axis=1) < (0.015 if tool == "needle" else 0.006)
         depth = h - nodes[under, 2].min()
-        print(f"phantom, {tool}: skin {depth * 1000:.1f} mm below rest, {sag * 1000:.1f} mm of it its own sag: "
-              f"indentation {(depth - sag) * 1000:.1f} mm")
+        print(
+            f"phantom, {tool}: skin {depth * 1000:.1f} mm below rest, {sag * 1000:.1f} mm of it its own sag: "
+            f"indentation {(depth - sag) * 1000:.1f} mm"
+        )
     return 0
 
 

@@ -15,6 +15,7 @@
 The suturing set is the corpus's (launch indices 6-11) when ``../shared/corpus`` is there, else
 the project's bundled suturing scene. Asserts nothing; prints figures.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -30,6 +31,7 @@ CORPUS = ROOT.parent / "shared" / "corpus"
 
 def scene_and_label():
     from adfkit.adf import load_scene
+
     launch = CORPUS / "src" / "launch.yaml"
     if launch.is_file():
         return load_scene(launch, [6, 7, 8, 9, 10, 11]), "corpus suturing set (launch -l 6-11)"
@@ -40,6 +42,7 @@ def pybullet_loop(scene, seconds: float, rounds: int) -> tuple[float, float]:
     """(loop, bare floor) in wall-time real-time factors: bench/run_suturing.py's alternated rounds."""
     sys.path.insert(0, str(ROOT / "bench"))
     from run_suturing import measure
+
     return measure(scene, {}, seconds, rounds)["wall"]
 
 
@@ -48,6 +51,7 @@ def mujoco_loop(scene, seconds: float) -> tuple[float, float, float]:
 
     from adfkit.runner.mj.world import MjWorld
     from adfkit.runner.world import Options
+
     world = MjWorld(scene, Options())
     try:
         world.run(seconds)
@@ -95,6 +99,7 @@ def one_pass_ms(scene, frames: int) -> float | str:
 
     from adfkit.runner.mj.world import MjWorld
     from adfkit.runner.options import Options
+
     try:
         world = MjWorld(scene, Options())
         world.run(0.1)
@@ -123,11 +128,13 @@ def one_pass_ms(scene, frames: int) -> float | str:
 def libyaml_ms(folder: Path, runs: int = 5) -> float:
     """Parsing every YAML file under ``folder`` with libyaml alone (``yaml.load`` with
     ``CSafeLoader``), in a fresh process, start-up included: the floor of ``adfkit validate``."""
-    code = ("import sys, yaml, pathlib\n"
-            "for p in sorted(pathlib.Path(sys.argv[1]).rglob('*')):\n"
-            "    if p.suffix in ('.yaml', '.yml') and p.is_file():\n"
-            "        try: yaml.load(p.read_text(encoding='utf-8', errors='replace'), Loader=yaml.CSafeLoader)\n"
-            "        except Exception: pass\n")
+    code = (
+        "import sys, yaml, pathlib\n"
+        "for p in sorted(pathlib.Path(sys.argv[1]).rglob('*')):\n"
+        "    if p.suffix in ('.yaml', '.yml') and p.is_file():\n"
+        "        try: yaml.load(p.read_text(encoding='utf-8', errors='replace'), Loader=yaml.CSafeLoader)\n"
+        "        except Exception: pass\n"
+    )
     times = []
     for _ in range(runs):
         t = time.perf_counter()
@@ -166,30 +173,60 @@ def main() -> int:
     print(f"scene: {label}; {args.seconds:g} s windows, {args.rounds} rounds, {args.frames} frames")
     rows = []
     loop, floor = pybullet_loop(scene, args.seconds, args.rounds)
-    rows.append(("PyBullet loop / bare stepSimulation floor", f"{loop:.2f}x / {floor:.2f}x real time, "
-                 f"ratio {loop / floor:.3f}", ">= 2.2x, ratio >= 0.93"))
+    rows.append(
+        (
+            "PyBullet loop / bare stepSimulation floor",
+            f"{loop:.2f}x / {floor:.2f}x real time, ratio {loop / floor:.3f}",
+            ">= 2.2x, ratio >= 0.93",
+        )
+    )
     first, settled, mfloor = mujoco_loop(scene, args.seconds)
     rows.append(("MuJoCo engine, first window (thread settling)", f"{first:.2f}x real time", ">= 10x"))
     rows.append(("MuJoCo first window / PyBullet loop", f"{first / loop:.2f}x", ">= 5x"))
-    rows.append(("MuJoCo engine, next window / bare mj_step floor", f"{settled:.2f}x / {mfloor:.2f}x, ratio "
-                 f"{settled / mfloor:.3f}", ">= 10x, ratio >= 0.95"))
+    rows.append(
+        (
+            "MuJoCo engine, next window / bare mj_step floor",
+            f"{settled:.2f}x / {mfloor:.2f}x, ratio {settled / mfloor:.3f}",
+            ">= 10x, ratio >= 0.95",
+        )
+    )
     for renderer in ("tiny", "egl", "mujoco"):
-        rows.append((f"stereo frame, PyBullet world, renderer={renderer}",
-                     stereo_ms(lambda: SimWorld(scene, Options(renderer=renderer)), args.frames), "<= 60 ms"))
+        rows.append(
+            (
+                f"stereo frame, PyBullet world, renderer={renderer}",
+                stereo_ms(lambda: SimWorld(scene, Options(renderer=renderer)), args.frames),
+                "<= 60 ms",
+            )
+        )
     engine_frame = stereo_ms(lambda: MjWorld(scene, Options()), args.frames)
     rows.append(("stereo frame (RGB + depth + seg), MuJoCo engine", engine_frame, "<= 15 ms"))
     one = one_pass_ms(scene, args.frames)
     if isinstance(one, float) and _ms(engine_frame) is not None:
-        rows.append(("  / one software RGB pass of camera L (bare mjr_render)",
-                     f"{_ms(engine_frame) / one:.2f}x ({one:.1f} ms a pass)", "<= 2x"))
+        rows.append(
+            (
+                "  / one software RGB pass of camera L (bare mjr_render)",
+                f"{_ms(engine_frame) / one:.2f}x ({one:.1f} ms a pass)",
+                "<= 2x",
+            )
+        )
     if CORPUS.is_dir():
-        val = cli_ms(['validate', str(CORPUS), '-f', 'json'])
+        val = cli_ms(["validate", str(CORPUS), "-f", "json"])
         rows.append(("adfkit validate corpus/ (CLI, start-up included)", f"{val:.0f} ms", "< 1000 ms"))
-        rows.append(("adfkit validate corpus/ -j 1 (one process)",
-                     f"{cli_ms(['validate', str(CORPUS), '-f', 'json', '-j', '1']):.0f} ms", ""))
+        rows.append(
+            (
+                "adfkit validate corpus/ -j 1 (one process)",
+                f"{cli_ms(['validate', str(CORPUS), '-f', 'json', '-j', '1']):.0f} ms",
+                "",
+            )
+        )
         floor_ms = libyaml_ms(CORPUS)
-        rows.append(("  / parsing the same files with libyaml alone (fresh process)",
-                     f"{val / floor_ms:.2f}x ({floor_ms:.0f} ms)", "<= 1.6x"))
+        rows.append(
+            (
+                "  / parsing the same files with libyaml alone (fresh process)",
+                f"{val / floor_ms:.2f}x ({floor_ms:.0f} ms)",
+                "<= 1.6x",
+            )
+        )
     rows.append(("adfkit --help", f"{cli_ms(['--help'], 9):.0f} ms", "< 80 ms"))
     width = max(len(r[0]) for r in rows)
     for name, value, goal in rows:

@@ -10,6 +10,7 @@ Figures:
   per kind, as it takes one schema per run), files/s, and the ratio adfkit / check-jsonschema.
 check-jsonschema only applies the JSON Schema; adfkit also runs the semantic and file rules.
 """
+
 from __future__ import annotations
 
 import json
@@ -25,7 +26,9 @@ BIN = Path(sys.executable).parent
 
 
 def main() -> int:
-    corpus = Path(sys.argv[1] if len(sys.argv) > 1 else os.environ.get("ADFKIT_CORPUS", ROOT.parent / "shared" / "corpus"))
+    corpus = Path(
+        sys.argv[1] if len(sys.argv) > 1 else os.environ.get("ADFKIT_CORPUS", ROOT.parent / "shared" / "corpus")
+    )
     if not corpus.is_dir():
         print(f"corpus not found: {corpus}", file=sys.stderr)
         return 2
@@ -38,8 +41,11 @@ def main() -> int:
 
     # 1. adfkit CLI, start-up included (no following of launch files: each file once).
     t0 = time.perf_counter()
-    proc = subprocess.run([str(BIN / "adfkit"), "validate", str(corpus), "--no-follow", "-f", "json",
-                           "--fail-on", "never"], capture_output=True, text=True)
+    proc = subprocess.run(
+        [str(BIN / "adfkit"), "validate", str(corpus), "--no-follow", "-f", "json", "--fail-on", "never"],
+        capture_output=True,
+        text=True,
+    )
     cli_wall = time.perf_counter() - t0
     report = json.loads(proc.stdout)
     counts = defaultdict(int)
@@ -60,27 +66,43 @@ def main() -> int:
     for kind, paths in sorted(by_kind.items()):
         if kind == "unparsed":
             continue  # not YAML for PyYAML either; counted as checked by adfkit only
-        p = subprocess.run([str(BIN / "check-jsonschema"), "--schemafile", str(schema_file(kind)),
-                            "-o", "json", *map(str, paths)], capture_output=True, text=True)
+        p = subprocess.run(
+            [str(BIN / "check-jsonschema"), "--schemafile", str(schema_file(kind)), "-o", "json", *map(str, paths)],
+            capture_output=True,
+            text=True,
+        )
         try:
             out = json.loads(p.stdout)
-            cj_failed_files += len({e.get("filename") for e in out.get("errors", [])} |
-                                   {e.get("filename") for e in out.get("parse_errors", [])})
+            cj_failed_files += len(
+                {e.get("filename") for e in out.get("errors", [])}
+                | {e.get("filename") for e in out.get("parse_errors", [])}
+            )
         except json.JSONDecodeError:
             pass
     cj_wall = time.perf_counter() - t0
     cj_n = sum(len(v) for k, v in by_kind.items() if k != "unparsed")
 
-    print(f"corpus: {corpus} ({n} YAML files; kinds: "
-          + ", ".join(f"{k} {len(v)}" for k, v in sorted(by_kind.items())) + ")")
-    print(f"adfkit validate (CLI, start-up included): {cli_wall:.2f} s wall, {n / cli_wall:.1f} files/s; "
-          f"findings: {counts['error']} error, {counts['warning']} warning, {counts['info']} info")
-    print(f"adfkit validate_file (in process):        {inproc:.2f} s, {n / inproc:.1f} files/s, "
-          f"{1000 * inproc / n:.1f} ms/file")
-    print(f"check-jsonschema (same schemas, {len([k for k in by_kind if k != 'unparsed'])} runs): "
-          f"{cj_wall:.2f} s wall, {cj_n / cj_wall:.1f} files/s; files failing: {cj_failed_files}")
-    print(f"ratio adfkit CLI / check-jsonschema wall time: {cli_wall / cj_wall:.2f}x "
-          f"(files/s ratio {(n / cli_wall) / (cj_n / cj_wall):.2f})")
+    print(
+        f"corpus: {corpus} ({n} YAML files; kinds: "
+        + ", ".join(f"{k} {len(v)}" for k, v in sorted(by_kind.items()))
+        + ")"
+    )
+    print(
+        f"adfkit validate (CLI, start-up included): {cli_wall:.2f} s wall, {n / cli_wall:.1f} files/s; "
+        f"findings: {counts['error']} error, {counts['warning']} warning, {counts['info']} info"
+    )
+    print(
+        f"adfkit validate_file (in process):        {inproc:.2f} s, {n / inproc:.1f} files/s, "
+        f"{1000 * inproc / n:.1f} ms/file"
+    )
+    print(
+        f"check-jsonschema (same schemas, {len([k for k in by_kind if k != 'unparsed'])} runs): "
+        f"{cj_wall:.2f} s wall, {cj_n / cj_wall:.1f} files/s; files failing: {cj_failed_files}"
+    )
+    print(
+        f"ratio adfkit CLI / check-jsonschema wall time: {cli_wall / cj_wall:.2f}x "
+        f"(files/s ratio {(n / cli_wall) / (cj_n / cj_wall):.2f})"
+    )
     return 0
 
 

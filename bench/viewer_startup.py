@@ -6,6 +6,7 @@ picture of the bodies in headless Chromium (software WebGL), polled every 100 ms
 
 Needs the system's Chromium (apt-get install chromium) and playwright. Asserts nothing.
 """
+
 from __future__ import annotations
 
 import shutil
@@ -31,10 +32,15 @@ def _port() -> int:
 
 def one(browser) -> tuple[float, float]:
     from PIL import Image
+
     port = _port()
     t0 = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-m", "adfkit", "view", str(ROOT / "sample_scenes" / "suturing"),
-                             "--port", str(port)], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "adfkit", "view", str(ROOT / "sample_scenes" / "suturing"), "--port", str(port)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
     try:
         for line in proc.stdout:
             if line.startswith("adfkit view:"):
@@ -65,14 +71,17 @@ def main() -> int:
         print("no Chromium here: apt-get install chromium")
         return 0
     from playwright.sync_api import sync_playwright
+
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=chromium, args=FLAGS)
         got = [one(browser) for _ in range(runs)]
         browser.close()
     ready = statistics.median(r for r, _ in got)
     first = statistics.median(f for _, f in got)
-    print(f"adfkit view, bundled suturing scene, median of {runs}: address printed {ready:.2f} s, "
-          f"first picture in headless Chromium (software WebGL) {first:.2f} s after the command started")
+    print(
+        f"adfkit view, bundled suturing scene, median of {runs}: address printed {ready:.2f} s, "
+        f"first picture in headless Chromium (software WebGL) {first:.2f} s after the command started"
+    )
     return 0
 
 

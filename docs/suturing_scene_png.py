@@ -3,6 +3,7 @@ picked the needle up (IK from above, grasp through the constraint actuator, lift
 
     python docs/suturing_scene_png.py
 """
+
 from __future__ import annotations
 
 import io

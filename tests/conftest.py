@@ -1,5 +1,6 @@
 """Shared fixtures. The public ADF corpus lives in ../shared/corpus (never copied here);
 tests that need it skip with a clear reason when it is absent."""
+
 from __future__ import annotations
 
 import os
@@ -39,13 +40,16 @@ def require_renderer(name: str) -> str:
     """Skip, with the reason, when renderer ``name`` of the PyBullet world's cameras
     (runner/cameras.choose_renderer) cannot start here; returns the name."""
     import pytest
+
     if name == "egl":
         from adfkit.runner import egl
+
         ok, why = egl.available()
         if not ok:
             pytest.skip(f"PyBullet's EGL renderer does not work here: {why}")
     if name == "mujoco":
         from adfkit.runner.glcontext import gl_context_class
+
         cls, why = gl_context_class()
         if cls is None:
             pytest.skip(f"MuJoCo has no headless OpenGL here: {why}")

@@ -1,4 +1,5 @@
 """Checks shared by the converter tests: models equal up to a tree format's spelling."""
+
 from __future__ import annotations
 
 import subprocess
@@ -10,9 +11,9 @@ import pytest
 
 from adfkit.adf.paths import visual_mesh_path
 from adfkit.converters.inertia import world_tensor
-from adfkit.model.tree import build_tree
 from adfkit.model.pose import Pose, Quat, Vec3
 from adfkit.model.semantics import JointKind, inertial_offset, joint_frames, joint_kind
+from adfkit.model.tree import build_tree
 
 
 def close_pose(a: Pose, b: Pose, tol=1e-6) -> bool:
@@ -22,8 +23,13 @@ def close_pose(a: Pose, b: Pose, tol=1e-6) -> bool:
 def joint_transform(joint, q: float) -> Pose:
     a, b = joint_frames(joint)
     kind = joint_kind(joint.type)
-    motion = Pose(Vec3(), Quat.from_axis_angle(Vec3(0, 0, 1), q)) if kind is JointKind.REVOLUTE else \
-        Pose(Vec3(q, 0, 0)) if kind is JointKind.PRISMATIC else Pose()
+    motion = (
+        Pose(Vec3(), Quat.from_axis_angle(Vec3(0, 0, 1), q))
+        if kind is JointKind.REVOLUTE
+        else Pose(Vec3(q, 0, 0))
+        if kind is JointKind.PRISMATIC
+        else Pose()
+    )
     return a * motion * b.inverse()
 
 
@@ -43,20 +49,24 @@ def assert_same_kinematics(orig, back, lost: set[str]):
         if b.mesh:
             assert Path(c.mesh).resolve() == visual_mesh_path(orig, b).resolve(), ident
         if b.inertia is not None and (b.mass or 0.0) > 0:  # a static body has no inertial frame to keep
-            wb = world_tensor((b.inertia.ix, b.inertia.iy, b.inertia.iz),
-                              (at_zero[ident] * inertial_offset(b)).orientation)
+            wb = world_tensor(
+                (b.inertia.ix, b.inertia.iy, b.inertia.iz), (at_zero[ident] * inertial_offset(b)).orientation
+            )
             wc = world_tensor((c.inertia.ix, c.inertia.iy, c.inertia.iz), (c.location * inertial_offset(c)).orientation)
             assert np.allclose(wb, wc, rtol=1e-9, atol=1e-15), ident
-            assert (((at_zero[ident] * inertial_offset(b)).position - (c.location * inertial_offset(c)).position).norm()
-                    < 1e-9)
+            assert (
+                (at_zero[ident] * inertial_offset(b)).position - (c.location * inertial_offset(c)).position
+            ).norm() < 1e-9
     oj = {j.identifier: j for j in orig.joints if j.identifier not in lost}
     bj = {j.identifier: j for j in back.joints if j.identifier not in lost}
     assert set(bj) == set(oj)
     for ident, j in oj.items():
         k = bj[ident]
         assert joint_kind(k.type) is joint_kind(j.type)
-        assert (k.parent.removeprefix("BODY "), k.child.removeprefix("BODY ")) == \
-            (j.parent.removeprefix("BODY "), j.child.removeprefix("BODY "))
+        assert (k.parent.removeprefix("BODY "), k.child.removeprefix("BODY ")) == (
+            j.parent.removeprefix("BODY "),
+            j.child.removeprefix("BODY "),
+        )
         if j.joint_limits is not None and joint_kind(j.type) is not JointKind.FIXED:
             assert (k.joint_limits.low, k.joint_limits.high) == pytest.approx((j.joint_limits.low, j.joint_limits.high))
         # AMBF's shortest arc is the identity below 1e-3 rad (§8.2): a child frame tilted less
@@ -91,6 +101,7 @@ def convert_cli(*args) -> subprocess.CompletedProcess:
 def expected_losses(model, body_keys=(), joint_keys=()) -> list[tuple[str, str]]:
     """(identifier, key) for every body/joint that sets one of the ADF keys a format cannot hold,
     plus the inertia the writers estimate for bodies with mass and no `inertia`."""
+
     def is_set(obj, key):
         return getattr(obj, key.replace(" ", "_")) not in (None, [], False)
 

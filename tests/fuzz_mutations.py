@@ -1,32 +1,137 @@
 """Mutation operators for the fuzz suite (tests/fuzzkit.py). Each takes (rng, files, seed) and
 returns (files, plants): plants may ask for symlinks, FIFOs and folders in the scene."""
+
 from __future__ import annotations
 
 import re
 
 from fuzz_seeds import SMALL_STL, Seed
 
-
 HOSTILE_PATHS = [
-    "/etc/passwd", "../../../../../../../../etc/passwd", "/dev/zero", "/dev/stdin", "/proc/self/environ",
-    "{outside}/secret.yaml", "{outside}/secret.stl", "link_out.yaml", "link_out.stl", "fifo.yaml", "folder",
-    "x" * 300 + ".stl", ("d" * 200 + "/") * 25 + "m.stl", "a\\0b.stl", "a\\nb.stl", "é/ü.stl", "\\x1b[2J.stl",
-    "C:\\\\meshes\\\\m.stl", "", " ", "~", "-", "part.STL", "./../part.stl",
+    "/etc/passwd",
+    "../../../../../../../../etc/passwd",
+    "/dev/zero",
+    "/dev/stdin",
+    "/proc/self/environ",
+    "{outside}/secret.yaml",
+    "{outside}/secret.stl",
+    "link_out.yaml",
+    "link_out.stl",
+    "fifo.yaml",
+    "folder",
+    "x" * 300 + ".stl",
+    ("d" * 200 + "/") * 25 + "m.stl",
+    "a\\0b.stl",
+    "a\\nb.stl",
+    "é/ü.stl",
+    "\\x1b[2J.stl",
+    "C:\\\\meshes\\\\m.stl",
+    "",
+    " ",
+    "~",
+    "-",
+    "part.STL",
+    "./../part.stl",
 ]
-ODD_VALUES = ["[1, 2]", "{a: 1}", "'text'", "true", "~", "''", "-1", "0", "1e-320", "[]", "{}", "[[], {}]",
-              "\"\\u0000\"", "*nope", "&a 1", "? x", "- x", "|\n    block", ">-\n    folded"]
-NONFINITE = [".inf", "-.inf", ".nan", ".NaN", "1e308", "-1e308", "1e400", "-1e400", "9" * 400, "-" + "1" * 5000,
-             "0x7fffffffffffffffffff", "1_000_000_000_000_000_000_000", "4.9e-324", "1e-400"]
-TAGGED = ["!!bool maybe", "!!int x", "!!float y", "!!timestamp z", '!!binary "@@"', "!!set {a, b}",
-          "!!omap [a: 1]", "!custom v", "!!python/object:os.system ls", "!!str 1", "!!null x", "!!int 99999999999999999999999",
-          "!!float .inf", "!<tag:yaml.org,2002:int> 3.5", "!!map [1]", "!!seq {a: 1}"]
-ODD_BYTES = [b"\x00", b"\xff", b"\xef\xbb\xbf", b"\r", b"\t", b"\x1b[31m", b"\xc3", b"\xe2\x80\xa8", b"\xc2\x85",
-             b"\xfe\xff", b"\x7f", b"\xf0\x9f\x98\x80", b"\r\n", b"\x0c", b"'", b'"', b"{", b"]", b": ", b"- ", b"#",
-             b"&", b"*", b"!", b"%YAML 1.1\n---\n", b"\n---\n", b"\n...\n"]
+ODD_VALUES = [
+    "[1, 2]",
+    "{a: 1}",
+    "'text'",
+    "true",
+    "~",
+    "''",
+    "-1",
+    "0",
+    "1e-320",
+    "[]",
+    "{}",
+    "[[], {}]",
+    '"\\u0000"',
+    "*nope",
+    "&a 1",
+    "? x",
+    "- x",
+    "|\n    block",
+    ">-\n    folded",
+]
+NONFINITE = [
+    ".inf",
+    "-.inf",
+    ".nan",
+    ".NaN",
+    "1e308",
+    "-1e308",
+    "1e400",
+    "-1e400",
+    "9" * 400,
+    "-" + "1" * 5000,
+    "0x7fffffffffffffffffff",
+    "1_000_000_000_000_000_000_000",
+    "4.9e-324",
+    "1e-400",
+]
+TAGGED = [
+    "!!bool maybe",
+    "!!int x",
+    "!!float y",
+    "!!timestamp z",
+    '!!binary "@@"',
+    "!!set {a, b}",
+    "!!omap [a: 1]",
+    "!custom v",
+    "!!python/object:os.system ls",
+    "!!str 1",
+    "!!null x",
+    "!!int 99999999999999999999999",
+    "!!float .inf",
+    "!<tag:yaml.org,2002:int> 3.5",
+    "!!map [1]",
+    "!!seq {a: 1}",
+]
+ODD_BYTES = [
+    b"\x00",
+    b"\xff",
+    b"\xef\xbb\xbf",
+    b"\r",
+    b"\t",
+    b"\x1b[31m",
+    b"\xc3",
+    b"\xe2\x80\xa8",
+    b"\xc2\x85",
+    b"\xfe\xff",
+    b"\x7f",
+    b"\xf0\x9f\x98\x80",
+    b"\r\n",
+    b"\x0c",
+    b"'",
+    b'"',
+    b"{",
+    b"]",
+    b": ",
+    b"- ",
+    b"#",
+    b"&",
+    b"*",
+    b"!",
+    b"%YAML 1.1\n---\n",
+    b"\n---\n",
+    b"\n...\n",
+]
 KEY_LINE = re.compile(rb"^(?P<indent> *)(?P<key>[^\s#:][^:\n]*?):(?P<sep> +)(?P<value>[^\n]+)$", re.M)
 NUMBER = re.compile(rb"(?<=[\s{,:\[])-?\d+\.?\d*(?:e-?\d+)?(?=[\s,}\]]|$)", re.M)
-PATH_KEYS = (b"mesh", b"collision mesh", b"world config", b"environment", b"input devices config", b"color config",
-             b"simulated multibody", b"high resolution path", b"low resolution path", b"path", b"filename")
+PATH_KEYS = (
+    b"mesh",
+    b"collision mesh",
+    b"world config",
+    b"environment",
+    b"input devices config",
+    b"color config",
+    b"simulated multibody",
+    b"high resolution path",
+    b"low resolution path",
+    b"path",
+    b"filename",
+)
 
 
 def _yaml_files(files: dict[str, bytes], seed: Seed) -> list[str]:
@@ -47,7 +152,7 @@ def _replace_value(rng, data: bytes, values: list[str], keys: tuple[bytes, ...] 
     if not lines:
         return data + b"\nextra: " + rng.choice(values).encode() + b"\n"
     m = rng.choice(lines)
-    return data[: m.start("value")] + rng.choice(values).encode("utf-8", "surrogateescape") + data[m.end("value"):]
+    return data[: m.start("value")] + rng.choice(values).encode("utf-8", "surrogateescape") + data[m.end("value") :]
 
 
 def op_type_swap(rng, files, seed):
@@ -62,7 +167,7 @@ def op_delete(rng, files, seed):
     if len(lines) > 1:
         i = rng.randrange(len(lines))
         n = 1 if rng.random() < 0.7 else rng.randint(2, 8)
-        del lines[i:i + n]
+        del lines[i : i + n]
     files[f] = b"\n".join(lines)
     if rng.random() < 0.15:  # a whole file gone
         victim = rng.choice(list(files))
@@ -73,10 +178,21 @@ def op_delete(rng, files, seed):
 
 def op_dangle(rng, files, seed):
     f = _pick_file(rng, files, seed)
-    files[f] = _replace_value(rng, files[f], ["BODY nowhere", "BODY base", "nope.yaml", "BODY ", "BODY link/x",
-                                              "/ambf/env/BODY link", "BODY Entry", "BODY Thread_01"],
-                              (b"parent", b"child", b"world config", b"environment", b"root link", b"chassis",
-                               b"simulated multibody"))
+    files[f] = _replace_value(
+        rng,
+        files[f],
+        [
+            "BODY nowhere",
+            "BODY base",
+            "nope.yaml",
+            "BODY ",
+            "BODY link/x",
+            "/ambf/env/BODY link",
+            "BODY Entry",
+            "BODY Thread_01",
+        ],
+        (b"parent", b"child", b"world config", b"environment", b"root link", b"chassis", b"simulated multibody"),
+    )
     return files, {}
 
 
@@ -88,7 +204,7 @@ def op_nonfinite(rng, files, seed):
         if not hits:
             break
         m = rng.choice(hits)
-        data = data[: m.start()] + rng.choice(NONFINITE).encode() + data[m.end():]
+        data = data[: m.start()] + rng.choice(NONFINITE).encode() + data[m.end() :]
         hits = list(NUMBER.finditer(data))
     files[f] = data
     return files, {}
@@ -117,7 +233,8 @@ def op_alias(rng, files, seed):
     if kind == "bomb":
         levels = rng.randint(5, 9)
         block = "lol0: &l0 [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
-            f"lol{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 10)}]\n" for i in range(1, levels))
+            f"lol{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 10)}]\n" for i in range(1, levels)
+        )
         files[f] = files[f] + b"\n" + block.encode()
         if rng.random() < 0.5:
             files[f] = _replace_value(rng, files[f], [f"*l{levels - 1}"])
@@ -164,22 +281,41 @@ def op_path(rng, files, seed):
 
 
 def _plants() -> dict:
-    return {"symlinks": {"link_out.yaml": "{outside}/secret.yaml", "link_out.stl": "{outside}/secret.stl",
-                         "link_passwd.yaml": "/etc/passwd"},
-            "fifos": ["fifo.yaml"], "dirs": ["folder"]}
+    return {
+        "symlinks": {
+            "link_out.yaml": "{outside}/secret.yaml",
+            "link_out.stl": "{outside}/secret.stl",
+            "link_passwd.yaml": "/etc/passwd",
+        },
+        "fifos": ["fifo.yaml"],
+        "dirs": ["folder"],
+    }
 
 
 def op_keys(rng, files, seed):
     f = _pick_file(rng, files, seed)
     data = files[f]
     lines = _key_lines(data)
-    insert = rng.choice(["1: x", "~: y", "? [a, b]\n{i}: c", "null: 1", "true: yes", "1.5: z", "[a]: 1",
-                         "{a: 1}: 2", "'': empty", "controller: {kDP, 0.001}", "<<: {mass: 2.0}"])
+    insert = rng.choice(
+        [
+            "1: x",
+            "~: y",
+            "? [a, b]\n{i}: c",
+            "null: 1",
+            "true: yes",
+            "1.5: z",
+            "[a]: 1",
+            "{a: 1}: 2",
+            "'': empty",
+            "controller: {kDP, 0.001}",
+            "<<: {mass: 2.0}",
+        ]
+    )
     if lines:
         m = rng.choice(lines)
         indent = m.group("indent").decode()
         text = indent + insert.replace("\n{i}", "\n" + indent) + "\n"
-        data = data[: m.start()] + text.encode() + data[m.start():]
+        data = data[: m.start()] + text.encode() + data[m.start() :]
     else:
         data = insert.encode() + b"\n" + data
     files[f] = data
@@ -192,10 +328,10 @@ def op_duplicate(rng, files, seed):
     lines = _key_lines(data)
     if lines:
         m = rng.choice(lines)
-        dup = data[m.start():m.end()] + b"\n"
+        dup = data[m.start() : m.end()] + b"\n"
         if rng.random() < 0.5:
-            dup = data[m.start():m.start("value")] + rng.choice(ODD_VALUES).encode() + b"\n"
-        data = data[: m.start()] + dup + data[m.start():]
+            dup = data[m.start() : m.start("value")] + rng.choice(ODD_VALUES).encode() + b"\n"
+        data = data[: m.start()] + dup + data[m.start() :]
     files[f] = data
     return files, {}
 
@@ -225,17 +361,40 @@ def op_garbage_mesh(rng, files, seed):
     return files, {}
 
 
-XML_ATTRS = ['velocity="abc"', 'effort="nan"', 'xyz="1 2"', 'rpy="inf 0 0"', 'value="-1"', 'size="0 0 0"',
-             'radius="1e400"', 'lower="1" upper="-1"', 'filename="/etc/passwd"', 'file="/dev/zero"',
-             'filename="{outside}/secret.stl"', 'file="../../../../etc/passwd"', 'name=""', 'type="ball"',
-             'axis="0 0 0"', 'scale="1e308 1 1"', 'pos="nan nan nan"', 'mass="1e308"']
+XML_ATTRS = [
+    'velocity="abc"',
+    'effort="nan"',
+    'xyz="1 2"',
+    'rpy="inf 0 0"',
+    'value="-1"',
+    'size="0 0 0"',
+    'radius="1e400"',
+    'lower="1" upper="-1"',
+    'filename="/etc/passwd"',
+    'file="/dev/zero"',
+    'filename="{outside}/secret.stl"',
+    'file="../../../../etc/passwd"',
+    'name=""',
+    'type="ball"',
+    'axis="0 0 0"',
+    'scale="1e308 1 1"',
+    'pos="nan nan nan"',
+    'mass="1e308"',
+]
 XML_BLOCKS = [
     '<!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">]>',
     '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>',
     '<!DOCTYPE r SYSTEM "http://example.invalid/x.dtd">',
-    '<include file="/etc/passwd"/>', '<include file="{outside}/secret.xml"/>', '<include file="link_out.xml"/>',
-    '<include file="fifo.yaml"/>', '<xi:include xmlns:xi="http://www.w3.org/2001/XInclude" href="/etc/passwd"/>',
-    "<?xml-stylesheet href='/etc/passwd'?>", "<![CDATA[ ]]>", "&x;", "<a>" * 5000 + "</a>" * 5000, "<unclosed>",
+    '<include file="/etc/passwd"/>',
+    '<include file="{outside}/secret.xml"/>',
+    '<include file="link_out.xml"/>',
+    '<include file="fifo.yaml"/>',
+    '<xi:include xmlns:xi="http://www.w3.org/2001/XInclude" href="/etc/passwd"/>',
+    "<?xml-stylesheet href='/etc/passwd'?>",
+    "<![CDATA[ ]]>",
+    "&x;",
+    "<a>" * 5000 + "</a>" * 5000,
+    "<unclosed>",
 ]
 
 
@@ -247,7 +406,7 @@ def op_xml(rng, files, seed):
         attrs = list(re.finditer(r'(\w+)="[^"]*"', data))
         if attrs:
             m = rng.choice(attrs)
-            data = data[: m.start()] + rng.choice(XML_ATTRS) + data[m.end():]
+            data = data[: m.start()] + rng.choice(XML_ATTRS) + data[m.end() :]
     elif kind < 0.7:
         block = rng.choice(XML_BLOCKS)
         if block.startswith("<!DOCTYPE") or block.startswith("<?xml-"):
@@ -261,15 +420,25 @@ def op_xml(rng, files, seed):
         elems = list(re.finditer(r"<(\w+)[^>]*/>", data))
         if elems:
             m = rng.choice(elems)
-            data = data[: m.start()] + data[m.end():]
+            data = data[: m.start()] + data[m.end() :]
     else:
         data = data[: rng.randrange(len(data) + 1)]
     files[f] = data.encode("utf-8", "surrogateescape")
     return files, _plants()
 
 
-YAML_OPS = {"type_swap": op_type_swap, "delete": op_delete, "dangle": op_dangle, "nonfinite": op_nonfinite,
-            "deep": op_deep, "alias": op_alias, "tag": op_tag, "odd_bytes": op_odd_bytes, "path": op_path,
-            "keys": op_keys, "duplicate": op_duplicate, "garbage_mesh": op_garbage_mesh}
+YAML_OPS = {
+    "type_swap": op_type_swap,
+    "delete": op_delete,
+    "dangle": op_dangle,
+    "nonfinite": op_nonfinite,
+    "deep": op_deep,
+    "alias": op_alias,
+    "tag": op_tag,
+    "odd_bytes": op_odd_bytes,
+    "path": op_path,
+    "keys": op_keys,
+    "duplicate": op_duplicate,
+    "garbage_mesh": op_garbage_mesh,
+}
 XML_OPS = {"xml": op_xml, "xml2": op_xml, "odd_bytes": op_odd_bytes, "garbage_mesh": op_garbage_mesh}
-

@@ -1,5 +1,6 @@
 """Seeds for the fuzz suite (tests/fuzzkit.py): small hand-written scenes, the bundled sample
 scene and, when present, the corpus."""
+
 from __future__ import annotations
 
 import re
@@ -186,17 +187,22 @@ SMALL_MJCF = """<mujoco model="arm">
 class Seed:
     name: str
     files: dict[str, bytes]  # path in the scene folder -> content
-    main: str                # the file commands are given
-    kind: str                # "model", "launch", "urdf", "mjcf"
-    small: bool = True       # cheap enough to play and convert
+    main: str  # the file commands are given
+    kind: str  # "model", "launch", "urdf", "mjcf"
+    small: bool = True  # cheap enough to play and convert
 
 
 def builtin_seeds() -> list[Seed]:
     model = {"model.yaml": SMALL_MODEL.encode(), "part.stl": SMALL_STL.encode()}
-    launch = {"launch.yaml": SMALL_LAUNCH.encode(), "world.yaml": SMALL_WORLD.encode(),
-              "floor.yaml": SMALL_FLOOR.encode(), "devices.yaml": SMALL_DEVICES.encode(),
-              "colors.yaml": b"red: {r: 1.0, g: 0.0, b: 0.0, a: 1.0}\n", **model,
-              "model2.yaml": SMALL_MODEL2.encode()}
+    launch = {
+        "launch.yaml": SMALL_LAUNCH.encode(),
+        "world.yaml": SMALL_WORLD.encode(),
+        "floor.yaml": SMALL_FLOOR.encode(),
+        "devices.yaml": SMALL_DEVICES.encode(),
+        "colors.yaml": b"red: {r: 1.0, g: 0.0, b: 0.0, a: 1.0}\n",
+        **model,
+        "model2.yaml": SMALL_MODEL2.encode(),
+    }
     return [
         Seed("small-model", model, "model.yaml", "model"),
         Seed("small-launch", launch, "launch.yaml", "launch"),
@@ -210,8 +216,10 @@ def sample_scene_seeds() -> list[Seed]:
     if not folder.is_dir():
         return []
     files = {p.name: p.read_bytes() for p in folder.glob("*.yaml")}
-    return [Seed("suturing-launch", files, "launch.yaml", "launch", small=False),
-            Seed("suturing-pad", files, "pad.yaml", "model", small=False)]
+    return [
+        Seed("suturing-launch", files, "launch.yaml", "launch", small=False),
+        Seed("suturing-pad", files, "pad.yaml", "model", small=False),
+    ]
 
 
 def corpus_seeds(corpus: Path, limit: int | None = None) -> list[Seed]:
@@ -226,5 +234,3 @@ def corpus_seeds(corpus: Path, limit: int | None = None) -> list[Seed]:
         if limit and len(out) >= limit:
             break
     return out
-
-

@@ -13,6 +13,7 @@ planted secret or of /etc/passwd in any output.
 
 Case ``i`` of seed ``s`` is the same on every machine: ``random.Random(f"{s}:{i}")``.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -32,13 +33,26 @@ PASSWD_MARK = "root:x:0:0"
 LOCATED = re.compile(r"^(?P<file>[^\n]+?)(?::(?P<line>\d+):(?P<col>\d+))?: error\[(?P<rule>[a-z0-9-]+)\]: ", re.M)
 
 from fuzz_mutations import (  # noqa: F401 - re-exported: the suite's one entry point is fuzzkit
-    HOSTILE_PATHS, XML_OPS, YAML_OPS, _plants,
+    HOSTILE_PATHS,
+    XML_OPS,
+    YAML_OPS,
+    _plants,
 )
 from fuzz_seeds import (  # noqa: F401
-    SMALL_DEVICES, SMALL_FLOOR, SMALL_LAUNCH, SMALL_MJCF, SMALL_MODEL, SMALL_MODEL2, SMALL_STL, SMALL_URDF,
-    SMALL_WORLD, Seed, builtin_seeds, corpus_seeds, sample_scene_seeds,
+    SMALL_DEVICES,
+    SMALL_FLOOR,
+    SMALL_LAUNCH,
+    SMALL_MJCF,
+    SMALL_MODEL,
+    SMALL_MODEL2,
+    SMALL_STL,
+    SMALL_URDF,
+    SMALL_WORLD,
+    Seed,
+    builtin_seeds,
+    corpus_seeds,
+    sample_scene_seeds,
 )
-
 
 # ---------------------------------------------------------------------------------------------
 # Cases
@@ -51,9 +65,9 @@ class Case:
     op: str
     command: str
     files: dict[str, bytes]
-    argv: list[str]              # "{dir}" and "{outside}" are filled in by run_case
+    argv: list[str]  # "{dir}" and "{outside}" are filled in by run_case
     plants: dict = field(default_factory=dict)
-    explicit: bool = False       # the hostile file is named on the command line itself
+    explicit: bool = False  # the hostile file is named on the command line itself
 
     @property
     def id(self) -> str:
@@ -64,17 +78,26 @@ def commands_for(seed: Seed, with_run: bool, with_blender: bool) -> list[tuple[s
     main = "{dir}/" + seed.main
     if seed.kind in ("urdf", "mjcf"):
         other = "mjcf" if seed.kind == "urdf" else "urdf"
-        return [("convert-adf", ["convert", main, "{dir}/out.yaml", "--json"]),
-                ("convert-" + other, ["convert", main, "{dir}/out." + ("xml" if other == "mjcf" else "urdf"), "--json"])]
-    cmds = [("validate-text", ["validate", main]), ("validate-json", ["validate", "-f", "json", main]),
-            ("validate-github", ["validate", "-f", "github", main]), ("validate-sarif", ["validate", "-f", "sarif", main]),
-            ("info", ["info", main]), ("info-json", ["info", "--json", main])]
+        return [
+            ("convert-adf", ["convert", main, "{dir}/out.yaml", "--json"]),
+            ("convert-" + other, ["convert", main, "{dir}/out." + ("xml" if other == "mjcf" else "urdf"), "--json"]),
+        ]
+    cmds = [
+        ("validate-text", ["validate", main]),
+        ("validate-json", ["validate", "-f", "json", main]),
+        ("validate-github", ["validate", "-f", "github", main]),
+        ("validate-sarif", ["validate", "-f", "sarif", main]),
+        ("info", ["info", main]),
+        ("info-json", ["info", "--json", main]),
+    ]
     if seed.kind == "launch":
         cmds += [("info-l", ["info", "-l", "0,1", main])]
     if seed.kind == "model" and seed.small:
-        cmds += [("convert-urdf", ["convert", main, "{dir}/out.urdf", "--json"]),
-                 ("convert-mjcf", ["convert", main, "{dir}/out.xml", "--json"]),
-                 ("convert-adf", ["convert", main, "{dir}/out.yaml"])]
+        cmds += [
+            ("convert-urdf", ["convert", main, "{dir}/out.urdf", "--json"]),
+            ("convert-mjcf", ["convert", main, "{dir}/out.xml", "--json"]),
+            ("convert-adf", ["convert", main, "{dir}/out.yaml"]),
+        ]
     if with_run and seed.small:
         extra = ["-l", "0,1"] if seed.kind == "launch" else []
         cmds += [("run", ["run", main, *extra, "--seconds", "0.004", "--no-frames", "--out", "{dir}/run"])]
@@ -101,14 +124,41 @@ def explicit_cases() -> list[Case]:
     """Hostile files named on the command line itself: refused at once (devices, FIFOs,
     folders, bad path text) or read because the user named them (a regular file anywhere)."""
     out = []
-    for i, target in enumerate(["/dev/zero", "/dev/stdin", "/dev/urandom", "{dir}/fifo.yaml", "{dir}/folder",
-                                "{dir}/a\0b.yaml", "{dir}/" + "x" * 300 + ".yaml", "{dir}/nope.yaml",
-                                "{dir}/link_out.yaml", "{dir}/" + "d/" * 3000 + "m.yaml"]):
-        for cmd in (["validate"], ["validate", "-f", "json"], ["info"], ["info", "-l", "0"], ["run", "--seconds", "0.004"],
-                    ["convert", "{target}", "{dir}/out.urdf"]):
+    for i, target in enumerate(
+        [
+            "/dev/zero",
+            "/dev/stdin",
+            "/dev/urandom",
+            "{dir}/fifo.yaml",
+            "{dir}/folder",
+            "{dir}/a\0b.yaml",
+            "{dir}/" + "x" * 300 + ".yaml",
+            "{dir}/nope.yaml",
+            "{dir}/link_out.yaml",
+            "{dir}/" + "d/" * 3000 + "m.yaml",
+        ]
+    ):
+        for cmd in (
+            ["validate"],
+            ["validate", "-f", "json"],
+            ["info"],
+            ["info", "-l", "0"],
+            ["run", "--seconds", "0.004"],
+            ["convert", "{target}", "{dir}/out.urdf"],
+        ):
             argv = [a.replace("{target}", target) for a in cmd] if "{target}" in cmd else [*cmd, target]
-            out.append(Case("explicit", i, "named", " ".join(cmd[:2]).replace("{target}", "").strip(), {}, argv,
-                            _plants(), explicit=True))
+            out.append(
+                Case(
+                    "explicit",
+                    i,
+                    "named",
+                    " ".join(cmd[:2]).replace("{target}", "").strip(),
+                    {},
+                    argv,
+                    _plants(),
+                    explicit=True,
+                )
+            )
     return out
 
 
@@ -142,7 +192,7 @@ class Outcome:
     rc: int | None
     out: str
     err: str
-    error: str | None        # an exception that escaped main, or a timeout
+    error: str | None  # an exception that escaped main, or a timeout
     opened: list[str]
     scene: Path
     outside: Path
@@ -153,7 +203,9 @@ def materialise(case: Case, scene: Path, outside: Path) -> None:
     outside.mkdir(parents=True, exist_ok=True)
     (outside / "secret.yaml").write_text(f"bodies: [BODY {SECRET}]\nBODY {SECRET}:\n  name: {SECRET}\n  mass: 1\n")
     (outside / "secret.stl").write_text(SMALL_STL.replace("solid part", f"solid {SECRET}"))
-    (outside / "secret.xml").write_text(f'<mujoco model="{SECRET}"><worldbody><body name="{SECRET}"/></worldbody></mujoco>\n')
+    (outside / "secret.xml").write_text(
+        f'<mujoco model="{SECRET}"><worldbody><body name="{SECRET}"/></worldbody></mujoco>\n'
+    )
     for name, data in case.files.items():
         p = scene / name
         p.parent.mkdir(parents=True, exist_ok=True)
@@ -179,9 +231,16 @@ def run_case(case: Case, workdir: Path, timeout: float = 20.0) -> Outcome:
     global _OPENED
     _install_hook()
     scene, outside = workdir / "scene", workdir / "outside"
-    case = Case(case.seed, case.index, case.op, case.command,
-                {k: v.replace(b"{outside}", str(outside).encode()) for k, v in case.files.items()},
-                case.argv, case.plants, case.explicit)
+    case = Case(
+        case.seed,
+        case.index,
+        case.op,
+        case.command,
+        {k: v.replace(b"{outside}", str(outside).encode()) for k, v in case.files.items()},
+        case.argv,
+        case.plants,
+        case.explicit,
+    )
     materialise(case, scene, outside)
     argv = [_fill(a, scene, outside) for a in case.argv]
     out, err = io.StringIO(), io.StringIO()
@@ -204,6 +263,7 @@ def run_case(case: Case, workdir: Path, timeout: float = 20.0) -> Outcome:
         error = f"timeout after {timeout} s"
     except Exception as exc:  # noqa: BLE001 - exactly what the fuzzer hunts
         import traceback
+
         error = "".join(traceback.format_exception(exc))[-3000:]
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
@@ -220,6 +280,7 @@ def run_case(case: Case, workdir: Path, timeout: float = 20.0) -> Outcome:
 def _strict_json(text: str) -> object:
     def refuse(name):
         raise ValueError(f"non-standard JSON constant {name}")
+
     return json.loads(text, parse_constant=refuse)
 
 

@@ -3,13 +3,13 @@
 One Blender session per module (bpy costs seconds to import); every test starts from an
 empty factory scene.
 """
+
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
 import pytest
-
 from conftest import CORPUS, require_corpus
 
 bpy = pytest.importorskip("bpy")
@@ -21,13 +21,23 @@ from adfkit.model.semantics import joint_frames  # noqa: E402
 
 ROBOTS = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots"
 PHANTOM = CORPUS / "src/ADF/Phantoms/Simple/phantom.yaml"
-JOINT_TYPES = ("revolute", "prismatic", "fixed", "linear spring", "torsion spring", "p2p", "cone twist",
-               "six dof", "six dof spring")
+JOINT_TYPES = (
+    "revolute",
+    "prismatic",
+    "fixed",
+    "linear spring",
+    "torsion spring",
+    "p2p",
+    "cone twist",
+    "six dof",
+    "six dof spring",
+)
 
 
 @pytest.fixture(scope="module")
 def addon():
     from adfkit.commands.blend_import import load_addon
+
     _, mod = load_addon()
     return mod
 
@@ -77,22 +87,26 @@ def build_everything(addon, tmp: Path) -> dict:
     a.mark(base, "BODY")
     base.adf.body.mass = 0.0
     for x in (-0.05, 0.05):
-        a.add_collision_primitive(base, "BOX", size=(0.1, 0.2, 0.2),
-                                  offset=__import__("mathutils").Matrix.Translation((x, 0, 0)))
+        a.add_collision_primitive(
+            base, "BOX", size=(0.1, 0.2, 0.2), offset=__import__("mathutils").Matrix.Translation((x, 0, 0))
+        )
     skin = _cube("Skin", 0.05, (0.0, 0.0, 0.2))
     bpy.ops.object.mode_set(mode="OBJECT")
     _textured(skin, tmp)
     a.mark(skin, "BODY")
     a.estimate_inertia(skin, density=500.0)
-    bpy.ops.mesh.primitive_torus_add(major_radius=0.05, minor_radius=0.015, major_segments=24, minor_segments=8,
-                                     location=(0.3, 0.0, 0.0))
+    bpy.ops.mesh.primitive_torus_add(
+        major_radius=0.05, minor_radius=0.015, major_segments=24, minor_segments=8, location=(0.3, 0.0, 0.0)
+    )
     ring = bpy.context.active_object
     ring.name = ring.data.name = "Ring"
     a.mark(ring, "BODY")
     a.estimate_inertia(ring, mass=0.05)
     hulls = a.generate_collision(ring, threshold=0.1, max_hulls=8)
-    joints = {"revolute": a.add_joint(base, skin, "revolute", name="J-revolute"),
-              "fixed": a.add_joint(base, ring, "fixed", name="J-fixed")}
+    joints = {
+        "revolute": a.add_joint(base, skin, "revolute", name="J-revolute"),
+        "fixed": a.add_joint(base, ring, "fixed", name="J-fixed"),
+    }
     for i, t in enumerate(JOINT_TYPES):
         if t in joints:
             continue
@@ -114,8 +128,14 @@ def build_everything(addon, tmp: Path) -> dict:
             for k in ("linear_low", "linear_high", "angular_low", "angular_high"):
                 setattr(p, "use_" + k, True)
         if t == "six dof spring":
-            for k in ("stiffness_linear", "stiffness_angular", "damping_linear", "damping_angular",
-                      "equilibrium_linear", "equilibrium_angular"):
+            for k in (
+                "stiffness_linear",
+                "stiffness_angular",
+                "damping_linear",
+                "damping_angular",
+                "equilibrium_linear",
+                "equilibrium_angular",
+            ):
                 setattr(p, "use_" + k, True)
         joints[t] = j
     ghost = a.add_ghost("Entry", radius=0.004, parent=base, location=(0.0, 0.0, 0.11))
@@ -131,8 +151,16 @@ def build_everything(addon, tmp: Path) -> dict:
     a.mark(lamp, "LIGHT")
     lamp.adf.light.use_shadow_quality, lamp.adf.light.shadow_quality = True, 3
     bpy.context.view_layer.update()
-    return {"base": base, "skin": skin, "ring": ring, "hulls": hulls, "joints": joints, "ghost": ghost,
-            "sensor": sensor, "actuator": actuator}
+    return {
+        "base": base,
+        "skin": skin,
+        "ring": ring,
+        "hulls": hulls,
+        "joints": joints,
+        "ghost": ghost,
+        "sensor": sensor,
+        "actuator": actuator,
+    }
 
 
 def test_authored_model_with_every_element_exports_clean(addon, scene, tmp_path):
@@ -141,6 +169,7 @@ def test_authored_model_with_every_element_exports_clean(addon, scene, tmp_path)
     errors = [d for d in res.diagnostics if d.severity >= Severity.ERROR]
     assert res.ok and not errors, errors
     from adfkit.validator import validate_file
+
     vres = validate_file(res.path)
     assert [d for d in vres.diagnostics if d.severity >= Severity.ERROR] == []
     doc, diags = read_file(res.path)
@@ -156,8 +185,8 @@ def test_authored_model_with_every_element_exports_clean(addon, scene, tmp_path)
     assert hull_obj.count("\no ") + hull_obj.startswith("o ") == len(made["hulls"]) > 1
     skin = doc.body("BODY Skin")
     # a 5 cm cube of density 500: m = 0.0625 kg, I = m·a²/6 about its centre
-    assert skin.mass == pytest.approx(500 * 0.05 ** 3, rel=1e-4)
-    assert skin.inertia.ix == pytest.approx(skin.mass * 0.05 ** 2 / 6, rel=1e-3)
+    assert skin.mass == pytest.approx(500 * 0.05**3, rel=1e-4)
+    assert skin.inertia.ix == pytest.approx(skin.mass * 0.05**2 / 6, rel=1e-3)
     mtl = (tmp_path / "out/meshes/high_res/Skin.mtl").read_text()
     assert "map_Kd skin_color.png" in mtl and "map_bump skin_normal.png" in mtl
     assert (tmp_path / "out/meshes/high_res/skin_normal.png").is_file()
@@ -193,7 +222,11 @@ def _export(addon, scene, out: Path, name="model"):
 
 
 def _tree(d: Path) -> dict:
-    return {str(p.relative_to(d)): p.read_bytes() for p in sorted(d.rglob("*")) if p.is_file() and not p.name.startswith(".")}
+    return {
+        str(p.relative_to(d)): p.read_bytes()
+        for p in sorted(d.rglob("*"))
+        if p.is_file() and not p.name.startswith(".")
+    }
 
 
 def test_round_trip_is_byte_identical(addon, scene, tmp_path):
@@ -201,7 +234,7 @@ def test_round_trip_is_byte_identical(addon, scene, tmp_path):
     first = _export(addon, scene, tmp_path / "a")
     bpy.ops.wm.read_factory_settings(use_empty=True)
     addon.build.import_model(first.path)
-    second = _export(addon, bpy.context.scene, tmp_path / "b")
+    _export(addon, bpy.context.scene, tmp_path / "b")
     a, b = _tree(tmp_path / "a"), _tree(tmp_path / "b")
     assert a.keys() == b.keys()
     assert a["model.yaml"].decode() == b["model.yaml"].decode()
@@ -213,7 +246,7 @@ def test_unchanged_meshes_are_not_rewritten(addon, scene, tmp_path):
     addon.build.import_model(ROBOTS / "blender-psm.yaml")
     first = _export(addon, scene, tmp_path, "psm")
     again = _export(addon, scene, tmp_path, "psm")
-    assert len(first.skipped) == 0 and len(again.skipped) == 28   # 14 visual + 14 collision
+    assert len(first.skipped) == 0 and len(again.skipped) == 28  # 14 visual + 14 collision
     bpy.data.objects["yaw link"].data.vertices[0].co.x += 0.001
     edited = _export(addon, scene, tmp_path, "psm")
     assert sorted(str(p.relative_to(tmp_path)) for p in edited.written) == ["meshes/high_res/yaw link.OBJ", "psm.yaml"]
@@ -227,9 +260,11 @@ def test_unchanged_meshes_are_not_rewritten(addon, scene, tmp_path):
 #   meshes/low_res/ inside it (the meshes are copied there);
 # - a body listed twice in 'bodies' (phantom: BODY BlackGround) is listed once;
 # - orientations go through the writer's roll/pitch/yaw, equal to 1e-9 rad.
-@pytest.mark.parametrize("path, listed_twice, folder", [(ROBOTS / "blender-psm.yaml", 0, "meshes/"),
-                                                       (ROBOTS / "blender-ecm.yaml", 0, "meshes/"),
-                                                       (PHANTOM, 1, "./")], ids=["psm", "ecm", "phantom"])
+@pytest.mark.parametrize(
+    "path, listed_twice, folder",
+    [(ROBOTS / "blender-psm.yaml", 0, "meshes/"), (ROBOTS / "blender-ecm.yaml", 0, "meshes/"), (PHANTOM, 1, "./")],
+    ids=["psm", "ecm", "phantom"],
+)
 def test_corpus_import_export(addon, scene, tmp_path, path, listed_twice, folder):
     require_corpus()
     addon.build.import_model(path)
@@ -275,6 +310,7 @@ def test_joint_to_missing_object_is_refused(addon, scene, tmp_path):
 def test_blend_export_and_import_commands(addon, scene, tmp_path):
     """The headless CLI path: blend-export of a saved .blend, blend-import of the result."""
     from adfkit.cli import main
+
     addon.authoring.create_rope("Rope", 3, 0.06, 0.001, 0.003)
     blend = tmp_path / "rope.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
@@ -313,10 +349,11 @@ def test_rope_chain_of_six_dof_springs(addon, scene, tmp_path):
 def test_garbage_mesh_imports_without_it_and_says_so(addon, scene, tmp_path):
     """Blender's STL importer raises on an empty STL: the body still imports, empty,
     with a located mesh-unreadable warning (was a RuntimeError traceback from blend-import)."""
-    (tmp_path / "bad.stl").write_bytes(b"")   # an empty file
+    (tmp_path / "bad.stl").write_bytes(b"")  # an empty file
     (tmp_path / "m.yaml").write_text(
         "bodies: [BODY a]\nBODY a:\n  name: a\n  mass: 1.0\n  mesh: bad.stl\n"
-        "  location: {position: {x: 0, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 0}}\n")
+        "  location: {position: {x: 0, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 0}}\n"
+    )
     made, diags = addon.build.import_model(tmp_path / "m.yaml")
     assert [o.name for o in made] == ["a"] and made[0].type == "EMPTY"
     (d,) = [d for d in diags if d.rule == "mesh-unreadable"]
@@ -326,12 +363,18 @@ def test_garbage_mesh_imports_without_it_and_says_so(addon, scene, tmp_path):
 DEGENERATE = {  # (vertices, faces) of the meshes a modeller meets: each operator says why, never a traceback
     "empty": ([], []),
     "single face": ([(0, 0, 0), (0.01, 0, 0), (0, 0.01, 0)], [(0, 1, 2)]),
-    "flat grid": ([(x * 0.01, y * 0.01, 0) for y in range(4) for x in range(4)],
-                  [(y * 4 + x, y * 4 + x + 1, y * 4 + x + 5, y * 4 + x + 4) for y in range(3) for x in range(3)]),
-    "open box": ([(x, y, z) for x in (0, 0.01) for y in (0, 0.02) for z in (0, 0.03)],
-                 [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6)]),          # two sides missing
-    "non-manifold": ([(0, 0, 0), (0.01, 0, 0), (0, 0.01, 0), (0, 0, 0.01), (0, -0.01, 0), (0, 0, -0.01)],
-                     [(0, 1, 2), (0, 1, 3), (0, 1, 4), (0, 1, 5)]),                 # four faces on one edge
+    "flat grid": (
+        [(x * 0.01, y * 0.01, 0) for y in range(4) for x in range(4)],
+        [(y * 4 + x, y * 4 + x + 1, y * 4 + x + 5, y * 4 + x + 4) for y in range(3) for x in range(3)],
+    ),
+    "open box": (
+        [(x, y, z) for x in (0, 0.01) for y in (0, 0.02) for z in (0, 0.03)],
+        [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6)],
+    ),  # two sides missing
+    "non-manifold": (
+        [(0, 0, 0), (0.01, 0, 0), (0, 0.01, 0), (0, 0, 0.01), (0, -0.01, 0), (0, 0, -0.01)],
+        [(0, 1, 2), (0, 1, 3), (0, 1, 4), (0, 1, 5)],
+    ),  # four faces on one edge
 }
 
 
@@ -351,7 +394,7 @@ def test_every_geometry_operator_on_a_degenerate_mesh_finishes_or_says_why(addon
     for op, kw in calls:
         try:
             assert getattr(bpy.ops.adf, op)(**kw) == {"FINISHED"}, (op, kw)
-        except RuntimeError as exc:   # bpy raises an operator's ERROR report; an exception it let out is a traceback
+        except RuntimeError as exc:  # bpy raises an operator's ERROR report; an exception it let out is a traceback
             text = str(exc)
             assert text.startswith("Error: ") and "Traceback" not in text and " — " in text, (op, kw, text)
 
@@ -366,14 +409,14 @@ def test_an_imported_joint_whose_child_is_cleared_is_refused_and_an_external_one
     addon.build.import_model(first.path)
     j = bpy.data.objects["J"]
     assert j.get("adf_external_ends") == ""
-    j.rigid_body_constraint.object2 = None          # the modeller clears the child
+    j.rigid_body_constraint.object2 = None  # the modeller clears the child
     res = addon.export.export_scene(bpy.context.scene, tmp_path / "second", "m")
     assert not res.ok
     (d,) = [d for d in res.diagnostics if d.rule == "joint-reference"]
     assert d.message == "joint 'J': its child was cleared (it was 'BODY B')" and "delete the joint" in d.hint
     # a joint to a body in another file (imported without it) is carried through as written
     text = first.path.read_text().replace("- BODY B\n", "", 1)
-    start, end = text.index("\nBODY B:\n") + 1, text.index("\nJOINT J:\n") + 1   # B's mapping, written before J's
+    start, end = text.index("\nBODY B:\n") + 1, text.index("\nJOINT J:\n") + 1  # B's mapping, written before J's
     alone = tmp_path / "alone.yaml"
     alone.write_text(text[:start] + text[end:])
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -381,7 +424,8 @@ def test_an_imported_joint_whose_child_is_cleared_is_refused_and_an_external_one
     assert bpy.data.objects["J"].get("adf_external_ends") == "child"
     res = addon.export.export_scene(bpy.context.scene, tmp_path / "third", "m")
     assert res.ok and [d.message for d in res.diagnostics if d.rule == "joint-reference"] == [
-        "joint 'J': child body is not in this scene; kept as written"]
+        "joint 'J': child body is not in this scene; kept as written"
+    ]
 
 
 def test_export_to_a_new_folder_keeps_shader_and_volume_slice_paths_resolving(addon, scene, tmp_path):
@@ -390,13 +434,18 @@ def test_export_to_a_new_folder_keeps_shader_and_volume_slice_paths_resolving(ad
     pytest.importorskip("skimage")
     from adfkit.scenes.drilling import write_drilling
     from adfkit.validator.engine import validate_file
+
     src = write_drilling(tmp_path / "a" / "scene").parent
     (src / "shaders").mkdir()
     for f in ("bone.vs", "bone.fs"):
         (src / "shaders" / f).write_text("// shader\n")
     drill = src / "drill.yaml"
-    drill.write_text(drill.read_text().replace("  iso-surface value: 0.5\n",
-                     "  iso-surface value: 0.5\n  shaders: {path: shaders/, vertex: bone.vs, fragment: bone.fs}\n"))
+    drill.write_text(
+        drill.read_text().replace(
+            "  iso-surface value: 0.5\n",
+            "  iso-surface value: 0.5\n  shaders: {path: shaders/, vertex: bone.vs, fragment: bone.fs}\n",
+        )
+    )
     addon.build.import_model(drill)
     res = _export(addon, scene, tmp_path / "b" / "out", "drill")
     back, _ = read_file(res.path)
@@ -415,8 +464,10 @@ def test_export_far_away_copies_the_slices_and_shaders_it_names(addon, scene, tm
     pytest.importorskip("skimage")
     import shutil
     import tempfile
+
     from adfkit.scenes.drilling import write_drilling
     from adfkit.validator.engine import validate_file
+
     src = write_drilling(tmp_path / "scene").parent
     addon.build.import_model(src / "drill.yaml")
     far = Path(tempfile.mkdtemp(dir="/var/tmp")) / "a" / "b" / "c" / "out"
@@ -436,6 +487,7 @@ def _float32_noise(text: str) -> list[str]:
     import re
 
     import numpy as np
+
     noisy = []
     for m in re.findall(r"(?<![\w.])-?\d+\.\d{12,}(?:e-?\d+)?", text):
         x = float(m)
@@ -472,7 +524,7 @@ def test_what_ambfs_own_add_on_had(addon, scene, tmp_path):
     assert bpy.ops.adf.rename_joints() == {"FINISHED"}
     rbc = passive.rigid_body_constraint
     assert passive.name.startswith(f"{rbc.object1.name}-{rbc.object2.name}")
-    scene.adf.use_gravity, scene.adf.gravity = True, (0.0, 0.0, -3.71)        # Mars
+    scene.adf.use_gravity, scene.adf.gravity = True, (0.0, 0.0, -3.71)  # Mars
     res = _export(addon, scene, tmp_path / "all")
     doc, _ = read_file(res.path)
     assert tuple(doc.gravity) == (0.0, 0.0, -3.71)

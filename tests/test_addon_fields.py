@@ -1,4 +1,5 @@
 """Pure parts of the Blender add-on (no bpy): joint frames from a placed frame, field merge."""
+
 from __future__ import annotations
 
 import sys
@@ -37,15 +38,15 @@ def test_revolute_axis_is_the_frame_z_in_the_parent_frame():
 def test_merge_keeps_exact_values_that_float32_storage_did_not_change():
     b = Body(mass=0.123456789, restitution=0.1)
     values = {f.prop: fields.get_value(b, f) for f in fields.BODY}
-    values["mass"] = fields.f32(0.123456789)          # what Blender stores
-    values["friction_static"] = 0.7                    # user edit creates the friction block
-    values["restitution"] = None                       # user unticked it
+    values["mass"] = fields.f32(0.123456789)  # what Blender stores
+    values["friction_static"] = 0.7  # user edit creates the friction block
+    values["restitution"] = None  # user unticked it
     fields.merge(b, fields.BODY, values)
     assert b.mass == 0.123456789 and b.friction.static == 0.7 and b.friction.rolling is None
     assert b.restitution is None
     values["friction_static"] = None
     fields.merge(b, fields.BODY, values)
-    assert b.friction is None                          # no empty 'friction: {}' left behind
+    assert b.friction is None  # no empty 'friction: {}' left behind
 
 
 def test_collision_groups_are_checked():

@@ -1,5 +1,6 @@
 """The extension package, checked with Blender's own extension tool (the `blender_ext.py`
 that `blender --command extension ...` runs, shipped inside the bpy wheel)."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -43,8 +44,11 @@ def test_manifest_wheel_list_is_rewritten_from_the_wheels_present(tmp_path):
         sys.path.pop(0)
     shutil.copy(ADDON / "blender_manifest.toml", tmp_path)
     (tmp_path / "wheels").mkdir()
-    for name in ("adfkit-0.1.0-py3-none-any.whl", "rpds_py-1-cp311-cp311-win_amd64.whl",
-                 "rpds_py-1-cp311-cp311-manylinux_2_17_x86_64.manylinux2014_x86_64.whl"):
+    for name in (
+        "adfkit-0.1.0-py3-none-any.whl",
+        "rpds_py-1-cp311-cp311-win_amd64.whl",
+        "rpds_py-1-cp311-cp311-manylinux_2_17_x86_64.manylinux2014_x86_64.whl",
+    ):
         (tmp_path / "wheels" / name).write_bytes(b"")
     text = rewrite(tmp_path)
     assert '"./wheels/rpds_py-1-cp311-cp311-win_amd64.whl",' in text
@@ -57,8 +61,23 @@ def test_extension_builds_with_blenders_tool_and_bundles_adfkit(tmp_path):
     src = tmp_path / "addon"
     shutil.copytree(ADDON, src, ignore=shutil.ignore_patterns("wheels", "__pycache__"))
     (src / "wheels").mkdir()
-    pip = subprocess.run([sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "--no-build-isolation",
-                          "-w", str(src / "wheels"), str(ROOT)], capture_output=True, text=True, timeout=300)
+    pip = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            "--quiet",
+            "--no-deps",
+            "--no-build-isolation",
+            "-w",
+            str(src / "wheels"),
+            str(ROOT),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     if pip.returncode != 0:
         pytest.skip(f"cannot build the adfkit wheel here: {pip.stderr[-300:]}")
     sys.path.insert(0, str(src))
@@ -84,6 +103,7 @@ def test_geometry_packages_are_bundled_at_the_tested_versions():
     and the manifest lists them for every platform (Generate convex collision in Blender)."""
     import importlib.metadata
     import re
+
     script = (ADDON / "build_wheels.sh").read_text()
     pins = dict(re.findall(r"([A-Za-z0-9_.-]+)==([0-9][^\s\"]*)", script.split("geometry_pins=", 1)[1].split("\n")[0]))
     assert set(pins) == {"trimesh", "manifold3d", "coacd", "scipy", "networkx"}
@@ -93,6 +113,6 @@ def test_geometry_packages_are_bundled_at_the_tested_versions():
         except importlib.metadata.PackageNotFoundError:
             pytest.skip(f"{name} is not installed here")
     manifest = (ADDON / "blender_manifest.toml").read_text()
-    for name in ("coacd", "manifold3d", "scipy"):   # binary: one wheel per platform
+    for name in ("coacd", "manifold3d", "scipy"):  # binary: one wheel per platform
         listed = re.findall(rf'"\./wheels/({name}-[^"]+)"', manifest)
         assert len(listed) == 3 and any("win_amd64" in w for w in listed) and any("macosx" in w for w in listed)

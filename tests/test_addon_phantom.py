@@ -1,13 +1,13 @@
 """Issue 16 (add-on half) and issue 14's add-on items, in the real bpy: soft bodies, pass-through
 of what the add-on does not edit, fitted collision primitives, mass from density, export
 options, joint tools, sensors. One Blender session for the module; each test starts empty."""
+
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
 import pytest
-
 from conftest import CORPUS, ROOT, corpus_files, corpus_id, require_corpus
 
 bpy = pytest.importorskip("bpy")
@@ -17,13 +17,15 @@ from adfkit.adf.writer import file_to_plain  # noqa: E402
 from adfkit.diagnostics import AdfError, Severity  # noqa: E402
 
 SB = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/sb"
-SAMPLES = sorted(p for p in (ROOT / "sample_scenes").glob("*/*.yaml") if p.stem not in (
-    "launch", "world", "colors", "input_devices"))
+SAMPLES = sorted(
+    p for p in (ROOT / "sample_scenes").glob("*/*.yaml") if p.stem not in ("launch", "world", "colors", "input_devices")
+)
 
 
 @pytest.fixture(scope="module")
 def addon():
     from adfkit.commands.blend_import import load_addon
+
     _, mod = load_addon()
     return mod
 
@@ -86,6 +88,7 @@ def _lost(orig_path: Path, back_path: Path) -> list[str]:
 
 # --- soft bodies ---------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("name", ["cloth.yaml", "cloth2.yaml"])
 def test_corpus_cloth_import_export_keeps_every_soft_body_key(addon, scene, tmp_path, name):
     require_corpus()
@@ -94,21 +97,24 @@ def test_corpus_cloth_import_export_keeps_every_soft_body_key(addon, scene, tmp_
     orig, _ = read_file(SB / name)
     (sb,) = orig.soft_bodies
     from adfkit.geometry.softmesh import load_soft_mesh
+
     nodes = load_soft_mesh(SB / "low_res/cloth.3DS").nodes
-    assert cloth.type == "MESH" and len(cloth.data.vertices) == len(nodes)    # vertex i is node i
+    assert cloth.type == "MESH" and len(cloth.data.vertices) == len(nodes)  # vertex i is node i
     assert [c for v in cloth.data.vertices[:3] for c in v.co] == pytest.approx(nodes[:3].ravel().tolist(), abs=1e-6)
     grp = cloth.vertex_groups[cloth.adf.soft.fixed_group]
-    assert [v.index for v in cloth.data.vertices if any(g.group == grp.index for g in v.groups)] == \
-        sorted(sb.config.fixed_nodes)
+    assert [v.index for v in cloth.data.vertices if any(g.group == grp.index for g in v.groups)] == sorted(
+        sb.config.fixed_nodes
+    )
     assert cloth.adf.soft.use_config_klst and cloth.adf.soft.config_klst == pytest.approx(sb.config.kLST)
     res = _export(addon, scene, tmp_path, Path(name).stem)
     back, _ = read_file(res.path)
     (sb2,) = back.soft_bodies
     from adfkit.adf.writer import node_to_plain
+
     p1, p2 = node_to_plain(sb), node_to_plain(sb2)
     for k in MESH_FOLDERS:
         p1.pop(k, None), p2.pop(k, None)
-    assert p1 == p2                                    # every soft-body key and value, config included
+    assert p1 == p2  # every soft-body key and value, config included
     assert (tmp_path / back.low_resolution_path / sb2.mesh).is_file()
     assert _lost(SB / name, res.path) == []
 
@@ -122,13 +128,19 @@ def _grid(name: str, n: int = 5, size: float = 0.1):
 
 def test_soft_body_authored_with_fixed_nodes_from_a_vertex_group(addon, scene, tmp_path):
     from adfkit.geometry.softmesh import load_soft_mesh
+
     pad = _grid("Pad")
     addon.authoring.mark(pad, "SOFT_BODY")
     s = pad.adf.soft
-    assert s.use_mass and s.mass == 1.0          # a flat sheet: no volume, AMBF's 1 kg stays
+    assert s.use_mass and s.mass == 1.0  # a flat sheet: no volume, AMBF's 1 kg stays
     s.mass = 0.05
-    for prop, value in (("config_klst", 0.4), ("config_kdp", 0.02), ("config_piterations", 8),
-                        ("config_bending_constraint", 2), ("randomize_constraints", True)):
+    for prop, value in (
+        ("config_klst", 0.4),
+        ("config_kdp", 0.02),
+        ("config_piterations", 8),
+        ("config_bending_constraint", 2),
+        ("randomize_constraints", True),
+    ):
         setattr(s, "use_" + prop, True)
         setattr(s, prop, value)
     corners = [v.index for v in pad.data.vertices if v.co.y > 0.049 and abs(v.co.x) > 0.049]
@@ -146,6 +158,7 @@ def test_soft_body_authored_with_fixed_nodes_from_a_vertex_group(addon, scene, t
     fixed = nodes[sb.config.fixed_nodes]
     assert len(fixed) == 2 and (fixed[:, 1] > 0.049).all() and (abs(fixed[:, 0]) > 0.049).all()
     from adfkit.validator import validate_file
+
     assert [d for d in validate_file(res.path).diagnostics if d.severity >= Severity.ERROR] == []
     bpy.ops.wm.read_factory_settings(use_empty=True)
     (obj,), _ = addon.build.import_model(res.path)
@@ -161,8 +174,12 @@ def test_bundled_sample_scenes_lose_nothing_on_import_export(addon, scene, tmp_p
     assert _lost(path, res.path) == []
 
 
-CORPUS_MODELS = [p for p in corpus_files() if "bodies" in p.read_text(errors="replace")[:4000]
-                 and not p.name.startswith(("world", "launch", "input_devices", "color"))]
+CORPUS_MODELS = [
+    p
+    for p in corpus_files()
+    if "bodies" in p.read_text(errors="replace")[:4000]
+    and not p.name.startswith(("world", "launch", "input_devices", "color"))
+]
 
 
 @pytest.mark.slow
@@ -173,6 +190,7 @@ def test_every_corpus_model_loses_nothing_on_import_export(addon, scene, tmp_pat
     except AdfError as exc:
         pytest.skip(f"not a model file the reader accepts: {exc.diagnostics[0].message}")
     from adfkit.validator.engine import SEVERITY_OVERRIDES
+
     bad = [d for d in diags if SEVERITY_OVERRIDES.get(d.rule, d.severity) >= Severity.ERROR]
     if bad:
         pytest.skip(f"AMBF rejects this file too ({bad[0].rule}: {bad[0].message})")
@@ -209,6 +227,7 @@ VEHICLE car:
 
 
 # --- sensors (issue 14) --------------------------------------------------------------------
+
 
 def test_sensor_with_full_name_parent_and_unknown_type_is_attached_and_carried(addon, scene, tmp_path):
     src = tmp_path / "exo.yaml"
@@ -247,10 +266,11 @@ SENSOR heel:
     assert tuple(toe.matrix_world.translation) == pytest.approx((0.1, 0.0, 0.5), abs=1e-6)
     h = heel.adf.sensor
     assert (h.use_contact_stiffness, h.contact_stiffness, h.use_friction_variable) == (True, 800.0, True)
-    h.contact_stiffness = 900.0                       # edited in the panel
+    h.contact_stiffness = 900.0  # edited in the panel
     res = _export(addon, scene, tmp_path / "out", "exo")
-    assert any(d.rule == "sensor-type" and "AMBF 2.0" in d.message and d.severity == Severity.WARNING
-               for d in res.diagnostics)
+    assert any(
+        d.rule == "sensor-type" and "AMBF 2.0" in d.message and d.severity == Severity.WARNING for d in res.diagnostics
+    )
     doc, _ = read_file(res.path)
     t, hh = doc.sensors
     assert (t.type, t.parent) == ("CONTACT", "/ambf/env/BODY ExoRightFoot")
@@ -259,11 +279,13 @@ SENSOR heel:
 
 # --- collision primitives ------------------------------------------------------------------
 
+
 def _tilted_cylinder(radius=0.02, depth=0.12):
     bpy.ops.mesh.primitive_cylinder_add(vertices=64, radius=radius, depth=depth)
     o = bpy.context.active_object
     o.name = o.data.name = "Rod"
     from mathutils import Matrix
+
     o.data.transform(Matrix.Rotation(math.radians(35), 4, "X") @ Matrix.Translation((0.01, 0.0, 0.0)))
     return o
 
@@ -274,15 +296,20 @@ def test_fit_primitive_on_a_cylinder_mesh_is_within_two_percent(addon, scene, tm
     cyl = addon.authoring.fit_collision_primitive(rod, "CYLINDER")
     s = cyl.adf.shape
     assert s.radius == pytest.approx(0.02, rel=0.02) and s.height == pytest.approx(0.12, rel=0.02)
-    axis = cyl.matrix_world.to_3x3() @ __import__("mathutils").Vector((0, 0, 1) if s.axis == "z" else
-                                                                       (1, 0, 0) if s.axis == "x" else (0, 1, 0))
-    tilt = math.degrees(math.acos(min(1.0, abs(axis.dot((0.0, -math.sin(math.radians(35)), math.cos(math.radians(35))))))))
+    axis = cyl.matrix_world.to_3x3() @ __import__("mathutils").Vector(
+        (0, 0, 1) if s.axis == "z" else (1, 0, 0) if s.axis == "x" else (0, 1, 0)
+    )
+    tilt = math.degrees(
+        math.acos(min(1.0, abs(axis.dot((0.0, -math.sin(math.radians(35)), math.cos(math.radians(35)))))))
+    )
     assert tilt < 1.0
     # the outline is the fitted cylinder: its bounding radius and length
     loc = [cyl.matrix_world @ v.co for v in cyl.data.vertices]
-    assert max((p - cyl.matrix_world.translation).length for p in loc) == pytest.approx(math.hypot(0.02, 0.06), rel=0.02)
+    assert max((p - cyl.matrix_world.translation).length for p in loc) == pytest.approx(
+        math.hypot(0.02, 0.06), rel=0.02
+    )
     cap = addon.authoring.fit_collision_primitive(rod, "CAPSULE")
-    assert [c.name for c in rod.children] == [cap.name]           # replaced, not stacked
+    assert [c.name for c in rod.children] == [cap.name]  # replaced, not stacked
     assert cap.adf.shape.radius >= 0.0199 and cap.adf.shape.height >= 0.12
     for shape in ("BOX", "SPHERE", "CONE"):
         addon.authoring.fit_collision_primitive(rod, shape)
@@ -314,19 +341,20 @@ def test_missing_geometry_package_is_a_readable_error(addon):
 
 # --- mass, inertia -------------------------------------------------------------------------
 
+
 def test_mass_follows_density_unless_typed(addon, scene, tmp_path):
     link = _cube("Link", 0.04)
     addon.authoring.mark(link, "BODY")
     b = link.adf.body
-    assert b.mass == pytest.approx(1000 * 0.04 ** 3, rel=1e-4) and not b.mass_typed      # 64 g, not 1 kg
+    assert b.mass == pytest.approx(1000 * 0.04**3, rel=1e-4) and not b.mass_typed  # 64 g, not 1 kg
     link.adf.density = 2700.0
-    assert b.mass == pytest.approx(2700 * 0.04 ** 3, rel=1e-4)
+    assert b.mass == pytest.approx(2700 * 0.04**3, rel=1e-4)
     addon.authoring.estimate_body(link)
-    assert b.mass == pytest.approx(2700 * 0.04 ** 3, rel=1e-4)
-    assert b.inertia[0] == pytest.approx(b.mass * 0.04 ** 2 / 6, rel=1e-3)
+    assert b.mass == pytest.approx(2700 * 0.04**3, rel=1e-4)
+    assert b.inertia[0] == pytest.approx(b.mass * 0.04**2 / 6, rel=1e-3)
     heavy = _cube("Heavy", 0.04, (0.2, 0, 0))
     addon.authoring.mark(heavy, "BODY")
-    heavy.adf.body.mass = 0.5                          # typed by hand
+    heavy.adf.body.mass = 0.5  # typed by hand
     assert heavy.adf.body.mass_typed
     heavy.adf.density = 100.0
     plane = bpy.data.objects.new("Floor", None)
@@ -334,10 +362,11 @@ def test_mass_follows_density_unless_typed(addon, scene, tmp_path):
     addon.authoring.mark(plane, "BODY")
     done, skipped = addon.authoring.estimate_all(bpy.context.scene)
     assert sorted(o.name for o in done) == ["Heavy", "Link"]
-    assert heavy.adf.body.mass == 0.5 and heavy.adf.body.inertia[0] == pytest.approx(0.5 * 0.04 ** 2 / 6, rel=1e-3)
+    assert heavy.adf.body.mass == 0.5 and heavy.adf.body.inertia[0] == pytest.approx(0.5 * 0.04**2 / 6, rel=1e-3)
 
 
 # --- export options ------------------------------------------------------------------------
+
 
 def test_precision_modifiers_and_decimated_low_res(addon, scene, tmp_path):
     o = _cube("Skin", 0.05, (0.1, 0.2, 0.3))
@@ -351,7 +380,7 @@ def test_precision_modifiers_and_decimated_low_res(addon, scene, tmp_path):
     assert "mass: 0.005\n" in text and "{x: 0.1, y: 0.2, z: 0.3}" in text and "0.0049999" not in text
     hi = (tmp_path / "a/meshes/high_res/Skin.OBJ").read_text()
     lo = (tmp_path / "a/meshes/low_res/Skin.OBJ").read_text()
-    assert hi.count("\nv ") == 98                     # a cube subdivided twice: 98 vertices, 96 quads
+    assert hi.count("\nv ") == 98  # a cube subdivided twice: 98 vertices, 96 quads
     assert 0 < lo.count("\nf ") < hi.count("\nf ") // 2
     sc.apply_modifiers, sc.low_res_ratio = False, 1.0
     res = _export(addon, scene, tmp_path / "b")
@@ -359,6 +388,7 @@ def test_precision_modifiers_and_decimated_low_res(addon, scene, tmp_path):
 
 
 # --- joints, lights, findings --------------------------------------------------------------
+
 
 def _two_bodies(addon, jtype="revolute"):
     base = _cube("Base", 0.1)
@@ -387,17 +417,20 @@ def test_joint_limits_typed_in_the_panel_are_mirrored_on_the_constraint(addon, s
 
 def test_gains_hide_show_and_cleanup(addon, scene):
     import importlib
+
     from mathutils import Matrix
+
     tuning = importlib.import_module(addon.__name__ + ".tuning")
     base, arm = _cube("Base", 0.1), _cube("Arm", 0.04, (0.0, 0.0, 0.2))
     for o in (base, arm):
         addon.authoring.mark(o, "BODY")
     arm.adf.body.use_inertia, arm.adf.body.inertia = True, (1e-4, 1e-4, 1e-4)
     # hinge about world X through (0, 0, 0.1): the arm's centre is 0.1 m off the axis
-    j = addon.authoring.add_joint(base, arm, "revolute",
-                                  Matrix.Translation((0, 0, 0.1)) @ Matrix.Rotation(math.pi / 2, 4, "Y"), "J")
-    m = 1000 * 0.04 ** 3
-    load = m * 0.1 ** 2 + 1e-4
+    j = addon.authoring.add_joint(
+        base, arm, "revolute", Matrix.Translation((0, 0, 0.1)) @ Matrix.Rotation(math.pi / 2, 4, "Y"), "J"
+    )
+    m = 1000 * 0.04**3
+    load = m * 0.1**2 + 1e-4
     done = tuning.estimate_gains(scene, [j], frequency_hz=2.0, damping_ratio=1.0)
     w = 2 * math.pi * 2.0
     assert done["J"] == pytest.approx((load * w * w, 2 * load * w), rel=1e-4)
@@ -409,11 +442,13 @@ def test_gains_hide_show_and_cleanup(addon, scene):
     stray.parent = None
     lost = _cube("Gone", 0.02, (1, 0, 0))
     addon.authoring.mark(lost, "BODY")
-    k = addon.authoring.add_joint(arm, lost, "fixed", name="K")
+    addon.authoring.add_joint(arm, lost, "fixed", name="K")
     bpy.data.objects.remove(lost, do_unlink=True)
     said = tuning.cleanup(scene)
-    assert sorted(said) == [f"removed collision {stray.name if False else 'Arm.sphere'} (not under a body)",
-                            "removed joint K (no parent or child body)"]
+    assert sorted(said) == [
+        f"removed collision {stray.name if False else 'Arm.sphere'} (not under a body)",
+        "removed joint K (no parent or child body)",
+    ]
     assert "K" not in bpy.data.objects and "J" in bpy.data.objects
 
 
@@ -476,7 +511,7 @@ def test_operators_run_from_blender(addon, scene, tmp_path):
     assert bpy.ops.adf.export_model(directory=str(tmp_path), model_name="ops") == {"FINISHED"}
     doc, _ = read_file(tmp_path / "ops.yaml")
     assert [b.identifier for b in doc.bodies] == ["BODY Rod"] and len(doc.soft_bodies) == 1
-    assert len(doc.soft_bodies[0].config.fixed_nodes) == len(pad.data.vertices)   # all were selected
+    assert len(doc.soft_bodies[0].config.fixed_nodes) == len(pad.data.vertices)  # all were selected
 
 
 def test_a_tissue_pad_with_thickness_exports_its_shell_and_its_mass(addon, scene, tmp_path):
@@ -484,7 +519,9 @@ def test_a_tissue_pad_with_thickness_exports_its_shell_and_its_mass(addon, scene
     mesh is the solid shell (both faces), the mass is density × its volume, the estimate acts on
     the soft body (not on rigid-body settings), and a flat sheet says why it has no mass."""
     import numpy as np
+
     from adfkit.geometry.softmesh import load_soft_mesh
+
     n, size, thick = 9, 0.1, 0.004
     pad = _grid("Pad", n, size)
     solid = pad.modifiers.new("Solidify", "SOLIDIFY")
@@ -499,15 +536,15 @@ def test_a_tissue_pad_with_thickness_exports_its_shell_and_its_mass(addon, scene
     for v in pad.data.vertices:
         v.select = v.index in border
     assert bpy.ops.adf.fix_selected_nodes() == {"FINISHED"}
-    assert bpy.ops.adf.estimate_inertia() == {"FINISHED"}          # acts on the soft body's mass
+    assert bpy.ops.adf.estimate_inertia() == {"FINISHED"}  # acts on the soft body's mass
     assert pad.adf.body.use_inertia is False
     res = _export(addon, scene, tmp_path / "out")
     doc, _ = read_file(res.path)
     (sb,) = doc.soft_bodies
     nodes = load_soft_mesh(tmp_path / "out" / doc.low_resolution_path / sb.mesh).nodes
-    assert len(nodes) == 2 * len(pad.data.vertices)                  # both faces of the shell
+    assert len(nodes) == 2 * len(pad.data.vertices)  # both faces of the shell
     assert np.ptp(nodes[:, 2]) == pytest.approx(thick, rel=1e-3)
-    assert len(sb.config.fixed_nodes) == 2 * len(border)              # the rim fixed on both faces
+    assert len(sb.config.fixed_nodes) == 2 * len(border)  # the rim fixed on both faces
     assert sb.mass == pytest.approx(1000.0 * size * size * thick, rel=1e-4)
     # a flat sheet says why it has no mass from density, and the estimate says so too
     pad.modifiers.remove(solid)

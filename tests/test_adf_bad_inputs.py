@@ -1,5 +1,6 @@
 """Issue 4: every user mistake gives the expected rule id at the right line:col, exit
 status 2 from `adfkit info`, and no traceback."""
+
 from __future__ import annotations
 
 import subprocess
@@ -29,35 +30,72 @@ CASES = [
     ("int-with-fraction", b"lights: [l]\nenvironment: e.yaml\nl:\n  shadow quality: 2.5\n", "bad-int", 4, 19),
     ("negative-uint", b"lights: [l]\nenvironment: e.yaml\nl:\n  shadow quality: -1\n", "bad-int", 4, 19),
     ("vec3-missing-z", (MODEL_HEAD + "  gravity: {x: 0, y: 0}\n").encode(), "missing-component", 3, 12),
-    ("rpy-missing-y", (MODEL_HEAD + "  location:\n    orientation: {r: 0, p: 0}\n").encode(), "missing-component", 4, 18),
+    (
+        "rpy-missing-y",
+        (MODEL_HEAD + "  location:\n    orientation: {r: 0, p: 0}\n").encode(),
+        "missing-component",
+        4,
+        18,
+    ),
     ("vec3-not-mapping", (MODEL_HEAD + "  gravity: [0, 0, -9.8]\n").encode(), "bad-type", 3, 12),
     ("list-not-list", b"bodies: BODY a\nBODY a: {mass: 1}\n", "bad-type", 1, 9),
     ("list-entry-mapping", b"bodies:\n  - {mass: 1}\n", "bad-type", 2, 5),
     ("joint-axis-text", b"joints: [j]\nj:\n  type: revolute\n  parent axis: up\n", "bad-type", 4, 16),
     ("shape-list-not-list", (MODEL_HEAD + "  compound collision shape: {shape: Box}\n").encode(), "bad-type", 3, 29),
     ("recursive-alias", b"bodies: &a [*a]\n", "yaml-recursive-alias", 1, 9),
-    ("alias-bomb", ("a: &a [x,x,x,x,x,x,x,x,x,x]\n" + "".join(
-        f"{chr(98 + i)}: &{chr(98 + i)} [*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},"
-        f"*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)}]\n"
-        for i in range(7)) + "bodies: []\n").encode(), "yaml-alias-bomb", 1, 1),
+    (
+        "alias-bomb",
+        (
+            "a: &a [x,x,x,x,x,x,x,x,x,x]\n"
+            + "".join(
+                f"{chr(98 + i)}: &{chr(98 + i)} [*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},"
+                f"*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)},*{chr(97 + i)}]\n"
+                for i in range(7)
+            )
+            + "bodies: []\n"
+        ).encode(),
+        "yaml-alias-bomb",
+        1,
+        1,
+    ),
     # issue 14: classes that used to be tracebacks
     ("deep-flow", b"bodies: []\nx: " + b"[" * 1000 + b"]" * 1000 + b"\n", "yaml-too-deep", 2, 103),
     ("deep-flow-100k", b"bodies: []\nx: " + b"[" * 100_000 + b"]" * 100_000 + b"\n", "yaml-too-deep", 2, 103),
-    ("deep-block", b"bodies: []\n" + b"".join(b"  " * i + b"k%d:\n" % i for i in range(1000)) + b"  " * 1000 + b"v\n",
-     "yaml-too-deep", 102, 201),
+    (
+        "deep-block",
+        b"bodies: []\n" + b"".join(b"  " * i + b"k%d:\n" % i for i in range(1000)) + b"  " * 1000 + b"v\n",
+        "yaml-too-deep",
+        102,
+        201,
+    ),
     # 1,000 levels a space apart: under the pre-scan's bound, so the composer meets the nesting
     # (libyaml 0.2.6 refuses it itself; older releases compose it): yaml-too-deep either way
-    ("deep-block-narrow", b"bodies: []\n" + b"".join(b" " * i + b"k:\n" for i in range(1000)) + b" " * 1000 + b"v\n",
-     "yaml-too-deep", 102, 101),
+    (
+        "deep-block-narrow",
+        b"bodies: []\n" + b"".join(b" " * i + b"k:\n" for i in range(1000)) + b" " * 1000 + b"v\n",
+        "yaml-too-deep",
+        102,
+        101,
+    ),
     ("deep-dashes", b"bodies: []\nx:\n" + b"- " * 50_000 + b"x\n", "yaml-too-deep", 3, 199),
     ("bad-bool-tag", (MODEL_HEAD + "  passive: !!bool maybe\n").encode(), "yaml-bad-tag", 3, 12),
     ("bad-int-tag", (MODEL_HEAD + "  mass: !!int many\n").encode(), "yaml-bad-tag", 3, 9),
     ("bad-timestamp-tag", (MODEL_HEAD + "  name: !!timestamp x\n").encode(), "yaml-bad-tag", 3, 9),
-    ("inf-orientation", (MODEL_HEAD + "  location: {orientation: {r: .inf, p: 0, y: 0}}\n").encode(),
-     "non-finite-number", 3, 31),
+    (
+        "inf-orientation",
+        (MODEL_HEAD + "  location: {orientation: {r: .inf, p: 0, y: 0}}\n").encode(),
+        "non-finite-number",
+        3,
+        31,
+    ),
     ("nan-offset", b"joints: [j]\nj:\n  joint offset: .nan\n", "non-finite-number", 3, 17),
-    ("huge-int-axis", b"joints: [j]\nj:\n  parent axis: {x: " + b"9" * 400 + b", y: 0, z: 1}\n",
-     "non-finite-number", 3, 20),
+    (
+        "huge-int-axis",
+        b"joints: [j]\nj:\n  parent axis: {x: " + b"9" * 400 + b", y: 0, z: 1}\n",
+        "non-finite-number",
+        3,
+        20,
+    ),
     ("huge-int-mass", (MODEL_HEAD + "  mass: " + "1" * 5000 + "\n").encode(), "non-finite-number", 3, 9),
     ("nul-character", b"bodies: []\nname: a\x00b\n", "yaml-syntax", 2, 8),
 ]
@@ -85,6 +123,7 @@ def test_duplicate_keys_are_warnings_and_the_first_value_wins(tmp_path, capsys, 
     err = capsys.readouterr().err
     assert f"{f}:5:3: warning[yaml-duplicate-key]" in err or args == ["convert"]
     from adfkit.adf import read_file
+
     doc, diags = read_file(f)
     assert [b.mass for b in doc.bodies] == [1.0]
     assert sorted((d.rule, d.location.line) for d in diags) == [("yaml-duplicate-key", 5), ("yaml-duplicate-key", 6)]
@@ -94,14 +133,17 @@ def test_duplicate_keys_are_warnings_and_the_first_value_wins(tmp_path, capsys, 
 @pytest.mark.parametrize("slot", ["named", "world config", "multibody configs", "input devices config"])
 def test_devices_are_refused_at_once(tmp_path, capsys, device, slot):
     import time
+
     if slot == "named":
         argv, where = ["info", device], f"{device}: error[not-a-regular-file]"
     else:
         launch = tmp_path / "launch.yaml"
         value = f"[{device}]" if slot == "multibody configs" else device
         head = "" if slot == "multibody configs" else "world config: w.yaml\n"
-        launch.write_text(f"{head}color config: c.yaml\n{slot}: {value}\n" +
-                          ("" if slot == "multibody configs" else "multibody configs: []\n"))
+        launch.write_text(
+            f"{head}color config: c.yaml\n{slot}: {value}\n"
+            + ("" if slot == "multibody configs" else "multibody configs: []\n")
+        )
         argv = ["validate", str(launch)] if slot == "input devices config" else ["info", "-l", "0", str(launch)]
         where = f"{launch}:{3 if head else 2}:{len(slot) + 3}: error[not-a-regular-file]"
         if slot == "world config":
@@ -186,8 +228,9 @@ def test_files_named_by_a_launch_outside_its_tree_are_not_read(tmp_path, capsys,
     (scene / "link.yaml").symlink_to(tmp_path / "secret.yaml")
     launch = scene / "launch.yaml"
     for target, col in (("/etc/passwd", 23), ("link.yaml", 23), ("../secret.yaml", 23)):
-        launch.write_text(f"world config: w.yaml\ncolor config: c.yaml\ninput devices config: {target}\n"
-                          "multibody configs: []\n")
+        launch.write_text(
+            f"world config: w.yaml\ncolor config: c.yaml\ninput devices config: {target}\nmultibody configs: []\n"
+        )
         for fmt in ("text", "json", "github", "sarif"):
             status = main(["validate", "-f", fmt, str(launch)])
             out = capsys.readouterr()
@@ -206,8 +249,10 @@ def test_unknown_sensor_type_is_a_warning_and_survives_a_round_trip(tmp_path, ca
     from adfkit.validator import validate_file
 
     f = tmp_path / "s.yaml"
-    f.write_text("bodies: [BODY a]\nsensors: [S]\nBODY a:\n  name: a\n  mass: 1.0\nS:\n  name: s\n  type: CONTACT\n"
-                 "  parent: BODY a\n  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n")
+    f.write_text(
+        "bodies: [BODY a]\nsensors: [S]\nBODY a:\n  name: a\n  mass: 1.0\nS:\n  name: s\n  type: CONTACT\n"
+        "  parent: BODY a\n  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n"
+    )
     hits = [d for d in validate_file(f).diagnostics if d.rule == "sensor-type"]
     assert [(str(d.severity), d.location.line) for d in hits] == [("warning", 8)]
     assert "unknown to AMBF 2.0" in hits[0].message

@@ -1,5 +1,6 @@
 """Issue 4, data-driven over the public corpus: every file PyYAML parses loads into the
 model, its counts match the raw YAML, and read → write → read round-trips."""
+
 from __future__ import annotations
 
 import functools
@@ -7,13 +8,12 @@ import math
 
 import pytest
 import yaml
+from conftest import corpus_files, corpus_id
 
 from adfkit.adf import dumps, read_file
 from adfkit.model import ModelFile, World, rpy_to_quat
 from adfkit.model.compare import differences
 from adfkit.summary import model_summary
-
-from conftest import corpus_files, corpus_id
 
 FILES = corpus_files()
 
@@ -69,8 +69,9 @@ def test_corpus_file_loads_and_counts_match_raw_yaml(path):
         raw_types = sorted(raw[j]["type"] for j in raw.get("joints") or [] if isinstance(raw.get(j), dict))
         assert sorted(j.type for j in doc.joints if j.defined) == raw_types
         # Mass: missing mass means 1 kg (AMBF), quoted masses are numbers.
-        raw_mass = sum(float(raw[b].get("mass", 1.0)) if isinstance(raw.get(b), dict) else 1.0
-                       for b in raw.get("bodies") or [])
+        raw_mass = sum(
+            float(raw[b].get("mass", 1.0)) if isinstance(raw.get(b), dict) else 1.0 for b in raw.get("bodies") or []
+        )
         assert math.isclose(s["total mass"], raw_mass, rel_tol=1e-9, abs_tol=1e-9)
     elif isinstance(doc, World):
         assert len(doc.lights) == _list_len(raw, "lights")
@@ -154,7 +155,7 @@ def _first_wins_load(text: str):
     return plain(compose(text, "<orig>", []))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _read_and_dump(path):
     doc, _ = read_file(path)
     return doc, dumps(doc)

@@ -1,4 +1,5 @@
 """Unit tests of the spine: pose maths, joint frames, writer details, the sample scene."""
+
 from __future__ import annotations
 
 import math
@@ -12,7 +13,7 @@ import yaml
 from adfkit.adf import dumps, load_scene, read_file, write_file
 from adfkit.model import Body, Joint, ModelFile, Pose, Quat, Vec3, quat_to_rpy, rpy_to_quat
 from adfkit.model.compare import differences
-from adfkit.model.semantics import joint_frames, joint_kind, shape_kind, JointKind, ShapeKind
+from adfkit.model.semantics import JointKind, ShapeKind, joint_frames, joint_kind, shape_kind
 from adfkit.scenes import SuturingPadParams, build_suturing_pad, write_suturing_pad
 from adfkit.summary import scene_summary
 
@@ -51,8 +52,14 @@ def test_pose_compose_and_inverse():
 
 def test_joint_frames_child_orientation_follows_section_8_2():
     # At zero the child's orientation relative to the parent is Rot(a, offset)·Rmin(b→a).
-    j = Joint(type="revolute", parent_axis=Vec3(0, 0, 1), child_axis=Vec3(1, 0, 0),
-              parent_pivot=Vec3(0.1, 0, 0), child_pivot=Vec3(0, 0.2, 0), offset=0.5)
+    j = Joint(
+        type="revolute",
+        parent_axis=Vec3(0, 0, 1),
+        child_axis=Vec3(1, 0, 0),
+        parent_pivot=Vec3(0.1, 0, 0),
+        child_pivot=Vec3(0, 0.2, 0),
+        offset=0.5,
+    )
     fa, fb = joint_frames(j)
     rel = fa.orientation * fb.orientation.inverse()
     # Rmin(x→z) is +90° about -y; then 0.5 rad about z
@@ -73,22 +80,28 @@ def test_spelling_tables():
 
 def test_pose_half_and_text_scalar_normalisations(tmp_path):
     f = tmp_path / "m.yaml"
-    f.write_text("bodies: [BODY a]\nBODY a:\n  name: 12\n  mass: '0.5'\n  location:\n    position: {x: 1, y: 2, z: 3}\n")
+    f.write_text(
+        "bodies: [BODY a]\nBODY a:\n  name: 12\n  mass: '0.5'\n  location:\n    position: {x: 1, y: 2, z: 3}\n"
+    )
     doc, diags = read_file(f)
     assert diags == []
     body = doc.bodies[0]
     assert body.name == "12" and body.mass == 0.5 and body.location == Pose(Vec3(1, 2, 3), Quat())
     written = yaml.safe_load(dumps(doc))["BODY a"]
     assert written["name"] == "12" and written["mass"] == 0.5
-    assert written["location"] == {"position": {"x": 1.0, "y": 2.0, "z": 3.0},
-                                   "orientation": {"r": 0.0, "p": 0.0, "y": 0.0}}
+    assert written["location"] == {
+        "position": {"x": 1.0, "y": 2.0, "z": 3.0},
+        "orientation": {"r": 0.0, "p": 0.0, "y": 0.0},
+    }
 
 
 def test_unknown_keys_survive_a_round_trip(tmp_path):
     f = tmp_path / "m.yaml"
-    f.write_text("bodies: [BODY a]\ncontroller: &c {linear: {P: 1, D: 0}}\n"
-                 "BODY a:\n  mass: 1\n  my note: keep me\n  compound collision shape:\n"
-                 "  - {name: s, shape: Box, geometry: {x: 1, y: 1, z: 1}}\n")
+    f.write_text(
+        "bodies: [BODY a]\ncontroller: &c {linear: {P: 1, D: 0}}\n"
+        "BODY a:\n  mass: 1\n  my note: keep me\n  compound collision shape:\n"
+        "  - {name: s, shape: Box, geometry: {x: 1, y: 1, z: 1}}\n"
+    )
     doc, _ = read_file(f)
     assert doc.extras == {"controller": {"linear": {"P": 1, "D": 0}}}
     assert doc.bodies[0].extras == {"my note": "keep me"}
@@ -149,4 +162,6 @@ def test_bundled_sample_scene_is_current(tmp_path):
     bundled = Path(__file__).resolve().parent.parent / "sample_scenes" / "suturing_pad"
     write_suturing_pad(tmp_path)
     for f in sorted(tmp_path.iterdir()):
-        assert (bundled / f.name).read_text() == f.read_text(), f"regenerate with: adfkit build-scene suturing-pad {bundled}"
+        assert (bundled / f.name).read_text() == f.read_text(), (
+            f"regenerate with: adfkit build-scene suturing-pad {bundled}"
+        )

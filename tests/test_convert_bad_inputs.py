@@ -5,6 +5,7 @@ column >= 1); MJCF includes are resolved by us inside the model's folder or refu
 of 1,000 bodies needs no recursion; converted output loads in PyBullet (URDF) and MuJoCo
 (MJCF), or a loss says why a part was changed.
 """
+
 from __future__ import annotations
 
 import sys
@@ -21,30 +22,36 @@ BAD_VALUES = ("abc", "", "nan", "-inf", "1e999", "1 2", "-1", "0")
 
 
 def _chain_adf(n: int) -> str:
-    out = ["bodies: [" + ", ".join(f"BODY b{i}" for i in range(n)) + "]",
-           "joints: [" + ", ".join(f"JOINT j{i}" for i in range(1, n)) + "]"]
+    out = [
+        "bodies: [" + ", ".join(f"BODY b{i}" for i in range(n)) + "]",
+        "joints: [" + ", ".join(f"JOINT j{i}" for i in range(1, n)) + "]",
+    ]
     for i in range(n):
-        out.append(textwrap.dedent(f"""\
+        out.append(
+            textwrap.dedent(f"""\
             BODY b{i}:
               name: b{i}
               mass: {0.0 if i == 0 else 0.1}
               inertia: {{ix: 1.0e-3, iy: 1.0e-3, iz: 1.0e-3}}
               location: {{position: {{x: 0.0, y: 0.0, z: {0.01 * i}}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
               collision shape: SPHERE
-              collision geometry: {{radius: 0.005}}"""))
+              collision geometry: {{radius: 0.005}}""")
+        )
     for i in range(1, n):
-        out.append(textwrap.dedent(f"""\
+        out.append(
+            textwrap.dedent(f"""\
             JOINT j{i}:
               name: j{i}
               parent: BODY b{i - 1}
               child: BODY b{i}
-              type: {'revolute' if i % 2 else 'prismatic'}
+              type: {"revolute" if i % 2 else "prismatic"}
               parent pivot: {{x: 0, y: 0, z: 0.01}}
               parent axis: {{x: 1, y: 0, z: 0}}
               child pivot: {{x: 0, y: 0, z: 0}}
               child axis: {{x: 1, y: 0, z: 0}}
               joint limits: {{low: -0.5, high: 0.5}}
-              damping: 0.01"""))
+              damping: 0.01""")
+        )
     return "\n".join(out) + "\n"
 
 
@@ -84,9 +91,11 @@ def small_chain(tmp_path_factory):
 
 def test_urdf_limit_with_bad_velocity_is_a_located_error(tmp_path):
     f = tmp_path / "r.urdf"
-    f.write_text('<robot name="r">\n  <link name="a"/>\n  <link name="b"/>\n'
-                 '  <joint name="j" type="revolute">\n    <parent link="a"/>\n    <child link="b"/>\n'
-                 '    <limit lower="0" upper="1" effort="0" velocity="abc"/>\n  </joint>\n</robot>\n')
+    f.write_text(
+        '<robot name="r">\n  <link name="a"/>\n  <link name="b"/>\n'
+        '  <joint name="j" type="revolute">\n    <parent link="a"/>\n    <child link="b"/>\n'
+        '    <limit lower="0" upper="1" effort="0" velocity="abc"/>\n  </joint>\n</robot>\n'
+    )
     with pytest.raises(AdfError) as exc:
         read(f)
     d = exc.value.diagnostics[0]
@@ -100,7 +109,7 @@ def test_every_bad_attribute_value_is_read_or_a_located_error(small_chain, tmp_p
     or raises AdfError at a line and a column >= 1 (never a traceback, column 0 or None)."""
     text = (small_chain / f"chain.{fmt}").read_text()
     checked = errors = 0
-    for name, mutant in _mutants(text):
+    for _name, mutant in _mutants(text):
         f = tmp_path / f"m.{fmt}"
         f.write_text(mutant)
         try:
@@ -114,8 +123,10 @@ def test_every_bad_attribute_value_is_read_or_a_located_error(small_chain, tmp_p
 
 def test_mjcf_error_points_at_the_element_mujoco_names(tmp_path):
     f = tmp_path / "m.xml"
-    f.write_text('<mujoco>\n  <worldbody>\n    <body name="a">\n      <joint type="hinge"/>\n'
-                 '    </body>\n    <body name="b">\n        <geom size="abc"/>\n    </body>\n  </worldbody>\n</mujoco>\n')
+    f.write_text(
+        '<mujoco>\n  <worldbody>\n    <body name="a">\n      <joint type="hinge"/>\n'
+        '    </body>\n    <body name="b">\n        <geom size="abc"/>\n    </body>\n  </worldbody>\n</mujoco>\n'
+    )
     with pytest.raises(AdfError) as exc:
         read(f)
     d = exc.value.diagnostics[0]
@@ -124,13 +135,16 @@ def test_mjcf_error_points_at_the_element_mujoco_names(tmp_path):
 
 def _include_tree(tmp_path):
     (tmp_path / "model" / "parts").mkdir(parents=True)
-    (tmp_path / "outside.xml").write_text('<mujoco><worldbody><body name="secret"><geom size="1"/></body>'
-                                         '</worldbody></mujoco>')
+    (tmp_path / "outside.xml").write_text(
+        '<mujoco><worldbody><body name="secret"><geom size="1"/></body></worldbody></mujoco>'
+    )
     (tmp_path / "model" / "parts" / "body.xml").write_text(
         '<mujoco>\n  <body name="arm" pos="0 0 1">\n    <freejoint/>\n    <geom size="0.1" mass="2"/>\n'
-        '  </body>\n</mujoco>\n')
+        "  </body>\n</mujoco>\n"
+    )
     (tmp_path / "model" / "parts" / "bad.xml").write_text(
-        '<mujoco>\n  <body name="arm">\n      <joint type="hinge"/>\n  </body>\n</mujoco>\n')
+        '<mujoco>\n  <body name="arm">\n      <joint type="hinge"/>\n  </body>\n</mujoco>\n'
+    )
     return tmp_path / "model"
 
 
@@ -147,13 +161,16 @@ def test_mjcf_include_inside_the_model_folder_is_resolved(tmp_path):
     assert arm.location.position[2] == pytest.approx(1.0)
 
 
-@pytest.mark.parametrize("include,rule", [
-    ("{abs}", "mjcf-include"),            # absolute: never followed
-    ("../outside.xml", "outside-tree"),   # out of the model's folder
-    ("main.xml", "mjcf-include"),         # itself
-    ("/dev/zero", "mjcf-include"),
-    ("parts/missing.xml", "file-not-found"),
-])
+@pytest.mark.parametrize(
+    "include,rule",
+    [
+        ("{abs}", "mjcf-include"),  # absolute: never followed
+        ("../outside.xml", "outside-tree"),  # out of the model's folder
+        ("main.xml", "mjcf-include"),  # itself
+        ("/dev/zero", "mjcf-include"),
+        ("parts/missing.xml", "file-not-found"),
+    ],
+)
 def test_mjcf_include_out_of_the_tree_is_refused_where_it_is_written(tmp_path, include, rule):
     folder = _include_tree(tmp_path)
     f = _main(folder, include.format(abs=tmp_path / "outside.xml"))
@@ -261,9 +278,10 @@ JOINT j2:
 def odd_model(tmp_path):
     trimesh = pytest.importorskip("trimesh")
     (tmp_path / "meshes").mkdir()
-    trimesh.Trimesh(vertices=[[0, 0, 0], [.1, 0, 0], [.1, .1, 0], [0, .1, 0]],
-                    faces=[[0, 1, 2], [0, 2, 3]]).export(tmp_path / "meshes" / "flat.stl")
-    trimesh.creation.box((.1, .1, .1)).export(tmp_path / "meshes" / "cube.ply")
+    trimesh.Trimesh(vertices=[[0, 0, 0], [0.1, 0, 0], [0.1, 0.1, 0], [0, 0.1, 0]], faces=[[0, 1, 2], [0, 2, 3]]).export(
+        tmp_path / "meshes" / "flat.stl"
+    )
+    trimesh.creation.box((0.1, 0.1, 0.1)).export(tmp_path / "meshes" / "cube.ply")
     (tmp_path / "meshes" / "thing.3ds").write_bytes(b"MM\x00\x00not a 3ds file")
     (tmp_path / "fit.yaml").write_text(FIT_ADF)
     return read(tmp_path / "fit.yaml")[0]
@@ -272,8 +290,14 @@ def odd_model(tmp_path):
 def test_mjcf_output_with_flat_mesh_inverted_limits_odd_formats_and_huge_scale_loads_in_mujoco(odd_model, tmp_path):
     mujoco = pytest.importorskip("mujoco")
     losses = write(odd_model, tmp_path / "out" / "fit.xml")
-    assert set(loss_keys(losses)) >= {("BODY cloth", "collision mesh"), ("BODY arm", "mesh"), ("BODY odd", "mesh"),
-                                      ("BODY big", "scale"), ("JOINT j1", "joint limits"), ("JOINT j2", "joint limits")}
+    assert set(loss_keys(losses)) >= {
+        ("BODY cloth", "collision mesh"),
+        ("BODY arm", "mesh"),
+        ("BODY odd", "mesh"),
+        ("BODY big", "scale"),
+        ("JOINT j1", "joint limits"),
+        ("JOINT j2", "joint limits"),
+    }
     assert (tmp_path / "out" / "fit_meshes" / "cube.stl").is_file()
     m = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "fit.xml"))
     assert m.nbody == 6 and not m.jnt_limited.any()
@@ -291,8 +315,10 @@ def test_urdf_output_with_odd_meshes_and_inverted_limits_loads_in_pybullet(odd_m
     cid = pybullet.connect(pybullet.DIRECT)
     try:
         rid = pybullet.loadURDF(str(tmp_path / "out" / "fit.urdf"), physicsClientId=cid)
-        info = {pybullet.getJointInfo(rid, i, physicsClientId=cid)[1]: pybullet.getJointInfo(rid, i, physicsClientId=cid)
-                for i in range(pybullet.getNumJoints(rid, physicsClientId=cid))}
+        info = {
+            pybullet.getJointInfo(rid, i, physicsClientId=cid)[1]: pybullet.getJointInfo(rid, i, physicsClientId=cid)
+            for i in range(pybullet.getNumJoints(rid, physicsClientId=cid))
+        }
         assert set(info) == {b"world_to_base", b"j1", b"j2"}
         assert info[b"j1"][8:10] == (0.0, -1.0)  # continuous: no limit
     finally:
@@ -307,6 +333,7 @@ def test_flat_box_of_a_point_or_a_line_is_its_bounds(points):
     import trimesh
 
     from adfkit.converters.engine_fit import FLAT_THICKNESS, flat_box
+
     mesh = trimesh.Trimesh(vertices=np.array(points, float), faces=np.zeros((0, 3), int), process=False)
     centre, rot, sizes = flat_box(mesh, 2.0)
     span = 2.0 * (len(points) - 1)

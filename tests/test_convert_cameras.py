@@ -1,5 +1,6 @@
 """Cameras and lights through the MJCF converter, checked in real MuJoCo: where a camera is,
 where it looks, which way is up and its field of view; where a light is and where it points."""
+
 from __future__ import annotations
 
 import math
@@ -98,8 +99,13 @@ def _expected_view(model, q: float):
     forward = arm.orientation.rotate((cam.look_at - cam.location).normalized())
     up = arm.orientation.rotate(cam.up)
     up = (up - forward.scaled(up.dot(forward))).normalized()
-    return (np.array(eye), np.array(forward), np.array(up),
-            np.array(arm.transform(lamp.location)), np.array(arm.orientation.rotate(lamp.direction.normalized())))
+    return (
+        np.array(eye),
+        np.array(forward),
+        np.array(up),
+        np.array(arm.transform(lamp.location)),
+        np.array(arm.orientation.rotate(lamp.direction.normalized())),
+    )
 
 
 def test_adf_camera_and_light_written_to_mjcf_see_what_adf_says(tmp_path):
@@ -119,8 +125,8 @@ def test_adf_camera_and_light_written_to_mjcf_see_what_adf_says(tmp_path):
         eye, forward, up, lamp_at, lamp_dir = _expected_view(model, q)
         frame = d.cam_xmat[c].reshape(3, 3)
         assert np.allclose(d.cam_xpos[c], eye, atol=1e-9)
-        assert np.allclose(-frame[:, 2], forward, atol=1e-9)   # MuJoCo looks along -Z
-        assert np.allclose(frame[:, 1], up, atol=1e-9)         # +Y is image up
+        assert np.allclose(-frame[:, 2], forward, atol=1e-9)  # MuJoCo looks along -Z
+        assert np.allclose(frame[:, 1], up, atol=1e-9)  # +Y is image up
         assert np.allclose(d.light_xpos[li], lamp_at, atol=1e-9)
         assert np.allclose(d.light_xdir[li], lamp_dir, atol=1e-9)
 
@@ -131,7 +137,8 @@ def test_mjcf_cameras_and_lights_read_into_adf_keep_their_view(tmp_path):
     unit) are where MuJoCo puts them; the tracking camera keeps its view at qpos0 (and says it
     no longer tracks)."""
     src = tmp_path / "src.xml"
-    src.write_text(textwrap.dedent("""
+    src.write_text(
+        textwrap.dedent("""
         <mujoco>
           <worldbody>
             <camera name="watch" mode="targetbody" target="link" pos="1 -1 1"/>
@@ -144,7 +151,8 @@ def test_mjcf_cameras_and_lights_read_into_adf_keep_their_view(tmp_path):
                      attenuation="1 0.1 0.01"/>
             </body>
           </worldbody>
-        </mujoco>"""))
+        </mujoco>""")
+    )
     model, losses = read(src)
     assert loss_keys(losses) == [("CAMERA watch", "camera mode")]
     plan = next(c for c in model.cameras if c.name == "plan")
@@ -154,8 +162,11 @@ def test_mjcf_cameras_and_lights_read_into_adf_keep_their_view(tmp_path):
     back, _ = read(adf)
     out = tmp_path / "back.xml"
     # MuJoCo's global near/far, read into each ADF camera, cannot be written per camera
-    assert loss_keys(write(back, out)) == [("CAMERA eye", "clipping plane"), ("CAMERA plan", "clipping plane"),
-                                           ("CAMERA watch", "clipping plane")]
+    assert loss_keys(write(back, out)) == [
+        ("CAMERA eye", "clipping plane"),
+        ("CAMERA plan", "clipping plane"),
+        ("CAMERA watch", "clipping plane"),
+    ]
     ma, da = _mj(src)
     mb, db = _mj(out)
     rng = random.Random(5)
@@ -185,4 +196,4 @@ def test_mjcf_cameras_and_lights_read_into_adf_keep_their_view(tmp_path):
     watch = next(c for c in model.cameras if c.name == "watch")
     view = (watch.look_at - watch.location).normalized()
     to_link = Vec3(*(da.xpos[ma.body("link").id] - da.cam_xpos[a])).normalized()
-    assert view.dot(to_link) == pytest.approx(1.0)   # it looks at the body it tracked
+    assert view.dot(to_link) == pytest.approx(1.0)  # it looks at the body it tracked

@@ -1,5 +1,6 @@
 """ADF ⇄ MJCF, checked in real MuJoCo: every converted file compiles; kinematics, masses and
 world inertias agree at random configurations; round trips; exact losses; bad input."""
+
 from __future__ import annotations
 
 import random
@@ -10,24 +11,39 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco", reason="mujoco (sim extra) is not installed")
 
+from conftest import CORPUS  # noqa: E402
+from convert_checks import assert_located_error, assert_same_kinematics, close_pose, convert_cli, expected_losses  # noqa: E402
+
 from adfkit.adf.reader import load  # noqa: E402
 from adfkit.converters import mjcf, read, write  # noqa: E402
 from adfkit.converters.inertia import world_tensor  # noqa: E402
 from adfkit.converters.losses import loss_keys  # noqa: E402
-from adfkit.model.tree import build_tree  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
 from adfkit.model.semantics import inertial_offset  # noqa: E402
-from conftest import CORPUS  # noqa: E402
-from convert_checks import assert_located_error, assert_same_kinematics, close_pose, convert_cli, expected_losses  # noqa: E402
+from adfkit.model.tree import build_tree  # noqa: E402
 
 ROBOTS = CORPUS / "ambf" / "ambf_models" / "descriptions" / "multi-bodies" / "robots"
 needs_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason="../shared/corpus is absent (public ADF corpus)")
 TOL = 1e-6
 HINGE, SLIDE = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
 FAST_SUITE = ["acrobot.xml", "cartpole.xml"]
-SLOW_SUITE = ["reacher.xml", "finger.xml", "walker.xml", "pendulum.xml", "humanoid.xml", "manipulator.xml",
-              "hopper.xml", "swimmer.xml", "fish.xml", "ball_in_cup.xml", "point_mass.xml", "quadruped.xml",
-              "stacker.xml", "humanoid_CMU.xml", "dog.xml"]
+SLOW_SUITE = [
+    "reacher.xml",
+    "finger.xml",
+    "walker.xml",
+    "pendulum.xml",
+    "humanoid.xml",
+    "manipulator.xml",
+    "hopper.xml",
+    "swimmer.xml",
+    "fish.xml",
+    "ball_in_cup.xml",
+    "point_mass.xml",
+    "quadruped.xml",
+    "stacker.xml",
+    "humanoid_CMU.xml",
+    "dog.xml",
+]
 
 
 def _suite() -> Path:
@@ -41,8 +57,7 @@ def _compile(path: Path):
 
 
 def _hinges_and_slides(m) -> dict[str, int]:
-    return {m.joint(j).name: j for j in range(m.njnt)
-            if int(m.jnt_type[j]) in (HINGE, SLIDE) and m.joint(j).name}
+    return {m.joint(j).name: j for j in range(m.njnt) if int(m.jnt_type[j]) in (HINGE, SLIDE) and m.joint(j).name}
 
 
 def _random_value(m, j, rng) -> float:
@@ -66,19 +81,32 @@ def _state(m, d, values: dict[str, float]) -> dict:
     out = {"body": {}, "joint": {}, "camera": {}, "light": {}}
     for c in range(m.ncam):  # fixed cameras and lights: where they are, where they look, their optics
         if m.cam_mode[c] == 0:
-            out["camera"][m.camera(c).name] = (d.cam_xpos[c].copy(), d.cam_xmat[c].copy(), np.array(
-                [m.cam_fovy[c], *m.cam_resolution[c], m.cam_projection[c]], dtype=float))
+            out["camera"][m.camera(c).name] = (
+                d.cam_xpos[c].copy(),
+                d.cam_xmat[c].copy(),
+                np.array([m.cam_fovy[c], *m.cam_resolution[c], m.cam_projection[c]], dtype=float),
+            )
     for i in range(m.nlight):
         if m.light_mode[i] == 0:
-            out["light"][m.light(i).name] = (d.light_xpos[i].copy(), d.light_xdir[i].copy(), np.array(
-                [m.light_cutoff[i], m.light_exponent[i], *m.light_attenuation[i], m.light_castshadow[i]], dtype=float))
+            out["light"][m.light(i).name] = (
+                d.light_xpos[i].copy(),
+                d.light_xdir[i].copy(),
+                np.array(
+                    [m.light_cutoff[i], m.light_exponent[i], *m.light_attenuation[i], m.light_castshadow[i]],
+                    dtype=float,
+                ),
+            )
     for b in range(1, m.nbody):
         r = d.ximat[b].reshape(3, 3)
         out["body"][m.body(b).name] = (d.xipos[b].copy(), r @ np.diag(m.body_inertia[b]) @ r.T, float(m.body_mass[b]))
     for name in _hinges_and_slides(m):
         j = m.joint(name).id
-        out["joint"][name] = (d.xanchor[j].copy(), d.xaxis[j].copy(), int(m.jnt_type[j]),
-                              tuple(m.jnt_range[j]) if m.jnt_limited[j] else None)
+        out["joint"][name] = (
+            d.xanchor[j].copy(),
+            d.xaxis[j].copy(),
+            int(m.jnt_type[j]),
+            tuple(m.jnt_range[j]) if m.jnt_limited[j] else None,
+        )
     return out
 
 
@@ -143,26 +171,37 @@ def test_several_joints_on_one_body_become_a_chain(tmp_path):
     matches the written MJCF at 100 random configurations."""
     losses = _mjcf_round_trip(_suite() / "cheetah.xml", tmp_path, configs=100)
     chained = [l for l in losses if l.feature == "joints"]
-    assert [(l.element, l.reason) for l in chained] == [(
-        "BODY torso", "3 joints on one body; ADF joins two bodies by one joint: built as a chain through "
-        "torso_rootx, torso_rootz (1 % of the body's mass and inertia each)")]
+    assert [(l.element, l.reason) for l in chained] == [
+        (
+            "BODY torso",
+            "3 joints on one body; ADF joins two bodies by one joint: built as a chain through "
+            "torso_rootx, torso_rootz (1 % of the body's mass and inertia each)",
+        )
+    ]
     model, _ = read(_suite() / "cheetah.xml")
     by_name = {b.name: b for b in model.bodies}
     torso, rootx, rootz = by_name["torso"], by_name["torso_rootx"], by_name["torso_rootz"]
     assert rootx.mass == rootz.mass == pytest.approx(0.01 * torso.mass)
     assert not rootx.collision_shape and not rootx.compound_collision_shape
     chain = [(j.parent, j.child, j.type) for j in model.joints if "root" in j.name]
-    assert chain == [("BODY world", "BODY torso_rootx", "prismatic"), ("BODY torso_rootx", "BODY torso_rootz", "prismatic"),
-                     ("BODY torso_rootz", "BODY torso", "revolute")]
+    assert chain == [
+        ("BODY world", "BODY torso_rootx", "prismatic"),
+        ("BODY torso_rootx", "BODY torso_rootz", "prismatic"),
+        ("BODY torso_rootz", "BODY torso", "revolute"),
+    ]
 
 
 def test_cartpole_read_losses_are_exact():
     _m, losses = read(_suite() / "cartpole.xml")
-    assert loss_keys(losses) == [("BODY world", "collision plane"), ("CAMERA lookatcart", "camera mode"),
-                                 ("slide", "actuator")]
+    assert loss_keys(losses) == [
+        ("BODY world", "collision plane"),
+        ("CAMERA lookatcart", "camera mode"),
+        ("slide", "actuator"),
+    ]
 
 
 # --- ADF -> MJCF against the ADF model's own kinematics ----------------------------------------
+
 
 def _adf_to_mjcf(name: str, tmp_path, configs: int):
     src = ROBOTS / name
@@ -173,7 +212,9 @@ def _adf_to_mjcf(name: str, tmp_path, configs: int):
     tree = build_tree(model)
     links = {lk.body.name: lk for lk in tree.ordered()}
     joints = _hinges_and_slides(m)
-    assert len(joints) == sum(1 for lk in tree.ordered() if lk.joint is not None and lk.kind.value in ("revolute", "prismatic"))
+    assert len(joints) == sum(
+        1 for lk in tree.ordered() if lk.joint is not None and lk.kind.value in ("revolute", "prismatic")
+    )
     rng = random.Random(5)
     by_joint = {lk.joint.name: lk for lk in tree.ordered() if lk.joint is not None}
     for _ in range(configs):
@@ -198,8 +239,9 @@ def _adf_to_mjcf(name: str, tmp_path, configs: int):
             assert m.body_mass[b] == pytest.approx(body.mass, rel=TOL)
             r = d.ximat[b].reshape(3, 3)
             got = r @ np.diag(m.body_inertia[b]) @ r.T
-            want = world_tensor((body.inertia.ix, body.inertia.iy, body.inertia.iz),
-                                (body.location * inertial_offset(body)).orientation)
+            want = world_tensor(
+                (body.inertia.ix, body.inertia.iy, body.inertia.iz), (body.location * inertial_offset(body)).orientation
+            )
             assert np.allclose(got, want, rtol=1e-6, atol=1e-9), body.identifier
     # qpos0 reproduces the file's locations (to the file's rounding)
     for b in range(1, m.nbody):
@@ -243,23 +285,38 @@ def test_psm_adf_mjcf_adf_round_trip_and_exact_losses(tmp_path):
     _compile(out)
     keys = loss_keys(losses)
     structural = [k for k in keys if k[1] in ("joint", "joint axis", "body")]
-    assert structural == sorted([
-        ("JOINT pitch back link-pitch bottom link", "joint axis"),   # loop: equality/connect
-        ("JOINT pitch top link-pitch end link", "joint axis"),       # loop: equality/connect
-    ])
+    assert structural == sorted(
+        [
+            ("JOINT pitch back link-pitch bottom link", "joint axis"),  # loop: equality/connect
+            ("JOINT pitch top link-pitch end link", "joint axis"),  # loop: equality/connect
+        ]
+    )
     # loop joints, the p2p included, are kept as equality constraints
     xml = out.read_text()
     assert xml.count("<connect ") == 3
-    per_body = {"collision groups", "collision margin", "damping", "friction", "passive", "inertia",
-                "collision mesh", "mass", "restitution"}
+    per_body = {
+        "collision groups",
+        "collision margin",
+        "damping",
+        "friction",
+        "passive",
+        "inertia",
+        "collision mesh",
+        "mass",
+        "restitution",
+    }
     assert {k[1] for k in keys} <= per_body | {"controller", "max motor impulse", "joint axis"}
     assert {k[0] for k in keys if k[1] == "collision mesh"} == {
-        b.identifier for b in orig.bodies if b.mesh and not b.collision_shape and not b.compound_collision_shape}
+        b.identifier for b in orig.bodies if b.mesh and not b.collision_shape and not b.compound_collision_shape
+    }
     back, read_losses = read(out)
     # the file's own sub-mrad tilts between joint axes, which AMBF ignores, are reported
     assert {k[1] for k in loss_keys(read_losses)} <= {"axis tilt"}
-    lost = {"JOINT pitch back link-pitch bottom link", "JOINT pitch top link-pitch end link",
-            "JOINT yaw link-pitch end link"}
+    lost = {
+        "JOINT pitch back link-pitch bottom link",
+        "JOINT pitch top link-pitch end link",
+        "JOINT yaw link-pitch end link",
+    }
     # target_fk/target_ik float (free joints) and come back as free bodies: compare them too
     assert_same_kinematics(orig, back, lost)
 
@@ -268,9 +325,13 @@ def test_psm_adf_mjcf_adf_round_trip_and_exact_losses(tmp_path):
 
 BAD = {
     "entity bomb": ('<?xml version="1.0"?>\n<!DOCTYPE m [<!ENTITY a "aaaa">]>\n<mujoco/>\n', "xml-unsafe", 2),
-    "not xml": ('<mujoco>\n  <worldbody>\n</mujoco>\n', "xml-syntax", 3),
-    "compile error": ('<mujoco>\n  <worldbody>\n    <body name="a">\n      <geom type="box" size="1 1"/>\n'
-                      '      <joint type="hinge" bogus="1"/>\n    </body>\n  </worldbody>\n</mujoco>\n', "mjcf-compile", 5),
+    "not xml": ("<mujoco>\n  <worldbody>\n</mujoco>\n", "xml-syntax", 3),
+    "compile error": (
+        '<mujoco>\n  <worldbody>\n    <body name="a">\n      <geom type="box" size="1 1"/>\n'
+        '      <joint type="hinge" bogus="1"/>\n    </body>\n  </worldbody>\n</mujoco>\n',
+        "mjcf-compile",
+        5,
+    ),
     "wrong root": ('<robot name="r"/>\n', "mjcf-root", 1),
 }
 

@@ -1,5 +1,6 @@
 """ADF ⇄ URDF, checked in real PyBullet: kinematics, masses and inertias of the source in its
 own engine against the converted file in the target engine; round trips; exact losses."""
+
 from __future__ import annotations
 
 import math
@@ -12,18 +13,19 @@ import pytest
 pb = pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
 pybullet_data = pytest.importorskip("pybullet_data")
 
-from adfkit.adf.reader import load  # noqa: E402
-from adfkit.converters import read, write  # noqa: E402
-from adfkit.converters.inertia import world_tensor  # noqa: E402
-from adfkit.converters.losses import loss_keys  # noqa: E402
-from adfkit.model.tree import build_tree  # noqa: E402
-from adfkit.diagnostics import AdfError  # noqa: E402
-from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
-from adfkit.model.semantics import JointKind, inertial_offset  # noqa: E402
 from conftest import CORPUS  # noqa: E402
 from convert_checks import assert_located_error, convert_cli, expected_losses  # noqa: E402
 from convert_checks import assert_same_kinematics as _assert_same_kinematics  # noqa: E402
 from convert_checks import close_pose as _close_pose  # noqa: E402
+
+from adfkit.adf.reader import load  # noqa: E402
+from adfkit.converters import read, write  # noqa: E402
+from adfkit.converters.inertia import world_tensor  # noqa: E402
+from adfkit.converters.losses import loss_keys  # noqa: E402
+from adfkit.diagnostics import AdfError  # noqa: E402
+from adfkit.model.pose import Pose, Quat, Vec3  # noqa: E402
+from adfkit.model.semantics import JointKind, inertial_offset  # noqa: E402
+from adfkit.model.tree import build_tree  # noqa: E402
 
 ROBOTS = CORPUS / "ambf" / "ambf_models" / "descriptions" / "multi-bodies" / "robots"
 needs_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason="../shared/corpus is absent (public ADF corpus)")
@@ -31,9 +33,19 @@ DATA = Path(pybullet_data.getDataPath())
 # revolute, continuous, prismatic and fixed joints; meshes and primitives; fixed and floating
 # bases; a `world` link with moving joints; full inertia tensors (some breaking the triangle
 # inequality, which PyBullet zeroes on both sides); PyBullet's <contact> inertia scaling
-URDFS = ["kuka_iiwa/model.urdf", "r2d2.urdf", "franka_panda/panda.urdf", "racecar/racecar.urdf", "cartpole.urdf",
-         "kuka_iiwa/model_free_base.urdf", "quadruped/minitaur.urdf", "xarm/xarm6_robot.urdf",
-         "TwoJointRobot_w_fixedJoints.urdf", "cube_no_rotation.urdf", "cube_small.urdf"]
+URDFS = [
+    "kuka_iiwa/model.urdf",
+    "r2d2.urdf",
+    "franka_panda/panda.urdf",
+    "racecar/racecar.urdf",
+    "cartpole.urdf",
+    "kuka_iiwa/model_free_base.urdf",
+    "quadruped/minitaur.urdf",
+    "xarm/xarm6_robot.urdf",
+    "TwoJointRobot_w_fixedJoints.urdf",
+    "cube_no_rotation.urdf",
+    "cube_small.urdf",
+]
 CORPUS_ROBOTS = ["blender-kuka.yaml", "blender-psm.yaml", "blender-ecm.yaml", "blender-mtm.yaml"]
 TOL = 1e-6
 
@@ -98,11 +110,12 @@ def _visual_frames(cid, uid) -> dict[int, Pose]:
 
 # --- URDF -> ADF -> URDF, both in PyBullet ----------------------------------------------------
 
+
 def _urdf_round_trip(client, rel: str, tmp_path, configs: int):
     src = DATA / rel
     model, read_losses = read(src)
     adf = tmp_path / (src.stem + ".yaml")
-    write(model, adf)                       # through ADF on disk, as a user would
+    write(model, adf)  # through ADF on disk, as a user would
     back_model, _ = read(adf)
     out = tmp_path / (src.stem + "_back.urdf")
     write(back_model, out)
@@ -162,12 +175,20 @@ def _snapshot(cid, uid, configs, qs):
     moving = _movable(cid, uid)
     rng = random.Random(7)
     if qs is None:
-        qs = [{pb.getJointInfo(uid, j, physicsClientId=cid)[1].decode(): _random_q(info, rng) for j, info in moving}
-              for _ in range(configs)]
+        qs = [
+            {pb.getJointInfo(uid, j, physicsClientId=cid)[1].decode(): _random_q(info, rng) for j, info in moving}
+            for _ in range(configs)
+        ]
     vis = _visual_frames(cid, uid)
-    state = {"links": names, "qs": qs, "mass": {}, "inertia": {}, "poses": [],
-             "types": sorted((info[1].decode(), info[2]) for _j, info in moving),
-             "moving_children": {info[12].decode() for _j, info in moving}}
+    state = {
+        "links": names,
+        "qs": qs,
+        "mass": {},
+        "inertia": {},
+        "poses": [],
+        "types": sorted((info[1].decode(), info[2]) for _j, info in moving),
+        "moving_children": {info[12].decode() for _j, info in moving},
+    }
     for name, link in names.items():
         _lf, com = _frames(cid, uid, link)
         state["mass"][name] = pb.getDynamicsInfo(uid, link, physicsClientId=cid)[0]
@@ -179,8 +200,12 @@ def _snapshot(cid, uid, configs, qs):
         poses = {}
         for name, link in names.items():
             lf, com = _frames(cid, uid, link)
-            entry = {"com": com.position, "visual": lf * vis[link] if link in vis else None,
-                     "anchor": lf.position if link >= 0 else None, "axis": None}
+            entry = {
+                "com": com.position,
+                "visual": lf * vis[link] if link in vis else None,
+                "anchor": lf.position if link >= 0 else None,
+                "axis": None,
+            }
             poses[name] = entry
         for jname, (j, info) in by_name.items():  # world axis, measured: move the joint a little
             # measured on the COM frame: PyBullet's reported URDF link frame carries ~1e-6 rad of
@@ -209,10 +234,20 @@ def test_pybullet_urdf_round_trip_through_adf(client, rel, tmp_path):
 
 # pybullet_data files adfkit refuses, each with a located error: not URDF as the spec (or
 # PyBullet's own parser) reads it, or a non-uniform mesh scale, which ADF cannot hold
-REFUSED = {"bicycle/bike.urdf", "biped/biped2d_pybullet.urdf", "differential/diff_ring.urdf",
-           "humanoid/humanoid.urdf", "husky/husky.urdf", "jenga/jenga.urdf", "quadruped/microtaur/microtaur.urdf",
-           "racecar/racecar_differential.urdf", "spherical_joint_limit.urdf", "table/table.urdf",
-           "table_square/table_square.urdf", "torus_deform.urdf"}
+REFUSED = {
+    "bicycle/bike.urdf",
+    "biped/biped2d_pybullet.urdf",
+    "differential/diff_ring.urdf",
+    "humanoid/humanoid.urdf",
+    "husky/husky.urdf",
+    "jenga/jenga.urdf",
+    "quadruped/microtaur/microtaur.urdf",
+    "racecar/racecar_differential.urdf",
+    "spherical_joint_limit.urdf",
+    "table/table.urdf",
+    "table_square/table_square.urdf",
+    "torus_deform.urdf",
+}
 # files PyBullet itself cannot load (a missing mesh, a .cdf collision file)
 UNLOADABLE = {"kuka_iiwa/model_for_sdf.urdf", "toys/concave_box.urdf"}
 
@@ -249,6 +284,7 @@ def test_kuka_read_losses_are_exact():
 
 # --- ADF -> URDF against the ADF model's own kinematics -----------------------------------------
 
+
 def _adf_to_urdf(client, name: str, tmp_path, configs: int):
     src = ROBOTS / name
     model = load(src)
@@ -259,10 +295,14 @@ def _adf_to_urdf(client, name: str, tmp_path, configs: int):
     names = _link_names(client, uid)
     links = {lk.body.identifier: lk for lk in tree.ordered()}
     in_urdf = {bid: names[lk.body.name] for bid, lk in links.items() if lk.body.name in names}
-    moving = {pb.getJointInfo(uid, j, physicsClientId=client)[1].decode(): (j, info)
-              for j, info in _movable(client, uid)}
-    assert len(moving) == sum(1 for lk in tree.ordered() if lk.kind in (JointKind.REVOLUTE, JointKind.PRISMATIC)
-                              and lk.body.identifier in in_urdf)
+    moving = {
+        pb.getJointInfo(uid, j, physicsClientId=client)[1].decode(): (j, info) for j, info in _movable(client, uid)
+    }
+    assert len(moving) == sum(
+        1
+        for lk in tree.ordered()
+        if lk.kind in (JointKind.REVOLUTE, JointKind.PRISMATIC) and lk.body.identifier in in_urdf
+    )
     rng = random.Random(3)
     for _ in range(configs):
         q = {}
@@ -285,8 +325,9 @@ def _adf_to_urdf(client, name: str, tmp_path, configs: int):
         assert dyn[0] == pytest.approx(body.mass or 0.0, rel=TOL, abs=1e-12)
         if body.inertia is not None and (body.mass or 0) > 0:
             _lf, com = _frames(client, uid, link)
-            want = world_tensor((body.inertia.ix, body.inertia.iy, body.inertia.iz),
-                                (expected[bid] * inertial_offset(body)).orientation)
+            want = world_tensor(
+                (body.inertia.ix, body.inertia.iy, body.inertia.iz), (expected[bid] * inertial_offset(body)).orientation
+            )
             assert np.allclose(_inertia_world(client, uid, link, com), want, rtol=TOL, atol=1e-12), bid
     return model, tree, losses
 
@@ -314,8 +355,9 @@ def _adf_to_urdf_against_runner(client, name: str, tmp_path, configs: int) -> tu
     write(model, out)
     uid = _load(client, out)
     names = _link_names(client, uid)
-    urdf_joint = {pb.getJointInfo(uid, j, physicsClientId=client)[1].decode(): (j, info)
-                  for j, info in _movable(client, uid)}
+    urdf_joint = {
+        pb.getJointInfo(uid, j, physicsClientId=client)[1].decode(): (j, info) for j, info in _movable(client, uid)
+    }
     sim = SimWorld(scene, Options(visuals=False, gravity=(0.0, 0.0, 0.0)))
     try:
         tree = build_tree(model)
@@ -334,8 +376,14 @@ def _adf_to_urdf_against_runner(client, name: str, tmp_path, configs: int) -> tu
         ident = {j.identifier: j.name for j in model.joints}
         common = {j for j in runner_joint if ident[j] in urdf_joint and j in {x for p in tree_path.values() for x in p}}
         bodies = {sb.body.identifier: sb for sb in sim.bodies}
-        compared = [b for b in tree_path if b in bodies and bodies[b].body.name in names
-                    and tree_path[b] <= common | _fixed(model) and runner_path[b] <= common | _fixed(model)]
+        compared = [
+            b
+            for b in tree_path
+            if b in bodies
+            and bodies[b].body.name in names
+            and tree_path[b] <= common | _fixed(model)
+            and runner_path[b] <= common | _fixed(model)
+        ]
         rng = random.Random(11)
         worst = 0.0
         for _ in range(configs):
@@ -349,8 +397,10 @@ def _adf_to_urdf_against_runner(client, name: str, tmp_path, configs: int) -> tu
                 p, o, _v, _w = sb.state()
                 runner_com = Pose(Vec3(*p), Quat(*o))
                 _lf, urdf_com = _frames(client, uid, names[sb.body.name])
-                err = max((runner_com.position - urdf_com.position).norm(),
-                          runner_com.orientation.angle_to(urdf_com.orientation))
+                err = max(
+                    (runner_com.position - urdf_com.position).norm(),
+                    runner_com.orientation.angle_to(urdf_com.orientation),
+                )
                 worst = max(worst, err)
                 assert err < TOL, (name, b, err)
         for b in compared:
@@ -367,12 +417,15 @@ def _adf_to_urdf_against_runner(client, name: str, tmp_path, configs: int) -> tu
 
 def _fixed(model) -> set[str]:
     from adfkit.model.semantics import joint_kind
+
     return {j.identifier for j in model.joints if joint_kind(j.type) is JointKind.FIXED}
 
 
 @needs_corpus
-@pytest.mark.parametrize("name, bodies", [("blender-kuka.yaml", 8), ("blender-mtm.yaml", 10),
-                                          ("blender-psm.yaml", 5), ("blender-ecm.yaml", 5)])
+@pytest.mark.parametrize(
+    "name, bodies",
+    [("blender-kuka.yaml", 8), ("blender-mtm.yaml", 10), ("blender-psm.yaml", 5), ("blender-ecm.yaml", 5)],
+)
 def test_corpus_robot_to_urdf_matches_adfkit_runner(client, name, bodies, tmp_path):
     compared, _worst = _adf_to_urdf_against_runner(client, name, tmp_path, configs=100)
     assert compared == bodies
@@ -394,13 +447,17 @@ def test_tree_at_initial_values_reproduces_the_files_locations(name):
 
 # --- ADF -> URDF -> ADF -------------------------------------------------------------------------
 
+
 @needs_corpus
 def test_kuka_adf_urdf_adf_round_trip_and_exact_losses(tmp_path):
     orig = load(ROBOTS / "blender-kuka.yaml")
     out = tmp_path / "kuka.urdf"
     losses = write(orig, out)
-    expected = expected_losses(orig, ("collision groups", "collision margin", "damping", "friction", "passive"),
-                               ("max motor impulse", "controller"))
+    expected = expected_losses(
+        orig,
+        ("collision groups", "collision margin", "damping", "friction", "passive"),
+        ("max motor impulse", "controller"),
+    )
     assert loss_keys(losses) == expected
     assert len(losses) == 46  # friction, damping, margin, groups on 8 links; 7 inertias, 7 controllers
     back, read_losses = read(out)
@@ -415,25 +472,39 @@ def test_psm_adf_urdf_adf_round_trip_and_exact_losses(tmp_path):
     losses = write(orig, out)
     keys = loss_keys(losses)
     structural = [k for k in keys if k[1] in ("joint", "body", "initial value")]
-    assert structural == sorted([
-        ("BODY target_fk", "body"), ("BODY target_ik", "body"),
-        ("JOINT pitch back link-pitch bottom link", "joint"),   # closes the parallelogram
-        ("JOINT pitch top link-pitch end link", "joint"),       # closes the parallelogram
-        ("JOINT yaw link-pitch end link", "joint"),             # p2p
-    ])
+    assert structural == sorted(
+        [
+            ("BODY target_fk", "body"),
+            ("BODY target_ik", "body"),
+            ("JOINT pitch back link-pitch bottom link", "joint"),  # closes the parallelogram
+            ("JOINT pitch top link-pitch end link", "joint"),  # closes the parallelogram
+            ("JOINT yaw link-pitch end link", "joint"),  # p2p
+        ]
+    )
     # and per body/joint, exactly: the ADF keys URDF has no element for, and the inertias the
     # file leaves out (written as Bullet's estimate), on what is written
     not_written = {k[0] for k in structural if k[1] in ("joint", "body")}
-    per_key = [k for k in expected_losses(orig, ("collision groups", "collision margin", "damping", "friction",
-                                                 "passive", "restitution"), ("max motor impulse", "controller"))
-               if k[0] not in not_written]
+    per_key = [
+        k
+        for k in expected_losses(
+            orig,
+            ("collision groups", "collision margin", "damping", "friction", "passive", "restitution"),
+            ("max motor impulse", "controller"),
+        )
+        if k[0] not in not_written
+    ]
     assert keys == sorted(structural + per_key)
     assert len(keys) == 80  # 5 structural; 64 keys on the 12 bodies written, 11 on the joints written
     back, read_losses = read(out)
     # the file's own 0.36 mrad tilt between this joint's axes, which AMBF ignores, is reported
     assert loss_keys(read_losses) == [("JOINT pitch back link-pitch top link", "axis tilt")]
-    lost = {"BODY target_fk", "BODY target_ik", "JOINT pitch back link-pitch bottom link",
-            "JOINT pitch top link-pitch end link", "JOINT yaw link-pitch end link"}
+    lost = {
+        "BODY target_fk",
+        "BODY target_ik",
+        "JOINT pitch back link-pitch bottom link",
+        "JOINT pitch top link-pitch end link",
+        "JOINT yaw link-pitch end link",
+    }
     _assert_same_kinematics(orig, back, lost)
 
 
@@ -442,14 +513,26 @@ def test_psm_adf_urdf_adf_round_trip_and_exact_losses(tmp_path):
 BAD = {
     "entity bomb": ('<?xml version="1.0"?>\n<!DOCTYPE r [<!ENTITY a "aaaa">]>\n<robot name="r"/>\n', "xml-unsafe", 2),
     "not xml": ('<robot name="r">\n  <link name="a">\n</robot>\n', "xml-syntax", 3),
-    "missing parent": ('<robot name="r">\n  <link name="a"/>\n  <joint name="j" type="fixed">\n'
-                       '    <parent link="nope"/>\n    <child link="a"/>\n  </joint>\n</robot>\n', "urdf-reference", 4),
-    "cycle": ('<robot name="r">\n  <link name="a"/>\n  <link name="b"/>\n'
-              '  <joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>\n'
-              '  <joint name="j2" type="fixed"><parent link="b"/><child link="a"/></joint>\n</robot>\n', "urdf-tree", None),
-    "bad origin": ('<robot name="r">\n  <link name="a"/>\n  <link name="b"/>\n'
-                   '  <joint name="j" type="fixed">\n    <origin xyz="0 zero 0"/>\n'
-                   '    <parent link="a"/><child link="b"/>\n  </joint>\n</robot>\n', "urdf-number", 5),
+    "missing parent": (
+        '<robot name="r">\n  <link name="a"/>\n  <joint name="j" type="fixed">\n'
+        '    <parent link="nope"/>\n    <child link="a"/>\n  </joint>\n</robot>\n',
+        "urdf-reference",
+        4,
+    ),
+    "cycle": (
+        '<robot name="r">\n  <link name="a"/>\n  <link name="b"/>\n'
+        '  <joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>\n'
+        '  <joint name="j2" type="fixed"><parent link="b"/><child link="a"/></joint>\n</robot>\n',
+        "urdf-tree",
+        None,
+    ),
+    "bad origin": (
+        '<robot name="r">\n  <link name="a"/>\n  <link name="b"/>\n'
+        '  <joint name="j" type="fixed">\n    <origin xyz="0 zero 0"/>\n'
+        '    <parent link="a"/><child link="b"/>\n  </joint>\n</robot>\n',
+        "urdf-number",
+        5,
+    ),
     "wrong root": ('<mujoco model="m"/>\n', "urdf-root", 1),
 }
 

@@ -1,12 +1,12 @@
 """The dataset writer and loader (adfkit/dataset): a short recording written and read back,
 and the segmentation colouriser."""
+
 from __future__ import annotations
 
 import json
 
 import numpy as np
 import pytest
-
 from conftest import ROOT
 
 from adfkit.dataset import colourise, load
@@ -31,6 +31,7 @@ def test_write_and_load_round_trip(tmp_path):
     from adfkit.adf import load_scene
     from adfkit.dataset.writer import DatasetWriter
     from adfkit.runner.world import Options, SimWorld
+
     world = SimWorld(load_scene(BUNDLED), Options())
     try:
         writer = DatasetWriter(world, tmp_path / "ds", cameras=[world.cameras[0].name])
@@ -66,14 +67,14 @@ def test_write_and_load_round_trip(tmp_path):
         world.close()
 
 
-
 def test_depth_counts_are_0_1_mm_and_nothing_is_zero():
     from adfkit.dataset.writer import DEPTH_UNIT_M, depth_to_png16
+
     depth = np.array([[np.inf, np.nan, 0.0, 1e-6], [0.12344, 0.12356, 6.5535, 2.0]], dtype=np.float32)
     counts = depth_to_png16(depth)
     assert counts.dtype == np.uint16
-    assert counts.tolist() == [[0, 0, 1, 1], [1234, 1236, 65535, 20000]]   # a hit is never "nothing"
-    assert depth_to_png16(np.array([[0.5, 6.6]], dtype=np.float32)) is None   # beyond 16 bits: kept as float32
+    assert counts.tolist() == [[0, 0, 1, 1], [1234, 1236, 65535, 20000]]  # a hit is never "nothing"
+    assert depth_to_png16(np.array([[0.5, 6.6]], dtype=np.float32)) is None  # beyond 16 bits: kept as float32
     assert depth_to_png16(np.full((2, 2), np.inf, dtype=np.float32)).tolist() == [[0, 0], [0, 0]]
     assert DEPTH_UNIT_M == 1e-4
 
@@ -86,11 +87,12 @@ def test_a_recorded_frame_reads_back_as_rendered(tmp_path):
     from adfkit.adf import load_scene
     from adfkit.dataset.writer import DEPTH_UNIT_M, DatasetWriter
     from adfkit.runner.world import Options, SimWorld
+
     world = SimWorld(load_scene(BUNDLED), Options())
     try:
         world.step(5)
         cam = world.cameras[0]
-        want = cam.render(world)        # the world does not move between this and the writer's render
+        want = cam.render(world)  # the world does not move between this and the writer's render
         writer = DatasetWriter(world, tmp_path / "ds", cameras=[cam.name])
         writer.write(5, {"needle": world.body("Needle").world_matrix(), "psms": {}}, "test")
         writer.close()
@@ -104,4 +106,4 @@ def test_a_recorded_frame_reads_back_as_rendered(tmp_path):
     assert seen.any() and (np.isfinite(depth) == seen).all()
     assert np.abs(depth[seen].astype(np.float64) - want["depth"][seen]).max() <= DEPTH_UNIT_M / 2 + 1e-7
     frame_bytes = sum((tmp_path / "ds" / f.paths[k]).stat().st_size for k in ("rgb", "depth", "seg", "seg_color"))
-    assert frame_bytes < 500_000, frame_bytes     # was 1.24 MB with float32 .npy depth
+    assert frame_bytes < 500_000, frame_bytes  # was 1.24 MB with float32 .npy depth

@@ -1,4 +1,5 @@
 """Scenes at the edge of what an engine can load: a located error, never a traceback."""
+
 from __future__ import annotations
 
 import pytest
@@ -12,14 +13,27 @@ def _chain(n: int) -> str:
     """ADF text of ``n`` boxes in a line, each hinged to the one before."""
     out = ["bodies:"] + [f"- BODY L{i}" for i in range(n)] + ["joints:"] + [f"- JOINT J{i}" for i in range(1, n)]
     for i in range(n):
-        out += [f"BODY L{i}:", f"  name: L{i}", f"  mass: {0.0 if i == 0 else 0.01}",
-                "  inertia: {ix: 1.0e-6, iy: 1.0e-6, iz: 1.0e-6}",
-                "  collision shape: Box", "  collision geometry: {x: 0.02, y: 0.01, z: 0.01}",
-                f"  location: {{position: {{x: {0.02 * i:.3f}, y: 0.0, z: 1.0}}, orientation: {{r: 0, p: 0, y: 0}}}}"]
+        out += [
+            f"BODY L{i}:",
+            f"  name: L{i}",
+            f"  mass: {0.0 if i == 0 else 0.01}",
+            "  inertia: {ix: 1.0e-6, iy: 1.0e-6, iz: 1.0e-6}",
+            "  collision shape: Box",
+            "  collision geometry: {x: 0.02, y: 0.01, z: 0.01}",
+            f"  location: {{position: {{x: {0.02 * i:.3f}, y: 0.0, z: 1.0}}, orientation: {{r: 0, p: 0, y: 0}}}}",
+        ]
     for i in range(1, n):
-        out += [f"JOINT J{i}:", f"  name: J{i}", f"  parent: BODY L{i - 1}", f"  child: BODY L{i}", "  type: revolute",
-                "  parent pivot: {x: 0.01, y: 0, z: 0}", "  child pivot: {x: -0.01, y: 0, z: 0}",
-                "  parent axis: {x: 0, y: 1, z: 0}", "  child axis: {x: 0, y: 1, z: 0}"]
+        out += [
+            f"JOINT J{i}:",
+            f"  name: J{i}",
+            f"  parent: BODY L{i - 1}",
+            f"  child: BODY L{i}",
+            "  type: revolute",
+            "  parent pivot: {x: 0.01, y: 0, z: 0}",
+            "  child pivot: {x: -0.01, y: 0, z: 0}",
+            "  parent axis: {x: 0, y: 1, z: 0}",
+            "  child axis: {x: 0, y: 1, z: 0}",
+        ]
     return "\n".join(out) + "\n"
 
 
@@ -46,15 +60,18 @@ def test_constraint_algebra_follows_the_inertia_matrix(tmp_path):
     from adfkit.adf import load_scene
     from adfkit.runner.mj.world import MjWorld
     from adfkit.runner.world import Options
+
     hinged = tmp_path / "hinged.yaml"
     hinged.write_text(_chain(80))
     p2p = tmp_path / "p2p.yaml"
     p2p.write_text(_chain(80).replace("type: revolute", "type: p2p"))
     worlds = [MjWorld(load_scene(f), Options(ground=False)) for f in (hinged, p2p)]
     try:
-        assert [w.model.opt.jacobian for w in worlds] == [mujoco.mjtJacobian.mjJAC_DENSE,
-                                                           mujoco.mjtJacobian.mjJAC_SPARSE]
-        assert worlds[1].model.nv == 6 * 79      # free bodies: the matrix is block-diagonal
+        assert [w.model.opt.jacobian for w in worlds] == [
+            mujoco.mjtJacobian.mjJAC_DENSE,
+            mujoco.mjtJacobian.mjJAC_SPARSE,
+        ]
+        assert worlds[1].model.nv == 6 * 79  # free bodies: the matrix is block-diagonal
     finally:
         for w in worlds:
             w.close()

@@ -1,5 +1,6 @@
 """The MuJoCo engine (adfkit/runner/mj/) against physics and against the PyBullet engine: real
 MuJoCo and real PyBullet, no mocks."""
+
 from __future__ import annotations
 
 import json
@@ -10,7 +11,6 @@ import textwrap
 
 import numpy as np
 import pytest
-
 from conftest import CORPUS, ROOT, box_camera_model, require_corpus
 
 mujoco = pytest.importorskip("mujoco")
@@ -88,8 +88,9 @@ def _period(samples) -> float:
     """Mean time between successive downward zero crossings, interpolated."""
     t = [s[0] for s in samples]
     a = [s[1] for s in samples]
-    ups = [t[i - 1] + (t[i] - t[i - 1]) * a[i - 1] / (a[i - 1] - a[i])
-           for i in range(1, len(a)) if a[i - 1] > 0 >= a[i]]
+    ups = [
+        t[i - 1] + (t[i] - t[i - 1]) * a[i - 1] / (a[i - 1] - a[i]) for i in range(1, len(a)) if a[i - 1] > 0 >= a[i]
+    ]
     return float(np.mean(np.diff(ups)))
 
 
@@ -98,7 +99,7 @@ def test_pendulum_period_and_positions_agree_in_both_engines(tmp_path):
     within 0.5 % of it, and their bob positions within 5 mm of each other over 2 s."""
     scene = _model(tmp_path, pendulum_model())
     t0 = 2 * math.pi * math.sqrt((I_C + M * L * L) / (M * G * L))
-    expected = t0 * (1 + THETA0 ** 2 / 16 + 11 * THETA0 ** 4 / 3072)
+    expected = t0 * (1 + THETA0**2 / 16 + 11 * THETA0**4 / 3072)
     runs = {}
     for engine in ENGINES:
         world = engine(scene, Options(gravity=(0, 0, -G), ground=False, visuals=False))
@@ -110,7 +111,7 @@ def test_pendulum_period_and_positions_agree_in_both_engines(tmp_path):
     for name, samples in runs.items():
         assert _period(samples) == pytest.approx(expected, rel=5e-3), name
         amplitude = max(abs(s[1]) for s in samples[-200:])
-        assert amplitude == pytest.approx(THETA0, abs=0.01), name   # no numerical damping to speak of
+        assert amplitude == pytest.approx(THETA0, abs=0.01), name  # no numerical damping to speak of
     gap = max(np.linalg.norm(a[2] - b[2]) for a, b in zip(runs["MjWorld"], runs["SimWorld"]))
     assert gap < 5e-3
 
@@ -125,14 +126,18 @@ def thread_model() -> str:
     names = ["anchor"] + [f"e{i}" for i in range(N_ELEMENTS)]
     text = f"bodies: [{', '.join('BODY ' + n for n in names)}]\n"
     text += f"joints: [{', '.join(f'JOINT {a}-{b}' for a, b in zip(names, names[1:]))}]\n"
-    text += (f"BODY anchor:\n  name: anchor\n  mass: 0.0\n  location: {_pose()}\n"
-             "  collision shape: BOX\n  collision geometry: {x: 0.005, y: 0.005, z: 0.005}\n")
+    text += (
+        f"BODY anchor:\n  name: anchor\n  mass: 0.0\n  location: {_pose()}\n"
+        "  collision shape: BOX\n  collision geometry: {x: 0.005, y: 0.005, z: 0.005}\n"
+    )
     for i in range(N_ELEMENTS):
-        ix = SEG_MASS * (SEG ** 2 + SEG ** 2) / 12
+        ix = SEG_MASS * (SEG**2 + SEG**2) / 12
         iy = ix
-        text += (f"BODY e{i}:\n  name: e{i}\n  mass: {SEG_MASS}\n  inertia: {{ix: {ix}, iy: {iy}, iz: {iy}}}\n"
-                 f"  location: {_pose(x=SEG * (i + 0.5))}\n  collision shape: BOX\n"
-                 f"  collision geometry: {{x: {SEG * 0.9}, y: {SEG * 0.9}, z: {SEG * 0.9}}}\n  damping: {{linear: 0.0, angular: 0.0}}\n")
+        text += (
+            f"BODY e{i}:\n  name: e{i}\n  mass: {SEG_MASS}\n  inertia: {{ix: {ix}, iy: {iy}, iz: {iy}}}\n"
+            f"  location: {_pose(x=SEG * (i + 0.5))}\n  collision shape: BOX\n"
+            f"  collision geometry: {{x: {SEG * 0.9}, y: {SEG * 0.9}, z: {SEG * 0.9}}}\n  damping: {{linear: 0.0, angular: 0.0}}\n"
+        )
     for a, b in zip(names, names[1:]):
         pa = 0.0 if a == "anchor" else SEG / 2
         text += textwrap.dedent(f"""\
@@ -161,12 +166,15 @@ def thread_equilibrium() -> np.ndarray:
     from scipy.optimize import minimize
 
     def centres(th):
-        phi = np.cumsum(th)          # absolute angle below the horizontal
-        ends = np.concatenate([[0.0], np.cumsum(SEG * np.cos(phi))]), np.concatenate([[0.0], -np.cumsum(SEG * np.sin(phi))])
+        phi = np.cumsum(th)  # absolute angle below the horizontal
+        ends = (
+            np.concatenate([[0.0], np.cumsum(SEG * np.cos(phi))]),
+            np.concatenate([[0.0], -np.cumsum(SEG * np.sin(phi))]),
+        )
         return np.stack([(ends[0][:-1] + ends[0][1:]) / 2, (ends[1][:-1] + ends[1][1:]) / 2], axis=1)
 
     def energy(th):
-        return 0.5 * K_ANG * np.sum(th ** 2) + SEG_MASS * G * np.sum(centres(th)[:, 1])
+        return 0.5 * K_ANG * np.sum(th**2) + SEG_MASS * G * np.sum(centres(th)[:, 1])
 
     th = minimize(energy, np.full(N_ELEMENTS, 0.1), method="BFGS", options={"gtol": 1e-12}).x
     return centres(th)
@@ -182,8 +190,9 @@ def test_thread_hangs_to_its_static_equilibrium():
     see docs/mujoco.md), so only that is asserted for it."""
     import tempfile
     from pathlib import Path
+
     expected = thread_equilibrium()
-    assert expected[-1, 1] < -0.01          # a real sag (the tip drops more than 1 cm)
+    assert expected[-1, 1] < -0.01  # a real sag (the tip drops more than 1 cm)
     with tempfile.TemporaryDirectory() as d:
         scene = _model(Path(d), thread_model())
         opt = Options(gravity=(0, 0, -G), ground=False, visuals=False)
@@ -192,12 +201,12 @@ def test_thread_hangs_to_its_static_equilibrium():
             try:
                 world.run(4.0)
                 got = np.array([world.body(f"e{i}").com_position() for i in range(N_ELEMENTS)])
-                assert np.abs(got[:, 1]).max() < 1e-6                          # stays in its plane
+                assert np.abs(got[:, 1]).max() < 1e-6  # stays in its plane
                 assert world.constraint_error() < 1e-3
                 if tol is not None:
                     err = np.linalg.norm(got[:, [0, 2]] - expected, axis=1).max()
                     assert err < tol, f"{err * 1e3:.3f} mm from the equilibrium (sleep {world.sleep})"
-                    assert world.diagnostics == []          # no spring was softened for stability
+                    assert world.diagnostics == []  # no spring was softened for stability
             finally:
                 world.close()
 
@@ -222,12 +231,13 @@ def test_psm_tracks_a_joint_trajectory_in_both_engines():
             assert psm.calibration_error < 2e-4
             lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
             mid = (lo + hi) / 2
+
             def at(s):
                 q = mid + 0.3 * math.sin(2 * math.pi * s) * (hi - mid)
                 q[2] = 0.12 + 0.05 * math.sin(2 * math.pi * s)
                 return q
 
-            psm.servo_jp(at(0.0))     # to the start, 12 cm in, and settle
+            psm.servo_jp(at(0.0))  # to the start, 12 cm in, and settle
             world.run(0.5)
             errs, tip = [], []
             for k in range(1, 251):
@@ -320,7 +330,7 @@ def test_grasp_weld_carries_the_body_and_release_drops_it(tmp_path):
         assert world.grasp("tool", False) is None and world.data.eq_active[act.eq] == 0
         z0 = needle.com_position()[2]
         world.run(0.2)
-        assert z0 - needle.com_position()[2] == pytest.approx(0.5 * G * 0.2 ** 2, rel=0.05)
+        assert z0 - needle.com_position()[2] == pytest.approx(0.5 * G * 0.2**2, rel=0.05)
     finally:
         world.close()
 
@@ -376,6 +386,7 @@ def test_proximity_sensor_rays_see_what_is_in_range(tmp_path):
 # ---- cameras and CLI -------------------------------------------------------------------------
 def test_mujoco_camera_depth_segmentation_rgb(tmp_path):
     from adfkit.runner.mj.render import CameraUnavailable
+
     world = MjWorld(_model(tmp_path, box_camera_model()), Options(gravity=(0, 0, 0)))
     try:
         cam = world.cameras[0]
@@ -385,11 +396,11 @@ def test_mujoco_camera_depth_segmentation_rgb(tmp_path):
         except CameraUnavailable as e:
             pytest.skip(f"no headless OpenGL here: {e}")
         assert f["rgb"].shape == (48, 64, 3) and f["depth"].shape == (48, 64)
-        assert abs(float(f["depth"][24, 32]) - 0.9) < 2e-3     # box face 0.1 m in front of the centre
+        assert abs(float(f["depth"][24, 32]) - 0.9) < 2e-3  # box face 0.1 m in front of the centre
         assert np.isinf(f["depth"][0, 0])
         assert f["segmentation"][24, 32] == 0 and f["segmentation"][0, 0] == -1
         rgb = f["rgb"].astype(float)
-        assert rgb[24, 32, 0] > 2 * rgb[24, 32, 2]              # the red box
+        assert rgb[24, 32, 0] > 2 * rgb[24, 32, 2]  # the red box
     finally:
         world.close()
 
@@ -397,9 +408,11 @@ def test_mujoco_camera_depth_segmentation_rgb(tmp_path):
 def _cli(*args, cwd=None):
     env = {"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"}
     import os
+
     env.update({k: v for k, v in os.environ.items() if k in ("HOME", "MUJOCO_GL", "ADFKIT_CORPUS")})
-    return subprocess.run([sys.executable, "-m", "adfkit", *args], capture_output=True, text=True, env=env,
-                          cwd=cwd, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "adfkit", *args], capture_output=True, text=True, env=env, cwd=cwd, timeout=300
+    )
 
 
 def test_run_command_with_mujoco_engine(tmp_path):
@@ -410,8 +423,10 @@ def test_run_command_with_mujoco_engine(tmp_path):
     assert r.returncode == 0, r.stderr
     report = json.loads((out / "report.json").read_text())
     assert report["engine"] == "mujoco" and report["steps"] == 500 and report["nan"] == []
-    assert report["ground_plane_z"] == pytest.approx(0.399, abs=1e-6)   # 1 mm under the box
-    assert report["frames"] == ["cam_rgb.png", "cam_depth.npy", "cam_seg.npy", "cam_seg.png"] or report["camera_problem"]
+    assert report["ground_plane_z"] == pytest.approx(0.399, abs=1e-6)  # 1 mm under the box
+    assert (
+        report["frames"] == ["cam_rgb.png", "cam_depth.npy", "cam_seg.npy", "cam_seg.png"] or report["camera_problem"]
+    )
     bad = _cli("run", str(model), "--engine", "mujoco", "--gui")
     assert bad.returncode == 2 and "error[bad-option]" in bad.stderr and "Traceback" not in bad.stderr
 
@@ -434,7 +449,7 @@ def test_suturing_set_grasp_in_mujoco():
         at = (act.parent.world_matrix() @ act.location)[:3, 3]
         m, d = world.model, world.data
         q = m.jnt_qposadr[m.body_jntadr[needle.id]]
-        d.qpos[q:q + 3] += at - np.array(needle.com_position())
+        d.qpos[q : q + 3] += at - np.array(needle.com_position())
         d.qvel[:] = 0.0
         mujoco.mj_forward(m, d)
         assert psm.grasp(True) is needle
@@ -467,9 +482,29 @@ def test_both_engines_answer_the_same_public_api(tmp_path):
     for engine in ENGINES:
         world = engine(scene, Options())
         try:
-            for name in ("dt", "opt", "sim_time", "ghosts", "actuators", "sensors", "cameras", "articulations",
-                         "bodies", "diagnostics", "step", "run", "body", "grasp", "overlapping", "place_ghosts",
-                         "joint_state", "reset_joints", "constraint_error", "report", "close"):
+            for name in (
+                "dt",
+                "opt",
+                "sim_time",
+                "ghosts",
+                "actuators",
+                "sensors",
+                "cameras",
+                "articulations",
+                "bodies",
+                "diagnostics",
+                "step",
+                "run",
+                "body",
+                "grasp",
+                "overlapping",
+                "place_ghosts",
+                "joint_state",
+                "reset_joints",
+                "constraint_error",
+                "report",
+                "close",
+            ):
                 assert hasattr(world, name), (engine.__name__, name)
             box = world.body("box")
             for name in ("world_matrix", "com_position", "state", "force", "torque", "static", "mass", "key"):
@@ -483,7 +518,7 @@ def test_both_engines_answer_the_same_public_api(tmp_path):
     assert set(reports["MjWorld"]) - set(reports["SimWorld"]) == {"engine", "awake_trees", "trees", "engine_warnings"}
     assert reports["MjWorld"]["instabilities"] == reports["SimWorld"]["instabilities"] == []
     p_mj, p_pb = reports["MjWorld"]["ground_plane_z"], reports["SimWorld"]["ground_plane_z"]
-    assert p_mj == pytest.approx(p_pb, abs=1e-6)      # the same floor 1 mm under the box
+    assert p_mj == pytest.approx(p_pb, abs=1e-6)  # the same floor 1 mm under the box
 
 
 def test_missing_and_flat_meshes_are_warned_not_fatal(tmp_path):
@@ -521,7 +556,7 @@ BODY box:
         assert rules == ["runner-flat-mesh", "runner-mesh"]
         world.run(1.0)
         z = world.body("box").com_position()[2]
-        assert z == pytest.approx(0.01 + 5e-4, abs=1e-3)   # on the floor's 1 mm box, not through it
+        assert z == pytest.approx(0.01 + 5e-4, abs=1e-3)  # on the floor's 1 mm box, not through it
     finally:
         world.close()
 
@@ -567,7 +602,7 @@ def test_task_api_set_collision_move_base_ghost_pose(tmp_path, engine):
         floor, box, post = world.body("floor"), world.body("box"), world.body("post")
         world.set_collision(floor, box, False)
         world.run(0.25)
-        assert box.world_matrix()[2, 3] < 0.0                 # through the floor's top face (0.05)
+        assert box.world_matrix()[2, 3] < 0.0  # through the floor's top face (0.05)
         world.set_collision(floor, box, True)
         top = post.world_matrix()
         top[:3, 3] = [0.5, -0.2, 0.4]
@@ -587,6 +622,6 @@ def test_set_collision_turned_on_again_collides(tmp_path):
         world.set_collision(floor, box, False)
         world.set_collision(floor, box, True)
         world.run(0.5)
-        assert abs(box.world_matrix()[2, 3] - 0.1) < 2e-3    # resting on the floor's top face
+        assert abs(box.world_matrix()[2, 3] - 0.1) < 2e-3  # resting on the floor's top face
     finally:
         world.close()

@@ -1,6 +1,7 @@
 """Fan-out on Ray (adfkit/fanout.py): episodes as Ray tasks merged into one index; a failed
 episode retried once and reported; a worker killed mid-run loses no episode. One local Ray
 (2 CPUs) for the whole module."""
+
 from __future__ import annotations
 
 import json
@@ -24,13 +25,16 @@ def local_ray():
 
 def test_a_failing_episode_is_retried_once_and_reported(tmp_path):
     from adfkit.gym.record import record_episode
-    jobs = [{"env": "adfkit/NoSuchTask-v0", "seed": 5, "out": str(tmp_path)},
-            {"env": "adfkit/NoSuchTask-v0", "seed": 6, "out": str(tmp_path), "kill_once": str(tmp_path / "k")}]
+
+    jobs = [
+        {"env": "adfkit/NoSuchTask-v0", "seed": 5, "out": str(tmp_path)},
+        {"env": "adfkit/NoSuchTask-v0", "seed": 6, "out": str(tmp_path), "kill_once": str(tmp_path / "k")},
+    ]
     runs = fanout.fan_out(record_episode, jobs, workers=2)
     assert [r["ok"] for r in runs] == [False, False]
     assert [r["attempts"] for r in runs] == [2, 2]
     assert "NoSuchTask" in runs[0]["error"]
-    assert (tmp_path / "k").is_file()          # the first run of seed 6 did kill its worker
+    assert (tmp_path / "k").is_file()  # the first run of seed 6 did kill its worker
     index = json.loads(fanout.write_index(tmp_path, runs, {"env": "x"}).read_text())
     assert index["failed"] == [5, 6] and index["retried"] == [5, 6]
 
@@ -43,13 +47,14 @@ def test_dataset_of_4_episodes_on_2_workers_survives_a_killed_worker(tmp_path):
         pytest.skip(str(exc))
     from adfkit.commands.dataset import record
     from adfkit.gym.record import load_episode
+
     marker = tmp_path / "killed"
     assert record("adfkit/NeedleReach-v0", 4, 0, 2, None, tmp_path / "ds", {}, kill_once=str(marker)) == 0
     assert marker.is_file()
     index = json.loads((tmp_path / "ds" / "index.json").read_text())
     assert [e["seed"] for e in index["episodes"]] == [0, 1, 2, 3]
     assert all(e["ok"] for e in index["episodes"]) and index["retried"] == [0]
-    assert int(marker.read_text()) != index["episodes"][0]["pid"]   # the retry ran in another worker
+    assert int(marker.read_text()) != index["episodes"][0]["pid"]  # the retry ran in another worker
     for e in index["episodes"]:
         ep = load_episode(tmp_path / "ds" / e["file"])
         assert ep["action"].shape == (e["steps"], 7)
@@ -77,6 +82,7 @@ def test_validate_on_workers_prints_what_one_process_prints(capsys):
     from conftest import ROOT
 
     from adfkit.cli import main
+
     tree = str(ROOT / "sample_scenes")
     rc1 = main(["validate", tree, "-f", "json", "--fail-on", "warning"])
     one = capsys.readouterr().out

@@ -1,11 +1,11 @@
 """Mesh I/O, repair, CoACD decomposition (+cache), primitive fits and the CLI, on corpus meshes."""
+
 from __future__ import annotations
 
 import json
 
 import numpy as np
 import pytest
-
 from conftest import CORPUS, require_corpus
 
 trimesh = pytest.importorskip("trimesh")
@@ -101,8 +101,9 @@ def test_repair_closes_and_reports():
     solid, rep = repair_mesh(trimesh.util.concatenate([a, b]))
     assert rep.shells_unioned == 2 and solid.volume == pytest.approx(1.5, rel=1e-9)
     # a fin of three faces on one edge is beyond repair
-    bad = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]],
-                          [[0, 1, 2], [0, 1, 3], [0, 1, 4]], process=False)
+    bad = trimesh.Trimesh(
+        [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], [[0, 1, 2], [0, 1, 3], [0, 1, 4]], process=False
+    )
     with pytest.raises(AdfError) as exc:
         repair_mesh(bad)
     assert exc.value.diagnostics[0].rule == "mesh-not-manifold"
@@ -148,13 +149,16 @@ def test_cli_decompose_and_inertia(tmp_path, capsys):
     assert data["volume"] == pytest.approx(8.922667552e-09, rel=1e-6)
 
 
-@pytest.mark.parametrize("argv", [
-    ["inertia", "/no/such/mesh.stl", "--mass", "1"],
-    ["decompose", "/no/such/mesh.stl"],
-    ["inertia", "@NAN@", "--mass", "1"],
-    ["inertia", "@FIN@", "--mass", "1"],
-    ["decompose", "@FIN@"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["inertia", "/no/such/mesh.stl", "--mass", "1"],
+        ["decompose", "/no/such/mesh.stl"],
+        ["inertia", "@NAN@", "--mass", "1"],
+        ["inertia", "@FIN@", "--mass", "1"],
+        ["decompose", "@FIN@"],
+    ],
+)
 def test_cli_bad_meshes_are_diagnostics(tmp_path, capsys, argv):
     nan = tmp_path / "nan.obj"
     nan.write_text("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n")

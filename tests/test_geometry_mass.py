@@ -1,4 +1,5 @@
 """Mass properties against closed forms (1e-6 relative for primitives) and tessellated meshes."""
+
 from __future__ import annotations
 
 import math
@@ -9,8 +10,12 @@ import pytest
 trimesh = pytest.importorskip("trimesh")
 
 from adfkit.geometry.mass import (  # noqa: E402
-    MassProperties, apply_to_body, mesh_mass_properties, primitive_mass_properties,
-    shape_entries_mass_properties, to_adf,
+    MassProperties,
+    apply_to_body,
+    mesh_mass_properties,
+    primitive_mass_properties,
+    shape_entries_mass_properties,
+    to_adf,
 )
 from adfkit.model import Body, Geometry, ShapeEntry  # noqa: E402
 from adfkit.model.pose import Pose, Quat, Vec3, rpy_to_quat  # noqa: E402
@@ -60,16 +65,25 @@ def _capsule_mesh():
     from adfkit.geometry.primitives import entry_manifold
     from adfkit.geometry.repair import from_manifold
 
-    return from_manifold(entry_manifold(ShapeEntry(shape="capsule", geometry=Geometry(radius=0.05, height=0.3)),
-                                        segments=256))
+    return from_manifold(
+        entry_manifold(ShapeEntry(shape="capsule", geometry=Geometry(radius=0.05, height=0.3)), segments=256)
+    )
 
 
-@pytest.mark.parametrize("kind,geometry,mesh,tol", [
-    # Bound: an inscribed tessellation loses volume O((2π/n)²); relative error below tol.
-    ("sphere", Geometry(radius=0.05), lambda: trimesh.creation.icosphere(6, 0.05), 2e-4),
-    ("cylinder", Geometry(radius=0.05, height=0.3), lambda: trimesh.creation.cylinder(0.05, 0.3, sections=512), 1e-4),
-    ("capsule", Geometry(radius=0.05, height=0.3), _capsule_mesh, 1e-3),
-])
+@pytest.mark.parametrize(
+    "kind,geometry,mesh,tol",
+    [
+        # Bound: an inscribed tessellation loses volume O((2π/n)²); relative error below tol.
+        ("sphere", Geometry(radius=0.05), lambda: trimesh.creation.icosphere(6, 0.05), 2e-4),
+        (
+            "cylinder",
+            Geometry(radius=0.05, height=0.3),
+            lambda: trimesh.creation.cylinder(0.05, 0.3, sections=512),
+            1e-4,
+        ),
+        ("capsule", Geometry(radius=0.05, height=0.3), _capsule_mesh, 1e-3),
+    ],
+)
 def test_tessellated_meshes_agree_within_bound(kind, geometry, mesh, tol):
     exact = primitive_mass_properties(kind, geometry, density=RHO)
     approx = mesh_mass_properties(mesh(), density=RHO)
@@ -94,7 +108,8 @@ def test_offset_rotated_pose_parallel_axis():
     inertia, offset = to_adf(moved)
     m = 6.0
     assert sorted([inertia.ix, inertia.iy, inertia.iz]) == pytest.approx(
-        sorted([m * 0.13 / 12, m * 0.10 / 12, m * 0.05 / 12]), rel=1e-9)
+        sorted([m * 0.13 / 12, m * 0.10 / 12, m * 0.05 / 12]), rel=1e-9
+    )
     r = np.array(Quat(*offset.orientation).matrix())
     assert np.allclose(r @ np.diag([inertia.ix, inertia.iy, inertia.iz]) @ r.T, moved.inertia, atol=1e-12)
     # parallel axis: about the world origin
@@ -103,15 +118,18 @@ def test_offset_rotated_pose_parallel_axis():
 
 
 def test_compound_of_two_boxes_equals_one_box():
-    halves = [ShapeEntry(shape="box", geometry=Geometry(x=0.1, y=0.2, z=0.15), offset=Pose(Vec3(0, 0, z)))
-              for z in (-0.075, 0.075)]
+    halves = [
+        ShapeEntry(shape="box", geometry=Geometry(x=0.1, y=0.2, z=0.15), offset=Pose(Vec3(0, 0, z)))
+        for z in (-0.075, 0.075)
+    ]
     total = shape_entries_mass_properties(halves, mass=6.0)
     whole = primitive_mass_properties("box", Geometry(x=0.1, y=0.2, z=0.3), mass=6.0)
     assert rel(total.inertia, whole.inertia) < 1e-12 and np.allclose(total.com, 0)
     body = apply_to_body(Body(identifier="BODY b"), total)
     assert body.mass == pytest.approx(6.0)
     assert sorted([body.inertia.ix, body.inertia.iy, body.inertia.iz]) == pytest.approx(
-        sorted(np.diag(whole.inertia)), rel=1e-12)
+        sorted(np.diag(whole.inertia)), rel=1e-12
+    )
 
 
 def test_open_mesh_is_a_diagnostic():

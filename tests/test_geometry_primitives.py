@@ -1,5 +1,6 @@
 """Primitive fits on the meshes a modeller really has: an empty one, a single face, a flat grid,
 an open box, two boxes sharing an edge. Each fit encloses every vertex, or says why it cannot."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -57,7 +58,7 @@ def _inside(entry, pts: np.ndarray, tol: float = 1e-9) -> bool:
     radial = np.linalg.norm(np.delete(local, a, axis=1), axis=1)
     if kind == "cylinder":
         return bool(np.all(np.abs(t) <= g.height / 2 + tol) and np.all(radial <= g.radius + tol))
-    half = g.height / 2 - g.radius                       # capsule: distance to the core segment
+    half = g.height / 2 - g.radius  # capsule: distance to the core segment
     d = np.hypot(np.maximum(np.abs(t) - half, 0.0), radial)
     return bool(np.all(d <= g.radius + tol))
 
@@ -80,7 +81,7 @@ def test_every_fit_on_every_degenerate_mesh_encloses_or_says_why(mesh_name, kind
     err, volume = fit_error(mesh, entry)
     assert 0.0 <= err <= 1.0 and volume > 0
     if mesh_name in ("single face", "flat grid"):
-        assert err == 1.0                                 # nothing has volume to overlap
+        assert err == 1.0  # nothing has volume to overlap
 
 
 def test_an_open_box_fits_its_own_box_exactly():

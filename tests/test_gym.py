@@ -1,5 +1,6 @@
 """Gymnasium environments on the suturing scene (adfkit/gym): the Gymnasium API checker, random
 play without NaN, resets from the world's snapshot, and the scripted experts."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -48,8 +49,9 @@ IDS = ["adfkit/NeedleReach-v0", "adfkit/NeedlePick-v0", "adfkit/SutureOnePair-v0
 
 def _check(env_id):
     from gymnasium.utils.env_checker import check_env
+
     env = make(env_id).unwrapped
-    spec, env.spec = env.spec, None     # else check_env builds a second copy from the spec
+    spec, env.spec = env.spec, None  # else check_env builds a second copy from the spec
     try:
         check_env(env, skip_render_check=True)
     finally:
@@ -81,7 +83,7 @@ def _random_play(env_id, steps):
         worst = max(worst, float(np.abs(obs["needle_pose"][:3]).max()))
         if term or trunc:
             obs, _ = env.reset()
-    assert worst < 5.0    # the needle stays in the scene (metres)
+    assert worst < 5.0  # the needle stays in the scene (metres)
 
 
 @pytest.mark.slow
@@ -100,7 +102,7 @@ def test_reset_restores_the_snapshot():
     expert = expert_for(env)
     expert.reset()
     obs = a
-    for _ in range(40):           # grasp and lift: the reset must undo a grasp too
+    for _ in range(40):  # grasp and lift: the reset must undo a grasp too
         obs, *_ = env.step(expert(obs))
     assert env.unwrapped.holding()
     b, _ = env.reset(seed=11)
@@ -108,22 +110,23 @@ def test_reset_restores_the_snapshot():
     for k in a:
         assert np.allclose(a[k], b[k], atol=1e-6), k
     c, _ = env.reset(seed=12)
-    assert not np.allclose(a["psm1_pose"][:3], c["psm1_pose"][:3], atol=1e-4)   # seeds differ
+    assert not np.allclose(a["psm1_pose"][:3], c["psm1_pose"][:3], atol=1e-4)  # seeds differ
 
 
 def test_sparse_reward_and_image_observations():
-    env = make("adfkit/NeedleReach-v0", obs_mode="rgbd", reward_type="sparse", image_size=(32, 24),
-               render_mode="rgb_array")
+    env = make(
+        "adfkit/NeedleReach-v0", obs_mode="rgbd", reward_type="sparse", image_size=(32, 24), render_mode="rgb_array"
+    )
     obs, _ = env.reset(seed=0)
     cams = [k[:-4] for k in obs if k.endswith("_rgb")]
-    assert len(cams) >= 2    # the stereo pair
+    assert len(cams) >= 2  # the stereo pair
     assert obs[cams[0] + "_rgb"].shape == (24, 32, 3) and obs[cams[0] + "_rgb"].dtype == np.uint8
     assert obs[cams[0] + "_depth"].shape == (24, 32, 1)
     assert env.observation_space.contains(obs)
     obs, r, *_ = env.step(np.zeros(7, np.float32))
     assert r == -1.0
     assert env.render().ndim == 3
-    world = env.unwrapped.world   # the resized cameras drew with the renderer chosen, no fall-back
+    world = env.unwrapped.world  # the resized cameras drew with the renderer chosen, no fall-back
     assert not [d for d in world.diagnostics if d.rule == "runner-renderer"]
 
 
@@ -163,6 +166,7 @@ def test_mujoco_engine_is_a_clear_error_or_works():
     _need_scene()
     try:
         from adfkit.runner.mj.world import MjWorld
+
         complete = all(hasattr(MjWorld, m) for m in scenes.NEEDS)
     except ImportError:
         complete = False
@@ -175,6 +179,7 @@ def test_mujoco_engine_is_a_clear_error_or_works():
 
 def test_dataset_command_refuses_bad_options(tmp_path, capsys):
     from adfkit.cli import main
+
     assert main(["dataset", "--env", "adfkit/NoSuchTask-v0", "--out", str(tmp_path)]) == 2
     assert "no scripted expert" in capsys.readouterr().err
     assert main(["dataset", "--episodes", "0", "--out", str(tmp_path)]) == 2
@@ -187,6 +192,7 @@ def test_an_engine_instability_terminates_the_episode_with_its_reason():
     """What the world's stability watch met during a step (runner/stability.py) ends the episode,
     with the event in ``info``; the next episode starts clean."""
     from adfkit.runner.stability import Instability
+
     env = make("adfkit/NeedleReach-v0")
     env.reset(seed=1)
     zero = np.zeros(env.action_space.shape, dtype=np.float32)

@@ -1,4 +1,5 @@
 """The house drawn from its own imports: no import circles, and the core never imports the edges."""
+
 from __future__ import annotations
 
 import ast
@@ -96,8 +97,15 @@ def test_no_import_circles(pkg):
 
 # the core (model, ADF I/O, validator) never reaches up into the edges
 CORE = ("adfkit.model", "adfkit.adf", "adfkit.validator")
-EDGES = ("adfkit.runner", "adfkit.tasks", "adfkit.gym", "adfkit.converters", "adfkit.commands", "adfkit.scenes",
-         "adfkit.dataset")
+EDGES = (
+    "adfkit.runner",
+    "adfkit.tasks",
+    "adfkit.gym",
+    "adfkit.converters",
+    "adfkit.commands",
+    "adfkit.scenes",
+    "adfkit.dataset",
+)
 
 
 def test_the_core_does_not_import_the_edges():

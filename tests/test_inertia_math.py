@@ -1,4 +1,5 @@
 """Principal moments as the converters write them: the same numbers on every machine."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -17,8 +18,11 @@ def _holds(m) -> bool:
 
 def test_rounding_noise_is_taken_out():
     # the eigen-solver's output on one processor: one ulp on the wrong side of the inequality
-    assert without_noise((5.551115123125559e-17, 0.21499999999999989, 0.215)) == (0.0, 0.21499999999999989,
-                                                                                   0.21499999999999989)
+    assert without_noise((5.551115123125559e-17, 0.21499999999999989, 0.215)) == (
+        0.0,
+        0.21499999999999989,
+        0.21499999999999989,
+    )
     assert without_noise((-3e-18, 0.215, 0.215)) == (0.0, 0.215, 0.215)
 
 

@@ -1,13 +1,21 @@
 """PSM (LND 400006) kinematics: FK against poses derived by hand, closed-form IK round trips,
 joint-limit checking. Pure numpy, fast."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from adfkit.runner.psm_kinematics import (
-    L_PITCH2YAW, L_TOOL2RCM, JointLimitError, PSMKinematics, UnreachablePoseError, fk, ik,
-    pose_error, signed_angle,
+    L_PITCH2YAW,
+    L_TOOL2RCM,
+    JointLimitError,
+    PSMKinematics,
+    UnreachablePoseError,
+    fk,
+    ik,
+    pose_error,
+    signed_angle,
 )
 
 KIN = PSMKinematics()
@@ -17,12 +25,14 @@ LO, HI = KIN.lower_limits[:6], KIN.upper_limits[:6]
 # (base origin); the wrist pitch point sits L_tool2rcm = 0.4389 - 0.416 = 0.0229 m above
 # the RCM at q3 = 0, the yaw point (= control point) L_pitch2yaw = 0.009 m further down,
 # at z = 0.0139; x_E = y0, y_E = x0, z_E = -z0.
-HOME = np.array([
-    [0.0, 1.0, 0.0, 0.0],
-    [1.0, 0.0, 0.0, 0.0],
-    [0.0, 0.0, -1.0, 0.0139],
-    [0.0, 0.0, 0.0, 1.0],
-])
+HOME = np.array(
+    [
+        [0.0, 1.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0, 0.0139],
+        [0.0, 0.0, 0.0, 1.0],
+    ]
+)
 
 
 def rot(axis, angle) -> np.ndarray:
@@ -53,9 +63,15 @@ def poe(q) -> np.ndarray:
     roll about -z0, wrist pitch about -x0 through the pitch point (0, 0, 0.0229), wrist yaw
     about -y0 through the yaw point (0, 0, 0.0139)."""
     q1, q2, q3, q4, q5, q6 = q
-    return (rot(-Y, q1) @ rot(-X, q2) @ trans(-q3 * Z) @ rot(-Z, q4)
-            @ about_line(-X, [0, 0, L_TOOL2RCM], q5)
-            @ about_line(-Y, [0, 0, L_TOOL2RCM - L_PITCH2YAW], q6) @ HOME)
+    return (
+        rot(-Y, q1)
+        @ rot(-X, q2)
+        @ trans(-q3 * Z)
+        @ rot(-Z, q4)
+        @ about_line(-X, [0, 0, L_TOOL2RCM], q5)
+        @ about_line(-Y, [0, 0, L_TOOL2RCM - L_PITCH2YAW], q6)
+        @ HOME
+    )
 
 
 def random_configs(n, seed):
@@ -63,6 +79,7 @@ def random_configs(n, seed):
 
 
 # ---------------------------------------------------------------- forward kinematics
+
 
 def test_fk_home_pose():
     np.testing.assert_allclose(fk(np.zeros(6)), HOME, atol=1e-12)
@@ -133,6 +150,7 @@ def test_limits_arrays():
 
 # ---------------------------------------------------------------- inverse kinematics
 
+
 def test_ik_round_trip_500_random_configurations():
     worst_pose = worst_q = 0.0
     for q in random_configs(500, seed=2024):
@@ -141,8 +159,8 @@ def test_ik_round_trip_500_random_configurations():
         assert KIN.within_limits(q_ik)
         worst_pose = max(worst_pose, pose_error(KIN.fk(q_ik), T))
         worst_q = max(worst_q, float(np.abs(q_ik - q).max()))
-    assert worst_pose < 1e-9        # FK(IK(T)) = T, metres and radians
-    assert worst_q < 1e-8           # IK(FK(q)) = q: the limits leave one solution
+    assert worst_pose < 1e-9  # FK(IK(T)) = T, metres and radians
+    assert worst_q < 1e-8  # IK(FK(q)) = q: the limits leave one solution
 
 
 def test_ik_deep_insertion_uses_the_reference_branch():
@@ -174,7 +192,7 @@ def test_ik_at_joint_limits():
 
 
 def test_ik_out_of_reach_insertion_is_reported():
-    T = fk([0.1, 0.1, 0.40, 0, 0, 0])      # the pitch point 0.377 m from the RCM
+    T = fk([0.1, 0.1, 0.40, 0, 0, 0])  # the pitch point 0.377 m from the RCM
     with pytest.raises(JointLimitError) as info:
         ik(T)
     assert [v[0] for v in info.value.violations] == ["outer_insertion"]
@@ -200,7 +218,7 @@ def test_ik_rejects_malformed_poses():
     bad[:3, :3] *= 2.0
     with pytest.raises(ValueError, match="rotation"):
         KIN.ik(bad)
-    at_rcm = np.eye(4)            # the yaw point at the RCM on the x_E axis: no palm direction
+    at_rcm = np.eye(4)  # the yaw point at the RCM on the x_E axis: no palm direction
     with pytest.raises(UnreachablePoseError):
         KIN.ik(at_rcm)
 

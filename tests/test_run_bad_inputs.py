@@ -2,6 +2,7 @@
 warnings (never a pybullet.error), a spring joint from a free body to a multibody link is built
 (PyBullet's `createConstraint failed`), `--no-ground` has no floor to fall through, and every
 JSON output is strict."""
+
 from __future__ import annotations
 
 import json
@@ -35,6 +36,7 @@ def _body(name, mass=1.0, x=0.0, z=0.0, shape=SPHERE):
 def _strict(text: str):
     def refuse(const):
         raise ValueError(f"bare {const} in JSON")
+
     return json.loads(text, parse_constant=refuse)
 
 
@@ -65,6 +67,7 @@ def test_run_and_validate_on_a_mesh_without_triangles(tmp_path, capsys, mesh):
 def test_sound_meshes_pass_the_mesh_check(tmp_path):
     trimesh = pytest.importorskip("trimesh")
     from adfkit.geometry.meshcheck import mesh_problem
+
     box = trimesh.creation.box((1, 1, 1))
     box.export(tmp_path / "b.stl")
     (tmp_path / "a.stl").write_text(trimesh.exchange.stl.export_stl_ascii(box))
@@ -73,8 +76,12 @@ def test_sound_meshes_pass_the_mesh_check(tmp_path):
         assert mesh_problem(tmp_path / name) is None, name
 
 
-SPRING_MODEL = "bodies: [BODY free, BODY base, BODY link]\njoints: [JOINT hinge, JOINT spring]\n" + \
-    _body("free", 0.5, x=0.0, z=1.0) + _body("base", 0.0, z=0.0) + _body("link", 0.5, z=0.5) + textwrap.dedent("""\
+SPRING_MODEL = (
+    "bodies: [BODY free, BODY base, BODY link]\njoints: [JOINT hinge, JOINT spring]\n"
+    + _body("free", 0.5, x=0.0, z=1.0)
+    + _body("base", 0.0, z=0.0)
+    + _body("link", 0.5, z=0.5)
+    + textwrap.dedent("""\
     JOINT hinge:
       name: hinge
       parent: BODY base
@@ -97,6 +104,7 @@ SPRING_MODEL = "bodies: [BODY free, BODY base, BODY link]\njoints: [JOINT hinge,
       stiffness: 1.0
       damping: 0.01
     """)
+)
 
 
 def test_spring_from_a_free_body_to_a_multibody_link_is_built(tmp_path):
@@ -114,7 +122,7 @@ def test_spring_from_a_free_body_to_a_multibody_link_is_built(tmp_path):
         parent, child = world.constraints[0][2], world.constraints[0][3]
         assert parent.articulation is None and child.articulation is not None
         world.run(0.3)
-        assert world.constraint_error() < 1e-3   # the pivots stay together
+        assert world.constraint_error() < 1e-3  # the pivots stay together
         assert not [d for d in world.diagnostics if d.rule == "runner-constraint"]
     finally:
         world.close()
@@ -131,15 +139,16 @@ def test_no_ground_reports_nothing_fell_through_a_floor(tmp_path):
 
 def test_json_output_is_strict_and_explains_its_nulls():
     text = jsonout.dumps({"a": math.nan, "b": [1.0, math.inf, {"c": -math.inf}], "d": "x"})
-    assert _strict(text) == {"a": None, "b": [1.0, None, {"c": None}], "d": "x",
-                             "non_finite": ["a", "b[1]", "b[2].c"]}
+    assert _strict(text) == {"a": None, "b": [1.0, None, {"c": None}], "d": "x", "non_finite": ["a", "b[1]", "b[2].c"]}
     assert _strict(jsonout.dumps({"ok": 1.5})) == {"ok": 1.5}
 
 
 def test_collision_primitive_missing_a_dimension_is_a_located_warning(tmp_path, capsys):
     f = tmp_path / "m.yaml"
-    f.write_text("bodies: [BODY a]\n" + _body("a", z=0.5, shape="  collision shape: BOX\n"
-                                                             "  collision geometry: {x: 0.1, y: 0.1}\n"))
+    f.write_text(
+        "bodies: [BODY a]\n"
+        + _body("a", z=0.5, shape="  collision shape: BOX\n  collision geometry: {x: 0.1, y: 0.1}\n")
+    )
     rc = main(["run", str(f), "--seconds", "0.02", "--no-frames"])
     err = capsys.readouterr().err
     assert rc in (0, 1) and "Traceback" not in err

@@ -1,5 +1,6 @@
 """`adfkit run` and `adfkit demo` end to end: real PyBullet, the files they leave behind, exit
 statuses and located errors for bad input."""
+
 from __future__ import annotations
 
 import json
@@ -7,7 +8,6 @@ import textwrap
 
 import numpy as np
 import pytest
-
 from conftest import CORPUS, ROOT, box_camera_model, require_corpus
 
 pytest.importorskip("pybullet")
@@ -37,9 +37,9 @@ def test_run_writes_report_and_camera_frames(box_model, tmp_path, capsys):
     assert rep["ground_plane_z"] == pytest.approx(-0.001, abs=1e-6)
     assert sorted(rep["frames"]) == ["cam_depth.npy", "cam_rgb.png", "cam_seg.npy", "cam_seg.png"]
     rgb = np.asarray(Image.open(out / "cam_rgb.png"))
-    assert rgb.shape == (48, 64, 3) and rgb[24, 32, 1] > 2 * rgb[24, 32, 0]   # the green box in the middle
+    assert rgb.shape == (48, 64, 3) and rgb[24, 32, 1] > 2 * rgb[24, 32, 0]  # the green box in the middle
     depth = np.load(out / "cam_depth.npy")
-    assert abs(float(depth[24, 32]) - 0.9) < 2e-3       # its near face, 0.1 m in front of its centre
+    assert abs(float(depth[24, 32]) - 0.9) < 2e-3  # its near face, 0.1 m in front of its centre
     seg = np.load(out / "cam_seg.npy")
     assert seg[24, 32] == 0
     printed = capsys.readouterr().out
@@ -49,13 +49,14 @@ def test_run_writes_report_and_camera_frames(box_model, tmp_path, capsys):
 def test_run_selects_launch_indices(tmp_path, capsys):
     require_corpus()
     out = tmp_path / "out"
-    rc = main(["run", str(CORPUS / "src" / "launch.yaml"), "-l", "6", "--seconds", "0.05", "--no-frames",
-               "--out", str(out)])
+    rc = main(
+        ["run", str(CORPUS / "src" / "launch.yaml"), "-l", "6", "--seconds", "0.05", "--no-frames", "--out", str(out)]
+    )
     assert rc == 0
     rep = json.loads((out / "report.json").read_text())
     # psm1 alone, with the world's floor (its environment model)
     assert rep["bodies"] == 11 and rep["joints"] == 8 and rep["multibodies"] == 1
-    assert rep["steps"] == 48   # 0.05 s in whole control steps of 4 ms
+    assert rep["steps"] == 48  # 0.05 s in whole control steps of 4 ms
     # the world's stereo pair hangs from the phantom's CameraFrame, which index 10 would load
     assert "frames" not in rep and rep["cameras"] == []
     assert capsys.readouterr().err.count("warning[runner-camera]") == 2
@@ -68,12 +69,15 @@ def test_run_reports_an_unstable_scene_with_exit_status_1(box_model, capsys):
     assert "unstable" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("args, said", [
-    (["--seconds", "0"], "--seconds"),
-    (["--solver-iterations", "0"], "--solver-iterations"),
-    (["--contact-threshold", "-1"], "--contact-threshold"),
-    (["--gravity", "0,0"], "is not x,y,z"),
-])
+@pytest.mark.parametrize(
+    "args, said",
+    [
+        (["--seconds", "0"], "--seconds"),
+        (["--solver-iterations", "0"], "--solver-iterations"),
+        (["--contact-threshold", "-1"], "--contact-threshold"),
+        (["--gravity", "0,0"], "is not x,y,z"),
+    ],
+)
 def test_run_refuses_bad_options(box_model, capsys, args, said):
     assert main(["run", str(box_model)] + args) == 2
     assert said in capsys.readouterr().err
@@ -86,8 +90,17 @@ def test_run_refuses_a_missing_file(tmp_path, capsys):
 
 def test_demo_plays_the_bundled_scene(tmp_path, capsys):
     out = tmp_path / "demo"
-    rc = main(["demo", "--scene", str(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"),
-               "--seconds", "0.1", "--out", str(out)])
+    rc = main(
+        [
+            "demo",
+            "--scene",
+            str(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"),
+            "--seconds",
+            "0.1",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     rep = json.loads((out / "report.json").read_text())
     assert rep["steps"] == 100 and rep["bodies"] > 0

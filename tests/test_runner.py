@@ -1,4 +1,5 @@
 """PyBullet reference runner: real PyBullet, real corpus scenes, no mocks."""
+
 from __future__ import annotations
 
 import math
@@ -6,7 +7,6 @@ import textwrap
 
 import numpy as np
 import pytest
-
 from conftest import CORPUS, box_camera_model, require_corpus, require_renderer
 
 pb = pytest.importorskip("pybullet")
@@ -36,8 +36,8 @@ def test_suturing_scene_is_complete(suturing):
     assert len(world.actuators) == sum(len(m.actuators) for m in models) == 2
     assert len(world.sensors) == sum(len(m.sensors) for m in models)
     assert [c.name for c in world.cameras] == ["cameraL", "cameraR"]
-    assert len(world.articulations) == 2          # the two PSMs as multibodies
-    assert len(world.springs.joints) == 47        # thread + hole boundaries (six dof spring)
+    assert len(world.articulations) == 2  # the two PSMs as multibodies
+    assert len(world.springs.joints) == 47  # thread + hole boundaries (six dof spring)
 
 
 def test_suturing_plays_stable_and_thread_holds(suturing):
@@ -55,7 +55,9 @@ def test_suturing_plays_10_seconds_stable():
 
 
 def _check_suturing_play(world, seconds: float) -> None:
-    thread = [world.registry.items["/ambf/env/phantom/BODY Thread"]] + [world.body(f"BODY Thread_{i:03d}") for i in range(1, 40)]
+    thread = [world.registry.items["/ambf/env/phantom/BODY Thread"]] + [
+        world.body(f"BODY Thread_{i:03d}") for i in range(1, 40)
+    ]
     pivots = [(j.frame_a[:3, 3], j.frame_b[:3, 3]) for j in world.springs.joints if "Thread" in j.name]
     world.run(seconds)
     rep = world.report()
@@ -93,12 +95,12 @@ def test_camera_depth_segmentation_rgb(tmp_path, renderer):
         k = cam.intrinsics()
         assert k[1, 1] == pytest.approx(24 / math.tan(0.35)) and k[0, 2] == 32 and k[1, 2] == 24
         f = cam.render(world)
-        assert abs(float(f["depth"][24, 32]) - 0.9) < 1e-3      # box face 0.1 m in front of the centre
-        assert np.isinf(f["depth"][0, 0])                        # background
+        assert abs(float(f["depth"][24, 32]) - 0.9) < 1e-3  # box face 0.1 m in front of the centre
+        assert np.isinf(f["depth"][0, 0])  # background
         assert f["segmentation"][24, 32] == 0 and f["segmentation"][0, 0] == -1
         assert set(np.unique(f["segmentation"])) == {-1, 0}
         rgb = f["rgb"].astype(float)
-        assert rgb[24, 32, 0] > 2 * rgb[24, 32, 2] and rgb.std() > 10   # red box, non-trivial image
+        assert rgb[24, 32, 0] > 2 * rgb[24, 32, 2] and rgb.std() > 10  # red box, non-trivial image
     finally:
         world.close()
 
@@ -133,7 +135,7 @@ def test_ghost_viscous_friction_matches_exponential(tmp_path):
         v = pb.getBaseVelocity(needle.uid, physicsClientId=world.cid)[0][0]
         expected = 0.1 * math.exp(-k * 0.4 / 0.1)
         assert v == pytest.approx(expected, rel=0.05)
-        assert expected < 0.02   # it really slowed
+        assert expected < 0.02  # it really slowed
     finally:
         world.close()
 
@@ -181,7 +183,7 @@ def test_a_carried_ghost_senses_where_its_parent_has_taken_it(tmp_path):
         carrier_at = carrier.com_position()
         assert np.allclose(np.array(ghost_at) - carrier_at, [0, -0.05, 0], atol=1e-9)
         assert carrier_at[0] == pytest.approx(0.05, abs=1e-4)
-        world.run(0.2)   # carried past the probe: empty again
+        world.run(0.2)  # carried past the probe: empty again
         assert world.overlapping(g) == []
     finally:
         world.close()
@@ -195,17 +197,16 @@ def test_grasp_moves_needle_with_tool_and_release_drops_it():
     world = SimWorld(load_scene(CORPUS / "src" / "launch.yaml", SUTURING), Options(visuals=False))
     try:
         psm = PSM(world, "psm1")
-        psm.move_cp(psm.kin.fk([0.0, 0.0, 0.12, 0.0, 0.0, 0.0]), 0.3)   # tool out of the cannula
+        psm.move_cp(psm.kin.fk([0.0, 0.0, 0.12, 0.0, 0.0, 0.0]), 0.3)  # tool out of the cannula
         world.run(0.2)
         act = next(a for a in world.actuators if "psm1" in a.key)
         needle = world.body("BODY Needle")
         at = (act.parent.world_matrix() @ act.location)[:3, 3]
         shift = at - np.array(needle.com_position())
-        for b in world.bodies:   # needle and thread moved together between the jaws
+        for b in world.bodies:  # needle and thread moved together between the jaws
             if b is needle or "Thread" in b.key:
                 p, q = pb.getBasePositionAndOrientation(b.uid, physicsClientId=world.cid)
-                pb.resetBasePositionAndOrientation(b.uid, (np.array(p) + shift).tolist(), q,
-                                                   physicsClientId=world.cid)
+                pb.resetBasePositionAndOrientation(b.uid, (np.array(p) + shift).tolist(), q, physicsClientId=world.cid)
                 pb.resetBaseVelocity(b.uid, [0, 0, 0], [0, 0, 0], physicsClientId=world.cid)
         assert psm.grasp(True) is needle
         assert len(act.constraint) == 3 and psm.art.targets[psm.jaws[0]] == 0.0
@@ -230,22 +231,32 @@ def test_grasp_moves_needle_with_tool_and_release_drops_it():
 
 def _box(name: str, mass: float, y: float) -> str:
     inertia = "  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}\n" if mass else ""
-    return (f"BODY {name}:\n  name: {name}\n  mass: {mass}\n{inertia}"
-            f"  location: {{position: {{x: 0.0, y: {y}, z: 0.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
-            "  collision shape: BOX\n  collision geometry: {x: 0.02, y: 0.02, z: 0.02}\n")
+    return (
+        f"BODY {name}:\n  name: {name}\n  mass: {mass}\n{inertia}"
+        f"  location: {{position: {{x: 0.0, y: {y}, z: 0.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
+        "  collision shape: BOX\n  collision geometry: {x: 0.02, y: 0.02, z: 0.02}\n"
+    )
 
 
 def _slider(parent: str, child: str, y: float) -> str:
-    return (f"JOINT {parent}-{child}:\n  name: {parent}-{child}\n  parent: BODY {parent}\n  child: BODY {child}\n"
-            f"  type: prismatic\n  parent pivot: {{x: 0.0, y: {y}, z: 0.0}}\n  child pivot: {{x: 0.0, y: 0.0, z: 0.0}}\n"
-            "  parent axis: {x: 1.0, y: 0.0, z: 0.0}\n  child axis: {x: 1.0, y: 0.0, z: 0.0}\n"
-            "  joint limits: {low: -0.2, high: 0.2}\n")
+    return (
+        f"JOINT {parent}-{child}:\n  name: {parent}-{child}\n  parent: BODY {parent}\n  child: BODY {child}\n"
+        f"  type: prismatic\n  parent pivot: {{x: 0.0, y: {y}, z: 0.0}}\n  child pivot: {{x: 0.0, y: 0.0, z: 0.0}}\n"
+        "  parent axis: {x: 1.0, y: 0.0, z: 0.0}\n  child axis: {x: 1.0, y: 0.0, z: 0.0}\n"
+        "  joint limits: {low: -0.2, high: 0.2}\n"
+    )
 
 
 # base -> a and base -> b slide along x; a -> b, also along x, closes the loop
-SLIDER_LOOP = ("bodies: [BODY base, BODY a, BODY b]\njoints: [JOINT base-a, JOINT base-b, JOINT a-b]\n"
-               + _box("base", 0.0, 0.0) + _box("a", 0.1, 0.1) + _box("b", 0.1, 0.2)
-               + _slider("base", "a", 0.1) + _slider("base", "b", 0.2) + _slider("a", "b", 0.1))
+SLIDER_LOOP = (
+    "bodies: [BODY base, BODY a, BODY b]\njoints: [JOINT base-a, JOINT base-b, JOINT a-b]\n"
+    + _box("base", 0.0, 0.0)
+    + _box("a", 0.1, 0.1)
+    + _box("b", 0.1, 0.2)
+    + _slider("base", "a", 0.1)
+    + _slider("base", "b", 0.2)
+    + _slider("a", "b", 0.1)
+)
 
 
 def test_prismatic_joint_closing_a_loop_slides(tmp_path):

@@ -1,29 +1,45 @@
 """Every corpus model whose meshes are present (MANIFEST.md) loads in the PyBullet runner and
 plays: no NaN, nothing faster than 10 m/s, joint constraints closed to 1 mm at the end.
 A short run of two models by default; 5 s of every model under `-m slow`."""
+
 from __future__ import annotations
 
 import pytest
 
 pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
 
+from conftest import CORPUS, require_corpus  # noqa: E402
+
 from adfkit.adf import load_scene  # noqa: E402
 from adfkit.runner.world import Options, SimWorld  # noqa: E402
-from conftest import CORPUS, require_corpus  # noqa: E402
 
 MB = "ambf/ambf_models/descriptions/multi-bodies"
 WITH_MESHES = [  # MANIFEST.md: models whose meshes and textures are in the corpus
-    f"{MB}/robots/blender-psm.yaml", f"{MB}/robots/blender-ecm.yaml", f"{MB}/robots/blender-mtm.yaml",
-    f"{MB}/robots/blender-kuka.yaml", f"{MB}/robots/blender-kuka-springy.yaml",
-    f"{MB}/puzzles/puzzle1.yaml", f"{MB}/puzzles/puzzle2.yaml", f"{MB}/puzzles/puzzle4.yaml",
-    f"{MB}/puzzles/puzzle5.yaml", f"{MB}/puzzles/puzzle6.yaml", f"{MB}/puzzles/parallel_structure.yaml",
-    f"{MB}/puzzles/peg_and_base.yaml", f"{MB}/grippers/resistive/gripper1/gripperA.yaml",
-    pytest.param(f"{MB}/grippers/resistive/gripper3/gripper.yaml", marks=pytest.mark.xfail(
-        strict=True, reason="the file's locations put 'LeftL1-LeftL2' at -0.676 rad, outside its limits "
-                            "-1.2…-0.8; the limit turns the left finger to -0.79 while the right one holds -0.75, so "
-                            "the prismatic loop between the distal links cannot close (4-7 mm)")),
+    f"{MB}/robots/blender-psm.yaml",
+    f"{MB}/robots/blender-ecm.yaml",
+    f"{MB}/robots/blender-mtm.yaml",
+    f"{MB}/robots/blender-kuka.yaml",
+    f"{MB}/robots/blender-kuka-springy.yaml",
+    f"{MB}/puzzles/puzzle1.yaml",
+    f"{MB}/puzzles/puzzle2.yaml",
+    f"{MB}/puzzles/puzzle4.yaml",
+    f"{MB}/puzzles/puzzle5.yaml",
+    f"{MB}/puzzles/puzzle6.yaml",
+    f"{MB}/puzzles/parallel_structure.yaml",
+    f"{MB}/puzzles/peg_and_base.yaml",
+    f"{MB}/grippers/resistive/gripper1/gripperA.yaml",
+    pytest.param(
+        f"{MB}/grippers/resistive/gripper3/gripper.yaml",
+        marks=pytest.mark.xfail(
+            strict=True,
+            reason="the file's locations put 'LeftL1-LeftL2' at -0.676 rad, outside its limits "
+            "-1.2…-0.8; the limit turns the left finger to -0.79 while the right one holds -0.75, so "
+            "the prismatic loop between the distal links cannot close (4-7 mm)",
+        ),
+    ),
     f"{MB}/tools/cylinder.yaml",
-    "src/ADF/Phantoms/Simple/phantom.yaml", "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml",
+    "src/ADF/Phantoms/Simple/phantom.yaml",
+    "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml",
     "src/ADF/PSMs/LND_400006_SIMPLE/psm2.yaml",
 ]
 SOFT = [f"{MB}/sb/cloth.yaml"]
@@ -73,9 +89,25 @@ def test_corpus_model_plays_5_seconds(rel, tmp_path):
     import json
     import subprocess
     import sys
+
     require_corpus()
-    r = subprocess.run([sys.executable, "-m", "adfkit", "run", str(CORPUS / rel), "--seconds", "5", "--no-frames",
-                        "--out", str(tmp_path)], capture_output=True, text=True, timeout=600)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "adfkit",
+            "run",
+            str(CORPUS / rel),
+            "--seconds",
+            "5",
+            "--no-frames",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert r.returncode in (0, 1), r.stderr[-2000:]
     rep = json.loads((tmp_path / "report.json").read_text())
     assert rep["skipped_bodies"] == [], rep["skipped_bodies"]
@@ -100,8 +132,9 @@ def test_soft_body_is_played_and_its_approximations_reported(rel):
 # Springy robots and knot environments: PyBullet refused their spring joints from a free body to
 # a multibody link (`createConstraint failed`, issue 14); they must build and play. Meshes that
 # are absent are skipped bodies with a warning, as AMBF does.
-SPRINGY = [f"{MB}/robots/blender-{r}-springy.yaml" for r in ("psm", "ecm", "mtm", "pr2")] + \
-    [f"{MB}/environments/{k}/env.yaml" for k in ("KnotEnv", "KnotEnv2", "KnotEnv3")]
+SPRINGY = [f"{MB}/robots/blender-{r}-springy.yaml" for r in ("psm", "ecm", "mtm", "pr2")] + [
+    f"{MB}/environments/{k}/env.yaml" for k in ("KnotEnv", "KnotEnv2", "KnotEnv3")
+]
 
 
 def _build_and_play(rel: str, seconds: float) -> dict:
@@ -130,9 +163,12 @@ def test_springy_and_knot_models_play(rel):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="builds and plays, but its 1 g tool roll and pitch links, joined by a "
-                                       "force-driven linear spring, reach > 10 m/s within 0.1 s: the explicit "
-                                       "spring emulation is unstable for such light links (open)")
+@pytest.mark.xfail(
+    strict=True,
+    reason="builds and plays, but its 1 g tool roll and pitch links, joined by a "
+    "force-driven linear spring, reach > 10 m/s within 0.1 s: the explicit "
+    "spring emulation is unstable for such light links (open)",
+)
 def test_springy_psm_stays_stable():
     rep = _build_and_play(SPRINGY[0], 0.5)
     assert rep["exploded"] == []

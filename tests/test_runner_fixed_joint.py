@@ -1,6 +1,7 @@
 """A `fixed` joint between two maximal-coordinate bodies keeps the relative pose the file
 gives them, whatever their inertial frames (PyBullet's own fixed constraint does not: it holds
 the two inertial frames parallel, which turned the suturing thread 90 degrees off its needle)."""
+
 from __future__ import annotations
 
 import textwrap
@@ -51,8 +52,8 @@ def test_fixed_joint_keeps_the_relative_pose(tmp_path):
     world = SimWorld(load_scene(p, None, []))
     try:
         a, b = world.body("BODY a"), world.body("BODY b")
-        rel0 = np.linalg.inv(a.world_matrix()) @ b.world_matrix()   # the file's pose: the joint's own
-        b.force([0.0, 0.05, 0.0], list(b.com_position()))            # a jolt on the light body
+        rel0 = np.linalg.inv(a.world_matrix()) @ b.world_matrix()  # the file's pose: the joint's own
+        b.force([0.0, 0.05, 0.0], list(b.com_position()))  # a jolt on the light body
         world.run(0.5)
         rel = np.linalg.inv(a.world_matrix()) @ b.world_matrix()
         turn = np.degrees(np.arccos(np.clip((np.trace(rel0[:3, :3].T @ rel[:3, :3]) - 1) / 2, -1, 1)))

@@ -1,5 +1,6 @@
 """The PSM API of the runner (adfkit/runner/psm.py): the challenge's LND 400006 PSM played in
 real PyBullet, driven through the closed-form IK."""
+
 from __future__ import annotations
 
 import math
@@ -7,7 +8,6 @@ import re
 
 import numpy as np
 import pytest
-
 from conftest import CORPUS, require_corpus
 
 pb = pytest.importorskip("pybullet")
@@ -49,9 +49,11 @@ def test_hand_eye_recovers_known_frames():
         q /= np.linalg.norm(q)
         x, y, z, w = q
         t = np.eye(4)
-        t[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+        t[:3, :3] = [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
         t[:3, 3] = rng.normal(size=3)
         return t
 
@@ -88,7 +90,7 @@ def test_servo_cp_reaches_poses_through_the_ik(psm):
     for _ in range(3):
         goal = _random_pose(rng, psm.kin.fk([0.0, 0.0, 0.12, 0.0, 0.0, 0.0]))
         q = psm.servo_cp(goal)
-        assert pose_error(psm.kin.fk(q), goal) < 1e-7     # the IK solution itself
+        assert pose_error(psm.kin.fk(q), goal) < 1e-7  # the IK solution itself
         world.run(0.8)
         assert pose_error(psm.measured_cp(), goal) < 1e-3  # the played arm got there
 
@@ -106,6 +108,7 @@ def test_move_cp_follows_a_straight_line(psm):
     def spy(n=1):
         world_step(n)
         seen.append(psm.measured_cp()[:3, 3].copy())
+
     world.step = spy
     try:
         psm.move_cp(goal, 0.4)
@@ -123,7 +126,7 @@ def test_bad_set_points_are_refused_with_the_joint_named(psm):
     with pytest.raises(ValueError, match=r"outer_insertion|insertion"):
         psm.servo_jp([0.0, 0.0, 0.5, 0.0, 0.0, 0.0])
     far = np.eye(4)
-    far[:3, 3] = [0.0, 0.0, -1.0]   # 1 m from the RCM: beyond the insertion range
+    far[:3, 3] = [0.0, 0.0, -1.0]  # 1 m from the RCM: beyond the insertion range
     with pytest.raises(ValueError):
         psm.servo_cp(far)
 
@@ -138,8 +141,12 @@ def test_a_model_that_is_not_a_psm_is_refused(tmp_path):
     require_corpus()
     text = (CORPUS / PSM1).read_text()
     # the first arm joint turned by 0.3 rad at zero: the tool no longer moves as the DH model says
-    bent = re.sub(r"(JOINT yaw link-pitch back link:\n(?:  .*\n|    .*\n)*?  offset: )(-?[0-9.]+)",
-                  lambda m: m.group(1) + str(float(m.group(2)) + 0.3), text, count=1)
+    bent = re.sub(
+        r"(JOINT yaw link-pitch back link:\n(?:  .*\n|    .*\n)*?  offset: )(-?[0-9.]+)",
+        lambda m: m.group(1) + str(float(m.group(2)) + 0.3),
+        text,
+        count=1,
+    )
     assert bent != text
     (tmp_path / "psm1.yaml").write_text(bent)
     world = SimWorld(load_scene(tmp_path / "psm1.yaml"), Options(visuals=False, ground=False))

@@ -2,6 +2,7 @@
 (runner/egl.py) and MuJoCo's renderer on a mirror of the scene (runner/mjview.py) give the same
 pictures as TinyRenderer; the EGL plugin's known crash is avoided and its chatter kept off
 standard output. Each skips where its OpenGL cannot start here."""
+
 from __future__ import annotations
 
 import json
@@ -12,10 +13,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import require_renderer
 
 from adfkit.adf import load_scene
 from adfkit.runner.world import Options, SimWorld
-from conftest import require_renderer
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -55,18 +56,34 @@ def test_lone_plane_without_visual_renders_and_stdout_stays_clean(tmp_path, rend
     model = tmp_path / "model.yaml"
     model.write_text(textwrap.dedent(PLANE_AND_CAMERA))
     out = tmp_path / "run"
-    r = subprocess.run([sys.executable, "-m", "adfkit", "run", str(model), "--seconds", "0.05", "--renderer", renderer,
-                        "--out", str(out)], capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "adfkit",
+            "run",
+            str(model),
+            "--seconds",
+            "0.05",
+            "--renderer",
+            renderer,
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode == 0, r.stderr[-2000:]
-    assert "GL_VENDOR" not in r.stdout and "EGL" not in r.stdout     # the plugin's chatter went to stderr
+    assert "GL_VENDOR" not in r.stdout and "EGL" not in r.stdout  # the plugin's chatter went to stderr
     report = json.loads((out / "report.json").read_text())
     assert report["renderer"] == renderer
     seg = np.load(out / "cam_seg.npy")
     depth = np.load(out / "cam_depth.npy")
-    assert seg[24, 32] == 1                                  # the box (body index 1) under the camera
-    assert abs(float(depth[24, 32]) - 0.9) < 2e-3             # its top face 0.9 m below the camera
-    if renderer == "egl":   # (the MJCF writer has no PLANE on a body: MuJoCo draws only its own ground there)
-        assert seg[0, 0] == 0 and abs(float(depth[0, 0]) - 1.0) < 2e-3   # the floor (depth along the optical axis)
+    assert seg[24, 32] == 1  # the box (body index 1) under the camera
+    assert abs(float(depth[24, 32]) - 0.9) < 2e-3  # its top face 0.9 m below the camera
+    if renderer == "egl":  # (the MJCF writer has no PLANE on a body: MuJoCo draws only its own ground there)
+        assert seg[0, 0] == 0 and abs(float(depth[0, 0]) - 1.0) < 2e-3  # the floor (depth along the optical axis)
 
 
 @pytest.mark.parametrize("renderer", ["egl", "mujoco"])
@@ -74,12 +91,12 @@ def test_renderer_agrees_with_tinyrenderer_on_the_suturing_pad(renderer):
     require_renderer(renderer)
     scene = load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml")
     frames = {}
-    for renderer in (renderer, "tiny"):
-        world = SimWorld(scene, Options(renderer=renderer))
+    for name in (renderer, "tiny"):
+        world = SimWorld(scene, Options(renderer=name))
         try:
-            assert world.renderer == renderer and world.cameras
+            assert world.renderer == name and world.cameras
             world.run(0.05)
-            frames[renderer] = [c.render(world) for c in world.cameras]
+            frames[name] = [c.render(world) for c in world.cameras]
         finally:
             world.close()
     (a_frames, b_frames) = frames.values()
@@ -95,14 +112,17 @@ def test_renderer_agrees_with_tinyrenderer_on_the_suturing_pad(renderer):
 def test_mujoco_renderer_draws_a_resized_copy_of_a_camera():
     """The Gymnasium environments render copies of the scene's cameras at their own size."""
     from dataclasses import replace
+
     require_renderer("mujoco")
     world = SimWorld(load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"), Options(renderer="mujoco"))
     try:
         full = world.cameras[0].render(world)
         small = replace(world.cameras[0], width=64, height=48).render(world)
         assert world.renderer == "mujoco" and not [d for d in world.diagnostics if d.rule == "runner-renderer"]
-        assert small["rgb"].shape == (48, 64, 3) and full["rgb"].shape[:2] == (world.cameras[0].height,
-                                                                              world.cameras[0].width)
+        assert small["rgb"].shape == (48, 64, 3) and full["rgb"].shape[:2] == (
+            world.cameras[0].height,
+            world.cameras[0].width,
+        )
         # the same view: the centre pixel sees the same body at the same depth
         h, w = full["segmentation"].shape
         assert small["segmentation"][24, 32] == full["segmentation"][h // 2, w // 2]

@@ -1,10 +1,10 @@
 """A folder named where a scene is expected: its launch.yaml, or a clear error naming what is there."""
+
 from __future__ import annotations
 
 import json
 
 import pytest
-
 from conftest import ROOT
 
 from adfkit.cli import main

@@ -1,6 +1,7 @@
 """The project's own suturing scene (adfkit build-scene suturing): deterministic files, a
 clean validation, the expected objects in the runner, PSMs that calibrate to the DH
 kinematics and reach every hole from above, a stable short play, the bundled copy current."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -31,6 +32,7 @@ def built(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def world(built):
     from adfkit.runner.world import SimWorld
+
     w = SimWorld(load_scene(built / "launch.yaml", None, []))
     yield w
     w.close()
@@ -58,8 +60,10 @@ def test_runner_builds_the_expected_objects(world):
     assert sum(1 for b in world.bodies if b.body.name and b.body.name.startswith("Thread")) == 40
     assert rep["spring_joints"] == 39
     names = sorted(g.ghost.name for g in world.ghosts)
-    assert names == sorted([f"ghost{k}{i}" for k in ("Entry", "Exit") for i in range(1, 5)]
-                           + ["left_finger_ghost", "right_finger_ghost"] * 2)
+    assert names == sorted(
+        [f"ghost{k}{i}" for k in ("Entry", "Exit") for i in range(1, 5)]
+        + ["left_finger_ghost", "right_finger_ghost"] * 2
+    )
     assert rep["actuators"] == 2 and rep["sensors"] == 2
     assert {"cameraL", "cameraR"} <= set(rep["cameras"])
     assert not world.diagnostics
@@ -67,6 +71,7 @@ def test_runner_builds_the_expected_objects(world):
 
 def test_both_psms_calibrate_exactly(world):
     from adfkit.runner.psm import PSM
+
     for name in ("psm1", "psm2"):
         psm = PSM(world, name)
         assert psm.calibration_error < 1e-8
@@ -79,8 +84,9 @@ def test_ik_reaches_the_needle_and_every_hole_from_above():
     assert len(reach) == 10
     assert all(r.q is not None for r in reach), [r.error for r in reach if r.q is None]
     from adfkit.runner.psm_kinematics import default
+
     kin = default()
-    for r in reach:   # comfortably inside: every joint 0.07 (m or rad) or more from its limits
+    for r in reach:  # comfortably inside: every joint 0.07 (m or rad) or more from its limits
         margin = np.minimum(r.q - kin.lower_limits[:6], kin.upper_limits[:6] - r.q)
         assert margin.min() > 0.07, (r.name, r.label, r.q)
 
@@ -93,19 +99,21 @@ def test_needle_at_entry_puts_the_tip_in_the_hole_and_its_turn_reaches_the_exit(
         # the tip enters along the hole's -z (into the tissue)
         assert np.dot(layout.arc_tangent(n, layout.NEEDLE_TIP_ANGLE), -entry[:3, 2]) > 0.999
         from adfkit.scenes.suturing.frames import rot_z
+
         turn = 2 * (np.pi / 2 - layout.entry_angle())
         assert np.allclose(layout.arc_point(n @ rot_z(-turn), layout.NEEDLE_TIP_ANGLE), exit_[:3, 3], atol=1e-9)
 
 
 def test_a_short_play_is_stable(world):
     from adfkit.runner.psm import PSM
+
     psm = PSM(world, "psm1")
     q0 = psm.measured_jp()
     world.run(1.0)
     rep = world.report()
     assert not rep["nan"] and not rep["exploded"] and not rep["fell_through_floor"]
     assert rep["max_constraint_error_m"] < 1e-3
-    assert np.allclose(psm.measured_jp(), q0, atol=1e-4)   # the arm holds its home pose
+    assert np.allclose(psm.measured_jp(), q0, atol=1e-4)  # the arm holds its home pose
     # the thread holds together: every pair of neighbouring elements still meets at its pivots
     thread = {b.body.name: b for b in world.bodies if b.body.name and b.body.name.startswith("Thread")}
     p = layout.THREAD_PITCH
@@ -125,6 +133,7 @@ def test_psm1_picks_the_needle_up_from_above(built):
     lift 2 cm: the needle (not a thread element) comes along, held within a millimetre."""
     from adfkit.runner.psm import PSM
     from adfkit.runner.world import SimWorld
+
     world = SimWorld(load_scene(built / "launch.yaml", None, []))
     try:
         psm = PSM(world, "psm1")
@@ -152,7 +161,7 @@ def test_psm1_picks_the_needle_up_from_above(built):
         assert np.linalg.norm(now[:3, 3] - held[:3, 3]) < 1e-3
         psm.grasp(False)
         world.step(50)
-        assert needle.world_matrix()[2, 3] - start[2, 3] < 0.01     # released: it fell back
+        assert needle.world_matrix()[2, 3] - start[2, 3] < 0.01  # released: it fell back
     finally:
         world.close()
 
@@ -160,8 +169,11 @@ def test_psm1_picks_the_needle_up_from_above(built):
 def test_help_does_not_import_the_scene_builders():
     import subprocess
     import sys
-    code = ("import sys; from adfkit.cli import build_parser; build_parser(); "
-            "print(any(m.startswith('adfkit.scenes.') for m in sys.modules))")
+
+    code = (
+        "import sys; from adfkit.cli import build_parser; build_parser(); "
+        "print(any(m.startswith('adfkit.scenes.') for m in sys.modules))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert out.stdout.strip() == "False"
 
@@ -171,23 +183,26 @@ def test_needle_hulls_cover_the_needle():
 
     from adfkit.geometry.decompose import load_hulls
     from adfkit.scenes.suturing.needle import HULLS_FILE, needle_mesh
+
     v, f = needle_mesh()
     mesh = trimesh.Trimesh(v, f, process=False)
     assert mesh.is_watertight and mesh.volume > 0
     hulls = load_hulls(HULLS_FILE)
     assert 4 <= len(hulls) <= 16 and all(h.is_watertight and h.volume > 0 for h in hulls)
     from scipy.spatial import ConvexHull
+
     inside = np.zeros(len(v), bool)
     for h in hulls:
-        eq = ConvexHull(h.vertices).equations            # outward normals: inside is <= 0
+        eq = ConvexHull(h.vertices).equations  # outward normals: inside is <= 0
         inside |= (v @ eq[:, :3].T + eq[:, 3]).max(axis=1) < 2e-5
     assert inside.all()
-    assert sum(h.volume for h in hulls) < 1.6 * mesh.volume      # tight: no hull spans the arc's chord
+    assert sum(h.volume for h in hulls) < 1.6 * mesh.volume  # tight: no hull spans the arc's chord
 
 
 @pytest.mark.slow
 def test_committed_needle_hulls_are_coacds_output(tmp_path, monkeypatch):
     from adfkit.scenes.suturing.needle import HULLS_FILE, needle_hulls_text
+
     monkeypatch.setenv("ADFKIT_CACHE", str(tmp_path))
     assert needle_hulls_text(refresh=True)[0] == HULLS_FILE.read_text()
 
@@ -198,6 +213,7 @@ def test_needle_matches_the_challenge_needle():
 
     import trimesh
     from conftest import CORPUS, require_corpus
+
     require_corpus()
     v = trimesh.load(CORPUS / "src/ADF/Phantoms/Simple/high_res/Needle.OBJ", force="mesh").vertices
     a = np.c_[2 * v[:, 0], 2 * v[:, 1], np.ones(len(v))]
@@ -206,7 +222,7 @@ def test_needle_matches_the_challenge_needle():
     assert abs(radius - layout.NEEDLE_RADIUS) < 3e-4
     ang = np.sort(np.arctan2(v[:, 1] - cy, v[:, 0] - cx) % (2 * math.pi))
     gaps = np.diff(np.concatenate([ang, ang[:1] + 2 * math.pi]))
-    arc = 2 * math.pi - gaps.max()                       # the circle minus its largest empty gap
+    arc = 2 * math.pi - gaps.max()  # the circle minus its largest empty gap
     assert abs(arc - layout.NEEDLE_ARC) < math.radians(10)
     wire = (np.hypot(v[:, 0] - cx, v[:, 1] - cy).max() - np.hypot(v[:, 0] - cx, v[:, 1] - cy).min()) / 2
     assert abs(wire - layout.NEEDLE_WIRE) < 1.5e-4
@@ -223,6 +239,7 @@ def test_the_needle_turns_through_every_pair_without_touching(built):
     from adfkit.runner.rotations import matrix_to_pq
     from adfkit.runner.world import SimWorld
     from adfkit.scenes.suturing.frames import rot_z
+
     world = SimWorld(load_scene(built / "launch.yaml", None, []))
     try:
         needle = world.body("Needle")
@@ -231,10 +248,14 @@ def test_the_needle_turns_through_every_pair_without_touching(built):
         for k in range(1, 5):
             for s in np.linspace(-0.1, 1.1, 13):
                 pose = layout.needle_at_entry(k) @ rot_z(-s * turn)
-                pb.resetBasePositionAndOrientation(needle.uid, *matrix_to_pq(pose @ needle.com_in_body),
-                                                   physicsClientId=world.cid)
-                near = [b.key for b in statics
-                        if pb.getClosestPoints(needle.uid, b.uid, 0.0003, -1, b.link, physicsClientId=world.cid)]
+                pb.resetBasePositionAndOrientation(
+                    needle.uid, *matrix_to_pq(pose @ needle.com_in_body), physicsClientId=world.cid
+                )
+                near = [
+                    b.key
+                    for b in statics
+                    if pb.getClosestPoints(needle.uid, b.uid, 0.0003, -1, b.link, physicsClientId=world.cid)
+                ]
                 assert not near, (k, s, near)
     finally:
         world.close()
@@ -252,6 +273,7 @@ def test_ten_seconds_of_play_stay_still(built):
     """Left alone for 10 s the scene stays where it was built: arms at home, needle flat on
     the slab, the thread lying on it with its pivots together."""
     from adfkit.runner.world import Options, SimWorld
+
     world = SimWorld(load_scene(built / "launch.yaml", None, []), Options(visuals=False))
     try:
         needle = world.body("Needle")

@@ -1,5 +1,6 @@
 """The shipped JSON Schemas: in sync with the model, complete, valid draft 2020-12, and
 accepting exactly what AMBF accepts on the corpus and on scalar forms (adf-format.md §1)."""
+
 from __future__ import annotations
 
 import json
@@ -8,6 +9,7 @@ from pathlib import Path
 import jsonschema
 import pytest
 import yaml
+from conftest import corpus_files, corpus_id
 
 from adfkit.adf_schema import KINDS, load_schema, schema_file
 from adfkit.model import FILE_KINDS
@@ -15,13 +17,13 @@ from adfkit.model.spec import Node, adf_fields
 from adfkit.validator.engine import validate_file
 from adfkit.validator.schemagen import build_schema, schema_text
 from adfkit.validator.yamlcompat import repair
-from conftest import corpus_files, corpus_id
 
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_shipped_schema_is_generated_from_the_model(kind):
-    assert schema_file(kind).read_text(encoding="utf-8") == schema_text(kind), \
+    assert schema_file(kind).read_text(encoding="utf-8") == schema_text(kind), (
         "run: python -m adfkit.validator.schemagen"
+    )
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -70,8 +72,12 @@ def test_defaults_and_descriptions_follow_the_reference():
     assert joint["required"] == ["type", "parent pivot", "child pivot", "parent axis", "child axis"]
     assert joint["properties"]["ignore inter-collision"]["default"] is True
     assert joint["dependentRequired"] == {"enable motor": ["enable feedback"]}
-    assert load_schema("launch")["required"] == ["world config", "color config", "input devices config",
-                                                 "multibody configs"]
+    assert load_schema("launch")["required"] == [
+        "world config",
+        "color config",
+        "input devices config",
+        "multibody configs",
+    ]
     assert load_schema("world")["properties"]["gravity"]["default"] == {"x": 0, "y": 0, "z": -9.8}
 
 
@@ -88,24 +94,62 @@ def _accepts(definition: str, value) -> bool:
 
 def _fast_validator_for(definition):
     from adfkit.validator.schema_check import _fast_validator
+
     return _fast_validator("model", definition)
 
 
-@pytest.mark.parametrize("value, ok", [(0.5, True), (3, True), ("0.5", True), (" -1.5e3 ", True), ("1e-3", True),
-                                       (".5", True), ("abc", False), (True, False), (None, False), ([1], False)])
+@pytest.mark.parametrize(
+    "value, ok",
+    [
+        (0.5, True),
+        (3, True),
+        ("0.5", True),
+        (" -1.5e3 ", True),
+        ("1e-3", True),
+        (".5", True),
+        ("abc", False),
+        (True, False),
+        (None, False),
+        ([1], False),
+    ],
+)
 def test_float_scalar_forms(value, ok):
     assert _accepts("float", value) is ok
 
 
-@pytest.mark.parametrize("value, ok", [(True, True), ("True", True), ("y", True), ("N", True), ("off", True),
-                                       ("YES", True), (1, False), (0, False), ("tRue", False), ("1", False)])
+@pytest.mark.parametrize(
+    "value, ok",
+    [
+        (True, True),
+        ("True", True),
+        ("y", True),
+        ("N", True),
+        ("off", True),
+        ("YES", True),
+        (1, False),
+        (0, False),
+        ("tRue", False),
+        ("1", False),
+    ],
+)
 def test_bool_scalar_forms(value, ok):
     assert _accepts("bool", value) is ok
 
 
-@pytest.mark.parametrize("definition, value, ok", [("int", 3, True), ("int", "-4", True), ("int", 2.5, False),
-                                                   ("uint", 0, True), ("uint", -1, False), ("uint", "7", True),
-                                                   ("uint", "-7", False), ("str", 12, True), ("str", None, False)])
+@pytest.mark.parametrize(
+    "definition, value, ok",
+    [
+        ("int", 3, True),
+        ("int", "-4", True),
+        ("int", 2.5, False),
+        ("uint", 0, True),
+        ("uint", -1, False),
+        ("uint", "7", True),
+        ("uint", "-7", False),
+        ("str", 12, True),
+        ("str", None, False),
+    ],
+)
 def test_integer_and_text_forms(definition, value, ok):
     assert _accepts(definition, value) is ok
 
@@ -120,7 +164,9 @@ def test_whole_file_schema_agrees_with_ambf_on_the_corpus(path):
     text = path.read_text(encoding="utf-8")
     data = yaml.safe_load(repair(text)[0])
     errors = list(jsonschema.Draft202012Validator(load_schema(res.kind)).iter_errors(data))
-    if path.name in {f"urdf-{n}.yaml" for n in ("ecm", "kuka", "mtm", "psm", "suj")}:  # rejected by AMBF: enable motor without enable feedback
+    if path.name in {
+        f"urdf-{n}.yaml" for n in ("ecm", "kuka", "mtm", "psm", "suj")
+    }:  # rejected by AMBF: enable motor without enable feedback
         assert errors and {e.validator for e in errors} == {"dependentRequired"}
     else:
         assert errors == [], [e.message for e in errors][:3]
@@ -128,6 +174,7 @@ def test_whole_file_schema_agrees_with_ambf_on_the_corpus(path):
 
 def test_schema_command_matches_package_data(capsys):
     from adfkit.cli import main
+
     for kind in KINDS:
         assert main(["schema", kind]) == 0
         assert json.loads(capsys.readouterr().out) == load_schema(kind)
@@ -141,6 +188,7 @@ def test_fast_schema_path_agrees_with_jsonschema_on_corpus_objects_and_mutations
     pytest.importorskip("jsonschema_rs", reason="jsonschema-rs (the validator's accelerator) is not installed")
     from adfkit.adf.yamlnodes import compose, plain
     from adfkit.validator.schema_check import _fast_validator, _validator, object_lists
+
     checked = disagreements = invalid = 0
     bad_values = ["abc", "1", "tRue", -1, 2.5, None, [1], {"x": 1}, " -1.5e3 ", "off"]
     paths = corpus_files()
@@ -160,9 +208,10 @@ def test_fast_schema_path_agrees_with_jsonschema_on_corpus_objects_and_mutations
                 if not isinstance(obj, dict):
                     continue
                 scalars = [k for k in obj if not isinstance(obj[k], (dict, list))]
-                picks = scalars[checked % max(1, len(scalars))::max(1, len(scalars) // 2)][:2]
-                variants = [obj] + [{**obj, k: bad_values[(checked + n) % len(bad_values)]}
-                                    for n, k in enumerate(picks)]
+                picks = scalars[checked % max(1, len(scalars)) :: max(1, len(scalars) // 2)][:2]
+                variants = [obj] + [
+                    {**obj, k: bad_values[(checked + n) % len(bad_values)]} for n, k in enumerate(picks)
+                ]
                 for v in variants:
                     checked += 1
                     ok = slow.is_valid(v)

@@ -1,4 +1,5 @@
 """`adfkit score-needle-pose`: the challenge's position/orientation errors on known poses."""
+
 from __future__ import annotations
 
 import json
@@ -27,18 +28,23 @@ def test_known_poses(tmp_path, capsys):
 def test_quaternion_and_matrix_agree(tmp_path, capsys):
     h = math.sqrt(0.5)
     gt = _write(tmp_path / "gt.json", {"poses": [{"position": [0, 0, 0], "orientation": [h, 0, 0, h]}]})
-    est = _write(tmp_path / "est.json", {"poses": [{"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}]})
+    est = _write(
+        tmp_path / "est.json", {"poses": [{"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}]}
+    )
     assert main(["score-needle-pose", gt, est, "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["poses"][0]["orientation_error_rad"] == pytest.approx(math.pi / 2, abs=1e-9)
     assert out["poses"][0]["position_error_m"] == 0.0
 
 
-@pytest.mark.parametrize("doc, rule", [
-    ({"position": [0, 0]}, "bad-pose"),
-    ({"position": [0, 0, 0], "orientation": [0, 0, 0, 2]}, "bad-pose"),
-    ({"poses": []}, "bad-pose"),
-])
+@pytest.mark.parametrize(
+    "doc, rule",
+    [
+        ({"position": [0, 0]}, "bad-pose"),
+        ({"position": [0, 0, 0], "orientation": [0, 0, 0, 2]}, "bad-pose"),
+        ({"poses": []}, "bad-pose"),
+    ],
+)
 def test_bad_input_is_exit_2(tmp_path, capsys, doc, rule):
     gt = _write(tmp_path / "gt.json", {"position": [0, 0, 0], "orientation": [0, 0, 0, 1]})
     est = _write(tmp_path / "est.json", doc)

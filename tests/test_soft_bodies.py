@@ -1,5 +1,6 @@
 """Issue 16: soft bodies through the model, reader/writer, schema, validator, geometry,
 runner and MJCF. Corpus tests (sb/cloth.yaml, cloth2.yaml) skip when the corpus is absent."""
+
 from __future__ import annotations
 
 import shutil
@@ -9,6 +10,7 @@ import jsonschema
 import numpy as np
 import pytest
 import yaml
+from conftest import CORPUS, require_corpus
 
 from adfkit.adf import dumps, read_file
 from adfkit.adf.yamlnodes import compose, plain
@@ -19,17 +21,43 @@ from adfkit.model import ModelFile
 from adfkit.model.objects import SoftBodyConfig
 from adfkit.model.spec import adf_keys
 from adfkit.validator import validate_file
-from conftest import CORPUS, require_corpus
 
 SB = "ambf/ambf_models/descriptions/multi-bodies/sb/"
 CLOTHS = ["cloth.yaml", "cloth2.yaml"]
 # Every key AMBF 2.0's loader reads inside `config:` (ADFLoader_1_0::loadSoftBodyAttribs),
 # less `cutting`, which it reads into a node and never uses.
 AMBF_CONFIG_KEYS = {
-    "kLST", "kAST", "kVST", "kVCF", "kDP", "kDG", "kLF", "kPR", "kVC", "kDF", "kMT", "kCHR", "kKHR", "kSHR",
-    "kAHR", "kSRHR_CL", "kSKHR_CL", "kSSHR_CL", "kSR_SPLT_CL", "kSK_SPLT_CL", "kSS_SPLT_CL", "maxvolume",
-    "timescale", "viterations", "piterations", "diterations", "citerations", "flags", "bending constraint",
-    "clusters", "fixed nodes",
+    "kLST",
+    "kAST",
+    "kVST",
+    "kVCF",
+    "kDP",
+    "kDG",
+    "kLF",
+    "kPR",
+    "kVC",
+    "kDF",
+    "kMT",
+    "kCHR",
+    "kKHR",
+    "kSHR",
+    "kAHR",
+    "kSRHR_CL",
+    "kSKHR_CL",
+    "kSSHR_CL",
+    "kSR_SPLT_CL",
+    "kSK_SPLT_CL",
+    "kSS_SPLT_CL",
+    "maxvolume",
+    "timescale",
+    "viterations",
+    "piterations",
+    "diterations",
+    "citerations",
+    "flags",
+    "bending constraint",
+    "clusters",
+    "fixed nodes",
 }
 
 
@@ -40,6 +68,7 @@ def _cloth(name: str):
 
 # --- model, reader, writer -------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("name", CLOTHS)
 def test_corpus_cloth_reads_every_soft_body_key(name):
     doc, _ = read_file(_cloth(name))
@@ -47,8 +76,14 @@ def test_corpus_cloth_reads_every_soft_body_key(name):
     (sb,) = doc.soft_bodies
     assert (sb.identifier, sb.name, sb.mesh, sb.mass, sb.scale) == ("BODY Cloth", "cloth", "cloth.3DS", 1.0, 1.0)
     cfg = sb.config
-    assert (cfg.kLST, cfg.kDP, cfg.piterations, cfg.bending_constraint, cfg.flags, cfg.fixed_nodes) == \
-        (0.005, 0.001, 6, 2, 16, [0])
+    assert (cfg.kLST, cfg.kDP, cfg.piterations, cfg.bending_constraint, cfg.flags, cfg.fixed_nodes) == (
+        0.005,
+        0.001,
+        6,
+        2,
+        16,
+        [0],
+    )
     assert sb.randomize_constraints is True
     # AMBF keeps the first of the duplicated `collision margin`; `margin` is not read by AMBF
     assert sb.collision_margin == {"cloth.yaml": 0.001, "cloth2.yaml": 0.1}[name]
@@ -64,13 +99,13 @@ def test_corpus_cloth_round_trips_byte_stable_with_every_key(name, tmp_path):
     out = tmp_path / name
     out.write_text(text)
     again, _ = read_file(out)
-    assert dumps(again) == text                      # byte-stable
-    original = plain(compose(path.read_text(), str(path), []))   # AMBF's first-wins reading
+    assert dumps(again) == text  # byte-stable
+    original = plain(compose(path.read_text(), str(path), []))  # AMBF's first-wins reading
     written = yaml.safe_load(text)
     assert written["soft bodies"] == ["BODY Cloth"]
     orig_sb, new_sb = original["BODY Cloth"], written["BODY Cloth"]
-    assert set(orig_sb) == set(new_sb)               # every key of the soft body kept
-    assert orig_sb["config"] == new_sb["config"]     # config values exactly, margin included
+    assert set(orig_sb) == set(new_sb)  # every key of the soft body kept
+    assert orig_sb["config"] == new_sb["config"]  # config values exactly, margin included
     assert new_sb["collision margin"] == orig_sb["collision margin"]
     assert new_sb["randomize constraints"] is True
 
@@ -83,11 +118,27 @@ def test_soft_body_written_from_the_model_reads_back(tmp_path):
     from adfkit.model.objects import SoftBody
 
     m = ModelFile()
-    m.soft_bodies.append(SoftBody(identifier="SOFT pad", name="pad", mesh="pad.obj", mass=0.2,
-                                  config=SoftBodyConfig(kLST=0.4, kAST=0.3, kVST=0.2, kDF=0.6, kDP=0.05,
-                                                        piterations=8, clusters=4, bending_constraint=2,
-                                                        fixed_nodes=[0, 3, 7]),
-                                  randomize_constraints=True, collision_margin=0.002))
+    m.soft_bodies.append(
+        SoftBody(
+            identifier="SOFT pad",
+            name="pad",
+            mesh="pad.obj",
+            mass=0.2,
+            config=SoftBodyConfig(
+                kLST=0.4,
+                kAST=0.3,
+                kVST=0.2,
+                kDF=0.6,
+                kDP=0.05,
+                piterations=8,
+                clusters=4,
+                bending_constraint=2,
+                fixed_nodes=[0, 3, 7],
+            ),
+            randomize_constraints=True,
+            collision_margin=0.002,
+        )
+    )
     text = dumps(m)
     p = tmp_path / "pad.yaml"
     p.write_text(text)
@@ -99,6 +150,7 @@ def test_soft_body_written_from_the_model_reads_back(tmp_path):
 
 
 # --- schema ------------------------------------------------------------------------------------
+
 
 def test_schema_lists_every_soft_body_config_key():
     schema = load_schema("model")
@@ -120,6 +172,7 @@ def test_schema_accepts_the_corpus_cloth_and_rejects_a_bad_config(name):
 
 
 # --- geometry: the nodes AMBF makes of a mesh -------------------------------------------------------
+
 
 def test_corpus_cloth_mesh_has_386_unique_nodes():
     mesh = load_soft_mesh(_cloth("cloth.yaml").parent / "low_res" / "cloth.3DS")
@@ -195,15 +248,18 @@ def test_clean_soft_body_has_no_findings(tmp_path):
     assert _findings(tmp_path) == []
 
 
-@pytest.mark.parametrize("change, expected", [
-    (dict(mesh="''"), ("soft-body-mesh", 4, "warning")),
-    (dict(mass="0.0"), ("soft-body-mass", 5, "warning")),
-    (dict(klst="1.5"), ("soft-body-coefficient", 6, "warning")),
-    (dict(pit="0"), ("soft-body-iterations", 6, "warning")),
-    (dict(bend="1"), ("soft-body-iterations", 6, "warning")),
-    (dict(fixed="[0, 4]"), ("soft-body-fixed-nodes", 6, "error")),
-    (dict(fixed="[-1]"), ("soft-body-fixed-nodes", 6, "error")),
-])
+@pytest.mark.parametrize(
+    "change, expected",
+    [
+        (dict(mesh="''"), ("soft-body-mesh", 4, "warning")),
+        (dict(mass="0.0"), ("soft-body-mass", 5, "warning")),
+        (dict(klst="1.5"), ("soft-body-coefficient", 6, "warning")),
+        (dict(pit="0"), ("soft-body-iterations", 6, "warning")),
+        (dict(bend="1"), ("soft-body-iterations", 6, "warning")),
+        (dict(fixed="[0, 4]"), ("soft-body-fixed-nodes", 6, "error")),
+        (dict(fixed="[-1]"), ("soft-body-fixed-nodes", 6, "error")),
+    ],
+)
 def test_soft_body_rules(tmp_path, change, expected):
     assert expected in _findings(tmp_path, **change)
 
@@ -246,7 +302,7 @@ def _world(path, seconds: float, **opt):
 
 def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path, monkeypatch):
     """cloth.yaml (386 nodes, hung from node 0) over a 0.4 m box whose top is 0.1 m below it."""
-    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")   # the launch in tmp names the corpus file by path
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")  # the launch in tmp names the corpus file by path
     cloth = _cloth("cloth.yaml")
     (tmp_path / "box.yaml").write_text(BOX_UNDER_CLOTH)
     (tmp_path / "launch.yaml").write_text(f"multibody configs:\n  - {cloth}\n  - box.yaml\n")
@@ -262,7 +318,7 @@ def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path, monkeypatch):
     assert (row["name"], row["nodes"], row["fixed_nodes"]) == ("/ambf/env/BODY Cloth", 386, 1)
     assert rep["nan"] == rep["exploded"] == rep["fell_through_floor"] == []
     assert np.all(np.isfinite(nodes))
-    np.testing.assert_allclose(nodes[0], [0.38972265, 2.67708838, 0.0], atol=1e-6)   # the anchored corner
+    np.testing.assert_allclose(nodes[0], [0.38972265, 2.67708838, 0.0], atol=1e-6)  # the anchored corner
     top = -0.1
     on_box = (np.abs(nodes[:, 0]) < 0.2) & (np.abs(nodes[:, 1] - 2.0) < 0.2)
     assert on_box.sum() >= 10
@@ -271,13 +327,13 @@ def test_corpus_cloth_falls_and_drapes_on_a_box(tmp_path, monkeypatch):
     assert nodes[on_box, 2].min() > top - 0.005, nodes[on_box, 2]
     assert nodes[on_box, 2].max() < -0.02
     assert nodes[~on_box, 2].min() < top - 0.3
-    assert row["size_m"] < 1.5 * row["rest_size_m"]                            # stretched, not exploded
+    assert row["size_m"] < 1.5 * row["rest_size_m"]  # stretched, not exploded
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", CLOTHS)
 def test_corpus_cloth_plays_5_seconds_on_a_box(name, tmp_path, monkeypatch):
-    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")   # the launch in tmp names the corpus file by path
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")  # the launch in tmp names the corpus file by path
     cloth = _cloth(name)
     y = {"cloth.yaml": 2.0, "cloth2.yaml": -0.5}[name]
     (tmp_path / "box.yaml").write_text(BOX_UNDER_CLOTH.replace("y: 2.0", f"y: {y}"))
@@ -300,6 +356,7 @@ def test_adfkit_run_plays_corpus_cloth2_and_reports_it(tmp_path, capsys):
     assert rc == 0, err
     assert "warning[yaml-duplicate-key]" in err and "runner-soft-body-approx" in err
     import json
+
     rep = json.loads((tmp_path / "report.json").read_text())
     (row,) = rep["soft_bodies"]
     assert (row["nodes"], row["triangles"], row["fixed_nodes"]) == (386, 768, 1)
@@ -348,8 +405,10 @@ def test_soft_rigid_attachment_and_parameter_mapping(tmp_path):
 
     # grid_obj is centred; shift it so node 0 is at the origin and node 24 at (0.1, 0.1)
     text = grid_obj(0.1, 4).splitlines()
-    shifted = [f"v {float(l.split()[1]) + 0.05:.6f} {float(l.split()[2]) + 0.05:.6f} 0.0" if l.startswith("v ")
-               else l for l in text]
+    shifted = [
+        f"v {float(l.split()[1]) + 0.05:.6f} {float(l.split()[2]) + 0.05:.6f} 0.0" if l.startswith("v ") else l
+        for l in text
+    ]
     (tmp_path / "sheet.obj").write_text("\n".join(shifted) + "\n")
     (tmp_path / "sheet.yaml").write_text(SHEET.format())
     world = _world(tmp_path / "sheet.yaml", 0.6, ground=False)
@@ -362,14 +421,14 @@ def test_soft_rigid_attachment_and_parameter_mapping(tmp_path):
     finally:
         world.close()
     assert soft.attached == {"BODY weight": [24]}
-    assert world.joint_names == []                       # the joint became an anchor, not a rigid joint
+    assert world.joint_names == []  # the joint became an anchor, not a rigid joint
     np.testing.assert_allclose(nodes[0], [0.0, 0.0, 1.0], atol=1e-6)
-    assert np.linalg.norm(nodes[24] - weight) < 0.01     # the weight hangs on its node
-    assert 0.8 < weight[2] < 0.99                        # held up by the sheet, not falling freely
+    assert np.linalg.norm(nodes[24] - weight) < 0.01  # the weight hangs on its node
+    assert 0.8 < weight[2] < 0.99  # held up by the sheet, not falling freely
     assert "config.kAST, config.clusters not played" in rules["runner-soft-body-approx"]
     p = soft.params
     m_node = 0.02 / 25
-    assert p["springElasticStiffness"] == pytest.approx(min(1 - 0.5 ** 4, 0.4) * m_node / 1e-6)
+    assert p["springElasticStiffness"] == pytest.approx(min(1 - 0.5**4, 0.4) * m_node / 1e-6)
     assert p["springDampingStiffness"] == pytest.approx(0.5 * m_node / 1e-3)
     assert (p["collisionMargin"], p["frictionCoeff"], p["useBendingSprings"]) == (0.002, 0.2, 0)
     assert rep["soft_bodies"][0]["attached_nodes"] == {"BODY weight": 1}
@@ -381,24 +440,28 @@ def test_plane_beside_a_soft_body_is_warned_and_the_default_floor_is_a_slab(tmp_
     (tmp_path / "plane.yaml").write_text(
         "bodies: [BODY floor]\nsoft bodies: [SOFT s]\nBODY floor:\n  name: floor\n  mass: 0.0\n"
         "  location: {position: {x: 0, y: 0, z: -0.5}, orientation: {r: 0, p: 0, y: 0}}\n"
-        "  collision shape: PLANE\n  collision geometry: {normal: {x: 0, y: 0, z: 1}, offset: 0}\n" + soft)
+        "  collision shape: PLANE\n  collision geometry: {normal: {x: 0, y: 0, z: 1}, offset: 0}\n" + soft
+    )
     world = _world(tmp_path / "plane.yaml", 0.0)
     try:
         assert "runner-soft-plane" in {d.rule for d in world.diagnostics}
     finally:
         world.close()
-    (tmp_path / "alone.yaml").write_text("soft bodies: [SOFT s]\n" + soft.replace("mesh", "location: {position: "
-                                         "{x: 0, y: 0, z: 0.3}, orientation: {r: 0, p: 0, y: 0}}\n  mesh"))
+    (tmp_path / "alone.yaml").write_text(
+        "soft bodies: [SOFT s]\n"
+        + soft.replace("mesh", "location: {position: {x: 0, y: 0, z: 0.3}, orientation: {r: 0, p: 0, y: 0}}\n  mesh")
+    )
     world = _world(tmp_path / "alone.yaml", 0.5)
     try:
         z = world.soft.items[0].nodes(world.cid)[:, 2]
-        assert world.ground_z == pytest.approx(0.299)            # 1 mm under the sheet, as for rigid bodies
-        assert np.all(np.abs(z - 0.3) < 0.003), z                # resting on it, not centimetres above
+        assert world.ground_z == pytest.approx(0.299)  # 1 mm under the sheet, as for rigid bodies
+        assert np.all(np.abs(z - 0.3) < 0.003), z  # resting on it, not centimetres above
     finally:
         world.close()
 
 
 # --- the soft phantom sample scene -------------------------------------------------------------------
+
 
 def _skin_under_tool(launch, seconds, tool="Probe"):
     world = _world(launch, seconds)
@@ -432,13 +495,13 @@ def test_soft_phantom_is_indented_by_a_spherical_probe(tmp_path, sag):
     far = np.linalg.norm(nodes[:, :2], axis=1) > 0.035
     depth = p.height - nodes[centre, 2].min()
     print(f"skin indentation under the probe: {(depth - sag) * 1000:.1f} mm (sag alone {sag * 1000:.1f} mm)")
-    assert 0.005 < depth - sag < 0.03                           # visibly indented: millimetres to centimetres
+    assert 0.005 < depth - sag < 0.03  # visibly indented: millimetres to centimetres
     assert probe[2] - p.probe_radius == pytest.approx(nodes[centre, 2].min(), abs=0.004)  # tip on the skin
     # the dent is local: far from the probe the skin moved much less than under it
     assert (p.height - nodes[far, 2].min()) < 0.5 * depth
 
 
-@pytest.mark.slow   # six capsules against the skin: ~3x the sphere's contact cost
+@pytest.mark.slow  # six capsules against the skin: ~3x the sphere's contact cost
 def test_soft_phantom_is_indented_by_the_suturing_needle(tmp_path, sag):
     """The bundled scene's tool: the suturing pad's needle lying flat, pressed with 0.49 N."""
     from adfkit.scenes.soft_phantom import SoftPhantomParams, write_soft_phantom
@@ -452,7 +515,7 @@ def test_soft_phantom_is_indented_by_the_suturing_needle(tmp_path, sag):
     assert 0.005 < depth - sag < 0.03
     # the needle rests on the skin (its wire within a few millimetres of the skin's lowest node), not through it
     assert -0.002 < needle[2] - nodes[under, 2].min() < 0.006
-    assert needle[2] > 0.015                                    # well above the tray (top at 0.01)
+    assert needle[2] > 0.015  # well above the tray (top at 0.01)
 
 
 def test_soft_phantom_sample_scene_is_generated(tmp_path):
@@ -471,6 +534,7 @@ def test_soft_phantom_sample_scene_is_generated(tmp_path):
 
 # --- MJCF and URDF ---------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("name", CLOTHS)
 def test_convert_cloth_to_mjcf_loads_and_plays_in_mujoco(name, tmp_path):
     mujoco = pytest.importorskip("mujoco")
@@ -484,9 +548,10 @@ def test_convert_cloth_to_mjcf_loads_and_plays_in_mujoco(name, tmp_path):
         mujoco.mj_step(model, data)
     pos = data.flexvert_xpos
     assert np.all(np.isfinite(pos))
-    np.testing.assert_allclose(pos[0], [0.38972265, {"cloth.yaml": 2.67708838, "cloth2.yaml": 0.17708838}[name], 0.0],
-                               atol=1e-6)                     # fixed node 0: a pin
-    assert pos[:, 2].min() < -0.05                            # the rest falls
+    np.testing.assert_allclose(
+        pos[0], [0.38972265, {"cloth.yaml": 2.67708838, "cloth2.yaml": 0.17708838}[name], 0.0], atol=1e-6
+    )  # fixed node 0: a pin
+    assert pos[:, 2].min() < -0.05  # the rest falls
     assert start is None or np.linalg.norm(pos - start, axis=1).max() < 5.0
 
 
@@ -498,22 +563,33 @@ def test_mjcf_flex_parameters_and_losses(tmp_path):
 
     (tmp_path / "sq.obj").write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n")
     m = ModelFile(path=tmp_path / "m.yaml")
-    m.soft_bodies.append(SoftBody(identifier="SOFT s", name="s", mesh="sq.obj", mass=0.4, collision_margin=0.01,
-                                  config=SoftBodyConfig(kLST=0.5, piterations=2, kDF=0.7, kVC=3.0, kDP=0.2,
-                                                        fixed_nodes=[1, 9]),
-                                  randomize_constraints=True))
+    m.soft_bodies.append(
+        SoftBody(
+            identifier="SOFT s",
+            name="s",
+            mesh="sq.obj",
+            mass=0.4,
+            collision_margin=0.01,
+            config=SoftBodyConfig(kLST=0.5, piterations=2, kDF=0.7, kVC=3.0, kDP=0.2, fixed_nodes=[1, 9]),
+            randomize_constraints=True,
+        )
+    )
     losses = write(m, tmp_path / "m.xml", "mjcf")
     flex = ET.parse(tmp_path / "m.xml").getroot().find("worldbody/flexcomp")
     assert flex.get("point") == "0.0 0.0 0.0 1.0 0.0 0.0 1.0 1.0 0.0 0.0 1.0 0.0"
     assert (flex.get("element"), flex.get("mass"), flex.get("radius")) == ("0 1 2 0 2 3", "0.4", "0.01")
-    k = (1 - 0.5 ** 2) * 0.1 / 1e-6
+    k = (1 - 0.5**2) * 0.1 / 1e-6
     el = flex.find("elasticity")
     assert float(el.get("young")) * float(el.get("thickness")) == pytest.approx(k)
     assert el.get("elastic2d") == "stretch"
     assert flex.find("contact").get("friction") == "0.7" and flex.find("pin").get("id") == "1"
     feats = {(l.element, l.feature) for l in losses}
-    assert {("SOFT s", "config.kVC"), ("SOFT s", "randomize constraints"), ("SOFT s", "fixed nodes"),
-            ("SOFT s", "soft body")} <= feats
+    assert {
+        ("SOFT s", "config.kVC"),
+        ("SOFT s", "randomize constraints"),
+        ("SOFT s", "fixed nodes"),
+        ("SOFT s", "soft body"),
+    } <= feats
     # and back: MuJoCo's flex is a named loss, its vertex bodies are not made ADF bodies
     from adfkit.converters import read
 
@@ -540,6 +616,7 @@ def test_soft_body_mesh_outside_the_tree_or_unnameable_is_not_read(tmp_path, mon
     validator and `convert` read /etc/passwd there), and a name over 255 bytes is a located
     finding, not an OSError."""
     from adfkit.cli import main
+
     scene = tmp_path / "scene"
     scene.mkdir()
     secret = tmp_path / "secret.3ds"
@@ -548,12 +625,13 @@ def test_soft_body_mesh_outside_the_tree_or_unnameable_is_not_read(tmp_path, mon
     f = scene / "soft.yaml"
     f.write_text(SOFT.format(mesh=mesh, mass="0.1", klst="0.5", pit="4", bend="2", fixed="[0, 9]"))
     monkeypatch.setenv("ADFKIT_INPUT_ROOT", str(scene))
-    import fuzzkit   # its audit hook records every open (one hook for the whole session)
+    import fuzzkit  # its audit hook records every open (one hook for the whole session)
+
     fuzzkit._install_hook()
     fuzzkit._OPENED = []
     try:
         rules = [d.rule for d in validate_file(f).diagnostics]
-        assert rules and "soft-body-fixed-nodes" not in rules          # the mesh was not counted
+        assert rules and "soft-body-fixed-nodes" not in rules  # the mesh was not counted
         assert ({"outside-tree"} if where == "outside" else {"missing-mesh", "bad-path"}) & set(rules)
         assert main(["convert", str(f), str(scene / "out.xml")]) in (0, 1, 2)
         opened = [str(p) for p in fuzzkit._OPENED]

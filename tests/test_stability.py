@@ -1,5 +1,6 @@
 """Instability is caught while a scene plays, in both engines, and fails the run: a state reset
 (MuJoCo), NaN or a body flung by the solver (PyBullet) is reported with its time and body."""
+
 from __future__ import annotations
 
 import json
@@ -46,15 +47,16 @@ def _play(tmp_path, engine: str, gz: str, capsys):
     f = tmp_path / "bob.yaml"
     f.write_text(SCENE.replace("GZ", gz))
     out = tmp_path / f"out_{engine}"
-    status = main(["run", str(f), "--engine", engine, "--seconds", "0.3", "--no-frames", "--no-ground",
-                   "--out", str(out)])
+    status = main(
+        ["run", str(f), "--engine", engine, "--seconds", "0.3", "--no-frames", "--no-ground", "--out", str(out)]
+    )
     return status, json.loads((out / "report.json").read_text()), capsys.readouterr()
 
 
 @pytest.mark.parametrize("engine,kind", [("pybullet", "flung"), ("mujoco", "state-reset")])
 def test_a_scene_built_to_blow_up_fails_with_time_and_body(tmp_path, capsys, monkeypatch, engine, kind):
-    monkeypatch.chdir(tmp_path)          # MuJoCo writes MUJOCO_LOG.TXT into the current folder unless handled
-    status, rep, out = _play(tmp_path, engine, "-1.0e12", capsys)   # a body pulled by 10^11 g
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes MUJOCO_LOG.TXT into the current folder unless handled
+    status, rep, out = _play(tmp_path, engine, "-1.0e12", capsys)  # a body pulled by 10^11 g
     assert status == 1, out.err
     events = rep["instabilities"]
     assert events and events[0]["body"] == "BODY bob" and events[0]["kind"] == kind

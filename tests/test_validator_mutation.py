@@ -1,58 +1,74 @@
 """Mutation test: broken variants of every corpus file. Each variant must give at least one
 diagnostic naming the damage, every diagnostic must point at a line:col inside the
 variant, and nothing may raise. ~150 variants by default, the full set (> 2,000) with -m slow."""
+
 from __future__ import annotations
 
 import os
 import random
 import re
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import pytest
+from conftest import CORPUS, corpus_files
 
 from adfkit.adf import read_file
 from adfkit.diagnostics import AdfError
 from adfkit.model.spec import adf_fields, adf_keys
 from adfkit.validator import validate_file
-from conftest import CORPUS, corpus_files
 
 SEEDS_PER_OPERATOR = 3
-BOMB = "".join([
-    "lol0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol, lol]\n",
-    *(f"lol{i}: &l{i} [*l{i-1}, *l{i-1}, *l{i-1}, *l{i-1}, *l{i-1}, *l{i-1}, *l{i-1}, *l{i-1}, *l{i-1}, *l{i-1}]\n"
-      for i in range(1, 8)),
-])
+BOMB = "".join(
+    [
+        "lol0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol, lol]\n",
+        *(
+            f"lol{i}: &l{i} [*l{i - 1}, *l{i - 1}, *l{i - 1}, *l{i - 1}, *l{i - 1}, *l{i - 1}, *l{i - 1}, *l{i - 1}, *l{i - 1}, *l{i - 1}]\n"
+            for i in range(1, 8)
+        ),
+    ]
+)
 NUMBER = r"-?[0-9]+\.?[0-9]*(?:[eE][-+]?[0-9]+)?"
 
 
 def _lines_matching(text: str, pattern: str) -> list[re.Match]:
     """Matches outside comments."""
-    return [m for m in re.finditer(pattern, text, flags=re.M)
-            if "#" not in text[text.rfind("\n", 0, m.start()) + 1:m.start()]]
+    return [
+        m
+        for m in re.finditer(pattern, text, flags=re.M)
+        if "#" not in text[text.rfind("\n", 0, m.start()) + 1 : m.start()]
+    ]
 
 
 def _replace(text: str, m: re.Match, group: int, new: str) -> str:
-    return text[:m.start(group)] + new + text[m.end(group):]
+    return text[: m.start(group)] + new + text[m.end(group) :]
 
 
 def op_delete_required(text, rng):
-    for pat in (r"^[ \t]+(?:parent pivot|child pivot|parent axis|child axis|type):.*\n",
-                r"^(?:world config|input devices config|multibody configs):.*\n",
-                r"^environment:.*\n", r"^[ \t]+hardware name:.*\n"):
+    for pat in (
+        r"^[ \t]+(?:parent pivot|child pivot|parent axis|child axis|type):.*\n",
+        r"^(?:world config|input devices config|multibody configs):.*\n",
+        r"^environment:.*\n",
+        r"^[ \t]+hardware name:.*\n",
+    ):
         found = _lines_matching(text, pat)
         if found:
             m = rng.choice(found)
-            return text[:m.start()] + text[m.end():]
+            return text[: m.start()] + text[m.end() :]
     return None
 
 
 def op_wrong_type(text, rng):
-    found = _lines_matching(text, rf"^[ \t]+(?:mass|scale|restitution|collision margin|range|max motor impulse"
-                                  rf"|spot exponent|field view angle|workspace scaling):[ \t]*({NUMBER})[ \t]*$")
+    found = _lines_matching(
+        text,
+        rf"^[ \t]+(?:mass|scale|restitution|collision margin|range|max motor impulse"
+        rf"|spot exponent|field view angle|workspace scaling):[ \t]*({NUMBER})[ \t]*$",
+    )
     if found:
         return _replace(text, rng.choice(found), 1, "not_a_number")
-    found = _lines_matching(text, r"^[ \t]+(?:passive|visible|publish image|enable feedback):[ \t]*(true|false|True|False)")
+    found = _lines_matching(
+        text, r"^[ \t]+(?:passive|visible|publish image|enable feedback):[ \t]*(true|false|True|False)"
+    )
     if found:
         return _replace(text, rng.choice(found), 1, "1")
     found = _lines_matching(text, r"\b[rgba]: (" + NUMBER + ")")
@@ -66,7 +82,9 @@ def op_dangling(text, rng):
 
 def op_bad_path(text, rng):
     found = _lines_matching(text, r"^[ \t]+(?:mesh|collision mesh):[ \t]*([^'\s].*?)[ \t]*$")
-    found = found or _lines_matching(text, r"^(?:world config|color config|input devices config|environment):[ \t]*(\S.*?)[ \t]*$")
+    found = found or _lines_matching(
+        text, r"^(?:world config|color config|input devices config|environment):[ \t]*(\S.*?)[ \t]*$"
+    )
     return _replace(text, rng.choice(found), 1, f"no/such/file_{rng.randrange(10**6)}.stl") if found else None
 
 
@@ -94,12 +112,12 @@ def op_truncate(text, rng):
     """Cut inside a flow mapping, or else in the middle of a (non-comment) line of the first half."""
     braces = [m.start() + 1 for m in re.finditer(r"\{", text)]
     if braces:
-        return text[:rng.choice(braces)]
+        return text[: rng.choice(braces)]
     lines = [m for m in _lines_matching(text[: max(1, len(text) // 2)] + "\n", r"^[ \t]*[^#\s].{2,}$")]
     if not lines:
         return text[: len(text) // 2]
     m = rng.choice(lines)
-    return text[:m.start() + (m.end() - m.start()) // 2]
+    return text[: m.start() + (m.end() - m.start()) // 2]
 
 
 def op_duplicate_key(text, rng):
@@ -108,7 +126,7 @@ def op_duplicate_key(text, rng):
     if not found:
         return None
     m = rng.choice(found)
-    return text[:m.end()] + m.group(0) + text[m.end():]
+    return text[: m.end()] + m.group(0) + text[m.end() :]
 
 
 def op_invalid_utf8(data: bytes, rng) -> bytes:
@@ -121,8 +139,18 @@ def op_invalid_utf8(data: bytes, rng) -> bytes:
 # AMBF does not read, and the validator says so) count as detecting it.
 ALWAYS_DETECTED_BY = {"yaml-syntax", "unknown-key", "ignored-key"}
 OPERATORS = {
-    "delete_required": (op_delete_required, {"schema-required", "no-environment", "input-device", "missing-type",
-                                             "unknown-kind", "undefined-object", "bad-type"}),
+    "delete_required": (
+        op_delete_required,
+        {
+            "schema-required",
+            "no-environment",
+            "input-device",
+            "missing-type",
+            "unknown-kind",
+            "undefined-object",
+            "bad-type",
+        },
+    ),
     "wrong_type": (op_wrong_type, {"bad-type", "bad-bool", "schema-type", "missing-component"}),
     "dangling": (op_dangling, {"dangling-reference", "external-reference", "input-device"}),
     "bad_path": (op_bad_path, {"missing-mesh", "missing-file", "missing-color-file", "missing-model-file"}),
@@ -130,10 +158,27 @@ OPERATORS = {
     "recursive_alias": (op_recursive_alias, {"yaml-recursive-alias"}),
     "nan": (op_nan, {"non-finite-number"}),
     "huge": (op_huge, {"absurd-value"}),
-    "truncate": (op_truncate, {"undefined-object", "schema-required", "empty-file", "unknown-kind", "not-a-mapping",
-                               "missing-component", "no-environment", "bad-type", "missing-model-file",
-                               "missing-file", "missing-mesh", "dangling-reference", "external-reference",
-                               "schema-type", "bad-bool", "input-device"}),
+    "truncate": (
+        op_truncate,
+        {
+            "undefined-object",
+            "schema-required",
+            "empty-file",
+            "unknown-kind",
+            "not-a-mapping",
+            "missing-component",
+            "no-environment",
+            "bad-type",
+            "missing-model-file",
+            "missing-file",
+            "missing-mesh",
+            "dangling-reference",
+            "external-reference",
+            "schema-type",
+            "bad-bool",
+            "input-device",
+        },
+    ),
     "duplicate_key": (op_duplicate_key, {"yaml-duplicate-key"}),
     "invalid_utf8": (op_invalid_utf8, {"yaml-encoding"}),
 }
@@ -158,7 +203,7 @@ ALL = variants()
 FAST = ALL[:: max(1, len(ALL) // 150)]
 
 
-@lru_cache(maxsize=None)
+@cache
 def _read_keys(path: Path) -> frozenset[str]:
     """Top-level keys AMBF reads in the original file: its own keys and listed identifiers."""
     doc, _ = read_file(path)

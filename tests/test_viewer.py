@@ -1,6 +1,7 @@
 """`adfkit view` driven in a real headless browser (the system's Chromium through Playwright):
 the bundled suturing scene is drawn (not a blank canvas), a joint slider moves the picture, a
 recorded episode replays on its timeline; and bad input is a clear error."""
+
 from __future__ import annotations
 
 import json
@@ -9,7 +10,6 @@ import socket
 
 import numpy as np
 import pytest
-
 from conftest import ROOT
 
 from adfkit.cli import main
@@ -45,12 +45,14 @@ def _canvas(page) -> np.ndarray:
     from io import BytesIO
 
     from PIL import Image
+
     png = page.screenshot(clip={"x": 0, "y": 160, "width": 900, "height": 600})
     return np.asarray(Image.open(BytesIO(png)).convert("RGB")).astype(np.int16)
 
 
 def _serve(episode=None):
     from adfkit.viewer.server import Viewer
+
     v = Viewer(BUNDLED, None, "pybullet", "127.0.0.1", _free_port(), episode)
     v.load()
     return v, v.start()
@@ -60,7 +62,7 @@ def _open(browser, address):
     page = browser.new_page(viewport={"width": 1280, "height": 800})
     page.goto(address)
     page.wait_for_selector("canvas", timeout=30_000)
-    page.wait_for_timeout(4000)       # the scene's meshes arrive over the websocket
+    page.wait_for_timeout(4000)  # the scene's meshes arrive over the websocket
     return page
 
 
@@ -90,12 +92,12 @@ def test_the_scene_is_drawn_and_a_joint_slider_moves_it(browser):
         # not a blank canvas: many colours and real contrast where the bodies are
         assert len(np.unique(before.reshape(-1, 3), axis=0)) > 200 and before.std() > 10
         _expand(page, "Joints", "psm1/base link simple")
-        _to_end(page.locator("[role=slider]").first)   # the first joint (the arm's yaw) to its upper limit
+        _to_end(page.locator("[role=slider]").first)  # the first joint (the arm's yaw) to its upper limit
         arm = v.world.articulations[0]
         assert v.world.joint_state(arm, [0])[0][0] == pytest.approx(arm.records[0][0].joint_limits.high, abs=1e-6)
         after = _canvas(page)
         moved = np.abs(after - before).max(axis=2) > 40
-        assert moved.mean() > 0.002, moved.mean()      # the arm swung: its pixels changed
+        assert moved.mean() > 0.002, moved.mean()  # the arm swung: its pixels changed
         page.close()
     finally:
         v.close()
@@ -108,6 +110,7 @@ def _record_episode(folder):
     from adfkit.dataset.writer import DatasetWriter
     from adfkit.runner.psm import PSM
     from adfkit.runner.world import Options, SimWorld
+
     world = SimWorld(load_scene(BUNDLED), Options())
     try:
         psm = PSM(world, "psm1")
@@ -118,14 +121,20 @@ def _record_episode(folder):
             q[0] += 0.25 * k
             psm.reset_jp(q)
             world.step(2)
-            writer.write(k, {"needle": world.body("Needle").world_matrix(),
-                             "psms": {"psm1": {"jp": [float(x) for x in psm.measured_jp()], "jaw": 0.5}}},
-                         f"phase {k}")
+            writer.write(
+                k,
+                {
+                    "needle": world.body("Needle").world_matrix(),
+                    "psms": {"psm1": {"jp": [float(x) for x in psm.measured_jp()], "jaw": 0.5}},
+                },
+                f"phase {k}",
+            )
         writer.close()
     finally:
         world.close()
-    (folder / "metrics.json").write_text(json.dumps({"pairs": [{"pair": 1, "passed": False,
-                                                                "reason": "blocked at entry 1"}]}))
+    (folder / "metrics.json").write_text(
+        json.dumps({"pairs": [{"pair": 1, "passed": False, "reason": "blocked at entry 1"}]})
+    )
 
 
 def test_a_recorded_episode_replays_on_its_timeline(browser, tmp_path):
@@ -134,9 +143,9 @@ def test_a_recorded_episode_replays_on_its_timeline(browser, tmp_path):
     try:
         assert v.episode is not None and len(v.episode.frames) == 4
         page = _open(browser, address)
-        assert page.get_by_text("blocked at entry 1").count() >= 1     # the verdicts are listed
+        assert page.get_by_text("blocked at entry 1").count() >= 1  # the verdicts are listed
         first = _canvas(page)
-        _to_end(page.locator("[role=slider]").last)                  # the timeline (the last panel) to the last frame
+        _to_end(page.locator("[role=slider]").last)  # the timeline (the last panel) to the last frame
         assert page.get_by_text("phase 3", exact=False).count() >= 1
         last = _canvas(page)
         assert (np.abs(last - first).max(axis=2) > 40).mean() > 0.002
@@ -149,6 +158,7 @@ def test_a_scene_with_errors_opens_with_them_listed(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("bodies: [BODY a]\nBODY a:\n  mass: heavy\n")
     from adfkit.viewer.server import Viewer
+
     v = Viewer(bad, None, "pybullet", "127.0.0.1", _free_port())
     v.load()
     try:
@@ -161,7 +171,7 @@ def test_a_scene_with_errors_opens_with_them_listed(tmp_path):
 def test_bad_input_is_a_clear_error(tmp_path, capsys):
     assert main(["view", str(tmp_path / "absent.yaml")]) == 2
     assert "error[file-not-found]" in capsys.readouterr().err
-    with socket.socket() as s:             # a port in use
+    with socket.socket() as s:  # a port in use
         s.bind(("127.0.0.1", 0))
         s.listen()
         port = s.getsockname()[1]
@@ -173,15 +183,16 @@ def test_bad_input_is_a_clear_error(tmp_path, capsys):
 @pytest.mark.parametrize("scene, soft, volume", [("soft_phantom", 1, False), ("drilling", 0, True)])
 def test_soft_bodies_deform_and_volumes_show_in_the_page(scene, soft, volume):
     from adfkit.viewer.server import Viewer
+
     v = Viewer(ROOT / "sample_scenes" / scene / "launch.yaml", None, "pybullet", "127.0.0.1", _free_port())
     v.load()
     v.start()
     try:
         assert len(v.soft_nodes) == soft
-        for s, h in v.soft_nodes:
+        for _s, h in v.soft_nodes:
             before = np.array(h.vertices)
             with v.lock:
-                v.world.run(0.3)          # the probe presses into the skin
+                v.world.run(0.3)  # the probe presses into the skin
             v.update_poses()
             assert np.abs(np.array(h.vertices) - before).max() > 1e-4
         drawn = [sb for sb, _ in v.body_nodes if getattr(sb, "surface", None) is not None]

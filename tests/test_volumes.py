@@ -1,6 +1,7 @@
 """ADF volumes: the bundled drilling scene's bone, read from its PNG slices, validated, and played
 as an iso-surface body in the camera images and the segmentation; hostile volume inputs are
 located errors; whatever an engine does not play is named in report.json."""
+
 from __future__ import annotations
 
 import json
@@ -32,6 +33,7 @@ def _copy(launch, tmp_path):
 
 def test_the_bone_has_two_tissues_and_its_iso_surface_is_closed(drilling):
     from adfkit.geometry.volume import iso_surface, load_volume
+
     vox = bone_voxels(DrillingParams())
     assert (vox == CANAL).sum() > 100 and (vox >= BONE - 20).sum() > 10_000 and (vox == 0).sum() > 10_000
     scene = load_scene(drilling)
@@ -40,11 +42,12 @@ def test_the_bone_has_two_tissues_and_its_iso_surface_is_closed(drilling):
     assert data.voxels.shape == (48, 48, 48) and np.allclose(data.dimensions, 0.04)
     verts, faces = iso_surface(data, model.volumes[0].iso_surface_value)
     import trimesh
+
     surface = trimesh.Trimesh(verts, faces)
     assert surface.is_watertight and surface.volume > 0
-    bone = ((data.voxels >= 0.5).sum()) * (0.04 / 48) ** 3       # the voxels above the level
+    bone = ((data.voxels >= 0.5).sum()) * (0.04 / 48) ** 3  # the voxels above the level
     assert surface.volume == pytest.approx(bone, rel=0.1)
-    assert np.all(np.abs(verts) <= 0.02 + 1e-9)                  # inside the volume's box
+    assert np.all(np.abs(verts) <= 0.02 + 1e-9)  # inside the volume's box
 
 
 def test_the_drilling_scene_validates_clean_and_plays_with_its_volume(drilling, tmp_path, capsys):
@@ -56,12 +59,13 @@ def test_the_drilling_scene_validates_clean_and_plays_with_its_volume(drilling, 
     assert vol["object"] == "VOLUME Bone" and vol["triangles"] > 1000 and rep["not_played"] == []
     from adfkit.runner.options import Options
     from adfkit.runner.world import SimWorld
+
     world = SimWorld(load_scene(drilling), Options())
     try:
         label = next(i for i, sb in enumerate(world.bodies) if sb.key.endswith("VOLUME Bone"))
         frame = world.cameras[0].render(world)
         seen = frame["segmentation"] == label
-        assert seen.mean() > 0.02                                   # the bone is in the picture, labelled
+        assert seen.mean() > 0.02  # the bone is in the picture, labelled
         assert np.isfinite(frame["depth"][seen]).all()
     finally:
         world.close()
@@ -70,10 +74,13 @@ def test_the_drilling_scene_validates_clean_and_plays_with_its_volume(drilling, 
 def test_the_mujoco_engine_names_the_volume_it_does_not_play(drilling, tmp_path, capsys):
     pytest.importorskip("mujoco")
     out = tmp_path / "mj"
-    assert main(["run", str(drilling), "--engine", "mujoco", "--seconds", "0.05", "--no-frames", "--out", str(out)]) == 0
+    assert (
+        main(["run", str(drilling), "--engine", "mujoco", "--seconds", "0.05", "--no-frames", "--out", str(out)]) == 0
+    )
     rep = json.loads((out / "report.json").read_text())
-    assert rep["not_played"] == [{"object": "VOLUME Bone", "what": "volume",
-                                  "why": "volumes are not played by the MuJoCo engine"}]
+    assert rep["not_played"] == [
+        {"object": "VOLUME Bone", "what": "volume", "why": "volumes are not played by the MuJoCo engine"}
+    ]
     assert "runner-volume" in capsys.readouterr().err
 
 
@@ -82,17 +89,26 @@ def _volume_findings(scene_dir) -> list:
 
 
 def _images_line(scene_dir) -> int:
-    return next(n for n, line in enumerate((scene_dir / "drill.yaml").read_text().splitlines(), 1)
-                if line.strip().startswith("images:"))
+    return next(
+        n
+        for n, line in enumerate((scene_dir / "drill.yaml").read_text().splitlines(), 1)
+        if line.strip().startswith("images:")
+    )
 
 
-@pytest.mark.parametrize("case, rule", [("missing slice", "volume-slice-missing"),
-                                        ("mixed sizes", "volume-slice-size"),
-                                        ("count 10^9", "volume-images"),
-                                        ("outside the tree", "volume-slice-missing"),
-                                        ("not an image", "volume-slice-unreadable")])
+@pytest.mark.parametrize(
+    "case, rule",
+    [
+        ("missing slice", "volume-slice-missing"),
+        ("mixed sizes", "volume-slice-size"),
+        ("count 10^9", "volume-images"),
+        ("outside the tree", "volume-slice-missing"),
+        ("not an image", "volume-slice-unreadable"),
+    ],
+)
 def test_hostile_volume_inputs_are_located_errors(drilling, tmp_path, case, rule):
     from PIL import Image
+
     scene = _copy(drilling, tmp_path)
     drill = scene / "drill.yaml"
     if case == "missing slice":
@@ -103,7 +119,8 @@ def test_hostile_volume_inputs_are_located_errors(drilling, tmp_path, case, rule
         drill.write_text(drill.read_text().replace("count: 48", "count: 1000000000"))
     elif case == "outside the tree":
         import tempfile
-        outside = Path(tempfile.mkdtemp(dir="/var/tmp")) / "slices"   # far from the scene's folders
+
+        outside = Path(tempfile.mkdtemp(dir="/var/tmp")) / "slices"  # far from the scene's folders
         shutil.copytree(scene / "slices", outside)
         drill.write_text(drill.read_text().replace("path: slices/", f"path: {outside}/"))
     else:

@@ -1,5 +1,6 @@
 """Which ADF file kind a mapping is (adf-format.md §2): AMBF decides by slot; tools guess
 from the top-level keys."""
+
 from __future__ import annotations
 
 import yaml
@@ -26,4 +27,8 @@ def detect_kind(keys, values: dict | None = None) -> str | None:
 
 
 def _is_rgba(node) -> bool:
-    return isinstance(node, yaml.MappingNode) and {k.value for k, _ in node.value if isinstance(k, yaml.ScalarNode)} <= {"r", "g", "b", "a"} and len(node.value) > 0
+    return (
+        isinstance(node, yaml.MappingNode)
+        and {k.value for k, _ in node.value if isinstance(k, yaml.ScalarNode)} <= {"r", "g", "b", "a"}
+        and len(node.value) > 0
+    )

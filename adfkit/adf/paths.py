@@ -1,4 +1,5 @@
 """Where AMBF looks for the files an ADF names (adf-format.md §6.2, §1.1, §3, §4)."""
+
 from __future__ import annotations
 
 from pathlib import Path

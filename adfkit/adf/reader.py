@@ -3,6 +3,7 @@
 A value that cannot be decoded becomes a located diagnostic and is kept verbatim in the
 element's ``extras`` so that writing the file back loses nothing.
 """
+
 from __future__ import annotations
 
 import math
@@ -20,8 +21,7 @@ from ..model.spec import FloatOr, ListOf, Node, Obj, adf_fields
 from .kinds import detect_kind
 from .yamlnodes import STR_TAG, compose, location, mapping_items, plain, read_text, scalar_value
 
-_BOOL_WORDS = {"true": True, "yes": True, "on": True, "y": True,
-               "false": False, "no": False, "off": False, "n": False}
+_BOOL_WORDS = {"true": True, "yes": True, "on": True, "y": True, "false": False, "no": False, "off": False, "n": False}
 
 
 _NUMBER_TAGS = ("tag:yaml.org,2002:float", "tag:yaml.org,2002:int")
@@ -50,8 +50,12 @@ class Reader:
     def as_float(self, node) -> float:
         v = self._number(node)
         if v - v != 0.0:  # NaN or infinite (faster than math.isfinite on the hot path)
-            raise BadValue("non-finite-number", f"{_short(node.value)} is not a finite number", node,
-                           "write a finite number; Bullet turns NaN and infinity into a broken simulation")
+            raise BadValue(
+                "non-finite-number",
+                f"{_short(node.value)} is not a finite number",
+                node,
+                "write a finite number; Bullet turns NaN and infinity into a broken simulation",
+            )
         return v
 
     def _number(self, node) -> float:
@@ -76,11 +80,18 @@ class Reader:
         v = self.scalar(node, "true or false")
         if isinstance(v, bool):
             return v
-        if isinstance(v, str) and v.strip().lower() in _BOOL_WORDS and (v.strip() in
-                                                                         (v.strip().lower(), v.strip().upper(), v.strip().capitalize())):
+        if (
+            isinstance(v, str)
+            and v.strip().lower() in _BOOL_WORDS
+            and (v.strip() in (v.strip().lower(), v.strip().upper(), v.strip().capitalize()))
+        ):
             return _BOOL_WORDS[v.strip().lower()]
-        raise BadValue("bad-bool", f"expected true or false, found {_short(node.value)}", node,
-                       "AMBF reads true/false/yes/no/on/off/y/n; 1 and 0 make it reject the file")
+        raise BadValue(
+            "bad-bool",
+            f"expected true or false, found {_short(node.value)}",
+            node,
+            "AMBF reads true/false/yes/no/on/off/y/n; 1 and 0 make it reject the file",
+        )
 
     def as_int(self, node, unsigned: bool = False) -> int:
         v = self.scalar(node, "an integer")
@@ -90,13 +101,21 @@ class Reader:
             except ValueError:
                 pass
         if isinstance(v, bool) or not isinstance(v, int):
-            raise BadValue("bad-int", f"expected an integer, found {_short(node.value)}", node,
-                           "AMBF rejects the file when an integer field holds 2.5 or 5.0")
+            raise BadValue(
+                "bad-int",
+                f"expected an integer, found {_short(node.value)}",
+                node,
+                "AMBF rejects the file when an integer field holds 2.5 or 5.0",
+            )
         if unsigned and v < 0:
             raise BadValue("bad-int", f"expected a non-negative integer, found {_short(node.value)}", node)
-        if not -2**63 <= v < 2**64:
-            raise BadValue("bad-int", f"{_short(node.value)} is out of range for an integer", node,
-                           "AMBF reads integers as 32-bit values")
+        if not -(2**63) <= v < 2**64:
+            raise BadValue(
+                "bad-int",
+                f"{_short(node.value)} is out of range for an integer",
+                node,
+                "AMBF reads integers as 32-bit values",
+            )
         return v
 
     def as_str(self, node) -> str:
@@ -107,16 +126,23 @@ class Reader:
 
     def fields3(self, node, names: tuple[str, str, str], what: str) -> tuple[float, float, float]:
         if not isinstance(node, yaml.MappingNode):
-            raise BadValue("bad-type", f"expected a {what} mapping {{{', '.join(names)}}}, found a {_shape(node)}", node)
+            raise BadValue(
+                "bad-type", f"expected a {what} mapping {{{', '.join(names)}}}, found a {_shape(node)}", node
+            )
         got = {k: v for k, _, v in mapping_items(node)}
         missing = [n for n in names if n not in got]
         if missing:
-            raise BadValue("missing-component", f"{what} lacks {', '.join(missing)}", node,
-                           f"write all of {', '.join(names)}; AMBF rejects the file otherwise")
+            raise BadValue(
+                "missing-component",
+                f"{what} lacks {', '.join(missing)}",
+                node,
+                f"write all of {', '.join(names)}; AMBF rejects the file otherwise",
+            )
         extra = [k for k in got if k not in names]
         if extra:
-            self.diagnostics.append(warning("unknown-key", f"{what} ignores key(s) {', '.join(extra)}",
-                                            self.loc(got[extra[0]])))
+            self.diagnostics.append(
+                warning("unknown-key", f"{what} ignores key(s) {', '.join(extra)}", self.loc(got[extra[0]]))
+            )
         return tuple(self.as_float(got[n]) for n in names)  # type: ignore[return-value]
 
     def as_vec3(self, node) -> Vec3:
@@ -131,9 +157,14 @@ class Reader:
         got = {k: v for k, _, v in mapping_items(node)}
         extra = [k for k in got if k not in ("position", "orientation")]
         if extra:
-            raise BadValue("bad-pose", f"a pose holds position and orientation, not {', '.join(extra)}; "
-                           "AMBF ignores the block and uses the identity pose",
-                           node, "write {position: {x, y, z}, orientation: {r, p, y}}", Severity.WARNING)
+            raise BadValue(
+                "bad-pose",
+                f"a pose holds position and orientation, not {', '.join(extra)}; "
+                "AMBF ignores the block and uses the identity pose",
+                node,
+                "write {position: {x, y, z}, orientation: {r, p, y}}",
+                Severity.WARNING,
+            )
         pos = self.as_vec3(got["position"]) if "position" in got else Vec3()
         rot = self.as_rpy(got["orientation"]) if "orientation" in got else Quat()
         return Pose(pos, rot)
@@ -177,7 +208,7 @@ class Reader:
         """Set obj's declared fields from a mapping node; unknown keys go to extras."""
         by_key = {f.metadata["adf_key"]: f for f in adf_fields(obj) if not isinstance(f.metadata["kind"], ObjectList)}
         obj.source = self.loc(node)
-        for text, knode, vnode in mapping_items(node):
+        for text, _knode, vnode in mapping_items(node):
             if text in skip:
                 continue
             obj.key_sources[text] = self.loc(vnode)
@@ -192,8 +223,9 @@ class Reader:
                 obj.extras[text] = plain(vnode)
 
     def report(self, bad: BadValue, key_text: str) -> None:
-        self.diagnostics.append(Diagnostic(bad.severity, bad.rule, f"'{key_text}': {bad.message}",
-                                           self.loc(bad.node), bad.hint))
+        self.diagnostics.append(
+            Diagnostic(bad.severity, bad.rule, f"'{key_text}': {bad.message}", self.loc(bad.node), bad.hint)
+        )
 
     def struct(self, cls, node: yaml.MappingNode):
         obj = cls()
@@ -219,9 +251,14 @@ def _shape(node) -> str:
     return f"scalar {_short(node.value)}"
 
 
-def read_file(path: str | Path, kind: str | None = None, text: str | None = None,
-              root_out: list | None = None, tree: inputs.Tree | None = None,
-              referrer: SourceLocation | None = None) -> tuple[AdfFile, list[Diagnostic]]:
+def read_file(
+    path: str | Path,
+    kind: str | None = None,
+    text: str | None = None,
+    root_out: list | None = None,
+    tree: inputs.Tree | None = None,
+    referrer: SourceLocation | None = None,
+) -> tuple[AdfFile, list[Diagnostic]]:
     """Read one ADF file. Returns the model element and the diagnostics met on the way.
 
     Raises AdfError when the file cannot be read at all (missing, not YAML, wrong kind).
@@ -239,26 +276,55 @@ def read_file(path: str | Path, kind: str | None = None, text: str | None = None
     if root_out is not None:
         root_out.append(root)
     if root is None:
-        raise AdfError(error("empty-file", "the file is empty", SourceLocation(shown, 1, 1),
-                             "an ADF file is a YAML mapping of keys such as bodies:, joints: or world config:"))
+        raise AdfError(
+            error(
+                "empty-file",
+                "the file is empty",
+                SourceLocation(shown, 1, 1),
+                "an ADF file is a YAML mapping of keys such as bodies:, joints: or world config:",
+            )
+        )
     if not isinstance(root, yaml.MappingNode):
-        raise AdfError(error("not-a-mapping", f"the top level is a {_shape(root)}, not a mapping",
-                             location(shown, root), "an ADF file is a YAML mapping of keys"))
+        raise AdfError(
+            error(
+                "not-a-mapping",
+                f"the top level is a {_shape(root)}, not a mapping",
+                location(shown, root),
+                "an ADF file is a YAML mapping of keys",
+            )
+        )
     keys = [k for k, _, _ in mapping_items(root)]
     detected = detect_kind(keys, {k: v for k, _, v in mapping_items(root)})
     if kind is None:
         if detected is None:
-            raise AdfError(error("unknown-kind", "cannot tell which kind of ADF file this is",
-                                 location(shown, root),
-                                 "a launch file has 'world config', a world 'environment', a model 'bodies' "
-                                 "or 'joints', an input-devices file 'input devices'; or pass --kind"))
+            raise AdfError(
+                error(
+                    "unknown-kind",
+                    "cannot tell which kind of ADF file this is",
+                    location(shown, root),
+                    "a launch file has 'world config', a world 'environment', a model 'bodies' "
+                    "or 'joints', an input-devices file 'input devices'; or pass --kind",
+                )
+            )
         kind = detected
     elif kind not in FILE_KINDS:
-        raise AdfError(error("unknown-kind", f"unknown file kind '{kind}'", SourceLocation(shown),
-                             f"use one of {', '.join(FILE_KINDS)}"))
+        raise AdfError(
+            error(
+                "unknown-kind",
+                f"unknown file kind '{kind}'",
+                SourceLocation(shown),
+                f"use one of {', '.join(FILE_KINDS)}",
+            )
+        )
     elif detected is not None and detected != kind:
-        raise AdfError(error("wrong-kind", f"this looks like a {detected} file, not a {kind} file",
-                             location(shown, root), f"pass --kind {detected}, or the file meant for this slot"))
+        raise AdfError(
+            error(
+                "wrong-kind",
+                f"this looks like a {detected} file, not a {kind} file",
+                location(shown, root),
+                f"pass --kind {detected}, or the file meant for this slot",
+            )
+        )
     cls = FILE_KINDS[kind]
     obj: AdfFile
     if cls is Colors:
@@ -289,16 +355,27 @@ def _read_with_objects(reader: Reader, cls, root: yaml.MappingNode) -> AdfFile:
             setattr(obj, f.name, objects)
             continue
         if not isinstance(lnode, yaml.SequenceNode):
-            reader.diagnostics.append(error("bad-type", f"'{list_key}' must be a list of names, found a {_shape(lnode)}",
-                                            reader.loc(lnode), f"write {list_key}: [NAME, ...]"))
+            reader.diagnostics.append(
+                error(
+                    "bad-type",
+                    f"'{list_key}' must be a list of names, found a {_shape(lnode)}",
+                    reader.loc(lnode),
+                    f"write {list_key}: [NAME, ...]",
+                )
+            )
             obj.extras[list_key] = plain(lnode)
             obj.present_lists.discard(list_key)
             continue
         for entry in lnode.value:
             if not isinstance(entry, yaml.ScalarNode) or _is_null(entry):
-                reader.diagnostics.append(error("bad-type", f"'{list_key}' entries are names of mappings in this file, "
-                                                f"found a {_shape(entry)}", reader.loc(entry),
-                                                "list the key of each object's mapping"))
+                reader.diagnostics.append(
+                    error(
+                        "bad-type",
+                        f"'{list_key}' entries are names of mappings in this file, found a {_shape(entry)}",
+                        reader.loc(entry),
+                        "list the key of each object's mapping",
+                    )
+                )
                 continue
             ident = entry.value
             item = kind.kind(identifier=ident)
@@ -309,14 +386,19 @@ def _read_with_objects(reader: Reader, cls, root: yaml.MappingNode) -> AdfFile:
             else:
                 item.defined = False
                 item.source = reader.loc(entry)
-                reader.diagnostics.append(warning("undefined-object",
-                                                  f"'{ident}' is listed in '{list_key}' but has no mapping in this file",
-                                                  reader.loc(entry),
-                                                  f"add a mapping '{ident}:' or remove it from the list; AMBF builds an empty object"))
+                reader.diagnostics.append(
+                    warning(
+                        "undefined-object",
+                        f"'{ident}' is listed in '{list_key}' but has no mapping in this file",
+                        reader.loc(entry),
+                        f"add a mapping '{ident}:' or remove it from the list; AMBF builds an empty object",
+                    )
+                )
             objects.append(item)
         setattr(obj, f.name, objects)
-    rest = yaml.MappingNode(root.tag, [(kn, v) for k, (kn, v) in items.items() if k not in consumed],
-                            root.start_mark, root.end_mark)
+    rest = yaml.MappingNode(
+        root.tag, [(kn, v) for k, (kn, v) in items.items() if k not in consumed], root.start_mark, root.end_mark
+    )
     reader.fill(obj, rest)
     obj.source = reader.loc(root)
     return obj

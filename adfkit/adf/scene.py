@@ -1,9 +1,11 @@
 """Load what a launch file selects: the world, its environment and the chosen model files,
 like AMBF's ``--launch_file ... -l 6,7,8``."""
+
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable, cast
+from typing import cast
 
 from ..diagnostics import AdfError, Diagnostic, SourceLocation, error
 from ..model import InputDevices, Launch, ModelFile, Scene, World
@@ -27,13 +29,15 @@ def parse_indices(text: str | None) -> list[int] | None:
             else:
                 out.append(int(part))
         except ValueError:
-            raise AdfError(error("bad-index", f"'{part}' is not an index or a range", None,
-                                 "write indices like 6,7,8 or 6-11")) from None
+            raise AdfError(
+                error("bad-index", f"'{part}' is not an index or a range", None, "write indices like 6,7,8 or 6-11")
+            ) from None
     return out
 
 
-def load_scene(path: str | Path, indices: Iterable[int] | None = None,
-               diagnostics: list[Diagnostic] | None = None) -> Scene:
+def load_scene(
+    path: str | Path, indices: Iterable[int] | None = None, diagnostics: list[Diagnostic] | None = None
+) -> Scene:
     """Load a launch file (with `multibody configs` picked by 0-based ``indices``; all when
     None), a world file (with its environment) or a single model file as a scene."""
     diags = diagnostics if diagnostics is not None else []
@@ -47,23 +51,36 @@ def load_scene(path: str | Path, indices: Iterable[int] | None = None,
         _attach_world(scene, doc, diags)
         return scene
     if not isinstance(doc, Launch):
-        raise AdfError(error("wrong-kind", f"{path} is a {type(doc).__name__} file; a scene starts from a "
-                             "launch, world or model file", SourceLocation(str(path))))
+        raise AdfError(
+            error(
+                "wrong-kind",
+                f"{path} is a {type(doc).__name__} file; a scene starts from a launch, world or model file",
+                SourceLocation(str(path)),
+            )
+        )
     scene.launch = doc
     if doc.world_config:
-        world, found = read_file(relative_to_file(doc.path, doc.world_config), "world",
-                                 tree=doc.tree, referrer=doc.where("world config"))
+        world, found = read_file(
+            relative_to_file(doc.path, doc.world_config), "world", tree=doc.tree, referrer=doc.where("world config")
+        )
         diags.extend(found)
         _attach_world(scene, cast(World, world), diags)
     configs = doc.multibody_configs or []
     chosen = range(len(configs)) if indices is None else list(indices)
     for i in chosen:
         if not 0 <= i < len(configs):
-            raise AdfError(error("bad-index", f"index {i} is out of range: the launch file lists "
-                                 f"{len(configs)} model files (0–{len(configs) - 1})",
-                                 doc.where("multibody configs"), "pick indices from the multibody configs list"))
-        model, found = read_file(relative_to_file(doc.path, configs[i]), "model",
-                                 tree=doc.tree, referrer=doc.where("multibody configs"))
+            raise AdfError(
+                error(
+                    "bad-index",
+                    f"index {i} is out of range: the launch file lists "
+                    f"{len(configs)} model files (0–{len(configs) - 1})",
+                    doc.where("multibody configs"),
+                    "pick indices from the multibody configs list",
+                )
+            )
+        model, found = read_file(
+            relative_to_file(doc.path, configs[i]), "model", tree=doc.tree, referrer=doc.where("multibody configs")
+        )
         diags.extend(found)
         scene.models.append(cast(ModelFile, model))
     return scene
@@ -81,6 +98,10 @@ def _attach_world(scene: Scene, world: World, diags: list[Diagnostic]) -> None:
 def load_input_devices(launch: Launch) -> InputDevices | None:
     if not launch.input_devices_config:
         return None
-    doc, _ = read_file(relative_to_file(launch.path, launch.input_devices_config), "input_devices",
-                       tree=launch.tree, referrer=launch.where("input devices config"))
+    doc, _ = read_file(
+        relative_to_file(launch.path, launch.input_devices_config),
+        "input_devices",
+        tree=launch.tree,
+        referrer=launch.where("input devices config"),
+    )
     return doc  # type: ignore[return-value]

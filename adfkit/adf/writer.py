@@ -3,6 +3,7 @@
 Key order follows the field declarations (the order the Blender add-on writes), then any
 keys the reader did not recognise, so a file read and written back keeps everything.
 """
+
 from __future__ import annotations
 
 import math
@@ -85,9 +86,19 @@ def value_to_plain(kind, value) -> Any:
     raise TypeError(f"unknown field kind {kind!r}")  # pragma: no cover
 
 
-_FLOW_KEYS = [{"r", "g", "b", "a"}, {"r", "g", "b"}, {"low", "high"}, {"near", "far"}, {"width", "height"},
-              {"static", "rolling"}, {"linear", "angular"}, {"P", "I", "D"}, {"P", "D"}, {"ix", "iy", "iz"},
-              {"x", "y", "z"}]
+_FLOW_KEYS = [
+    {"r", "g", "b", "a"},
+    {"r", "g", "b"},
+    {"low", "high"},
+    {"near", "far"},
+    {"width", "height"},
+    {"static", "rolling"},
+    {"linear", "angular"},
+    {"P", "I", "D"},
+    {"P", "D"},
+    {"ix", "iy", "iz"},
+    {"x", "y", "z"},
+]
 
 
 def node_to_plain(obj: Node) -> dict:
@@ -139,8 +150,9 @@ HEADER = "# ADF 1.0, written by adfkit\n"
 
 
 def dumps(doc: AdfFile, header: bool = True) -> str:
-    text = yaml.dump(file_to_plain(doc), Dumper=_Dumper, sort_keys=False, allow_unicode=True,
-                     default_flow_style=False, width=100)
+    text = yaml.dump(
+        file_to_plain(doc), Dumper=_Dumper, sort_keys=False, allow_unicode=True, default_flow_style=False, width=100
+    )
     return (HEADER if header else "") + text
 
 

@@ -3,6 +3,7 @@
 Duplicate keys, recursive aliases and alias bombs become diagnostics here, so nothing
 downstream ever sees them as Python exceptions.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -39,6 +40,7 @@ class _Loader(_BaseLoader):
             return tag
         return _BaseLoader.resolve(self, kind, value, implicit)
 
+
 _constructor = yaml.constructor.SafeConstructor()
 
 # Scalars, mappings and sequences a file may expand to through aliases before we stop.
@@ -66,8 +68,14 @@ MAX_DEPTH = 100
 # Below this bound on the nesting (see _depth_bound) the C composer is safe without a pre-scan.
 _SAFE_BOUND = 3000
 
-_SCALAR_TAGS_CHECKED = {"tag:yaml.org,2002:bool", "tag:yaml.org,2002:int", "tag:yaml.org,2002:float",
-                        "tag:yaml.org,2002:null", "tag:yaml.org,2002:timestamp", "tag:yaml.org,2002:binary"}
+_SCALAR_TAGS_CHECKED = {
+    "tag:yaml.org,2002:bool",
+    "tag:yaml.org,2002:int",
+    "tag:yaml.org,2002:float",
+    "tag:yaml.org,2002:null",
+    "tag:yaml.org,2002:timestamp",
+    "tag:yaml.org,2002:binary",
+}
 
 
 def _syntax_error(exc: yaml.YAMLError, file: str, text: str) -> AdfError:
@@ -76,15 +84,27 @@ def _syntax_error(exc: yaml.YAMLError, file: str, text: str) -> AdfError:
         loc = SourceLocation(file, mark.line + 1, mark.column + 1) if mark else SourceLocation(file, 1, 1)
         problem = exc.problem or "invalid YAML"
         ctx = f" ({exc.context})" if exc.context else ""
-        return AdfError(error("yaml-syntax", f"not valid YAML: {problem}{ctx}", loc,
-                              "fix the YAML syntax; an online or editor YAML linter shows the exact spot"))
+        return AdfError(
+            error(
+                "yaml-syntax",
+                f"not valid YAML: {problem}{ctx}",
+                loc,
+                "fix the YAML syntax; an online or editor YAML linter shows the exact spot",
+            )
+        )
     line = col = 1
     position = getattr(exc, "position", None)  # ReaderError: a character YAML does not allow
     if isinstance(position, int):
         before = text[:position]
         line, col = before.count("\n") + 1, position - (before.rfind("\n") + 1) + 1
-    return AdfError(error("yaml-syntax", f"not valid YAML: {exc}", SourceLocation(file, line, col),
-                          "remove control characters; YAML allows tab, newline and printable text"))
+    return AdfError(
+        error(
+            "yaml-syntax",
+            f"not valid YAML: {exc}",
+            SourceLocation(file, line, col),
+            "remove control characters; YAML allows tab, newline and printable text",
+        )
+    )
 
 
 def _depth_bound(text: str) -> int:
@@ -122,9 +142,14 @@ def _scan_depth(text: str, file: str, loader) -> None:
             if depth > MAX_DEPTH:
                 m = ev.start_mark
                 assert m is not None  # parsers always mark their events
-                raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
-                                     SourceLocation(file, m.line + 1, m.column + 1),
-                                     "an ADF file nests a few levels; flatten the data"))
+                raise AdfError(
+                    error(
+                        "yaml-too-deep",
+                        f"collections nest more than {MAX_DEPTH} levels deep here",
+                        SourceLocation(file, m.line + 1, m.column + 1),
+                        "an ADF file nests a few levels; flatten the data",
+                    )
+                )
         elif isinstance(ev, ends):
             depth -= 1
 
@@ -163,7 +188,7 @@ def check_tree(root: yaml.Node, file: str, check_tags: bool = True, aliases: boo
         return diags
     sizes: dict[int, int] = {}
     on_stack: set[int] = set()
-    Mapping, Sequence, Scalar = yaml.MappingNode, yaml.SequenceNode, yaml.ScalarNode
+    Mapping, _Sequence, Scalar = yaml.MappingNode, yaml.SequenceNode, yaml.ScalarNode
     # Frames: [node, child iterator, size so far]; a node's size is counted when it is left.
     stack: list[list] = []
 
@@ -179,11 +204,23 @@ def check_tree(root: yaml.Node, file: str, check_tags: bool = True, aliases: boo
         if known is not None:
             return known
         if nid in on_stack:
-            raise AdfError(error("yaml-recursive-alias", "an alias refers to a node that contains it",
-                                 location(file, node), "ADF data is a tree; replace the recursive alias with data"))
+            raise AdfError(
+                error(
+                    "yaml-recursive-alias",
+                    "an alias refers to a node that contains it",
+                    location(file, node),
+                    "ADF data is a tree; replace the recursive alias with data",
+                )
+            )
         if len(stack) >= MAX_DEPTH:
-            raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
-                                 location(file, node), "an ADF file nests a few levels; flatten the data"))
+            raise AdfError(
+                error(
+                    "yaml-too-deep",
+                    f"collections nest more than {MAX_DEPTH} levels deep here",
+                    location(file, node),
+                    "an ADF file nests a few levels; flatten the data",
+                )
+            )
         on_stack.add(nid)
         if cls is Mapping:
             _check_keys(node, file, diags)
@@ -214,8 +251,14 @@ def check_tree(root: yaml.Node, file: str, check_tags: bool = True, aliases: boo
         if size > MAX_EXPANDED_NODES:
             break
     if expanded > MAX_EXPANDED_NODES or any(f[2] > MAX_EXPANDED_NODES for f in stack):
-        raise AdfError(error("yaml-alias-bomb", f"aliases expand this file to over {MAX_EXPANDED_NODES:,} nodes",
-                             location(file, root), "an ADF file never needs this; remove the nested aliases"))
+        raise AdfError(
+            error(
+                "yaml-alias-bomb",
+                f"aliases expand this file to over {MAX_EXPANDED_NODES:,} nodes",
+                location(file, root),
+                "an ADF file never needs this; remove the nested aliases",
+            )
+        )
     return diags
 
 
@@ -226,8 +269,14 @@ def _check_alias_free(root: yaml.Node, file: str, check_tags: bool, diags: list[
     while stack:
         node, depth = stack.pop()
         if depth > MAX_DEPTH:
-            raise AdfError(error("yaml-too-deep", f"collections nest more than {MAX_DEPTH} levels deep here",
-                                 location(file, node), "an ADF file nests a few levels; flatten the data"))
+            raise AdfError(
+                error(
+                    "yaml-too-deep",
+                    f"collections nest more than {MAX_DEPTH} levels deep here",
+                    location(file, node),
+                    "an ADF file nests a few levels; flatten the data",
+                )
+            )
         if node.__class__ is Mapping:
             _check_keys(node, file, diags)
             for k, v in node.value:
@@ -248,8 +297,6 @@ def _check_alias_free(root: yaml.Node, file: str, check_tags: bool, diags: list[
             _check_scalar_tag(node, file, diags)  # type: ignore[arg-type]  # neither collection: a scalar
 
 
-
-
 def _check_keys(node: yaml.MappingNode, file: str, diags: list[Diagnostic]) -> None:
     seen: dict[Any, yaml.Node] = {}
     Scalar = yaml.ScalarNode
@@ -257,23 +304,38 @@ def _check_keys(node: yaml.MappingNode, file: str, diags: list[Diagnostic]) -> N
         if k.__class__ is Scalar:
             kv = k.value
             if k.tag != STR_TAG:
-                diags.append(warning(
-                    "yaml-key-type", f"the key {_quote(kv)} is read as {_tag_name(k.tag)}, not text; "
-                    "AMBF (yaml-cpp) compares it as the text written",
-                    location(file, k), "quote the key, or check the mapping: `{a, b}` is a mapping of two keys"))
+                diags.append(
+                    warning(
+                        "yaml-key-type",
+                        f"the key {_quote(kv)} is read as {_tag_name(k.tag)}, not text; "
+                        "AMBF (yaml-cpp) compares it as the text written",
+                        location(file, k),
+                        "quote the key, or check the mapping: `{a, b}` is a mapping of two keys",
+                    )
+                )
             first = seen.get(kv)
             if first is not None:
-                diags.append(warning(  # AMBF loads the file (sb/cloth.yaml): every command reads it
-                    "yaml-duplicate-key",
-                    f"duplicate key {_quote(kv)} (first at line {first.start_mark.line + 1}); "
-                    "AMBF keeps the first value, PyYAML the last",
-                    location(file, k), "remove one of the two entries"))
+                diags.append(
+                    warning(  # AMBF loads the file (sb/cloth.yaml): every command reads it
+                        "yaml-duplicate-key",
+                        f"duplicate key {_quote(kv)} (first at line {first.start_mark.line + 1}); "
+                        "AMBF keeps the first value, PyYAML the last",
+                        location(file, k),
+                        "remove one of the two entries",
+                    )
+                )
             else:
                 seen[kv] = k
         else:
-            diags.append(warning("yaml-key-type", f"a {'mapping' if isinstance(k, yaml.MappingNode) else 'list'} "
-                                 "is used as a key; AMBF reads it as text", location(file, k),
-                                 "use a text key"))
+            diags.append(
+                warning(
+                    "yaml-key-type",
+                    f"a {'mapping' if isinstance(k, yaml.MappingNode) else 'list'} "
+                    "is used as a key; AMBF reads it as text",
+                    location(file, k),
+                    "use a text key",
+                )
+            )
 
 
 def _check_scalar_tag(node: yaml.ScalarNode, file: str, diags: list[Diagnostic]) -> None:
@@ -284,8 +346,14 @@ def _check_scalar_tag(node: yaml.ScalarNode, file: str, diags: list[Diagnostic])
     try:
         construct(_constructor, node)
     except Exception:  # noqa: BLE001 - every constructor failure is the same finding
-        diags.append(error("yaml-bad-tag", f"{_quote(node.value)} is not a valid {_tag_name(node.tag)}",
-                           location(file, node), "remove the explicit tag (`!!...`) or fix the value"))
+        diags.append(
+            error(
+                "yaml-bad-tag",
+                f"{_quote(node.value)} is not a valid {_tag_name(node.tag)}",
+                location(file, node),
+                "remove the explicit tag (`!!...`) or fix the value",
+            )
+        )
 
 
 def _tag_name(tag: str) -> str:

@@ -2,10 +2,11 @@
 
 Generated from :mod:`adfkit.model` by ``python -m adfkit.validator.schemagen``.
 """
+
 from __future__ import annotations
 
 import json
-from functools import lru_cache
+from functools import cache
 from importlib import resources
 
 KINDS = ("launch", "world", "input_devices", "model", "colors")
@@ -17,6 +18,6 @@ def schema_file(kind: str):
     return resources.files(__name__).joinpath(f"{kind}.schema.json")
 
 
-@lru_cache(maxsize=None)
+@cache
 def load_schema(kind: str) -> dict:
     return json.loads(schema_file(kind).read_text(encoding="utf-8"))

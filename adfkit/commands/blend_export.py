@@ -1,4 +1,5 @@
 """adfkit blend-export FILE.blend OUT_DIR: export a .blend scene as an ADF model, headless."""
+
 from __future__ import annotations
 
 NAME = "blend-export"
@@ -20,8 +21,11 @@ def run(args) -> int:
 
     blend = Path(args.blend)
     if not blend.is_file():
-        raise AdfError(error("missing-file", f"{blend} does not exist", SourceLocation(str(blend)),
-                             "give the path of a .blend file"))
+        raise AdfError(
+            error(
+                "missing-file", f"{blend} does not exist", SourceLocation(str(blend)), "give the path of a .blend file"
+            )
+        )
     _, addon = load_addon()
     res = addon.headless.export_blend(blend, args.out_dir, args.name or blend.stem)
     if res.diagnostics:

@@ -1,4 +1,5 @@
 """adfkit blend-import MODEL.yaml OUT.blend: build a Blender scene from an ADF model, headless."""
+
 from __future__ import annotations
 
 NAME = "blend-import"
@@ -25,9 +26,12 @@ def load_addon():
     if name not in sys.modules:
         root = Path(__file__).resolve().parents[2] / "addon"
         if not (root / "__init__.py").is_file():
-            raise AdfError(error("no-addon", f"the Blender add-on is not at {root}", None,
-                                 "run from a source checkout of adfkit"))
-        spec = importlib.util.spec_from_file_location(name, root / "__init__.py", submodule_search_locations=[str(root)])
+            raise AdfError(
+                error("no-addon", f"the Blender add-on is not at {root}", None, "run from a source checkout of adfkit")
+            )
+        spec = importlib.util.spec_from_file_location(
+            name, root / "__init__.py", submodule_search_locations=[str(root)]
+        )
         mod = importlib.util.module_from_spec(spec)
         sys.modules[name] = mod
         spec.loader.exec_module(mod)
@@ -37,8 +41,14 @@ def load_addon():
     except ImportError as exc:
         if "bpy" not in str(exc):
             raise
-        raise AdfError(error("no-bpy", "the bpy module (Blender as a Python module) is not installed", None,
-                             "pip install bpy (Python 3.11), or run inside Blender")) from None
+        raise AdfError(
+            error(
+                "no-bpy",
+                "the bpy module (Blender as a Python module) is not installed",
+                None,
+                "pip install bpy (Python 3.11), or run inside Blender",
+            )
+        ) from None
     headless.ensure_registered()
     for sub in ("export", "build", "gather", "render", "authoring"):
         importlib.import_module(f"{name}.{sub}")

@@ -1,4 +1,5 @@
 """`adfkit build-scene NAME OUT_DIR`: author a sample scene from code."""
+
 from __future__ import annotations
 
 NAME = "build-scene"

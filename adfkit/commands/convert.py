@@ -1,8 +1,10 @@
 """`adfkit convert IN OUT`: ADF ⇄ URDF ⇄ MJCF through the scene model; prints what was dropped."""
+
 from __future__ import annotations
 
-from .. import jsonout
 import sys
+
+from .. import jsonout
 
 NAME = "convert"
 HELP = "convert a model between ADF, URDF and MJCF, listing everything the target cannot express"
@@ -28,16 +30,32 @@ def run(args) -> int:
     inputs.check_file(src, "xml", what="model file")  # a regular file (adfkit.inputs); readers check again
     inputs.check_path_text(dst)
     if src.resolve() == dst.resolve():
-        raise AdfError(error("convert-overwrite", "input and output are the same file", SourceLocation(str(dst)),
-                             "write the converted model to a new file"))
+        raise AdfError(
+            error(
+                "convert-overwrite",
+                "input and output are the same file",
+                SourceLocation(str(dst)),
+                "write the converted model to a new file",
+            )
+        )
     fin, fout = format_of(src, args.source_format), format_of(dst, args.to)
     model, read_losses = read(src, fin)
     write_losses = write(model, dst, fout)
     losses = [("read", l) for l in read_losses] + [("write", l) for l in write_losses]
     if args.json:
-        jsonout.dump({"input": str(src), "output": str(dst), "from": fin, "to": fout,
-                   "losses": [{"stage": s, "element": l.element, "feature": l.feature, "reason": l.reason}
-                              for s, l in losses]}, sys.stdout, indent=2)
+        jsonout.dump(
+            {
+                "input": str(src),
+                "output": str(dst),
+                "from": fin,
+                "to": fout,
+                "losses": [
+                    {"stage": s, "element": l.element, "feature": l.feature, "reason": l.reason} for s, l in losses
+                ],
+            },
+            sys.stdout,
+            indent=2,
+        )
         sys.stdout.write("\n")
     else:
         print(f"{src} ({fin}) -> {dst} ({fout}): {len(model.bodies)} bodies, {len(model.joints)} joints")

@@ -1,8 +1,10 @@
 """`adfkit decompose MESH`: convex decomposition (CoACD) into a hull OBJ for ADF collision."""
+
 from __future__ import annotations
 
-from .. import jsonout
 import sys
+
+from .. import jsonout
 
 NAME = "decompose"
 HELP = "convex decomposition of a mesh (CoACD) into one OBJ with a sub-mesh per hull"
@@ -31,12 +33,18 @@ def run(args) -> int:
     from ..report import Progress
 
     if args.max_hulls == 0 or args.max_hulls < -1 or args.threshold <= 0 or args.resolution <= 0:
-        raise AdfError(error("bad-argument", "--max-hulls must be >= 1 (or -1), --threshold and --resolution > 0",
-                             hint="e.g. --max-hulls 8 --threshold 0.05"))
+        raise AdfError(
+            error(
+                "bad-argument",
+                "--max-hulls must be >= 1 (or -1), --threshold and --resolution > 0",
+                hint="e.g. --max-hulls 8 --threshold 0.05",
+            )
+        )
     src = Path(args.mesh)
     out = Path(args.output) if args.output else src.with_name(src.stem + "_hulls.obj")
-    params = DecompositionParams(threshold=args.threshold, max_hulls=args.max_hulls,
-                                 preprocess_resolution=args.resolution, seed=args.seed)
+    params = DecompositionParams(
+        threshold=args.threshold, max_hulls=args.max_hulls, preprocess_resolution=args.resolution, seed=args.seed
+    )
     with Progress(4, "decompose") as bar:
         mesh = load_mesh(src, scale=args.scale)
         bar.update(1, suffix="repairing")
@@ -50,11 +58,16 @@ def run(args) -> int:
         union = manifold_volume(result.hulls)
         bar.update(1, suffix="done")
     summary = {
-        "input": str(src), "output": str(out), "repair": report.summary(),
-        "hulls": len(result.hulls), "hull_volumes": result.volumes,
-        "input_volume": float(solid.volume), "union_volume": union,
+        "input": str(src),
+        "output": str(out),
+        "repair": report.summary(),
+        "hulls": len(result.hulls),
+        "hull_volumes": result.volumes,
+        "input_volume": float(solid.volume),
+        "union_volume": union,
         "union_over_input": union / float(solid.volume),
-        "seconds": result.seconds, "cache_hit": result.cache_hit,
+        "seconds": result.seconds,
+        "cache_hit": result.cache_hit,
         "adf": {"collision mesh": out.name, "collision mesh type": "CONVEX_HULL"},
     }
     if args.json:
@@ -62,11 +75,14 @@ def run(args) -> int:
         sys.stdout.write("\n")
         return 0
     print(f"{src.name}: {report.summary()}")
-    print(f"{len(result.hulls)} convex hulls in {result.seconds:.2f} s"
-          f"{' (cache hit)' if result.cache_hit else ''} -> {out}")
+    print(
+        f"{len(result.hulls)} convex hulls in {result.seconds:.2f} s"
+        f"{' (cache hit)' if result.cache_hit else ''} -> {out}"
+    )
     for i, v in enumerate(result.volumes):
         print(f"  hull_{i:03d}  volume {v:.6g} m³")
-    print(f"input volume {solid.volume:.6g} m³, union of hulls {union:.6g} m³ "
-          f"({100 * (union / solid.volume - 1):+.1f}%)")
+    print(
+        f"input volume {solid.volume:.6g} m³, union of hulls {union:.6g} m³ ({100 * (union / solid.volume - 1):+.1f}%)"
+    )
     print(f"ADF: collision mesh: {out.name}   collision mesh type: CONVEX_HULL")
     return 0

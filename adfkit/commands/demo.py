@@ -4,6 +4,7 @@ the PyBullet runner and write a report and camera images into run-output/.
 The scene is the project's own suturing scene, bundled in sample_scenes/suturing/ (two PSMs,
 the phantom, the needle and its thread; see `adfkit build-scene suturing`). The challenge's
 scene files play with ``--scene ../shared/corpus/src/launch.yaml -l 6-11``."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -33,11 +34,13 @@ def run(args) -> int:
 
     if args.scene:
         from .. import inputs
-        launch, indices = inputs.scene_file(args.scene), args.indices   # a folder: its launch.yaml
+
+        launch, indices = inputs.scene_file(args.scene), args.indices  # a folder: its launch.yaml
     else:
         launch, indices = BUNDLED, None
         if not launch.exists():  # installed without the repository's sample_scenes/: author it now
             from ..scenes import write_suturing
+
             launch = write_suturing(Path(tempfile.mkdtemp(prefix="adfkit-demo-")))
     diags: list = []
     scene = load_scene(launch, parse_indices(indices) if indices else None, diags)
@@ -49,6 +52,7 @@ def run(args) -> int:
 
     from ..runner.play import play, summary, unstable
     from ..runner.world import Options, SimWorld
+
     out = Path(args.out)
     world = SimWorld(scene, Options())
     try:

@@ -1,8 +1,10 @@
 """`adfkit inertia MESH --mass M | --density D`: volume, COM and principal inertia."""
+
 from __future__ import annotations
 
-from .. import jsonout
 import sys
+
+from .. import jsonout
 
 NAME = "inertia"
 HELP = "mass properties of a mesh (volume, COM, principal moments and axes) for ADF"
@@ -27,20 +29,36 @@ def run(args) -> int:
 
     value = args.mass if args.mass is not None else args.density
     if not math.isfinite(value) or value <= 0:
-        raise AdfError(error("bad-argument", f"--mass/--density must be positive, got {value}",
-                             hint="e.g. --mass 0.5 or --density 1000"))
+        raise AdfError(
+            error(
+                "bad-argument",
+                f"--mass/--density must be positive, got {value}",
+                hint="e.g. --mass 0.5 or --density 1000",
+            )
+        )
     solid, report = repair_mesh(load_mesh(args.mesh, scale=args.scale))
     props = mesh_mass_properties(solid, density=args.density, mass=args.mass)
     moments, axes = props.principal()
     inertia, offset = to_adf(props)
     rpy = offset.rpy()
     out = {
-        "mesh": args.mesh, "repair": report.summary(), "mass": props.mass, "volume": props.volume,
-        "density": props.density, "com": props.com.tolist(), "inertia_tensor": props.inertia.tolist(),
-        "principal_moments": moments.tolist(), "principal_axes": axes.T.tolist(),
-        "adf": {"mass": props.mass, "inertia": {"ix": inertia.ix, "iy": inertia.iy, "iz": inertia.iz},
-                "inertial offset": {"position": dict(zip("xyz", offset.position)),
-                                    "orientation": dict(zip(("r", "p", "y"), rpy))}},
+        "mesh": args.mesh,
+        "repair": report.summary(),
+        "mass": props.mass,
+        "volume": props.volume,
+        "density": props.density,
+        "com": props.com.tolist(),
+        "inertia_tensor": props.inertia.tolist(),
+        "principal_moments": moments.tolist(),
+        "principal_axes": axes.T.tolist(),
+        "adf": {
+            "mass": props.mass,
+            "inertia": {"ix": inertia.ix, "iy": inertia.iy, "iz": inertia.iz},
+            "inertial offset": {
+                "position": dict(zip("xyz", offset.position)),
+                "orientation": dict(zip(("r", "p", "y"), rpy)),
+            },
+        },
     }
     if args.json:
         jsonout.dump(out, sys.stdout, indent=2)
@@ -57,6 +75,8 @@ def run(args) -> int:
     print(f"  mass: {props.mass:.9g}")
     print(f"  inertia: {{ix: {inertia.ix:.9g}, iy: {inertia.iy:.9g}, iz: {inertia.iz:.9g}}}")
     p = offset.position
-    print(f"  inertial offset: {{position: {{x: {p[0]:.9g}, y: {p[1]:.9g}, z: {p[2]:.9g}}}, "
-          f"orientation: {{r: {rpy[0]:.9g}, p: {rpy[1]:.9g}, y: {rpy[2]:.9g}}}}}")
+    print(
+        f"  inertial offset: {{position: {{x: {p[0]:.9g}, y: {p[1]:.9g}, z: {p[2]:.9g}}}, "
+        f"orientation: {{r: {rpy[0]:.9g}, p: {rpy[1]:.9g}, y: {rpy[2]:.9g}}}}}"
+    )
     return 0

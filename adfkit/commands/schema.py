@@ -1,4 +1,5 @@
 """`adfkit schema KIND`: print the JSON Schema of an ADF file kind (for editors and CI)."""
+
 from __future__ import annotations
 
 import sys

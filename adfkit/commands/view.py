@@ -3,6 +3,7 @@
 Listens on localhost only unless --host is given; from another machine, forward the port over
 SSH (docs/viewer.md). Runs until Ctrl-C. Exit status 2 for bad input (a missing scene, a port
 in use); a scene with errors opens with them listed in the page."""
+
 from __future__ import annotations
 
 import sys
@@ -36,12 +37,20 @@ def run(args) -> int:
         raise AdfError(error("bad-option", f"--port {args.port} is not a port number", None, "e.g. --port 8080"))
     episode = Path(args.episode) if args.episode else None
     if episode is not None and not episode.is_dir():
-        raise AdfError(error("bad-episode", f"{inputs.shown(episode)} is not a folder", SourceLocation(str(episode)),
-                             "give the --out folder of `adfkit suture --record`"))
+        raise AdfError(
+            error(
+                "bad-episode",
+                f"{inputs.shown(episode)} is not a folder",
+                SourceLocation(str(episode)),
+                "give the --out folder of `adfkit suture --record`",
+            )
+        )
     viewer = Viewer(scene, parse_indices(args.indices), args.engine, args.host, args.port, episode)
     viewer.load()
     address = viewer.start()
-    print(f"adfkit view: {address}  ({'the scene cannot be played: see the findings in the page' if viewer.world is None else scene})")
+    print(
+        f"adfkit view: {address}  ({'the scene cannot be played: see the findings in the page' if viewer.world is None else scene})"
+    )
     if args.host in ("127.0.0.1", "localhost", "::1"):
         print(f"  from another machine: ssh -L {args.port}:localhost:{args.port} THIS-HOST, then open {address}")
     print("  Ctrl-C stops it", flush=True)

@@ -3,6 +3,7 @@
 Each format module offers ``read(path) -> (ModelFile, [Loss])`` and
 ``write(model, path) -> [Loss]``; nothing converts one file format directly into another.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -24,8 +25,14 @@ def format_of(path: str | Path, given: str | None = None) -> str:
     p = Path(path)
     fmt = _EXTENSIONS.get(p.suffix.lower())
     if fmt is None:
-        raise AdfError(error("convert-format", f"cannot tell the format of {p.name!r} from its extension",
-                             SourceLocation(str(p)), "use .yaml (ADF), .urdf or .xml (MJCF), or pass --from/--to"))
+        raise AdfError(
+            error(
+                "convert-format",
+                f"cannot tell the format of {p.name!r} from its extension",
+                SourceLocation(str(p)),
+                "use .yaml (ADF), .urdf or .xml (MJCF), or pass --from/--to",
+            )
+        )
     if fmt == "mjcf" and inputs.is_regular(p):
         with open(inputs.check_file(p, "xml", what="XML file"), "rb") as fh:  # regular file only
             head = fh.read(4096).decode("utf-8", "replace")

@@ -1,4 +1,5 @@
 """ADF as one more converter format: a model file read and written through adfkit.adf."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -14,12 +15,19 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
     doc, diags = read_file(path)
     # what AMBF loads anyway (duplicate keys: it keeps the first) does not stop a conversion
     from ..validator.engine import SEVERITY_OVERRIDES
+
     errors = [d for d in diags if SEVERITY_OVERRIDES.get(d.rule, d.severity) >= 2]
     if errors:
         raise AdfError(errors)
     if not isinstance(doc, ModelFile):
-        raise AdfError(error("convert-kind", f"{path.name} is a {type(doc).__name__} file, not a model file",
-                             SourceLocation(str(path), 1, 1), "convert one model (multibody) file at a time"))
+        raise AdfError(
+            error(
+                "convert-kind",
+                f"{path.name} is a {type(doc).__name__} file, not a model file",
+                SourceLocation(str(path), 1, 1),
+                "convert one model (multibody) file at a time",
+            )
+        )
     return doc, []
 
 

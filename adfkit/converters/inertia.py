@@ -1,4 +1,5 @@
 """Inertia between ADF's principal form (ix, iy, iz + `inertial offset`) and full tensors."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -101,8 +102,12 @@ def estimate_from_collision(model, body, mass: float) -> tuple[float, float, flo
             from ..geometry.meshio import load_mesh
         except ImportError:
             return None
-        mesh = load_mesh(path, scale=body.scale if body.scale is not None else 1.0,
-                         tree=getattr(model, "tree", None), referrer=body.where("mesh"))
+        mesh = load_mesh(
+            path,
+            scale=body.scale if body.scale is not None else 1.0,
+            tree=getattr(model, "tree", None),
+            referrer=body.where("mesh"),
+        )
         r = np.asarray(com.orientation.matrix())
         pts = np.asarray(mesh.vertices) @ r.T + np.asarray(com.position)
         points = pts.tolist()

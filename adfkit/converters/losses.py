@@ -1,4 +1,5 @@
 """What a conversion could not carry over: one record per element and feature, never silent."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -7,6 +7,7 @@ ADF body frames, principal inertias and their frames become `inertia` and `inert
 directly, hinge/slide joints become revolute/prismatic joints whose ADF value equals MuJoCo's
 ``qpos`` (the `ref` of a joint is the initial value the bodies' `location`s show).
 """
+
 from __future__ import annotations
 
 import math
@@ -19,9 +20,9 @@ from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import shortest_arc
 from .losses import Loss
-from .urdf import _unique
 from .mjcf_cameras import read_cameras, read_lights
 from .mjcf_source import Source, load
+from .urdf import _unique
 
 # mjtGeom / mjtJoint values (MuJoCo's enums, stable across 2.x-4.x)
 PLANE, HFIELD, SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = range(8)
@@ -46,8 +47,14 @@ def _compile(source: Source, path: Path):
         first = text.splitlines()[0] if text else type(exc).__name__
         if "XML_ELEMENT_DEPTH_EXCEEDED" in text:
             first = "elements nested too deep for MuJoCo's XML parser (at most 499 levels)"
-        raise AdfError(error("mjcf-compile", f"MuJoCo cannot load the file: {first}", source.locate(text),
-                             "fix what MuJoCo names; `python -m mujoco.viewer` shows the same message")) from None
+        raise AdfError(
+            error(
+                "mjcf-compile",
+                f"MuJoCo cannot load the file: {first}",
+                source.locate(text),
+                "fix what MuJoCo names; `python -m mujoco.viewer` shows the same message",
+            )
+        ) from None
     return mujoco, spec, model
 
 
@@ -71,8 +78,14 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
     source = load(path)  # safe XML, includes resolved inside the model's folder tree
     doc = source.doc
     if doc.root.tag != "mujoco":
-        raise AdfError(error("mjcf-root", f"the root element is <{doc.root.tag}>, not <mujoco>", doc.where(doc.root),
-                             "an MJCF file holds one <mujoco> element"))
+        raise AdfError(
+            error(
+                "mjcf-root",
+                f"the root element is <{doc.root.tag}>, not <mujoco>",
+                doc.where(doc.root),
+                "an MJCF file holds one <mujoco> element",
+            )
+        )
     mujoco, spec, m = _compile(source, path)
     d = mujoco.MjData(m)
     d.qpos[:] = m.qpos0
@@ -89,11 +102,13 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
         frames[b] = _visual_mesh_frame(m, b, meshes)
         world_pose[b] = _pose(d.xpos[b], d.xquat[b]) * frames[b]
     bodies: dict[int, Body] = {}
-    flex = _flex_vertex_bodies(m, losses)   # MuJoCo's bodies for flex vertices: not ADF bodies
+    flex = _flex_vertex_bodies(m, losses)  # MuJoCo's bodies for flex vertices: not ADF bodies
     # the world body becomes a static ADF body when something is attached to it
     needs_world = any(m.geom_bodyid[g] == 0 for g in range(m.ngeom)) or any(
         m.body_parentid[b] == 0 and m.body_jntnum[b] > 0 and m.jnt_type[m.body_jntadr[b]] != FREE
-        for b in range(1, m.nbody) if b not in flex)
+        for b in range(1, m.nbody)
+        if b not in flex
+    )
     if needs_world:
         names[0], frames[0], world_pose[0] = "world", Pose(), Pose()
         bodies[0] = Body(identifier="BODY world", name="world", location=Pose(), mass=0.0)
@@ -120,8 +135,12 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
     mujoco.mj_camlight(m, d)  # cameras and lights where they are at qpos0, tracking modes included
     model.cameras = read_cameras(m, d, names, world_pose, losses)
     model.lights = read_lights(m, d, names, world_pose, losses)
-    for kind, count, label in (("actuator", m.nu, "actuator"), ("sensor", m.nsensor, "sensor"),
-                               ("tendon", m.ntendon, "tendon"), ("site", m.nsite, "site")):
+    for kind, count, label in (
+        ("actuator", m.nu, "actuator"),
+        ("sensor", m.nsensor, "sensor"),
+        ("tendon", m.ntendon, "tendon"),
+        ("site", m.nsite, "site"),
+    ):
         for i in range(count):
             nm = getattr(m, kind)(i).name or f"{label} {i}"
             losses.append(Loss(nm, label, "not converted to ADF"))
@@ -137,10 +156,16 @@ def _flex_vertex_bodies(m, losses) -> set[int]:
     out: set[int] = set()
     for f in range(getattr(m, "nflex", 0)):
         adr, num = int(m.flex_vertadr[f]), int(m.flex_vertnum[f])
-        out.update(int(b) for b in m.flex_vertbodyid[adr:adr + num] if int(b) > 0)
+        out.update(int(b) for b in m.flex_vertbodyid[adr : adr + num] if int(b) > 0)
         name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_FLEX, f) or f"flex {f}"
-        losses.append(Loss(name, "flex", f"a MuJoCo flex ({num} vertices) is not read: "
-                           "an ADF soft body needs a mesh file; export the flex as OBJ and list it in 'soft bodies'"))
+        losses.append(
+            Loss(
+                name,
+                "flex",
+                f"a MuJoCo flex ({num} vertices) is not read: "
+                "an ADF soft body needs a mesh file; export the flex as OBJ and list it in 'soft bodies'",
+            )
+        )
     return out
 
 
@@ -177,11 +202,15 @@ def _read_geoms(m, b: int, body: Body, meshes, losses, frame: Pose) -> None:
         if gtype == SPHERE:
             entry = ShapeEntry(shape="sphere", geometry=Geometry(radius=size[0]), offset=pose)
         elif gtype == CAPSULE:
-            entry = ShapeEntry(shape="capsule", geometry=Geometry(radius=size[0], height=2 * size[1] + 2 * size[0],
-                                                                  axis="z"), offset=pose)
+            entry = ShapeEntry(
+                shape="capsule",
+                geometry=Geometry(radius=size[0], height=2 * size[1] + 2 * size[0], axis="z"),
+                offset=pose,
+            )
         elif gtype == CYLINDER:
-            entry = ShapeEntry(shape="cylinder", geometry=Geometry(radius=size[0], height=2 * size[1], axis="z"),
-                               offset=pose)
+            entry = ShapeEntry(
+                shape="cylinder", geometry=Geometry(radius=size[0], height=2 * size[1], axis="z"), offset=pose
+            )
         elif gtype == BOX:
             entry = ShapeEntry(shape="box", geometry=Geometry(x=2 * size[0], y=2 * size[1], z=2 * size[2]), offset=pose)
         elif gtype == MESH:
@@ -233,12 +262,28 @@ def _read_joint(m, b: int, names, bodies, world_pose, frames, model: ModelFile, 
     if n == 0:
         if parent_id == 0 and 0 not in bodies:
             if child.mass:
-                losses.append(Loss(child.identifier, "mass", "welded to the world: an ADF body fixed to the world "
-                                                             "is static (mass 0)"))
+                losses.append(
+                    Loss(
+                        child.identifier,
+                        "mass",
+                        "welded to the world: an ADF body fixed to the world is static (mass 0)",
+                    )
+                )
             child.mass = 0.0
             return
-        _add_joint(model, f"{names[parent_id]}-{names[b]}", "fixed", bodies[parent_id], child,
-                   world_pose[parent_id].inverse() * world_pose[b], Vec3(), Vec3(0.0, 0.0, 1.0), 0.0, None, losses)
+        _add_joint(
+            model,
+            f"{names[parent_id]}-{names[b]}",
+            "fixed",
+            bodies[parent_id],
+            child,
+            world_pose[parent_id].inverse() * world_pose[b],
+            Vec3(),
+            Vec3(0.0, 0.0, 1.0),
+            0.0,
+            None,
+            losses,
+        )
         return
     if int(m.jnt_type[adr]) == FREE:
         return  # a free body: no ADF joint (MuJoCo allows a free joint only alone)
@@ -262,21 +307,32 @@ def _read_joint(m, b: int, names, bodies, world_pose, frames, model: ModelFile, 
         _read_one_joint(m, j, jname, previous, nxt, previous_pose.inverse() * nxt_pose, to_body, model, losses)
         previous, previous_pose = nxt, nxt_pose
     if added:
-        losses.append(Loss(child.identifier, "joints", f"{n} joints on one body; ADF joins two bodies by one joint: "
-                                                       f"built as a chain through {', '.join(added)} (1 % of the "
-                                                       "body's mass and inertia each)"))
+        losses.append(
+            Loss(
+                child.identifier,
+                "joints",
+                f"{n} joints on one body; ADF joins two bodies by one joint: "
+                f"built as a chain through {', '.join(added)} (1 % of the "
+                "body's mass and inertia each)",
+            )
+        )
 
 
 def _chain_body(m, b: int, name: str, frame: Pose) -> Body:
     """A shapeless body between two of a multi-joint body's joints, at the body frame."""
     mass = max(0.01 * float(m.body_mass[b]), 1e-6)
     i = max(0.01 * float(sum(m.body_inertia[b])) / 3.0, 1e-9)
-    return Body(identifier=f"BODY {name}", name=name, location=frame, mass=mass,
-                inertia=Inertia(ix=i, iy=i, iz=i), inertial_offset=Pose())
+    return Body(
+        identifier=f"BODY {name}",
+        name=name,
+        location=frame,
+        mass=mass,
+        inertia=Inertia(ix=i, iy=i, iz=i),
+        inertial_offset=Pose(),
+    )
 
 
-def _read_one_joint(m, j: int, jname: str, parent: Body, child: Body, rel: Pose, to_body: Pose, model,
-                    losses) -> None:
+def _read_one_joint(m, j: int, jname: str, parent: Body, child: Body, rel: Pose, to_body: Pose, model, losses) -> None:
     """MuJoCo joint ``j`` between ``parent`` and ``child`` (``rel``: child frame in the parent
     frame at qpos0; ``to_body``: MuJoCo body coordinates → the child's ADF frame)."""
     jtype = int(m.jnt_type[j])
@@ -287,27 +343,45 @@ def _read_one_joint(m, j: int, jname: str, parent: Body, child: Body, rel: Pose,
         return
     ref = float(m.qpos0[m.jnt_qposadr[j]])
     # the ADF zero configuration is MuJoCo's qpos = 0: undo the reference value
-    undo = Pose(axis.scaled(-ref)) if jtype == SLIDE else \
-        Pose(pivot) * Pose(Vec3(), Quat.from_axis_angle(axis, -ref)) * Pose(pivot.scaled(-1.0))
+    undo = (
+        Pose(axis.scaled(-ref))
+        if jtype == SLIDE
+        else Pose(pivot) * Pose(Vec3(), Quat.from_axis_angle(axis, -ref)) * Pose(pivot.scaled(-1.0))
+    )
     limits = None
     if m.jnt_limited[j]:
         lo, hi = (float(v) for v in m.jnt_range[j])
         limits = JointLimits(low=lo, high=hi)
-    joint = _add_joint(model, jname, "revolute" if jtype == HINGE else "prismatic", parent, child,
-                       rel * undo, pivot, axis, ref, limits, losses)
+    joint = _add_joint(
+        model,
+        jname,
+        "revolute" if jtype == HINGE else "prismatic",
+        parent,
+        child,
+        rel * undo,
+        pivot,
+        axis,
+        ref,
+        limits,
+        losses,
+    )
     damping = float(m.dof_damping[m.jnt_dofadr[j]])
     if damping:
         joint.damping = damping
-    for attr, label in (("jnt_stiffness", "stiffness"), ("dof_armature", "armature"),
-                        ("dof_frictionloss", "friction loss")):
+    for attr, label in (
+        ("jnt_stiffness", "stiffness"),
+        ("dof_armature", "armature"),
+        ("dof_frictionloss", "friction loss"),
+    ):
         arr = getattr(m, attr)
         idx = j if attr.startswith("jnt") else m.jnt_dofadr[j]
         if float(arr[idx]) != 0.0:
             losses.append(Loss(joint.identifier, label, "ADF revolute/prismatic joints have no such property"))
 
 
-def _add_joint(model, name, jtype, parent: Body, child: Body, rel0: Pose, pivot: Vec3, axis: Vec3, ref,
-               limits, losses) -> Joint:
+def _add_joint(
+    model, name, jtype, parent: Body, child: Body, rel0: Pose, pivot: Vec3, axis: Vec3, ref, limits, losses
+) -> Joint:
     """An ADF joint whose frames put ``child`` at ``rel0`` (in the parent body frame) at value 0,
     rotating about ``axis`` through ``pivot`` (both in the child body frame)."""
     who = f"JOINT {name}"
@@ -316,12 +390,28 @@ def _add_joint(model, name, jtype, parent: Body, child: Body, rel0: Pose, pivot:
     d = Vec3(1.0, 0.0, 0.0) if jtype == "prismatic" else Vec3(0.0, 0.0, 1.0)
     tilt = sum(t for t in (d.cross(a).norm(), a.cross(axis).norm()) if 1e-12 < t < 1e-3)
     if tilt:
-        losses.append(Loss(who, "axis tilt", f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
-                                             "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away"))
+        losses.append(
+            Loss(
+                who,
+                "axis tilt",
+                f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
+                "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away",
+            )
+        )
     twist = rel0.orientation * shortest_arc(axis, a).inverse()
     offset = _angle_about(a, twist)
-    joint = Joint(identifier=who, name=name, parent=parent.identifier, child=child.identifier, type=jtype,
-                  parent_pivot=pa, parent_axis=a, child_pivot=pivot, child_axis=axis, joint_limits=limits)
+    joint = Joint(
+        identifier=who,
+        name=name,
+        parent=parent.identifier,
+        child=child.identifier,
+        type=jtype,
+        parent_pivot=pa,
+        parent_axis=a,
+        child_pivot=pivot,
+        child_axis=axis,
+        joint_limits=limits,
+    )
     if abs(offset) > 1e-12:
         joint.offset = offset
     model.joints.append(joint)
@@ -335,13 +425,40 @@ def _read_equalities(m, names, bodies, world_pose, frames, model, losses) -> Non
         etype = int(m.eq_type[e])
         b1, b2 = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
         name = m.eq(e).name or f"equality{e}"
-        if etype == int(mujoco.mjtEq.mjEQ_CONNECT) and b1 > 0 and b2 > 0 and m.eq_objtype[e] == mujoco.mjtObj.mjOBJ_BODY:
+        if (
+            etype == int(mujoco.mjtEq.mjEQ_CONNECT)
+            and b1 > 0
+            and b2 > 0
+            and m.eq_objtype[e] == mujoco.mjtObj.mjOBJ_BODY
+        ):
             anchor1 = frames[b1].inverse().transform(Vec3(*(float(v) for v in m.eq_data[e][0:3])))
             rel = world_pose[b2].inverse() * world_pose[b1]
-            _add_joint(model, name, "p2p", bodies[b1], bodies[b2], rel.inverse(), rel.transform(anchor1),
-                       Vec3(0.0, 0.0, 1.0), 0.0, None, losses)
+            _add_joint(
+                model,
+                name,
+                "p2p",
+                bodies[b1],
+                bodies[b2],
+                rel.inverse(),
+                rel.transform(anchor1),
+                Vec3(0.0, 0.0, 1.0),
+                0.0,
+                None,
+                losses,
+            )
         elif etype == int(mujoco.mjtEq.mjEQ_WELD) and b1 > 0 and b2 > 0 and m.eq_objtype[e] == mujoco.mjtObj.mjOBJ_BODY:
-            _add_joint(model, name, "fixed", bodies[b1], bodies[b2], world_pose[b1].inverse() * world_pose[b2],
-                       Vec3(), Vec3(0.0, 0.0, 1.0), 0.0, None, losses)
+            _add_joint(
+                model,
+                name,
+                "fixed",
+                bodies[b1],
+                bodies[b2],
+                world_pose[b1].inverse() * world_pose[b2],
+                Vec3(),
+                Vec3(0.0, 0.0, 1.0),
+                0.0,
+                None,
+                losses,
+            )
         else:
             losses.append(Loss(name, "equality", "only body connect/weld equalities map to ADF joints"))

@@ -15,6 +15,7 @@ its collision mesh (unique vertices, placed by `location` and `scale`) and its t
 Everything else a file sets is a named loss, as is a soft body whose mesh cannot be read
 and a joint between a soft body and a rigid body.
 """
+
 from __future__ import annotations
 
 import re
@@ -26,9 +27,9 @@ from ..model.spec import adf_fields
 from .losses import Loss
 from .urdf import _material, _num
 
-AMBF_DT = 0.001            # AMBF's fixed internal step, s
-DEFAULT_MARGIN = 0.001     # adf-format.md §7.4
-CL_SELF = 0x40             # btSoftBody::fCollision::CL_SELF
+AMBF_DT = 0.001  # AMBF's fixed internal step, s
+DEFAULT_MARGIN = 0.001  # adf-format.md §7.4
+CL_SELF = 0x40  # btSoftBody::fCollision::CL_SELF
 MAPPED = {"kLST", "piterations", "bending constraint", "kDP", "kDF", "fixed nodes", "flags"}
 
 
@@ -58,25 +59,42 @@ def write_soft_bodies(model: ModelFile, world: ET.Element, used: dict, losses: l
             losses.append(Loss(who, "soft body", f"not written: {exc.diagnostics[0].message}"))
             continue
         cfg = sb.config
-        get = (lambda k, d: getattr(cfg, k) if cfg is not None and getattr(cfg, k) is not None else d)
+        get = lambda k, d, cfg=cfg: getattr(cfg, k) if cfg is not None and getattr(cfg, k) is not None else d
         margin = sb.collision_margin if sb.collision_margin is not None else DEFAULT_MARGIN
         thickness = 2.0 * margin
         k = link_stiffness(sb, mesh.node_count, AMBF_DT)
         bending = get("bending_constraint", 0) >= 2
-        fc = ET.SubElement(world, "flexcomp", name=_flex_name(sb.name or who, flex_names), type="direct", dim="2",
-                           radius=_num(margin),
-                           point=" ".join(_num(round(float(x), 9)) for x in mesh.nodes.reshape(-1)),
-                           element=" ".join(str(int(i)) for i in mesh.triangles.reshape(-1)))
+        fc = ET.SubElement(
+            world,
+            "flexcomp",
+            name=_flex_name(sb.name or who, flex_names),
+            type="direct",
+            dim="2",
+            radius=_num(margin),
+            point=" ".join(_num(round(float(x), 9)) for x in mesh.nodes.reshape(-1)),
+            element=" ".join(str(int(i)) for i in mesh.triangles.reshape(-1)),
+        )
         if sb.mass is not None and sb.mass > 0:
             fc.set("mass", _num(sb.mass))
         rgba = _material(sb)
         if rgba is not None:
             fc.set("rgba", " ".join(_num(x) for x in rgba))
-        ET.SubElement(fc, "elasticity", young=_num(k / thickness), poisson="0.0", thickness=_num(thickness),
-                      damping=_num(min(max(get("kDP", 0.0), 0.0), 1.0) * AMBF_DT),
-                      elastic2d="both" if bending else "stretch")
-        ET.SubElement(fc, "contact", margin=_num(margin), friction=_num(get("kDF", 0.2)),
-                      selfcollide="auto" if get("flags", 1) & CL_SELF else "none")
+        ET.SubElement(
+            fc,
+            "elasticity",
+            young=_num(k / thickness),
+            poisson="0.0",
+            thickness=_num(thickness),
+            damping=_num(min(max(get("kDP", 0.0), 0.0), 1.0) * AMBF_DT),
+            elastic2d="both" if bending else "stretch",
+        )
+        ET.SubElement(
+            fc,
+            "contact",
+            margin=_num(margin),
+            friction=_num(get("kDF", 0.2)),
+            selfcollide="auto" if get("flags", 1) & CL_SELF else "none",
+        )
         fixed = [i for i in (cfg.fixed_nodes or []) if 0 <= i < mesh.node_count] if cfg is not None else []
         if fixed:
             ET.SubElement(fc, "pin", id=" ".join(map(str, fixed)))
@@ -86,8 +104,14 @@ def write_soft_bodies(model: ModelFile, world: ET.Element, used: dict, losses: l
             losses.append(Loss(who, key, "no MuJoCo flex counterpart"))
         if sb.mass is None:
             losses.append(Loss(who, "mass", "not in the ADF file: MuJoCo's default flex mass is written (AMBF: 1 kg)"))
-        losses.append(Loss(who, "soft body", "Bullet's position-based links become a MuJoCo flex membrane "
-                                             "(elasticity from kLST and piterations; docs/soft-bodies.md)"))
+        losses.append(
+            Loss(
+                who,
+                "soft body",
+                "Bullet's position-based links become a MuJoCo flex membrane "
+                "(elasticity from kLST and piterations; docs/soft-bodies.md)",
+            )
+        )
         written += 1
     return written
 

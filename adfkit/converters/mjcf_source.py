@@ -11,6 +11,7 @@ MuJoCo's messages name a line and sometimes an element (``Element 'geom', line 3
 ``Element name 'a', id 1, line 3``), never a column, and a line of the text it was given.
 :class:`Source` maps such a message back to a file, line and column of the user's files.
 """
+
 from __future__ import annotations
 
 import os
@@ -30,8 +31,13 @@ class Source:
     """The document(s) of one MJCF model. ``text`` is None when the file has no include (MuJoCo
     then reads the file itself, and its line numbers are the file's)."""
 
-    def __init__(self, doc: XmlDocument, text: str | None = None,
-                 merged: XmlDocument | None = None, origin: dict[int, SourceLocation] | None = None):
+    def __init__(
+        self,
+        doc: XmlDocument,
+        text: str | None = None,
+        merged: XmlDocument | None = None,
+        origin: dict[int, SourceLocation] | None = None,
+    ):
         self.doc = doc
         self.text = text
         self._merged = merged
@@ -91,17 +97,30 @@ def load(path: Path) -> Source:
                 raise AdfError(error("mjcf-include", "<include> without a file", where, 'add file="part.xml"'))
             inputs.check_path_text(name, where)
             if os.path.isabs(name):
-                raise AdfError(error("mjcf-include", f"<include file=\"{inputs.shown(name)}\">: an absolute path is not "
-                                     "followed", where, "include files by a path relative to the model's folder"))
+                raise AdfError(
+                    error(
+                        "mjcf-include",
+                        f'<include file="{inputs.shown(name)}">: an absolute path is not followed',
+                        where,
+                        "include files by a path relative to the model's folder",
+                    )
+                )
             target = folder / name
             real = os.path.realpath(target)
             if real in chain:
-                raise AdfError(error("mjcf-include", f"<include file=\"{inputs.shown(name)}\"> includes itself "
-                                     "(directly or through other files)", where, "remove the include cycle"))
+                raise AdfError(
+                    error(
+                        "mjcf-include",
+                        f'<include file="{inputs.shown(name)}"> includes itself (directly or through other files)',
+                        where,
+                        "remove the include cycle",
+                    )
+                )
             followed += 1
             if followed > MAX_INCLUDES:
-                raise AdfError(error("mjcf-include", f"more than {MAX_INCLUDES} includes", where,
-                                     "merge the included files"))
+                raise AdfError(
+                    error("mjcf-include", f"more than {MAX_INCLUDES} includes", where, "merge the included files")
+                )
             data = inputs.read_bytes(target, "xml", tree=tree, referrer=where, what="included MJCF file")
             sub = parse_xml(target, text=data)
             for el in sub.elements():

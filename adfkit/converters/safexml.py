@@ -1,5 +1,6 @@
 """Safe XML for URDF and MJCF: expat with DOCTYPE and ENTITY declarations refused (no external
 entities, no expansion bombs), building an ``xml.etree`` tree and keeping each element's line."""
+
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
@@ -14,8 +15,13 @@ class XmlDocument:
     """The parsed root plus ``line(element)`` and ``where(element)`` (line and column of the
     element's start tag, both 1-based) for diagnostics."""
 
-    def __init__(self, root: ET.Element, lines: dict[int, tuple[int, int]], path: Path | None,
-                 keep: list[ET.Element] | None = None):
+    def __init__(
+        self,
+        root: ET.Element,
+        lines: dict[int, tuple[int, int]],
+        path: Path | None,
+        keep: list[ET.Element] | None = None,
+    ):
         self.root = root
         self._lines = lines
         self.path = path
@@ -81,13 +87,23 @@ def parse_xml(path: str | Path | None = None, text: str | bytes | None = None) -
     try:
         parser.Parse(text, True)
     except _Refused:
-        raise AdfError(error("xml-unsafe", "DOCTYPE or ENTITY declarations are not accepted",
-                             SourceLocation(where, parser.CurrentLineNumber, parser.CurrentColumnNumber + 1),
-                             "URDF and MJCF need no DTD; remove the <!DOCTYPE ...> block")) from None
+        raise AdfError(
+            error(
+                "xml-unsafe",
+                "DOCTYPE or ENTITY declarations are not accepted",
+                SourceLocation(where, parser.CurrentLineNumber, parser.CurrentColumnNumber + 1),
+                "URDF and MJCF need no DTD; remove the <!DOCTYPE ...> block",
+            )
+        ) from None
     except expat.ExpatError as exc:
-        raise AdfError(error("xml-syntax", f"not well-formed XML: {expat.ErrorString(exc.code)}",
-                             SourceLocation(where, exc.lineno, exc.offset + 1),
-                             "fix the XML syntax at that position")) from None
+        raise AdfError(
+            error(
+                "xml-syntax",
+                f"not well-formed XML: {expat.ErrorString(exc.code)}",
+                SourceLocation(where, exc.lineno, exc.offset + 1),
+                "fix the XML syntax at that position",
+            )
+        ) from None
     root = builder.close()
     return XmlDocument(root, lines, Path(path) if path is not None else None, keep)
 

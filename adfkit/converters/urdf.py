@@ -10,6 +10,7 @@ Reading: each link becomes a body whose frame is the link frame times its (first
 origin, because ADF has no visual offset; joints get pivots and axes in both body frames and
 the ADF `offset` that reproduces the URDF origin's twist about the axis.
 """
+
 from __future__ import annotations
 
 import math
@@ -25,13 +26,18 @@ from ..model.files import ModelFile
 from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import (
-    JointKind, ShapeKind, collision_primitives, effective_mass, inertial_offset, shortest_arc,
+    JointKind,
+    ShapeKind,
+    collision_primitives,
+    effective_mass,
+    inertial_offset,
+    shortest_arc,
 )
+from ..model.tree import Link, build_tree
 from . import inertia as inertia_math
 from .engine_fit import MeshFiles, joint_range, usable_scales
 from .losses import Loss
 from .safexml import XmlDocument, parse_xml, to_text
-from ..model.tree import Link, build_tree
 
 # --- writing ------------------------------------------------------------------------------
 
@@ -46,14 +52,28 @@ INITIAL_VALUE_TOLERANCE = 1e-4
 
 # Body keys URDF has no element for (reported when the file sets them).
 _BODY_ONLY = {
-    "friction": "friction", "restitution": "restitution", "damping": "damping",
-    "collision_groups": "collision groups", "collision_margin": "collision margin",
-    "controller": "controller", "gravity": "gravity", "shaders": "shaders", "plugins": "plugins",
-    "publish_frequency": "publish frequency", "passive": "passive",
+    "friction": "friction",
+    "restitution": "restitution",
+    "damping": "damping",
+    "collision_groups": "collision groups",
+    "collision_margin": "collision margin",
+    "controller": "controller",
+    "gravity": "gravity",
+    "shaders": "shaders",
+    "plugins": "plugins",
+    "publish_frequency": "publish frequency",
+    "passive": "passive",
 }
-_LOSSY_OBJECTS = (("ghost_objects", "ghost object"), ("sensors", "sensor"), ("actuators", "actuator"),
-                  ("cameras", "camera"), ("lights", "light"), ("soft_bodies", "soft body"),
-                  ("vehicles", "vehicle"), ("volumes", "volume"))
+_LOSSY_OBJECTS = (
+    ("ghost_objects", "ghost object"),
+    ("sensors", "sensor"),
+    ("actuators", "actuator"),
+    ("cameras", "camera"),
+    ("lights", "light"),
+    ("soft_bodies", "soft body"),
+    ("vehicles", "vehicle"),
+    ("volumes", "volume"),
+)
 
 
 def _num(v: float) -> str:
@@ -144,8 +164,9 @@ def _mesh_element(link_el: ET.Element, tag: str, pose: Pose, mesh: Path, scale: 
     return el
 
 
-def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_dir: Path, losses: list[Loss],
-                files: MeshFiles) -> None:
+def _write_link(
+    robot: ET.Element, model: ModelFile, link: Link, name: str, out_dir: Path, losses: list[Loss], files: MeshFiles
+) -> None:
     body = link.body
     el = ET.SubElement(robot, "link", name=name)
     who = body.identifier
@@ -158,11 +179,19 @@ def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_
     if body.inertia is None and mass > 0:
         est = inertia_math.estimate_from_collision(model, body, mass)
         if est is None:
-            losses.append(Loss(who, "inertia", "not in the ADF file and no collision shape to estimate it from; written as 0"))
+            losses.append(
+                Loss(who, "inertia", "not in the ADF file and no collision shape to estimate it from; written as 0")
+            )
         else:
             ix, iy, iz = est
-            losses.append(Loss(who, "inertia", "not in the ADF file: written as Bullet's estimate "
-                                               "(box inertia of the collision shape's bounding box)"))
+            losses.append(
+                Loss(
+                    who,
+                    "inertia",
+                    "not in the ADF file: written as Bullet's estimate "
+                    "(box inertia of the collision shape's bounding box)",
+                )
+            )
     ET.SubElement(inertial, "inertia", ixx=_num(ix), ixy="0.0", ixz="0.0", iyy=_num(iy), iyz="0.0", izz=_num(iz))
     to_link = link.frame_in_body.inverse()
     mesh = visual_mesh_path(model, body)
@@ -192,7 +221,9 @@ def _write_link(robot: ET.Element, model: ModelFile, link: Link, name: str, out_
                 losses.append(Loss(who, f"collision {prim.kind.value}", "URDF has no such primitive"))
                 continue
             if prim.kind is ShapeKind.CAPSULE:
-                losses.append(Loss(who, "collision capsule", "URDF has no capsule: written as a cylinder and two spheres"))
+                losses.append(
+                    Loss(who, "collision capsule", "URDF has no capsule: written as a cylinder and two spheres")
+                )
             for geo, local in parts:
                 col = ET.SubElement(el, "collision")
                 _origin(col, to_link * prim.pose * local)
@@ -210,10 +241,16 @@ def _is_bare(model: ModelFile, body: Body) -> bool:
     """A static body with nothing to show, collide or weigh, at the world origin: an empty
     URDF link (what a URDF's `world` link reads as)."""
     loc = body.location or Pose()
-    return (visual_mesh_path(model, body) is None and not body.shape and not body.compound_shape
-            and collision_primitives(body) is None and collision_mesh_path(model, body) is None
-            and body.inertia is None and loc.position.norm() < 1e-12
-            and loc.orientation.angle_to(Quat(0.0, 0.0, 0.0, 1.0)) < 1e-12)
+    return (
+        visual_mesh_path(model, body) is None
+        and not body.shape
+        and not body.compound_shape
+        and collision_primitives(body) is None
+        and collision_mesh_path(model, body) is None
+        and body.inertia is None
+        and loc.position.norm() < 1e-12
+        and loc.orientation.angle_to(Quat(0.0, 0.0, 0.0, 1.0)) < 1e-12
+    )
 
 
 def _write_joint(robot: ET.Element, link: Link, name: str, parent: str, child: str, losses: list[Loss]) -> None:
@@ -225,7 +262,9 @@ def _write_joint(robot: ET.Element, link: Link, name: str, parent: str, child: s
     elif link.kind is JointKind.PRISMATIC:
         jtype = "prismatic"
         if not has_limits:
-            losses.append(Loss(j.identifier, "unlimited prismatic", "URDF prismatic joints need limits; written as ±1e3 m"))
+            losses.append(
+                Loss(j.identifier, "unlimited prismatic", "URDF prismatic joints need limits; written as ±1e3 m")
+            )
     else:
         jtype = "fixed"
     el = ET.SubElement(robot, "joint", name=name, type=jtype)
@@ -240,11 +279,20 @@ def _write_joint(robot: ET.Element, link: Link, name: str, parent: str, child: s
     if isinstance(j.damping, float) and jtype != "fixed":
         ET.SubElement(el, "dynamics", damping=_num(j.damping))
     if abs(link.q0) > INITIAL_VALUE_TOLERANCE:
-        losses.append(Loss(j.identifier, "initial value",
-                           f"the bodies' locations put the joint at {link.q0:.6g}; URDF starts every joint at 0"))
-    for attr, key in (("controller", "controller"), ("max_motor_impulse", "max motor impulse"),
-                      ("stiffness", "stiffness"), ("equilibrium_point", "equilibrium point"),
-                      ("controller_output_type", "controller output type")):
+        losses.append(
+            Loss(
+                j.identifier,
+                "initial value",
+                f"the bodies' locations put the joint at {link.q0:.6g}; URDF starts every joint at 0",
+            )
+        )
+    for attr, key in (
+        ("controller", "controller"),
+        ("max_motor_impulse", "max motor impulse"),
+        ("stiffness", "stiffness"),
+        ("equilibrium_point", "equilibrium point"),
+        ("controller_output_type", "controller output type"),
+    ):
         if getattr(j, attr, None) is not None:
             losses.append(Loss(j.identifier, key, "URDF has no element for it"))
     if j.damping is not None and not isinstance(j.damping, float):
@@ -262,8 +310,14 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     robot = ET.Element("robot", name=name)
     roots = [r for r in tree.roots]
     if not roots:
-        raise AdfError(error("convert-empty", "the model has no bodies; there is nothing to write as URDF",
-                             model.where(), "convert a model file with at least one body"))
+        raise AdfError(
+            error(
+                "convert-empty",
+                "the model has no bodies; there is nothing to write as URDF",
+                model.where(),
+                "convert a model file with at least one body",
+            )
+        )
     # URDF holds one tree: the one with the most bodies (the first of equals, in file order)
     sizes = {id(r): sum(1 for lk in tree.ordered() if _root_of(lk) is r) for r in roots}
     main = max(roots, key=lambda r: sizes[id(r)])
@@ -271,8 +325,13 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
         stack = [other]
         while stack:
             lk = stack.pop()
-            losses.append(Loss(lk.body.identifier, "body", "not joined to the root by revolute/prismatic/fixed "
-                                                           "joints; URDF holds one tree"))
+            losses.append(
+                Loss(
+                    lk.body.identifier,
+                    "body",
+                    "not joined to the root by revolute/prismatic/fixed joints; URDF holds one tree",
+                )
+            )
             if lk.joint is not None:
                 losses.append(Loss(lk.joint.identifier, "joint", "its bodies are outside the URDF tree"))
             stack.extend(lk.children)
@@ -304,8 +363,11 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
         if lk.parent is not None:
             _write_joint(robot, lk, _unique(_joint_name(lk.joint), used), names[id(lk.parent)], names[id(lk)], losses)
     for j, kind, _p, _c in tree.loops:
-        why = "closes a loop; URDF is a tree" if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) \
+        why = (
+            "closes a loop; URDF is a tree"
+            if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)
             else f"URDF has no {kind.value} joint"
+        )
         losses.append(Loss(j.identifier, "joint", why))
     for j in tree.unresolved:
         losses.append(Loss(j.identifier, "joint", "unknown type or parent/child body not in this file"))
@@ -343,20 +405,33 @@ def write(model: ModelFile, path: Path) -> list[Loss]:
 
 # --- reading ------------------------------------------------------------------------------
 
+
 def _floats(doc: XmlDocument, el: ET.Element, attr: str, n: int, default=None) -> tuple[float, ...]:
     raw = el.get(attr)
     if raw is None:
         if default is None:
-            raise AdfError(error("urdf-attribute", f"<{el.tag}> lacks '{attr}'", doc.where(el),
-                                 f"add {attr}=\"...\" with {n} number(s)"))
+            raise AdfError(
+                error(
+                    "urdf-attribute",
+                    f"<{el.tag}> lacks '{attr}'",
+                    doc.where(el),
+                    f'add {attr}="..." with {n} number(s)',
+                )
+            )
         return default
     try:
         vals = tuple(float(x) for x in raw.split())
     except ValueError:
         vals = ()
     if len(vals) != n or not all(math.isfinite(v) for v in vals):
-        raise AdfError(error("urdf-number", f"<{el.tag} {attr}=\"{raw}\">: expected {n} finite number(s)",
-                             doc.where(el), f"write {attr} as {n} space-separated numbers"))
+        raise AdfError(
+            error(
+                "urdf-number",
+                f'<{el.tag} {attr}="{raw}">: expected {n} finite number(s)',
+                doc.where(el),
+                f"write {attr} as {n} space-separated numbers",
+            )
+        )
     return vals
 
 
@@ -375,7 +450,9 @@ def _twist(a: Vec3, q: Quat) -> float:
 def _geometry_entry(doc: XmlDocument, geo: ET.Element, pose: Pose, who: str, losses: list[Loss]) -> ShapeEntry | None:
     kid = next(iter(geo), None)
     if kid is None:
-        raise AdfError(error("urdf-geometry", "<geometry> is empty", doc.where(geo), "add box, cylinder, sphere or mesh"))
+        raise AdfError(
+            error("urdf-geometry", "<geometry> is empty", doc.where(geo), "add box, cylinder, sphere or mesh")
+        )
     if kid.tag == "box":
         x, y, z = _floats(doc, kid, "size", 3)
         return ShapeEntry(shape="box", geometry=Geometry(x=x, y=y, z=z), offset=pose)
@@ -395,12 +472,18 @@ def _mesh_file(doc: XmlDocument, mesh: ET.Element) -> tuple[str, float | None]:
     if not fn:
         raise AdfError(error("urdf-attribute", "<mesh> lacks 'filename'", doc.where(mesh), "name the mesh file"))
     if fn.startswith("file://"):
-        fn = fn[len("file://"):]
+        fn = fn[len("file://") :]
     if fn.startswith("package://"):
         p = _package_file(doc, fn)
         if p is None:
-            raise AdfError(error("urdf-package-uri", f"cannot find {fn!r} near the URDF file", doc.where(mesh),
-                                 "replace package:// URIs with paths relative to the URDF file"))
+            raise AdfError(
+                error(
+                    "urdf-package-uri",
+                    f"cannot find {fn!r} near the URDF file",
+                    doc.where(mesh),
+                    "replace package:// URIs with paths relative to the URDF file",
+                )
+            )
         fn = str(p)
     p = Path(fn)
     if not p.is_absolute() and doc.path is not None:
@@ -409,8 +492,14 @@ def _mesh_file(doc: XmlDocument, mesh: ET.Element) -> tuple[str, float | None]:
     if mesh.get("scale") is not None:
         s = _floats(doc, mesh, "scale", 3)
         if not (abs(s[0] - s[1]) < 1e-12 and abs(s[1] - s[2]) < 1e-12):
-            raise AdfError(error("urdf-scale", f"non-uniform mesh scale {mesh.get('scale')!r}", doc.where(mesh),
-                                 "ADF scales a body uniformly; rescale the mesh file"))
+            raise AdfError(
+                error(
+                    "urdf-scale",
+                    f"non-uniform mesh scale {mesh.get('scale')!r}",
+                    doc.where(mesh),
+                    "ADF scales a body uniformly; rescale the mesh file",
+                )
+            )
         scale = s[0]
     return str(p), scale
 
@@ -418,7 +507,7 @@ def _mesh_file(doc: XmlDocument, mesh: ET.Element) -> tuple[str, float | None]:
 def _package_file(doc: XmlDocument, uri: str) -> Path | None:
     """Resolve ``package://PKG/REST`` without ROS the way PyBullet does: look for REST (and
     PKG/REST) beside the URDF file and in its parent folders."""
-    rest = uri[len("package://"):]
+    rest = uri[len("package://") :]
     pkg, _, tail = rest.partition("/")
     base = doc.path.parent if doc.path is not None else Path.cwd()
     for root in [base, *list(base.parents)[:3]]:
@@ -436,42 +525,71 @@ def read(path: Path) -> tuple[ModelFile, list[Loss]]:
 def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
     root = doc.root
     if root.tag != "robot":
-        raise AdfError(error("urdf-root", f"the root element is <{root.tag}>, not <robot>", doc.where(root),
-                             "a URDF file holds one <robot>"))
+        raise AdfError(
+            error(
+                "urdf-root",
+                f"the root element is <{root.tag}>, not <robot>",
+                doc.where(root),
+                "a URDF file holds one <robot>",
+            )
+        )
     losses: list[Loss] = []
     links: dict[str, ET.Element] = {}
     for el in root.findall("link"):
         name = el.get("name")
         if not name:
-            raise AdfError(error("urdf-attribute", "<link> without a name", doc.where(el), "add name=\"...\""))
+            raise AdfError(error("urdf-attribute", "<link> without a name", doc.where(el), 'add name="..."'))
         if name in links:
             raise AdfError(error("urdf-duplicate", f"link {name!r} defined twice", doc.where(el), "rename one of them"))
         links[name] = el
     if not links:
-        raise AdfError(error("urdf-empty", "the robot has no links", doc.where(root), "a URDF robot needs at least one <link>"))
+        raise AdfError(
+            error("urdf-empty", "the robot has no links", doc.where(root), "a URDF robot needs at least one <link>")
+        )
     joints = root.findall("joint")
     parent_of: dict[str, tuple[str, ET.Element]] = {}
     for j in joints:
         jn = j.get("name") or "?"
         p, c = j.find("parent"), j.find("child")
         if p is None or c is None or not p.get("link") or not c.get("link"):
-            raise AdfError(error("urdf-joint", f"joint {jn!r} lacks <parent link> or <child link>", doc.where(j),
-                                 "name both links"))
+            raise AdfError(
+                error(
+                    "urdf-joint", f"joint {jn!r} lacks <parent link> or <child link>", doc.where(j), "name both links"
+                )
+            )
         for end in (p, c):
             if end.get("link") not in links:
-                raise AdfError(error("urdf-reference", f"joint {jn!r} names link {end.get('link')!r}, which is not defined",
-                                     doc.where(end), "define the link or fix the name"))
+                raise AdfError(
+                    error(
+                        "urdf-reference",
+                        f"joint {jn!r} names link {end.get('link')!r}, which is not defined",
+                        doc.where(end),
+                        "define the link or fix the name",
+                    )
+                )
         child = c.get("link")
         if child in parent_of:
-            raise AdfError(error("urdf-tree", f"link {child!r} has two parent joints", doc.where(j),
-                                 "URDF is a tree: each link has at most one parent joint"))
+            raise AdfError(
+                error(
+                    "urdf-tree",
+                    f"link {child!r} has two parent joints",
+                    doc.where(j),
+                    "URDF is a tree: each link has at most one parent joint",
+                )
+            )
         parent_of[child] = (p.get("link"), j)
     for name in links:  # cycles
         seen, cur = set(), name
         while cur in parent_of:
             if cur in seen:
-                raise AdfError(error("urdf-tree", f"the joints form a cycle through link {cur!r}",
-                                     doc.where(parent_of[cur][1]), "URDF is a tree; remove one joint of the cycle"))
+                raise AdfError(
+                    error(
+                        "urdf-tree",
+                        f"the joints form a cycle through link {cur!r}",
+                        doc.where(parent_of[cur][1]),
+                        "URDF is a tree; remove one joint of the cycle",
+                    )
+                )
             seen.add(cur)
             cur = parent_of[cur][0]
     for tag in ("transmission", "gazebo"):
@@ -494,8 +612,11 @@ def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
     # an empty root whose joints are all fixed is the world frame: its children are welded to
     # the world (static ADF bodies); an empty root with moving joints stays, as a static body
     fixed_only = {n: all(jel.get("type") == "fixed" for _c, (p, jel) in parent_of.items() if p == n) for n in links}
-    ground = {n for n, el in links.items()
-              if n not in parent_of and _is_empty(el) and fixed_only[n] and any(p == n for p, _j in parent_of.values())}
+    ground = {
+        n
+        for n, el in links.items()
+        if n not in parent_of and _is_empty(el) and fixed_only[n] and any(p == n for p, _j in parent_of.values())
+    }
     colors = _named_colors(doc, root)
     model = ModelFile()
     bodies: dict[str, Body] = {}
@@ -525,14 +646,16 @@ def from_urdf(doc: XmlDocument) -> tuple[ModelFile, list[Loss]]:
                 body.color_rgba = RGBA(r=r, g=g, b=b, a=a)
             if mat is not None and (mat.find("texture") is not None or (col is None and mat.get("name") not in colors)):
                 losses.append(Loss(who, "material", "URDF textures (and materials without a colour) are not carried"))
-            for extra in visuals[1:]:
+            for _extra in visuals[1:]:
                 losses.append(Loss(who, "visual", "ADF has one visual mesh per body; extra visuals dropped"))
         _read_inertial(doc, el, frame, body, losses, quiet=name not in parent_of and _is_empty(el) and name == "world")
         _read_contact(doc, el, body, losses)
         _read_collisions(doc, el, frame, body, losses)
         if parent_of.get(name, ("",))[0] in ground:
             if (body.mass or 0.0) != 0.0:
-                losses.append(Loss(who, "mass", "welded to the world: an ADF body fixed to the world is static (mass 0)"))
+                losses.append(
+                    Loss(who, "mass", "welded to the world: an ADF body fixed to the world is static (mass 0)")
+                )
             body.mass = 0.0
         bodies[name] = body
         model.bodies.append(body)
@@ -565,7 +688,9 @@ def _read_contact(doc: XmlDocument, el: ET.Element, body: Body, losses: list[Los
         if kid.tag in _CONTACT_KEPT:
             values[kid.tag] = _floats(doc, kid, "value", 1)[0]
         else:
-            losses.append(Loss(body.identifier, f"contact {kid.tag}", "PyBullet's <contact> extension: ADF has no such key"))
+            losses.append(
+                Loss(body.identifier, f"contact {kid.tag}", "PyBullet's <contact> extension: ADF has no such key")
+            )
     if "lateral_friction" in values or "rolling_friction" in values:
         body.friction = Friction(static=values.get("lateral_friction"), rolling=values.get("rolling_friction"))
     if "restitution" in values:
@@ -574,8 +699,13 @@ def _read_contact(doc: XmlDocument, el: ET.Element, body: Body, losses: list[Los
     if k is not None and k != 1.0 and body.inertia is not None:
         i = body.inertia
         body.inertia = Inertia(ix=i.ix * k, iy=i.iy * k, iz=i.iz * k)
-        losses.append(Loss(body.identifier, "contact inertia_scaling",
-                           f"PyBullet's inertia scaling ({k!r}) is folded into the ADF inertia"))
+        losses.append(
+            Loss(
+                body.identifier,
+                "contact inertia_scaling",
+                f"PyBullet's inertia scaling ({k!r}) is folded into the ADF inertia",
+            )
+        )
 
 
 def _is_empty(el: ET.Element) -> bool:
@@ -587,8 +717,13 @@ def _read_inertial(doc, el, frame: Pose, body: Body, losses, quiet: bool = False
     if inertial is None:
         body.mass = 0.0
         if not quiet:  # an empty root link named world: static in PyBullet too
-            losses.append(Loss(body.identifier, "inertial", "no <inertial>: mass 0 as ROS reads it (PyBullet assumes 1 kg), which makes the "
-                                                           "ADF body static"))
+            losses.append(
+                Loss(
+                    body.identifier,
+                    "inertial",
+                    "no <inertial>: mass 0 as ROS reads it (PyBullet assumes 1 kg), which makes the ADF body static",
+                )
+            )
         return
     m = inertial.find("mass")
     body.mass = _floats(doc, m, "value", 1)[0] if m is not None else 0.0
@@ -596,14 +731,23 @@ def _read_inertial(doc, el, frame: Pose, body: Body, losses, quiet: bool = False
     tensor = [[0.0] * 3 for _ in range(3)]
     if it is not None:
         vals = {k: _floats(doc, it, k, 1, (0.0,))[0] for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-        tensor = [[vals["ixx"], vals["ixy"], vals["ixz"]], [vals["ixy"], vals["iyy"], vals["iyz"]],
-                  [vals["ixz"], vals["iyz"], vals["izz"]]]
+        tensor = [
+            [vals["ixx"], vals["ixy"], vals["ixz"]],
+            [vals["ixy"], vals["iyy"], vals["iyz"]],
+            [vals["ixz"], vals["iyz"], vals["izz"]],
+        ]
     (ix, iy, iz), rot = inertia_math.principal(tensor)
     body.inertia = Inertia(ix=ix, iy=iy, iz=iz)
     problem = inertia_math.physical_problem((ix, iy, iz))
     if problem:
-        losses.append(Loss(body.identifier, "inertia", f"principal moments {_vec((ix, iy, iz))} {problem}: "
-                                                       "kept as written; PyBullet sets such an inertia to zero"))
+        losses.append(
+            Loss(
+                body.identifier,
+                "inertia",
+                f"principal moments {_vec((ix, iy, iz))} {problem}: "
+                "kept as written; PyBullet sets such an inertia to zero",
+            )
+        )
     offset = frame.inverse() * _pose_of(doc, inertial) * Pose(Vec3(), rot)
     body.inertial_offset = offset
 
@@ -624,7 +768,9 @@ def _read_collisions(doc, el, frame: Pose, body: Body, losses) -> None:
         if e is not None:
             entries.append(e)
     if meshes and entries:
-        losses.append(Loss(body.identifier, "collision meshes", "ADF takes primitives or a mesh, not both; meshes dropped"))
+        losses.append(
+            Loss(body.identifier, "collision meshes", "ADF takes primitives or a mesh, not both; meshes dropped")
+        )
         meshes = []
     if entries:
         body.compound_collision_shape = entries
@@ -638,7 +784,9 @@ def _read_collisions(doc, el, frame: Pose, body: Body, losses) -> None:
             else:
                 body.collision_mesh = fn
                 if scale != body.scale:
-                    losses.append(Loss(body.identifier, "collision mesh scale", "ADF scales visual and collision alike"))
+                    losses.append(
+                        Loss(body.identifier, "collision mesh scale", "ADF scales visual and collision alike")
+                    )
         if pose.position.norm() > 1e-9 or pose.orientation.angle_to(Quat(0, 0, 0, 1)) > 1e-9:
             losses.append(Loss(body.identifier, "collision mesh origin", "ADF collision meshes share the body frame"))
         for _extra in meshes[1:]:
@@ -657,32 +805,58 @@ def _read_joint(doc, j, links, ground, bodies, frame_in_link, world, model: Mode
         if jtype in ("floating", "planar"):
             losses.append(Loss(who, f"{jtype} joint", "ADF has none; the child body floats free"))
             return
-        raise AdfError(error("urdf-joint-type", f"joint {jn!r} has unknown type {jtype!r}", doc.where(j),
-                             "use revolute, continuous, prismatic, fixed, floating or planar"))
+        raise AdfError(
+            error(
+                "urdf-joint-type",
+                f"joint {jn!r} has unknown type {jtype!r}",
+                doc.where(j),
+                "use revolute, continuous, prismatic, fixed, floating or planar",
+            )
+        )
     parent, child = bodies[pname], bodies[cname]
-    u = Vec3(0.0, 0.0, 1.0) if jtype == "fixed" else Vec3(*_floats(doc, j.find("axis"), "xyz", 3)) \
-        if j.find("axis") is not None else Vec3(1.0, 0.0, 0.0)
+    u = (
+        Vec3(0.0, 0.0, 1.0)
+        if jtype == "fixed"
+        else Vec3(*_floats(doc, j.find("axis"), "xyz", 3))
+        if j.find("axis") is not None
+        else Vec3(1.0, 0.0, 0.0)
+    )
     if u.norm() < 1e-12:
         raise AdfError(error("urdf-axis", f"joint {jn!r} has a zero axis", doc.where(j), "give a unit axis"))
     u = u.normalized()
-    joint_in_parent_body = frame_in_link[pname].inverse() * _pose_of(doc, j)   # J in the parent body frame
-    joint_in_child_body = frame_in_link[cname].inverse()                        # J (= child link) in the child body
+    joint_in_parent_body = frame_in_link[pname].inverse() * _pose_of(doc, j)  # J in the parent body frame
+    joint_in_child_body = frame_in_link[cname].inverse()  # J (= child link) in the child body
     a = joint_in_parent_body.orientation.rotate(u)
     b = joint_in_child_body.orientation.rotate(u)
     # AMBF's shortest arc is the identity below 1e-3 rad (§8.2): an axis that close to the
     # reference axis, or to the other body's axis, is snapped onto it
     d = Vec3(1.0, 0.0, 0.0) if kinds[jtype] == "prismatic" else Vec3(0.0, 0.0, 1.0)
-    tilt = sum(t for t in (d.cross(a.normalized()).norm(), a.normalized().cross(b.normalized()).norm())
-               if 1e-12 < t < 1e-3)
+    tilt = sum(
+        t for t in (d.cross(a.normalized()).norm(), a.normalized().cross(b.normalized()).norm()) if 1e-12 < t < 1e-3
+    )
     if tilt:
-        losses.append(Loss(who, "axis tilt", f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
-                                             "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away"))
+        losses.append(
+            Loss(
+                who,
+                "axis tilt",
+                f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
+                "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away",
+            )
+        )
     rel = parent.location.inverse() * child.location
     twist = rel.orientation * shortest_arc(b, a).inverse()
     offset = _twist(a.normalized(), twist)
-    joint = Joint(identifier=who, name=jn, parent=parent.identifier, child=child.identifier, type=kinds[jtype],
-                  parent_pivot=joint_in_parent_body.position, parent_axis=a,
-                  child_pivot=joint_in_child_body.position, child_axis=b)
+    joint = Joint(
+        identifier=who,
+        name=jn,
+        parent=parent.identifier,
+        child=child.identifier,
+        type=kinds[jtype],
+        parent_pivot=joint_in_parent_body.position,
+        parent_axis=a,
+        child_pivot=joint_in_child_body.position,
+        child_axis=b,
+    )
     if abs(offset) > 1e-12:
         joint.offset = offset
     lim = j.find("limit")

@@ -7,6 +7,7 @@ needle and PSM poses; ``index.jsonl`` lists the frames (layout in writer.py).
     for frame in load("out/dataset"):
         frame.rgb(), frame.depth(), frame.labels(), frame.K, frame.T_world_camera, frame.needle
 """
+
 from __future__ import annotations
 
 from .colors import colourise  # noqa: F401

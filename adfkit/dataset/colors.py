@@ -1,5 +1,6 @@
 """A colouriser for segmentation label images a person can read: every label its own
 saturated colour (golden-ratio hues), nothing black."""
+
 from __future__ import annotations
 
 import colorsys

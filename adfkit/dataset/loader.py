@@ -1,4 +1,5 @@
 """Reads a dataset written by writer.py: ``load(DIR)`` -> frames in order."""
+
 from __future__ import annotations
 
 import json
@@ -23,6 +24,7 @@ class Frame:
 
     def rgb(self) -> np.ndarray:
         from PIL import Image
+
         return np.asarray(Image.open(self.root / self.paths["rgb"]).convert("RGB"))
 
     def depth(self) -> np.ndarray:
@@ -33,6 +35,7 @@ class Frame:
             from PIL import Image
 
             from .writer import DEPTH_UNIT_M
+
             counts = np.asarray(Image.open(path)).astype(np.float64)
             return np.where(counts > 0, counts * DEPTH_UNIT_M, np.inf).astype(np.float32)
         if path.suffix == ".npz":
@@ -43,10 +46,12 @@ class Frame:
     def labels(self) -> np.ndarray:
         """int32 H×W: body index of labels.json, -1 nothing."""
         from PIL import Image
+
         return np.asarray(Image.open(self.root / self.paths["seg"])).astype(np.int32) - 1
 
     def seg_color(self) -> np.ndarray:
         from PIL import Image
+
         return np.asarray(Image.open(self.root / self.paths["seg_color"]).convert("RGB"))
 
 
@@ -56,15 +61,24 @@ def load(root) -> list[Frame]:
     if not index.is_file():
         raise FileNotFoundError(f"{index} does not exist: not a dataset folder")
     out = []
-    for n, line in enumerate(index.read_text(encoding="utf-8").splitlines(), 1):
+    for _n, line in enumerate(index.read_text(encoding="utf-8").splitlines(), 1):
         if not line.strip():
             continue
         d = json.loads(line)
-        out.append(Frame(root, d["step"], d["time_s"], d["camera"],
-                         {k: d[k] for k in ("rgb", "depth", "seg", "seg_color")},
-                         np.array(d["K"]), np.array(d["T_world_camera"]),
-                         np.array(d["needle"]) if d.get("needle") is not None else None,
-                         d.get("psms", {}), d.get("phase", "")))
+        out.append(
+            Frame(
+                root,
+                d["step"],
+                d["time_s"],
+                d["camera"],
+                {k: d[k] for k in ("rgb", "depth", "seg", "seg_color")},
+                np.array(d["K"]),
+                np.array(d["T_world_camera"]),
+                np.array(d["needle"]) if d.get("needle") is not None else None,
+                d.get("psms", {}),
+                d.get("phase", ""),
+            )
+        )
     return out
 
 

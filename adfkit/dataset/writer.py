@@ -15,6 +15,7 @@ DIR), "K" (3x3 pinhole intrinsics, pixels), "T_world_camera" (4x4, OpenCV camera
 y down, z forward), "needle" (4x4 world pose of the needle body), "psms" ({name: {"T_world_ee"
 4x4, "jp" [q1..q6], "jaw" rad}}), "phase"}.
 """
+
 from __future__ import annotations
 
 import json
@@ -59,17 +60,31 @@ class DatasetWriter:
         self.world, self.root = world, Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
         self.cameras = [c for c in world.cameras if cameras is None or c.name in cameras]
-        (self.root / "labels.json").write_text(json.dumps({str(i): sb.key for i, sb in enumerate(world.bodies)},
-                                                          indent=1))
-        (self.root / "cameras.json").write_text(json.dumps(
-            {c.name: {"width": c.width, "height": c.height, "K": c.intrinsics().tolist(), "near": c.near,
-                      "far": c.far} for c in self.cameras}, indent=1))
+        (self.root / "labels.json").write_text(
+            json.dumps({str(i): sb.key for i, sb in enumerate(world.bodies)}, indent=1)
+        )
+        (self.root / "cameras.json").write_text(
+            json.dumps(
+                {
+                    c.name: {
+                        "width": c.width,
+                        "height": c.height,
+                        "K": c.intrinsics().tolist(),
+                        "near": c.near,
+                        "far": c.far,
+                    }
+                    for c in self.cameras
+                },
+                indent=1,
+            )
+        )
         self.index = open(self.root / "index.jsonl", "w", encoding="utf-8")
         self.frames = 0
 
     def write(self, step: int, poses: dict, phase: str = "") -> list:
         """Render every camera now and write its frame; ``poses``: {"needle": 4x4, "psms": {...}}."""
         from PIL import Image
+
         lines = []
         for cam in self.cameras:
             frame = cam.render(self.world)
@@ -78,9 +93,15 @@ class DatasetWriter:
             stem = f"{step:07d}"
             depth = np.asarray(frame["depth"], dtype=np.float32)
             quantised = depth_to_png16(depth)
-            names = {k: f"{cam.name}/{stem}_{k}{ext}" for k, ext in
-                     (("rgb", ".png"), ("depth", ".png" if quantised is not None else ".npz"), ("seg", ".png"),
-                      ("seg_color", ".png"))}
+            names = {
+                k: f"{cam.name}/{stem}_{k}{ext}"
+                for k, ext in (
+                    ("rgb", ".png"),
+                    ("depth", ".png" if quantised is not None else ".npz"),
+                    ("seg", ".png"),
+                    ("seg_color", ".png"),
+                )
+            }
             Image.fromarray(frame["rgb"]).save(self.root / names["rgb"])
             if quantised is not None:
                 Image.fromarray(quantised).save(self.root / names["depth"])
@@ -89,10 +110,17 @@ class DatasetWriter:
             seg = frame["segmentation"]
             Image.fromarray((seg.astype(np.int64) + 1).clip(0, 65535).astype(np.uint16)).save(self.root / names["seg"])
             Image.fromarray(colourise(seg)).save(self.root / names["seg_color"])
-            line = {"step": step, "time_s": self.world.sim_time, "camera": cam.name, **names,
-                    "K": cam.intrinsics().tolist(), "T_world_camera": camera_to_world(*cam.view(self.world)).tolist(),
-                    "needle": np.asarray(poses.get("needle")).tolist() if poses.get("needle") is not None else None,
-                    "psms": poses.get("psms", {}), "phase": phase}
+            line = {
+                "step": step,
+                "time_s": self.world.sim_time,
+                "camera": cam.name,
+                **names,
+                "K": cam.intrinsics().tolist(),
+                "T_world_camera": camera_to_world(*cam.view(self.world)).tolist(),
+                "needle": np.asarray(poses.get("needle")).tolist() if poses.get("needle") is not None else None,
+                "psms": poses.get("psms", {}),
+                "phase": phase,
+            }
             self.index.write(json.dumps(line, allow_nan=False) + "\n")
             lines.append(line)
             self.frames += 1

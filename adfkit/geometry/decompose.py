@@ -9,6 +9,7 @@ This is the layout of the corpus' own ``NeedleCollision.OBJ`` and ``PhantomColli
 Cache: ``$ADFKIT_CACHE/coacd`` or ``~/.cache/adfkit/coacd``; the key is a SHA-256 of the
 repaired mesh's vertex and face bytes, the parameters and the CoACD version.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -21,8 +22,8 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
-import numpy as np
 import manifold3d
+import numpy as np
 import trimesh
 
 from .repair import from_manifold
@@ -33,14 +34,14 @@ COACD_CALLS = 0
 
 @dataclass(frozen=True)
 class DecompositionParams:
-    threshold: float = 0.05            # CoACD concavity threshold (smaller = more, tighter hulls)
-    max_hulls: int = 16                # upper bound on the hull count (-1: no bound)
-    preprocess_resolution: int = 30    # manifold pre-processing voxel resolution
-    resolution: int = 1000             # sampling resolution of the concavity metric
+    threshold: float = 0.05  # CoACD concavity threshold (smaller = more, tighter hulls)
+    max_hulls: int = 16  # upper bound on the hull count (-1: no bound)
+    preprocess_resolution: int = 30  # manifold pre-processing voxel resolution
+    resolution: int = 1000  # sampling resolution of the concavity metric
     mcts_iterations: int = 60
     mcts_nodes: int = 10
     mcts_max_depth: int = 3
-    preprocess: str = "auto"           # CoACD's own manifold pre-pass: auto, on, off
+    preprocess: str = "auto"  # CoACD's own manifold pre-pass: auto, on, off
     merge: bool = True
     seed: int = 0
 
@@ -89,7 +90,7 @@ def _read_cache(path: Path) -> list[trimesh.Trimesh] | None:
         return None  # a missing or damaged entry is recomputed
     hulls, v0, f0 = [], 0, 0
     for nv, nf in zip(vsplit, fsplit):
-        hulls.append(trimesh.Trimesh(verts[v0:v0 + nv], faces[f0:f0 + nf], process=False))
+        hulls.append(trimesh.Trimesh(verts[v0 : v0 + nv], faces[f0 : f0 + nf], process=False))
         v0, f0 = v0 + nv, f0 + nf
     return hulls
 
@@ -99,10 +100,13 @@ def _write_cache(path: Path, hulls: list[trimesh.Trimesh]) -> None:
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
     os.close(fd)
     try:
-        np.savez(tmp, vertices=np.concatenate([h.vertices for h in hulls]),
-                 faces=np.concatenate([h.faces for h in hulls]),
-                 vertex_counts=np.array([len(h.vertices) for h in hulls]),
-                 face_counts=np.array([len(h.faces) for h in hulls]))
+        np.savez(
+            tmp,
+            vertices=np.concatenate([h.vertices for h in hulls]),
+            faces=np.concatenate([h.faces for h in hulls]),
+            vertex_counts=np.array([len(h.vertices) for h in hulls]),
+            face_counts=np.array([len(h.faces) for h in hulls]),
+        )
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
@@ -117,12 +121,19 @@ def _run_coacd(mesh: trimesh.Trimesh, p: DecompositionParams) -> list[trimesh.Tr
     COACD_CALLS += 1
     parts = coacd.run_coacd(
         coacd.Mesh(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32)),
-        threshold=p.threshold, max_convex_hull=p.max_hulls, preprocess_mode=p.preprocess,
-        preprocess_resolution=p.preprocess_resolution, resolution=p.resolution,
-        mcts_nodes=p.mcts_nodes, mcts_iterations=p.mcts_iterations, mcts_max_depth=p.mcts_max_depth,
-        merge=p.merge, seed=p.seed)
+        threshold=p.threshold,
+        max_convex_hull=p.max_hulls,
+        preprocess_mode=p.preprocess,
+        preprocess_resolution=p.preprocess_resolution,
+        resolution=p.resolution,
+        mcts_nodes=p.mcts_nodes,
+        mcts_iterations=p.mcts_iterations,
+        mcts_max_depth=p.mcts_max_depth,
+        merge=p.merge,
+        seed=p.seed,
+    )
     hulls = []
-    for verts, faces in parts:
+    for verts, _faces in parts:
         # Re-hull with manifold3d: CoACD's hull triangles can carry slivers that fail a strict
         # convexity check; the hull of its vertices is the same solid, closed and convex.
         solid = manifold3d.Manifold.hull_points(np.ascontiguousarray(verts, dtype=np.float64))
@@ -131,8 +142,9 @@ def _run_coacd(mesh: trimesh.Trimesh, p: DecompositionParams) -> list[trimesh.Tr
     return hulls
 
 
-def decompose(mesh: trimesh.Trimesh, params: DecompositionParams | None = None,
-              use_cache: bool = True) -> Decomposition:
+def decompose(
+    mesh: trimesh.Trimesh, params: DecompositionParams | None = None, use_cache: bool = True
+) -> Decomposition:
     """Convex hulls of ``mesh`` (closed; run ``repair_mesh`` first) by CoACD."""
     params = params or DecompositionParams()
     start = time.perf_counter()
@@ -193,6 +205,7 @@ def write_hull_files(hulls: list[trimesh.Trimesh], directory: str | os.PathLike,
         p = Path(directory) / f"{stem}_{i:03d}.obj"
         text, _ = hulls_obj_text([h], p.with_suffix(".mtl").name, prefix=stem)
         from ..adf import atomic_write_text
+
         atomic_write_text(p, "\n".join(l for l in text.splitlines() if not l.startswith(("mtllib", "usemtl"))) + "\n")
         out.append(p)
     return out

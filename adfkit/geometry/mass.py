@@ -9,6 +9,7 @@ Meshes use trimesh's exact polyhedral integral (the mesh must be closed; see ``r
 Primitives use closed forms, in ADF's conventions: box x/y/z are FULL lengths, capsule
 ``height`` is the TOTAL length including both caps, ``axis`` is x, y or z.
 """
+
 from __future__ import annotations
 
 import math
@@ -42,7 +43,7 @@ class MassProperties:
             axes[:, 2] *= -1.0
         return moments, axes
 
-    def transformed(self, pose: Pose) -> "MassProperties":
+    def transformed(self, pose: Pose) -> MassProperties:
         """The same body placed at ``pose`` (its frame expressed in the parent frame)."""
         rot = np.array(Quat(*pose.orientation).matrix(), dtype=float)
         com = rot @ self.com + np.asarray(pose.position, dtype=float)
@@ -53,12 +54,12 @@ class MassProperties:
         d = np.asarray(point, dtype=float) - self.com
         return self.inertia + self.mass * (np.dot(d, d) * np.eye(3) - np.outer(d, d))
 
-    def __add__(self, other: "MassProperties") -> "MassProperties":
+    def __add__(self, other: MassProperties) -> MassProperties:
         mass = self.mass + other.mass
         com = (self.mass * self.com + other.mass * other.com) / mass
         return MassProperties(mass, self.volume + other.volume, com, self.about(com) + other.about(com))
 
-    def with_mass(self, mass: float) -> "MassProperties":
+    def with_mass(self, mass: float) -> MassProperties:
         k = mass / self.mass
         return MassProperties(mass, self.volume, self.com, self.inertia * k)
 
@@ -77,16 +78,27 @@ def _scale_for(volume: float, density: float | None, mass: float | None) -> floa
 def mesh_mass_properties(mesh, density: float | None = None, mass: float | None = None) -> MassProperties:
     """Exact integral over a closed triangle mesh (trimesh). Raises AdfError for open meshes."""
     if not mesh.is_watertight:
-        raise AdfError(error("mesh-not-closed", "mass properties need a closed (watertight) mesh",
-                             hint="repair it first (adfkit.geometry.repair_mesh)"))
+        raise AdfError(
+            error(
+                "mesh-not-closed",
+                "mass properties need a closed (watertight) mesh",
+                hint="repair it first (adfkit.geometry.repair_mesh)",
+            )
+        )
     volume = float(mesh.volume)
     if volume <= 0:
-        raise AdfError(error("mesh-inverted", f"the mesh encloses a non-positive volume ({volume:g} m³)",
-                             hint="the faces point inwards; repair_mesh fixes the winding"))
+        raise AdfError(
+            error(
+                "mesh-inverted",
+                f"the mesh encloses a non-positive volume ({volume:g} m³)",
+                hint="the faces point inwards; repair_mesh fixes the winding",
+            )
+        )
     rho = _scale_for(volume, density, mass)
     props = mesh.mass_properties  # unit density
-    return MassProperties(rho * volume, volume, np.array(props["center_mass"], dtype=float),
-                          rho * np.array(props["inertia"], dtype=float))
+    return MassProperties(
+        rho * volume, volume, np.array(props["center_mass"], dtype=float), rho * np.array(props["inertia"], dtype=float)
+    )
 
 
 def _axis_index(axis: str | None) -> int:
@@ -98,19 +110,20 @@ def primitive_volume(kind: str, g: Geometry) -> float:
     if k == "box":
         return g.x * g.y * g.z
     if k == "sphere":
-        return 4.0 / 3.0 * math.pi * g.radius ** 3
+        return 4.0 / 3.0 * math.pi * g.radius**3
     if k == "cylinder":
-        return math.pi * g.radius ** 2 * g.height
+        return math.pi * g.radius**2 * g.height
     if k == "capsule":
         r, h = g.radius, g.height - 2 * g.radius
-        return math.pi * r * r * h + 4.0 / 3.0 * math.pi * r ** 3
+        return math.pi * r * r * h + 4.0 / 3.0 * math.pi * r**3
     if k == "cone":
-        return math.pi * g.radius ** 2 * g.height / 3.0
+        return math.pi * g.radius**2 * g.height / 3.0
     raise ValueError(f"no volume for shape {kind!r}")
 
 
-def primitive_mass_properties(kind: str, geometry: Geometry, pose: Pose | None = None,
-                              density: float | None = None, mass: float | None = None) -> MassProperties:
+def primitive_mass_properties(
+    kind: str, geometry: Geometry, pose: Pose | None = None, density: float | None = None, mass: float | None = None
+) -> MassProperties:
     """Closed forms for an ADF primitive (box, sphere, cylinder, capsule, cone) at ``pose``.
 
     The primitive is centred on its frame (a cone on its half height, as Bullet's btCone).
@@ -124,7 +137,7 @@ def primitive_mass_properties(kind: str, geometry: Geometry, pose: Pose | None =
         diag = [m * (y * y + z * z) / 12, m * (x * x + z * z) / 12, m * (x * x + y * y) / 12]
         com_local = np.zeros(3)
     elif k == "sphere":
-        diag = [0.4 * m * g.radius ** 2] * 3
+        diag = [0.4 * m * g.radius**2] * 3
         com_local = np.zeros(3)
     else:
         r, hgt = g.radius, g.height
@@ -136,8 +149,7 @@ def primitive_mass_properties(kind: str, geometry: Geometry, pose: Pose | None =
             m_cyl = m * (math.pi * r * r * h) / volume
             m_hemi = 0.5 * (m - m_cyl)
             axial = 0.5 * m_cyl * r * r + 2 * 0.4 * m_hemi * r * r
-            perp = (m_cyl * (3 * r * r + h * h) / 12
-                    + 2 * m_hemi * (0.4 * r * r + h * h / 4 + 3 * h * r / 8))
+            perp = m_cyl * (3 * r * r + h * h) / 12 + 2 * m_hemi * (0.4 * r * r + h * h / 4 + 3 * h * r / 8)
             com_local = np.zeros(3)
         elif k == "cone":  # about its centroid, which lies h/4 above the base
             axial = 0.3 * m * r * r
@@ -161,8 +173,7 @@ def compound_mass_properties(parts: list[MassProperties]) -> MassProperties:
     return total
 
 
-def shape_entries_mass_properties(entries, density: float | None = None,
-                                  mass: float | None = None) -> MassProperties:
+def shape_entries_mass_properties(entries, density: float | None = None, mass: float | None = None) -> MassProperties:
     """Mass properties of a list of ``ShapeEntry`` (overlaps counted twice; uniform density)."""
     unit = [primitive_mass_properties(e.shape, e.geometry, e.offset or Pose(), density=1.0) for e in entries]
     total = compound_mass_properties(unit)

@@ -6,6 +6,7 @@ No trimesh here: the validator imports this, and it must stay fast. A binary STL
 80-byte header, a triangle count and 50 bytes per triangle; an ASCII STL has ``facet`` and
 ``vertex`` lines; an OBJ has ``v`` and ``f`` lines. Other formats get no opinion (None).
 """
+
 from __future__ import annotations
 
 import os
@@ -60,8 +61,10 @@ def _stl_problem(data: bytes) -> str | None:
     (n,) = struct.unpack_from("<I", data, 80)
     if n and len(data) >= 84 + 50 * n:  # some exporters pad the end
         return None
-    return (f"not a valid STL file: a binary STL with {n} triangles has {84 + 50 * n} bytes, this one "
-            f"{len(data)} (and it does not start with 'solid')")
+    return (
+        f"not a valid STL file: a binary STL with {n} triangles has {84 + 50 * n} bytes, this one "
+        f"{len(data)} (and it does not start with 'solid')"
+    )
 
 
 def _obj_problem(data: bytes) -> str | None:

@@ -4,10 +4,10 @@
 signature is stable. Every failure a user can cause is an ``AdfError`` carrying a
 diagnostic with a rule id and a hint, never a bare trimesh/numpy exception.
 """
+
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 import numpy as np
 import trimesh
@@ -35,15 +35,24 @@ def _as_single_mesh(loaded, path) -> trimesh.Trimesh:
             if isinstance(geom, trimesh.Trimesh) and len(geom.faces):
                 meshes.append(geom.copy().apply_transform(transform))
         if not meshes:
-            raise _fail("mesh-empty", "the mesh file holds no triangles", path,
-                        "export the object as a triangle mesh (not only points or lines)")
+            raise _fail(
+                "mesh-empty",
+                "the mesh file holds no triangles",
+                path,
+                "export the object as a triangle mesh (not only points or lines)",
+            )
         return trimesh.util.concatenate(meshes)
-    raise _fail("mesh-empty", f"the file holds no triangle mesh (got {type(loaded).__name__})", path,
-                "export the object as a triangle mesh (not only points or lines)")
+    raise _fail(
+        "mesh-empty",
+        f"the file holds no triangle mesh (got {type(loaded).__name__})",
+        path,
+        "export the object as a triangle mesh (not only points or lines)",
+    )
 
 
-def load_mesh(path: str | os.PathLike, scale: float = 1.0, tree: inputs.Tree | None = None,
-              referrer: SourceLocation | None = None) -> trimesh.Trimesh:
+def load_mesh(
+    path: str | os.PathLike, scale: float = 1.0, tree: inputs.Tree | None = None, referrer: SourceLocation | None = None
+) -> trimesh.Trimesh:
     """Load STL/OBJ/PLY/DAE (whatever trimesh reads) as one triangle mesh, times ``scale``.
 
     ``scale`` multiplies vertex coordinates about the mesh origin, as ADF's per-body
@@ -58,26 +67,42 @@ def load_mesh(path: str | os.PathLike, scale: float = 1.0, tree: inputs.Tree | N
     """
     p = inputs.check_mesh(path, tree=tree, referrer=referrer)
     if not np.isfinite(scale) or scale <= 0:
-        raise _fail("mesh-bad-scale", f"scale must be a positive finite number, got {scale!r}", p,
-                    "ADF 'scale' is a positive factor (default 1.0)")
+        raise _fail(
+            "mesh-bad-scale",
+            f"scale must be a positive finite number, got {scale!r}",
+            p,
+            "ADF 'scale' is a positive factor (default 1.0)",
+        )
     suffix = p.suffix.lower()
     try:
-        loaded = trimesh.load(str(p), file_type=suffix.lstrip(".") or None, force=None,
-                              process=False, skip_materials=True)
+        loaded = trimesh.load(
+            str(p), file_type=suffix.lstrip(".") or None, force=None, process=False, skip_materials=True
+        )
     except Exception as exc:  # trimesh raises many types for bad input
-        raise _fail("mesh-unreadable", f"cannot read mesh: {type(exc).__name__}: {exc}", p,
-                    f"is this a valid {suffix.lstrip('.').upper() or 'mesh'} file? formats: "
-                    + ", ".join(s.lstrip('.').upper() for s in MESH_SUFFIXES)) from None
+        raise _fail(
+            "mesh-unreadable",
+            f"cannot read mesh: {type(exc).__name__}: {exc}",
+            p,
+            f"is this a valid {suffix.lstrip('.').upper() or 'mesh'} file? formats: "
+            + ", ".join(s.lstrip(".").upper() for s in MESH_SUFFIXES),
+        ) from None
     mesh = _as_single_mesh(loaded, p)
     if len(mesh.faces) == 0 or len(mesh.vertices) == 0:
-        raise _fail("mesh-empty", "the mesh has no triangles", p,
-                    "export the object as a triangle mesh")
+        raise _fail("mesh-empty", "the mesh has no triangles", p, "export the object as a triangle mesh")
     if not np.all(np.isfinite(mesh.vertices)):
         bad = int((~np.isfinite(mesh.vertices)).any(axis=1).sum())
-        raise _fail("mesh-non-finite", f"{bad} vertices have NaN or infinite coordinates", p,
-                    "fix the exporter or the modelling tool; NaN vertices cannot be simulated")
-    mesh = trimesh.Trimesh(vertices=np.asarray(mesh.vertices, dtype=np.float64) * float(scale),
-                           faces=np.asarray(mesh.faces), process=True, validate=False)
+        raise _fail(
+            "mesh-non-finite",
+            f"{bad} vertices have NaN or infinite coordinates",
+            p,
+            "fix the exporter or the modelling tool; NaN vertices cannot be simulated",
+        )
+    mesh = trimesh.Trimesh(
+        vertices=np.asarray(mesh.vertices, dtype=np.float64) * float(scale),
+        faces=np.asarray(mesh.faces),
+        process=True,
+        validate=False,
+    )
     mesh.metadata["file_name"] = p.name
     mesh.metadata["file_path"] = str(p)
     return mesh

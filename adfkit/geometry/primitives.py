@@ -6,6 +6,7 @@ mesh solid (manifold3d booleans), so 0 is perfect. Results are ``ShapeEntry`` in
 conventions: box x/y/z FULL lengths, capsule ``height`` TOTAL including caps, ``axis`` z with
 the orientation in ``offset`` (or x/y/z when the fitted axis is a body axis).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -26,8 +27,8 @@ _FLAT = 1e-9
 @dataclass
 class PrimitiveFit:
     entry: ShapeEntry
-    error: float          # 1 - IoU with the mesh solid
-    volume: float         # of the primitive
+    error: float  # 1 - IoU with the mesh solid
+    volume: float  # of the primitive
 
 
 def _pose(rot: np.ndarray, center) -> Pose:
@@ -81,8 +82,11 @@ def _points(mesh: trimesh.Trimesh) -> np.ndarray:
     faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     verts = np.asarray(mesh.vertices, dtype=np.float64).reshape(-1, 3)
     if len(faces) == 0 or len(verts) == 0:
-        raise _refuse("mesh-empty", "the mesh has no triangles to fit a shape around",
-                      "give the object a mesh with faces (or add a primitive by hand)")
+        raise _refuse(
+            "mesh-empty",
+            "the mesh has no triangles to fit a shape around",
+            "give the object a mesh with faces (or add a primitive by hand)",
+        )
     pts = verts[np.unique(faces)]
     if not np.all(np.isfinite(pts)):
         raise _refuse("mesh-unreadable", "the mesh has NaN or infinite vertex coordinates", "fix or re-export the mesh")
@@ -134,24 +138,32 @@ def _axial_extent(pts: np.ndarray, center: np.ndarray, axis: np.ndarray):
 def fit_box(mesh: trimesh.Trimesh) -> ShapeEntry:
     pts = _points(mesh)
     if spread(pts) < 3:
-        raise _refuse("mesh-flat", "the mesh is flat (its vertices lie in one plane or on one line): a box "
-                      "around it would have no thickness",
-                      "give it thickness (a Solidify modifier), or fit a capsule or a sphere around it")
+        raise _refuse(
+            "mesh-flat",
+            "the mesh is flat (its vertices lie in one plane or on one line): a box around it would have no thickness",
+            "give it thickness (a Solidify modifier), or fit a capsule or a sphere around it",
+        )
     transform, extents = trimesh.bounds.oriented_bounds(pts)
     inv = np.linalg.inv(transform)  # box frame in mesh frame
-    return ShapeEntry(shape="box", geometry=Geometry(x=float(extents[0]), y=float(extents[1]), z=float(extents[2])),
-                      offset=_pose(inv[:3, :3], inv[:3, 3]))
+    return ShapeEntry(
+        shape="box",
+        geometry=Geometry(x=float(extents[0]), y=float(extents[1]), z=float(extents[2])),
+        offset=_pose(inv[:3, :3], inv[:3, 3]),
+    )
 
 
 def fit_sphere(mesh: trimesh.Trimesh) -> ShapeEntry:
     pts = _points(mesh)
     dims = spread(pts)
     if dims == 0:
-        raise _refuse("mesh-degenerate", "every vertex of the mesh is at one point: no sphere can enclose it",
-                      "give the object a mesh with extent")
+        raise _refuse(
+            "mesh-degenerate",
+            "every vertex of the mesh is at one point: no sphere can enclose it",
+            "give the object a mesh with extent",
+        )
     if dims == 3:
         center, radius = trimesh.nsphere.minimum_nsphere(pts)
-    else:   # flat or straight: the sphere about the bounding box's centre (encloses; not the smallest)
+    else:  # flat or straight: the sphere about the bounding box's centre (encloses; not the smallest)
         center = (pts.min(axis=0) + pts.max(axis=0)) / 2
         radius = float(np.linalg.norm(pts - center, axis=1).max())
     return ShapeEntry(shape="sphere", geometry=Geometry(radius=float(radius)), offset=_pose(np.eye(3), center))
@@ -164,8 +176,11 @@ def _principal_axis(mesh: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray, np.n
     pts = _points(mesh)
     dims = spread(pts)
     if dims == 0:
-        raise _refuse("mesh-degenerate", "every vertex of the mesh is at one point: nothing to fit around",
-                      "give the object a mesh with extent")
+        raise _refuse(
+            "mesh-degenerate",
+            "every vertex of the mesh is at one point: nothing to fit around",
+            "give the object a mesh with extent",
+        )
     if dims < 3:
         axes, c = _principal_frame(pts)
         return axes[:, 0], c, pts
@@ -178,23 +193,29 @@ def fit_cylinder(mesh: trimesh.Trimesh) -> ShapeEntry:
     axis, center, pts = _principal_axis(mesh)
     t, radial = _axial_extent(pts, center, axis)
     if radial.max() <= _FLAT * max(1e-300, float(t.max() - t.min())):
-        raise _refuse("mesh-degenerate", "the mesh is a straight line: a cylinder around it has no radius",
-                      "fit a capsule, or give the object a mesh with width")
+        raise _refuse(
+            "mesh-degenerate",
+            "the mesh is a straight line: a cylinder around it has no radius",
+            "fit a capsule, or give the object a mesh with width",
+        )
     center = center + axis * (t.max() + t.min()) / 2
     name, rot = _axis_frame(axis)
-    return ShapeEntry(shape="cylinder", geometry=Geometry(radius=float(radial.max()), height=float(t.max() - t.min()), axis=name),
-                      offset=_pose(rot, center))
+    return ShapeEntry(
+        shape="cylinder",
+        geometry=Geometry(radius=float(radial.max()), height=float(t.max() - t.min()), axis=name),
+        offset=_pose(rot, center),
+    )
 
 
 def capsule_around(points: np.ndarray, center: np.ndarray, axis: np.ndarray) -> tuple[float, float, np.ndarray]:
     """(radius, total height, centre) of the smallest capsule on this axis line enclosing points."""
     t, radial = _axial_extent(points, center, axis)
     r = float(radial.max())
-    reach = np.sqrt(np.maximum(r * r - radial ** 2, 0.0))
+    reach = np.sqrt(np.maximum(r * r - radial**2, 0.0))
     lo, hi = float((t + reach).min()), float((t - reach).max())  # segment ends [lo, hi]
     if lo > hi:
         lo = hi = 0.5 * (lo + hi)
-        r = float(np.sqrt(radial ** 2 + (t - lo) ** 2).max())
+        r = float(np.sqrt(radial**2 + (t - lo) ** 2).max())
     return r, (hi - lo) + 2 * r, center + axis * (lo + hi) / 2
 
 
@@ -202,8 +223,11 @@ def fit_capsule(mesh: trimesh.Trimesh) -> ShapeEntry:
     axis, center, pts = _principal_axis(mesh)
     r, height, c = capsule_around(pts, center, axis)
     if r <= 0.0:
-        raise _refuse("mesh-degenerate", "the mesh is a straight line: a capsule around it has no radius",
-                      "give the object a mesh with width")
+        raise _refuse(
+            "mesh-degenerate",
+            "the mesh is a straight line: a capsule around it has no radius",
+            "give the object a mesh with width",
+        )
     name, rot = _axis_frame(axis)
     return ShapeEntry(shape="capsule", geometry=Geometry(radius=r, height=height, axis=name), offset=_pose(rot, c))
 
@@ -229,8 +253,13 @@ def capsule_chain(points, radius: float) -> list[ShapeEntry]:
         d = b - a
         length = float(np.linalg.norm(d))
         name, rot = _axis_frame(d / length)
-        out.append(ShapeEntry(shape="capsule", geometry=Geometry(radius=radius, height=length + 2 * radius, axis=name),
-                              offset=_pose(rot, (a + b) / 2)))
+        out.append(
+            ShapeEntry(
+                shape="capsule",
+                geometry=Geometry(radius=radius, height=length + 2 * radius, axis=name),
+                offset=_pose(rot, (a + b) / 2),
+            )
+        )
     return out
 
 
@@ -263,6 +292,7 @@ def fit_capsule_chain(mesh: trimesh.Trimesh, count: int = 4) -> list[ShapeEntry]
         axis = vt2[0]
         r, height, c0 = capsule_around(sel, center, axis)
         name, rot = _axis_frame(axis)
-        out.append(ShapeEntry(shape="capsule", geometry=Geometry(radius=r, height=height, axis=name),
-                              offset=_pose(rot, c0)))
+        out.append(
+            ShapeEntry(shape="capsule", geometry=Geometry(radius=r, height=height, axis=name), offset=_pose(rot, c0))
+        )
     return out

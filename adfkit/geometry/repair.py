@@ -6,6 +6,7 @@ a 2-manifold and unions overlapping shells so their volume is not counted twice.
 changed is reported in a ``RepairReport``. A mesh manifold3d still rejects after that is
 "beyond repair": ``AdfError`` with rule ``mesh-not-manifold``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -20,18 +21,19 @@ from ..diagnostics import AdfError, SourceLocation, error
 @dataclass
 class RepairReport:
     vertices_merged: int = 0
-    faces_removed: int = 0          # degenerate or duplicate triangles
-    faces_flipped: bool = False      # winding made consistent / turned outwards
-    holes_filled: int = 0            # faces added to close holes
-    shells_unioned: int = 0          # overlapping closed shells merged into one solid
+    faces_removed: int = 0  # degenerate or duplicate triangles
+    faces_flipped: bool = False  # winding made consistent / turned outwards
+    holes_filled: int = 0  # faces added to close holes
+    shells_unioned: int = 0  # overlapping closed shells merged into one solid
     volume_before: float = float("nan")
     volume_after: float = float("nan")
     notes: list[str] = field(default_factory=list)
 
     @property
     def changed(self) -> bool:
-        return bool(self.vertices_merged or self.faces_removed or self.faces_flipped
-                    or self.holes_filled or self.shells_unioned)
+        return bool(
+            self.vertices_merged or self.faces_removed or self.faces_flipped or self.holes_filled or self.shells_unioned
+        )
 
     def summary(self) -> str:
         if not self.changed:
@@ -52,23 +54,33 @@ class RepairReport:
 
 def to_manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:
     # Mesh64 keeps double precision: corpus meshes are in metres with millimetre detail.
-    return manifold3d.Manifold(manifold3d.Mesh64(
-        vert_properties=np.ascontiguousarray(mesh.vertices, dtype=np.float64),
-        tri_verts=np.ascontiguousarray(mesh.faces, dtype=np.uint64)))
+    return manifold3d.Manifold(
+        manifold3d.Mesh64(
+            vert_properties=np.ascontiguousarray(mesh.vertices, dtype=np.float64),
+            tri_verts=np.ascontiguousarray(mesh.faces, dtype=np.uint64),
+        )
+    )
 
 
 def from_manifold(m: manifold3d.Manifold) -> trimesh.Trimesh:
     out = m.to_mesh64()
-    return trimesh.Trimesh(vertices=np.asarray(out.vert_properties)[:, :3].astype(np.float64),
-                           faces=np.asarray(out.tri_verts, dtype=np.int64), process=True)
+    return trimesh.Trimesh(
+        vertices=np.asarray(out.vert_properties)[:, :3].astype(np.float64),
+        faces=np.asarray(out.tri_verts, dtype=np.int64),
+        process=True,
+    )
 
 
 def _not_manifold(mesh, why: str) -> AdfError:
     where = mesh.metadata.get("file_path")
-    return AdfError(error("mesh-not-manifold", f"the mesh cannot be made a closed 2-manifold: {why}",
-                          SourceLocation(where) if where else None,
-                          "close the mesh in a modelling tool (e.g. Blender's 3D-Print toolbox) "
-                          "or use a primitive collision shape"))
+    return AdfError(
+        error(
+            "mesh-not-manifold",
+            f"the mesh cannot be made a closed 2-manifold: {why}",
+            SourceLocation(where) if where else None,
+            "close the mesh in a modelling tool (e.g. Blender's 3D-Print toolbox) or use a primitive collision shape",
+        )
+    )
 
 
 def repair_mesh(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, RepairReport]:
@@ -98,8 +110,9 @@ def repair_mesh(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, RepairReport]:
         report.holes_filled = len(work.faces) - n
     if work.is_watertight:
         trimesh.repair.fix_inversion(work, multibody=True)
-    report.faces_flipped = len(before) == len(work.faces[:len(before)]) and not np.array_equal(
-        before, work.faces[:len(before)])
+    report.faces_flipped = len(before) == len(work.faces[: len(before)]) and not np.array_equal(
+        before, work.faces[: len(before)]
+    )
 
     if not work.is_watertight:
         raise _not_manifold(mesh, f"{_open_edges(work)} open edges remain after filling holes")

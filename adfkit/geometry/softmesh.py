@@ -7,6 +7,7 @@ vertex positions; `fixed nodes` index them. We keep them in order of first appea
 (AMBF's sequential variant; its block-sorted variant may number them differently, see
 docs/soft-bodies.md). numpy only: the validator calls this too.
 """
+
 from __future__ import annotations
 
 import os
@@ -21,13 +22,13 @@ from ..diagnostics import AdfError, SourceLocation, error
 # 3DS chunk ids (Autodesk 3D Studio binary format)
 _MAIN, _EDITOR, _OBJECT, _TRIMESH, _VERTICES, _FACES = 0x4D4D, 0x3D3D, 0x4000, 0x4100, 0x4110, 0x4120
 _CONTAINERS = (_MAIN, _EDITOR, _TRIMESH)
-MERGE_DECIMALS = 9   # vertices equal to 1e-9 m are one node
+MERGE_DECIMALS = 9  # vertices equal to 1e-9 m are one node
 
 
 @dataclass
 class SoftMesh:
-    nodes: np.ndarray       # (n, 3) float64, unique vertex positions, metres (times scale)
-    triangles: np.ndarray   # (m, 3) int64, node indices
+    nodes: np.ndarray  # (n, 3) float64, unique vertex positions, metres (times scale)
+    triangles: np.ndarray  # (m, 3) int64, node indices
 
     @property
     def node_count(self) -> int:
@@ -75,8 +76,14 @@ def read_3ds(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     except (struct.error, ValueError) as exc:
         raise _bad(path, f"cannot read 3DS file: {exc}", "re-export the mesh as OBJ or STL") from None
     if not verts or not faces:
-        raise AdfError(error("mesh-empty", "the 3DS file holds no triangle object", SourceLocation(str(path)),
-                             "export the object as a triangle mesh"))
+        raise AdfError(
+            error(
+                "mesh-empty",
+                "the 3DS file holds no triangle object",
+                SourceLocation(str(path)),
+                "export the object as a triangle mesh",
+            )
+        )
     return np.concatenate(verts), np.concatenate(faces)
 
 
@@ -98,7 +105,7 @@ def unique_nodes(vertices: np.ndarray, faces: np.ndarray) -> SoftMesh:
     key = np.round(vertices, MERGE_DECIMALS)
     _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
     inverse = inverse.reshape(-1)
-    order = np.argsort(first)              # unique rows in order of first appearance
+    order = np.argsort(first)  # unique rows in order of first appearance
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
     nodes = vertices[first[order]]
@@ -133,8 +140,14 @@ def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0, tree=None) -> So
     p = inputs.check_mesh(path, tree=tree)
     v, f = _raw_triangles(p)
     if len(v) == 0 or len(f) == 0:
-        raise AdfError(error("mesh-empty", "the mesh has no triangles", SourceLocation(str(p)),
-                             "export the object as a triangle mesh"))
+        raise AdfError(
+            error(
+                "mesh-empty",
+                "the mesh has no triangles",
+                SourceLocation(str(p)),
+                "export the object as a triangle mesh",
+            )
+        )
     if f.min() < 0 or f.max() >= len(v):
         raise _bad(p, "a triangle refers to a vertex the file does not hold", "re-export the mesh")
     mesh = unique_nodes(v, f)
@@ -149,8 +162,14 @@ def placed_soft_mesh(model, sb) -> SoftMesh:
 
     path = collision_mesh_path(model, sb) if sb.mesh else None
     if path is None:
-        raise AdfError(error("mesh-not-found", f"soft body '{sb.identifier}' names no mesh", sb.where(),
-                             "AMBF builds soft bodies from their collision mesh; name one with `mesh`"))
+        raise AdfError(
+            error(
+                "mesh-not-found",
+                f"soft body '{sb.identifier}' names no mesh",
+                sb.where(),
+                "AMBF builds soft bodies from their collision mesh; name one with `mesh`",
+            )
+        )
     mesh = load_soft_mesh(path, sb.scale or 1.0, tree=getattr(model, "tree", None))
     if sb.location is not None:
         rot = np.array(sb.location.orientation.matrix())
@@ -158,7 +177,7 @@ def placed_soft_mesh(model, sb) -> SoftMesh:
     return mesh
 
 
-DEFAULT_SOFT_MASS = 1.0     # AMBF's when `mass` is missing
+DEFAULT_SOFT_MASS = 1.0  # AMBF's when `mass` is missing
 
 
 def link_stiffness(sb, nodes: int, dt: float) -> float:
@@ -171,7 +190,7 @@ def link_stiffness(sb, nodes: int, dt: float) -> float:
     pit = cfg.piterations if cfg is not None and cfg.piterations is not None else 1
     mass = sb.mass if sb.mass is not None and sb.mass > 0 else DEFAULT_SOFT_MASS
     share = 1.0 - (1.0 - min(max(klst, 0.0), 1.0)) ** max(pit, 1)
-    return share * (mass / max(nodes, 1)) / dt ** 2
+    return share * (mass / max(nodes, 1)) / dt**2
 
 
 def write_obj(mesh: SoftMesh, path: str | os.PathLike) -> Path:
@@ -183,5 +202,14 @@ def write_obj(mesh: SoftMesh, path: str | os.PathLike) -> Path:
     return p
 
 
-__all__ = ["SoftMesh", "read_3ds", "unique_nodes", "nodes_at", "load_soft_mesh", "placed_soft_mesh", "link_stiffness",
-           "write_obj", "DEFAULT_SOFT_MASS"]
+__all__ = [
+    "SoftMesh",
+    "read_3ds",
+    "unique_nodes",
+    "nodes_at",
+    "load_soft_mesh",
+    "placed_soft_mesh",
+    "link_stiffness",
+    "write_obj",
+    "DEFAULT_SOFT_MASS",
+]

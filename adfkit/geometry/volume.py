@@ -9,6 +9,7 @@ the format's maximum, so ``iso-surface value`` (default 0.5) is a fraction of fu
 AMBF's volume shader compares it. The volume fills a box of ``dimensions`` (times ``scale``)
 centred on its ``location``: slice i lies at z = -d_z/2 + (i + 1/2)·d_z/count.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -22,14 +23,14 @@ from ..diagnostics import AdfError, SourceLocation, error
 
 #: More slices than this, or more voxels than MAX_VOXELS, is refused before a file is opened.
 MAX_SLICES = 4096
-MAX_VOXELS = 512 ** 3
+MAX_VOXELS = 512**3
 DEFAULT_ISO = 0.5
 
 
 @dataclass
 class VolumeData:
-    voxels: np.ndarray          # (count, height, width) float32 in 0..1: slice, row, column
-    dimensions: np.ndarray      # (3,) metres along x (columns), y (rows), z (slices), scale applied
+    voxels: np.ndarray  # (count, height, width) float32 in 0..1: slice, row, column
+    dimensions: np.ndarray  # (3,) metres along x (columns), y (rows), z (slices), scale applied
     files: list[Path]
 
 
@@ -48,11 +49,20 @@ def slice_paths(model, vol) -> list[Path]:
     im = vol.images
     missing = [k for k in ("path", "prefix", "format", "count") if im is None or getattr(im, k) is None]
     if missing:
-        raise _fail(vol, "volume-images", f"`images` lacks {', '.join(missing)}; AMBF skips the volume",
-                    "give images: {path: slices/, prefix: slice_, format: png, count: N}")
+        raise _fail(
+            vol,
+            "volume-images",
+            f"`images` lacks {', '.join(missing)}; AMBF skips the volume",
+            "give images: {path: slices/, prefix: slice_, format: png, count: N}",
+        )
     if im.count <= 0 or im.count > MAX_SLICES:
-        raise _fail(vol, "volume-images", f"`images: count` is {im.count}; a volume has 1 to {MAX_SLICES} slices",
-                    "count the slice files", "images")
+        raise _fail(
+            vol,
+            "volume-images",
+            f"`images: count` is {im.count}; a volume has 1 to {MAX_SLICES} slices",
+            "count the slice files",
+            "images",
+        )
     fmt = str(im.format).lstrip(".")
     base = relative_to_file(model.path, str(im.path))
     return [base / f"{im.prefix}{i}.{fmt}" for i in range(im.count)]
@@ -75,31 +85,60 @@ def load_volume(model, vol) -> VolumeData:
                 mode = img.mode
                 arr = np.asarray(img.convert("L") if mode in ("RGB", "RGBA", "P", "LA", "CMYK") else img)
         except (UnidentifiedImageError, OSError, ValueError) as exc:
-            raise _fail(vol, "volume-slice-unreadable", f"slice {i} ({inputs.shown(f.name)}) is not an image Pillow "
-                        f"reads ({type(exc).__name__})", "write the slices as PNG, TIFF or another Pillow format") from None
+            raise _fail(
+                vol,
+                "volume-slice-unreadable",
+                f"slice {i} ({inputs.shown(f.name)}) is not an image Pillow reads ({type(exc).__name__})",
+                "write the slices as PNG, TIFF or another Pillow format",
+            ) from None
         if arr.ndim != 2:
-            raise _fail(vol, "volume-slice-unreadable", f"slice {i} ({inputs.shown(f.name)}) is not a single-channel "
-                        "image", "write grey slices")
+            raise _fail(
+                vol,
+                "volume-slice-unreadable",
+                f"slice {i} ({inputs.shown(f.name)}) is not a single-channel image",
+                "write grey slices",
+            )
         if size is None:
             size = arr.shape
             if len(files) * size[0] * size[1] > MAX_VOXELS:
-                raise _fail(vol, "volume-too-large", f"{len(files)} slices of {size[1]}x{size[0]} are more than "
-                            f"{MAX_VOXELS:,} voxels", "downsample the slices")
+                raise _fail(
+                    vol,
+                    "volume-too-large",
+                    f"{len(files)} slices of {size[1]}x{size[0]} are more than {MAX_VOXELS:,} voxels",
+                    "downsample the slices",
+                )
         elif arr.shape != size:
-            raise _fail(vol, "volume-slice-size", f"slice {i} ({inputs.shown(f.name)}) is {arr.shape[1]}x{arr.shape[0]}, "
-                        f"slice 0 is {size[1]}x{size[0]}", "every slice of a volume has the same size")
-        peak = 65535.0 if arr.dtype == np.uint16 or mode.startswith("I;16") else 255.0 if arr.dtype == np.uint8 else peak
+            raise _fail(
+                vol,
+                "volume-slice-size",
+                f"slice {i} ({inputs.shown(f.name)}) is {arr.shape[1]}x{arr.shape[0]}, slice 0 is {size[1]}x{size[0]}",
+                "every slice of a volume has the same size",
+            )
+        peak = (
+            65535.0 if arr.dtype == np.uint16 or mode.startswith("I;16") else 255.0 if arr.dtype == np.uint8 else peak
+        )
         slices.append(arr)
     voxels = np.stack(slices).astype(np.float32)
-    if peak == 1.0 and voxels.size and voxels.max() > 1.0:   # 32-bit integer or float slices: their own maximum
+    if peak == 1.0 and voxels.size and voxels.max() > 1.0:  # 32-bit integer or float slices: their own maximum
         peak = float(voxels.max())
     voxels /= peak
     d = vol.dimensions
-    dims = np.array([d.x if d and d.x is not None else 1.0, d.y if d and d.y is not None else 1.0,
-                     d.z if d and d.z is not None else 1.0], dtype=float) * (vol.scale if vol.scale is not None else 1.0)
+    dims = np.array(
+        [
+            d.x if d and d.x is not None else 1.0,
+            d.y if d and d.y is not None else 1.0,
+            d.z if d and d.z is not None else 1.0,
+        ],
+        dtype=float,
+    ) * (vol.scale if vol.scale is not None else 1.0)
     if not np.all(dims > 0):
-        raise _fail(vol, "volume-dimensions", f"`dimensions` {dims.tolist()} must be positive", "give a size in metres",
-                    "dimensions")
+        raise _fail(
+            vol,
+            "volume-dimensions",
+            f"`dimensions` {dims.tolist()} must be positive",
+            "give a size in metres",
+            "dimensions",
+        )
     return VolumeData(voxels, dims, files)
 
 
@@ -118,5 +157,5 @@ def iso_surface(data: VolumeData, level: float | None = None) -> tuple[np.ndarra
     verts, faces, _, _ = marching_cubes(vox, level=level, spacing=spacing)
     # (slice, row, column) -> (x, y, z); the padding shifts by one voxel; centre the box
     step = np.array([spacing[2], spacing[1], spacing[0]])
-    xyz = verts[:, ::-1] - 0.5 * step - data.dimensions / 2    # padded index p is voxel p-1, centred at (p-1/2)·step
+    xyz = verts[:, ::-1] - 0.5 * step - data.dimensions / 2  # padded index p is voxel p-1, centred at (p-1/2)·step
     return xyz, faces.astype(np.int64)

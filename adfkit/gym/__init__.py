@@ -12,6 +12,7 @@ render_mode "rgb_array", engine "pybullet"|"mujoco", scene/indices (a launch fil
 project's suturing scene), image_size, control_steps, randomize. Scripted experts for
 demonstrations: adfkit.gym.experts.
 """
+
 from __future__ import annotations
 
 try:

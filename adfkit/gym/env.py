@@ -10,6 +10,7 @@ end-effector set-point along the world axes (x MAX_STEP m), a turn about the wor
 end-effector (x MAX_TURN rad), and the jaw (-1 closed ... +1 open; closing grasps what lies
 between the fingers through the scene's constraint actuator, opening releases it).
 """
+
 from __future__ import annotations
 
 from dataclasses import replace
@@ -22,17 +23,18 @@ from ..runner.rotations import rotation_exp
 from ..tasks.suture import JAW_DEPTH
 from . import scenes
 
-MAX_STEP = 0.003      # m of set-point motion per env step at |action| = 1
-MAX_TURN = 0.05       # rad per env step
-GRASP_REACH = 0.004   # m from the point between the jaws to the needle's surface for a grasp
-READY_HEIGHT = 0.03   # m: the acting arms start this far above the needle's grasp point
+MAX_STEP = 0.003  # m of set-point motion per env step at |action| = 1
+MAX_TURN = 0.05  # rad per env step
+GRASP_REACH = 0.004  # m from the point between the jaws to the needle's surface for a grasp
+READY_HEIGHT = 0.03  # m: the acting arms start this far above the needle's grasp point
 OBS_MODES = ("state", "rgb", "rgbd")
 REWARD_TYPES = ("dense", "sparse")
-POSE = spaces.Box(-np.inf, np.inf, (7,), np.float32)    # position (m), quaternion x, y, z, w
+POSE = spaces.Box(-np.inf, np.inf, (7,), np.float32)  # position (m), quaternion x, y, z, w
 
 
 def _pose7(t: np.ndarray) -> np.ndarray:
     from ..runner.rotations import matrix_to_quat
+
     q = matrix_to_quat(t[:3, :3])
     if q[3] < 0:
         q = -q
@@ -45,10 +47,22 @@ class SuturingEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
     arms: tuple = ("psm1",)
 
-    def __init__(self, obs_mode: str = "state", reward_type: str = "dense", render_mode: str | None = None,
-                 engine: str = "pybullet", scene=None, indices: str | None = None,
-                 image_size: tuple = (128, 96), render_size: tuple = (320, 240), control_steps: int = 5,
-                 randomize: float = 0.008, randomize_needle: float = 0.0, settle_seconds: float = 0.5, setup_joints: bool = True) -> None:
+    def __init__(
+        self,
+        obs_mode: str = "state",
+        reward_type: str = "dense",
+        render_mode: str | None = None,
+        engine: str = "pybullet",
+        scene=None,
+        indices: str | None = None,
+        image_size: tuple = (128, 96),
+        render_size: tuple = (320, 240),
+        control_steps: int = 5,
+        randomize: float = 0.008,
+        randomize_needle: float = 0.0,
+        settle_seconds: float = 0.5,
+        setup_joints: bool = True,
+    ) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode {obs_mode!r}: choose one of {', '.join(OBS_MODES)}")
         if reward_type not in REWARD_TYPES:
@@ -58,16 +72,20 @@ class SuturingEnv(gym.Env):
         self.obs_mode, self.reward_type, self.render_mode = obs_mode, reward_type, render_mode
         self.control_steps, self.randomize = int(control_steps), float(randomize)
         self.randomize_needle = float(randomize_needle)
-        self.built = b = scenes.build(scene, indices, engine, self.arms, obs_mode != "state" or render_mode is not None,
-                                      setup_joints)
+        self.built = b = scenes.build(
+            scene, indices, engine, self.arms, obs_mode != "state" or render_mode is not None, setup_joints
+        )
         self.world, self.psms, self.needle = b.world, b.psms, b.needle
         self._cameras = [replace(c, width=int(image_size[0]), height=int(image_size[1])) for c in self.world.cameras]
-        self._render_camera = (replace(self.world.cameras[0], width=int(render_size[0]), height=int(render_size[1]))
-                               if self.world.cameras else None)
+        self._render_camera = (
+            replace(self.world.cameras[0], width=int(render_size[0]), height=int(render_size[1]))
+            if self.world.cameras
+            else None
+        )
         if obs_mode != "state" and not self._cameras:
             raise ValueError(f"obs_mode {obs_mode!r}: the scene has no camera")
         self._task_setup()
-        for body in self.world.bodies:   # the grasp is the actuator's; the fingers never shove the needle
+        for body in self.world.bodies:  # the grasp is the actuator's; the fingers never shove the needle
             if any(body.articulation is self.psms[n].art for n in self.arms):
                 self.world.set_collision(body, self.needle, False)
         self.world.run(settle_seconds)
@@ -122,7 +140,7 @@ class SuturingEnv(gym.Env):
                 self.world.place_body(body, pose)
         self._closed = {n: False for n in self.arms}
         self._steps = 0
-        self._events_seen = len(self.world.watch.events)   # instabilities of earlier episodes are theirs
+        self._events_seen = len(self.world.watch.events)  # instabilities of earlier episodes are theirs
         self._task_reset()
         obs = self._observe()
         return obs, self._info(self._evaluate())
@@ -140,7 +158,7 @@ class SuturingEnv(gym.Env):
         bad = not all(np.all(np.isfinite(v)) for k, v in obs.items() if not k.endswith("_depth"))
         info = self._info(ev)
         info["unreachable_setpoints"] = unreachable
-        events = self.world.watch.events[self._events_seen:]   # the engine blew up (runner/stability.py)
+        events = self.world.watch.events[self._events_seen :]  # the engine blew up (runner/stability.py)
         if bad or events:
             bad = True
             info["unstable"] = [str(e) for e in events] or ["the observation holds NaN or Inf"]
@@ -180,6 +198,7 @@ class SuturingEnv(gym.Env):
             self.world.release(self._actuator(name))
         if not close:
             from ..runner.psm import JAW_OPEN
+
             psm.servo_jaw((act[6] + 1.0) / 2.0 * JAW_OPEN)
         self._closed[name] = close
         return refused
@@ -188,6 +207,7 @@ class SuturingEnv(gym.Env):
         """Start pose of the acting arms: jaws open, READY_HEIGHT above the needle's grasp
         point (the home orientation kept); an arm that cannot go there stays home."""
         from ..runner.psm import JAW_OPEN
+
         above = self.grasp_point() + (0.0, 0.0, READY_HEIGHT)
         for n in self.arms:
             psm = self.psms[n]
@@ -244,8 +264,11 @@ class SuturingEnv(gym.Env):
         return obs
 
     def _info(self, ev: dict) -> dict:
-        return {"is_success": bool(ev["success"]), **{k: v for k, v in ev.items() if k not in ("dense", "success")},
-                "sim_time": self.world.sim_time}
+        return {
+            "is_success": bool(ev["success"]),
+            **{k: v for k, v in ev.items() if k not in ("dense", "success")},
+            "sim_time": self.world.sim_time,
+        }
 
     # ---- task hooks -----------------------------------------------------------------------
     def _task_setup(self) -> None:

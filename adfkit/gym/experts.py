@@ -6,6 +6,7 @@
     while True:
         obs, r, term, trunc, info = env.step(expert(obs))
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -14,8 +15,8 @@ from ..runner.rotations import quat_to_matrix, rotation_log
 from ..tasks.suture import JAW_DEPTH
 from .env import MAX_STEP
 
-HOVER = 0.012     # m above the grasp point before coming down
-AT = 0.0015       # m: close enough to a waypoint
+HOVER = 0.012  # m above the grasp point before coming down
+AT = 0.0015  # m: close enough to a waypoint
 
 
 def jaw_point(pose7: np.ndarray) -> np.ndarray:
@@ -89,16 +90,17 @@ class SutureExpert:
 
     def reset(self) -> None:
         from ..tasks.suture import SutureTask
+
         env = self.env
-        self.task = SutureTask(env.world, [env.pair], seed=int(env.np_random.integers(1 << 30)),
-                               psm_names=env.arms)
-        self.task.psms = {n: env.psms[n] for n in env.arms}    # the env's arms, the env's set-points
+        self.task = SutureTask(env.world, [env.pair], seed=int(env.np_random.integers(1 << 30)), psm_names=env.arms)
+        self.task.psms = {n: env.psms[n] for n in env.arms}  # the env's arms, the env's set-points
         self.plan = self.task.steps()
         self.done = False
 
     def __call__(self, obs) -> np.ndarray:
         from ..runner.psm import JAW_OPEN
         from .env import MAX_TURN
+
         env = self.env
         for _ in range(env.control_steps):
             if self.done:
@@ -113,8 +115,8 @@ class SutureExpert:
             base = psm.base_in_world()
             want = base @ psm.setpoint_cp()
             have = base @ env._setpoint[n]
-            a[7 * k:7 * k + 3] = np.clip((want[:3, 3] - have[:3, 3]) / MAX_STEP, -1, 1)
-            a[7 * k + 3:7 * k + 6] = np.clip(rotation_log(want[:3, :3] @ have[:3, :3].T) / MAX_TURN, -1, 1)
+            a[7 * k : 7 * k + 3] = np.clip((want[:3, 3] - have[:3, 3]) / MAX_STEP, -1, 1)
+            a[7 * k + 3 : 7 * k + 6] = np.clip(rotation_log(want[:3, :3] @ have[:3, :3].T) / MAX_TURN, -1, 1)
             jaw = sum(psm.art.targets[i] for i in psm.jaws)
             a[7 * k + 6] = np.clip(2.0 * jaw / JAW_OPEN - 1.0, -1.0, 1.0)
         return a

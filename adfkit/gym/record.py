@@ -5,6 +5,7 @@ Ray task runs (adfkit.fanout) and the one a single process calls are the same.
 Layout of DIR/episode_<seed>.npz: obs/<key> (T+1, ...), action (T, A), reward (T,),
 is_success (T,); DIR/index.json (written by the caller) lists every episode.
 """
+
 from __future__ import annotations
 
 import os
@@ -13,13 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
-_ENVS: dict = {}   # one environment per worker process and configuration (built once, reset per episode)
+_ENVS: dict = {}  # one environment per worker process and configuration (built once, reset per episode)
 
 
 def _env(env_id: str, kwargs: dict):
     import gymnasium as gym
 
     from . import ENVS  # noqa: F401  (registers the environments)
+
     key = (env_id, tuple(sorted(kwargs.items())))
     if key not in _ENVS:
         _ENVS[key] = gym.make(env_id, **kwargs)
@@ -30,8 +32,10 @@ def record_episode(job: dict) -> dict:
     """job: {"env", "seed", "out", "kwargs" (env keywords), "kill_once" (a marker path: the
     first worker to run this job kills itself, for the fault-tolerance test)}."""
     from ..fanout import _die_once
+
     _die_once(job)
     from .experts import expert_for
+
     t0 = time.perf_counter()
     env = _env(job["env"], dict(job.get("kwargs", {})))
     expert = expert_for(env)
@@ -52,11 +56,22 @@ def record_episode(job: dict) -> dict:
     name = f"episode_{int(job['seed']):05d}.npz"
     arrays = {f"obs/{k}": np.stack([f[k] for f in frames]) for k in frames[0]}
     tmp = out / f".{name}.{os.getpid()}.tmp.npz"
-    np.savez_compressed(tmp, action=np.array(actions, np.float32), reward=np.array(rewards, np.float64),
-                        is_success=np.array(success, bool), **arrays)
+    np.savez_compressed(
+        tmp,
+        action=np.array(actions, np.float32),
+        reward=np.array(rewards, np.float64),
+        is_success=np.array(success, bool),
+        **arrays,
+    )
     os.replace(tmp, out / name)
-    return {"file": name, "steps": len(actions), "success": bool(success[-1]) if success else False,
-            "return": float(np.sum(rewards)), "wall_s": time.perf_counter() - t0, "pid": os.getpid()}
+    return {
+        "file": name,
+        "steps": len(actions),
+        "success": bool(success[-1]) if success else False,
+        "return": float(np.sum(rewards)),
+        "wall_s": time.perf_counter() - t0,
+        "pid": os.getpid(),
+    }
 
 
 def load_episode(path) -> dict:

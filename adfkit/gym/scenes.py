@@ -5,6 +5,7 @@ the default; on a checkout without it, the public corpus's suturing set (launch 
 when ../shared/corpus is present. Anything else is named by the caller (``scene=`` and
 ``indices=``).
 """
+
 from __future__ import annotations
 
 import os
@@ -23,8 +24,19 @@ SETUP_DISTANCE = 0.17
 
 
 #: the world methods the environments use beyond stepping and reading bodies
-NEEDS = ("save_state", "restore_state", "place_body", "move_base", "set_collision", "nearest_point", "grasped",
-         "actuate", "release", "ghost_pose", "overlapping")
+NEEDS = (
+    "save_state",
+    "restore_state",
+    "place_body",
+    "move_base",
+    "set_collision",
+    "nearest_point",
+    "grasped",
+    "actuate",
+    "release",
+    "ghost_pose",
+    "overlapping",
+)
 
 
 class SceneUnavailable(FileNotFoundError):
@@ -45,21 +57,23 @@ def default_scene() -> tuple[Path, str | None]:
         return corpus, CORPUS_INDICES
     raise SceneUnavailable(
         f"no suturing scene: neither {BUNDLED} (write it with `adfkit build-scene suturing "
-        f"{BUNDLED.parent}`) nor the corpus launch file {corpus} exists; pass scene=PATH")
+        f"{BUNDLED.parent}`) nor the corpus launch file {corpus} exists; pass scene=PATH"
+    )
 
 
 @dataclass
 class Built:
     world: object
-    psms: dict            # name -> adfkit.runner.PSM
-    needle: object        # SimBody
-    carried: list         # bodies moved with the needle when it is placed (its thread)
-    grasp_in_needle: np.ndarray   # 4x4: where a PSM holds the needle, in the needle body frame
-    setup_moves: dict     # name -> metres the setup joints moved the PSM base
+    psms: dict  # name -> adfkit.runner.PSM
+    needle: object  # SimBody
+    carried: list  # bodies moved with the needle when it is placed (its thread)
+    grasp_in_needle: np.ndarray  # 4x4: where a PSM holds the needle, in the needle body frame
+    setup_moves: dict  # name -> metres the setup joints moved the PSM base
 
 
-def build(scene: str | Path | None, indices: str | None, engine: str, arms, visuals: bool,
-          setup_joints: bool = True) -> Built:
+def build(
+    scene: str | Path | None, indices: str | None, engine: str, arms, visuals: bool, setup_joints: bool = True
+) -> Built:
     """Load the scene, build its world on ``engine`` and the PSMs; find the needle, its thread and
     the grasp point (the needle's surface nearest its centre of mass: mid-arc on a curved needle)."""
     from ..adf import load_scene, parse_indices
@@ -77,6 +91,7 @@ def build(scene: str | Path | None, indices: str | None, engine: str, arms, visu
         raise AdfError(errors)
     world = _world(model, engine, visuals)
     from ..runner.psm import PSM
+
     psms = {name: PSM(world, name) for name in arms}
     others = [a.root.key for a in world.articulations]
     for name in ("psm1", "psm2"):
@@ -111,18 +126,24 @@ def _soft_tissue(world, psms, needle) -> None:
 
 def _world(model, engine: str, visuals: bool):
     from ..runner.world import Options
+
     if engine == "mujoco":
         try:
-            from ..runner.mj.world import MjWorld   # the MuJoCo back end (its own branch)
+            from ..runner.mj.world import MjWorld  # the MuJoCo back end (its own branch)
         except ImportError:
-            raise NotImplementedError("engine='mujoco': this adfkit has no MuJoCo back end "
-                                      "(adfkit.runner.mj); use engine='pybullet'") from None
+            raise NotImplementedError(
+                "engine='mujoco': this adfkit has no MuJoCo back end (adfkit.runner.mj); use engine='pybullet'"
+            ) from None
         missing = [m for m in NEEDS if not hasattr(MjWorld, m)]
         if missing:
-            raise NotImplementedError("engine='mujoco': the MuJoCo back end lacks what the environments use: "
-                                      + ", ".join(missing) + "; use engine='pybullet'")
+            raise NotImplementedError(
+                "engine='mujoco': the MuJoCo back end lacks what the environments use: "
+                + ", ".join(missing)
+                + "; use engine='pybullet'"
+            )
         return MjWorld(model, Options(visuals=visuals))
     from ..runner.world import SimWorld
+
     # image observations: a frame every step, so the fastest renderer that works (cameras.choose_renderer)
     return SimWorld(model, Options(visuals=visuals, renderer="auto" if visuals else "tiny"))
 

@@ -8,14 +8,15 @@
 Dense rewards are negative distances (m, x10) plus stage bonuses; sparse rewards are 0 on
 success and -1 otherwise (the SurRoL / Fetch convention).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from .env import SuturingEnv
 
-REACH_TOLERANCE = 0.003   # m
-LIFT = 0.01               # m
+REACH_TOLERANCE = 0.003  # m
+LIFT = 0.01  # m
 
 
 def f32(x) -> np.ndarray:
@@ -64,6 +65,7 @@ class _TipWatch:
 
     def __init__(self, world, pair: int) -> None:
         from ..tasks.suture import find_needle, hole_pairs
+
         self.world = world
         self.needle, self.geom = find_needle(world)
         self.pairs = [p for p in hole_pairs(world) if p.index == pair]
@@ -90,6 +92,7 @@ class SutureOnePair(SuturingEnv):
 
     def _task_reset(self) -> None:
         from ..tasks.metrics import SutureObserver
+
         self.observer = SutureObserver(self.watch)
         self.observer.observe()
 
@@ -105,7 +108,5 @@ class SutureOnePair(SuturingEnv):
         held = self.holding("psm1") or self.holding("psm2")
         d_tip = float(np.linalg.norm(f32(self.watch.tip_world()) - f32(self._goal())))
         d_tool = float(np.linalg.norm(f32(self.tool_position("psm1")) - f32(self.grasp_point())))
-        dense = (-10.0 * (d_tool if not held and not entered else d_tip)
-                 + 1.0 * held + 2.0 * entered + 5.0 * r["passed"])
-        return {"dense": dense, "success": bool(r["passed"]), "entered": entered, "held": held,
-                "distance": d_tip}
+        dense = -10.0 * (d_tool if not held and not entered else d_tip) + 1.0 * held + 2.0 * entered + 5.0 * r["passed"]
+        return {"dense": dense, "success": bool(r["passed"]), "entered": entered, "held": held, "distance": d_tip}

@@ -1,10 +1,11 @@
 """Sub-structures shared by several ADF elements (adf-format.md §1.1, §7.3–§7.6)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from .pose import Vec3
-from .spec import ListOf, Node, key
+from .spec import Node, key
 
 
 @dataclass(kw_only=True)
@@ -77,7 +78,7 @@ class ShapeEntry(Node):
 
     shape: str | None = key("shape", "str")
     geometry: Geometry | None = key("geometry", Geometry)
-    offset: "object | None" = key("offset", "pose")
+    offset: object | None = key("offset", "pose")
 
 
 @dataclass(kw_only=True)
@@ -106,6 +107,17 @@ class CartesianController(Node):
 
 
 __all__ = [
-    "Plugin", "PublishFrequency", "Shaders", "RGBA", "RGB", "AmbientLevel", "ColorComponents",
-    "Geometry", "ShapeEntry", "Friction", "VelocityDamping", "PID", "CartesianController",
+    "Plugin",
+    "PublishFrequency",
+    "Shaders",
+    "RGBA",
+    "RGB",
+    "AmbientLevel",
+    "ColorComponents",
+    "Geometry",
+    "ShapeEntry",
+    "Friction",
+    "VelocityDamping",
+    "PID",
+    "CartesianController",
 ]

@@ -1,4 +1,5 @@
 """Compare two models field by field, floats to a tolerance; quaternions q and -q are equal."""
+
 from __future__ import annotations
 
 import dataclasses

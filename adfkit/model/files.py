@@ -1,5 +1,6 @@
 """The four ADF file kinds (launch, world, input devices, model) and the colors file,
 plus :class:`Scene`, a launch with the world and the model files it selects."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -8,7 +9,16 @@ from typing import TYPE_CHECKING
 
 from .common import RGBA, CartesianController, Plugin, Shaders
 from .objects import (
-    Actuator, Body, Camera, Ghost, Joint, Light, Sensor, SoftBody, Vehicle, Volume,
+    Actuator,
+    Body,
+    Camera,
+    Ghost,
+    Joint,
+    Light,
+    Sensor,
+    SoftBody,
+    Vehicle,
+    Volume,
 )
 from .pose import Pose, Quat, Vec3
 from .spec import ListOf, Node, Obj, key
@@ -80,8 +90,18 @@ class ModelFile(AdfFile):
         return None
 
     def all_objects(self) -> list[Obj]:
-        return [*self.bodies, *self.soft_bodies, *self.ghost_objects, *self.sensors, *self.actuators,
-                *self.joints, *self.vehicles, *self.cameras, *self.lights, *self.volumes]
+        return [
+            *self.bodies,
+            *self.soft_bodies,
+            *self.ghost_objects,
+            *self.sensors,
+            *self.actuators,
+            *self.joints,
+            *self.vehicles,
+            *self.cameras,
+            *self.lights,
+            *self.volumes,
+        ]
 
 
 @dataclass(kw_only=True)

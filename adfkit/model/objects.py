@@ -1,18 +1,29 @@
 """The ADF objects of a model file (adf-format.md §7–§11): bodies, soft bodies, ghosts,
 joints, sensors, actuators, cameras, lights, vehicles and volumes."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from .common import (
-    RGBA, CartesianController, ColorComponents, Friction, Geometry, Node, Plugin, PID,
-    PublishFrequency, Shaders, ShapeEntry, VelocityDamping,
+    PID,
+    RGBA,
+    CartesianController,
+    ColorComponents,
+    Friction,
+    Geometry,
+    Node,
+    Plugin,
+    PublishFrequency,
+    Shaders,
+    ShapeEntry,
+    VelocityDamping,
 )
 from .pose import Pose, Vec3
 from .spec import FloatOr, ListOf, Obj, key
 
-
 # --- key groups shared by several objects ---------------------------------------------
+
 
 @dataclass(kw_only=True)
 class _Ident(Obj):
@@ -58,6 +69,7 @@ class _Comm(Node):
 
 # --- rigid body ---------------------------------------------------------------------------
 
+
 @dataclass(kw_only=True)
 class Inertia(Node):
     ix: float | None = key("ix", "float")
@@ -86,6 +98,7 @@ class Body(_Comm, _Collision, _Visual, _Ident):
 
 
 # --- soft body ----------------------------------------------------------------------------
+
 
 @dataclass(kw_only=True)
 class SoftBodyConfig(Node):
@@ -143,6 +156,7 @@ class SoftBody(_Comm, _Collision, _Visual, _Ident):
 
 # --- ghost object -------------------------------------------------------------------------
 
+
 @dataclass(kw_only=True)
 class Ghost(_Comm, _Collision, _Visual, _Ident):
     """A non-colliding trigger volume (§7.9); ``location`` is relative to ``parent`` if set."""
@@ -153,6 +167,7 @@ class Ghost(_Comm, _Collision, _Visual, _Ident):
 
 
 # --- joints -------------------------------------------------------------------------------
+
 
 @dataclass(kw_only=True)
 class Vec3Range(Node):
@@ -197,9 +212,9 @@ class Joint(_Comm, _Ident):
     offset: float | None = key("offset", "float")
     child_offset: float | None = key("child offset", "float")
     joint_offset: float | None = key("joint offset", "float")
-    damping: "float | AxesGains | None" = key("damping", FloatOr(AxesGains))
-    stiffness: "float | AxesGains | None" = key("stiffness", FloatOr(AxesGains))
-    equilibrium_point: "float | AxesGains | None" = key("equilibrium point", FloatOr(AxesGains))
+    damping: float | AxesGains | None = key("damping", FloatOr(AxesGains))
+    stiffness: float | AxesGains | None = key("stiffness", FloatOr(AxesGains))
+    equilibrium_point: float | AxesGains | None = key("equilibrium point", FloatOr(AxesGains))
     max_motor_impulse: float | None = key("max motor impulse", "float")
     controller: PID | None = key("controller", PID)
     controller_output_type: str | None = key("controller output type", "str")
@@ -211,6 +226,7 @@ class Joint(_Comm, _Ident):
 
 
 # --- sensors and actuators ----------------------------------------------------------------
+
 
 @dataclass(kw_only=True)
 class Ray(Node):
@@ -267,6 +283,7 @@ class Actuator(_Comm, _Ident):
 
 
 # --- cameras and lights -------------------------------------------------------------------
+
 
 @dataclass(kw_only=True)
 class ClippingPlane(Node):
@@ -352,6 +369,7 @@ class Light(_Comm, _Ident):
 
 
 # --- vehicles and volumes -----------------------------------------------------------------
+
 
 @dataclass(kw_only=True)
 class Suspension(Node):

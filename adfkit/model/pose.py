@@ -4,6 +4,7 @@ Quaternions are stored as (x, y, z, w), the order PyBullet uses. ADF's RPY is fi
 X-Y-Z: R = Rz(yaw) * Ry(pitch) * Rx(roll), the same as URDF ``rpy``.
 Pure ``math`` on purpose: the core must import fast, without numpy.
 """
+
 from __future__ import annotations
 
 import math
@@ -21,19 +22,19 @@ class Vec3(NamedTuple):
     def __sub__(self, o):
         return Vec3(self.x - o[0], self.y - o[1], self.z - o[2])
 
-    def scaled(self, s: float) -> "Vec3":
+    def scaled(self, s: float) -> Vec3:
         return Vec3(self.x * s, self.y * s, self.z * s)
 
     def dot(self, o) -> float:
         return self.x * o[0] + self.y * o[1] + self.z * o[2]
 
-    def cross(self, o) -> "Vec3":
+    def cross(self, o) -> Vec3:
         return Vec3(self.y * o[2] - self.z * o[1], self.z * o[0] - self.x * o[2], self.x * o[1] - self.y * o[0])
 
     def norm(self) -> float:
         return math.hypot(self.x, self.y, self.z)  # no overflow for components near 1e308
 
-    def normalized(self) -> "Vec3":
+    def normalized(self) -> Vec3:
         n = self.norm()
         if n == 0.0:
             raise ValueError("cannot normalise a zero vector")
@@ -48,7 +49,7 @@ class Quat(NamedTuple):
     z: float = 0.0
     w: float = 1.0
 
-    def __mul__(self, o: "Quat") -> "Quat":  # type: ignore[override]
+    def __mul__(self, o: Quat) -> Quat:  # type: ignore[override]
         ax, ay, az, aw = self
         bx, by, bz, bw = o
         return Quat(
@@ -58,14 +59,14 @@ class Quat(NamedTuple):
             aw * bw - ax * bx - ay * by - az * bz,
         )
 
-    def conjugate(self) -> "Quat":
+    def conjugate(self) -> Quat:
         return Quat(-self.x, -self.y, -self.z, self.w)
 
-    def inverse(self) -> "Quat":
+    def inverse(self) -> Quat:
         """The inverse rotation (the conjugate of a unit quaternion)."""
         return Quat(-self.x, -self.y, -self.z, self.w)
 
-    def normalized(self) -> "Quat":
+    def normalized(self) -> Quat:
         n = math.sqrt(sum(c * c for c in self))
         if not 0.0 < n < math.inf:  # zero, infinite or NaN: no rotation can be read from it
             return NAN_QUAT
@@ -85,7 +86,7 @@ class Quat(NamedTuple):
         )
 
     @classmethod
-    def from_axis_angle(cls, axis, angle: float) -> "Quat":
+    def from_axis_angle(cls, axis, angle: float) -> Quat:
         a = Vec3(*axis).normalized()
         if not math.isfinite(angle) or not all(map(math.isfinite, a)):
             return NAN_QUAT
@@ -93,7 +94,7 @@ class Quat(NamedTuple):
         return cls(a.x * s, a.y * s, a.z * s, math.cos(angle / 2.0))
 
     @classmethod
-    def from_matrix(cls, m) -> "Quat":
+    def from_matrix(cls, m) -> Quat:
         m00, m01, m02 = m[0]
         m10, m11, m12 = m[1]
         m20, m21, m22 = m[2]
@@ -105,7 +106,7 @@ class Quat(NamedTuple):
             return NAN_QUAT
 
     @classmethod
-    def _from_finite_matrix(cls, m00, m01, m02, m10, m11, m12, m20, m21, m22) -> "Quat":
+    def _from_finite_matrix(cls, m00, m01, m02, m10, m11, m12, m20, m21, m22) -> Quat:
         tr = m00 + m11 + m22
         if tr > 0:
             s = math.sqrt(tr + 1.0) * 2
@@ -121,7 +122,7 @@ class Quat(NamedTuple):
             q = cls((m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s)
         return q.normalized()
 
-    def angle_to(self, o: "Quat") -> float:
+    def angle_to(self, o: Quat) -> float:
         """Smallest rotation angle between two orientations, radians."""
         d = self.conjugate() * o
         return 2.0 * math.atan2(math.sqrt(d.x * d.x + d.y * d.y + d.z * d.z), abs(d.w))
@@ -171,11 +172,11 @@ class Pose(NamedTuple):
     position: Vec3 = Vec3()
     orientation: Quat = IDENTITY
 
-    def __mul__(self, o: "Pose") -> "Pose":  # type: ignore[override]
+    def __mul__(self, o: Pose) -> Pose:  # type: ignore[override]
         """Compose: self (A in W) * o (B in A) = B in W."""
         return Pose(self.position + self.orientation.rotate(o.position), self.orientation * o.orientation)
 
-    def inverse(self) -> "Pose":
+    def inverse(self) -> Pose:
         qi = self.orientation.conjugate()
         return Pose(qi.rotate(self.position).scaled(-1.0), qi)
 
@@ -183,7 +184,7 @@ class Pose(NamedTuple):
         return self.position + self.orientation.rotate(v)
 
     @classmethod
-    def from_rpy(cls, xyz=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0)) -> "Pose":
+    def from_rpy(cls, xyz=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0)) -> Pose:
         return cls(Vec3(*map(float, xyz)), rpy_to_quat(*rpy))
 
     def rpy(self) -> tuple[float, float, float]:

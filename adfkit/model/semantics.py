@@ -1,5 +1,6 @@
 """What AMBF makes of the raw values: canonical kinds for the spellings it accepts, and
 the effective defaults it uses for keys a file leaves out (adf-format.md §7–§11)."""
+
 from __future__ import annotations
 
 import math
@@ -11,8 +12,8 @@ from .pose import IDENTITY, Pose, Quat, Vec3
 
 
 class JointKind(str, Enum):
-    REVOLUTE = "revolute"          # revolute, hinge, continuous
-    PRISMATIC = "prismatic"        # prismatic, slider
+    REVOLUTE = "revolute"  # revolute, hinge, continuous
+    PRISMATIC = "prismatic"  # prismatic, slider
     FIXED = "fixed"
     LINEAR_SPRING = "linear spring"
     TORSION_SPRING = "torsion spring"
@@ -23,11 +24,16 @@ class JointKind(str, Enum):
 
 
 JOINT_TYPE_NAMES: dict[str, JointKind] = {
-    "revolute": JointKind.REVOLUTE, "hinge": JointKind.REVOLUTE, "continuous": JointKind.REVOLUTE,
-    "prismatic": JointKind.PRISMATIC, "slider": JointKind.PRISMATIC,
+    "revolute": JointKind.REVOLUTE,
+    "hinge": JointKind.REVOLUTE,
+    "continuous": JointKind.REVOLUTE,
+    "prismatic": JointKind.PRISMATIC,
+    "slider": JointKind.PRISMATIC,
     "fixed": JointKind.FIXED,
-    "linear spring": JointKind.LINEAR_SPRING, "spring": JointKind.LINEAR_SPRING,
-    "torsion spring": JointKind.TORSION_SPRING, "torsional spring": JointKind.TORSION_SPRING,
+    "linear spring": JointKind.LINEAR_SPRING,
+    "spring": JointKind.LINEAR_SPRING,
+    "torsion spring": JointKind.TORSION_SPRING,
+    "torsional spring": JointKind.TORSION_SPRING,
     "angular spring": JointKind.TORSION_SPRING,
     "p2p": JointKind.P2P,
     "cone twist": JointKind.CONE_TWIST,
@@ -90,12 +96,16 @@ class CollisionMeshType(str, Enum):
 
 
 _MESH_TYPES = {
-    "CONVEX_HULL": CollisionMeshType.CONVEX_HULL, "convex_hull": CollisionMeshType.CONVEX_HULL,
+    "CONVEX_HULL": CollisionMeshType.CONVEX_HULL,
+    "convex_hull": CollisionMeshType.CONVEX_HULL,
     "hull": CollisionMeshType.CONVEX_HULL,
-    "CONVEX_MESH": CollisionMeshType.CONVEX_MESH, "convex_mesh": CollisionMeshType.CONVEX_MESH,
-    "CONCAVE_MESH": CollisionMeshType.CONCAVE_MESH, "TRIMESH": CollisionMeshType.CONCAVE_MESH,
+    "CONVEX_MESH": CollisionMeshType.CONVEX_MESH,
+    "convex_mesh": CollisionMeshType.CONVEX_MESH,
+    "CONCAVE_MESH": CollisionMeshType.CONCAVE_MESH,
+    "TRIMESH": CollisionMeshType.CONCAVE_MESH,
     "trimesh": CollisionMeshType.CONCAVE_MESH,
-    "POINT_CLOUD": CollisionMeshType.POINT_CLOUD, "point_cloud": CollisionMeshType.POINT_CLOUD,
+    "POINT_CLOUD": CollisionMeshType.POINT_CLOUD,
+    "point_cloud": CollisionMeshType.POINT_CLOUD,
 }
 
 
@@ -107,12 +117,25 @@ def collision_mesh_type(text: str | None) -> tuple[CollisionMeshType, bool]:
     return (t, True) if t else (CollisionMeshType.CONCAVE_MESH, False)
 
 
-SENSOR_TYPES = {"Proximity": "proximity", "proximity": "proximity", "PROXIMITY": "proximity",
-                "Resistance": "resistance", "resistance": "resistance", "RESISTANCE": "resistance"}
+SENSOR_TYPES = {
+    "Proximity": "proximity",
+    "proximity": "proximity",
+    "PROXIMITY": "proximity",
+    "Resistance": "resistance",
+    "resistance": "resistance",
+    "RESISTANCE": "resistance",
+}
 ACTUATOR_TYPES = {"Constraint": "constraint", "constraint": "constraint", "CONSTRAINT": "constraint"}
-CONTROLLER_OUTPUT_TYPES = {"FORCE": "force", "EFFORT": "force", "force": "force", "effort": "force",
-                           "VELOCITY": "velocity", "velocity": "velocity",
-                           "POSITION": "position", "position": "position"}
+CONTROLLER_OUTPUT_TYPES = {
+    "FORCE": "force",
+    "EFFORT": "force",
+    "force": "force",
+    "effort": "force",
+    "VELOCITY": "velocity",
+    "velocity": "velocity",
+    "POSITION": "position",
+    "position": "position",
+}
 
 
 # --- effective defaults --------------------------------------------------------------------
@@ -229,8 +252,12 @@ def joint_frames(joint, parent_scale: float = 1.0, child_scale: float = 1.0) -> 
     joint_offset = joint.joint_offset or 0.0
     offset = joint.offset if joint.offset is not None else (joint.child_offset or 0.0)
     r_a = Quat.from_axis_angle(a, joint_offset) * shortest_arc(d, a)
-    r_b = (shortest_arc(b, a).inverse() * Quat.from_axis_angle(a, offset).inverse()
-           * Quat.from_axis_angle(a, joint_offset) * shortest_arc(d, a))
+    r_b = (
+        shortest_arc(b, a).inverse()
+        * Quat.from_axis_angle(a, offset).inverse()
+        * Quat.from_axis_angle(a, joint_offset)
+        * shortest_arc(d, a)
+    )
     pa = Vec3(*(joint.parent_pivot or Vec3())).scaled(parent_scale)
     pb = Vec3(*(joint.child_pivot or Vec3())).scaled(child_scale)
     return Pose(pa, r_a), Pose(pb, r_b)

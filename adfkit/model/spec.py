@@ -6,10 +6,11 @@ these declarations, so a field added here is read, written and round-tripped eve
 A field left ``None`` was not written by the user; effective defaults live in
 ``adfkit.model.defaults``.
 """
+
 from __future__ import annotations
 
-from functools import lru_cache
 from dataclasses import MISSING, dataclass, field, fields
+from functools import cache
 from typing import Any
 
 from ..diagnostics import SourceLocation
@@ -62,12 +63,12 @@ class Obj(Node):
     defined: bool = True
 
 
-@lru_cache(maxsize=None)
+@cache
 def _adf_fields_of(cls: type) -> tuple:
     return tuple(f for f in fields(cls) if "adf_key" in f.metadata)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _adf_keys_of(cls: type) -> frozenset:
     return frozenset(f.metadata["adf_key"] for f in _adf_fields_of(cls))
 

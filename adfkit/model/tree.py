@@ -9,6 +9,7 @@ parent's link frame, the initial joint value that reproduces the file's `locatio
 forward kinematics. The converters and the validator build on it; nothing here knows a file
 format.
 """
+
 from __future__ import annotations
 
 import math
@@ -30,13 +31,13 @@ class Link:
     frame (for a root: the link's world pose). ``axis``: the joint axis in the link frame."""
 
     body: Body
-    parent: "Link | None" = None
+    parent: Link | None = None
     joint: Joint | None = None
     kind: JointKind | None = None
     frame_in_body: Pose = field(default_factory=Pose)
     origin: Pose = field(default_factory=Pose)
     q0: float = 0.0
-    children: list["Link"] = field(default_factory=list)
+    children: list[Link] = field(default_factory=list)
 
     @property
     def name(self) -> str:
@@ -54,9 +55,9 @@ class Link:
 @dataclass
 class KinematicTree:
     roots: list[Link]
-    links: dict[str, Link]                 # body identifier -> link
-    loops: list[tuple[Joint, JointKind, Body, Body]]   # joints left out of the tree
-    unresolved: list[Joint]                # joints whose parent or child is not a body here
+    links: dict[str, Link]  # body identifier -> link
+    loops: list[tuple[Joint, JointKind, Body, Body]]  # joints left out of the tree
+    unresolved: list[Joint]  # joints whose parent or child is not a body here
 
     def ordered(self) -> list[Link]:
         """Every link, parents before children (depth first from each root)."""
@@ -114,7 +115,9 @@ def _scale(b: Body) -> float:
     return b.scale if b.scale is not None else 1.0
 
 
-def build_tree(model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)) -> KinematicTree:
+def build_tree(
+    model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)
+) -> KinematicTree:
     """Spanning tree over the joints whose kind is in ``tree_kinds``.
 
     Roots, in file order: bodies that are no joint's child (static ones, mass 0, first), then
@@ -154,8 +157,7 @@ def build_tree(model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISM
                     continue
                 used.add(id(r))
                 a, b = joint_frames(j, _scale(parent), _scale(child))
-                node = Link(child, parent=link, joint=j, kind=kind, frame_in_body=b,
-                            origin=link.in_link(a))
+                node = Link(child, parent=link, joint=j, kind=kind, frame_in_body=b, origin=link.in_link(a))
                 node.q0 = _initial_value(link, node)
                 link.children.append(node)
                 links[child.identifier] = node

@@ -1,5 +1,6 @@
 """Trees of revolute/prismatic(/fixed) joints as PyBullet multibodies: exact joints with
 native limits and position motors; no constraint drift. Loops stay outside (joints.py)."""
+
 from __future__ import annotations
 
 from collections import defaultdict, deque
@@ -7,7 +8,7 @@ from collections import defaultdict, deque
 import numpy as np
 import pybullet as pb
 
-from ..model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, joint_frames, joint_kind
+from ..model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, joint_frames
 from .rotations import invert, matrix_to_pq, pose_matrix
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC)
@@ -69,9 +70,14 @@ class Articulation:
         return [s[0] for s in pb.getJointStates(self.uid, list(range(len(self.records))), physicsClientId=self.cid)]
 
     def drive(self) -> None:
-        pb.setJointMotorControlArray(self.uid, list(range(len(self.records))), pb.POSITION_CONTROL,
-                                     targetPositions=self.targets, forces=self.forces,
-                                     physicsClientId=self.cid)
+        pb.setJointMotorControlArray(
+            self.uid,
+            list(range(len(self.records))),
+            pb.POSITION_CONTROL,
+            targetPositions=self.targets,
+            forces=self.forces,
+            physicsClientId=self.cid,
+        )
 
 
 def depth_first(root, records):
@@ -97,7 +103,7 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
     for n, r in enumerate(records):
         idx[id(r[3])] = n
     lm, lc, lv, lp, lo, lip, lio, lpi, lt, la = ([] for _ in range(10))
-    for n, (joint, kind, parent, child) in enumerate(records):
+    for joint, kind, parent, child in records:
         ps = parent.body.scale if parent.body.scale is not None else 1.0
         cs = child.body.scale if child.body.scale is not None else 1.0
         if kind is JointKind.FIXED:
@@ -106,26 +112,46 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
         else:
             a, b = joint_frames(joint, ps, cs)
             fa, fb = pose_matrix(*_pose(a)), pose_matrix(*_pose(b))
-        child.ref_in_body = fb                       # link frame = joint frame B
-        rel = invert(parent.ref_in_body) @ fa        # joint frame in the parent's link frame
+        child.ref_in_body = fb  # link frame = joint frame B
+        rel = invert(parent.ref_in_body) @ fa  # joint frame in the parent's link frame
         col, vis = shapes_for(child, fb)
         pos, orn = matrix_to_pq(rel)
         ipos, iorn = matrix_to_pq(invert(fb) @ child.com_in_body)
-        lm.append(child.mass); lc.append(col); lv.append(vis)
-        lp.append(pos); lo.append(orn); lip.append(ipos); lio.append(iorn)
+        lm.append(child.mass)
+        lc.append(col)
+        lv.append(vis)
+        lp.append(pos)
+        lo.append(orn)
+        lip.append(ipos)
+        lio.append(iorn)
         lpi.append(idx[id(parent)] + 1)
-        lt.append({JointKind.REVOLUTE: pb.JOINT_REVOLUTE, JointKind.PRISMATIC: pb.JOINT_PRISMATIC}
-                  .get(kind, pb.JOINT_FIXED))
+        lt.append(
+            {JointKind.REVOLUTE: pb.JOINT_REVOLUTE, JointKind.PRISMATIC: pb.JOINT_PRISMATIC}.get(kind, pb.JOINT_FIXED)
+        )
         la.append([1, 0, 0] if kind is JointKind.PRISMATIC else [0, 0, 1])
     bcol, bvis = shapes_for(root, root.ref_in_body)
     world = root.body_world_matrix
     bpos, born = matrix_to_pq(world @ root.ref_in_body)
     flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT if self_collision else 0
-    uid = pb.createMultiBody(root.mass, bcol, bvis, bpos, born, linkMasses=lm, linkCollisionShapeIndices=lc,
-                             linkVisualShapeIndices=lv, linkPositions=lp, linkOrientations=lo,
-                             linkInertialFramePositions=lip, linkInertialFrameOrientations=lio,
-                             linkParentIndices=lpi, linkJointTypes=lt, linkJointAxis=la, flags=flags,
-                             physicsClientId=cid)
+    uid = pb.createMultiBody(
+        root.mass,
+        bcol,
+        bvis,
+        bpos,
+        born,
+        linkMasses=lm,
+        linkCollisionShapeIndices=lc,
+        linkVisualShapeIndices=lv,
+        linkPositions=lp,
+        linkOrientations=lo,
+        linkInertialFramePositions=lip,
+        linkInertialFrameOrientations=lio,
+        linkParentIndices=lpi,
+        linkJointTypes=lt,
+        linkJointAxis=la,
+        flags=flags,
+        physicsClientId=cid,
+    )
     # PyBullet names joint n "joint{n+1}" after the position in our lists; check the link order
     order = [int(pb.getJointInfo(uid, n, physicsClientId=cid)[1].decode()[5:]) - 1 for n in range(len(records))]
     if order != list(range(len(records))):

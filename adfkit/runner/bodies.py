@@ -1,5 +1,6 @@
 """Rigid bodies: free (maximal-coordinate) bodies and Featherstone articulations for the
 revolute/prismatic trees (adf-format.md §7, §8.2)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -7,10 +8,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..model.pose import Vec3
 from ..model.semantics import (
-    DEFAULT_ANGULAR_DAMPING, DEFAULT_FRICTION_ROLLING, DEFAULT_FRICTION_STATIC, DEFAULT_LINEAR_DAMPING,
-    DEFAULT_RESTITUTION, effective_mass, inertial_offset,
+    DEFAULT_ANGULAR_DAMPING,
+    DEFAULT_FRICTION_ROLLING,
+    DEFAULT_FRICTION_STATIC,
+    DEFAULT_LINEAR_DAMPING,
+    DEFAULT_RESTITUTION,
+    effective_mass,
+    inertial_offset,
 )
 from .rotations import pose_to_matrix
 
@@ -18,12 +23,13 @@ from .rotations import pose_to_matrix
 @dataclass(eq=False)
 class SimBody:
     """One ADF body as PyBullet holds it: (uid, link); link -1 is a base or a free body."""
+
     key: str
     body: object
     model: object
     mass: float
-    com_in_body: np.ndarray          # 4×4, §7.2
-    ref_in_body: np.ndarray = None   # PyBullet frame of the body (COM, or the joint frame for a link)
+    com_in_body: np.ndarray  # 4×4, §7.2
+    ref_in_body: np.ndarray = None  # PyBullet frame of the body (COM, or the joint frame for a link)
     uid: int = -1
     link: int = -1
     cid: int = 0
@@ -50,8 +56,9 @@ class SimBody:
                 return p, q, None, None
             v, w = pb.getBaseVelocity(self.uid, physicsClientId=self.cid)
             return p, q, v, w
-        s = pb.getLinkState(self.uid, self.link, computeLinkVelocity=int(velocity), computeForwardKinematics=1,
-                           physicsClientId=self.cid)
+        s = pb.getLinkState(
+            self.uid, self.link, computeLinkVelocity=int(velocity), computeForwardKinematics=1, physicsClientId=self.cid
+        )
         if not velocity:
             return s[0], s[1], None, None
         return s[0], s[1], s[6], s[7]  # the COM frame: constraint pivots are relative to it
@@ -64,6 +71,7 @@ class SimBody:
     def world_matrix(self) -> np.ndarray:
         """Pose of the ADF body frame (the mesh origin) in the world, 4×4."""
         from .rotations import invert, pose_matrix
+
         p, q, _, _ = self.state(velocity=False)
         return pose_matrix(p, q) @ invert(self.com_in_body)
 
@@ -78,8 +86,16 @@ def make_sim_body(key: str, body, model) -> SimBody:
     mass = effective_mass(body)
     com = pose_to_matrix(inertial_offset(body))
     from ..model.semantics import pose_or_identity
-    return SimBody(key=key, body=body, model=model, mass=max(mass, 0.0), com_in_body=com, ref_in_body=com,
-                   body_world_matrix=pose_to_matrix(pose_or_identity(body.location)))
+
+    return SimBody(
+        key=key,
+        body=body,
+        model=model,
+        mass=max(mass, 0.0),
+        com_in_body=com,
+        ref_in_body=com,
+        body_world_matrix=pose_to_matrix(pose_or_identity(body.location)),
+    )
 
 
 def body_gravity(body, model, world_g: np.ndarray) -> np.ndarray | None:
@@ -98,13 +114,20 @@ def set_dynamics(sb: SimBody) -> None:
         lateralFriction=fr.static if fr is not None and fr.static is not None else DEFAULT_FRICTION_STATIC,
         rollingFriction=fr.rolling if fr is not None and fr.rolling is not None else DEFAULT_FRICTION_ROLLING,
         restitution=b.restitution if b.restitution is not None else DEFAULT_RESTITUTION,
-        linearDamping=b.damping.linear if b.damping is not None and b.damping.linear is not None
+        linearDamping=b.damping.linear
+        if b.damping is not None and b.damping.linear is not None
         else DEFAULT_LINEAR_DAMPING,
-        angularDamping=b.damping.angular if b.damping is not None and b.damping.angular is not None
+        angularDamping=b.damping.angular
+        if b.damping is not None and b.damping.angular is not None
         else DEFAULT_ANGULAR_DAMPING,
     )
-    if not sb.static and b.mass is not None and b.inertia is not None and None not in (
-            b.inertia.ix, b.inertia.iy, b.inertia.iz) and min(b.inertia.ix, b.inertia.iy, b.inertia.iz) > 0:
+    if (
+        not sb.static
+        and b.mass is not None
+        and b.inertia is not None
+        and None not in (b.inertia.ix, b.inertia.iy, b.inertia.iz)
+        and min(b.inertia.ix, b.inertia.iy, b.inertia.iz) > 0
+    ):
         kw["localInertiaDiagonal"] = [b.inertia.ix, b.inertia.iy, b.inertia.iz]
         kw["mass"] = sb.mass  # PyBullet zeroes a maximal body's mass when only the inertia is given
     pb.changeDynamics(sb.uid, sb.link, physicsClientId=sb.cid, **kw)

@@ -2,6 +2,7 @@
 segmentation, pinhole intrinsics, rendered headless by the renderer the world chose
 (:func:`choose_renderer`): TinyRenderer, PyBullet's EGL plugin (runner/egl.py) or MuJoCo's
 renderer on a mirror of the scene (runner/mjview.py)."""
+
 from __future__ import annotations
 
 import contextlib
@@ -21,16 +22,16 @@ class SimCamera:
     name: str
     key: str
     camera: object
-    parent: object            # SimBody or None
-    eye: np.ndarray           # in the parent body frame (or world)
+    parent: object  # SimBody or None
+    eye: np.ndarray  # in the parent body frame (or world)
     target: np.ndarray
     up: np.ndarray
-    fov: float                # vertical, rad
+    fov: float  # vertical, rad
     near: float
     far: float
     width: int
     height: int
-    eye_offset: float = 0.0   # along the image's right axis (stereo eyes)
+    eye_offset: float = 0.0  # along the image's right axis (stereo eyes)
 
     def intrinsics(self) -> np.ndarray:
         fy = (self.height / 2) / math.tan(self.fov / 2)
@@ -61,17 +62,24 @@ class SimCamera:
         world.place_ghosts()
         eye, target, up = self.view(world)
         vm = pb.computeViewMatrix(eye, target, up, physicsClientId=world.cid)
-        pm = pb.computeProjectionMatrixFOV(math.degrees(self.fov), self.width / self.height, self.near, self.far,
-                                           physicsClientId=world.cid)
+        pm = pb.computeProjectionMatrixFOV(
+            math.degrees(self.fov), self.width / self.height, self.near, self.far, physicsClientId=world.cid
+        )
         with egl.quiet_stdout() if world.renderer == "egl" else contextlib.nullcontext():
-            _, _, rgba, zbuf, seg = pb.getCameraImage(self.width, self.height, vm, pm,
-                                                      renderer=egl.flag(world.renderer),
-                                                      flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,
-                                                      shadow=0, physicsClientId=world.cid)
+            _, _, rgba, zbuf, seg = pb.getCameraImage(
+                self.width,
+                self.height,
+                vm,
+                pm,
+                renderer=egl.flag(world.renderer),
+                flags=pb.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX,
+                shadow=0,
+                physicsClientId=world.cid,
+            )
         rgb = np.reshape(np.asarray(rgba, dtype=np.uint8), (self.height, self.width, 4))[:, :, :3]
         z = np.reshape(np.asarray(zbuf, dtype=np.float64), (self.height, self.width))
         n, f = self.near, self.far
-        depth = (f * n / (f - (f - n) * z)).astype(np.float32)   # linearised z-buffer
+        depth = (f * n / (f - (f - n) * z)).astype(np.float32)  # linearised z-buffer
         depth[z >= 1.0] = np.inf
         seg = np.reshape(np.asarray(seg, dtype=np.int64), (self.height, self.width))
         return {"rgb": rgb, "depth": depth, "segmentation": label_image(world, seg)}
@@ -100,6 +108,7 @@ def choose_renderer(wanted: str, cid: int, has_cameras: bool, soft: bool, gui: b
     notes = []
     if wanted in ("mujoco", "auto"):
         from .glcontext import gl_context_class
+
         cls, why = gl_context_class()
         if cls is not None:
             return "mujoco", ""
@@ -123,7 +132,7 @@ def label_table(world) -> np.ndarray:
     if ids:
         uids, links, index = (np.array(c) for c in zip(*ids))
         table = np.full((uids.max() + 1, links.max() + 2), -1, dtype=np.int32)
-        table[uids, links + 1] = index   # as a dict would: the last body of a (uid, link) wins
+        table[uids, links + 1] = index  # as a dict would: the last body of a (uid, link) wins
     else:
         table = np.full((1, 1), -1, dtype=np.int32)
     world._seg_label_table = (len(bodies), table)
@@ -155,8 +164,7 @@ def _camera(world, cam, ns: str) -> list[SimCamera]:
     look = np.array(cam.look_at or (0, 0, 0), float)
     up = np.array(cam.up or (0, 0, 1), float)
     if np.allclose(loc, look) or np.linalg.norm(np.cross(look - loc, up)) < 1e-12:
-        world._warn("runner-camera", f"{cam.identifier}: look at equals location or up is parallel to the view",
-                    cam)
+        world._warn("runner-camera", f"{cam.identifier}: look at equals location or up is parallel to the view", cam)
     clip = cam.clipping_plane
     near = clip.near if clip is not None and clip.near is not None else DEFAULT_CAMERA_NEAR
     far = clip.far if clip is not None and clip.far is not None else DEFAULT_CAMERA_FAR
@@ -170,8 +178,10 @@ def _camera(world, cam, ns: str) -> list[SimCamera]:
     if cam.stereo is None:
         return [base]
     sep = cam.stereo.eye_separation if cam.stereo.eye_separation is not None else 0.2
-    return [SimCamera(name + "_left", key, cam, parent, loc, look, up, fov, near, far, w, h, -sep / 2),
-            SimCamera(name + "_right", key, cam, parent, loc, look, up, fov, near, far, w, h, sep / 2)]
+    return [
+        SimCamera(name + "_left", key, cam, parent, loc, look, up, fov, near, far, w, h, -sep / 2),
+        SimCamera(name + "_right", key, cam, parent, loc, look, up, fov, near, far, w, h, sep / 2),
+    ]
 
 
 def build_cameras(world) -> list[SimCamera]:
@@ -189,7 +199,9 @@ def build_cameras(world) -> list[SimCamera]:
 def save_frames(world, out_dir, size_limit: int | None = None) -> list[str]:
     """Write <camera>_rgb.png, <camera>_depth.npy, <camera>_seg.npy (+ _seg.png) for every camera."""
     from pathlib import Path
+
     from PIL import Image
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -199,7 +211,8 @@ def save_frames(world, out_dir, size_limit: int | None = None) -> list[str]:
         Image.fromarray(frame["rgb"]).save(out / f"{stem}_rgb.png")
         np.save(out / f"{stem}_depth.npy", frame["depth"])
         np.save(out / f"{stem}_seg.npy", frame["segmentation"])
-        from ..dataset.colors import colourise   # every body its own colour (was grey, nearly black)
+        from ..dataset.colors import colourise  # every body its own colour (was grey, nearly black)
+
         Image.fromarray(colourise(frame["segmentation"])).save(out / f"{stem}_seg.png")
         written += [f"{stem}_rgb.png", f"{stem}_depth.npy", f"{stem}_seg.npy", f"{stem}_seg.png"]
     return written

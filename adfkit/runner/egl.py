@@ -12,6 +12,7 @@ Known plugin crash (PyBullet 3.2.7), avoided by the world: a body whose only col
 a PLANE and that has no visual shape segfaults when it is converted (and the plugin has no visual
 plane either); such bodies get a thin slab visual of their own (:func:`plane_visual`).
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -22,7 +23,6 @@ import subprocess
 import sys
 
 import pybullet as pb
-
 
 _PROBE = r"""
 import numpy as np, pybullet as pb, sys
@@ -117,8 +117,13 @@ def plane_visual(cid: int, normal, offset: float, half: float = 50.0) -> int:
         quat = [*(axis / s * np.sin(half_angle)), float(np.cos(half_angle))]
     thick = 5e-4
     centre = n * (offset - thick)
-    return pb.createVisualShape(pb.GEOM_BOX, halfExtents=[half, half, thick], visualFramePosition=centre.tolist(),
-                                visualFrameOrientation=[float(q) for q in quat], physicsClientId=cid)
+    return pb.createVisualShape(
+        pb.GEOM_BOX,
+        halfExtents=[half, half, thick],
+        visualFramePosition=centre.tolist(),
+        visualFrameOrientation=[float(q) for q in quat],
+        physicsClientId=cid,
+    )
 
 
 def flag(renderer: str) -> int:

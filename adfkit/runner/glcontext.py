@@ -1,6 +1,7 @@
 """Which headless OpenGL context MuJoCo's renderer can use here (EGL, else OSMesa, or the one
 MUJOCO_GL names). Probed by the camera set-up of either world without importing an engine's
 renderer."""
+
 from __future__ import annotations
 
 import os
@@ -20,6 +21,6 @@ def gl_context_class():
             else:
                 from mujoco.rendering.classic.gl_context import GLContext
             return GLContext, None
-        except Exception as e:   # a missing libEGL/libOSMesa surfaces as ImportError, OSError or AttributeError
+        except Exception as e:  # a missing libEGL/libOSMesa surfaces as ImportError, OSError or AttributeError
             tried.append(f"{name}: {type(e).__name__}: {e}")
     return None, "; ".join(tried)

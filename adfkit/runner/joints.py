@@ -13,9 +13,9 @@ JOINT_POINT2POINT and JOINT_GEAR. So:
 Spring and damping gains are clamped to what an explicit step keeps stable
 (k ≤ 0.25·I/dt², c ≤ 0.5·I/dt); limits are velocity corrections with Baumgarte feedback.
 """
+
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,17 +24,17 @@ import pybullet as pb
 from ..model.semantics import DEFAULT_SIX_DOF_LIMIT, DEFAULT_SIX_DOF_SPRING, JointKind
 from .rotations import euler_xyz, matrix_to_pq, pose_matrix, quat_to_matrix
 
-FIXED_SPAN = 0.005      # m between the three p2p pivots of a fixed joint outside a multibody
+FIXED_SPAN = 0.005  # m between the three p2p pivots of a fixed joint outside a multibody
 HINGE_HALF_SPAN = 0.01  # m: the two p2p constraints of a loop-closing hinge sit ±this along the axis
 
 
 @dataclass
 class SpringJoint:
     name: str
-    parent: object   # SimBody
+    parent: object  # SimBody
     child: object
-    frame_a: np.ndarray   # joint frame in the parent's PyBullet frame (4×4)
-    frame_b: np.ndarray   # joint frame in the child's PyBullet frame
+    frame_a: np.ndarray  # joint frame in the parent's PyBullet frame (4×4)
+    frame_b: np.ndarray  # joint frame in the child's PyBullet frame
     lin_low: np.ndarray
     lin_high: np.ndarray
     ang_low: np.ndarray
@@ -45,7 +45,7 @@ class SpringJoint:
     k_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
     c_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
     eq_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    linear_constrained: bool = True   # a p2p holds the pivots together
+    linear_constrained: bool = True  # a p2p holds the pivots together
 
 
 def _vec(v, default: float) -> np.ndarray:
@@ -57,7 +57,7 @@ def _vec(v, default: float) -> np.ndarray:
 def spring_joint(joint, kind: JointKind, parent, child, frame_a, frame_b) -> SpringJoint:
     """Limits and gains of a six-dof-family joint in the joint frame (§8.1)."""
     lim = joint.joint_limits
-    big = np.full(3, np.inf)
+    np.full(3, np.inf)
     zero = np.zeros(3)
     if kind in (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING):
         d = DEFAULT_SIX_DOF_LIMIT
@@ -86,7 +86,11 @@ def spring_joint(joint, kind: JointKind, parent, child, frame_a, frame_b) -> Spr
     sj = SpringJoint(joint.identifier, parent, child, frame_a, frame_b, lin_low, lin_high, ang_low, ang_high)
     sj.linear_constrained = bool(np.all(lin_low == 0) and np.all(lin_high == 0))
     if kind is JointKind.SIX_DOF_SPRING:
-        for attr, key in (("stiffness", "stiffness"), ("damping", "damping"), ("equilibrium_point", "equilibrium point")):
+        for attr, key in (
+            ("stiffness", "stiffness"),
+            ("damping", "damping"),
+            ("equilibrium_point", "equilibrium point"),
+        ):
             block = getattr(joint, attr)
             dflt = DEFAULT_SIX_DOF_SPRING[key]
             lin = _vec(getattr(block, "linear", None), dflt)
@@ -98,8 +102,11 @@ def spring_joint(joint, kind: JointKind, parent, child, frame_a, frame_b) -> Spr
         k = joint.stiffness if isinstance(joint.stiffness, (int, float)) else 0.0
         c = joint.damping if isinstance(joint.damping, (int, float)) else 0.0
         lim_ok = lim is not None and lim.low is not None and lim.high is not None
-        eq = joint.equilibrium_point if isinstance(joint.equilibrium_point, (int, float)) else (
-            (lim.low + lim.high) / 2 if lim_ok else 0.0)
+        eq = (
+            joint.equilibrium_point
+            if isinstance(joint.equilibrium_point, (int, float))
+            else ((lim.low + lim.high) / 2 if lim_ok else 0.0)
+        )
         if lim_ok:
             if kind is JointKind.LINEAR_SPRING:
                 sj.k_lin, sj.c_lin, sj.eq_lin = np.array([0, 0, k]), np.array([0, 0, c]), np.array([0, 0, eq])
@@ -119,31 +126,51 @@ class ConstraintRefused(Exception):
     """PyBullet could not join the two bodies as asked (the world warns and skips the joint)."""
 
 
-_JTYPE_NAMES = {pb.JOINT_FIXED: "fixed", pb.JOINT_POINT2POINT: "point-to-point", pb.JOINT_PRISMATIC: "prismatic",
-                pb.JOINT_GEAR: "gear"}
+_JTYPE_NAMES = {
+    pb.JOINT_FIXED: "fixed",
+    pb.JOINT_POINT2POINT: "point-to-point",
+    pb.JOINT_PRISMATIC: "prismatic",
+    pb.JOINT_GEAR: "gear",
+}
 
 
-def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray,
-                    max_force: float) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray | None]]:
+def make_constraint(
+    cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray, max_force: float
+) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray | None]]:
     """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child
     frame, slide axis in the parent frame or None)]."""
     out = []
 
     def create(a, b, jtype, axis, pa, pb_, oa, ob):
-        return pb.createConstraint(a.uid, a.link, b.uid, b.link, jtype,
-                                   list(map(float, axis)) if axis is not None else [0, 0, 0],
-                                   list(map(float, pa)), list(map(float, pb_)), list(oa), list(ob),
-                                   physicsClientId=cid)
+        return pb.createConstraint(
+            a.uid,
+            a.link,
+            b.uid,
+            b.link,
+            jtype,
+            list(map(float, axis)) if axis is not None else [0, 0, 0],
+            list(map(float, pa)),
+            list(map(float, pb_)),
+            list(oa),
+            list(ob),
+            physicsClientId=cid,
+        )
 
     def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1), axis=None):
         # PyBullet joins a multibody link to a free (maximal-coordinate) body only with the link
         # first (btMultiBodyPoint2Point/btMultiBodyFixedConstraint take the multibody as body A):
         # such a joint is made with its ends swapped, which is the same joint
-        swap = (axis is None and getattr(parent, "articulation", None) is None
-                and getattr(child, "articulation", None) is not None)
+        swap = (
+            axis is None
+            and getattr(parent, "articulation", None) is None
+            and getattr(child, "articulation", None) is not None
+        )
         try:
-            c = create(child, parent, jtype, None, pb_, pa, ob, oa) if swap else \
-                create(parent, child, jtype, axis, pa, pb_, oa, ob)
+            c = (
+                create(child, parent, jtype, None, pb_, pa, ob, oa)
+                if swap
+                else create(parent, child, jtype, axis, pa, pb_, oa, ob)
+            )
         except pb.error:
             c = None
         if c is None and getattr(parent, "static", False):
@@ -151,15 +178,30 @@ def make_constraint(cid: int, kind: JointKind, parent, child, frame_a: np.ndarra
             # base; a static parent never moves, so build it from the child to the world frame
             pw, ow = matrix_to_pq(pose_matrix(*_static_frame(cid, parent)) @ pose_matrix(pa, oa))
             try:
-                c = pb.createConstraint(child.uid, child.link, -1, -1, jtype, [0, 0, 0], list(map(float, pb_)),
-                                        list(map(float, pw)), list(ob), list(ow), physicsClientId=cid)
+                c = pb.createConstraint(
+                    child.uid,
+                    child.link,
+                    -1,
+                    -1,
+                    jtype,
+                    [0, 0, 0],
+                    list(map(float, pb_)),
+                    list(map(float, pw)),
+                    list(ob),
+                    list(ow),
+                    physicsClientId=cid,
+                )
             except pb.error:
                 c = None
         if c is None:
-            raise ConstraintRefused(f"PyBullet refused a {_JTYPE_NAMES.get(jtype, jtype)} constraint between "
-                                    f"{getattr(parent, 'key', 'the parent')} and {getattr(child, 'key', 'the child')}")
+            raise ConstraintRefused(
+                f"PyBullet refused a {_JTYPE_NAMES.get(jtype, jtype)} constraint between "
+                f"{getattr(parent, 'key', 'the parent')} and {getattr(child, 'key', 'the child')}"
+            )
         pb.changeConstraint(c, maxForce=max_force, physicsClientId=cid)
-        out.append((c, np.asarray(pa, float), np.asarray(pb_, float), None if axis is None else np.asarray(axis, float)))
+        out.append(
+            (c, np.asarray(pa, float), np.asarray(pb_, float), None if axis is None else np.asarray(axis, float))
+        )
 
     if kind is JointKind.FIXED:
         # Three point pivots at non-collinear points of the joint frame, not JOINT_FIXED:
@@ -206,8 +248,18 @@ class SpringSet:
         fa, fb = st([j.frame_a for j in joints]), st([j.frame_b for j in joints])
         self.ra_in_p, self.pa_in_p = fa[:, :3, :3], fa[:, :3, 3]
         self.rb_in_c, self.pb_in_c = fb[:, :3, :3], fb[:, :3, 3]
-        for name in ("lin_low", "lin_high", "ang_low", "ang_high", "k_lin", "c_lin", "eq_lin",
-                     "k_ang", "c_ang", "eq_ang"):
+        for name in (
+            "lin_low",
+            "lin_high",
+            "ang_low",
+            "ang_high",
+            "k_lin",
+            "c_lin",
+            "eq_lin",
+            "k_ang",
+            "c_ang",
+            "eq_ang",
+        ):
             setattr(self, name, st([getattr(j, name) for j in joints]))
         self.free_lin = np.flatnonzero([not j.linear_constrained for j in joints])
         bodies = []
@@ -243,9 +295,9 @@ class SpringSet:
         c ≤ I/(2·dt) (I the joint's effective inertia or mass)."""
         if self._gains_dt != dt:
             i_eff, m_eff = self.i_eff[:, None], self.m_eff[:, None]
-            self._k_ang = np.minimum(self.k_ang, 0.25 * i_eff / dt ** 2)
+            self._k_ang = np.minimum(self.k_ang, 0.25 * i_eff / dt**2)
             self._c_ang = np.minimum(self.c_ang, 0.5 * i_eff / dt)
-            self._k_lin = np.minimum(self.k_lin, 0.25 * m_eff / dt ** 2)
+            self._k_lin = np.minimum(self.k_lin, 0.25 * m_eff / dt**2)
             self._c_lin = np.minimum(self.c_lin, 0.5 * m_eff / dt)
             self._gains_dt = dt
         return self._k_ang, self._c_ang, self._k_lin, self._c_lin
@@ -263,7 +315,7 @@ class SpringSet:
         order = [i for i, _ in bases] + [i for group in links.values() for i, _ in group]
         self._bases = [uid for _, uid in bases]
         self._links = [(uid, [k for _, k in group]) for uid, group in links.items()]
-        self._order = np.argsort(np.array(order, dtype=int))   # read order -> body order
+        self._order = np.argsort(np.array(order, dtype=int))  # read order -> body order
         self._apply_ids = [(i, self.bodies[i].uid, self.bodies[i].link, bool(self.pushed[i])) for i in self.dynamic]
 
     def states(self):
@@ -276,10 +328,16 @@ class SpringSet:
         for uid in self._bases:
             p, q = get_pose(uid, physicsClientId=cid)
             v, w = get_vel(uid, physicsClientId=cid)
-            pos.append(p); orn.append(q); lv.append(v); av.append(w)
+            pos.append(p)
+            orn.append(q)
+            lv.append(v)
+            av.append(w)
         for uid, ks in self._links:
             for s in get_links(uid, ks, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=cid):
-                pos.append(s[0]); orn.append(s[1]); lv.append(s[6]); av.append(s[7])
+                pos.append(s[0])
+                orn.append(s[1])
+                lv.append(s[6])
+                av.append(s[7])
         o = self._order
         return (np.array(pos)[o], quat_to_matrix(np.array(orn)[o]), np.array(lv)[o], np.array(av)[o])
 
@@ -289,9 +347,9 @@ class SpringSet:
         k_ang, c_ang, k_lin, c_lin = self._gains(dt)
         pos, rot, lv, av = self.states()
         ip, ic = self.ip, self.ic
-        ra = rot[ip] @ self.ra_in_p            # joint frame A in the world
+        ra = rot[ip] @ self.ra_in_p  # joint frame A in the world
         rat = ra.transpose(0, 2, 1)
-        rel = rat @ (rot[ic] @ self.rb_in_c)   # frame B in frame A
+        rel = rat @ (rot[ic] @ self.rb_in_c)  # frame B in frame A
         ang = euler_xyz(rel)
         w_rel = (rat @ (av[ic] - av[ip])[:, :, None])[..., 0]
         # angular springs and limits, in joint frame A, turned into the world
@@ -312,8 +370,9 @@ class SpringSet:
             f += self._limit(d, v_rel, self.lin_low[fl], self.lin_high[fl], self.m_eff[fl][:, None], dt, erp)
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
             force = self.net[:, fl] @ f_w
-            torque += (self.to_child[fl].T @ _cross(pbw - pos[ic[fl]], f_w)
-                       - self.to_parent[fl].T @ _cross(pbw - pos[ip[fl]], f_w))
+            torque += self.to_child[fl].T @ _cross(pbw - pos[ic[fl]], f_w) - self.to_parent[fl].T @ _cross(
+                pbw - pos[ip[fl]], f_w
+            )
         torque = torque.tolist()
         if force is not None:
             force, pos = force.tolist(), pos.tolist()

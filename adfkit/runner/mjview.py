@@ -10,6 +10,7 @@ kinematics), and MuJoCo's offscreen renderer draws RGB, depth and per-body segme
 segmentation frame of the suturing set costs ~30 ms on the 2-core box's software OpenGL,
 against ~0.5 s with TinyRenderer; building the view costs ~1 s once.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -26,13 +27,14 @@ def _wxyz_to_matrix(q: np.ndarray) -> np.ndarray:
 class MjView:
     def __init__(self, world) -> None:
         from .mj.world import MjWorld
+
         self.world = world
         opt = dataclasses.replace(world.opt, renderer="tiny")
         self.mj = mj = MjWorld(world.scene, opt, sleep=False)
         m = mj.model
         sim_index = {sb.key: i for i, sb in enumerate(world.bodies)}
         matched = [(mb, sim_index[mb.key]) for mb in mj.bodies if mb.id > 0 and mb.key in sim_index]
-        label = np.full(m.ngeom, -1, dtype=np.int32)   # segmentation labels: PyBullet's body indices
+        label = np.full(m.ngeom, -1, dtype=np.int32)  # segmentation labels: PyBullet's body indices
         for mb, i in matched:
             label[m.geom_bodyid == mb.id] = i
         mj._geom_label = label
@@ -47,8 +49,10 @@ class MjView:
         self._light_dir = np.array(m.light_dir)
         self.cameras = list(mj.cameras)
         if [c.name for c in self.cameras] != [c.name for c in world.cameras]:
-            raise ValueError("MuJoCo's build placed other cameras than PyBullet's "
-                             f"({[c.name for c in self.cameras]} against {[c.name for c in world.cameras]})")
+            raise ValueError(
+                "MuJoCo's build placed other cameras than PyBullet's "
+                f"({[c.name for c in self.cameras]} against {[c.name for c in world.cameras]})"
+            )
         # MuJoCo body id -> (PyBullet SimBody, MuJoCo link frame in the ADF body frame), for the
         # bodies something is drawn on (only their poses are read from PyBullet)
         drawn = set(self._geom_body.tolist()) | set(self._cam_body.tolist()) | set(self._light_body.tolist())
@@ -63,7 +67,8 @@ class MjView:
             xpos[bid], xmat[bid] = t[:3, 3], t[:3, :3]
         d.xpos[:] = xpos
         d.xmat[:] = xmat.reshape(-1, 9)
-        def on(bodies, local):   # points (or directions) fixed on their bodies, in the world
+
+        def on(bodies, local):  # points (or directions) fixed on their bodies, in the world
             return np.einsum("nij,nj->ni", xmat[bodies], local)
 
         gb, cb, lb = self._geom_body, self._cam_body, self._light_body
@@ -84,16 +89,23 @@ class MjView:
         sims = self.world.cameras
         index = next((i for i, c in enumerate(sims) if c is camera), None)
         if index is None:
-            index = next((i for i, c in enumerate(sims) if (c.key, c.name, c.eye_offset) ==
-                          (camera.key, camera.name, camera.eye_offset)), None)
+            index = next(
+                (
+                    i
+                    for i, c in enumerate(sims)
+                    if (c.key, c.name, c.eye_offset) == (camera.key, camera.name, camera.eye_offset)
+                ),
+                None,
+            )
         if index is None:
             raise ValueError(f"camera {camera.name!r} is not one of the scene's")
         cam = self.cameras[index]
         if (cam.width, cam.height) != (camera.width, camera.height):
             g = self.mj.model.vis.global_
             if camera.width > g.offwidth or camera.height > g.offheight:
-                raise ValueError(f"{camera.width}x{camera.height} is larger than the offscreen buffer "
-                                 f"({g.offwidth}x{g.offheight})")
+                raise ValueError(
+                    f"{camera.width}x{camera.height} is larger than the offscreen buffer ({g.offwidth}x{g.offheight})"
+                )
             cam = copy.copy(cam)
             cam.width, cam.height = camera.width, camera.height
         self._sync()

@@ -1,4 +1,5 @@
 """AMBF's object keys and string lookup (adf-format.md §12.1)."""
+
 from __future__ import annotations
 
 import re

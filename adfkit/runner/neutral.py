@@ -3,6 +3,7 @@ worlds: playing for a while with a progress bar, and the scene's grasp (close th
 and fix what its finger ghosts or sensors detect to the tool with its constraint actuator).
 The engine supplies ``step``, ``actuate``/``release``, ``overlapping``, the bodies' poses and
 the articulation's drive."""
+
 from __future__ import annotations
 
 import numpy as np

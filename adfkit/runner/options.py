@@ -1,5 +1,6 @@
 """What a world is played with, for every engine (the PyBullet and MuJoCo worlds read the same
 options; neither engine's module is needed to make them)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -7,15 +8,15 @@ from dataclasses import dataclass
 
 @dataclass
 class Options:
-    physics_hz: float = 1000.0           # internal Bullet step (AMBF: fixed 1 ms)
-    control_substeps: int = 4            # physics steps per control step (springs, ghosts, drives held between)
-    solver_iterations: int | None = 10    # Bullet's own default, which AMBF runs with (PyBullet raises it to 50)
+    physics_hz: float = 1000.0  # internal Bullet step (AMBF: fixed 1 ms)
+    control_substeps: int = 4  # physics steps per control step (springs, ghosts, drives held between)
+    solver_iterations: int | None = 10  # Bullet's own default, which AMBF runs with (PyBullet raises it to 50)
     contact_threshold: float | None = None  # Bullet's contact breaking threshold; None: its default 0.02
-    gravity: tuple | None = None          # override the world's
+    gravity: tuple | None = None  # override the world's
     visuals: bool = True
-    hole_friction: float = 2.0            # K of F = -K·v_rel inside hole ghosts, N·s/m
+    hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
-    ground: bool = True                   # a model played without a world gets a floor under it
+    ground: bool = True  # a model played without a world gets a floor under it
     # cameras (cameras.choose_renderer): "tiny" (TinyRenderer, CPU; nothing to set up, best for a
     # frame or two), "mujoco" (MuJoCo's renderer on a mirror of the scene: ~1 s to build, then
     # ~15x faster frames), "egl" (PyBullet's EGL plugin), "auto" (mujoco, else egl, else tiny)

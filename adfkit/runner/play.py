@@ -1,9 +1,11 @@
 """Play a built SimWorld for a while with a progress bar and write what `adfkit run` and
 `adfkit demo` leave behind: report.json and each camera's frames."""
+
 from __future__ import annotations
 
-from .. import jsonout
 from pathlib import Path
+
+from .. import jsonout
 
 
 def play(world, seconds: float, out: Path | None = None, frames: bool = True, scene_label: str = "") -> dict:
@@ -26,7 +28,7 @@ def play(world, seconds: float, out: Path | None = None, frames: bool = True, sc
         if frames:
             try:
                 report["frames"] = save_frames(world, out)
-            except RuntimeError as e:   # the MuJoCo engine without a headless OpenGL (CameraUnavailable)
+            except RuntimeError as e:  # the MuJoCo engine without a headless OpenGL (CameraUnavailable)
                 if type(e).__name__ != "CameraUnavailable":
                     raise
                 report["frames"] = []
@@ -39,12 +41,15 @@ def unstable(report: dict) -> list[str]:
     """Bodies that became NaN, exploded (> 10 m/s) or fell through the floor at the end, and
     every instability the engine met on the way (runner/stability.py: a state reset, a singular
     inertia, NaN, a flung body), with its time."""
-    events = [f"{e['body'] or 'the scene'}: {e['kind']} at t = {e['time_s']:.3f} s"
-              for e in report.get("instabilities", [])]
+    events = [
+        f"{e['body'] or 'the scene'}: {e['kind']} at t = {e['time_s']:.3f} s" for e in report.get("instabilities", [])
+    ]
     return report["nan"] + report["exploded"] + report["fell_through_floor"] + events
 
 
 def summary(report: dict) -> str:
-    return (f"played {report['simulated_time_s']:.2f} s in {report['wall_time_s']:.2f} s "
-            f"({report['real_time_factor']:.2f}x real time): {report['bodies']} bodies, {report['joints']} joints, "
-            f"{report['steps']} steps, max constraint error {report['max_constraint_error_m'] * 1000:.3f} mm")
+    return (
+        f"played {report['simulated_time_s']:.2f} s in {report['wall_time_s']:.2f} s "
+        f"({report['real_time_factor']:.2f}x real time): {report['bodies']} bodies, {report['joints']} joints, "
+        f"{report['steps']} steps, max constraint error {report['max_constraint_error_m'] * 1000:.3f} mm"
+    )

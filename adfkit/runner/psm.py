@@ -13,6 +13,7 @@ wrist body. Both constant transforms are found from the played model itself (han
 calibration over joint configurations within the limits) and checked: where the model does
 not follow the DH kinematics, ``PSM`` refuses it with the residual it measured.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -22,12 +23,17 @@ from .rotations import invert, rotation_exp, rotation_log
 
 #: ADF joint names of the arm (dVRK order q1..q6) and of the two jaw fingers, as in the
 #: suturing challenge's PSM files (LND 400006)
-ARM_JOINTS = ("base link-yaw link", "yaw link-pitch back link", "pitch end link-main insertion link",
-              "main insertion link-tool roll link", "tool roll link-tool pitch link",
-              "tool pitch link-tool yaw link")
+ARM_JOINTS = (
+    "base link-yaw link",
+    "yaw link-pitch back link",
+    "pitch end link-main insertion link",
+    "main insertion link-tool roll link",
+    "tool roll link-tool pitch link",
+    "tool pitch link-tool yaw link",
+)
 JAW_JOINTS = ("tool yaw link-tool gripper1 link", "tool yaw link-tool gripper2 link")
-CALIBRATION_TOLERANCE = 1e-3   # m and rad: how far the model may be from the DH kinematics
-JAW_OPEN = 0.8                 # rad between the fingers when a grasp is released
+CALIBRATION_TOLERANCE = 1e-3  # m and rad: how far the model may be from the DH kinematics
+JAW_OPEN = 0.8  # rad between the fingers when a grasp is released
 
 
 class PSMModelError(ValueError):
@@ -57,8 +63,9 @@ def hand_eye(world_poses, model_poses) -> tuple[np.ndarray, np.ndarray]:
 class PSM:
     """One PSM of a SimWorld (see the module docstring)."""
 
-    def __init__(self, world, name: str = "psm1", kinematics: PSMKinematics | None = None,
-                 samples: int = 12, seed: int = 0) -> None:
+    def __init__(
+        self, world, name: str = "psm1", kinematics: PSMKinematics | None = None, samples: int = 12, seed: int = 0
+    ) -> None:
         self.world, self.name = world, name
         self.kin = kinematics or default()
         tag = f"/{name}/"
@@ -70,8 +77,9 @@ class PSM:
         by_name = {r[0].name or r[0].identifier.removeprefix("JOINT "): n for n, r in enumerate(art.records)}
         missing = [j for j in ARM_JOINTS + JAW_JOINTS if j not in by_name]
         if missing:
-            raise PSMModelError(f"{name}: the model lacks the PSM joints {', '.join(missing)}; "
-                                f"it has {', '.join(sorted(by_name))}")
+            raise PSMModelError(
+                f"{name}: the model lacks the PSM joints {', '.join(missing)}; it has {', '.join(sorted(by_name))}"
+            )
         self.arm = [by_name[j] for j in ARM_JOINTS]
         self.jaws = [by_name[j] for j in JAW_JOINTS]
         self.base = art.root
@@ -101,9 +109,11 @@ class PSM:
         b, y = hand_eye(world_poses, model_poses)
         err = max(pose_error(b @ f @ y, w) for w, f in zip(world_poses, model_poses))
         if err > CALIBRATION_TOLERANCE:
-            raise PSMModelError(f"{self.name}: the model's joints do not move its tool as the PSM's DH "
-                                f"kinematics do (residual {err:.3g} m/rad after calibration); check the "
-                                "joint axes, offsets and order of the arm")
+            raise PSMModelError(
+                f"{self.name}: the model's joints do not move its tool as the PSM's DH "
+                f"kinematics do (residual {err:.3g} m/rad after calibration); check the "
+                "joint axes, offsets and order of the arm"
+            )
         return b, y, err
 
     # ---- frames --------------------------------------------------------------------------
@@ -124,8 +134,10 @@ class PSM:
         q = np.asarray(q, dtype=float)
         bad = self.kin.violations(q)
         if bad:
-            raise ValueError("joint values outside the PSM's limits: " + ", ".join(
-                f"{n} = {v:.4g} (limits {lo:.4g}…{hi:.4g})" for n, v, lo, hi in bad))
+            raise ValueError(
+                "joint values outside the PSM's limits: "
+                + ", ".join(f"{n} = {v:.4g} (limits {lo:.4g}…{hi:.4g})" for n, v, lo, hi in bad)
+            )
         for i, v in zip(self.arm, q):
             self.art.targets[i] = float(v)
         self.art.drive()

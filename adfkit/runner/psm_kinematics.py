@@ -42,6 +42,7 @@ the end frame +L2 from the yaw axis, as the challenge's code has it); alpha is e
 where the dVRK configuration files write 1.5708.
 The jaw (optional 7th value) does not move the end-effector frame; it is only range-checked.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -51,13 +52,13 @@ import numpy as np
 PI_2 = np.pi / 2
 
 # LND 400006 lengths (dVRK configuration files psm_400006.json, LARGE_NEEDLE_DRIVER_400006.json)
-L_RCC = 0.4389          # base (RCM) to the insertion origin
-L_TOOL = 0.416          # tool shaft length
-L_PITCH2YAW = 0.009     # wrist pitch axis to wrist yaw axis
-L_YAW2CTRLPNT = 0.0     # wrist yaw axis to the control point (end effector) for the LND
+L_RCC = 0.4389  # base (RCM) to the insertion origin
+L_TOOL = 0.416  # tool shaft length
+L_PITCH2YAW = 0.009  # wrist pitch axis to wrist yaw axis
+L_YAW2CTRLPNT = 0.0  # wrist yaw axis to the control point (end effector) for the LND
 L_TOOL2RCM = L_RCC - L_TOOL  # 0.0229 m: pitch point to RCM at q3 = 0
 
-LIMIT_SLACK = 1e-9      # rad or m: IK accepts a solution this far past a limit (rounding)
+LIMIT_SLACK = 1e-9  # rad or m: IK accepts a solution this far past a limit (rounding)
 
 REVOLUTE = "revolute"
 PRISMATIC = "prismatic"
@@ -66,6 +67,7 @@ PRISMATIC = "prismatic"
 @dataclass(frozen=True)
 class DHLink:
     """One modified-DH link: (a, alpha, theta, d, offset, joint type) plus its joint limits."""
+
     name: str
     alpha: float
     a: float
@@ -83,12 +85,14 @@ class DHLink:
             theta, d = 0.0, self.d + self.offset + q
         ca, sa = np.cos(self.alpha), np.sin(self.alpha)
         ct, st = np.cos(theta), np.sin(theta)
-        return np.array([
-            [ct, -st, 0.0, self.a],
-            [st * ca, ct * ca, -sa, -d * sa],
-            [st * sa, ct * sa, ca, d * ca],
-            [0.0, 0.0, 0.0, 1.0],
-        ])
+        return np.array(
+            [
+                [ct, -st, 0.0, self.a],
+                [st * ca, ct * ca, -sa, -d * sa],
+                [st * sa, ct * sa, ca, d * ca],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+        )
 
 
 JAW_LIMITS = (-0.698132, 1.39626)
@@ -217,8 +221,9 @@ class PSMKinematics:
         towards = -p_yaw_local * np.array([0.0, 1.0, 1.0])
         n = np.linalg.norm(towards)
         if n < 1e-12:
-            raise UnreachablePoseError("the wrist yaw point lies on the end effector's x axis "
-                                       "through the RCM; the palm direction is undefined")
+            raise UnreachablePoseError(
+                "the wrist yaw point lies on the end effector's x axis through the RCM; the palm direction is undefined"
+            )
         palm_dir = R @ (towards / n)
 
         # The reference's branch first (palm toward the RCM, pitch point beyond the RCM);
@@ -231,21 +236,21 @@ class PSMKinematics:
                 solved = self._solve_from_pitch_point(R, p_yaw0, p_pitch0, behind_rcm)
                 if solved is None:
                     continue
-                q, end = solved   # the solve's own frames finish the FK: one FK per candidate
+                q, end = solved  # the solve's own frames finish the FK: one FK per candidate
                 err = pose_error(end, T)
                 candidates.append((err, q))
                 if err <= tol and not self.violations(q, LIMIT_SLACK):
                     # a solution at a limit may land a rounding error outside it
                     return np.clip(q, self.lower_limits[:6], self.upper_limits[:6])
         if not candidates:
-            raise UnreachablePoseError("the wrist pitch point is at the RCM; outer yaw and pitch "
-                                       "are undefined")
+            raise UnreachablePoseError("the wrist pitch point is at the RCM; outer yaw and pitch are undefined")
         reproducing = [c for c in candidates if c[0] <= tol]
         if not reproducing:
             best = min(c[0] for c in candidates)
             raise UnreachablePoseError(
                 f"no PSM configuration reproduces the pose (best error {best:.3g}); the "
-                "orientation is not one the wrist can take at that position")
+                "orientation is not one the wrist can take at that position"
+            )
         q = reproducing[0][1]
         if check_limits:
             raise JointLimitError(q, self.violations(q, LIMIT_SLACK))

@@ -1,4 +1,5 @@
 """Vectorised rotation helpers (numpy, quaternions as x, y, z, w like PyBullet)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,6 +27,7 @@ def quat_to_matrix(q: np.ndarray) -> np.ndarray:
 def matrix_to_quat(m: np.ndarray) -> np.ndarray:
     """One 3×3 rotation matrix → quaternion (x, y, z, w)."""
     from ..model.pose import Quat
+
     return np.array(Quat.from_matrix(np.asarray(m).tolist()))
 
 

@@ -3,6 +3,7 @@
 Every shape pose is given in the object's COM frame, the frame PyBullet uses as the base
 frame. Primitive collision dimensions are not scaled; meshes are (§12.3).
 """
+
 from __future__ import annotations
 
 import math
@@ -14,14 +15,19 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 
-from ..adf.paths import collision_mesh_path, visual_mesh_path
 from .. import inputs
+from ..adf.paths import collision_mesh_path, visual_mesh_path
 from ..diagnostics import AdfError, Diagnostic, warning
 from ..geometry.meshcheck import mesh_problem
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import (
-    CollisionMeshType, Primitive, ShapeKind, axis_vector, collision_mesh_type,
-    collision_primitives, shape_kind, shortest_arc,
+    CollisionMeshType,
+    Primitive,
+    ShapeKind,
+    collision_mesh_type,
+    collision_primitives,
+    shape_kind,
+    shortest_arc,
 )
 from .rotations import invert, matrix_to_pq, pose_to_matrix
 
@@ -31,9 +37,10 @@ MESH_SUFFIXES = {".obj", ".stl"}  # what PyBullet's GEOM_MESH reads from a file
 @dataclass
 class ShapeParts:
     """Arguments for createCollisionShapeArray (one entry per child shape)."""
+
     types: list[int] = field(default_factory=list)
     kwargs: list[dict] = field(default_factory=list)
-    plane: tuple[list[float], float] | None = None   # a lone PLANE (added directly, §7.4)
+    plane: tuple[list[float], float] | None = None  # a lone PLANE (added directly, §7.4)
 
     def add(self, shape_type: int, **kw) -> None:
         self.types.append(shape_type)
@@ -77,28 +84,51 @@ def _primitive(parts: ShapeParts, prim: Primitive, pose_in_com: np.ndarray, marg
     rot = pose_in_com @ pose_to_matrix(Pose(Vec3(), _axis_rotation(prim.axis)))
     pos, orn = matrix_to_pq(rot)
     if prim.kind is ShapeKind.BOX:
-        parts.add(pb.GEOM_BOX, halfExtents=[g.x / 2, g.y / 2, g.z / 2],
-                  collisionFramePosition=matrix_to_pq(pose_in_com)[0],
-                  collisionFrameOrientation=matrix_to_pq(pose_in_com)[1])
+        parts.add(
+            pb.GEOM_BOX,
+            halfExtents=[g.x / 2, g.y / 2, g.z / 2],
+            collisionFramePosition=matrix_to_pq(pose_in_com)[0],
+            collisionFrameOrientation=matrix_to_pq(pose_in_com)[1],
+        )
     elif prim.kind is ShapeKind.SPHERE:
         parts.add(pb.GEOM_SPHERE, radius=g.radius, collisionFramePosition=pos, collisionFrameOrientation=orn)
     elif prim.kind is ShapeKind.CYLINDER:
-        parts.add(pb.GEOM_CYLINDER, radius=g.radius, height=g.height,
-                  collisionFramePosition=pos, collisionFrameOrientation=orn)
+        parts.add(
+            pb.GEOM_CYLINDER,
+            radius=g.radius,
+            height=g.height,
+            collisionFramePosition=pos,
+            collisionFrameOrientation=orn,
+        )
     elif prim.kind is ShapeKind.CAPSULE:  # ADF height includes the caps
-        parts.add(pb.GEOM_CAPSULE, radius=g.radius, height=max(g.height - 2 * g.radius, 0.0),
-                  collisionFramePosition=pos, collisionFrameOrientation=orn)
+        parts.add(
+            pb.GEOM_CAPSULE,
+            radius=g.radius,
+            height=max(g.height - 2 * g.radius, 0.0),
+            collisionFramePosition=pos,
+            collisionFrameOrientation=orn,
+        )
     elif prim.kind is ShapeKind.CONE:
-        parts.add(pb.GEOM_MESH, fileName=cone_obj(g.radius, g.height), meshScale=[1, 1, 1],
-                  collisionFramePosition=pos, collisionFrameOrientation=orn)
+        parts.add(
+            pb.GEOM_MESH,
+            fileName=cone_obj(g.radius, g.height),
+            meshScale=[1, 1, 1],
+            collisionFramePosition=pos,
+            collisionFrameOrientation=orn,
+        )
     elif prim.kind is ShapeKind.PLANE:
         n = np.array(g.normal or (0, 0, 1), dtype=float)
         n = n / (np.linalg.norm(n) or 1.0)
         parts.plane = (list(map(float, n)), float(g.offset or 0.0))
 
 
-_DIMENSIONS = {ShapeKind.BOX: ("x", "y", "z"), ShapeKind.SPHERE: ("radius",), ShapeKind.CYLINDER: ("radius", "height"),
-               ShapeKind.CAPSULE: ("radius", "height"), ShapeKind.CONE: ("radius", "height")}
+_DIMENSIONS = {
+    ShapeKind.BOX: ("x", "y", "z"),
+    ShapeKind.SPHERE: ("radius",),
+    ShapeKind.CYLINDER: ("radius", "height"),
+    ShapeKind.CAPSULE: ("radius", "height"),
+    ShapeKind.CONE: ("radius", "height"),
+}
 
 
 def _missing_dimension(prim: Primitive) -> str | None:
@@ -168,8 +198,9 @@ def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
     return out, None
 
 
-def collision_parts(model, obj, frame_in_body, scale: float,
-                    static: bool, diags: list[Diagnostic]) -> ShapeParts | None:
+def collision_parts(
+    model, obj, frame_in_body, scale: float, static: bool, diags: list[Diagnostic]
+) -> ShapeParts | None:
     """The collision shape of a body or ghost, or None when AMBF would skip the object."""
     parts = ShapeParts()
     margin = obj.collision_margin if obj.collision_margin is not None else 0.001
@@ -177,14 +208,26 @@ def collision_parts(model, obj, frame_in_body, scale: float,
     prims = collision_primitives(obj)
     if prims is not None:
         if not prims:
-            diags.append(warning("runner-no-collision", f"{obj.identifier}: no usable collision primitive",
-                                 obj.source, "check `collision shape` and `collision geometry`"))
+            diags.append(
+                warning(
+                    "runner-no-collision",
+                    f"{obj.identifier}: no usable collision primitive",
+                    obj.source,
+                    "check `collision shape` and `collision geometry`",
+                )
+            )
         for prim in prims:
             missing = _missing_dimension(prim)
             if missing:
-                diags.append(warning("runner-no-collision", f"{obj.identifier}: collision {prim.kind.value} has no "
-                                     f"usable {missing}; that shape is left out", obj.where("collision geometry")
-                                     or obj.source, "give every dimension as a finite number ≥ 0"))
+                diags.append(
+                    warning(
+                        "runner-no-collision",
+                        f"{obj.identifier}: collision {prim.kind.value} has no "
+                        f"usable {missing}; that shape is left out",
+                        obj.where("collision geometry") or obj.source,
+                        "give every dimension as a finite number ≥ 0",
+                    )
+                )
                 continue
             _primitive(parts, prim, body_to_com @ pose_to_matrix(prim.pose), margin)
         return parts
@@ -193,25 +236,40 @@ def collision_parts(model, obj, frame_in_body, scale: float,
         return parts  # no collision geometry: an empty shape (AMBF prints an error)
     if mesh_refusal(model, path) is None and (problem := mesh_problem(path)) is not None:
         # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some, reads garbage from others
-        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: "
-                             f"{problem}; the body is skipped as AMBF does",
-                             obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
-                             "re-export the mesh as a triangle mesh (STL or OBJ)"))
+        diags.append(
+            warning(
+                "runner-bad-mesh",
+                f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: "
+                f"{problem}; the body is skipped as AMBF does",
+                obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
+                "re-export the mesh as a triangle mesh (STL or OBJ)",
+            )
+        )
         return None
     path, refused = pybullet_mesh(model, path)
     if refused is not None:
-        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: collision mesh {refused}; "
-                             "the body is skipped as AMBF does", obj.where("collision mesh") or obj.source,
-                             "fix `collision mesh`/`mesh` or the resolution paths"))
+        diags.append(
+            warning(
+                "runner-missing-mesh",
+                f"{obj.identifier}: collision mesh {refused}; the body is skipped as AMBF does",
+                obj.where("collision mesh") or obj.source,
+                "fix `collision mesh`/`mesh` or the resolution paths",
+            )
+        )
         return None
     if path.suffix.lower() not in MESH_SUFFIXES:
-        diags.append(warning("runner-mesh-format", f"{obj.identifier}: {path.suffix} meshes are not readable "
-                             "by PyBullet; no collision shape", obj.source, "convert the mesh to OBJ or STL"))
+        diags.append(
+            warning(
+                "runner-mesh-format",
+                f"{obj.identifier}: {path.suffix} meshes are not readable by PyBullet; no collision shape",
+                obj.source,
+                "convert the mesh to OBJ or STL",
+            )
+        )
         return parts
     kind, _ = collision_mesh_type(obj.collision_mesh_type)
     pos, orn = matrix_to_pq(body_to_com)
-    kw = dict(fileName=str(path), meshScale=[scale] * 3, collisionFramePosition=pos,
-              collisionFrameOrientation=orn)
+    kw = dict(fileName=str(path), meshScale=[scale] * 3, collisionFramePosition=pos, collisionFrameOrientation=orn)
     if kind is CollisionMeshType.CONCAVE_MESH and static:
         kw["flags"] = pb.GEOM_FORCE_CONCAVE_TRIMESH  # exact triangles: only static bodies in PyBullet
     # Dynamic concave meshes: PyBullet builds one convex hull per OBJ sub-mesh (documented approximation).
@@ -228,23 +286,41 @@ def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnost
         if diags is None:
             raise
         who = getattr(obj, "identifier", "an object")
-        diags.append(warning("runner-bad-shape", f"{who}: PyBullet refused its collision shape ({exc}); "
-                             "it has none", getattr(obj, "source", None), "check its meshes and shape sizes"))
+        diags.append(
+            warning(
+                "runner-bad-shape",
+                f"{who}: PyBullet refused its collision shape ({exc}); it has none",
+                getattr(obj, "source", None),
+                "check its meshes and shape sizes",
+            )
+        )
         return -1
 
 
 def _create_collision(parts: ShapeParts, cid: int) -> int:
     if parts.plane is not None and not parts.types:
         n, off = parts.plane
-        return pb.createCollisionShape(pb.GEOM_PLANE, planeNormal=n,
-                                       collisionFramePosition=[c * off for c in n], physicsClientId=cid)
+        return pb.createCollisionShape(
+            pb.GEOM_PLANE, planeNormal=n, collisionFramePosition=[c * off for c in n], physicsClientId=cid
+        )
     if not parts.types:
         return -1
     if len(parts.types) == 1:
         return pb.createCollisionShape(parts.types[0], physicsClientId=cid, **parts.kwargs[0])
-    arrays: dict[str, list] = {k: [] for k in ("radii", "halfExtents", "lengths", "fileNames", "meshScales",
-                                                "collisionFramePositions", "collisionFrameOrientations", "flags")}
-    for t, kw in zip(parts.types, parts.kwargs):
+    arrays: dict[str, list] = {
+        k: []
+        for k in (
+            "radii",
+            "halfExtents",
+            "lengths",
+            "fileNames",
+            "meshScales",
+            "collisionFramePositions",
+            "collisionFrameOrientations",
+            "flags",
+        )
+    }
+    for _t, kw in zip(parts.types, parts.kwargs):
         arrays["radii"].append(kw.get("radius", 0.5))
         arrays["halfExtents"].append(kw.get("halfExtents", [0.5, 0.5, 0.5]))
         arrays["lengths"].append(kw.get("height", 1.0))
@@ -271,8 +347,7 @@ def rgba(obj) -> list[float] | None:
     return None
 
 
-def create_visual(model, obj, frame_in_body, scale: float, cid: int,
-                  diags: list[Diagnostic]) -> int:
+def create_visual(model, obj, frame_in_body, scale: float, cid: int, diags: list[Diagnostic]) -> int:
     """Visual shape (primitive beats mesh; compound parts drawn at the body origin, §7.3)."""
     colour = rgba(obj) or [0.8, 0.8, 0.8, 1.0]
     pos, orn = matrix_to_pq(invert(frame_in_body))
@@ -287,16 +362,15 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
         k = shape_kind(shape)
         try:
             if k is ShapeKind.BOX:
-                return pb.createVisualShape(pb.GEOM_BOX, halfExtents=[g.x * scale / 2, g.y * scale / 2,
-                                                                      g.z * scale / 2], **base)
+                return pb.createVisualShape(
+                    pb.GEOM_BOX, halfExtents=[g.x * scale / 2, g.y * scale / 2, g.z * scale / 2], **base
+                )
             if k is ShapeKind.SPHERE:
                 return pb.createVisualShape(pb.GEOM_SPHERE, radius=g.radius * scale, **base)
             if k in (ShapeKind.CYLINDER, ShapeKind.CAPSULE):  # always along Z (§7.3)
-                return pb.createVisualShape(pb.GEOM_CYLINDER, radius=g.radius * scale,
-                                            length=g.height * scale, **base)
+                return pb.createVisualShape(pb.GEOM_CYLINDER, radius=g.radius * scale, length=g.height * scale, **base)
             if k is ShapeKind.CONE:
-                return pb.createVisualShape(pb.GEOM_MESH, fileName=cone_obj(g.radius * scale, g.height * scale),
-                                            **base)
+                return pb.createVisualShape(pb.GEOM_MESH, fileName=cone_obj(g.radius * scale, g.height * scale), **base)
         except (TypeError, pb.error):
             pass
         return -1
@@ -305,13 +379,25 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
         return -1
     suffix = path.suffix.lower()
     if suffix in MESH_SUFFIXES and mesh_refusal(model, path) is None and (problem := mesh_problem(path)) is not None:
-        diags.append(warning("runner-bad-mesh", f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: {problem}",
-                             obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
+        diags.append(
+            warning(
+                "runner-bad-mesh",
+                f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: {problem}",
+                obj.where("mesh") or obj.source,
+                "the body is drawn without a visual mesh",
+            )
+        )
         return -1
     path, refused = pybullet_mesh(model, path) if suffix in MESH_SUFFIXES else (path, mesh_refusal(model, path))
     if refused is not None:
-        diags.append(warning("runner-missing-mesh", f"{obj.identifier}: visual mesh {refused}",
-                             obj.where("mesh") or obj.source, "the body is drawn without a visual mesh"))
+        diags.append(
+            warning(
+                "runner-missing-mesh",
+                f"{obj.identifier}: visual mesh {refused}",
+                obj.where("mesh") or obj.source,
+                "the body is drawn without a visual mesh",
+            )
+        )
         return -1
     if suffix not in MESH_SUFFIXES:
         return -1
@@ -321,6 +407,9 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int,
     try:
         return pb.createVisualShape(pb.GEOM_MESH, fileName=str(path), meshScale=[scale] * 3, **kw)
     except pb.error:
-        diags.append(warning("runner-visual", f"{obj.identifier}: PyBullet could not read {path}",
-                             obj.source, "re-export the mesh"))
+        diags.append(
+            warning(
+                "runner-visual", f"{obj.identifier}: PyBullet could not read {path}", obj.source, "re-export the mesh"
+            )
+        )
         return -1

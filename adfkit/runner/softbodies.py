@@ -21,6 +21,7 @@ it as follows (docs/soft-bodies.md gives the reasoning):
 Everything else a file sets (kAST, kVST, kVC, kPR, kMT, clusters, the hardness keys,
 randomize constraints, ...) has no PyBullet counterpart and is reported once per soft body.
 """
+
 from __future__ import annotations
 
 import shutil
@@ -38,11 +39,11 @@ from .names import merge_namespace
 from .rotations import pose_to_matrix
 from .shapes import rgba
 
-DEFAULT_MARGIN = 0.001      # adf-format.md §7.4
-CL_SELF = 0x40              # btSoftBody::fCollision::CL_SELF
-ELASTIC_CAP = 0.4           # largest stable spring stiffness, in m_node/dt² (see parameters())
+DEFAULT_MARGIN = 0.001  # adf-format.md §7.4
+CL_SELF = 0x40  # btSoftBody::fCollision::CL_SELF
+ELASTIC_CAP = 0.4  # largest stable spring stiffness, in m_node/dt² (see parameters())
 BENDING_CAP = 0.15
-EXPLODED_STRETCH = 3.0      # a soft body wider than this many times its rest size has exploded
+EXPLODED_STRETCH = 3.0  # a soft body wider than this many times its rest size has exploded
 # ADF config keys the mapping above uses; every other key a file sets is reported as not played
 MAPPED = {"kLST", "piterations", "bending constraint", "kDP", "kDF", "fixed nodes", "flags"}
 
@@ -50,15 +51,15 @@ MAPPED = {"kLST", "piterations", "bending constraint", "kDP", "kDF", "fixed node
 @dataclass(eq=False)
 class SimSoftBody:
     key: str
-    soft: object                 # the model's SoftBody
+    soft: object  # the model's SoftBody
     model: object
     uid: int
     node_count: int
     triangles: int
-    rest_size: float             # diagonal of the nodes' bounding box at build, m
-    params: dict                 # what loadSoftBody was given
+    rest_size: float  # diagonal of the nodes' bounding box at build, m
+    params: dict  # what loadSoftBody was given
     fixed: list = field(default_factory=list)
-    attached: dict = field(default_factory=dict)   # rigid body key -> node indices
+    attached: dict = field(default_factory=dict)  # rigid body key -> node indices
     unmapped: list = field(default_factory=list)
 
     def nodes(self, cid: int) -> np.ndarray:
@@ -102,7 +103,7 @@ class SoftBodies:
     def __init__(self, world) -> None:
         self.world = world
         self.items: list[SimSoftBody] = []
-        self.joints: list[tuple] = []        # (model, joint) naming a soft body, claimed from the rigid build
+        self.joints: list[tuple] = []  # (model, joint) naming a soft body, claimed from the rigid build
         self._tmp = Path(tempfile.mkdtemp(prefix="adfkit-soft-"))
 
     def claim(self, m, j) -> bool:
@@ -125,11 +126,17 @@ class SoftBodies:
                     by_obj[id(sb)] = made
         for m, j in self.joints:
             self._attach(m, j, by_obj)
-        shutil.rmtree(self._tmp, ignore_errors=True)   # loadSoftBody has read the OBJ files
-        planes = [b.key for b in self.world.bodies if getattr(b, "_parts", None) is not None and b._parts.plane is not None]
+        shutil.rmtree(self._tmp, ignore_errors=True)  # loadSoftBody has read the OBJ files
+        planes = [
+            b.key for b in self.world.bodies if getattr(b, "_parts", None) is not None and b._parts.plane is not None
+        ]
         if self.items and planes:
-            self.world._warn("runner-soft-plane", f"{', '.join(planes)}: PyBullet's soft bodies stop centimetres above a "
-                             "PLANE (36-100 mm measured)", None, "give the floor a thick BOX collision shape instead")
+            self.world._warn(
+                "runner-soft-plane",
+                f"{', '.join(planes)}: PyBullet's soft bodies stop centimetres above a PLANE (36-100 mm measured)",
+                None,
+                "give the floor a thick BOX collision shape instead",
+            )
 
     def _make(self, m, sb) -> SimSoftBody | None:
         w = self.world
@@ -152,27 +159,33 @@ class SoftBodies:
             pb.changeVisualShape(uid, -1, rgbaColor=colour, physicsClientId=w.cid)
         span = mesh.nodes.max(axis=0) - mesh.nodes.min(axis=0)
         key = w.registry.add(merge_namespace(m.namespace or "", sb.namespace) + sb.identifier, None)
-        made = SimSoftBody(key, sb, m, uid, mesh.node_count, len(mesh.triangles), float(np.linalg.norm(span)),
-                           params)
+        made = SimSoftBody(key, sb, m, uid, mesh.node_count, len(mesh.triangles), float(np.linalg.norm(span)), params)
         cfg = sb.config
         for i in (cfg.fixed_nodes or []) if cfg is not None else []:
             if 0 <= i < mesh.node_count:
                 pb.createSoftBodyAnchor(uid, i, -1, -1, physicsClientId=w.cid)
                 made.fixed.append(i)
             else:
-                w._warn("runner-soft-body", f"{sb.identifier}: fixed node {i} is not one of its "
-                        f"{mesh.node_count} nodes; ignored", cfg)
+                w._warn(
+                    "runner-soft-body",
+                    f"{sb.identifier}: fixed node {i} is not one of its {mesh.node_count} nodes; ignored",
+                    cfg,
+                )
         made.unmapped = self._unmapped(sb)
         if made.unmapped:
-            w._warn("runner-soft-body-approx", f"{sb.identifier}: {', '.join(made.unmapped)} not played "
-                    "(no counterpart in PyBullet's deformable world)", sb,
-                    "see docs/soft-bodies.md for what is mapped")
+            w._warn(
+                "runner-soft-body-approx",
+                f"{sb.identifier}: {', '.join(made.unmapped)} not played "
+                "(no counterpart in PyBullet's deformable world)",
+                sb,
+                "see docs/soft-bodies.md for what is mapped",
+            )
         return made
 
     def parameters(self, sb, nodes: int) -> dict:
         """loadSoftBody keywords for a soft body of ``nodes`` nodes (the module doc's mapping)."""
         cfg = sb.config
-        get = (lambda k, d: getattr(cfg, k) if cfg is not None and getattr(cfg, k) is not None else d)
+        get = lambda k, d: getattr(cfg, k) if cfg is not None and getattr(cfg, k) is not None else d
         mass = sb.mass if sb.mass is not None and sb.mass > 0 else DEFAULT_SOFT_MASS
         dt = self.world.dt
         m_node = mass / max(nodes, 1)
@@ -181,14 +194,21 @@ class SoftBodies:
         margin = sb.collision_margin if sb.collision_margin is not None else DEFAULT_MARGIN
         # PyBullet's mass-spring solver diverges above about these stiffnesses (measured on a
         # 21 x 21 grid, 0.1 mm nodes: docs/soft-bodies.md); stiffer links are capped there
-        k_bend = min(k, BENDING_CAP * m_node / dt ** 2)
-        k = min(k, ELASTIC_CAP * m_node / dt ** 2)
-        return dict(mass=float(mass), useMassSpring=1, useBendingSprings=int(bending),
-                    springElasticStiffness=float(k), springBendingStiffness=float(k_bend) if bending else 0.0,
-                    springDampingStiffness=float(min(max(get("kDP", 0.0), 0.0), 1.0) * m_node / dt),
-                    frictionCoeff=float(get("kDF", 0.2)), collisionMargin=float(margin),
-                    useSelfCollision=int(bool(get("flags", 1) & CL_SELF)), useFaceContact=1,
-                    springDampingAllDirections=1)
+        k_bend = min(k, BENDING_CAP * m_node / dt**2)
+        k = min(k, ELASTIC_CAP * m_node / dt**2)
+        return dict(
+            mass=float(mass),
+            useMassSpring=1,
+            useBendingSprings=int(bending),
+            springElasticStiffness=float(k),
+            springBendingStiffness=float(k_bend) if bending else 0.0,
+            springDampingStiffness=float(min(max(get("kDP", 0.0), 0.0), 1.0) * m_node / dt),
+            frictionCoeff=float(get("kDF", 0.2)),
+            collisionMargin=float(margin),
+            useSelfCollision=int(bool(get("flags", 1) & CL_SELF)),
+            useFaceContact=1,
+            springDampingAllDirections=1,
+        )
 
     @staticmethod
     def _unmapped(sb) -> list[str]:
@@ -196,6 +216,7 @@ class SoftBodies:
         cfg = sb.config
         if cfg is not None:
             from ..model.spec import adf_fields
+
             for f in adf_fields(cfg):
                 key = f.metadata["adf_key"]
                 if key not in MAPPED and getattr(cfg, f.name) is not None:
@@ -252,11 +273,20 @@ class SoftBodies:
             p = s.nodes(self.world.cid)
             finite = bool(np.all(np.isfinite(p)))
             size = float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) if finite else None
-            rows.append({"name": s.key, "nodes": s.node_count, "triangles": s.triangles,
-                         "fixed_nodes": len(s.fixed), "attached_nodes": {k: len(v) for k, v in s.attached.items()},
-                         "lowest_z": float(p[:, 2].min()) if finite else None, "size_m": size,
-                         "rest_size_m": s.rest_size, "spring_stiffness": s.params["springElasticStiffness"],
-                         "not_played": s.unmapped})
+            rows.append(
+                {
+                    "name": s.key,
+                    "nodes": s.node_count,
+                    "triangles": s.triangles,
+                    "fixed_nodes": len(s.fixed),
+                    "attached_nodes": {k: len(v) for k, v in s.attached.items()},
+                    "lowest_z": float(p[:, 2].min()) if finite else None,
+                    "size_m": size,
+                    "rest_size_m": s.rest_size,
+                    "spring_stiffness": s.params["springElasticStiffness"],
+                    "not_played": s.unmapped,
+                }
+            )
             if not finite:
                 nan.append(s.key)
             elif size > EXPLODED_STRETCH * max(s.rest_size, 1e-6):

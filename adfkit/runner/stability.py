@@ -15,6 +15,7 @@ while it steps and keeps every event, with the simulated time and the body, for 
 - PyBullet: every dynamic body's position and velocity every ``CHECK_EVERY_S`` of simulated
   time: NaN or Inf, or a speed above ``FLUNG_SPEED``.
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
@@ -33,7 +34,7 @@ MAX_EVENTS = 50
 class Instability:
     time_s: float
     body: str | None
-    kind: str          # "state-reset" (MuJoCo), "singular-inertia" (MuJoCo), "nan", "flung"
+    kind: str  # "state-reset" (MuJoCo), "singular-inertia" (MuJoCo), "nan", "flung"
     message: str
 
     def as_dict(self) -> dict:
@@ -58,8 +59,10 @@ class Watch:
             self.dropped += 1
 
     def report(self) -> dict:
-        return {"instabilities": [e.as_dict() for e in self.events],
-                **({"instabilities_not_listed": self.dropped} if self.dropped else {})}
+        return {
+            "instabilities": [e.as_dict() for e in self.events],
+            **({"instabilities_not_listed": self.dropped} if self.dropped else {}),
+        }
 
 
 # ---- MuJoCo -----------------------------------------------------------------------------------
@@ -74,6 +77,7 @@ def install_mujoco_handler() -> None:
     if _MJ_HANDLER_SET:
         return
     import mujoco
+
     mujoco.set_mju_user_warning(_MJ_MESSAGES.append)
     _MJ_HANDLER_SET = True
 
@@ -86,14 +90,17 @@ def drain_mujoco(world, watch: Watch) -> None:
     """Turn the warnings MuJoCo raised since the last call into events of ``world``: the kind and
     the body from the warning counters (``lastinfo`` is the DOF), the text from the callback."""
     import mujoco
+
     messages = list(_MJ_MESSAGES)
     _MJ_MESSAGES.clear()
-    m, d = world.model, world.data
+    _m, d = world.model, world.data
     w = mujoco.mjtWarning
-    kinds = {w.mjWARN_BADQPOS: ("state-reset", "positions", "QPOS"),
-             w.mjWARN_BADQVEL: ("state-reset", "velocities", "QVEL"),
-             w.mjWARN_BADQACC: ("state-reset", "accelerations", "QACC"),
-             w.mjWARN_INERTIA: ("singular-inertia", None, "inertia")}
+    kinds = {
+        w.mjWARN_BADQPOS: ("state-reset", "positions", "QPOS"),
+        w.mjWARN_BADQVEL: ("state-reset", "velocities", "QVEL"),
+        w.mjWARN_BADQACC: ("state-reset", "accelerations", "QACC"),
+        w.mjWARN_INERTIA: ("singular-inertia", None, "inertia"),
+    }
     seen = getattr(world, "_warnings_seen", {})
     found = False
     for code, (kind, what, word) in kinds.items():
@@ -104,14 +111,16 @@ def drain_mujoco(world, watch: Watch) -> None:
             body = _body_of_dof(world, int(stat.lastinfo))
             text = next((x for x in messages if word.lower() in x.lower()), None)
             if kind == "state-reset":
-                message = (f"MuJoCo met NaN, Inf or a huge value in the {what} (DOF {stat.lastinfo}) and reset "
-                           "the whole state to the initial pose")
+                message = (
+                    f"MuJoCo met NaN, Inf or a huge value in the {what} (DOF {stat.lastinfo}) and reset "
+                    "the whole state to the initial pose"
+                )
             else:
                 message = f"MuJoCo found a singular inertia at DOF {stat.lastinfo}"
             watch.add(Instability(world.sim_time, body, kind, message + (f" ({text.strip()})" if text else "")))
     world._warnings_seen = seen
     if not found:
-        for text in messages:   # another warning (contact buffer full, ...): reported, not an instability
+        for text in messages:  # another warning (contact buffer full, ...): reported, not an instability
             world.engine_warnings.append(f"t = {world.sim_time:.3f} s: {text.strip()}")
 
 
@@ -133,10 +142,19 @@ def check_pybullet(world, watch: Watch) -> None:
         p, _, v, _ = sb.state()
         if not (np.all(np.isfinite(p)) and np.all(np.isfinite(v))):
             if not any(e.body == sb.key and e.kind == "nan" for e in watch.events):
-                watch.add(Instability(world.sim_time, sb.key, "nan", "PyBullet gives the body a NaN or Inf "
-                                      "position or velocity"))
+                watch.add(
+                    Instability(
+                        world.sim_time, sb.key, "nan", "PyBullet gives the body a NaN or Inf position or velocity"
+                    )
+                )
             continue
         speed = float(np.linalg.norm(v))
         if speed > FLUNG_SPEED and not any(e.body == sb.key and e.kind == "flung" for e in watch.events):
-            watch.add(Instability(world.sim_time, sb.key, "flung", f"the solver flung the body at {speed:.3g} m/s "
-                                  f"(more than {FLUNG_SPEED:g} m/s)"))
+            watch.add(
+                Instability(
+                    world.sim_time,
+                    sb.key,
+                    "flung",
+                    f"the solver flung the body at {speed:.3g} m/s (more than {FLUNG_SPEED:g} m/s)",
+                )
+            )

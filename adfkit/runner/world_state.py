@@ -6,6 +6,7 @@ filter pair has changed since the snapshot; PyBullet cannot restore a state once
 grasp toggles the pairs between the jaws and what they hold), so the snapshot also keeps every
 body's and joint's state, restored one by one in that case (contacts then start afresh).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -43,10 +44,10 @@ class WorldState:
         for a in self.actuators:
             self.release(a)
         bases, joints, targets, steps, bullet = self._snapshots[sid]
-        try:   # exact, contact caches too, while no collision pair changed since the snapshot
+        try:  # exact, contact caches too, while no collision pair changed since the snapshot
             pb.restoreState(stateId=bullet, physicsClientId=cid)
             bases, joints = [], [[] for _ in self.articulations]
-        except pb.error:   # Bullet refuses once a collision filter pair changed (a grasp): per body
+        except pb.error:  # Bullet refuses once a collision filter pair changed (a grasp): per body
             pass
         for uid, p, q, v, w in bases:
             pb.resetBasePositionAndOrientation(uid, p, q, physicsClientId=cid)
@@ -78,11 +79,11 @@ class WorldState:
         is farther than ``reach``."""
         if getattr(self, "_probe", None) is None:
             shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=1e-5, physicsClientId=self.cid)
-            self._probe = pb.createMultiBody(0, shape, -1, [0, 0, 0], useMaximalCoordinates=True,
-                                             physicsClientId=self.cid)
+            self._probe = pb.createMultiBody(
+                0, shape, -1, [0, 0, 0], useMaximalCoordinates=True, physicsClientId=self.cid
+            )
             pb.setCollisionFilterGroupMask(self._probe, -1, 0, 0, physicsClientId=self.cid)
-        pb.resetBasePositionAndOrientation(self._probe, list(map(float, point)), [0, 0, 0, 1],
-                                           physicsClientId=self.cid)
+        pb.resetBasePositionAndOrientation(self._probe, list(map(float, point)), [0, 0, 0, 1], physicsClientId=self.cid)
         hits = pb.getClosestPoints(self._probe, sb.uid, reach, -1, sb.link, physicsClientId=self.cid)
         if not hits:
             return None

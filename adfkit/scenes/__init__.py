@@ -2,6 +2,7 @@
 
 Imported lazily: ``BUILDERS`` maps a scene name to a writer that imports its builder only
 when called, so ``adfkit --help`` (which lists the names) loads none of them."""
+
 from __future__ import annotations
 
 from importlib import import_module
@@ -10,6 +11,7 @@ from importlib import import_module
 def _lazy(module: str, function: str):
     def write(out_dir):
         return getattr(import_module(f"{__name__}.{module}"), function)(out_dir)
+
     write.__name__ = function
     write.__doc__ = f"{function} from adfkit.scenes.{module} (imported on first use)"
     return write
@@ -23,8 +25,12 @@ BUILDERS = {
 }
 
 _EXPORTS = {
-    "SuturingPadParams": "suturing_pad", "build_suturing_pad": "suturing_pad", "write_suturing_pad": "suturing_pad",
-    "write_suturing": "suturing", "write_soft_phantom": "soft_phantom", "write_drilling": "drilling",
+    "SuturingPadParams": "suturing_pad",
+    "build_suturing_pad": "suturing_pad",
+    "write_suturing_pad": "suturing_pad",
+    "write_suturing": "suturing",
+    "write_soft_phantom": "soft_phantom",
+    "write_drilling": "drilling",
 }
 
 

@@ -6,6 +6,7 @@ Voxel values (8 bit): 0 air, CANAL inside the canal, BONE elsewhere in the bone,
 texture; the iso-surface at 0.5 of full scale (127.5) is the bone's surface, and the canal,
 below it, is a tunnel through the bone.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -15,34 +16,49 @@ import numpy as np
 
 from ..adf.writer import write_file
 from ..model import (
-    RGBA, Body, Camera, ClippingPlane, Colors, Geometry, InputDevices, Joint, JointLimits, Launch, Light,
-    ModelFile, Pose, Quat, Resolution, Stereo, Vec3, World,
+    RGBA,
+    Body,
+    Camera,
+    ClippingPlane,
+    Colors,
+    Geometry,
+    InputDevices,
+    Joint,
+    JointLimits,
+    Launch,
+    Light,
+    ModelFile,
+    Pose,
+    Resolution,
+    Stereo,
+    Vec3,
+    World,
 )
 from ..model.objects import Volume, VolumeImages
 from .suturing_pad import build_floor
 
-BONE, CANAL = 230, 90            # voxel values of the two tissues (air is 0)
+BONE, CANAL = 230, 90  # voxel values of the two tissues (air is 0)
 BONE_RGBA = RGBA(r=0.93, g=0.89, b=0.78, a=1.0)
 STEEL = RGBA(r=0.7, g=0.7, b=0.75, a=1.0)
 
 
 @dataclass
 class DrillingParams:
-    voxels: int = 48                          # slices, and pixels per slice side
-    size: float = 0.04                        # m, the volume's cube side
-    canal_radius: float = 0.004               # m
-    burr_radius: float = 0.002                # m
-    shaft_length: float = 0.05                # m
+    voxels: int = 48  # slices, and pixels per slice side
+    size: float = 0.04  # m, the volume's cube side
+    canal_radius: float = 0.004  # m
+    burr_radius: float = 0.002  # m
+    shaft_length: float = 0.05  # m
     seed: int = 7
 
 
 def bone_voxels(p: DrillingParams) -> np.ndarray:
     """(slices, rows, columns) uint8: a rounded bone block with a canal along x through it."""
     n = p.voxels
-    c = (np.arange(n) + 0.5) / n - 0.5                      # voxel centres in units of the size
+    c = (np.arange(n) + 0.5) / n - 0.5  # voxel centres in units of the size
     z, y, x = np.meshgrid(c, c, c, indexing="ij")
     block = (np.abs(x) / 0.42) ** 4 + (np.abs(y) / 0.38) ** 4 + (np.abs(z) / 0.30) ** 4 <= 1.0
-    canal = (y ** 2 + (z + 0.05) ** 2) <= (p.canal_radius / p.size) ** 2
+    canal = (y**2 + (z + 0.05) ** 2) <= (p.canal_radius / p.size) ** 2
     rng = np.random.default_rng(p.seed)
     vol = np.where(block, BONE - rng.integers(0, 20, size=block.shape), 0)
     vol = np.where(block & canal, CANAL, vol)
@@ -51,6 +67,7 @@ def bone_voxels(p: DrillingParams) -> np.ndarray:
 
 def write_slices(vox: np.ndarray, folder: Path, prefix: str = "bone_") -> None:
     from PIL import Image
+
     folder.mkdir(parents=True, exist_ok=True)
     for i, s in enumerate(vox):
         Image.fromarray(s).save(folder / f"{prefix}{i}.png", optimize=True)
@@ -58,43 +75,114 @@ def write_slices(vox: np.ndarray, folder: Path, prefix: str = "bone_") -> None:
 
 def build_drill_model(p: DrillingParams) -> ModelFile:
     m = ModelFile(namespace="/ambf/env/drilling/")
-    m.volumes.append(Volume(identifier="VOLUME Bone", name="Bone", location=Pose(Vec3(0, 0, p.size / 2)),
-                            dimensions=Vec3(p.size, p.size, p.size), iso_surface_value=0.5,
-                            color_rgba=BONE_RGBA,
-                            images=VolumeImages(path="slices/", prefix="bone_", format="png", count=p.voxels)))
+    m.volumes.append(
+        Volume(
+            identifier="VOLUME Bone",
+            name="Bone",
+            location=Pose(Vec3(0, 0, p.size / 2)),
+            dimensions=Vec3(p.size, p.size, p.size),
+            iso_surface_value=0.5,
+            color_rgba=BONE_RGBA,
+            images=VolumeImages(path="slices/", prefix="bone_", format="png", count=p.voxels),
+        )
+    )
     top = p.size + 0.03
-    m.bodies.append(Body(identifier="BODY Mount", name="Mount", mass=0.0, shape="Box",
-                         geometry=Geometry(x=0.01, y=0.01, z=0.01), location=Pose(Vec3(0, 0, top + p.shaft_length)),
-                         color_rgba=STEEL))
+    m.bodies.append(
+        Body(
+            identifier="BODY Mount",
+            name="Mount",
+            mass=0.0,
+            shape="Box",
+            geometry=Geometry(x=0.01, y=0.01, z=0.01),
+            location=Pose(Vec3(0, 0, top + p.shaft_length)),
+            color_rgba=STEEL,
+        )
+    )
     shaft_r = 0.6 * p.burr_radius
-    m.bodies.append(Body(identifier="BODY Shaft", name="Shaft", mass=0.05, shape="Cylinder",
-                         geometry=Geometry(radius=shaft_r, height=p.shaft_length, axis="z"),
-                         collision_shape="Cylinder",
-                         collision_geometry=Geometry(radius=shaft_r, height=p.shaft_length, axis="z"),
-                         location=Pose(Vec3(0, 0, top + p.shaft_length / 2)), color_rgba=STEEL))
-    m.bodies.append(Body(identifier="BODY Burr", name="Burr", mass=0.01, shape="Sphere",
-                         geometry=Geometry(radius=p.burr_radius), collision_shape="Sphere",
-                         collision_geometry=Geometry(radius=p.burr_radius), location=Pose(Vec3(0, 0, top)),
-                         color_rgba=RGBA(r=0.85, g=0.7, b=0.2, a=1.0)))
-    m.joints.append(Joint(identifier="JOINT Mount-Shaft", name="Mount-Shaft", parent="BODY Mount", child="BODY Shaft",
-                          type="prismatic", parent_pivot=Vec3(0, 0, -p.shaft_length / 2),
-                          child_pivot=Vec3(0, 0, 0), parent_axis=Vec3(0, 0, 1), child_axis=Vec3(0, 0, 1),
-                          joint_limits=JointLimits(low=-0.08, high=0.0)))
-    m.joints.append(Joint(identifier="JOINT Shaft-Burr", name="Shaft-Burr", parent="BODY Shaft", child="BODY Burr",
-                          type="fixed", parent_pivot=Vec3(0, 0, -p.shaft_length / 2), child_pivot=Vec3(0, 0, 0),
-                          parent_axis=Vec3(0, 0, 1), child_axis=Vec3(0, 0, 1)))
+    m.bodies.append(
+        Body(
+            identifier="BODY Shaft",
+            name="Shaft",
+            mass=0.05,
+            shape="Cylinder",
+            geometry=Geometry(radius=shaft_r, height=p.shaft_length, axis="z"),
+            collision_shape="Cylinder",
+            collision_geometry=Geometry(radius=shaft_r, height=p.shaft_length, axis="z"),
+            location=Pose(Vec3(0, 0, top + p.shaft_length / 2)),
+            color_rgba=STEEL,
+        )
+    )
+    m.bodies.append(
+        Body(
+            identifier="BODY Burr",
+            name="Burr",
+            mass=0.01,
+            shape="Sphere",
+            geometry=Geometry(radius=p.burr_radius),
+            collision_shape="Sphere",
+            collision_geometry=Geometry(radius=p.burr_radius),
+            location=Pose(Vec3(0, 0, top)),
+            color_rgba=RGBA(r=0.85, g=0.7, b=0.2, a=1.0),
+        )
+    )
+    m.joints.append(
+        Joint(
+            identifier="JOINT Mount-Shaft",
+            name="Mount-Shaft",
+            parent="BODY Mount",
+            child="BODY Shaft",
+            type="prismatic",
+            parent_pivot=Vec3(0, 0, -p.shaft_length / 2),
+            child_pivot=Vec3(0, 0, 0),
+            parent_axis=Vec3(0, 0, 1),
+            child_axis=Vec3(0, 0, 1),
+            joint_limits=JointLimits(low=-0.08, high=0.0),
+        )
+    )
+    m.joints.append(
+        Joint(
+            identifier="JOINT Shaft-Burr",
+            name="Shaft-Burr",
+            parent="BODY Shaft",
+            child="BODY Burr",
+            type="fixed",
+            parent_pivot=Vec3(0, 0, -p.shaft_length / 2),
+            child_pivot=Vec3(0, 0, 0),
+            parent_axis=Vec3(0, 0, 1),
+            child_axis=Vec3(0, 0, 1),
+        )
+    )
     return m
 
 
 def build_world(p: DrillingParams) -> World:
     w = World(namespace="/ambf/env/", gravity=Vec3(0, 0, -9.81), max_iterations=50, environment="floor.yaml")
-    w.cameras.append(Camera(identifier="cameraL", name="cameraL", namespace="cameras/",
-                            location=Vec3(0.09, -0.10, 0.12), look_at=Vec3(0.0, 0.0, p.size / 2), up=Vec3(0, 0, 1),
-                            clipping_plane=ClippingPlane(near=0.01, far=1.0), field_view_angle=0.7,
-                            publish_image_resolution=Resolution(width=640, height=480),
-                            stereo=Stereo(mode="", eye_separation=0.005, focal_length=0.15)))
-    w.lights.append(Light(identifier="light1", name="light1", namespace="lights/", location=Vec3(0.1, -0.1, 0.5),
-                          direction=Vec3(-0.2, 0.2, -1), spot_exponent=0.3, cutoff_angle=1.2, shadow_quality=0))
+    w.cameras.append(
+        Camera(
+            identifier="cameraL",
+            name="cameraL",
+            namespace="cameras/",
+            location=Vec3(0.09, -0.10, 0.12),
+            look_at=Vec3(0.0, 0.0, p.size / 2),
+            up=Vec3(0, 0, 1),
+            clipping_plane=ClippingPlane(near=0.01, far=1.0),
+            field_view_angle=0.7,
+            publish_image_resolution=Resolution(width=640, height=480),
+            stereo=Stereo(mode="", eye_separation=0.005, focal_length=0.15),
+        )
+    )
+    w.lights.append(
+        Light(
+            identifier="light1",
+            name="light1",
+            namespace="lights/",
+            location=Vec3(0.1, -0.1, 0.5),
+            direction=Vec3(-0.2, 0.2, -1),
+            spot_exponent=0.3,
+            cutoff_angle=1.2,
+            shadow_quality=0,
+        )
+    )
     return w
 
 
@@ -110,8 +198,12 @@ def write_drilling(out_dir: str | Path, p: DrillingParams | None = None) -> Path
     write_file(build_world(p), out / "world.yaml")
     write_file(InputDevices(present_lists={"input devices"}), out / "input_devices.yaml")
     write_file(Colors(colors={"bone": BONE_RGBA, "steel": STEEL}), out / "colors.yaml")
-    launch = Launch(world_config="world.yaml", color_config="colors.yaml", input_devices_config="input_devices.yaml",
-                    multibody_configs=["drill.yaml"])
+    launch = Launch(
+        world_config="world.yaml",
+        color_config="colors.yaml",
+        input_devices_config="input_devices.yaml",
+        multibody_configs=["drill.yaml"],
+    )
     return write_file(launch, out / "launch.yaml")
 
 

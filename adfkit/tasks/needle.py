@@ -7,6 +7,7 @@ the tip, z along the circle's axis oriented so that turning the needle by +a abo
 tip forward (the tail lies at angle -span). A point of the wire at angle phi is
 ``centre + r (cos phi x + sin phi y)``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -28,7 +29,7 @@ def obj_vertices(path: Path) -> np.ndarray:
 @dataclass
 class NeedleGeometry:
     radius: float
-    span: float               # rad, tail to tip
+    span: float  # rad, tail to tip
     arc_in_needle: np.ndarray  # 4x4: arc frame A in the needle body frame N
 
     def point(self, phi: float) -> np.ndarray:
@@ -54,18 +55,18 @@ def fit_needle(vertices: np.ndarray, tail_hint: np.ndarray | None = None) -> Nee
     mean = v.mean(axis=0)
     _, _, vt = np.linalg.svd(v - mean)
     e1, e2 = vt[0], vt[1]
-    n = np.cross(e1, e2)          # right-handed: angles below run counter-clockwise about n
+    n = np.cross(e1, e2)  # right-handed: angles below run counter-clockwise about n
     xy = np.c_[(v - mean) @ e1, (v - mean) @ e2]
     a = np.c_[2 * xy, np.ones(len(xy))]
-    sol = np.linalg.lstsq(a, (xy ** 2).sum(axis=1), rcond=None)[0]
+    sol = np.linalg.lstsq(a, (xy**2).sum(axis=1), rcond=None)[0]
     c2 = sol[:2]
     radius = float(np.sqrt(sol[2] + c2 @ c2))
     centre = mean + c2[0] * e1 + c2[1] * e2
     ang = np.sort(np.arctan2(xy[:, 1] - c2[1], xy[:, 0] - c2[0]))
     gaps = np.diff(np.r_[ang, ang[0] + 2 * np.pi])
     k = int(np.argmax(gaps))
-    start = ang[(k + 1) % len(ang)]            # the arc runs counter-clockwise from start ...
-    span = float(2 * np.pi - gaps[k])           # ... to start + span
+    start = ang[(k + 1) % len(ang)]  # the arc runs counter-clockwise from start ...
+    span = float(2 * np.pi - gaps[k])  # ... to start + span
     end = start + span
 
     def at(phi):
@@ -74,14 +75,16 @@ def fit_needle(vertices: np.ndarray, tail_hint: np.ndarray | None = None) -> Nee
     if tail_hint is not None:
         tail_is_start = np.linalg.norm(at(start) - tail_hint) < np.linalg.norm(at(end) - tail_hint)
     else:
+
         def width(phi):
             near = np.abs(((np.arctan2(xy[:, 1] - c2[1], xy[:, 0] - c2[0]) - phi + np.pi) % (2 * np.pi)) - np.pi) < 0.1
             return float(np.ptp((v[near] - mean) @ n)) if near.any() else 0.0
+
         tail_is_start = width(start) >= width(end)
-    if tail_is_start:      # tip at end: counter-clockwise about n moves the tip forward
+    if tail_is_start:  # tip at end: counter-clockwise about n moves the tip forward
         x = np.cos(end) * e1 + np.sin(end) * e2
         z = n
-    else:                  # tip at start: clockwise about n, so the axis is -n
+    else:  # tip at start: clockwise about n, so the axis is -n
         x = np.cos(start) * e1 + np.sin(start) * e2
         z = -n
     y = np.cross(z, x)

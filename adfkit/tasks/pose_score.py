@@ -9,6 +9,7 @@ compared pairwise in order; a pose is
  or {"position": [x, y, z], "rpy": [roll, pitch, yaw]}           (ADF's fixed-axis x-y-z, rad)
  or {"matrix": [[...4 numbers...] x 4]}                          (homogeneous 4x4)
 """
+
 from __future__ import annotations
 
 import math
@@ -22,9 +23,13 @@ class PoseFormatError(ValueError):
 
 def _rpy(r, p, y) -> np.ndarray:
     cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
 
 
 def _quat(x, y, z, w) -> np.ndarray:
@@ -32,14 +37,21 @@ def _quat(x, y, z, w) -> np.ndarray:
     if not n or abs(n - 1.0) > 1e-3:
         raise PoseFormatError(f"orientation quaternion has norm {n:.4g}, not 1")
     x, y, z, w = x / n, y / n, z / n, w / n
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def _numbers(v, n: int, what: str) -> list[float]:
-    if not isinstance(v, list) or len(v) != n or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
-                                                          and math.isfinite(x) for x in v):
+    if (
+        not isinstance(v, list)
+        or len(v) != n
+        or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
+    ):
         raise PoseFormatError(f"{what} must be a list of {n} finite numbers")
     return [float(x) for x in v]
 
@@ -59,21 +71,21 @@ def read_pose(d) -> np.ndarray:
             raise PoseFormatError("matrix rotation part is not a rotation")
         return t
     if "position" not in d:
-        raise PoseFormatError("a pose needs \"position\" (or \"matrix\")")
+        raise PoseFormatError('a pose needs "position" (or "matrix")')
     t[:3, 3] = _numbers(d["position"], 3, "position")
     if "orientation" in d:
         t[:3, :3] = _quat(*_numbers(d["orientation"], 4, "orientation (x, y, z, w)"))
     elif "rpy" in d:
         t[:3, :3] = _rpy(*_numbers(d["rpy"], 3, "rpy"))
     else:
-        raise PoseFormatError("a pose needs \"orientation\" [qx, qy, qz, qw] or \"rpy\" [r, p, y]")
+        raise PoseFormatError('a pose needs "orientation" [qx, qy, qz, qw] or "rpy" [r, p, y]')
     return t
 
 
 def read_poses(doc) -> list[np.ndarray]:
     if isinstance(doc, dict) and "poses" in doc:
         if not isinstance(doc["poses"], list) or not doc["poses"]:
-            raise PoseFormatError("\"poses\" must be a non-empty list")
+            raise PoseFormatError('"poses" must be a non-empty list')
         return [read_pose(p) for p in doc["poses"]]
     return [read_pose(doc)]
 

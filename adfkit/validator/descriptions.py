@@ -4,6 +4,7 @@ One line per key: ``[Class.]key | default (JSON, or empty) | description``. A ``
 prefix overrides the plain entry for that element only. Kept as a table so that adding a
 key to the model without a line here is caught by ``tests/test_schema.py``.
 """
+
 from __future__ import annotations
 
 import json

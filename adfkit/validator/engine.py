@@ -4,6 +4,7 @@
 launch file to everything it names (world, environment, input devices, colors, models),
 checking each model's references against the models AMBF would have loaded before it.
 """
+
 from __future__ import annotations
 
 import os
@@ -55,12 +56,15 @@ def _read_with_compat(path: Path, kind: str | None, text: str, roots: list, tree
                 raise exc from None
             raise
         first = exc.diagnostics[0]
-        note = Diagnostic(RULES["pyyaml-unparseable"].severity, "pyyaml-unparseable",
-                          f"PyYAML cannot parse this file ({first.message.removeprefix('not valid YAML: ')}), "
-                          f"but AMBF's yaml-cpp does: a flow collection starts at its key's indentation "
-                          f"(line {moved[0]}). Validated after re-indenting it",
-                          SourceLocation(str(path), moved[0], 1),
-                          "indent the '{' or '[' block under its key so every YAML tool reads the file")
+        note = Diagnostic(
+            RULES["pyyaml-unparseable"].severity,
+            "pyyaml-unparseable",
+            f"PyYAML cannot parse this file ({first.message.removeprefix('not valid YAML: ')}), "
+            f"but AMBF's yaml-cpp does: a flow collection starts at its key's indentation "
+            f"(line {moved[0]}). Validated after re-indenting it",
+            SourceLocation(str(path), moved[0], 1),
+            "indent the '{' or '[' block under its key so every YAML tool reads the file",
+        )
         return doc, [note, *diags], fixed, moved
 
 
@@ -74,8 +78,14 @@ def _adjust(d: Diagnostic) -> Diagnostic:
     return d
 
 
-def validate_file(path: str | Path, kind: str | None = None, context_models=(), text: str | None = None,
-                  tree=None, referrer: SourceLocation | None = None) -> FileResult:
+def validate_file(
+    path: str | Path,
+    kind: str | None = None,
+    context_models=(),
+    text: str | None = None,
+    tree=None,
+    referrer: SourceLocation | None = None,
+) -> FileResult:
     """Check one file. ``tree``/``referrer``: the file was named by another one and must lie
     in that scene's tree (adfkit.inputs); None when the user named it."""
     path = Path(path)
@@ -141,13 +151,21 @@ def expand(paths) -> tuple[list[tuple[Path, inputs.Tree | None]], list[Diagnosti
             continue
         if is_dir:
             tree = inputs.Tree(Path(os.path.realpath(p)))
-            files += [(f, tree) for f in sorted(f for f in p.rglob("*")
-                                                 if f.suffix.lower() in YAML_SUFFIXES and f.is_file())]
+            files += [
+                (f, tree) for f in sorted(f for f in p.rglob("*") if f.suffix.lower() in YAML_SUFFIXES and f.is_file())
+            ]
         elif os.path.lexists(p):
             files.append((p, None))
         else:
-            problems.append(Diagnostic(Severity.ERROR, "file-not-found", f"no such file or folder: {inputs.shown(p)}",
-                                       SourceLocation(inputs.shown(p)), "check the path"))
+            problems.append(
+                Diagnostic(
+                    Severity.ERROR,
+                    "file-not-found",
+                    f"no such file or folder: {inputs.shown(p)}",
+                    SourceLocation(inputs.shown(p)),
+                    "check the path",
+                )
+            )
     return files, problems
 
 
@@ -177,7 +195,11 @@ def validate_files(files, kind: str | None = None, follow: bool = True) -> list[
     def follow_launch(launch: Launch) -> None:
         targets = paths_check.launch_targets(launch)
         context: list[ModelFile] = []
-        for slot, k in (("world config", "world"), ("input devices config", "input_devices"), ("color config", "colors")):
+        for slot, k in (
+            ("world config", "world"),
+            ("input devices config", "input_devices"),
+            ("color config", "colors"),
+        ):
             for p in targets.get(slot, []):
                 if os.path.lexists(p):
                     res = run(p, k, tree=launch.tree, referrer=launch.where(slot))
@@ -212,7 +234,7 @@ def chunked(files, parts: int) -> list[list]:
 def _cut(files: list, parts: int) -> list[list]:
     n = max(1, min(len(files), parts))
     size = -(-len(files) // n) if files else 1
-    return [files[i:i + size] for i in range(0, len(files), size)]
+    return [files[i : i + size] for i in range(0, len(files), size)]
 
 
 def merge_chunks(runs) -> list[FileResult]:
@@ -232,7 +254,7 @@ def _chunk_without_docs(args) -> list[FileResult]:
     files, kind, follow = args
     out = validate_files(files, kind, follow)
     for res in out:
-        res.doc = None          # the model stays in the worker: only findings and text travel back
+        res.doc = None  # the model stays in the worker: only findings and text travel back
     return out
 
 
@@ -264,13 +286,14 @@ def _work_units(files, follow: bool, parts: int) -> list[list]:
     the launch file's context, and so does this (no file is checked twice)."""
     if not follow:
         return chunked(files, parts)
-    launch_flags = [_looks_like_launch(*ft) for ft in files]   # each file opened once to sniff it
+    launch_flags = [_looks_like_launch(*ft) for ft in files]  # each file opened once to sniff it
     launches = [ft for ft, is_launch in zip(files, launch_flags) if is_launch]
     reached: set[str] = set()
     for path, tree in launches:
         reached |= _reached_from_launch(path, tree)
-    rest = [ft for ft, is_launch in zip(files, launch_flags)
-            if not is_launch and os.path.realpath(ft[0]) not in reached]
+    rest = [
+        ft for ft, is_launch in zip(files, launch_flags) if not is_launch and os.path.realpath(ft[0]) not in reached
+    ]
     return [[ft] for ft in launches] + (_cut(rest, max(1, parts - len(launches))) if rest else [])
 
 

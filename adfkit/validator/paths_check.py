@@ -1,5 +1,6 @@
 """Rules about files an ADF names: meshes (§6.2), their OBJ material libraries and textures,
 shaders, skyboxes, sensor meshes, and the files launch, world and input-devices files chain to."""
+
 from __future__ import annotations
 
 import os
@@ -7,8 +8,8 @@ import stat
 from functools import lru_cache
 from pathlib import Path
 
-from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
 from .. import inputs
+from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..geometry.meshcheck import mesh_problem
 from ..model import InputDevices, Launch, ModelFile, World
@@ -68,7 +69,7 @@ def obj_material_problems(obj_path: str) -> tuple[str, ...]:
     base = Path(obj_path).parent
     try:
         inputs.check_file(obj_path, "mesh")
-        with open(obj_path, "r", encoding="utf-8", errors="replace") as fh:
+        with open(obj_path, encoding="utf-8", errors="replace") as fh:
             libs = [line.split(None, 1)[1].strip() for line in fh if line.startswith("mtllib") and " " in line]
     except (OSError, ValueError, AdfError):
         return ()
@@ -99,8 +100,14 @@ def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:
     base = relative_to_file(doc_path, shaders.path)
     for name in (shaders.vertex, shaders.fragment):
         if name and not _exists(str(base / name)):
-            out.append(_d("missing-shader", f"shader {base / name} of {owner} not found", loc,
-                          "shader paths are relative to the file that declares them"))
+            out.append(
+                _d(
+                    "missing-shader",
+                    f"shader {base / name} of {owner} not found",
+                    loc,
+                    "shader paths are relative to the file that declares them",
+                )
+            )
     return out
 
 
@@ -121,23 +128,47 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
                 continue
             seen.add(str(path))
             if not _present(path):
-                out.append(_d("missing-mesh", f"mesh file {inputs.shown(path)} of '{obj.identifier}' not found",
-                              obj.where(key), "paths resolve against the body's and model's high/low resolution "
-                              "paths, then the model file's directory"))
+                out.append(
+                    _d(
+                        "missing-mesh",
+                        f"mesh file {inputs.shown(path)} of '{obj.identifier}' not found",
+                        obj.where(key),
+                        "paths resolve against the body's and model's high/low resolution "
+                        "paths, then the model file's directory",
+                    )
+                )
             elif (refused := _policy(path, m, "mesh", obj.where(key), f"mesh of '{obj.identifier}'")) is not None:
                 out.append(refused)
             elif (problem := mesh_problem(path)) is not None:
-                out.append(_d("mesh-unreadable", f"mesh {inputs.shown(path.name)} of '{obj.identifier}': {problem}",
-                              obj.where(key), "re-export the mesh as a triangle mesh (STL or OBJ)"))
+                out.append(
+                    _d(
+                        "mesh-unreadable",
+                        f"mesh {inputs.shown(path.name)} of '{obj.identifier}': {problem}",
+                        obj.where(key),
+                        "re-export the mesh as a triangle mesh (STL or OBJ)",
+                    )
+                )
             elif path.suffix.lower() == ".obj":
                 for what in obj_material_problems(str(path)):
-                    out.append(_d("missing-texture", f"{what} of mesh {path.name} ('{obj.identifier}') not found",
-                                  obj.where(key), "textures come from the mesh's own material (MTL) file"))
+                    out.append(
+                        _d(
+                            "missing-texture",
+                            f"{what} of mesh {path.name} ('{obj.identifier}') not found",
+                            obj.where(key),
+                            "textures come from the mesh's own material (MTL) file",
+                        )
+                    )
         out += _shaders(m.path, getattr(obj, "shaders", None), f"'{obj.identifier}'", obj.where("shaders"))
     for s in m.sensors:
         if s.mesh and not _exists(str(m.directory / s.mesh)):
-            out.append(_d("missing-mesh", f"sensor mesh {m.directory / s.mesh} of '{s.identifier}' not found",
-                          s.where("mesh"), "sensor meshes resolve against the model directory only"))
+            out.append(
+                _d(
+                    "missing-mesh",
+                    f"sensor mesh {m.directory / s.mesh} of '{s.identifier}' not found",
+                    s.where("mesh"),
+                    "sensor meshes resolve against the model directory only",
+                )
+            )
     for v in m.volumes:
         out += _shaders(m.path, v.shaders, f"'{v.identifier}'", v.where("shaders"))
     for c in m.cameras:
@@ -147,15 +178,22 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
 
 
 def _camera_shaders(path, c) -> list[Diagnostic]:
-    return (_shaders(path, c.preprocessing_shaders, f"camera '{c.identifier}'", c.where("preprocessing shaders"))
-            + _shaders(path, c.depth_compute_shaders, f"camera '{c.identifier}'", c.where("depth compute shaders")))
+    return _shaders(
+        path, c.preprocessing_shaders, f"camera '{c.identifier}'", c.where("preprocessing shaders")
+    ) + _shaders(path, c.depth_compute_shaders, f"camera '{c.identifier}'", c.where("depth compute shaders"))
 
 
 def world_paths(w: World) -> list[Diagnostic]:
     out: list[Diagnostic] = []
     if w.environment and not _present(relative_to_file(w.path, w.environment)):
-        out.append(_d("missing-file", f"environment {relative_to_file(w.path, w.environment)} not found",
-                      w.where("environment"), "the environment path is relative to the world file"))
+        out.append(
+            _d(
+                "missing-file",
+                f"environment {relative_to_file(w.path, w.environment)} not found",
+                w.where("environment"),
+                "the environment path is relative to the world file",
+            )
+        )
     out += _shaders(w.path, w.shaders, "the world", w.where("shaders"))
     if w.skybox is not None and w.skybox.path:
         base = relative_to_file(w.path, w.skybox.path)
@@ -172,8 +210,11 @@ def world_paths(w: World) -> list[Diagnostic]:
 def launch_targets(launch: Launch) -> dict[str, list[Path]]:
     """Files a launch file chains to, by slot (only slots that are set)."""
     out: dict[str, list[Path]] = {}
-    for key, attr in (("world config", "world_config"), ("color config", "color_config"),
-                      ("input devices config", "input_devices_config")):
+    for key, attr in (
+        ("world config", "world_config"),
+        ("color config", "color_config"),
+        ("input devices config", "input_devices_config"),
+    ):
         value = getattr(launch, attr)
         if value:
             out[key] = [relative_to_file(launch.path, value)]
@@ -190,10 +231,19 @@ def launch_paths(launch: Launch) -> list[Diagnostic]:
         for p in paths:
             if _present(p):
                 continue
-            rule = {"multibody configs": "missing-model-file", "color config": "missing-color-file"}.get(key, "missing-file")
-            out.append(_d(rule, f"'{key}' names {inputs.shown(p)}, which does not exist", launch.where(key),
-                          "AMBF 2.0 stores this path and never opens it" if key == "color config" else
-                          "paths in a launch file are relative to the launch file's directory"))
+            rule = {"multibody configs": "missing-model-file", "color config": "missing-color-file"}.get(
+                key, "missing-file"
+            )
+            out.append(
+                _d(
+                    rule,
+                    f"'{key}' names {inputs.shown(p)}, which does not exist",
+                    launch.where(key),
+                    "AMBF 2.0 stores this path and never opens it"
+                    if key == "color config"
+                    else "paths in a launch file are relative to the launch file's directory",
+                )
+            )
     return out
 
 
@@ -201,9 +251,15 @@ def input_device_paths(d: InputDevices) -> list[Diagnostic]:
     out = []
     for dev in d.input_devices:
         if dev.simulated_multibody and not _exists(str(relative_to_file(d.path, dev.simulated_multibody))):
-            out.append(_d("input-device", f"simulated multibody {relative_to_file(d.path, dev.simulated_multibody)} "
-                          f"of '{dev.identifier}' not found; the device loads without it",
-                          dev.where("simulated multibody"), "the path is relative to the input-devices file"))
+            out.append(
+                _d(
+                    "input-device",
+                    f"simulated multibody {relative_to_file(d.path, dev.simulated_multibody)} "
+                    f"of '{dev.identifier}' not found; the device loads without it",
+                    dev.where("simulated multibody"),
+                    "the path is relative to the input-devices file",
+                )
+            )
     return out
 
 
@@ -217,9 +273,15 @@ def plugin_paths(doc) -> list[Diagnostic]:
             if plugin.path and plugin.filename:
                 lib = relative_to_file(doc.path, plugin.path) / plugin.filename
                 if not _exists(str(lib)):
-                    out.append(_d("missing-plugin", f"plugin library {lib} not found", owner.where("plugins"),
-                                  "plugin paths are relative to the declaring file; AMBF then tries its plugin "
-                                  "path list and the bare file name"))
+                    out.append(
+                        _d(
+                            "missing-plugin",
+                            f"plugin library {lib} not found",
+                            owner.where("plugins"),
+                            "plugin paths are relative to the declaring file; AMBF then tries its plugin "
+                            "path list and the bare file name",
+                        )
+                    )
     return out
 
 

@@ -1,5 +1,6 @@
 """AMBF's lookup of objects by string (adf-format.md §12.1): namespaced keys, exact match
 first, then the unique key containing the string."""
+
 from __future__ import annotations
 
 import re

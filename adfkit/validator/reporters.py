@@ -1,12 +1,12 @@
 """Output formats for validation results: text (with the source line and a caret), json,
 github (workflow annotations) and sarif (2.1.0)."""
+
 from __future__ import annotations
 
-from .. import jsonout
 from pathlib import Path
 from typing import IO
 
-from .. import __version__
+from .. import __version__, jsonout
 from ..diagnostics import Diagnostic, Severity, one_line
 from .rules import RULES
 
@@ -30,8 +30,13 @@ def _source_line(texts: dict[str, str | None], d: Diagnostic) -> str | None:
     return one_line(line[:400] + (" ..." if len(line) > 400 else ""))
 
 
-def write_text(diags: list[Diagnostic], stream: IO[str], texts: dict[str, str | None] | None = None,
-               summary: bool = True, files: int = 0) -> None:
+def write_text(
+    diags: list[Diagnostic],
+    stream: IO[str],
+    texts: dict[str, str | None] | None = None,
+    summary: bool = True,
+    files: int = 0,
+) -> None:
     texts = dict(texts or {})
     for d in diags:
         where = f"{d.location}: " if d.location else ""
@@ -45,15 +50,23 @@ def write_text(diags: list[Diagnostic], stream: IO[str], texts: dict[str, str | 
             stream.write(f"  hint: {one_line(d.hint)}\n")
     if summary:
         counts = {s: sum(1 for d in diags if d.severity == s) for s in Severity}
-        stream.write(f"{files} file(s) checked: {counts[Severity.ERROR]} error(s), "
-                     f"{counts[Severity.WARNING]} warning(s), {counts[Severity.INFO]} info\n")
+        stream.write(
+            f"{files} file(s) checked: {counts[Severity.ERROR]} error(s), "
+            f"{counts[Severity.WARNING]} warning(s), {counts[Severity.INFO]} info\n"
+        )
 
 
 def _dict(d: Diagnostic) -> dict:
     loc = d.location
-    return {"file": loc.file if loc else None, "line": loc.line if loc else None,
-            "column": loc.column if loc else None, "severity": str(d.severity), "rule": d.rule,
-            "message": d.message, "hint": d.hint}
+    return {
+        "file": loc.file if loc else None,
+        "line": loc.line if loc else None,
+        "column": loc.column if loc else None,
+        "severity": str(d.severity),
+        "rule": d.rule,
+        "message": d.message,
+        "hint": d.hint,
+    }
 
 
 def write_json(diags: list[Diagnostic], stream: IO[str], files: int = 0) -> None:
@@ -107,8 +120,12 @@ def sarif(diags: list[Diagnostic]) -> dict:
     index = {rid: i for i, rid in enumerate(used)}
     results = []
     for d in diags:
-        res = {"ruleId": d.rule, "ruleIndex": index[d.rule], "level": _LEVEL[d.severity],
-               "message": {"text": d.message + (f" Hint: {d.hint}" if d.hint else "")}}
+        res = {
+            "ruleId": d.rule,
+            "ruleIndex": index[d.rule],
+            "level": _LEVEL[d.severity],
+            "message": {"text": d.message + (f" Hint: {d.hint}" if d.hint else "")},
+        }
         if d.location:
             phys: dict = {"artifactLocation": {"uri": _uri(d.location.file)}}
             if d.location.line:
@@ -116,10 +133,22 @@ def sarif(diags: list[Diagnostic]) -> dict:
             res["locations"] = [{"physicalLocation": phys}]
         results.append(res)
     return {
-        "$schema": SARIF_SCHEMA, "version": "2.1.0",
-        "runs": [{"tool": {"driver": {"name": "adfkit", "version": __version__,
-                                      "informationUri": "https://github.com/WPI-AIM/ambf", "rules": rules}},
-                  "columnKind": "unicodeCodePoints", "results": results}],
+        "$schema": SARIF_SCHEMA,
+        "version": "2.1.0",
+        "runs": [
+            {
+                "tool": {
+                    "driver": {
+                        "name": "adfkit",
+                        "version": __version__,
+                        "informationUri": "https://github.com/WPI-AIM/ambf",
+                        "rules": rules,
+                    }
+                },
+                "columnKind": "unicodeCodePoints",
+                "results": results,
+            }
+        ],
     }
 
 

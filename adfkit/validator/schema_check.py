@@ -6,9 +6,10 @@ schema, then each listed object's mapping against its kind's ``$defs`` entry, lo
 that mapping. A listed identifier with no mapping is checked as an empty mapping (AMBF
 builds the object from an empty node) and located at the list entry.
 """
+
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import yaml
 
@@ -19,8 +20,12 @@ from ..model import FILE_KINDS
 from ..model.files import ObjectList
 from ..model.spec import adf_fields
 
-_RULE_BY_KEYWORD = {"required": "schema-required", "type": "schema-type", "anyOf": "schema-type",
-                    "pattern": "schema-type"}
+_RULE_BY_KEYWORD = {
+    "required": "schema-required",
+    "type": "schema-type",
+    "anyOf": "schema-type",
+    "pattern": "schema-type",
+}
 
 
 # Schema keywords whose findings a semantic rule reports with a better message.
@@ -45,7 +50,7 @@ def _inline(node, defs: dict, depth: int = 0):
     return out
 
 
-@lru_cache(maxsize=None)
+@cache
 def _inlined(kind: str, definition: str | None) -> dict:
     schema = load_schema(kind)
     defs = schema["$defs"]
@@ -55,14 +60,14 @@ def _inlined(kind: str, definition: str | None) -> dict:
     return inlined
 
 
-@lru_cache(maxsize=None)
+@cache
 def _validator(kind: str, definition: str | None):
     from jsonschema import Draft202012Validator  # imported on first use: only for files with findings
 
     return Draft202012Validator(_inlined(kind, definition))
 
 
-@lru_cache(maxsize=None)
+@cache
 def _fast_validator(kind: str, definition: str | None):
     """jsonschema-rs (compiled) for the same inlined schema, or None when not installed.
 
@@ -88,8 +93,11 @@ def _errors(kind: str, definition: str | None, instance):
 
 def object_lists(kind: str) -> dict[str, str]:
     """Top-level list key → $defs name of the objects it lists."""
-    return {f.metadata["adf_key"]: f.metadata["kind"].kind.__name__
-            for f in adf_fields(FILE_KINDS[kind]) if isinstance(f.metadata["kind"], ObjectList)}
+    return {
+        f.metadata["adf_key"]: f.metadata["kind"].kind.__name__
+        for f in adf_fields(FILE_KINDS[kind])
+        if isinstance(f.metadata["kind"], ObjectList)
+    }
 
 
 def node_at(node: yaml.Node, path) -> tuple[yaml.Node, str | None]:
@@ -121,7 +129,11 @@ def _diagnostic(err, base: yaml.Node, file: str, context: str, at: yaml.Node | N
         msg = f"{owner} lacks required key '{missing}'; AMBF rejects the file"
         hint = f"add '{missing}:'"
     elif err.validator in ("anyOf", "type", "pattern") and "title" in err.schema:
-        shown = node.value if isinstance(node, yaml.ScalarNode) else ("a mapping" if isinstance(node, yaml.MappingNode) else "a list")
+        shown = (
+            node.value
+            if isinstance(node, yaml.ScalarNode)
+            else ("a mapping" if isinstance(node, yaml.MappingNode) else "a list")
+        )
         shown = repr(shown) if len(repr(shown)) <= 80 else repr(shown)[:75] + "...'"
         msg = f"{label}: expected {err.schema['title']}, found {shown}"
         hint = "AMBF cannot convert this value and rejects the file"
@@ -142,8 +154,9 @@ def check(root: yaml.MappingNode, kind: str, file: str) -> list[Diagnostic]:
     schema = load_schema(kind)
     known = set(schema["properties"])
     items = {text: (k, v) for text, k, v in mapping_items(root)}
-    top = yaml.MappingNode(root.tag, [(k, v) for text, (k, v) in items.items() if text in known],
-                           root.start_mark, root.end_mark)
+    top = yaml.MappingNode(
+        root.tag, [(k, v) for text, (k, v) in items.items() if text in known], root.start_mark, root.end_mark
+    )
     for err in _errors(kind, None, plain(top)):
         out.append(_diagnostic(err, top, file, "the file", None))
     for list_key, definition in lists.items():

@@ -10,6 +10,7 @@ text is read. Unknown keys are allowed everywhere because AMBF ignores them (the
 reports them separately). Enumerations whose bad values AMBF still loads (joint type,
 shape names, collision mesh type) are left to semantic rules and given as ``examples``.
 """
+
 from __future__ import annotations
 
 import json
@@ -25,24 +26,45 @@ from .descriptions import describe
 DIALECT = "https://json-schema.org/draft/2020-12/schema"
 SCHEMA_DIR = Path(__file__).resolve().parent.parent / "adf_schema"
 
-_BOOL_WORDS = [w for base in ("true", "false", "yes", "no", "on", "off", "y", "n")
-               for w in dict.fromkeys((base, base.capitalize(), base.upper()))]
+_BOOL_WORDS = [
+    w
+    for base in ("true", "false", "yes", "no", "on", "off", "y", "n")
+    for w in dict.fromkeys((base, base.capitalize(), base.upper()))
+]
 NUMBER_PATTERN = r"^\s*[-+]?(([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?|\.(inf|Inf|INF|nan|NaN|NAN))\s*$"
 
 SCALARS: dict[str, dict] = {
     "float": {"title": "a number", "anyOf": [{"type": "number"}, {"type": "string", "pattern": NUMBER_PATTERN}]},
-    "bool": {"title": "true or false",
-             "anyOf": [{"type": "boolean"}, {"type": "string", "pattern": "^\\s*(" + "|".join(_BOOL_WORDS) + ")\\s*$"}]},
-    "int": {"title": "an integer", "anyOf": [{"type": "integer"}, {"type": "string", "pattern": r"^\s*[-+]?[0-9]+\s*$"}]},
-    "uint": {"title": "a non-negative integer",
-             "anyOf": [{"type": "integer", "minimum": 0}, {"type": "string", "pattern": r"^\s*\+?[0-9]+\s*$"}]},
+    "bool": {
+        "title": "true or false",
+        "anyOf": [{"type": "boolean"}, {"type": "string", "pattern": "^\\s*(" + "|".join(_BOOL_WORDS) + ")\\s*$"}],
+    },
+    "int": {
+        "title": "an integer",
+        "anyOf": [{"type": "integer"}, {"type": "string", "pattern": r"^\s*[-+]?[0-9]+\s*$"}],
+    },
+    "uint": {
+        "title": "a non-negative integer",
+        "anyOf": [{"type": "integer", "minimum": 0}, {"type": "string", "pattern": r"^\s*\+?[0-9]+\s*$"}],
+    },
     "str": {"title": "text", "type": ["string", "number", "boolean"]},
-    "vec3": {"title": "a vector {x, y, z}", "type": "object", "required": ["x", "y", "z"],
-             "properties": {k: {"$ref": "#/$defs/float"} for k in "xyz"}},
-    "rpy": {"title": "an orientation {r, p, y}", "type": "object", "required": ["r", "p", "y"],
-            "properties": {k: {"$ref": "#/$defs/float"} for k in "rpy"}},
-    "pose": {"title": "a pose {position, orientation}", "type": "object",
-             "properties": {"position": {"$ref": "#/$defs/vec3"}, "orientation": {"$ref": "#/$defs/rpy"}}},
+    "vec3": {
+        "title": "a vector {x, y, z}",
+        "type": "object",
+        "required": ["x", "y", "z"],
+        "properties": {k: {"$ref": "#/$defs/float"} for k in "xyz"},
+    },
+    "rpy": {
+        "title": "an orientation {r, p, y}",
+        "type": "object",
+        "required": ["r", "p", "y"],
+        "properties": {k: {"$ref": "#/$defs/float"} for k in "rpy"},
+    },
+    "pose": {
+        "title": "a pose {position, orientation}",
+        "type": "object",
+        "properties": {"position": {"$ref": "#/$defs/vec3"}, "orientation": {"$ref": "#/$defs/rpy"}},
+    },
     "any": {},
 }
 
@@ -50,13 +72,21 @@ SCALARS: dict[str, dict] = {
 REQUIRED = {
     "Launch": ["world config", "color config", "input devices config", "multibody configs"],
     "Joint": ["type", "parent pivot", "child pivot", "parent axis", "child axis"],
-    "Shaders": ["path", "vertex", "fragment"], "PublishFrequency": ["low", "high"],
-    "RGBA": ["r", "g", "b", "a"], "RGB": ["r", "g", "b"], "AmbientLevel": ["level"],
-    "ColorComponents": ["transparency"], "Inertia": ["ix", "iy", "iz"], "ClippingPlane": ["near", "far"],
-    "Stereo": ["mode", "eye separation", "focal length"], "HapticGain": ["linear", "angular"],
+    "Shaders": ["path", "vertex", "fragment"],
+    "PublishFrequency": ["low", "high"],
+    "RGBA": ["r", "g", "b", "a"],
+    "RGB": ["r", "g", "b"],
+    "AmbientLevel": ["level"],
+    "ColorComponents": ["transparency"],
+    "Inertia": ["ix", "iy", "iz"],
+    "ClippingPlane": ["near", "far"],
+    "Stereo": ["mode", "eye separation", "focal length"],
+    "HapticGain": ["linear", "angular"],
     "Suspension": ["stiffness", "damping", "compression", "rest length"],
     "Parametric": ["resolution", "horizontal angle", "vertical angle", "start offset"],
-    "Enclosure": ["length", "width", "height"], "Skybox": ["path"], "DepthNoise": ["mean"],
+    "Enclosure": ["length", "width", "height"],
+    "Skybox": ["path"],
+    "DepthNoise": ["mean"],
     "CartesianPID": ["P", "D"],
 }
 
@@ -66,26 +96,53 @@ ANY_VALUE = {"Joint.enable motor"}
 DEPENDENT_REQUIRED = {"Joint": {"enable motor": ["enable feedback"]}}
 
 EXAMPLES = {
-    "Joint.type": ["revolute", "prismatic", "fixed", "continuous", "linear spring", "torsion spring", "p2p",
-                   "cone twist", "six dof", "six dof spring"],
+    "Joint.type": [
+        "revolute",
+        "prismatic",
+        "fixed",
+        "continuous",
+        "linear spring",
+        "torsion spring",
+        "p2p",
+        "cone twist",
+        "six dof",
+        "six dof spring",
+    ],
     "shape": ["Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane"],
     "collision shape": ["Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane"],
     "collision mesh type": ["CONCAVE_MESH", "CONVEX_HULL", "CONVEX_MESH", "POINT_CLOUD"],
     "controller output type": ["FORCE", "VELOCITY", "POSITION"],
-    "Sensor.type": ["Proximity", "Resistance"], "Actuator.type": ["Constraint"],
+    "Sensor.type": ["Proximity", "Resistance"],
+    "Actuator.type": ["Constraint"],
     "Geometry.axis": ["x", "y", "z"],
 }
 
 # Geometry keys each primitive needs (§7.5); axis defaults to z.
-SHAPE_KEYS = {"Box": ["x", "y", "z"], "Sphere": ["radius"], "Cylinder": ["radius", "height"],
-              "Capsule": ["radius", "height"], "Cone": ["radius", "height"], "Plane": ["normal", "offset"]}
+SHAPE_KEYS = {
+    "Box": ["x", "y", "z"],
+    "Sphere": ["radius"],
+    "Cylinder": ["radius", "height"],
+    "Capsule": ["radius", "height"],
+    "Cone": ["radius", "height"],
+    "Plane": ["normal", "offset"],
+}
 
 # Add-on naming convention for top-level object mappings (for editors; AMBF goes by the lists).
-OBJECT_PREFIXES = {"^BODY ": "Body", "^JOINT ": "Joint", "^GHOST ": "Ghost", "^SENSOR ": "Sensor",
-                   "^ACTUATOR ": "Actuator"}
+OBJECT_PREFIXES = {
+    "^BODY ": "Body",
+    "^JOINT ": "Joint",
+    "^GHOST ": "Ghost",
+    "^SENSOR ": "Sensor",
+    "^ACTUATOR ": "Actuator",
+}
 
-KIND_TITLES = {"launch": "AMBF launch file", "world": "AMBF world file", "input_devices": "AMBF input-devices file",
-               "model": "AMBF model (multibody) file", "colors": "AMBF colors file"}
+KIND_TITLES = {
+    "launch": "AMBF launch file",
+    "world": "AMBF world file",
+    "input_devices": "AMBF input-devices file",
+    "model": "AMBF model (multibody) file",
+    "colors": "AMBF colors file",
+}
 
 
 def _shape_pattern(name: str) -> str:
@@ -93,10 +150,16 @@ def _shape_pattern(name: str) -> str:
 
 
 def _shape_rules(shape_key: str, geometry_key: str) -> list[dict]:
-    return [{"if": {"required": [shape_key, geometry_key],
-                    "properties": {shape_key: {"type": "string", "pattern": _shape_pattern(name)}}},
-             "then": {"properties": {geometry_key: {"required": keys}}}}
-            for name, keys in SHAPE_KEYS.items()]
+    return [
+        {
+            "if": {
+                "required": [shape_key, geometry_key],
+                "properties": {shape_key: {"type": "string", "pattern": _shape_pattern(name)}},
+            },
+            "then": {"properties": {geometry_key: {"required": keys}}},
+        }
+        for name, keys in SHAPE_KEYS.items()
+    ]
 
 
 class _Builder:
@@ -172,15 +235,21 @@ def build_schema(kind: str) -> dict:
     # Geometry and ShapeEntry always travel together; make sure both exist for the rules.
     top = b.node(cls)
     root = b.defs.pop(top)
-    schema = {"$schema": DIALECT, "$id": f"urn:adfkit:schema:{kind}", "title": KIND_TITLES[kind],
-              "description": f"{KIND_TITLES[kind]} as AMBF 2.x reads it (adf-format.md). Unknown keys are "
-                             "allowed because AMBF ignores them.",
-              **root}
+    schema = {
+        "$schema": DIALECT,
+        "$id": f"urn:adfkit:schema:{kind}",
+        "title": KIND_TITLES[kind],
+        "description": f"{KIND_TITLES[kind]} as AMBF 2.x reads it (adf-format.md). Unknown keys are "
+        "allowed because AMBF ignores them.",
+        **root,
+    }
     if kind == "colors":
         b.kind_schema("float", "Colors")
         schema["additionalProperties"] = {
-            "type": "object", "description": "A named colour {r, g, b, a}, 0–1.",
-            "properties": {k: {"$ref": "#/$defs/float"} for k in "rgba"}}
+            "type": "object",
+            "description": "A named colour {r, g, b, a}, 0–1.",
+            "properties": {k: {"$ref": "#/$defs/float"} for k in "rgba"},
+        }
     if kind == "model":
         schema["patternProperties"] = {pat: b.ref(name) for pat, name in OBJECT_PREFIXES.items()}
     schema["$defs"] = dict(sorted(b.defs.items()))

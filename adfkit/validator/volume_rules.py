@@ -1,15 +1,21 @@
 """Volumes (§11.4): every slice file read as the runner will read it (adfkit.geometry.volume:
 the input policy, Pillow, one size, a sane count), so a broken volume is a located error in CI
 rather than a volume AMBF silently skips."""
+
 from __future__ import annotations
 
 from ..diagnostics import AdfError, Diagnostic, Severity
 from ..model import ModelFile
 
 # the input policy's rules for a slice file, as the volume rule that names them
-_SLICE_RULES = {"file-not-found": "volume-slice-missing", "outside-tree": "volume-slice-missing",
-                "not-a-regular-file": "volume-slice-missing", "bad-path": "volume-slice-missing",
-                "file-unreadable": "volume-slice-unreadable", "file-too-large": "volume-too-large"}
+_SLICE_RULES = {
+    "file-not-found": "volume-slice-missing",
+    "outside-tree": "volume-slice-missing",
+    "not-a-regular-file": "volume-slice-missing",
+    "bad-path": "volume-slice-missing",
+    "file-unreadable": "volume-slice-unreadable",
+    "file-too-large": "volume-too-large",
+}
 
 
 def check(m: ModelFile) -> list[Diagnostic]:

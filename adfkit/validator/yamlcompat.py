@@ -13,6 +13,7 @@ indents such blocks so PyYAML can read the file with unchanged line numbers, and
 validator reports ``pyyaml-unparseable`` (a warning: the file is fine for AMBF, only
 PyYAML-based tools choke on it) instead of a syntax error.
 """
+
 from __future__ import annotations
 
 import re

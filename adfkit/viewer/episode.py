@@ -2,6 +2,7 @@
 ``--record`` writes: the needle's pose, each PSM's joints and jaw, the phase, the time) and the
 per-pair verdicts of ``metrics.json``. A replay is kinematic: the world is put in each frame's
 state, not simulated, so scrubbing back and forth is exact."""
+
 from __future__ import annotations
 
 import json
@@ -20,14 +21,14 @@ class Frame:
     time_s: float
     phase: str
     needle: np.ndarray | None
-    psms: dict                     # {name: {"jp": [...], "jaw": rad, ...}}
+    psms: dict  # {name: {"jp": [...], "jaw": rad, ...}}
 
 
 @dataclass
 class Episode:
     folder: Path
     frames: list[Frame]
-    pairs: list[dict] = field(default_factory=list)   # metrics.json "pairs"
+    pairs: list[dict] = field(default_factory=list)  # metrics.json "pairs"
     metrics: dict = field(default_factory=dict)
 
     def verdicts_markdown(self) -> str:
@@ -54,8 +55,11 @@ def load_episode(folder: str | Path) -> Episode:
     dataset = root / "dataset" if (root / "dataset" / "index.jsonl").is_file() else root
     index = dataset / "index.jsonl"
     if not index.is_file():
-        raise _fail(f"{inputs.shown(root)} holds no recorded frames (no dataset/index.jsonl)", root,
-                    "record one with `adfkit suture --record --out DIR`, then view DIR")
+        raise _fail(
+            f"{inputs.shown(root)} holds no recorded frames (no dataset/index.jsonl)",
+            root,
+            "record one with `adfkit suture --record --out DIR`, then view DIR",
+        )
     text = inputs.read_text(index, "text", tree=inputs.tree_of(root), what="episode index")
     by_step: dict[int, Frame] = {}
     for n, line in enumerate(text.splitlines(), 1):
@@ -65,12 +69,19 @@ def load_episode(folder: str | Path) -> Episode:
             d = json.loads(line)
             step = int(d["step"])
         except (ValueError, KeyError, TypeError) as exc:
-            raise AdfError(error("bad-episode", f"frame line {n} is not a frame record ({type(exc).__name__})",
-                                 SourceLocation(str(index), n, 1), "the file is written by adfkit suture --record"))
+            raise AdfError(
+                error(
+                    "bad-episode",
+                    f"frame line {n} is not a frame record ({type(exc).__name__})",
+                    SourceLocation(str(index), n, 1),
+                    "the file is written by adfkit suture --record",
+                )
+            ) from None
         if step not in by_step:
             needle = np.asarray(d["needle"], dtype=float) if d.get("needle") is not None else None
-            by_step[step] = Frame(step, float(d.get("time_s", 0.0)), str(d.get("phase", "")), needle,
-                                  dict(d.get("psms") or {}))
+            by_step[step] = Frame(
+                step, float(d.get("time_s", 0.0)), str(d.get("phase", "")), needle, dict(d.get("psms") or {})
+            )
     frames = [by_step[k] for k in sorted(by_step)]
     if not frames:
         raise _fail(f"{inputs.shown(index)} lists no frames", index, "record a longer episode")

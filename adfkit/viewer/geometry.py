@@ -3,6 +3,7 @@ body frame: the mesh origin): its visual (a primitive, else its visual mesh, sca
 colour) and its collision shape (primitives, compound entries or the collision mesh). The same
 ADF rules as the runner (a primitive beats a mesh; §7.3 and §7.4), read from the model, so the
 picture does not depend on the engine that plays the scene."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -20,9 +21,9 @@ DEFAULT_COLOUR = (0.8, 0.8, 0.8, 1.0)
 
 @dataclass
 class Part:
-    vertices: np.ndarray        # (n, 3) float32, object frame, metres
-    faces: np.ndarray           # (m, 3) uint32
-    colour: tuple               # (r, g, b, a) in 0..1
+    vertices: np.ndarray  # (n, 3) float32, object frame, metres
+    faces: np.ndarray  # (m, 3) uint32
+    colour: tuple  # (r, g, b, a) in 0..1
 
 
 def primitive(kind: ShapeKind, g, scale: float = 1.0) -> trimesh.Trimesh | None:
@@ -53,8 +54,11 @@ def primitive(kind: ShapeKind, g, scale: float = 1.0) -> trimesh.Trimesh | None:
 def _part(mesh: trimesh.Trimesh, colour) -> Part | None:
     if mesh is None or len(mesh.faces) == 0:
         return None
-    return Part(np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.uint32),
-                tuple(float(c) for c in colour))
+    return Part(
+        np.asarray(mesh.vertices, dtype=np.float32),
+        np.asarray(mesh.faces, dtype=np.uint32),
+        tuple(float(c) for c in colour),
+    )
 
 
 def _mesh_file(model, path, scale: float) -> trimesh.Trimesh | None:
@@ -62,6 +66,7 @@ def _mesh_file(model, path, scale: float) -> trimesh.Trimesh | None:
     cannot be read (the validator and the runner say why)."""
     from ..diagnostics import AdfError
     from ..geometry.meshio import load_mesh
+
     try:
         return load_mesh(path, scale=scale, tree=getattr(model, "tree", None))
     except (AdfError, ValueError):

@@ -1,6 +1,7 @@
 """The viewer's side panels: findings, simulation controls, what to show, a slider per joint,
 a PSM's jaw and Cartesian target, the cameras' images, a body's facts on click, and the replay
 of a recorded suture. Each control changes the world under the viewer's lock."""
+
 from __future__ import annotations
 
 import math
@@ -17,8 +18,11 @@ def findings_panel(v) -> None:
             gui.add_markdown("`adfkit validate`: no findings")
             return
         errors = sum(d.severity >= Severity.ERROR for d in v.findings)
-        head = (f"**The scene cannot be played: {errors} error(s).**" if v.world is None
-                else f"{len(v.findings)} finding(s)")
+        head = (
+            f"**The scene cannot be played: {errors} error(s).**"
+            if v.world is None
+            else f"{len(v.findings)} finding(s)"
+        )
         lines = [head, ""] + [f"- `{d.location}` **{d.severity}[{d.rule}]** {d.message}" for d in v.findings[:60]]
         gui.add_markdown("\n".join(lines))
 
@@ -50,38 +54,47 @@ def simulation_panel(v) -> None:
         v.reset()
         v.status.content = _status(v)
 
-    def tick() -> None:   # refresh the status line while playing
+    def tick() -> None:  # refresh the status line while playing
         if v.world is not None:
             v.status.content = _status(v)
+
     v.status_tick = tick
 
 
 def _status(v) -> str:
     w = v.world
-    return (f"t = {w.sim_time:.3f} s · {v.rtf:.2f}x real time · {len(w.bodies)} bodies · "
-            f"{v.engine}" if w is not None else "no world")
+    return (
+        f"t = {w.sim_time:.3f} s · {v.rtf:.2f}x real time · {len(w.bodies)} bodies · {v.engine}"
+        if w is not None
+        else "no world"
+    )
 
 
 def show_panel(v) -> None:
     gui = v.server.gui
     with gui.add_folder("Show"):
-        boxes = {"collision": gui.add_checkbox("Collision shapes", False),
-                 "ghosts": gui.add_checkbox("Ghost objects", False),
-                 "joints": gui.add_checkbox("Joint frames and axes", False),
-                 "frustums": gui.add_checkbox("Camera frustums", False)}
+        boxes = {
+            "collision": gui.add_checkbox("Collision shapes", False),
+            "ghosts": gui.add_checkbox("Ghost objects", False),
+            "joints": gui.add_checkbox("Joint frames and axes", False),
+            "frustums": gui.add_checkbox("Camera frustums", False),
+        }
         contacts = gui.add_checkbox("Contact points", False)
     for name, box in boxes.items():
+
         def flip(_e, name=name, box=box) -> None:
             for h in v.toggled[name]:
                 h.visible = box.value
             v.update_poses()
+
         box.on_update(flip)
 
     @contacts.on_update
     def _(_e) -> None:
         if contacts.value:
-            v.contacts = v.server.scene.add_point_cloud("/contacts", np.zeros((1, 3), np.float32),
-                                                        colors=(1.0, 0.1, 0.1), point_size=0.003)
+            v.contacts = v.server.scene.add_point_cloud(
+                "/contacts", np.zeros((1, 3), np.float32), colors=(1.0, 0.1, 0.1), point_size=0.003
+            )
             v.update_poses()
         elif v.contacts is not None:
             v.contacts.remove()
@@ -94,6 +107,7 @@ def contact_points(world) -> np.ndarray:
         d = world.data
         return np.array([d.contact[i].pos for i in range(d.ncon)], dtype=np.float32).reshape(-1, 3)
     import pybullet as pb
+
     pts = pb.getContactPoints(physicsClientId=world.cid)
     return np.array([p[5] for p in pts], dtype=np.float32).reshape(-1, 3)
 
@@ -106,6 +120,7 @@ def draw_contacts(v) -> None:
 def joints_panel(v) -> None:
     """A slider per joint of each multibody: the joint is put there and its motor holds it."""
     from ..model.semantics import JointKind
+
     gui = v.server.gui
     arts = list(getattr(v.world, "articulations", []))
     if not arts:
@@ -124,8 +139,13 @@ def joints_panel(v) -> None:
                     if not lo < hi:
                         lo, hi = -span, span
                     value = float(np.clip(q[k], lo, hi))
-                    s = gui.add_slider(jname.removeprefix("JOINT "), min=float(lo), max=float(hi),
-                                       step=(hi - lo) / 200, initial_value=value)
+                    s = gui.add_slider(
+                        jname.removeprefix("JOINT "),
+                        min=float(lo),
+                        max=float(hi),
+                        step=(hi - lo) / 200,
+                        initial_value=value,
+                    )
                     s.on_update(lambda _e, art=art, k=k, s=s: _set_joint(v, art, k, s.value))
 
 
@@ -147,6 +167,7 @@ def _set_joint(v, art, k: int, value: float) -> None:
 def psm_panel(v) -> None:
     """For each PSM the scene has: its jaw and a Cartesian target through the closed-form IK."""
     from ..runner.psm import PSM
+
     gui = v.server.gui
     for name in ("psm1", "psm2"):
         try:
@@ -156,8 +177,9 @@ def psm_panel(v) -> None:
             continue
         with gui.add_folder(f"PSM {name}", expand_by_default=False):
             ee = psm.measured_cp()
-            target = gui.add_vector3("Target (m, base frame)", initial_value=tuple(float(x) for x in ee[:3, 3]),
-                                     step=0.001)
+            target = gui.add_vector3(
+                "Target (m, base frame)", initial_value=tuple(float(x) for x in ee[:3, 3]), step=0.001
+            )
             go = gui.add_button("Move (IK)")
             jaw = gui.add_slider("Jaw (rad)", min=0.0, max=1.0, step=0.01, initial_value=0.5)
             note = gui.add_markdown("")
@@ -172,11 +194,13 @@ def psm_panel(v) -> None:
             except ValueError as exc:
                 note.content = f"out of reach: {exc}"
             v.update_poses()
+
         go.on_click(move)
 
         def set_jaw(_e, psm=psm, jaw=jaw) -> None:
             with v.lock:
                 psm.servo_jaw(jaw.value)
+
         jaw.on_update(set_jaw)
 
 
@@ -194,6 +218,7 @@ def camera_panel(v) -> None:
 
     def render(_e=None) -> None:
         from ..dataset.colors import colourise
+
         cam = next(c for c in cams if c.name == which.value)
         try:
             with v.lock:
@@ -213,6 +238,7 @@ def camera_panel(v) -> None:
             img = colourise(np.asarray(frame["segmentation"]))
         image.image = img
         image.label = f"{cam.name} · {mode.value} · t = {v.world.sim_time:.2f} s"
+
     draw.on_click(render)
 
 
@@ -221,10 +247,11 @@ def show_body(v, sb) -> None:
     b = sb.body
     where = b.where() if hasattr(b, "where") else None
     inertia = b.inertia
-    text = (f"**{b.identifier}** ({sb.key})\n\n- file: `{where}`\n- mass: {sb.mass:g} kg"
-            + (f"\n- inertia: ix {inertia.ix:g}, iy {inertia.iy:g}, iz {inertia.iz:g} kg·m²"
-               if inertia is not None and None not in (inertia.ix, inertia.iy, inertia.iz)
-               else "\n- inertia: estimated (not in the file)"))
+    text = f"**{b.identifier}** ({sb.key})\n\n- file: `{where}`\n- mass: {sb.mass:g} kg" + (
+        f"\n- inertia: ix {inertia.ix:g}, iy {inertia.iy:g}, iz {inertia.iz:g} kg·m²"
+        if inertia is not None and None not in (inertia.ix, inertia.iy, inertia.iz)
+        else "\n- inertia: estimated (not in the file)"
+    )
     if getattr(v, "selected", None) is None:
         v.selected = v.server.gui.add_markdown(text)
     else:
@@ -234,6 +261,7 @@ def show_body(v, sb) -> None:
 def episode_panel(v) -> None:
     """Replay a recorded suture: a timeline slider, the phase and the per-pair verdicts."""
     from .episode import load_episode
+
     gui = v.server.gui
     try:
         ep = load_episode(v.episode_dir)
@@ -252,6 +280,7 @@ def episode_panel(v) -> None:
         v.playing = False
         apply_frame(v, f)
         phase.content = f"t = {f.time_s:.2f} s · phase **{f.phase or '-'}** · step {f.step}"
+
     timeline.on_update(show)
     show()
 
@@ -259,6 +288,7 @@ def episode_panel(v) -> None:
 def apply_frame(v, f) -> None:
     """Put the world in a recorded frame's state: the needle's pose, each PSM's joints and jaw."""
     from ..runner.psm import PSM
+
     with v.lock:
         w = v.world
         if f.needle is not None:

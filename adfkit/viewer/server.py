@@ -5,6 +5,7 @@ PyBullet or MuJoCo world, steps it on a thread of its own, and sends the bodies'
 page. Geometry comes from the ADF model (viewer/geometry.py), so both engines look alike. The
 controls (panels.py) change the world only under ``lock``.
 """
+
 from __future__ import annotations
 
 import socket
@@ -18,7 +19,7 @@ from ..diagnostics import AdfError, Diagnostic, Severity, error
 from ..runner.rotations import matrix_to_quat
 from . import geometry
 
-FRAME_S = 1 / 30            # the page is sent poses this often while playing
+FRAME_S = 1 / 30  # the page is sent poses this often while playing
 
 
 def _wxyz(m: np.ndarray) -> tuple:
@@ -33,16 +34,29 @@ def check_port(host: str, port: int) -> None:
         try:
             s.bind((host, port))
         except OSError as exc:
-            raise AdfError(error("port-in-use", f"cannot listen on {host}:{port}: {exc.strerror or exc}", None,
-                                 "pick another port with --port, or stop what uses this one")) from None
+            raise AdfError(
+                error(
+                    "port-in-use",
+                    f"cannot listen on {host}:{port}: {exc.strerror or exc}",
+                    None,
+                    "pick another port with --port, or stop what uses this one",
+                )
+            ) from None
 
 
 class Viewer:
     """One scene in one viser server. ``findings`` are the scene's validation diagnostics; when
     the scene cannot be played (``world`` None) the page lists them instead."""
 
-    def __init__(self, scene_path: Path, indices, engine: str = "pybullet", host: str = "127.0.0.1",
-                 port: int = 8080, episode: Path | None = None) -> None:
+    def __init__(
+        self,
+        scene_path: Path,
+        indices,
+        engine: str = "pybullet",
+        host: str = "127.0.0.1",
+        port: int = 8080,
+        episode: Path | None = None,
+    ) -> None:
         self.scene_path, self.indices, self.engine = Path(scene_path), indices, engine
         self.host, self.port, self.episode_dir = host, port, episode
         self.lock = threading.RLock()
@@ -53,9 +67,9 @@ class Viewer:
         self.frames_sent = 0
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        self.body_nodes: list = []          # (sim body, frame handle)
-        self.soft_nodes: list = []          # (soft body, mesh handle): vertices resent each frame
-        self.ghost_nodes: list = []         # (sim ghost, frame handle)
+        self.body_nodes: list = []  # (sim body, frame handle)
+        self.soft_nodes: list = []  # (soft body, mesh handle): vertices resent each frame
+        self.ghost_nodes: list = []  # (sim ghost, frame handle)
         self.toggled: dict[str, list] = {"collision": [], "ghosts": [], "joints": [], "frustums": []}
         self.contacts = None
         self.episode = None
@@ -67,6 +81,7 @@ class Viewer:
         """Validate the scene and build its world; errors are kept as findings, not raised."""
         from ..adf import load_scene
         from ..validator.engine import validate_files
+
         try:
             results = validate_files([(self.scene_path, None)])
             self.findings = [d for r in results for d in r.diagnostics]
@@ -83,11 +98,14 @@ class Viewer:
 
     def _make_world(self):
         from ..runner.options import Options
+
         opt = Options(renderer="auto")
         if self.engine == "mujoco":
             from ..runner.mj.world import MjWorld
+
             return MjWorld(self.scene, opt)
         from ..runner.world import SimWorld
+
         return SimWorld(self.scene, opt)
 
     def reset(self) -> None:
@@ -102,11 +120,13 @@ class Viewer:
     def start(self) -> str:
         """Start the server (the port checked first) and draw the scene; returns its address."""
         import viser
+
         check_port(self.host, self.port)
         self.server = viser.ViserServer(host=self.host, port=self.port, verbose=False)
         self.server.scene.set_up_direction("+z")
         self._initial_view()
         from . import panels
+
         panels.findings_panel(self)
         if self.world is not None:
             self._draw()
@@ -143,18 +163,30 @@ class Viewer:
     def _draw(self) -> None:
         scene, w = self.server.scene, self.world
         from . import panels
+
         for i, sb in enumerate(w.bodies):
             frame = scene.add_frame(f"/bodies/b{i}", show_axes=False)
-            surface = getattr(sb, "surface", None)      # a volume's iso-surface (runner/volumes.py)
+            surface = getattr(sb, "surface", None)  # a volume's iso-surface (runner/volumes.py)
             parts = [geometry.Part(*surface)] if surface is not None else geometry.visual_parts(sb.model, sb.body)
             for k, part in enumerate(parts):
-                h = scene.add_mesh_simple(f"/bodies/b{i}/visual{k}", part.vertices, part.faces,
-                                          color=tuple(part.colour[:3]), opacity=part.colour[3] if part.colour[3] < 1 else None)
+                h = scene.add_mesh_simple(
+                    f"/bodies/b{i}/visual{k}",
+                    part.vertices,
+                    part.faces,
+                    color=tuple(part.colour[:3]),
+                    opacity=part.colour[3] if part.colour[3] < 1 else None,
+                )
                 h.on_click(lambda _e, sb=sb: panels.show_body(self, sb))
             for k, part in enumerate(geometry.collision_parts(sb.model, sb.body)):
-                h = scene.add_mesh_simple(f"/bodies/b{i}/collision{k}", part.vertices, part.faces,
-                                          color=tuple(part.colour[:3]), opacity=part.colour[3], wireframe=True,
-                                          visible=False)
+                h = scene.add_mesh_simple(
+                    f"/bodies/b{i}/collision{k}",
+                    part.vertices,
+                    part.faces,
+                    color=tuple(part.colour[:3]),
+                    opacity=part.colour[3],
+                    wireframe=True,
+                    visible=False,
+                )
                 self.toggled["collision"].append(h)
             self.body_nodes.append((sb, frame))
         self._draw_soft_bodies()
@@ -164,10 +196,12 @@ class Viewer:
             if model is None:
                 continue
             frame = scene.add_frame(f"/ghosts/g{j}", show_axes=False, visible=False)
-            for k, part in enumerate(geometry.visual_parts(model, g.ghost) or
-                                     geometry.collision_parts(model, g.ghost, (0.2, 0.5, 1.0, 0.3))):
-                scene.add_mesh_simple(f"/ghosts/g{j}/shape{k}", part.vertices, part.faces,
-                                      color=(0.2, 0.5, 1.0), opacity=0.35)
+            for k, part in enumerate(
+                geometry.visual_parts(model, g.ghost) or geometry.collision_parts(model, g.ghost, (0.2, 0.5, 1.0, 0.3))
+            ):
+                scene.add_mesh_simple(
+                    f"/ghosts/g{j}/shape{k}", part.vertices, part.faces, color=(0.2, 0.5, 1.0), opacity=0.35
+                )
             self.ghost_nodes.append((g, frame))
             self.toggled["ghosts"].append(frame)
         self._draw_joint_frames()
@@ -181,18 +215,21 @@ class Viewer:
             return
         from ..geometry.softmesh import placed_soft_mesh
         from ..runner.shapes import rgba
+
         for n, s in enumerate(soft.items):
             try:
                 tris = np.asarray(placed_soft_mesh(s.model, s.soft).triangles, dtype=np.uint32)
             except (AdfError, ValueError):
                 continue
             colour = rgba(s.soft) or (0.85, 0.55, 0.5, 1.0)
-            h = self.server.scene.add_mesh_simple(f"/soft/s{n}", s.nodes(self.world.cid).astype(np.float32), tris,
-                                                  color=tuple(colour[:3]), side="double")
+            h = self.server.scene.add_mesh_simple(
+                f"/soft/s{n}", s.nodes(self.world.cid).astype(np.float32), tris, color=tuple(colour[:3]), side="double"
+            )
             self.soft_nodes.append((s, h))
 
     def _draw_joint_frames(self) -> None:
         from ..model.semantics import joint_frames
+
         index = {id(sb.body): i for i, sb in enumerate(self.world.bodies)}
         for m in self.scene.all_models():
             for j in m.joints:
@@ -204,18 +241,31 @@ class Viewer:
                 except (TypeError, ValueError, ZeroDivisionError):
                     continue
                 q = a.orientation
-                h = self.server.scene.add_frame(f"/bodies/b{index[id(parent)]}/joint_{len(self.toggled['joints'])}",
-                                                axes_length=0.01, axes_radius=0.0006,
-                                                position=tuple(a.position), wxyz=(q.w, q.x, q.y, q.z), visible=False)
+                h = self.server.scene.add_frame(
+                    f"/bodies/b{index[id(parent)]}/joint_{len(self.toggled['joints'])}",
+                    axes_length=0.01,
+                    axes_radius=0.0006,
+                    position=tuple(a.position),
+                    wxyz=(q.w, q.x, q.y, q.z),
+                    visible=False,
+                )
                 self.toggled["joints"].append(h)
 
     def _draw_cameras(self) -> None:
         from ..dataset.writer import camera_to_world
+
         for n, cam in enumerate(self.world.cameras):
             t = camera_to_world(*cam.view(self.world))
-            h = self.server.scene.add_camera_frustum(f"/cameras/c{n}", fov=float(cam.fov), aspect=cam.width / cam.height,
-                                                     scale=0.02, color=(0.9, 0.6, 0.1), position=tuple(t[:3, 3]),
-                                                     wxyz=_wxyz(t), visible=False)
+            h = self.server.scene.add_camera_frustum(
+                f"/cameras/c{n}",
+                fov=float(cam.fov),
+                aspect=cam.width / cam.height,
+                scale=0.02,
+                color=(0.9, 0.6, 0.1),
+                position=tuple(t[:3, 3]),
+                wxyz=_wxyz(t),
+                visible=False,
+            )
             self.toggled["frustums"].append(h)
 
     def update_poses(self) -> None:
@@ -236,6 +286,7 @@ class Viewer:
                     frame.position, frame.wxyz = tuple(m[:3, 3]), _wxyz(m)
             if self.contacts is not None:
                 from . import panels
+
                 panels.draw_contacts(self)
             self.frames_sent += 1
 

@@ -11,6 +11,7 @@ runner adds (docs/mujoco.md):
 - one inactive weld equality per constraint actuator (the grasp), re-targeted when grasping;
 - collision groups as contype/conaffinity bits, `ignore inter collision` as excluded pairs.
 """
+
 from __future__ import annotations
 
 import tempfile
@@ -21,14 +22,19 @@ import mujoco
 import numpy as np
 
 from ...converters.mjcf_write import to_mjcf
-from ...diagnostics import AdfError, SourceLocation, error
 from ...converters.urdf import _material
+from ...diagnostics import AdfError, SourceLocation, error
 from ...model.semantics import JointKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
 from ..rotations import matrix_to_quat, pose_to_matrix
 
-SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
-                JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING)
+SPRING_KINDS = (
+    JointKind.SIX_DOF,
+    JointKind.SIX_DOF_SPRING,
+    JointKind.CONE_TWIST,
+    JointKind.LINEAR_SPRING,
+    JointKind.TORSION_SPRING,
+)
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
 GHOST_GROUP = 4
 # the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. A weld's
@@ -40,15 +46,15 @@ WELD_DAMPING_RATIO = 1.0
 
 @dataclass
 class BodyPlan:
-    key: str                      # namespace + identifier, as SimWorld keys it
-    body: object                  # ADF Body
-    model: object                 # ADF ModelFile
-    mjname: str                   # MJCF body name ("world" for ADF's world stand-in)
-    link: object                  # model.tree.Link
-    spring: tuple | None = None   # (joint, kind) of a six-dof-family joint to its parent
+    key: str  # namespace + identifier, as SimWorld keys it
+    body: object  # ADF Body
+    model: object  # ADF ModelFile
+    mjname: str  # MJCF body name ("world" for ADF's world stand-in)
+    link: object  # model.tree.Link
+    spring: tuple | None = None  # (joint, kind) of a six-dof-family joint to its parent
 
 
-EXCLUDE_SPARE = 512   # run-time excluded pairs (MjWorld.set_collision); the suture turns off ~300
+EXCLUDE_SPARE = 512  # run-time excluded pairs (MjWorld.set_collision); the suture turns off ~300
 
 
 @dataclass
@@ -58,7 +64,7 @@ class GhostPlan:
     parent: BodyPlan | None
     geoms: list[str] = field(default_factory=list)
     friction: bool = False
-    location: np.ndarray | None = None   # the ghost's frame in its parent's ADF body frame (or the world)
+    location: np.ndarray | None = None  # the ghost's frame in its parent's ADF body frame (or the world)
 
 
 @dataclass
@@ -66,22 +72,25 @@ class Plan:
     spec: object
     bodies: list[BodyPlan]
     ghosts: list[GhostPlan]
-    actuators: list[tuple]        # (key, ADF actuator, parent BodyPlan, weld name)
-    joints: list[tuple]           # (ADF joint, kind, parent BodyPlan, child BodyPlan, MJCF joint names)
-    loops: list[tuple]            # (ADF joint, kind, parent BodyPlan, child BodyPlan, pivot in parent link, pivot in child link)
+    actuators: list[tuple]  # (key, ADF actuator, parent BodyPlan, weld name)
+    joints: list[tuple]  # (ADF joint, kind, parent BodyPlan, child BodyPlan, MJCF joint names)
+    loops: list[tuple]  # (ADF joint, kind, parent BodyPlan, child BodyPlan, pivot in parent link, pivot in child link)
     springs: int = 0
     losses: list = field(default_factory=list)
     tmp: object = None
-    sensors: list = field(default_factory=list)   # (key, ADF sensor, parent BodyPlan)
+    sensors: list = field(default_factory=list)  # (key, ADF sensor, parent BodyPlan)
 
 
 def _spring_axes(joint, kind):
     """[(slide|hinge, axis index, low, high, stiffness, damping, equilibrium)] of a six-dof-family joint."""
     from ..joints import spring_joint
+
     sj = spring_joint(joint, kind, None, None, np.eye(4), np.eye(4))
     out = []
-    for tag, lo, hi, k, c, eq in (("slide", sj.lin_low, sj.lin_high, sj.k_lin, sj.c_lin, sj.eq_lin),
-                                  ("hinge", sj.ang_low, sj.ang_high, sj.k_ang, sj.c_ang, sj.eq_ang)):
+    for tag, lo, hi, k, c, eq in (
+        ("slide", sj.lin_low, sj.lin_high, sj.k_lin, sj.c_lin, sj.eq_lin),
+        ("hinge", sj.ang_low, sj.ang_high, sj.k_ang, sj.c_ang, sj.eq_ang),
+    ):
         for i in range(3):
             if hi[i] - lo[i] > 1e-12:
                 out.append((tag, i, float(lo[i]), float(hi[i]), float(k[i]), float(c[i]), float(eq[i])))
@@ -91,28 +100,37 @@ def _spring_axes(joint, kind):
 def _ghost_geoms(body_el, gh, pose_in_link: np.ndarray, name: str, warn) -> list[str]:
     prims = collision_primitives(gh)
     if not prims:
-        warn("runner-ghost", f"{gh.identifier}: only primitive ghost shapes are played by the MuJoCo engine; skipped", gh)
+        warn(
+            "runner-ghost", f"{gh.identifier}: only primitive ghost shapes are played by the MuJoCo engine; skipped", gh
+        )
         return []
     from ...model.semantics import ShapeKind
+
     out = []
     for n, p in enumerate(prims):
         t = pose_in_link @ pose_to_matrix(p.pose)
         g = p.geometry
-        kw = dict(contype=0, conaffinity=0, group=GHOST_GROUP, pos=t[:3, 3], rgba=[0, 1, 0, 0.2],
-                  name=f"{name}#{n}")
+        kw = dict(contype=0, conaffinity=0, group=GHOST_GROUP, pos=t[:3, 3], rgba=[0, 1, 0, 0.2], name=f"{name}#{n}")
         if p.kind is ShapeKind.BOX:
             kw.update(type=mujoco.mjtGeom.mjGEOM_BOX, size=[(g.x or 0) / 2, (g.y or 0) / 2, (g.z or 0) / 2])
         elif p.kind is ShapeKind.SPHERE:
             kw.update(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[g.radius or 0.0, 0, 0])
         elif p.kind in (ShapeKind.CYLINDER, ShapeKind.CAPSULE):
             ax = (g.axis or "z").lower()
-            turn = {"x": np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]]), "y": np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]])}
+            turn = {
+                "x": np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]]),
+                "y": np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]]),
+            }
             r = t[:3, :3] @ turn[ax].T if ax in turn else t[:3, :3]
             t = t.copy()
             t[:3, :3] = r
-            half = (g.height or 0) / 2 if p.kind is ShapeKind.CYLINDER else max((g.height or 0) / 2 - (g.radius or 0), 0)
-            kw.update(type=mujoco.mjtGeom.mjGEOM_CYLINDER if p.kind is ShapeKind.CYLINDER
-                      else mujoco.mjtGeom.mjGEOM_CAPSULE, size=[g.radius or 0.0, half, 0])
+            half = (
+                (g.height or 0) / 2 if p.kind is ShapeKind.CYLINDER else max((g.height or 0) / 2 - (g.radius or 0), 0)
+            )
+            kw.update(
+                type=mujoco.mjtGeom.mjGEOM_CYLINDER if p.kind is ShapeKind.CYLINDER else mujoco.mjtGeom.mjGEOM_CAPSULE,
+                size=[g.radius or 0.0, half, 0],
+            )
         else:
             warn("runner-ghost", f"{gh.identifier}: ghost shape {p.kind.value} not played by the MuJoCo engine", gh)
             continue
@@ -126,6 +144,7 @@ def _ghost_geoms(body_el, gh, pose_in_link: np.ndarray, name: str, warn) -> list
 def build_plan(world) -> Plan:
     """The MjSpec of ``world.scene`` (not compiled) and the tables the MuJoCo world reads."""
     from ..names import Registry, merge_namespace
+
     scene, opt = world.scene, world.opt
     tmp = tempfile.TemporaryDirectory(prefix="adfkit-mj-")
     out_dir = Path(tmp.name)
@@ -139,10 +158,15 @@ def build_plan(world) -> Plan:
         ns = m.namespace or ""
         for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles), ("volume", m.volumes)):
             for o in objs:
-                world._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
-                            "MuJoCo engine; skipped", o, "play it with --engine pybullet")
-                world.not_played.append({"object": o.identifier, "what": kind,
-                                         "why": f"{kind}s are not played by the MuJoCo engine"})
+                world._warn(
+                    f"runner-{kind.replace(' ', '-')}",
+                    f"{o.identifier}: {kind}s are not played by the MuJoCo engine; skipped",
+                    o,
+                    "play it with --engine pybullet",
+                )
+                world.not_played.append(
+                    {"object": o.identifier, "what": kind, "why": f"{kind}s are not played by the MuJoCo engine"}
+                )
         mine = {}
         if m.bodies:
             names: dict = {}
@@ -171,7 +195,7 @@ def build_plan(world) -> Plan:
         else:
             plans_by_model.append((m, mine, None))
     joints, loops, springs = [], [], 0
-    for m, mine, tree in plans_by_model:
+    for _m, mine, tree in plans_by_model:
         if tree is None:
             continue
         for lk in tree.ordered():
@@ -185,12 +209,17 @@ def build_plan(world) -> Plan:
             elif lk.kind in SPRING_KINDS:
                 springs += 1
                 mj = spec.body(child.mjname)
-                for n, (tag, ax, lo, hi, k, c, eq) in enumerate(_spring_axes(lk.joint, lk.kind)):
+                for _n, (tag, ax, lo, hi, k, c, eq) in enumerate(_spring_axes(lk.joint, lk.kind)):
                     axis = [0.0, 0.0, 0.0]
                     axis[ax] = 1.0
-                    j = mj.add_joint(type=mujoco.mjtJoint.mjJNT_SLIDE if tag == "slide" else mujoco.mjtJoint.mjJNT_HINGE,
-                                     axis=axis, name=f"{child.mjname}#{tag}{'xyz'[ax]}", stiffness=k, damping=c,
-                                     springref=eq)
+                    j = mj.add_joint(
+                        type=mujoco.mjtJoint.mjJNT_SLIDE if tag == "slide" else mujoco.mjtJoint.mjJNT_HINGE,
+                        axis=axis,
+                        name=f"{child.mjname}#{tag}{'xyz'[ax]}",
+                        stiffness=k,
+                        damping=c,
+                        springref=eq,
+                    )
                     if np.isfinite(lo) and np.isfinite(hi) and (tag == "slide" or hi - lo < 2 * np.pi):
                         j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
                         j.range = [lo, hi]
@@ -204,12 +233,15 @@ def build_plan(world) -> Plan:
                 pbv = np.array(child.link.in_link(b).position, float)
                 loops.append((j, kind, parent, child, pa, pbv))
             else:
-                world._warn("runner-loop", f"{j.identifier}: a {kind.value} joint closing a loop is not played by the "
-                            "MuJoCo engine; skipped", j)
+                world._warn(
+                    "runner-loop",
+                    f"{j.identifier}: a {kind.value} joint closing a loop is not played by the MuJoCo engine; skipped",
+                    j,
+                )
     _world_lights(world, spec)
     _collision_filters(world, spec, bodies, joints, plans_by_model)
     ghosts, actuators, sensors = [], [], []
-    for m, mine, tree in plans_by_model:
+    for m, _mine, _tree in plans_by_model:
         ns = m.namespace or ""
         for gh in m.ghost_objects:
             parent = _parent(world, gh.parent, ns, gh) if gh.parent else None
@@ -219,15 +251,25 @@ def build_plan(world) -> Plan:
             key = registry.add(merge_namespace(ns, gh.namespace) + gh.identifier, None)
             body_el = spec.worldbody if parent is None or parent.mjname == "world" else spec.body(parent.mjname)
             name = (gh.name or gh.identifier).lower()
-            gp = GhostPlan(key, gh, parent, _ghost_geoms(body_el, gh, loc, f"ghost:{key}", world._warn),
-                           any(w in name for w in opt.hole_ghost_words), location)
+            gp = GhostPlan(
+                key,
+                gh,
+                parent,
+                _ghost_geoms(body_el, gh, loc, f"ghost:{key}", world._warn),
+                any(w in name for w in opt.hole_ghost_words),
+                location,
+            )
             if gp.geoms:
                 ghosts.append(gp)
         from ...model.semantics import ACTUATOR_TYPES, SENSOR_TYPES
+
         for sn in m.sensors:
             if SENSOR_TYPES.get(sn.type) != "proximity" or not sn.array:
-                world._warn("runner-sensor", f"{sn.identifier}: only proximity sensors with an `array` of rays "
-                            "are played; skipped", sn)
+                world._warn(
+                    "runner-sensor",
+                    f"{sn.identifier}: only proximity sensors with an `array` of rays are played; skipped",
+                    sn,
+                )
                 continue
             parent = _parent(world, sn.parent, ns, sn)
             if parent is not None:
@@ -241,14 +283,20 @@ def build_plan(world) -> Plan:
                 continue
             key = merge_namespace(ns, a.namespace) + a.identifier
             weld = f"grasp:{key}"
-            spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name=weld, name1=parent.mjname, name2="world",
-                              objtype=mujoco.mjtObj.mjOBJ_BODY, active=False,
-                              solref=[WELD_TIMECONST_STEPS * world.dt, WELD_DAMPING_RATIO])
+            spec.add_equality(
+                type=mujoco.mjtEq.mjEQ_WELD,
+                name=weld,
+                name1=parent.mjname,
+                name2="world",
+                objtype=mujoco.mjtObj.mjOBJ_BODY,
+                active=False,
+                solref=[WELD_TIMECONST_STEPS * world.dt, WELD_DAMPING_RATIO],
+            )
             actuators.append((key, a, parent, weld))
-    for j, kind, parent, child, jn in joints:
+    for _j, kind, _pa, _ch, jn in joints:
         if kind in ONE_DOF and jn:
             act = spec.add_actuator(name=f"motor:{jn[0]}", target=jn[0], trntype=mujoco.mjtTrn.mjTRN_JOINT)
-            act.set_to_position(kp=1.0, kv=0.0)   # gains are set per joint once the model is compiled
+            act.set_to_position(kp=1.0, kv=0.0)  # gains are set per joint once the model is compiled
     return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors)
 
 
@@ -270,7 +318,9 @@ def _resolve_meshes(world, child, out_dir: Path, model) -> None:
         if g.meshname in missing:
             child.delete(g)
     for name, mesh in missing.items():
-        world._warn("runner-mesh", f"{model.name}: mesh file {missing_paths[name]} not found; its shapes are left out", model)
+        world._warn(
+            "runner-mesh", f"{model.name}: mesh file {missing_paths[name]} not found; its shapes are left out", model
+        )
         child.delete(mesh)
 
 
@@ -278,9 +328,11 @@ def _world_lights(world, spec) -> None:
     """The world file's spot lights (the writer handles model files' lights), without shadows:
     a shadow map is a render pass per light per camera."""
     import math
+
     from ...converters.mjcf_cameras import ADF_CUTOFF, ADF_SPOT_EXPONENT
+
     w = world.scene.world
-    for light in (w.lights if w is not None else []):
+    for light in w.lights if w is not None else []:
         el, to_link = spec.worldbody, np.eye(4)
         if light.parent:
             parent = _parent(world, light.parent, w.namespace or "", light)
@@ -293,10 +345,13 @@ def _world_lights(world, spec) -> None:
         if np.linalg.norm(d) == 0:
             d = np.array([1.0, 0.0, 0.0])
         pos = to_link[:3, :3] @ np.array(light.location or (0.0, 0.0, 0.0), float) + to_link[:3, 3]
-        el.add_light(pos=list(pos), dir=list(to_link[:3, :3] @ (d / np.linalg.norm(d))),
-                     cutoff=math.degrees(light.cutoff_angle if light.cutoff_angle is not None else ADF_CUTOFF),
-                     exponent=light.spot_exponent if light.spot_exponent is not None else ADF_SPOT_EXPONENT,
-                     castshadow=False)
+        el.add_light(
+            pos=list(pos),
+            dir=list(to_link[:3, :3] @ (d / np.linalg.norm(d))),
+            cutoff=math.degrees(light.cutoff_angle if light.cutoff_angle is not None else ADF_CUTOFF),
+            exponent=light.spot_exponent if light.spot_exponent is not None else ADF_SPOT_EXPONENT,
+            castshadow=False,
+        )
 
 
 def _parent(world, ref, ns, obj):
@@ -304,8 +359,11 @@ def _parent(world, ref, ns, obj):
     if key is None and ref:
         key, hit = world.registry.find(ns + ref)
     if key is None or not isinstance(hit, BodyPlan):
-        world._warn("runner-parent", f"{obj.identifier}: parent {ref!r} not found"
-                    + (f" (matches: {', '.join(hit)})" if hit else ""), obj)
+        world._warn(
+            "runner-parent",
+            f"{obj.identifier}: parent {ref!r} not found" + (f" (matches: {', '.join(hit)})" if hit else ""),
+            obj,
+        )
         return None
     return hit
 
@@ -330,7 +388,7 @@ def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
         rgba = _material(bp.body)
         for g in geoms:
             if not drawn and g.group == 3:
-                g.group = 0     # no visual shape written: the camera sees the collision shape
+                g.group = 0  # no visual shape written: the camera sees the collision shape
                 if rgba is not None:
                     g.rgba = rgba
 
@@ -340,14 +398,14 @@ def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
             if fr is not None and fr.static is not None:
                 g.friction = [fr.static, g.friction[1], fr.rolling if fr.rolling is not None else g.friction[2]]
     pairs = set()
-    for j, kind, parent, child, jn in joints:
+    for j, _kind, parent, child, _jn in joints:
         if j.ignore_inter_collision is not False:
             pairs.add((parent.mjname, child.mjname))
-    for m, mine, tree in plans_by_model:
+    for m, mine, _tree in plans_by_model:
         if m.ignore_inter_collision:
             bs = list(mine.values())
             for i, a in enumerate(bs):
-                for b in bs[i + 1:]:
+                for b in bs[i + 1 :]:
                     pairs.add((a.mjname, b.mjname))
     for a, b in sorted(pairs):
         if a != b and "world" not in (a, b):
@@ -362,6 +420,7 @@ def compile_spec(world, spec):
     """spec.compile(), replacing a collision mesh MuJoCo cannot hull (flat: coplanar vertices)
     by a box around its vertices (at least 1 mm thick), with a warning."""
     import re
+
     for _ in range(100):
         try:
             return spec.compile()
@@ -375,15 +434,25 @@ def compile_spec(world, spec):
                 if g.meshname != mesh.name:
                     continue
                 body = g.parent
-                box = body.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=np.maximum((hi - lo) / 2, 5e-4),
-                                    contype=g.contype, conaffinity=g.conaffinity, group=g.group, friction=g.friction,
-                                    rgba=g.rgba, name=(g.name or "") + "#box")
+                box = body.add_geom(
+                    type=mujoco.mjtGeom.mjGEOM_BOX,
+                    size=np.maximum((hi - lo) / 2, 5e-4),
+                    contype=g.contype,
+                    conaffinity=g.conaffinity,
+                    group=g.group,
+                    friction=g.friction,
+                    rgba=g.rgba,
+                    name=(g.name or "") + "#box",
+                )
                 r = _quat_matrix(np.array(g.quat, float))
                 box.pos = np.array(g.pos, float) + r @ ((lo + hi) / 2)
                 box.quat = g.quat
                 spec.delete(g)
-            world._warn("runner-flat-mesh", f"{Path(mesh.file).name}: a flat mesh has no convex hull for MuJoCo; "
-                        "it collides as its bounding box", None)
+            world._warn(
+                "runner-flat-mesh",
+                f"{Path(mesh.file).name}: a flat mesh has no convex hull for MuJoCo; it collides as its bounding box",
+                None,
+            )
             spec.delete(mesh)
     return spec.compile()
 
@@ -400,6 +469,7 @@ def _obj_bounds(path: Path, scale: np.ndarray):
 
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
     from ..rotations import quat_to_matrix
+
     return quat_to_matrix(np.array([q[1], q[2], q[3], q[0]]))
 
 
@@ -413,7 +483,12 @@ def _parse_spec(text: str, model) -> mujoco.MjSpec:
         if "DEPTH" not in str(exc).upper():
             raise
         where = model.source or SourceLocation(str(model.path) if model.path else "<model>", 1, 1)
-        raise AdfError(error("mujoco-tree-too-deep",
-                             "MuJoCo cannot load this model: its kinematic tree nests bodies deeper than "
-                             "MuJoCo's MJCF parser allows (about 500 levels)", where,
-                             "play it with --engine pybullet, or split the chain with p2p joints")) from None
+        raise AdfError(
+            error(
+                "mujoco-tree-too-deep",
+                "MuJoCo cannot load this model: its kinematic tree nests bodies deeper than "
+                "MuJoCo's MJCF parser allows (about 500 levels)",
+                where,
+                "play it with --engine pybullet, or split the chain with p2p joints",
+            )
+        ) from None

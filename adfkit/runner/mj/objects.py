@@ -1,6 +1,7 @@
 """The objects of a MuJoCo world, with the same queries as the PyBullet runner's: bodies
 (world_matrix/com_position/state/force/torque), articulations (records, targets, drive),
 ghosts, constraint actuators and proximity sensors."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -14,6 +15,7 @@ from ..rotations import invert, matrix_to_quat
 @dataclass(eq=False)
 class MjBody:
     """One ADF body in MuJoCo; the same queries as the PyBullet SimBody."""
+
     key: str
     body: object
     model: object
@@ -102,7 +104,7 @@ class MjGhost:
     geoms: np.ndarray
     friction: bool = False
     overlapping: list = field(default_factory=list)
-    pose_in_parent: np.ndarray | None = None   # the ghost's frame in its parent's ADF body frame (or the world)
+    pose_in_parent: np.ndarray | None = None  # the ghost's frame in its parent's ADF body frame (or the world)
 
 
 @dataclass(eq=False)
@@ -121,6 +123,7 @@ class MjActuator:
 class MjSensor:
     """A proximity sensor: rays from ``starts`` to ``ends`` in its frame (``location`` in the
     parent body frame); ``sensed``: the bodies its rays hit at the last control step."""
+
     key: str
     sensor: object
     parent: MjBody

@@ -6,6 +6,7 @@ segmentation (index into world.bodies, -1 for none) from one segmentation pass.
 Headless OpenGL: MUJOCO_GL when set, else EGL, then OSMesa. When none opens, the cameras
 are listed but render() raises CameraUnavailable with the reason (world.camera_problem).
 """
+
 from __future__ import annotations
 
 import math
@@ -42,8 +43,10 @@ class _Renderer:
     def __init__(self, world):
         cls, why = _gl_context_class()
         if cls is None:
-            raise CameraUnavailable(f"no headless OpenGL for MuJoCo's renderer ({why}); install libegl1 "
-                                    "(with a GPU driver or Mesa) or libosmesa6, or set MUJOCO_GL")
+            raise CameraUnavailable(
+                f"no headless OpenGL for MuJoCo's renderer ({why}); install libegl1 "
+                "(with a GPU driver or Mesa) or libosmesa6, or set MUJOCO_GL"
+            )
         m = world.model
         self.world = world
         w, h = m.vis.global_.offwidth, m.vis.global_.offheight
@@ -88,7 +91,7 @@ class _Renderer:
         dc = np.float32(-0.5) * (-(np.float32(2) * zf * zn) / (zf - zn))
         if self.ctx.readDepthMap == mujoco.mjtDepthMap.mjDEPTH_ZEROFAR:
             depth = (dc / (z.astype(np.float64) + cc)).astype(np.float32)
-        else:   # 0 at the near plane, 1 at the far one
+        else:  # 0 at the near plane, 1 at the far one
             depth = (zn * zf / (zf - z.astype(np.float64) * (zf - zn))).astype(np.float32)
         seg = ids[..., 0].astype(np.int32) | (ids[..., 1].astype(np.int32) << 8) | (ids[..., 2].astype(np.int32) << 16)
         lut = np.full(scn.ngeom + 1, -1, dtype=np.int32)
@@ -120,12 +123,15 @@ class _Pending:
             far = max(c.far for c in self.sims)
             m.vis.map.znear = near / m.stat.extent
             m.vis.map.zfar = far / m.stat.extent
-        return [MjCamera(world, c, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_CAMERA, n)) for c, n in zip(self.sims, self.ids)]
+        return [
+            MjCamera(world, c, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_CAMERA, n)) for c, n in zip(self.sims, self.ids)
+        ]
 
 
 def prepare_cameras(world, plan) -> _Pending:
     """Add an MJCF camera per ADF camera (two for a stereo pair) to the spec."""
     from ..cameras import build_cameras
+
     sims = build_cameras(world)
     spec = plan.spec
     names = []
@@ -146,8 +152,9 @@ def prepare_cameras(world, plan) -> _Pending:
         y = np.cross(right, fwd)
         name = f"adfkit-camera{n}:{c.name}"
         q = matrix_to_quat(np.column_stack([right, y, -fwd]))
-        el.add_camera(name=name, pos=eye, quat=[q[3], q[0], q[1], q[2]], fovy=math.degrees(c.fov),
-                      resolution=[c.width, c.height])
+        el.add_camera(
+            name=name, pos=eye, quat=[q[3], q[0], q[1], q[2]], fovy=math.degrees(c.fov), resolution=[c.width, c.height]
+        )
         names.append(name)
         maxw, maxh = max(maxw, c.width), max(maxh, c.height)
     # no multisampling: it would blend the segmentation pass's id colours at edges (and it

@@ -4,6 +4,7 @@ ghosts and capsule boundaries; the curved needle with its CoACD collision; the 4
 thread; two LND 400006 PSMs with finger ghosts, a constraint actuator and a proximity sensor
 each. Every ADF file goes through the model and the ADF writer; meshes and textures are made
 here (see layout.py for where things are and why)."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -15,9 +16,10 @@ LAUNCH = "launch.yaml"
 
 
 def _write_bytes(path: Path, data: bytes) -> None:
-    from ...adf.writer import atomic_write_text
     import os
     import tempfile
+
+    from ...adf.writer import atomic_write_text
 
     if isinstance(data, str):
         atomic_write_text(path, data)
@@ -71,9 +73,14 @@ def write_suturing(out_dir: str | Path) -> Path:
     from .needle import STEEL
     from .phantom import HOLE
     from .thread import COLOUR
+
     write_file(Colors(colors={"steel": STEEL, "thread": COLOUR, "hole": HOLE}), out / "colors.yaml")
-    launch = Launch(world_config="world/world.yaml", color_config="colors.yaml",
-                    input_devices_config="input_devices.yaml", multibody_configs=configs)
+    launch = Launch(
+        world_config="world/world.yaml",
+        color_config="colors.yaml",
+        input_devices_config="input_devices.yaml",
+        multibody_configs=configs,
+    )
     return write_file(launch, out / LAUNCH)
 
 

@@ -1,5 +1,6 @@
 """Small helpers shared by the suturing scene's builders: 4x4 transforms to ADF poses, with
 values rounded so that a build is byte-identical on every machine."""
+
 from __future__ import annotations
 
 import math
@@ -8,7 +9,7 @@ import numpy as np
 
 from ...model import Pose, Quat, Vec3
 
-DECIMALS = 10   # 0.1 nm and 1e-10 rad: far below anything the scene resolves
+DECIMALS = 10  # 0.1 nm and 1e-10 rad: far below anything the scene resolves
 
 
 def r(v: float) -> float:

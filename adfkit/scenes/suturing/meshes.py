@@ -1,5 +1,6 @@
 """Procedural meshes of the suturing scene as OBJ text (fixed number formatting, so the files
 are byte-identical build after build): boxes with texture coordinates and the needle's wire."""
+
 from __future__ import annotations
 
 import math
@@ -7,8 +8,9 @@ import math
 import numpy as np
 
 
-def obj_text(vertices, faces, uvs=None, mtllib: str | None = None, material: str | None = None,
-             comment: str = "") -> str:
+def obj_text(
+    vertices, faces, uvs=None, mtllib: str | None = None, material: str | None = None, comment: str = ""
+) -> str:
     """OBJ text of one mesh; faces index vertices (and, when given, the same-index uvs) from 0."""
     out = [f"# {comment}" if comment else "# written by adfkit"]
     if mtllib:
@@ -54,8 +56,9 @@ def boxes_mesh(boxes, texture_scale: float):
     return np.array(verts), np.array(uvs), faces
 
 
-def arc_wire(radius: float, wire: float, start: float, end: float, tip_length: float,
-             segments: int = 72, sides: int = 12):
+def arc_wire(
+    radius: float, wire: float, start: float, end: float, tip_length: float, segments: int = 72, sides: int = 12
+):
     """A closed tube of radius ``wire`` along the circle of ``radius`` (xy plane, centre at the
     origin) from angle ``start`` (blunt, capped) to ``end`` (sharp: the tube narrows to a point
     over the last ``tip_length`` of arc). Returns (vertices, faces)."""

@@ -5,6 +5,7 @@ The collision hulls come from CoACD (adfkit.geometry) once and are committed as
 ``data/NeedleCollision.OBJ``, so a build is quick and byte-identical; ``needle_hulls_text``
 re-runs the decomposition (``refresh=True``) when the mesh or the parameters change.
 """
+
 from __future__ import annotations
 
 import math
@@ -17,8 +18,8 @@ from .meshes import arc_wire, obj_text
 
 DATA = Path(__file__).with_name("data")
 HULLS_FILE = DATA / "NeedleCollision.OBJ"
-TIP_LENGTH = 0.003          # m of arc over which the wire narrows to the point
-MASS = 0.5                  # kg, as the challenge's needle (its heavy mass keeps the thread taut)
+TIP_LENGTH = 0.003  # m of arc over which the wire narrows to the point
+MASS = 0.5  # kg, as the challenge's needle (its heavy mass keeps the thread taut)
 STEEL = RGBA(r=0.8, g=0.8, b=0.82, a=1.0)
 #: CoACD settings for the needle: tight hulls along a thin curved wire
 HULL_THRESHOLD = 0.03
@@ -33,8 +34,13 @@ def needle_mesh():
 
 def needle_obj_text() -> str:
     v, f = needle_mesh()
-    return obj_text(v, f, mtllib="Needle.mtl", material="steel",
-                    comment="suture needle: 3/8 circle of radius 9.4 mm, wire 1 mm, written by adfkit")
+    return obj_text(
+        v,
+        f,
+        mtllib="Needle.mtl",
+        material="steel",
+        comment="suture needle: 3/8 circle of radius 9.4 mm, wire 1 mm, written by adfkit",
+    )
 
 
 def needle_mtl_text() -> str:
@@ -50,9 +56,12 @@ def needle_hulls_text(refresh: bool = False) -> tuple[str, str]:
     import trimesh
 
     from ...geometry.decompose import DecompositionParams, decompose, hulls_obj_text
+
     v, f = needle_mesh()
-    d = decompose(trimesh.Trimesh(v, f, process=False),
-                  DecompositionParams(threshold=HULL_THRESHOLD, max_hulls=HULL_MAX, preprocess="off"))
+    d = decompose(
+        trimesh.Trimesh(v, f, process=False),
+        DecompositionParams(threshold=HULL_THRESHOLD, max_hulls=HULL_MAX, preprocess="off"),
+    )
     obj, mtl = hulls_obj_text(d.hulls, "NeedleCollision.mtl")
     # vertices at fixed precision: small, and the same text on every machine
     lines = []
@@ -79,12 +88,22 @@ def needle_body(world) -> Body:
     i_x = i_bis
     i_y = i_perp - MASS * c * c
     i_z = MASS * rad * rad - MASS * c * c
-    return Body(identifier="BODY Needle", name="Needle", mass=MASS, location=pose(world),
-                inertia=Inertia(ix=r(i_x), iy=r(i_y), iz=r(i_z)),
-                inertial_offset=pose(translation(*com) @ rot_z(mid)),
-                mesh="Needle.OBJ", collision_mesh="NeedleCollision.OBJ", collision_mesh_type="CONVEX_HULL",
-                collision_margin=0.0001, friction=Friction(static=0.5, rolling=0.0), restitution=0.0,
-                damping=VelocityDamping(linear=0.9, angular=0.9), passive=False)
+    return Body(
+        identifier="BODY Needle",
+        name="Needle",
+        mass=MASS,
+        location=pose(world),
+        inertia=Inertia(ix=r(i_x), iy=r(i_y), iz=r(i_z)),
+        inertial_offset=pose(translation(*com) @ rot_z(mid)),
+        mesh="Needle.OBJ",
+        collision_mesh="NeedleCollision.OBJ",
+        collision_mesh_type="CONVEX_HULL",
+        collision_margin=0.0001,
+        friction=Friction(static=0.5, rolling=0.0),
+        restitution=0.0,
+        damping=VelocityDamping(linear=0.9, angular=0.9),
+        passive=False,
+    )
 
 
 __all__ = ["needle_mesh", "needle_obj_text", "needle_hulls_text", "needle_body", "HULLS_FILE"]

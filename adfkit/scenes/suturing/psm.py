@@ -12,6 +12,7 @@ the ``/ambf/env/psmN/`` and ``/ambf/env/ghosts/psmN/`` namespaces, finger ghosts
 ``Constraint`` actuator ``Actuator0`` on the tool yaw link), so scripts written for one
 scene run on the other; a ``Proximity`` sensor ``Sensor0`` looks between the jaws.
 """
+
 from __future__ import annotations
 
 import math
@@ -19,17 +20,42 @@ import math
 import numpy as np
 
 from ...model import (
-    RGBA, Actuator, Body, Friction, Geometry, Ghost, Inertia, Joint, JointLimits, ModelFile, Pose, Ray,
-    Sensor, VelocityDamping, Vec3,
+    RGBA,
+    Actuator,
+    Body,
+    Friction,
+    Geometry,
+    Ghost,
+    Inertia,
+    Joint,
+    JointLimits,
+    ModelFile,
+    Pose,
+    Ray,
+    Sensor,
+    Vec3,
+    VelocityDamping,
 )
 from ...runner.psm_kinematics import PRISMATIC, default
-from .frames import pose, r, translation, vec, rot_z
+from .frames import pose, r, rot_z, translation, vec
 
-ARM_BODIES = ("base link simple", "yaw link simple", "pitch end link simple", "main insertion link simple",
-              "tool roll link simple", "tool pitch link simple", "tool yaw link simple")
-ARM_JOINTS = ("base link-yaw link", "yaw link-pitch back link", "pitch end link-main insertion link",
-              "main insertion link-tool roll link", "tool roll link-tool pitch link",
-              "tool pitch link-tool yaw link")
+ARM_BODIES = (
+    "base link simple",
+    "yaw link simple",
+    "pitch end link simple",
+    "main insertion link simple",
+    "tool roll link simple",
+    "tool pitch link simple",
+    "tool yaw link simple",
+)
+ARM_JOINTS = (
+    "base link-yaw link",
+    "yaw link-pitch back link",
+    "pitch end link-main insertion link",
+    "main insertion link-tool roll link",
+    "tool roll link-tool pitch link",
+    "tool pitch link-tool yaw link",
+)
 FINGERS = ("tool gripper1 simple", "tool gripper2 simple")
 JAW_JOINTS = ("tool yaw link-tool gripper1 link", "tool yaw link-tool gripper2 link")
 #: mass (kg), as the challenge's PSM files give them
@@ -37,14 +63,14 @@ MASSES = (0.0, 5.0, 5.0, 2.0, 1.0, 1.0, 1.0)
 FINGER_MASS = 1.0
 MAX_IMPULSE = (50.0, 50.0, 2000.0, 50.0, 50.0, 50.0)
 JOINT_DAMPING = (5.0, 0.0, 100.0, 0.001, 0.05, 0.0)
-FINGER_LIMITS = (-0.349066, 0.698132)   # each finger takes half of the jaw's -0.698..1.396 rad
-JAW_LENGTH = 0.011                      # m, fingers along +y of the tool yaw link
-GRASP_POINT = 0.006                     # m along the jaws: the actuator and where a needle is held
-FINGER_GAP = 0.0002                     # m from the jaw plane to each finger's inner face (closed)
+FINGER_LIMITS = (-0.349066, 0.698132)  # each finger takes half of the jaw's -0.698..1.396 rad
+JAW_LENGTH = 0.011  # m, fingers along +y of the tool yaw link
+GRASP_POINT = 0.006  # m along the jaws: the actuator and where a needle is held
+FINGER_GAP = 0.0002  # m from the jaw plane to each finger's inner face (closed)
 FINGER_WIDTH = 0.001
-GHOST_REACH = 0.0024                    # m a finger ghost reaches past the jaw plane
-GHOST_LENGTH = 0.006                    # m of jaw the ghosts cover, centred at GRASP_POINT
-SENSOR_START = 0.0035                   # m along the jaws where the sensor's rays start
+GHOST_REACH = 0.0024  # m a finger ghost reaches past the jaw plane
+GHOST_LENGTH = 0.006  # m of jaw the ghosts cover, centred at GRASP_POINT
+SENSOR_START = 0.0035  # m along the jaws where the sensor's rays start
 
 ARM = RGBA(r=0.93, g=0.93, b=0.95, a=1.0)
 DARK = RGBA(r=0.15, g=0.15, b=0.17, a=1.0)
@@ -56,7 +82,7 @@ def _box_inertia(m, x, y, z) -> Inertia:
     return Inertia(ix=r(m * (y * y + z * z) / 12), iy=r(m * (x * x + z * z) / 12), iz=r(m * (x * x + y * y) / 12))
 
 
-def _cyl_inertia(m, rad, h) -> Inertia:    # axis z
+def _cyl_inertia(m, rad, h) -> Inertia:  # axis z
     t = m * (3 * rad * rad + h * h) / 12
     return Inertia(ix=r(t), iy=r(t), iz=r(m * rad * rad / 2))
 
@@ -70,8 +96,11 @@ def _link_shapes():
         # the carriage rail runs back along the shaft (the shaft points along -y of this frame)
         "pitch end link simple": ("Box", Geometry(x=0.012, y=0.35, z=0.03), (0.022, 0.295, 0)),
         "main insertion link simple": ("Box", Geometry(x=0.025, y=0.025, z=0.05), (0, 0, -0.01)),
-        "tool roll link simple": ("Cylinder", Geometry(radius=0.0042, height=lt - 0.004, axis="z"),
-                                  (0, 0, -(lt + 0.004) / 2)),
+        "tool roll link simple": (
+            "Cylinder",
+            Geometry(radius=0.0042, height=lt - 0.004, axis="z"),
+            (0, 0, -(lt + 0.004) / 2),
+        ),
         "tool pitch link simple": ("Box", Geometry(x=0.009, y=0.005, z=0.004), (0.0045, 0, 0)),
         "tool yaw link simple": ("Cylinder", Geometry(radius=0.0018, height=0.004, axis="z"), (0, 0, 0)),
     }
@@ -84,7 +113,7 @@ def _inertia(shape, g, m):
         return _box_inertia(m, g.x, g.y, g.z)
     if shape == "Cylinder":
         return _cyl_inertia(m, g.radius, g.height)
-    i = 0.4 * m * g.radius ** 2
+    i = 0.4 * m * g.radius**2
     return Inertia(ix=r(i), iy=r(i), iz=r(i))
 
 
@@ -105,15 +134,27 @@ def _body(name, world: np.ndarray, shape, g, centre, mass, colour, joint_offset:
     coincide (PyBullet places a link's shapes relative to its inertial frame)."""
     off = Pose(vec(centre))
     inertia = _inertia(shape, g, mass)
-    if inertia is not None and abs(math.sin(joint_offset)) > 0.5:   # turned by ±90°: x and y swap
+    if inertia is not None and abs(math.sin(joint_offset)) > 0.5:  # turned by ±90°: x and y swap
         inertia = Inertia(ix=inertia.iy, iy=inertia.ix, iz=inertia.iz)
     com = pose(rot_z(-joint_offset))
     visual = {"mesh": mesh_name(name)} if _offset(centre) else {"shape": shape, "geometry": g}
-    return Body(identifier=f"BODY {name}", name=name, mass=mass, location=pose(world),
-                inertia=inertia, inertial_offset=com if mass else None, **visual,
-                collision_shape=shape, collision_geometry=g, collision_offset=off,
-                collision_margin=0.0001, color_rgba=colour, friction=Friction(static=0.5, rolling=0.0),
-                restitution=0.0, damping=VelocityDamping(linear=0.04, angular=0.1))
+    return Body(
+        identifier=f"BODY {name}",
+        name=name,
+        mass=mass,
+        location=pose(world),
+        inertia=inertia,
+        inertial_offset=com if mass else None,
+        **visual,
+        collision_shape=shape,
+        collision_geometry=g,
+        collision_offset=off,
+        collision_margin=0.0001,
+        color_rgba=colour,
+        friction=Friction(static=0.5, rolling=0.0),
+        restitution=0.0,
+        damping=VelocityDamping(linear=0.04, angular=0.1),
+    )
 
 
 def _dh_joint(name, parent, child, link, limits, impulse, damping) -> Joint:
@@ -122,12 +163,23 @@ def _dh_joint(name, parent, child, link, limits, impulse, damping) -> Joint:
     axis = vec((0.0, -sa, ca))
     d = link.d + (link.offset if link.joint_type == PRISMATIC else 0.0)
     pivot = vec((link.a, -d * sa, d * ca))
-    return Joint(identifier=f"JOINT {name}", name=name, parent=f"BODY {parent}", child=f"BODY {child}",
-                 type="prismatic" if link.joint_type == PRISMATIC else "revolute",
-                 parent_pivot=pivot, child_pivot=Vec3(0.0, 0.0, 0.0), parent_axis=axis,
-                 child_axis=Vec3(0.0, 0.0, 1.0), offset=0.0 if link.joint_type == PRISMATIC else r(link.offset),
-                 joint_limits=JointLimits(low=r(limits[0]), high=r(limits[1])), damping=damping,
-                 max_motor_impulse=impulse, controller_output_type="VELOCITY", passive=False)
+    return Joint(
+        identifier=f"JOINT {name}",
+        name=name,
+        parent=f"BODY {parent}",
+        child=f"BODY {child}",
+        type="prismatic" if link.joint_type == PRISMATIC else "revolute",
+        parent_pivot=pivot,
+        child_pivot=Vec3(0.0, 0.0, 0.0),
+        parent_axis=axis,
+        child_axis=Vec3(0.0, 0.0, 1.0),
+        offset=0.0 if link.joint_type == PRISMATIC else r(link.offset),
+        joint_limits=JointLimits(low=r(limits[0]), high=r(limits[1])),
+        damping=damping,
+        max_motor_impulse=impulse,
+        controller_output_type="VELOCITY",
+        passive=False,
+    )
 
 
 def build_psm(name: str, base: np.ndarray, q_home, jaw_home: float = 0.8) -> ModelFile:
@@ -136,8 +188,13 @@ def build_psm(name: str, base: np.ndarray, q_home, jaw_home: float = 0.8) -> Mod
     kin = default()
     frames = kin.fk_all(q_home)
     shapes = _link_shapes()
-    m = ModelFile(namespace=f"/ambf/env/{name}/", ignore_inter_collision=True, gravity=Vec3(0.0, 0.0, 0.0),
-                  high_resolution_path="./meshes/", low_resolution_path="./meshes/")
+    m = ModelFile(
+        namespace=f"/ambf/env/{name}/",
+        ignore_inter_collision=True,
+        gravity=Vec3(0.0, 0.0, 0.0),
+        high_resolution_path="./meshes/",
+        low_resolution_path="./meshes/",
+    )
     for i, body in enumerate(ARM_BODIES):
         shape, g, centre = shapes[body]
         colour = DARK if body.startswith("tool") and "roll" not in body else (BLUE if i in (1, 2) else ARM)
@@ -145,24 +202,46 @@ def build_psm(name: str, base: np.ndarray, q_home, jaw_home: float = 0.8) -> Mod
         m.bodies.append(_body(body, base @ frames[i], shape, g, centre, MASSES[i], colour, link_offset))
     for i, joint in enumerate(ARM_JOINTS):
         link = kin.links[i]
-        m.joints.append(_dh_joint(joint, ARM_BODIES[i], ARM_BODIES[i + 1], link, (link.lower, link.upper),
-                                  MAX_IMPULSE[i], JOINT_DAMPING[i]))
+        m.joints.append(
+            _dh_joint(
+                joint,
+                ARM_BODIES[i],
+                ARM_BODIES[i + 1],
+                link,
+                (link.lower, link.upper),
+                MAX_IMPULSE[i],
+                JOINT_DAMPING[i],
+            )
+        )
     wrist = base @ frames[6]
     for k, (finger, joint) in enumerate(zip(FINGERS, JAW_JOINTS)):
         sign, g, centre = _finger_shape(k)
         m.bodies.append(_body(finger, wrist @ rot_z(sign * jaw_home / 2), "Box", g, centre, FINGER_MASS, DARK))
         axis = Vec3(0.0, 0.0, sign)
-        m.joints.append(Joint(identifier=f"JOINT {joint}", name=joint, parent="BODY tool yaw link simple",
-                              child=f"BODY {finger}", type="revolute", parent_pivot=Vec3(0.0, 0.0, 0.0),
-                              child_pivot=Vec3(0.0, 0.0, 0.0), parent_axis=axis, child_axis=axis, offset=0.0,
-                              joint_limits=JointLimits(low=FINGER_LIMITS[0], high=FINGER_LIMITS[1]),
-                              damping=0.005, max_motor_impulse=50.0, controller_output_type="VELOCITY",
-                              passive=False))
+        m.joints.append(
+            Joint(
+                identifier=f"JOINT {joint}",
+                name=joint,
+                parent="BODY tool yaw link simple",
+                child=f"BODY {finger}",
+                type="revolute",
+                parent_pivot=Vec3(0.0, 0.0, 0.0),
+                child_pivot=Vec3(0.0, 0.0, 0.0),
+                parent_axis=axis,
+                child_axis=axis,
+                offset=0.0,
+                joint_limits=JointLimits(low=FINGER_LIMITS[0], high=FINGER_LIMITS[1]),
+                damping=0.005,
+                max_motor_impulse=50.0,
+                controller_output_type="VELOCITY",
+                passive=False,
+            )
+        )
     return m
 
 
 def _finger_shape(k: int):
-    sign = 1.0 if k == 0 else -1.0          # finger 1 turns about +z of the yaw link, finger 2 about -z
+    sign = 1.0 if k == 0 else -1.0  # finger 1 turns about +z of the yaw link, finger 2 about -z
     g = Geometry(x=FINGER_WIDTH, y=JAW_LENGTH, z=0.0016)
     centre = (r(-sign * (FINGER_GAP + FINGER_WIDTH / 2)), r(JAW_LENGTH / 2 + 0.0005), 0.0)
     return sign, g, centre
@@ -171,6 +250,7 @@ def _finger_shape(k: int):
 def link_meshes() -> dict[str, str]:
     """OBJ text of every link drawn by a mesh, by file name (the same for both PSMs)."""
     from .meshes import box_mesh, cylinder_mesh, obj_text
+
     items = list(_link_shapes().items()) + [(f, ("Box",) + _finger_shape(k)[1:]) for k, f in enumerate(FINGERS)]
     out = {}
     for body, (shape, g, centre) in items:
@@ -196,19 +276,48 @@ def build_psm_ghosts(name: str) -> ModelFile:
         sign = 1.0 if k == 0 else -1.0
         outer = -sign * (FINGER_GAP + FINGER_WIDTH)
         at = Vec3(r(outer + sign * g.x / 2), r(GRASP_POINT), 0.0)
-        m.ghost_objects.append(Ghost(identifier=f"GHOST {side} finger", name=f"{side}_finger_ghost",
-                                     parent=f"{ns}BODY {finger}", location=Pose(at), shape="Box", geometry=g,
-                                     collision_shape="Box", collision_geometry=g, collision_margin=0.0001,
-                                     passive=False, color_rgba=GHOST))
-    m.actuators.append(Actuator(identifier="ACTUATOR Actuator0", name="Actuator0", type="Constraint",
-                                parent=f"{ns}BODY tool yaw link simple",
-                                location=Pose(Vec3(0.0, GRASP_POINT, 0.0)), visible=False, visible_size=0.00055))
+        m.ghost_objects.append(
+            Ghost(
+                identifier=f"GHOST {side} finger",
+                name=f"{side}_finger_ghost",
+                parent=f"{ns}BODY {finger}",
+                location=Pose(at),
+                shape="Box",
+                geometry=g,
+                collision_shape="Box",
+                collision_geometry=g,
+                collision_margin=0.0001,
+                passive=False,
+                color_rgba=GHOST,
+            )
+        )
+    m.actuators.append(
+        Actuator(
+            identifier="ACTUATOR Actuator0",
+            name="Actuator0",
+            type="Constraint",
+            parent=f"{ns}BODY tool yaw link simple",
+            location=Pose(Vec3(0.0, GRASP_POINT, 0.0)),
+            visible=False,
+            visible_size=0.00055,
+        )
+    )
     # rays along the middle of the jaws from where open fingers are clear of it (PyBullet's
     # ray test reports only the first hit, so a ray must not start at a finger)
     rays = [Ray(offset=Vec3(0.0, SENSOR_START, z), direction=Vec3(0.0, 1.0, 0.0)) for z in (-0.0004, 0.0, 0.0004)]
-    m.sensors.append(Sensor(identifier="SENSOR Sensor0", name="Sensor0", type="Proximity",
-                            parent=f"{ns}BODY tool yaw link simple", location=Pose(Vec3(0.0, 0.0, 0.0)),
-                            range=r(JAW_LENGTH + 0.0005 - SENSOR_START), array=rays, visible=False, visible_size=0.0003))
+    m.sensors.append(
+        Sensor(
+            identifier="SENSOR Sensor0",
+            name="Sensor0",
+            type="Proximity",
+            parent=f"{ns}BODY tool yaw link simple",
+            location=Pose(Vec3(0.0, 0.0, 0.0)),
+            range=r(JAW_LENGTH + 0.0005 - SENSOR_START),
+            array=rays,
+            visible=False,
+            visible_size=0.0003,
+        )
+    )
     return m
 
 

@@ -1,5 +1,6 @@
 """Procedural textures of the phantom (PNG, made with numpy and Pillow, same seed, same bytes):
 a tissue colour map with fibres and mottling, and the normal map of the same height field."""
+
 from __future__ import annotations
 
 import io

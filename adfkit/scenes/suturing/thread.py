@@ -2,6 +2,7 @@
 settings (angular limits ±pi/6, angular stiffness 0.02 N·m/rad, damping 0.01 N·m·s/rad,
 linear axes locked), the first element fixed to the needle's tail. Names and the element
 frame (z along the thread, the next element at -z) follow the challenge's phantom file."""
+
 from __future__ import annotations
 
 import math
@@ -9,7 +10,17 @@ import math
 import numpy as np
 
 from ...model import (
-    RGBA, AxesGains, Body, Friction, Geometry, Inertia, Joint, JointLimits, Pose, Vec3, Vec3Range,
+    RGBA,
+    AxesGains,
+    Body,
+    Friction,
+    Geometry,
+    Inertia,
+    Joint,
+    JointLimits,
+    Pose,
+    Vec3,
+    Vec3Range,
     VelocityDamping,
 )
 from ...model.semantics import shortest_arc
@@ -33,9 +44,11 @@ def fixed_axes(rel: np.ndarray, child_axis=(0.0, 0.0, 1.0)) -> tuple[Vec3, float
     b = np.asarray(child_axis, float)
     a = rel @ b
     arc = np.array(shortest_arc(Vec3(*b), Vec3(*a)).matrix())
-    twist = rel @ arc.T                      # a rotation about a
-    off = math.atan2(float(np.dot(a, np.array([twist[2, 1] - twist[1, 2], twist[0, 2] - twist[2, 0],
-                                                twist[1, 0] - twist[0, 1]]))), float(np.trace(twist) - 1.0))
+    twist = rel @ arc.T  # a rotation about a
+    off = math.atan2(
+        float(np.dot(a, np.array([twist[2, 1] - twist[1, 2], twist[0, 2] - twist[2, 0], twist[1, 0] - twist[0, 1]]))),
+        float(np.trace(twist) - 1.0),
+    )
     return vec(a), r(off)
 
 
@@ -52,8 +65,8 @@ def thread_path(tail: np.ndarray, rest_z: float) -> list[np.ndarray]:
     poses = []
     for i in range(L.THREAD_ELEMENTS):
         a = slope if i in (1, 2) else 0.0
-        d = np.array([0.0, -math.cos(a), -math.sin(a)])        # down the chain
-        m = rot_x(-math.pi / 2 + a)                              # z -> -d, x stays world x
+        d = np.array([0.0, -math.cos(a), -math.sin(a)])  # down the chain
+        m = rot_x(-math.pi / 2 + a)  # z -> -d, x stays world x
         m[:3, 3] = at + d * p / 2
         poses.append(m)
         at = at + d * p
@@ -63,42 +76,82 @@ def thread_path(tail: np.ndarray, rest_z: float) -> list[np.ndarray]:
 def thread_bodies_and_joints(needle_world: np.ndarray):
     """Bodies and joints of the thread lying along world -y from the needle's tail."""
     p = L.THREAD_PITCH
-    tail_local = np.array([L.NEEDLE_RADIUS * math.cos(L.NEEDLE_TAIL_ANGLE),
-                           L.NEEDLE_RADIUS * math.sin(L.NEEDLE_TAIL_ANGLE), 0.0])
+    tail_local = np.array(
+        [L.NEEDLE_RADIUS * math.cos(L.NEEDLE_TAIL_ANGLE), L.NEEDLE_RADIUS * math.sin(L.NEEDLE_TAIL_ANGLE), 0.0]
+    )
     tail = (needle_world @ np.append(tail_local, 1.0))[:3]
     path = thread_path(tail, L.SLAB[2] + L.THREAD_RADIUS + 0.00001)
     g = Geometry(radius=L.THREAD_RADIUS, height=0.00238, axis="z")
     m = L.THREAD_MASS
-    i_perp = m * (3 * L.THREAD_RADIUS ** 2 + p * p) / 12
-    inertia = Inertia(ix=r(i_perp), iy=r(i_perp), iz=r(m * L.THREAD_RADIUS ** 2 / 2))
+    i_perp = m * (3 * L.THREAD_RADIUS**2 + p * p) / 12
+    inertia = Inertia(ix=r(i_perp), iy=r(i_perp), iz=r(m * L.THREAD_RADIUS**2 / 2))
     bodies, joints = [], []
-    limits = JointLimits(linear=Vec3Range(low=Vec3(0.0, 0.0, 0.0), high=Vec3(0.0, 0.0, 0.0)),
-                         angular=Vec3Range(low=Vec3(-LIMIT, -LIMIT, -LIMIT), high=Vec3(LIMIT, LIMIT, LIMIT)))
+    limits = JointLimits(
+        linear=Vec3Range(low=Vec3(0.0, 0.0, 0.0), high=Vec3(0.0, 0.0, 0.0)),
+        angular=Vec3Range(low=Vec3(-LIMIT, -LIMIT, -LIMIT), high=Vec3(LIMIT, LIMIT, LIMIT)),
+    )
     for i in range(L.THREAD_ELEMENTS):
         name = element_name(i)
         world = path[i]
-        bodies.append(Body(identifier=f"BODY {name}", name=name, mass=m, location=pose(world), inertia=inertia,
-                           inertial_offset=Pose(), shape="Capsule", geometry=g, collision_shape="Capsule",
-                           collision_geometry=g, collision_offset=Pose(), collision_margin=0.0001,
-                           color_rgba=COLOUR, friction=Friction(static=0.5, rolling=0.0), restitution=0.0,
-                           damping=VelocityDamping(linear=0.9, angular=0.9), passive=False))
+        bodies.append(
+            Body(
+                identifier=f"BODY {name}",
+                name=name,
+                mass=m,
+                location=pose(world),
+                inertia=inertia,
+                inertial_offset=Pose(),
+                shape="Capsule",
+                geometry=g,
+                collision_shape="Capsule",
+                collision_geometry=g,
+                collision_offset=Pose(),
+                collision_margin=0.0001,
+                color_rgba=COLOUR,
+                friction=Friction(static=0.5, rolling=0.0),
+                restitution=0.0,
+                damping=VelocityDamping(linear=0.9, angular=0.9),
+                passive=False,
+            )
+        )
         if i == 0:
             rel = needle_world[:3, :3].T @ world[:3, :3]
             axis, off = fixed_axes(rel)
-            joints.append(Joint(identifier="JOINT Needle-Thread", name="Needle-Thread", parent="BODY Needle",
-                                child=f"BODY {name}", type="fixed", parent_pivot=vec(tail_local),
-                                child_pivot=Vec3(0.0, 0.0, r(p / 2)), parent_axis=axis,
-                                child_axis=Vec3(0.0, 0.0, 1.0), offset=off, passive=True))
+            joints.append(
+                Joint(
+                    identifier="JOINT Needle-Thread",
+                    name="Needle-Thread",
+                    parent="BODY Needle",
+                    child=f"BODY {name}",
+                    type="fixed",
+                    parent_pivot=vec(tail_local),
+                    child_pivot=Vec3(0.0, 0.0, r(p / 2)),
+                    parent_axis=axis,
+                    child_axis=Vec3(0.0, 0.0, 1.0),
+                    offset=off,
+                    passive=True,
+                )
+            )
             continue
         prev = element_name(i - 1)
-        joints.append(Joint(identifier=f"JOINT {prev}-{name}", name=f"{prev}-{name}", parent=f"BODY {prev}",
-                            child=f"BODY {name}", type="six dof spring", parent_pivot=Vec3(0.0, 0.0, r(-p / 2)),
-                            child_pivot=Vec3(0.0, 0.0, r(p / 2)), parent_axis=Vec3(0.0, 1.0, 0.0),
-                            child_axis=Vec3(0.0, 1.0, 0.0), joint_limits=limits,
-                            stiffness=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(STIFFNESS, STIFFNESS, STIFFNESS)),
-                            damping=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(DAMPING, DAMPING, DAMPING)),
-                            equilibrium_point=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(0.0, 0.0, 0.0)),
-                            passive=True))
+        joints.append(
+            Joint(
+                identifier=f"JOINT {prev}-{name}",
+                name=f"{prev}-{name}",
+                parent=f"BODY {prev}",
+                child=f"BODY {name}",
+                type="six dof spring",
+                parent_pivot=Vec3(0.0, 0.0, r(-p / 2)),
+                child_pivot=Vec3(0.0, 0.0, r(p / 2)),
+                parent_axis=Vec3(0.0, 1.0, 0.0),
+                child_axis=Vec3(0.0, 1.0, 0.0),
+                joint_limits=limits,
+                stiffness=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(STIFFNESS, STIFFNESS, STIFFNESS)),
+                damping=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(DAMPING, DAMPING, DAMPING)),
+                equilibrium_point=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(0.0, 0.0, 0.0)),
+                passive=True,
+            )
+        )
     return bodies, joints
 
 
