@@ -12,6 +12,7 @@ why a part of it was changed or left out:
 - (MJCF) a flat mesh, which MuJoCo cannot take as a collision hull, collides as a thin box
   around it; as a visual mesh it gets ``inertia="shell"`` (its volume is zero).
 """
+
 from __future__ import annotations
 
 import math
@@ -34,13 +35,20 @@ FLAT_THICKNESS = 1e-3
 
 def usable_scales(model, losses: list[Loss]):
     """``model`` itself, or a copy whose bodies with an unusable ``scale`` have scale 1."""
-    bad = [b for b in model.bodies if b.scale is not None
-           and not (math.isfinite(b.scale) and 0.0 < b.scale <= MAX_SCALE)]
+    bad = [
+        b for b in model.bodies if b.scale is not None and not (math.isfinite(b.scale) and 0.0 < b.scale <= MAX_SCALE)
+    ]
     if not bad:
         return model
     for b in bad:
-        losses.append(Loss(b.identifier, "scale", f"{b.scale!r} is not a positive finite scale up to {MAX_SCALE:g} "
-                                                  "(the engine's coordinates would overflow): written as 1"))
+        losses.append(
+            Loss(
+                b.identifier,
+                "scale",
+                f"{b.scale!r} is not a positive finite scale up to {MAX_SCALE:g} "
+                "(the engine's coordinates would overflow): written as 1",
+            )
+        )
     swap = {id(b): replace(b, scale=None) for b in bad}
     return replace(model, bodies=[swap.get(id(b), b) for b in model.bodies])
 
@@ -70,8 +78,13 @@ def joint_range(joint, losses: list[Loss]) -> tuple[float, float] | None:
         losses.append(Loss(joint.identifier, "joint limits", f"not finite ({low!r}, {high!r}): written as no limit"))
         return None
     if low > high:
-        losses.append(Loss(joint.identifier, "joint limits", f"low {low!r} > high {high!r}: Bullet (and so AMBF) "
-                                                             "applies no limit then; written as no limit"))
+        losses.append(
+            Loss(
+                joint.identifier,
+                "joint limits",
+                f"low {low!r} > high {high!r}: Bullet (and so AMBF) applies no limit then; written as no limit",
+            )
+        )
         return None
     return low, high
 
@@ -82,14 +95,16 @@ class MeshFiles:
 
     def __init__(self, engine: str, out_dir: Path, stem: str, tree=None):
         self.engine = engine
-        self.tree = tree   # the model's input tree (adfkit.inputs): meshes are read only inside it
+        self.tree = tree  # the model's input tree (adfkit.inputs): meshes are read only inside it
         self.folder = out_dir / f"{stem}_meshes"
         self._done: dict[str, tuple[Path | None, bool, object]] = {}
 
     def _load(self, path: Path):
         from ..diagnostics import AdfError
+
         try:
             from ..geometry.meshio import load_mesh
+
             return load_mesh(path, tree=self.tree), None
         except AdfError as exc:
             return None, exc.diagnostics[0].message
@@ -116,9 +131,15 @@ class MeshFiles:
             out: Path | None = path
             if not readable:
                 if mesh is None:
-                    losses.append(Loss(who, "mesh", f"{path.name}: {path.suffix or 'this'} format is not read by "
-                                                    f"{'PyBullet' if self.engine == 'urdf' else 'MuJoCo'} and could "
-                                                    f"not be converted ({why}): left out"))
+                    losses.append(
+                        Loss(
+                            who,
+                            "mesh",
+                            f"{path.name}: {path.suffix or 'this'} format is not read by "
+                            f"{'PyBullet' if self.engine == 'urdf' else 'MuJoCo'} and could "
+                            f"not be converted ({why}): left out",
+                        )
+                    )
                     out = None
                 else:
                     out = self.folder / (path.stem + ".stl")
@@ -128,8 +149,14 @@ class MeshFiles:
                         out = self.folder / f"{path.stem}_{n}.stl"
                     self.folder.mkdir(parents=True, exist_ok=True)
                     _write_bytes(out, mesh.export(file_type="stl"))
-                    losses.append(Loss(who, "mesh", f"{path.name}: {path.suffix} is not read by the engine: converted "
-                                                    f"to {out.parent.name}/{out.name} (normals, UVs and materials dropped)"))
+                    losses.append(
+                        Loss(
+                            who,
+                            "mesh",
+                            f"{path.name}: {path.suffix} is not read by the engine: converted "
+                            f"to {out.parent.name}/{out.name} (normals, UVs and materials dropped)",
+                        )
+                    )
             flat = mesh if (mesh is not None and _is_flat(mesh)) else None
             self._done[key] = (out, flat is not None, flat)
         out, is_flat, flat = self._done[key]
@@ -156,7 +183,7 @@ def flat_box(mesh, scale: float):
 
     v = np.asarray(mesh.vertices, dtype=float) * scale
     mean = v.mean(axis=0)
-    _u, _s, vt = np.linalg.svd(v - mean, full_matrices=True)   # 3x3: a plane even for < 3 vertices
+    _u, _s, vt = np.linalg.svd(v - mean, full_matrices=True)  # 3x3: a plane even for < 3 vertices
     e1, e2 = vt[0], vt[1]
     normal = np.cross(e1, e2)
     flat2d = np.column_stack(((v - mean) @ e1, (v - mean) @ e2))
@@ -166,7 +193,7 @@ def flat_box(mesh, scale: float):
         lo, hi = flat2d.min(axis=0), flat2d.max(axis=0)
         c2, a2, extents = (lo + hi) / 2, np.array([1.0, 0.0]), hi - lo
     else:
-        to_rect, extents = oriented_bounds_2D(flat2d)   # 3x3 homogeneous: points -> rectangle frame
+        to_rect, extents = oriented_bounds_2D(flat2d)  # 3x3 homogeneous: points -> rectangle frame
         back = np.linalg.inv(to_rect)
         c2 = back[:2, 2]
         a2 = back[:2, 0]
@@ -177,5 +204,7 @@ def flat_box(mesh, scale: float):
     centre = mean + c2[0] * e1 + c2[1] * e2
     thick = (v - mean) @ normal
     centre = centre + normal * (thick.max() + thick.min()) / 2
-    sizes = np.array([extents[0], extents[1], max(thick.max() - thick.min(), FLAT_THICKNESS * max(extents.max(), 1e-6))])
+    sizes = np.array(
+        [extents[0], extents[1], max(thick.max() - thick.min(), FLAT_THICKNESS * max(extents.max(), 1e-6))]
+    )
     return centre, rot, sizes

@@ -9,6 +9,7 @@ tree become ``equality/connect`` at the child pivot (their axis is lost, and rep
 Inertials are written explicitly (``inertiafromgeom="false"``); visual meshes are geoms in
 group 1 that do not collide; collision primitives and meshes are geoms in group 3.
 """
+
 from __future__ import annotations
 
 import os
@@ -21,16 +22,31 @@ from ..diagnostics import AdfError, error
 from ..model.files import ModelFile
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import (
-    JointKind, ShapeKind, collision_primitives, effective_mass, inertial_offset, joint_frames,
+    JointKind,
+    ShapeKind,
+    collision_primitives,
+    effective_mass,
+    inertial_offset,
+    joint_frames,
 )
+from ..model.tree import Link, build_tree, motion
 from . import inertia as inertia_math
 from .engine_fit import MeshFiles, flat_box, joint_range, usable_scales
 from .losses import Loss
 from .mjcf_cameras import write_cameras_lights
 from .mjcf_soft import write_soft_bodies
 from .safexml import to_text
-from ..model.tree import Link, build_tree, motion
-from .urdf import INITIAL_VALUE_TOLERANCE, _AXIS_TO_Z, _BODY_ONLY, _link_name, _joint_name, _material, _num, _unique, _vec
+from .urdf import (
+    _AXIS_TO_Z,
+    _BODY_ONLY,
+    INITIAL_VALUE_TOLERANCE,
+    _joint_name,
+    _link_name,
+    _material,
+    _num,
+    _unique,
+    _vec,
+)
 
 # MuJoCo's XML parser (tinyxml2) refuses elements nested deeper than ~500: <mujoco>,
 # <worldbody>, the bodies, and a body's own geoms and joints.
@@ -40,8 +56,13 @@ MAX_BODY_DEPTH = 496
 MIN_MASS = 1e-6
 MIN_INERTIA = 1e-9
 
-_LOSSY_OBJECTS = (("ghost_objects", "ghost object"), ("sensors", "sensor"), ("actuators", "actuator"),
-                  ("vehicles", "vehicle"), ("volumes", "volume"))
+_LOSSY_OBJECTS = (
+    ("ghost_objects", "ghost object"),
+    ("sensors", "sensor"),
+    ("actuators", "actuator"),
+    ("vehicles", "vehicle"),
+    ("volumes", "volume"),
+)
 
 
 def _place(el: ET.Element, pose: Pose) -> None:
@@ -68,8 +89,12 @@ class _Assets:
         key = (str(path.resolve()), scale)
         if key not in self.names:
             name = _unique(path.stem.replace(" ", "_"), self.used)
-            m = ET.SubElement(self.el, "mesh", name=name,
-                              file=Path(os.path.relpath(path.resolve(), self.out_dir.resolve())).as_posix())
+            m = ET.SubElement(
+                self.el,
+                "mesh",
+                name=name,
+                file=Path(os.path.relpath(path.resolve(), self.out_dir.resolve())).as_posix(),
+            )
             if scale != 1.0:
                 m.set("scale", _vec((scale,) * 3))
             if flat:  # zero volume: MuJoCo computes its (unused) inertia as a shell
@@ -80,8 +105,9 @@ class _Assets:
 
 def _geom_primitive(body_el: ET.Element, kind: ShapeKind, g, pose: Pose, name: str) -> bool:
     if kind is ShapeKind.BOX:
-        el = ET.SubElement(body_el, "geom", name=name, type="box",
-                           size=_vec(((g.x or 0) / 2, (g.y or 0) / 2, (g.z or 0) / 2)))
+        el = ET.SubElement(
+            body_el, "geom", name=name, type="box", size=_vec(((g.x or 0) / 2, (g.y or 0) / 2, (g.z or 0) / 2))
+        )
         _place(el, pose)
     elif kind is ShapeKind.SPHERE:
         el = ET.SubElement(body_el, "geom", name=name, type="sphere", size=_num(g.radius or 0.0))
@@ -98,8 +124,15 @@ def _geom_primitive(body_el: ET.Element, kind: ShapeKind, g, pose: Pose, name: s
     return True
 
 
-def _write_body(parent_el: ET.Element, model: ModelFile, link: Link, names: dict, assets: _Assets,
-                losses: list[Loss], used: dict[str, set[str]]) -> ET.Element:
+def _write_body(
+    parent_el: ET.Element,
+    model: ModelFile,
+    link: Link,
+    names: dict,
+    assets: _Assets,
+    losses: list[Loss],
+    used: dict[str, set[str]],
+) -> ET.Element:
     body = link.body
     who = body.identifier
     el = ET.SubElement(parent_el, "body", name=names[id(link)])
@@ -111,9 +144,13 @@ def _write_body(parent_el: ET.Element, model: ModelFile, link: Link, names: dict
         ET.SubElement(el, "freejoint", name=_unique(f"{names[id(link)]}_free", used["joint"]))
     elif link.parent is not None and link.kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
         j = link.joint
-        jel = ET.SubElement(el, "joint", name=_unique(_joint_name(j), used["joint"]),
-                            type="hinge" if link.kind is JointKind.REVOLUTE else "slide",
-                            axis=_vec(link.axis))
+        jel = ET.SubElement(
+            el,
+            "joint",
+            name=_unique(_joint_name(j), used["joint"]),
+            type="hinge" if link.kind is JointKind.REVOLUTE else "slide",
+            axis=_vec(link.axis),
+        )
         if q0:
             jel.set("ref", _num(q0))
         lim = joint_range(j, losses)
@@ -131,11 +168,23 @@ def _write_body(parent_el: ET.Element, model: ModelFile, link: Link, names: dict
             est = inertia_math.estimate_from_collision(model, body, mass)
             if est is not None:
                 ix, iy, iz = est
-                losses.append(Loss(who, "inertia", "not in the ADF file: written as Bullet's estimate "
-                                                   "(box inertia of the collision shape's bounding box)"))
+                losses.append(
+                    Loss(
+                        who,
+                        "inertia",
+                        "not in the ADF file: written as Bullet's estimate "
+                        "(box inertia of the collision shape's bounding box)",
+                    )
+                )
         if mass < MIN_MASS or min(ix, iy, iz) < MIN_INERTIA:
-            losses.append(Loss(who, "mass", f"a moving MuJoCo body needs mass and inertia: written as at least "
-                                            f"{MIN_MASS:g} kg and {MIN_INERTIA:g} kg·m²"))
+            losses.append(
+                Loss(
+                    who,
+                    "mass",
+                    f"a moving MuJoCo body needs mass and inertia: written as at least "
+                    f"{MIN_MASS:g} kg and {MIN_INERTIA:g} kg·m²",
+                )
+            )
             mass, ix, iy, iz = max(mass, MIN_MASS), max(ix, MIN_INERTIA), max(iy, MIN_INERTIA), max(iz, MIN_INERTIA)
         com = link.in_link(inertial_offset(body))
         inertial = ET.SubElement(el, "inertial", pos=_vec(com.position))
@@ -157,8 +206,13 @@ def _write_body(parent_el: ET.Element, model: ModelFile, link: Link, names: dict
 
 def _is_world(link: Link) -> bool:
     b = link.body
-    return (link.parent is None and b.name == "world" and effective_mass(b) == 0.0
-            and link.origin.position.norm() < 1e-12 and link.origin.orientation.angle_to(Quat(0, 0, 0, 1)) < 1e-12)
+    return (
+        link.parent is None
+        and b.name == "world"
+        and effective_mass(b) == 0.0
+        and link.origin.position.norm() < 1e-12
+        and link.origin.orientation.angle_to(Quat(0, 0, 0, 1)) < 1e-12
+    )
 
 
 def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets: _Assets, losses, used) -> None:
@@ -171,8 +225,16 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
     if mesh is not None:
         mesh, flat = assets.fit(mesh, who, losses)
     if mesh is not None:
-        g = ET.SubElement(el, "geom", name=_unique(f"{name}_visual", used["geom"]), type="mesh",
-                          mesh=assets.mesh(mesh, scale, flat is not None), contype="0", conaffinity="0", group="1")
+        g = ET.SubElement(
+            el,
+            "geom",
+            name=_unique(f"{name}_visual", used["geom"]),
+            type="mesh",
+            mesh=assets.mesh(mesh, scale, flat is not None),
+            contype="0",
+            conaffinity="0",
+            group="1",
+        )
         _place(g, to_link)
         rgba = _material(body)
         if rgba is not None:
@@ -185,27 +247,47 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
             cmesh, flat = assets.fit(cmesh, who, losses)
         if cmesh is not None and flat is not None:  # MuJoCo cannot hull a flat mesh: a thin box
             centre, rot, sizes = flat_box(flat, scale)
-            g = ET.SubElement(el, "geom", name=_unique(f"{name}_collision", used["geom"]), type="box",
-                              size=_vec(sizes / 2), group="3")
+            g = ET.SubElement(
+                el, "geom", name=_unique(f"{name}_collision", used["geom"]), type="box", size=_vec(sizes / 2), group="3"
+            )
             _place(g, to_link * Pose(Vec3(*centre), Quat.from_matrix(rot.tolist())))
-            losses.append(Loss(who, "collision mesh", f"{cmesh.name} is flat (no volume): MuJoCo cannot take its "
-                                                      "convex hull, so it collides as a thin box around it"))
+            losses.append(
+                Loss(
+                    who,
+                    "collision mesh",
+                    f"{cmesh.name} is flat (no volume): MuJoCo cannot take its "
+                    "convex hull, so it collides as a thin box around it",
+                )
+            )
         elif cmesh is not None:
-            g = ET.SubElement(el, "geom", name=_unique(f"{name}_collision", used["geom"]), type="mesh",
-                              mesh=assets.mesh(cmesh, scale), group="3")
+            g = ET.SubElement(
+                el,
+                "geom",
+                name=_unique(f"{name}_collision", used["geom"]),
+                type="mesh",
+                mesh=assets.mesh(cmesh, scale),
+                group="3",
+            )
             _place(g, to_link)
             losses.append(Loss(who, "collision mesh", "MuJoCo collides with the convex hull of a mesh"))
     else:
         for n, p in enumerate(prims):
-            if not _geom_primitive(el, p.kind, p.geometry, to_link * p.pose,
-                                   _unique(f"{name}_collision{n}", used["geom"])):
+            if not _geom_primitive(
+                el, p.kind, p.geometry, to_link * p.pose, _unique(f"{name}_collision{n}", used["geom"])
+            ):
                 losses.append(Loss(who, f"collision {p.kind.value}", "MJCF has no such primitive"))
     for n, e in enumerate(body.compound_shape or []):
         from ..model.semantics import pose_or_identity, shape_kind
+
         k = shape_kind(e.shape)
         g = ET.Element("g")
-        if k is None or e.geometry is None or not _geom_primitive(g, k, e.geometry, to_link * pose_or_identity(e.offset),
-                                                                  _unique(f"{name}_visual{n}", used["geom"])):
+        if (
+            k is None
+            or e.geometry is None
+            or not _geom_primitive(
+                g, k, e.geometry, to_link * pose_or_identity(e.offset), _unique(f"{name}_visual{n}", used["geom"])
+            )
+        ):
             losses.append(Loss(who, f"visual {e.shape}", "MJCF has no such primitive"))
             continue
         geom = g[0]
@@ -213,8 +295,9 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
         el.append(geom)
 
 
-def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None, *, tree_kinds=None,
-            names_out: dict | None = None) -> tuple[str, list[Loss]]:
+def to_mjcf(
+    model: ModelFile, out_dir: Path, name: str | None = None, *, tree_kinds=None, names_out: dict | None = None
+) -> tuple[str, list[Loss]]:
     """MJCF text and losses. ``tree_kinds``: joint kinds that join the tree (default revolute,
     prismatic, fixed); a link joined by another kind is written welded to its parent, for the
     caller to add its joints (the MuJoCo runner's six-dof springs). ``names_out`` receives
@@ -223,8 +306,14 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None, *, tree_ki
     model = usable_scales(model, losses)
     tree = build_tree(model) if tree_kinds is None else build_tree(model, tree_kinds)
     if not tree.roots and not any(sb.defined for sb in model.soft_bodies):
-        raise AdfError(error("convert-empty", "the model has no bodies or soft bodies; there is nothing to write as MJCF",
-                             model.where(), "convert a model file with at least one body"))
+        raise AdfError(
+            error(
+                "convert-empty",
+                "the model has no bodies or soft bodies; there is nothing to write as MJCF",
+                model.where(),
+                "convert a model file with at least one body",
+            )
+        )
     root = ET.Element("mujoco", model=name or model.name)
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false", autolimits="true")
     assets = _Assets(root, out_dir, name or model.name, getattr(model, "tree", None))
@@ -238,9 +327,15 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None, *, tree_ki
         names[id(lk)] = _unique(_link_name(lk.body), used["body"])
         depth[id(lk)] = 1 if lk.parent is None else depth[id(lk.parent)] + 1
         if depth[id(lk)] == MAX_BODY_DEPTH + 1:
-            losses.append(Loss(lk.body.identifier, "body nesting", f"MJCF nests each child body in its parent and "
-                               f"MuJoCo's XML parser refuses more than {MAX_BODY_DEPTH} levels: the file will not "
-                               "load in MuJoCo"))
+            losses.append(
+                Loss(
+                    lk.body.identifier,
+                    "body nesting",
+                    f"MJCF nests each child body in its parent and "
+                    f"MuJoCo's XML parser refuses more than {MAX_BODY_DEPTH} levels: the file will not "
+                    "load in MuJoCo",
+                )
+            )
     for lk in tree.ordered():
         parent_el = world if lk.parent is None else elements[id(lk.parent)]
         if _is_world(lk):  # ADF's stand-in for the world: its geoms and children go in <worldbody>
@@ -263,13 +358,24 @@ def to_mjcf(model: ModelFile, out_dir: Path, name: str | None = None, *, tree_ki
             pl = by_body[parent.identifier]
             anchor = pl.in_link(a).position
             tag = "weld" if kind is JointKind.FIXED else "connect"
-            e = ET.SubElement(eq, tag, name=_unique(_joint_name(j), used["equality"]), body1=names[id(pl)],
-                              body2=names[id(by_body[child.identifier])])
+            e = ET.SubElement(
+                eq,
+                tag,
+                name=_unique(_joint_name(j), used["equality"]),
+                body1=names[id(pl)],
+                body2=names[id(by_body[child.identifier])],
+            )
             if tag == "connect":
                 e.set("anchor", _vec(anchor))
             if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
-                losses.append(Loss(j.identifier, "joint axis", f"a {kind.value} joint closing a loop is written as "
-                                                               "equality/connect: a ball joint at the pivot"))
+                losses.append(
+                    Loss(
+                        j.identifier,
+                        "joint axis",
+                        f"a {kind.value} joint closing a loop is written as "
+                        "equality/connect: a ball joint at the pivot",
+                    )
+                )
         else:
             losses.append(Loss(j.identifier, "joint", f"no MJCF form for a {kind.value} joint here"))
     if eq is not None:
