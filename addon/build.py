@@ -111,7 +111,7 @@ def _snapshot(obj, x) -> None:
 
 
 def _shape_child(body_obj, prim, i, scene):
-    from .authoring import add_collision_primitive
+    from .elements import add_collision_primitive
 
     g = prim.geometry
     shape = prim.kind.name if prim.kind.name in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE") else "BOX"

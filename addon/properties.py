@@ -162,7 +162,7 @@ GROUP_OF = {
 
 def _density(self, context):
     if self.kind in ("BODY", "SOFT_BODY"):
-        from .authoring import mass_from_density
+        from .elements import mass_from_density
 
         mass_from_density(self.id_data)
 

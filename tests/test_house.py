@@ -90,7 +90,7 @@ def test_the_cycle_finder_finds_a_circle():
     assert _cycles({"a": {"b"}, "b": set()}) == []
 
 
-@pytest.mark.parametrize("pkg", ["adfkit"])
+@pytest.mark.parametrize("pkg", ["adfkit", "addon"])
 def test_no_import_circles(pkg):
     assert _cycles(_edges(_modules(pkg))) == []
 
