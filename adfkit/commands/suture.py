@@ -95,7 +95,8 @@ def run(args) -> int:
     for p in m["pairs"]:
         state = "passed" if p["passed"] else "NOT passed"
         print(f"pair {p['pair']}: {p['entry']} -> {p['exit']} {state}"
-              + (f" (entry {p['entry_passed_s']:.2f} s, exit {p['exit_passed_s']:.2f} s)" if p["passed"] else ""))
+              + (f" (entry {p['entry_passed_s']:.2f} s, exit {p['exit_passed_s']:.2f} s)" if p["passed"] else
+                 f" [{p.get('rule')}]: {p.get('reason')}"))
     if m.get("failure"):
         print(f"stopped: {m['failure']}", file=sys.stderr)
     rtf = m.get("real_time_factor")

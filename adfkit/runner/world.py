@@ -606,6 +606,15 @@ class SimWorld(EngineNeutral, WorldState):
         actuator.constraint, actuator.target = None, None
 
     # ---- measures -----------------------------------------------------------------------
+    def contacts(self, sb: SimBody) -> dict:
+        """{other SimBody: summed normal force (N)} of the contacts ``sb`` has after the last step."""
+        out: dict = {}
+        for c in pb.getContactPoints(bodyA=sb.uid, linkIndexA=sb.link, physicsClientId=self.cid) or ():
+            other = self._lookup.get((c[2], c[4]))
+            if other is not None and other is not sb:
+                out[other] = out.get(other, 0.0) + float(c[9])
+        return out
+
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of any joint (constraints and springs
         with a locked linear range); multibody joints are exact."""

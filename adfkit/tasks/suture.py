@@ -127,8 +127,10 @@ class SutureTask:
     """The scripted suture on a SimWorld with two PSMs (see the module docstring)."""
 
     def __init__(self, world, pairs: list[int], seed: int = 0, psm_names=("psm1", "psm2"),
-                 speed: float = 1.0) -> None:
+                 speed: float = 1.0, tools_collide_with_tissue: bool = False) -> None:
         self.world = world
+        self.tools_collide_with_tissue = tools_collide_with_tissue
+        self.switched_off: list[str] = []    # what of the physics the task does not carry out (reported)
         self.rng = np.random.default_rng(seed)
         self.speed = speed
         self.cdt = world.dt * world.opt.control_substeps
@@ -439,39 +441,27 @@ class SutureTask:
         raise SutureError(f"{self.driver}/{self.puller}: no pose over pair {self.pairs[k].index} where both "
                           "arms can hand the needle over")
 
-    def _tissue_pass_through(self) -> None:
-        """The needle passes through the phantom's bodies (its collision hull covers the holes;
-        the hole ghosts' friction is what holds an inserted needle) and the thread through the
-        tissue body."""
-        m = self.needle.model
-        for sb in self.world.bodies:
-            name = (sb.body.name or sb.body.identifier).lower()
-            if sb is self.needle or sb.model is not m or not (
-                    "phantom" in name or re.search(r"(entry|exit)\s*\d+$", name)):
-                continue
-            self.world.set_collision(self.needle, sb, False)
-        for t in self.tissue():
-            for sb in self.world.bodies:
-                if sb.model is m and "thread" in (sb.body.name or sb.body.identifier).lower():
-                    self.world.set_collision(t, sb, False)
-
     def tissue(self):
         m = self.needle.model
         return [sb for sb in self.world.bodies
                 if sb.model is m and sb.static and "phantom" in (sb.body.name or sb.body.identifier).lower()]
 
-    def _soft_tissue_for_tools(self) -> None:
-        """The tools' jaws reach the wire lying on the tissue: they press into it (and the pad
-        under it) rather than push the arm off its set-point (the phantom is soft; its collision
-        shape is a hull). The two arms, brought closer on their setup joints, do not collide
-        with each other's links either (their links are coarse primitives)."""
-        m = self.needle.model
-        static = [sb for sb in self.world.bodies if sb.model is m and sb.static]
+    def _arms_apart(self) -> None:
+        """The two arms, brought closer on their setup joints, do not collide with each other's
+        links (their links are coarse primitives). Everything else collides: the needle and the
+        thread with the phantom and the hole boundaries at every step. The tools collide with the
+        tissue when ``tools_collide_with_tissue`` (a touch is then recorded by the observer as an
+        event with its force); otherwise that is switched off and named in the metrics."""
         arms = {n: [sb for sb in self.world.bodies if sb.articulation is psm.art] for n, psm in self.psms.items()}
-        for links in arms.values():
-            for sb in links:
-                for t in static:
-                    self.world.set_collision(t, sb, False)
+        if not self.tools_collide_with_tissue:
+            m = self.needle.model
+            static = [sb for sb in self.world.bodies if sb.model is m and sb.static]
+            for links in arms.values():
+                for sb in links:
+                    for t in static:
+                        self.world.set_collision(t, sb, False)
+            self.switched_off.append("tool-tissue collisions (the scripted regrasp presses the puller's jaws "
+                                     "on the exit's boundary; see docs/suture.md)")
         names = list(arms)
         for i, a in enumerate(names):
             for b in names[i + 1:]:
@@ -495,7 +485,7 @@ class SutureTask:
         for name in self.psms:
             self.psms[name].servo_jaw(0.8)
         self.base_moves = self.setup_joints()
-        self._soft_tissue_for_tools()
+        self._arms_apart()
         yield from self.jitter()
         self.plan()
         d, p = self.psms[self.driver], self.psms[self.puller]
@@ -514,7 +504,6 @@ class SutureTask:
             yield from self.carry(lambda s: interpolate(over, start, _smooth(s)), 0.8)
             yield from self.wait(0.2)
             self._set_phase(f"insert {pair.index}")
-            self._tissue_pass_through()
             psi_end = psi_x + beyond
             a0 = -self.approach
             yield from self.carry(lambda s: self.needle_at(b, a0 + (psi_end - a0) * s), (psi_end - a0) / 0.5)

@@ -507,6 +507,23 @@ class MjWorld(EngineNeutral):
         actuator.target, actuator.constraint = None, None
 
     # ---- measures -----------------------------------------------------------------------
+    def contacts(self, sb: MjBody) -> dict:
+        """{other MjBody: summed normal force (N)} of the contacts ``sb`` has after the last step."""
+        m, d = self.model, self.data
+        out: dict = {}
+        f = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
+            if sb.id not in (b1, b2):
+                continue
+            other = self._body_of_id.get(b2 if b1 == sb.id else b1)
+            if other is None or other is sb:
+                continue
+            mujoco.mj_contactForce(m, d, i, f)
+            out[other] = out.get(other, 0.0) + abs(float(f[0]))
+        return out
+
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of a loop-closing joint (tree joints are exact)."""
         worst = 0.0
