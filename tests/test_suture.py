@@ -95,7 +95,7 @@ def test_needle_held_while_carried_and_released_when_the_jaws_open():
         task = SutureTask(world, [1], seed=0)
         run = lambda gen: [world.step(1) for _ in gen]   # noqa: E731
         run(task.wait(0.3))
-        task._soft_tissue_for_tools()
+        task._arms_apart()
         task.plan()
         run(task.take(task.driver, task.drive_grasps[0]))
         psm = task.psms[task.driver]

@@ -81,7 +81,7 @@ class SutureObserver:
                      [_Hole(self.world, p.index, "exit", p.exit_name, p.exit) for p in task.pairs]
         self.tissue = [sb for sb in self.world.bodies if sb.model is task.needle.model and sb.static]
         self._tissue_ids = {id(sb) for sb in self.tissue}
-        self._tool = {id(sb): n for n, psm in task.psms.items() for sb in self.world.bodies
+        self._tool = {id(sb): n for n, psm in getattr(task, "psms", {}).items() for sb in self.world.bodies
                       if sb.articulation is psm.art}
         self.needle_contacts: dict[str, dict[str, float]] = {}   # phase -> {tissue body: max N}
         self.tool_events: list[dict] = []
@@ -161,7 +161,7 @@ class SutureObserver:
             kind = phase.split()[0]
             self.error_by_phase[kind] = max(self.error_by_phase.get(kind, 0.0), e)
         if self.n % self.drift_every == 0 and self.task.holder is not None and self.task.held_ee_in_needle is not None:
-            psm = self.task.psms[self.task.holder]
+            psm = getattr(self.task, "psms", {})[self.task.holder]
             ee = psm.base_in_world() @ psm.measured_cp()
             expected = ee @ invert(self.task.held_ee_in_needle)
             drift = float(np.linalg.norm(expected[:3, 3] - self.task.needle_pose()[:3, 3]))

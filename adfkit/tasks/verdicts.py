@@ -66,7 +66,8 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     k = pair.index
     entry, exit_ = _hole(obs, k, "entry"), _hole(obs, k, "exit")
     failed_here = failure is not None and in_pair(failure_phase, k, first)
-    if not any(in_pair(name, k, first) for name, _ in obs.task.phase_log):
+    log = [name for name, _ in obs.task.phase_log]
+    if log and not any(in_pair(name, k, first) for name in log):
         return "not-tried", f"not tried: the episode stopped before it ({failure or 'no failure recorded'})"
     ins = [c for c in entry.crossings if c["inward"]]
     if not ins:
@@ -93,12 +94,15 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     if fault:
         return fault
     th = obs.thread_by_pair.get(k)
-    if th is None:
+    if th is None and f"pull {k}" not in log and not failed_here:
+        pass     # a task that does not pull the thread (a Gymnasium pair): the tip's pass is the test
+    elif th is None:
         if failed_here:
             return "reach", failure
         return "thread-not-through", "the pull of the thread never finished"
-    out["thread_through_m"] = th["length_m"]
-    if not (th["through_entry"] and th["through_exit"]):
+    if th is not None:
+        out["thread_through_m"] = th["length_m"]
+    if th is not None and not (th["through_entry"] and th["through_exit"]):
         miss = " and ".join(n for n, ok in ((entry.name, th["through_entry"]), (exit_.name, th["through_exit"])) if not ok)
         return "thread-not-through", f"the thread did not follow the needle through {miss}"
     for s in obs.slips:
