@@ -71,14 +71,18 @@ def _c(t, inward, outside=0.0, leading=True, ghost=True):
 def test_verdict_rules_on_exact_records():
     ok = pair_verdict(*_record(_c(5.0, True), _c(8.0, False)))
     assert ok["passed"] and ok["rule"] is None and ok["thread_through_m"] == 0.04
-    v = pair_verdict(*_record(_c(5.0, True, outside=0.001), _c(8.0, False)))
+    obs, pair = _record(_c(5.0, True, outside=0.001), _c(8.0, False))
+    obs.needle_contacts = {}
+    v = pair_verdict(obs, pair)
     assert v["rule"] == "entry-outside-opening" and "1.0 mm outside" in v["reason"]
+    v = pair_verdict(*_record(_c(5.0, True, outside=0.001), _c(8.0, False)))   # pushed there by the tissue
+    assert v["rule"] == "blocked-at-entry" and "1.0 mm outside the opening" in v["reason"]
     v = pair_verdict(*_record(_c(5.0, True, leading=False), _c(8.0, False)))
     assert v["rule"] == "entry-not-tip-first" and not v["passed"]
     v = pair_verdict(*_record(_c(5.0, True, ghost=False), _c(8.0, False)))
     assert v["rule"] == "entry-ghost-off-hole"
     v = pair_verdict(*_record(None, None))
-    assert v["rule"] == "blocked-at-entry" and "Phantom with 3.2 N" in v["reason"]
+    assert v["rule"] == "blocked-at-entry" and "Phantom (3.2 N)" in v["reason"]
     v = pair_verdict(*_record(_c(5.0, True), None))
     assert v["rule"] == "exit-missed" and "4.0 mm" in v["reason"]
     v = pair_verdict(*_record(_c(5.0, True), _c(8.0, False),
@@ -150,7 +154,8 @@ def test_unmodified_scene_passes_pair_1_with_everything_colliding(tmp_path):
 def test_filled_hole_is_blocked_at_its_entry(tmp_path):
     p = _pair_1(_scene(tmp_path, _fill_hole_1))
     assert not p["passed"] and p["rule"] == "blocked-at-entry"
-    assert "ghostEntry1" in p["reason"] and "Phantom" in p["reason"]
+    assert "blocked at Entry1: the tip pressed on" in p["reason"] and "Phantom (" in p["reason"]
+    assert "narrower" not in p["reason"]
 
 
 @pytest.mark.slow

@@ -606,13 +606,13 @@ class SimWorld(EngineNeutral, WorldState):
         actuator.constraint, actuator.target = None, None
 
     # ---- measures -----------------------------------------------------------------------
-    def contacts(self, sb: SimBody) -> dict:
-        """{other SimBody: summed normal force (N)} of the contacts ``sb`` has after the last step."""
-        out: dict = {}
+    def contacts(self, sb: SimBody) -> list:
+        """[(other SimBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
+        out = []
         for c in pb.getContactPoints(bodyA=sb.uid, linkIndexA=sb.link, physicsClientId=self.cid) or ():
             other = self._lookup.get((c[2], c[4]))
             if other is not None and other is not sb:
-                out[other] = out.get(other, 0.0) + float(c[9])
+                out.append((other, float(c[9]), c[5]))
         return out
 
     def constraint_error(self) -> float:

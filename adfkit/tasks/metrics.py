@@ -18,6 +18,8 @@ from .holes import chain_crossing, opening_half_extents, plane_crossing, tip_lea
 
 SLIP_LIMIT = 0.002        # m the needle may move in the grasp while one arm holds it
 TOOL_TOUCH_N = 0.05       # N: a tool-tissue contact at least this strong is recorded as an event
+NEAR_HOLE = 0.005         # m: a crossing of a hole's plane farther than this beside its opening is not an attempt at it
+TIP_CONTACT = 0.002       # m: a contact this near the tip is the tip's
 THREAD_TOLERANCE = 0.001  # m beyond a hole's opening a thread element's centre line may cross
 
 
@@ -48,6 +50,7 @@ class _Hole:
     def __init__(self, world, pair: int, kind: str, name: str, ghost) -> None:
         self.pair, self.kind, self.name, self.ghost = pair, kind, name, ghost
         self.body = ghost.parent
+        self.label = _name(self.body) if self.body is not None else name
         self.half = opening_half_extents(self.body.body) if self.body is not None else None
         self.world = world
         self.prev_local = None
@@ -84,6 +87,7 @@ class SutureObserver:
         self._tool = {id(sb): n for n, psm in getattr(task, "psms", {}).items() for sb in self.world.bodies
                       if sb.articulation is psm.art}
         self.needle_contacts: dict[str, dict[str, float]] = {}   # phase -> {tissue body: max N}
+        self.tip_contacts: dict[str, dict[str, float]] = {}      # the same, within TIP_CONTACT of the tip
         self.tool_events: list[dict] = []
         self._open_touch: dict[tuple, dict] = {}
         self._in_ghost: dict[str, bool] = {}
@@ -113,6 +117,8 @@ class SutureObserver:
             if hit is None:
                 continue
             at, outside = hit
+            if outside > NEAR_HOLE:      # the plane of another hole, far from this one
+                continue
             h.crossings.append({"t": t, "phase": self.task.phase, "inward": bool(prev[2] > 0),
                                 "at_mm": [float(v) * 1000 for v in at], "outside_opening_m": outside,
                                 "ghost_overlap": bool(in_ghost or was_in),
@@ -121,25 +127,37 @@ class SutureObserver:
     def _watch_contacts(self, t: float) -> None:
         phase = self.task.phase
         w = self.world
-        for other, f in w.contacts(self.task.needle).items():
+        tip = self.tip_path[-1][1:] if self.tip_path else None
+        per_body: dict[str, float] = {}
+        for other, f, at in w.contacts(self.task.needle):
             if id(other) in self._tissue_ids:
-                d = self.needle_contacts.setdefault(phase, {})
-                d[_name(other)] = max(d.get(_name(other), 0.0), f)
+                n = _name(other)
+                per_body[n] = per_body.get(n, 0.0) + f
+                if tip is not None and f > 0 and math.dist(at, tip) < TIP_CONTACT:
+                    d = self.tip_contacts.setdefault(phase, {})
+                    d[n] = max(d.get(n, 0.0), f)
+        for n, f in per_body.items():
+            d = self.needle_contacts.setdefault(phase, {})
+            d[n] = max(d.get(n, 0.0), f)
         touching = set()
+        per_touch: dict[tuple, float] = {}
         for sb in self.tissue:
-            for other, f in w.contacts(sb).items():
+            for other, f, _ in w.contacts(sb):
                 arm = self._tool.get(id(other))
-                if arm is None or f < TOOL_TOUCH_N:
-                    continue
-                key = (arm, _name(other), _name(sb))
-                touching.add(key)
-                ev = self._open_touch.get(key)
-                if ev is None:
-                    ev = self._open_touch[key] = {"t_start": t, "t_end": t, "phase": phase, "arm": arm,
-                                                  "link": key[1], "tissue": key[2], "max_force_n": f}
-                    self.tool_events.append(ev)
-                ev["t_end"] = t
-                ev["max_force_n"] = max(ev["max_force_n"], f)
+                if arm is not None:
+                    key = (arm, _name(other), _name(sb))
+                    per_touch[key] = per_touch.get(key, 0.0) + f
+        for key, f in per_touch.items():
+            if f < TOOL_TOUCH_N:
+                continue
+            touching.add(key)
+            ev = self._open_touch.get(key)
+            if ev is None:
+                ev = self._open_touch[key] = {"t_start": t, "t_end": t, "phase": phase, "arm": key[0],
+                                              "link": key[1], "tissue": key[2], "max_force_n": f}
+                self.tool_events.append(ev)
+            ev["t_end"] = t
+            ev["max_force_n"] = max(ev["max_force_n"], f)
         for key in list(self._open_touch):
             if key not in touching:
                 del self._open_touch[key]
@@ -247,6 +265,7 @@ class SutureObserver:
             "slips": self.slips,
             "tool_tissue_events": self.tool_events,
             "needle_tissue_contact_n": self.needle_contacts,
+            "tip_tissue_contact_n": self.tip_contacts,
             "constraint_error_by_phase_m": self.error_by_phase,
             "needle_wire_radius_m": self.wire_radius,
             "max_constraint_error_m": max(self.max_constraint_error, rep["max_constraint_error_m"]),

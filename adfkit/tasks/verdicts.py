@@ -36,16 +36,21 @@ def _hole(obs, k: int, kind: str):
 
 
 def _blocked_reason(obs, k: int, entry) -> tuple[str, str]:
-    forces = obs.needle_contacts.get(f"insert {k}", {})
+    """What stopped the tip at entry k: the bodies the tip pressed on (else the needle), with
+    their contact forces, and a boundary narrower than the wire."""
+    label = getattr(entry, "label", entry.name)
     width = 2 * float(min(entry.half)) if entry.half is not None else None
     narrow = ""
     if width is not None and width < 2 * obs.wire_radius:
         narrow = f"; its opening ({_mm(width)}) is narrower than the needle's wire ({_mm(2 * obs.wire_radius)})"
+    at_tip = getattr(obs, "tip_contacts", {}).get(f"insert {k}", {})
+    forces = at_tip or obs.needle_contacts.get(f"insert {k}", {})
     if forces:
-        body, f = max(forces.items(), key=lambda kv: kv[1])
-        return "blocked-at-entry", (f"blocked at {entry.name}: the needle pressed on {body} with {f:.1f} N "
-                                    f"and came no nearer than {_mm(entry.closest)} to the opening{narrow}")
-    return "entry-missed", f"the tip never went through {entry.name} (nearest {_mm(entry.closest)} from its opening){narrow}"
+        who = "the tip" if at_tip else "the needle"
+        hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forces.items(), key=lambda kv: -kv[1]) if f >= 0.05)
+        return "blocked-at-entry", (f"blocked at {label}: {who} pressed on {hits or 'the tissue'} and came no "
+                                    f"nearer than {_mm(entry.closest)} to the opening{narrow}")
+    return "entry-missed", f"the tip never went through {label} (nearest {_mm(entry.closest)} from its opening){narrow}"
 
 
 def _crossing_fault(c: dict, hole, side: str) -> tuple[str, str] | None:
@@ -75,6 +80,11 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
             return "reach", failure
         return _blocked_reason(obs, k, entry)
     c_in = ins[0]
+    if c_in["outside_opening_m"] > 0 and obs.needle_contacts.get(f"insert {k}"):
+        # deflected by the tissue: the tip crossed the hole's plane beside the opening, not through it
+        rule, reason = _blocked_reason(obs, k, entry)
+        return rule, (f"{reason}; the tip was pushed across {entry.name}'s plane "
+                      f"{_mm(c_in['outside_opening_m'])} outside the opening")
     out["entry_passed_s"] = c_in["t"]
     fault = _crossing_fault(c_in, entry, "entry")
     if fault:

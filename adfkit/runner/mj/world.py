@@ -507,10 +507,10 @@ class MjWorld(EngineNeutral):
         actuator.target, actuator.constraint = None, None
 
     # ---- measures -----------------------------------------------------------------------
-    def contacts(self, sb: MjBody) -> dict:
-        """{other MjBody: summed normal force (N)} of the contacts ``sb`` has after the last step."""
+    def contacts(self, sb: MjBody) -> list:
+        """[(other MjBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
         m, d = self.model, self.data
-        out: dict = {}
+        out = []
         f = np.zeros(6)
         for i in range(d.ncon):
             c = d.contact[i]
@@ -521,7 +521,7 @@ class MjWorld(EngineNeutral):
             if other is None or other is sb:
                 continue
             mujoco.mj_contactForce(m, d, i, f)
-            out[other] = out.get(other, 0.0) + abs(float(f[0]))
+            out.append((other, abs(float(f[0])), tuple(float(v) for v in c.pos)))
         return out
 
     def constraint_error(self) -> float:
