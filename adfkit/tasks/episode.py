@@ -125,8 +125,9 @@ def tissue_outline(task):
     return None
 
 
-def plot_trajectory(obs: SutureObserver, task, path: Path) -> None:
-    """Tip trajectory over the phantom with the holes, top (x-y) and side (x-z) views."""
+def plot_trajectory(obs: SutureObserver, task, path: Path, verdicts: list | None = None) -> None:
+    """Tip trajectory over the phantom with the holes, top (x-y) and side (x-z) views; with
+    ``verdicts`` (metrics' pairs) each pair is marked passed or failed with its rule."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -144,6 +145,12 @@ def plot_trajectory(obs: SutureObserver, task, path: Path) -> None:
             ax.plot(e[i], e[j], "o", mfc="none", mec="tab:blue", ms=9)
             ax.plot(x[i], x[j], "s", mfc="none", mec="tab:red", ms=9)
             ax.annotate(str(k), (e[i], e[j]), textcoords="offset points", xytext=(-12, 4), fontsize=8)
+            v = next((p for p in verdicts or [] if p.get("pair") == k), None)
+            if v is not None and i == 0 and j == 1:
+                ok = v.get("passed")
+                ax.annotate("\u2713 passed" if ok else f"\u2717 {v.get('rule') or 'failed'}", (x[i], x[j]),
+                            textcoords="offset points", xytext=(10, -3), fontsize=8,
+                            color="tab:green" if ok else "tab:red", weight="bold")
         if holes:
             pts = np.array([h[1] for h in holes] + [h[2] for h in holes])
             lo, hi = pts.min(axis=0) - 0.03, pts.max(axis=0) + 0.03
@@ -168,7 +175,7 @@ def write_outputs(out: Path, metrics: dict, obs, task, frames) -> list[str]:
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "metrics.json", json.dumps(finite(metrics), indent=2, allow_nan=False))
     written = ["metrics.json"]
-    plot_trajectory(obs, task, out / "trajectory.png")
+    plot_trajectory(obs, task, out / "trajectory.png", metrics.get("pairs"))
     written.append("trajectory.png")
     if frames:
         import imageio.v2 as imageio

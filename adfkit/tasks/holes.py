@@ -15,6 +15,25 @@ import numpy as np
 DEFAULT_HALF_OPENING = 0.0024
 
 
+def has_boundary(body) -> bool:
+    """Whether a hole body is framed by capsule boundary bodies (the bundled scene's holes; the
+    corpus's are meshes)."""
+    return any((s.shape or "").lower() == "capsule" for s in getattr(body, "compound_collision_shape", None) or [])
+
+
+def boundary_body(ghost):
+    """The capsule-framed hole body a hole ghost sits on, or None."""
+    parent = getattr(ghost, "parent", None)
+    return parent if parent is not None and has_boundary(parent.body) else None
+
+
+def hole_frame(world, ghost) -> np.ndarray:
+    """World pose of a hole: its boundary body's frame where it has one (the ghost may sit
+    off the hole: the needle must go through the hole), else the ghost's."""
+    b = boundary_body(ghost)
+    return b.world_matrix() if b is not None else world.ghost_pose(ghost)
+
+
 def opening_half_extents(body) -> np.ndarray:
     """Half-widths (x, y), m, of the free opening inside a hole body's boundary: per in-plane
     axis, the nearest capsule lying across that axis, less its radius. A body without

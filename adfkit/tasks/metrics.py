@@ -14,7 +14,7 @@ import numpy as np
 
 from ..runner.rotations import invert, matrix_to_quat
 from .verdicts import pair_verdict
-from .holes import chain_crossing, opening_half_extents, plane_crossing, tip_leading
+from .holes import DEFAULT_HALF_OPENING, boundary_body, chain_crossing, opening_half_extents, plane_crossing, tip_leading
 
 SLIP_LIMIT = 0.002        # m the needle may move in the grasp while one arm holds it
 TOOL_TOUCH_N = 0.05       # N: a tool-tissue contact at least this strong is recorded as an event
@@ -49,9 +49,10 @@ class _Hole:
 
     def __init__(self, world, pair: int, kind: str, name: str, ghost) -> None:
         self.pair, self.kind, self.name, self.ghost = pair, kind, name, ghost
-        self.body = ghost.parent
+        self.body = boundary_body(ghost)
         self.label = _name(self.body) if self.body is not None else name
-        self.half = opening_half_extents(self.body.body) if self.body is not None else None
+        self.half = opening_half_extents(self.body.body) if self.body is not None else \
+            np.full(2, DEFAULT_HALF_OPENING)
         self.world = world
         self.prev_local = None
         self.crossings: list[dict] = []

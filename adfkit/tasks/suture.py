@@ -28,6 +28,7 @@ from ..adf.paths import collision_mesh_path
 from ..runner.psm import PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
+from .holes import hole_frame
 from .needle import fit_needle, obj_vertices
 
 JAW_DEPTH = 0.01      # m from the end effector to the point between the jaws (LND: along z_E)
@@ -165,9 +166,10 @@ class SutureTask:
 
         The needle's circle goes through an aim point in each hole: the hole's centre, or,
         where the holes are farther apart than a bite of MAX_BITE, a point inside each hole
-        ghost toward the other one (the tip still passes through both ghosts)."""
-        e = self.world.ghost_pose(pair.entry)
-        x = self.world.ghost_pose(pair.exit)
+        ghost toward the other one (the tip still passes through both ghosts). A hole is where
+        its boundary body is (holes.hole_frame), the ghost only where there is none."""
+        e = hole_frame(self.world, pair.entry)
+        x = hole_frame(self.world, pair.exit)
         pe, px = e[:3, 3], x[:3, 3]
         up = e[:3, 2] + x[:3, 2]
         if up[2] < 0:
