@@ -170,3 +170,26 @@ def test_ghost_off_its_hole_fails_with_that_reason(tmp_path):
     p = _pair_1(_scene(tmp_path, _move_ghost_entry_1))
     assert not p["passed"] and p["rule"] == "entry-ghost-off-hole"
     assert "5.0 mm off" in p["reason"]
+
+
+def test_filled_hole_blocks_the_insertion_fast(tmp_path):
+    """The default run's check that the physics can say no: the insertion of pair 1 alone
+    (stopped when the regrasp begins) into the phantom with hole 1 filled."""
+    from adfkit.adf import load_scene
+    from adfkit.runner.world import Options, SimWorld
+    from adfkit.tasks.metrics import SutureObserver
+    from adfkit.tasks.suture import SutureTask
+    world = SimWorld(load_scene(_scene(tmp_path, _fill_hole_1)), Options(renderer="tiny"))
+    try:
+        task = SutureTask(world, [1], seed=0)
+        obs = SutureObserver(task)
+        for phase in task.steps():
+            if phase == "regrasp 1":
+                break
+            world.step(1)
+            obs.observe()
+        (v,) = obs.pair_results()
+        assert v["rule"] == "blocked-at-entry" and "Phantom (" in v["reason"]
+        assert v["entry_passed_s"] is None
+    finally:
+        world.close()
