@@ -16,7 +16,8 @@ from .metrics import SutureObserver, finite
 from .suture import SutureError, SutureTask
 
 GIF_EVERY_S = 1.0      # simulated seconds between GIF frames
-GIF_WIDTH = 200        # pixels
+GIF_WIDTH = 320        # pixels: the GIF is a preview; cameraL.mp4 has the camera's own resolution
+VIDEO_EVERY_S = 0.1    # simulated seconds between video frames (played at 10 fps: real time)
 #: Bullet solver iterations for the suture: at AMBF's 10 the needle-thread joint stretches up to
 #: 9 mm while the needle is carried and the thread can miss the hole the needle went through
 #: (2 of 10 seeds of pair 1); at 50 the thread follows (docs/suture.md has the figures)
@@ -71,7 +72,10 @@ def play_task(world, task, out: Path | None = None, record: bool = False, every:
         from ..dataset.writer import DatasetWriter
         writer = DatasetWriter(world, Path(out) / "dataset")
     cam = _left_camera(world) if gif else None
-    gif_every = max(1, int(round(GIF_EVERY_S / (world.dt * world.opt.control_substeps))))
+    cdt = world.dt * world.opt.control_substeps
+    gif_every = max(1, int(round(GIF_EVERY_S / cdt)))
+    video_every = max(1, int(round(VIDEO_EVERY_S / cdt)))
+    video = _Video(Path(out) / "cameraL.mp4", 1.0 / (video_every * cdt)) if cam is not None and out is not None else None
     frames = []
     bar = _Bar(progress)
     failure = None
@@ -89,8 +93,12 @@ def play_task(world, task, out: Path | None = None, record: bool = False, every:
             n += 1
             if writer is not None and n % every == 0:
                 writer.write(n, _poses(task), phase)
-            if cam is not None and n % gif_every == 0:
-                frames.append(_small(cam.render(world)["rgb"]))
+            if cam is not None and (n % gif_every == 0 or (video is not None and n % video_every == 0)):
+                rgb = cam.render(world)["rgb"]
+                if video is not None and n % video_every == 0:
+                    video.add(rgb)
+                if n % gif_every == 0:
+                    frames.append(_small(rgb))
             spent["render_s"] += clock() - b
             if n % 25 == 0:
                 rtf = world.sim_time / (time.perf_counter() - t0)
@@ -101,13 +109,45 @@ def play_task(world, task, out: Path | None = None, record: bool = False, every:
         bar.close()
         if writer is not None:
             writer.close()
+        if video is not None:
+            video.close()
     metrics = obs.metrics(time.perf_counter() - t0, failure)
     spent["physics_s"] = world.wall_time
     spent["planning_and_servo_s"] = metrics["episode_wall_time_s"] - sum(spent.values())
     metrics["where_the_time_goes"] = spent
+    if video is not None and video.frames:
+        h, w = cam.height, cam.width
+        metrics["video"] = {"file": video.path.name, "frames": video.frames, "fps": round(video.fps, 3),
+                            "width": w, "height": h, "camera": cam.name}
     if writer is not None:
         metrics["dataset"] = {"dir": "dataset", "frames": writer.frames, "every_control_steps": every}
     return metrics, obs, frames
+
+
+class _Video:
+    """Camera L at its own resolution as an H.264 MP4 (imageio's ffmpeg plugin), written as the
+    frames come (not held in memory) to a temporary file renamed when complete."""
+
+    def __init__(self, path: Path, fps: float) -> None:
+        self.path, self.fps = path, fps
+        self.tmp = path.with_name(path.stem + ".part.mp4")
+        self.w = None
+        self.frames = 0
+
+    def add(self, rgb: np.ndarray) -> None:
+        if self.w is None:
+            import imageio.v2 as imageio
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.w = imageio.get_writer(self.tmp, format="FFMPEG", fps=self.fps, codec="libx264", quality=7,
+                                        macro_block_size=2, pixelformat="yuv420p")
+        self.w.append_data(np.ascontiguousarray(rgb))
+        self.frames += 1
+
+    def close(self) -> None:
+        if self.w is not None:
+            self.w.close()
+            self.w = None
+            self.tmp.replace(self.path)
 
 
 def _small(rgb: np.ndarray) -> np.ndarray:
@@ -183,8 +223,12 @@ def write_outputs(out: Path, metrics: dict, obs, task, frames) -> list[str]:
     written.append("trajectory.png")
     if frames:
         import imageio.v2 as imageio
-        imageio.mimsave(out / "cameraL.gif", frames, duration=GIF_EVERY_S, loop=0)
+        tmp = out / "cameraL.part.gif"
+        imageio.mimsave(tmp, frames, duration=GIF_EVERY_S, loop=0)
+        tmp.replace(out / "cameraL.gif")
         written.append("cameraL.gif")
+    if metrics.get("video"):
+        written.append(metrics["video"]["file"])
     return written
 
 
