@@ -54,6 +54,9 @@ class _Hole:
         self.half = opening_half_extents(self.body.body) if self.body is not None else \
             np.full(2, DEFAULT_HALF_OPENING)
         self.world = world
+        owner = self.body if self.body is not None else ghost.parent
+        self._static = owner is not None and owner.static
+        self._inv = None
         self.prev_local = None
         self.crossings: list[dict] = []
         self.closest = math.inf      # m, the tip's nearest approach to the opening
@@ -64,6 +67,12 @@ class _Hole:
 
     def frame(self) -> np.ndarray:
         return self.body.world_matrix() if self.body is not None else self.world.ghost_pose(self.ghost)
+
+    def inverse_frame(self) -> np.ndarray:
+        """The world-to-hole transform (read once where the hole cannot move: a static body)."""
+        if self._inv is None or not self._static:
+            self._inv = invert(self.frame())
+        return self._inv
 
 
 class SutureObserver:
@@ -85,8 +94,9 @@ class SutureObserver:
                      [_Hole(self.world, p.index, "exit", p.exit_name, p.exit) for p in task.pairs]
         self.tissue = [sb for sb in self.world.bodies if sb.model is task.needle.model and sb.static]
         self._tissue_ids = {id(sb) for sb in self.tissue}
+        # the tools' links, watched for touches when they collide with the tissue
         self._tool = {id(sb): n for n, psm in getattr(task, "psms", {}).items() for sb in self.world.bodies
-                      if sb.articulation is psm.art}
+                      if sb.articulation is psm.art} if getattr(task, "tools_collide_with_tissue", False) else {}
         self.needle_contacts: dict[str, dict[str, float]] = {}   # phase -> {tissue body: max N}
         self.tip_contacts: dict[str, dict[str, float]] = {}      # the same, within TIP_CONTACT of the tip
         self.tool_events: list[dict] = []
@@ -103,9 +113,10 @@ class SutureObserver:
     def _watch_holes(self, t: float, tip: np.ndarray) -> None:
         tangent = self.task.needle_pose()[:3, :3] @ self.tangent_in_needle
         needle = self.task.needle
+        tip_h = np.r_[tip, 1.0]
         for h in self.holes:
-            f = h.frame()
-            local = (invert(f) @ np.r_[tip, 1.0])[:3]
+            inv = h.inverse_frame()
+            local = (inv @ tip_h)[:3]
             in_ghost = needle in h.ghost.overlapping
             was_in = self._in_ghost.get(h.name, False)
             self._in_ghost[h.name] = in_ghost
@@ -123,7 +134,7 @@ class SutureObserver:
             h.crossings.append({"t": t, "phase": self.task.phase, "inward": bool(prev[2] > 0),
                                 "at_mm": [float(v) * 1000 for v in at], "outside_opening_m": outside,
                                 "ghost_overlap": bool(in_ghost or was_in),
-                                "tip_leading": tip_leading(f[:3, :3].T @ tangent, prev, local)})
+                                "tip_leading": tip_leading(inv[:3, :3] @ tangent, prev, local)})
 
     def _watch_contacts(self, t: float) -> None:
         phase = self.task.phase
@@ -140,6 +151,8 @@ class SutureObserver:
         for n, f in per_body.items():
             d = self.needle_contacts.setdefault(phase, {})
             d[n] = max(d.get(n, 0.0), f)
+        if not self._tool:
+            return
         touching = set()
         per_touch: dict[tuple, float] = {}
         for sb in self.tissue:
