@@ -103,6 +103,7 @@ class SutureObserver:
         self._open_touch: dict[tuple, dict] = {}
         self._in_ghost: dict[str, bool] = {}
         self._last_phase = None
+        self._slip_base = None
         g = task.geom
         self.tangent_in_needle = g.arc_in_needle[:3, :3] @ np.array([0.0, 1.0, 0.0])
         self.wire_radius = wire_radius(task)
@@ -196,16 +197,26 @@ class SutureObserver:
             psm = getattr(self.task, "psms", {})[self.task.holder]
             ee = psm.base_in_world() @ psm.measured_cp()
             expected = ee @ invert(self.task.held_ee_in_needle)
-            drift = float(np.linalg.norm(expected[:3, 3] - self.task.needle_pose()[:3, 3]))
+            offset = expected[:3, 3] - self.task.needle_pose()[:3, 3]
+            drift = float(np.linalg.norm(offset))
             self.max_drift = max(self.max_drift, drift)
             kind = phase.split()[0]
             self.drift_by_phase[kind] = max(self.drift_by_phase.get(kind, 0.0), drift)
             self.drift_samples += 1
-            if drift > SLIP_LIMIT and self._holders() == 1 and not any(s["phase"] == phase for s in self.slips):
-                self.slips.append({"phase": phase, "t": t, "arm": self.task.holder, "slip_m": drift})
+            # slip: how far the needle moved in the grasp since one arm alone holds it (while two
+            # hold, the other arm's grasp may shift it; that is not this grasp slipping)
+            holders = self._holders()
+            key = (id(self.task.held_ee_in_needle), holders)
+            if holders != 1:
+                self._slip_base = None
+            elif self._slip_base is None or self._slip_base[0] != key:
+                self._slip_base = (key, offset)
+            slip = float(np.linalg.norm(offset - self._slip_base[1])) if self._slip_base is not None else 0.0
+            if slip > SLIP_LIMIT and not any(s["phase"] == phase for s in self.slips):
+                self.slips.append({"phase": phase, "t": t, "arm": self.task.holder, "slip_m": slip})
             for s in self.slips:
                 if s["phase"] == phase:
-                    s["slip_m"] = max(s["slip_m"], drift)
+                    s["slip_m"] = max(s["slip_m"], slip)
 
     def _thread_at_end_of_pull(self, k: int) -> None:
         """What of the thread is through pair k now that its pull ended: the chain (from the
