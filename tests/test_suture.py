@@ -83,10 +83,10 @@ def test_metrics_json_and_pictures(one_pair):
     assert Image.open(out / "trajectory.png").size[0] > 300
     gif = Image.open(out / "cameraL.gif")
     assert gif.n_frames > 5 and gif.size[0] <= 320
-    # camera L at its own resolution as an MP4, a frame every 0.1 s simulated
+    # camera L at its own resolution as an MP4, a frame every 0.2 s simulated
     import imageio.v2 as imageio
     v = j["video"]
-    assert "cameraL.mp4" in j["files"] and v["frames"] == pytest.approx(j["simulated_time_s"] / 0.1, abs=2)
+    assert "cameraL.mp4" in j["files"] and v["frames"] == pytest.approx(j["simulated_time_s"] / 0.2, abs=2)
     with imageio.get_reader(out / "cameraL.mp4") as r:
         frame = r.get_data(0)
     assert frame.shape == (v["height"], v["width"], 3) and v["width"] >= 640

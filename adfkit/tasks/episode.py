@@ -17,7 +17,7 @@ from .suture import SutureError, SutureTask
 
 GIF_EVERY_S = 1.0      # simulated seconds between GIF frames
 GIF_WIDTH = 320        # pixels: the GIF is a preview; cameraL.mp4 has the camera's own resolution
-VIDEO_EVERY_S = 0.1    # simulated seconds between video frames (played at 10 fps: real time)
+VIDEO_EVERY_S = 0.2    # simulated seconds between video frames (played at 5 fps: real time)
 #: Bullet solver iterations for the suture: at AMBF's 10 the needle-thread joint stretches up to
 #: 9 mm while the needle is carried and the thread can miss the hole the needle went through
 #: (2 of 10 seeds of pair 1); at 50 the thread follows (docs/suture.md has the figures)
