@@ -113,6 +113,8 @@ def suture_job(job: dict) -> dict:
                     engine=job.get("engine", "pybullet"))
     return {"dir": name, "all_passed": bool(m.get("all_passed")),
             "pairs_passed": [p["pair"] for p in m.get("pairs", []) if p.get("passed")],
+            "pairs_failed": [{"pair": p["pair"], "rule": p.get("rule"), "reason": p.get("reason")}
+                             for p in m.get("pairs", []) if not p.get("passed")],
             "failure": m.get("failure"), "simulated_time_s": m.get("simulated_time_s"),
             "wall_s": time.perf_counter() - t0, "pid": os.getpid()}
 
@@ -140,6 +142,9 @@ def suture_episodes(launch, indices, pairs, seed: int, episodes: int, workers: i
     passed = sum(1 for r in done if r["result"]["all_passed"])
     print(f"{len(done)}/{len(runs)} episodes ran, {passed} passed every pair, in {wall:.1f} s "
           f"({len(done) / wall:.3f} episodes/s); index: {index}")
+    for r in done:
+        for f in r["result"].get("pairs_failed", []):
+            print(f"seed {r['job']['seed']}: pair {f['pair']} NOT passed [{f['rule']}]: {f['reason']}")
     for r in runs:
         if r["attempts"] > 1 or not r["ok"]:
             print(f"seed {r['job']['seed']}: {'retried, ' if r['attempts'] > 1 else ''}"
