@@ -31,6 +31,11 @@ def in_pair(phase: str | None, k: int, first: bool) -> bool:
     return phase.endswith(f" {k}") or (first and phase in ("pick up", "settle"))
 
 
+def _label(hole) -> str:
+    """A hole's name in a reason: its boundary body's (Entry1), else its ghost's."""
+    return getattr(hole, "label", None) or hole.name
+
+
 def _hole(obs, k: int, kind: str):
     return next(h for h in obs.holes if h.pair == k and h.kind == kind)
 
@@ -38,7 +43,7 @@ def _hole(obs, k: int, kind: str):
 def _blocked_reason(obs, k: int, entry) -> tuple[str, str]:
     """What stopped the tip at entry k: the bodies the tip pressed on (else the needle), with
     their contact forces, and a boundary narrower than the wire."""
-    label = getattr(entry, "label", entry.name)
+    label = _label(entry)
     width = 2 * float(min(entry.half)) if entry.half is not None else None
     narrow = ""
     if width is not None and width < 2 * obs.wire_radius:
@@ -55,13 +60,13 @@ def _blocked_reason(obs, k: int, entry) -> tuple[str, str]:
 
 def _crossing_fault(c: dict, hole, side: str) -> tuple[str, str] | None:
     if c["outside_opening_m"] > 0:
-        return f"{side}-outside-opening", (f"the tip crossed {hole.name}'s plane {_mm(c['outside_opening_m'])} "
+        return f"{side}-outside-opening", (f"the tip crossed {_label(hole)}'s plane {_mm(c['outside_opening_m'])} "
                                            f"outside its opening (at {c['at_mm'][0]:.1f}, {c['at_mm'][1]:.1f} mm)")
     if not c["tip_leading"]:
-        return f"{side}-not-tip-first", f"the needle went through {hole.name} backwards (tail first)"
+        return f"{side}-not-tip-first", f"the needle went through {_label(hole)} backwards (tail first)"
     if not c["ghost_overlap"]:
         g = hole.ghost.ghost
-        return f"{side}-ghost-off-hole", (f"the tip went through {hole.name}'s opening but not through its ghost "
+        return f"{side}-ghost-off-hole", (f"the tip went through {_label(hole)}'s opening but not through its ghost "
                                           f"{g.name or g.identifier}, whose centre is {_mm(hole.ghost_offset)} off "
                                           "the hole: no friction holds the needle there; put the ghost on the hole")
     return None
@@ -83,7 +88,7 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     if c_in["outside_opening_m"] > 0 and obs.needle_contacts.get(f"insert {k}"):
         # deflected by the tissue: the tip crossed the hole's plane beside the opening, not through it
         rule, reason = _blocked_reason(obs, k, entry)
-        return rule, (f"{reason}; the tip was pushed across {entry.name}'s plane "
+        return rule, (f"{reason}; the tip was pushed across {_label(entry)}'s plane "
                       f"{_mm(c_in['outside_opening_m'])} outside the opening")
     out["entry_passed_s"] = c_in["t"]
     fault = _crossing_fault(c_in, entry, "entry")
@@ -93,12 +98,12 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     back = [c for c in entry.crossings if not c["inward"] and c["t"] > c_in["t"]
             and (not outs or c["t"] < outs[0]["t"])]
     if back:
-        return "left-boundary", (f"the needle left the boundary of {entry.name}: the tip came back out at "
-                                 f"t = {back[0]['t']:.2f} s before reaching {exit_.name}")
+        return "left-boundary", (f"the needle left the boundary of {_label(entry)}: the tip came back out at "
+                                 f"t = {back[0]['t']:.2f} s before reaching {_label(exit_)}")
     if not outs:
         if failed_here:
             return "reach", failure
-        return "exit-missed", f"exit missed by {_mm(exit_.closest)}: the tip never came out through {exit_.name}"
+        return "exit-missed", f"exit missed by {_mm(exit_.closest)}: the tip never came out through {_label(exit_)}"
     out["exit_passed_s"] = outs[0]["t"]
     fault = _crossing_fault(outs[0], exit_, "exit")
     if fault:
@@ -113,7 +118,8 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     if th is not None:
         out["thread_through_m"] = th["length_m"]
     if th is not None and not (th["through_entry"] and th["through_exit"]):
-        miss = " and ".join(n for n, ok in ((entry.name, th["through_entry"]), (exit_.name, th["through_exit"])) if not ok)
+        miss = " and ".join(n for n, ok in ((_label(entry), th["through_entry"]), (_label(exit_), th["through_exit"]))
+                            if not ok)
         return "thread-not-through", f"the thread did not follow the needle through {miss}"
     for s in obs.slips:
         if in_pair(s["phase"], k, first):
