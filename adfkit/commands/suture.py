@@ -2,8 +2,10 @@
 drives it along its arc through entry k and out of exit k, the other pulls it through; writes
 DIR/metrics.json, DIR/trajectory.png, DIR/cameraL.gif and, with --record, DIR/dataset/.
 
-Exit status: 0 when every requested pair was passed (entry then exit, through the hole
-ghosts), 1 otherwise, 2 for bad input."""
+Exit status: 0 when every requested pair was passed (the per-pair verdict of
+adfkit/tasks/verdicts.py: the tip in through entry k's opening and out through exit k's, tip
+first, through their ghosts, the thread following, no slip past 2 mm; docs/suture.md), 1
+otherwise (each failed pair printed with its rule and reason), 2 for bad input."""
 from __future__ import annotations
 
 import json
