@@ -2,11 +2,13 @@
 drives it along its arc through entry k and out of exit k, the other pulls it through; writes
 DIR/metrics.json, DIR/trajectory.png, DIR/cameraL.gif and, with --record, DIR/dataset/.
 
-Exit status: 0 when every requested pair was passed (entry then exit, through the hole
-ghosts), 1 otherwise, 2 for bad input."""
+Exit status: 0 when every requested pair was passed (the per-pair verdict of
+adfkit/tasks/verdicts.py: the tip in through entry k's opening and out through exit k's, tip
+first, through their ghosts, the thread following, no slip past 2 mm; docs/suture.md), 1
+otherwise (each failed pair printed with its rule and reason), 2 for bad input."""
+
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -20,25 +22,37 @@ CORPUS_INDICES = "6-11"
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scene", nargs="?", help="launch file (default: the bundled sample_scenes/suturing, "
-                   "else the corpus suturing set with -l 6-11)")
+    p.add_argument(
+        "scene",
+        nargs="?",
+        help="launch file (default: the bundled sample_scenes/suturing, else the corpus suturing set with -l 6-11)",
+    )
     p.add_argument("-l", "--indices", help="launch indices, e.g. 6-11")
     p.add_argument("--pairs", default="1", help="how many hole pairs, 1..4 (pairs 1..N), or a list such as 2,3")
     p.add_argument("--out", default="suture-output", help="output folder (default suture-output)")
     p.add_argument("--seed", type=int, default=0, help="seed of the plan's small randomisation")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
-    p.add_argument("--engine", choices=("pybullet", "mujoco"), default="pybullet",
-                   help="physics engine (default pybullet; docs/mujoco.md says how the suture fares in MuJoCo)")
+    p.add_argument(
+        "--engine",
+        choices=("pybullet", "mujoco"),
+        default="pybullet",
+        help="physics engine (default pybullet; docs/mujoco.md says how the suture fares in MuJoCo)",
+    )
     p.add_argument("--record", action="store_true", help="write the dataset (RGB, depth, segmentation, poses)")
     p.add_argument("--every", type=int, default=10, help="with --record: a frame every N control steps")
-    p.add_argument("--episodes", type=int, default=1,
-                   help="episodes (seeds SEED..SEED+N-1) as Ray tasks, each in OUT/episode_<seed>, merged in OUT/index.json")
+    p.add_argument(
+        "--episodes",
+        type=int,
+        default=1,
+        help="episodes (seeds SEED..SEED+N-1) as Ray tasks, each in OUT/episode_<seed>, merged in OUT/index.json",
+    )
     p.add_argument("--workers", type=int, default=None, help="Ray workers on a local Ray (default 2 with --episodes)")
     p.add_argument("--address", help="Ray cluster address (auto, ray://head:10001); default: a local Ray")
 
 
 def _pairs(text: str) -> list[int]:
     from ..diagnostics import AdfError, error
+
     try:
         if "," in text:
             pairs = [int(x) for x in text.split(",")]
@@ -47,19 +61,27 @@ def _pairs(text: str) -> list[int]:
     except ValueError:
         pairs = []
     if not pairs or any(k < 1 for k in pairs) or len(set(pairs)) != len(pairs):
-        raise AdfError(error("bad-option", f"--pairs {text!r} is not a count 1..4 or a list of pair numbers",
-                             None, "e.g. --pairs 4 or --pairs 2,3"))
+        raise AdfError(
+            error(
+                "bad-option",
+                f"--pairs {text!r} is not a count 1..4 or a list of pair numbers",
+                None,
+                "e.g. --pairs 4 or --pairs 2,3",
+            )
+        )
     return pairs
 
 
 def run(args) -> int:
     from ..diagnostics import AdfError, error
+
     pairs = _pairs(args.pairs)
     if args.every < 1:
         raise AdfError(error("bad-option", "--every must be ≥ 1", None, "e.g. --every 10"))
     if args.scene:
         from .. import inputs
-        launch, indices = inputs.scene_file(args.scene), args.indices   # a folder: its launch.yaml
+
+        launch, indices = inputs.scene_file(args.scene), args.indices  # a folder: its launch.yaml
         if not launch.is_file():
             raise AdfError(error("no-file", f"{launch} does not exist", None, "give a launch file"))
     elif BUNDLED.is_file():
@@ -67,11 +89,18 @@ def run(args) -> int:
     elif CORPUS_LAUNCH.is_file():
         launch, indices = CORPUS_LAUNCH, args.indices or CORPUS_INDICES
     else:
-        raise AdfError(error("no-scene", "no suturing scene: neither sample_scenes/suturing/launch.yaml nor "
-                             "../shared/corpus is here", None, "run `adfkit build-scene suturing DIR` and give DIR/launch.yaml"))
+        raise AdfError(
+            error(
+                "no-scene",
+                "no suturing scene: neither sample_scenes/suturing/launch.yaml nor ../shared/corpus is here",
+                None,
+                "run `adfkit build-scene suturing DIR` and give DIR/launch.yaml",
+            )
+        )
     from ..adf import load_scene, parse_indices
     from ..diagnostics import Severity
     from ..report import print_diagnostics
+
     diags: list = []
     load_scene(launch, parse_indices(indices) if indices else None, diags)
     if any(d.severity >= Severity.ERROR for d in diags):
@@ -80,29 +109,76 @@ def run(args) -> int:
     out = Path(args.out)
     if args.episodes > 1 or args.workers or args.address:
         if args.episodes < 1 or (args.workers is not None and args.workers < 1):
-            raise AdfError(error("bad-option", "--episodes and --workers must be at least 1", None, "e.g. --episodes 4 --workers 2"))
+            raise AdfError(
+                error(
+                    "bad-option", "--episodes and --workers must be at least 1", None, "e.g. --episodes 4 --workers 2"
+                )
+            )
         from ..fanout import suture_episodes
-        return suture_episodes(launch, indices, pairs, args.seed, args.episodes, args.workers or 2, args.address, out,
-                               args.record, args.every, engine=args.engine)
+
+        return suture_episodes(
+            launch,
+            indices,
+            pairs,
+            args.seed,
+            args.episodes,
+            args.workers or 2,
+            args.address,
+            out,
+            args.record,
+            args.every,
+            engine=args.engine,
+        )
     from ..tasks.episode import run_episode
+
     if args.gui and args.engine == "mujoco":
-        raise AdfError(error("bad-option", "--gui opens PyBullet's window; the MuJoCo engine plays headless", None,
-                             "drop --gui, or use --engine pybullet"))
-    m = run_episode(launch, indices, pairs, args.seed, out, args.record, args.gui, progress=True, every=args.every,
-                    engine=args.engine)
+        raise AdfError(
+            error(
+                "bad-option",
+                "--gui opens PyBullet's window; the MuJoCo engine plays headless",
+                None,
+                "drop --gui, or use --engine pybullet",
+            )
+        )
+    m = run_episode(
+        launch,
+        indices,
+        pairs,
+        args.seed,
+        out,
+        args.record,
+        args.gui,
+        progress=True,
+        every=args.every,
+        engine=args.engine,
+    )
     if m.get("failure", "").startswith("setup:") if m.get("failure") else False:
-        raise AdfError(error("suture-setup", m["failure"].removeprefix("setup: "), None,
-                             "the scene needs a Needle, Entry k/Exit k hole ghosts and two PSMs"))
+        raise AdfError(
+            error(
+                "suture-setup",
+                m["failure"].removeprefix("setup: "),
+                None,
+                "the scene needs a Needle, Entry k/Exit k hole ghosts and two PSMs",
+            )
+        )
     for p in m["pairs"]:
         state = "passed" if p["passed"] else "NOT passed"
-        print(f"pair {p['pair']}: {p['entry']} -> {p['exit']} {state}"
-              + (f" (entry {p['entry_passed_s']:.2f} s, exit {p['exit_passed_s']:.2f} s)" if p["passed"] else ""))
+        print(
+            f"pair {p['pair']}: {p['entry']} -> {p['exit']} {state}"
+            + (
+                f" (entry {p['entry_passed_s']:.2f} s, exit {p['exit_passed_s']:.2f} s)"
+                if p["passed"]
+                else f" [{p.get('rule')}]: {p.get('reason')}"
+            )
+        )
     if m.get("failure"):
         print(f"stopped: {m['failure']}", file=sys.stderr)
     rtf = m.get("real_time_factor")
-    print(f"simulated {m.get('simulated_time_s', 0):.2f} s, {rtf:.2f}x real time, thread through tissue "
-          f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm, max constraint error "
-          f"{(m.get('max_constraint_error_m') or 0) * 1000:.2f} mm" + (", EXPLODED" if m.get("exploded") else ""))
+    print(
+        f"simulated {m.get('simulated_time_s', 0):.2f} s, {rtf:.2f}x real time, thread through tissue "
+        f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm, max constraint error "
+        f"{(m.get('max_constraint_error_m') or 0) * 1000:.2f} mm" + (", EXPLODED" if m.get("exploded") else "")
+    )
     print(f"metrics: {(out / 'metrics.json').resolve()}")
     for e in m.get("instabilities", []):
         print(f"  unstable at t = {e['time_s']:.3f} s, {e['body'] or 'the scene'}: {e['message']}")

@@ -163,6 +163,52 @@ class MeshFiles:
         return out, flat if (check_flat and is_flat) else None
 
 
+def obj_objects(text: str) -> list[tuple[list, list]]:
+    """The objects (``o``) of a Wavefront OBJ text, each as (vertices, faces with indices into
+    its own vertices); one entry when the file has no or one object."""
+    verts, objects, faces = [], [], []
+    for line in text.splitlines():
+        if line.startswith("v "):
+            verts.append(line.split()[1:4])
+        elif line.startswith("o ") and faces:
+            objects.append(faces)
+            faces = []
+        elif line.startswith("f "):
+            idx = []
+            for tok in line.split()[1:]:
+                i = int(tok.split("/")[0])
+                idx.append(i - 1 if i > 0 else len(verts) + i)
+            faces.append(idx)
+    if faces:
+        objects.append(faces)
+    out = []
+    for fs in objects:
+        used = sorted({i for f in fs for i in f})
+        remap = {old: new for new, old in enumerate(used)}
+        out.append(([verts[i] for i in used], [[remap[i] for i in f] for f in fs]))
+    return out
+
+
+def split_objects(path: Path, folder: Path) -> list[Path]:
+    """An OBJ file of several objects (a convex decomposition: one hull per object) as one OBJ
+    per object in ``folder``; [path] itself when it holds one object or is no OBJ."""
+    if path.suffix.lower() != ".obj" or not path.is_file():
+        return [path]
+    objs = obj_objects(path.read_text(encoding="utf-8", errors="replace"))
+    if len(objs) < 2:
+        return [path]
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for n, (v, f) in enumerate(objs):
+        p = folder / f"{path.stem}_part{n:03d}.obj"
+        text = "".join(f"v {' '.join(x)}\n" for x in v) + "".join(
+            "f " + " ".join(str(i + 1) for i in face) + "\n" for face in f
+        )
+        _write_bytes(p, text.encode())
+        out.append(p)
+    return out
+
+
 def _is_flat(mesh) -> bool:
     """True when the mesh spans (almost) no volume: all its vertices on one plane."""
     import numpy as np

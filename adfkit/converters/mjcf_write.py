@@ -31,7 +31,7 @@ from ..model.semantics import (
 )
 from ..model.tree import Link, build_tree, motion
 from . import inertia as inertia_math
-from .engine_fit import MeshFiles, flat_box, joint_range, usable_scales
+from .engine_fit import MeshFiles, flat_box, joint_range, split_objects, usable_scales
 from .losses import Loss
 from .mjcf_cameras import write_cameras_lights
 from .mjcf_soft import write_soft_bodies
@@ -260,16 +260,27 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
                 )
             )
         elif cmesh is not None:
-            g = ET.SubElement(
-                el,
-                "geom",
-                name=_unique(f"{name}_collision", used["geom"]),
-                type="mesh",
-                mesh=assets.mesh(cmesh, scale),
-                group="3",
+            # an OBJ of several objects (a convex decomposition) collides as one hull per object,
+            # as in PyBullet, not as the hull of them all (a curved needle's would fill its arc)
+            parts = split_objects(cmesh, assets.files.folder)
+            for n, part in enumerate(parts):
+                g = ET.SubElement(
+                    el,
+                    "geom",
+                    name=_unique(f"{name}_collision" + (f"{n}" if len(parts) > 1 else ""), used["geom"]),
+                    type="mesh",
+                    mesh=assets.mesh(part, scale),
+                    group="3",
+                )
+                _place(g, to_link)
+            losses.append(
+                Loss(
+                    who,
+                    "collision mesh",
+                    "MuJoCo collides with the convex hull of a mesh"
+                    + (f" (here of each of its {len(parts)} objects)" if len(parts) > 1 else ""),
+                )
             )
-            _place(g, to_link)
-            losses.append(Loss(who, "collision mesh", "MuJoCo collides with the convex hull of a mesh"))
     else:
         for n, p in enumerate(prims):
             if not _geom_primitive(

@@ -4,6 +4,7 @@ Bodies joined by revolute/prismatic trees become multibodies (exact joints, nati
 position motors); every other body is a maximal-coordinate rigid body and every other joint a
 createConstraint plus per-step forces (joints.py). docs/runner.md says why.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -16,24 +17,37 @@ import pybullet as pb
 
 from ..diagnostics import Diagnostic, warning
 from ..model.semantics import (
-    ACTUATOR_TYPES, DEFAULT_ACTUATOR_MAX_IMPULSE, DEFAULT_GRAVITY, DEFAULT_SENSOR_RANGE, JointKind,
-    SENSOR_TYPES, joint_frames, joint_kind, pose_or_identity,
+    ACTUATOR_TYPES,
+    DEFAULT_ACTUATOR_MAX_IMPULSE,
+    DEFAULT_GRAVITY,
+    DEFAULT_SENSOR_RANGE,
+    SENSOR_TYPES,
+    JointKind,
+    joint_frames,
+    joint_kind,
+    pose_or_identity,
 )
 from . import articulation, egl, stability
-from .neutral import EngineNeutral
-from .cameras import choose_renderer
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
+from .cameras import choose_renderer
 from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .names import Registry, merge_namespace
-from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix, quat_to_matrix
-from .shapes import collision_parts, create_collision, create_visual
-from .softbodies import SoftBodies, enable_deformable_world, in_scene as soft_in_scene
+from .neutral import EngineNeutral
 from .options import Options  # noqa: F401 - the world's options, imported from here by callers
+from .rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix
+from .shapes import collision_parts, create_collision, create_visual
+from .softbodies import SoftBodies, enable_deformable_world
+from .softbodies import in_scene as soft_in_scene
 from .world_state import WorldState
 
-GRASP_SPAN = 0.005   # m between the three point constraints of a grasp (SimWorld.actuate)
-SPRING_KINDS = (JointKind.SIX_DOF, JointKind.SIX_DOF_SPRING, JointKind.CONE_TWIST,
-                JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING)
+GRASP_SPAN = 0.005  # m between the three point constraints of a grasp (SimWorld.actuate)
+SPRING_KINDS = (
+    JointKind.SIX_DOF,
+    JointKind.SIX_DOF_SPRING,
+    JointKind.CONE_TWIST,
+    JointKind.LINEAR_SPRING,
+    JointKind.TORSION_SPRING,
+)
 
 
 @dataclass(eq=False)
@@ -42,11 +56,11 @@ class SimGhost:
     ghost: object
     uid: int
     parent: SimBody | None
-    pose_in_parent: np.ndarray       # ghost COM frame in the parent's PyBullet frame (or world)
+    pose_in_parent: np.ndarray  # ghost COM frame in the parent's PyBullet frame (or world)
     friction: bool = False
     overlapping: list = field(default_factory=list)
-    pq_in_parent: tuple = ()         # pose_in_parent as PyBullet (position, quaternion)
-    moves: bool = False              # a dynamic parent: the ghost follows it every step
+    pq_in_parent: tuple = ()  # pose_in_parent as PyBullet (position, quaternion)
+    moves: bool = False  # a dynamic parent: the ghost follows it every step
 
 
 @dataclass(eq=False)
@@ -54,7 +68,7 @@ class SimActuator:
     key: str
     actuator: object
     parent: SimBody
-    location: np.ndarray            # in the parent body frame
+    location: np.ndarray  # in the parent body frame
     max_force: float
     constraint: list | None = None  # the grasp's constraint ids (see SimWorld.actuate)
     target: SimBody | None = None
@@ -78,13 +92,16 @@ class SimWorld(EngineNeutral, WorldState):
         self.diagnostics: list[Diagnostic] = []
         self.gui = gui
         self.cid = pb.connect(pb.GUI if gui else pb.DIRECT)
-        self.soft = SoftBodies(self) if soft_in_scene(scene) else None   # soft bodies: a deformable world
+        self.soft = SoftBodies(self) if soft_in_scene(scene) else None  # soft bodies: a deformable world
         if self.soft is not None:
             enable_deformable_world(self.cid)
-        has_cameras = bool(scene.world is not None and scene.world.cameras) or any(m.cameras for m in scene.all_models())
+        has_cameras = bool(scene.world is not None and scene.world.cameras) or any(
+            m.cameras for m in scene.all_models()
+        )
         self._mj_view = None
-        self.renderer, self.renderer_note = choose_renderer(self.opt.renderer, self.cid, has_cameras,
-                                                            self.soft is not None, gui)
+        self.renderer, self.renderer_note = choose_renderer(
+            self.opt.renderer, self.cid, has_cameras, self.soft is not None, gui
+        )
         self.dt = 1.0 / self.opt.physics_hz
         w = scene.world
         g = self.opt.gravity or (tuple(w.gravity) if w is not None and w.gravity is not None else DEFAULT_GRAVITY)
@@ -102,7 +119,9 @@ class SimWorld(EngineNeutral, WorldState):
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         self.registry = Registry()
         self.bodies: list[SimBody] = []
-        self.constraints: list[tuple] = []   # (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
+        self.constraints: list[
+            tuple
+        ] = []  # (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self.articulations: list = []
         self.ghosts: list[SimGhost] = []
         self.actuators: list[SimActuator] = []
@@ -115,8 +134,8 @@ class SimWorld(EngineNeutral, WorldState):
         self.wall_time = 0.0
         self.watch = stability.Watch()
         self._next_stability_check = 0.0
-        self.volumes: list[dict] = []        # volumes played as iso-surface bodies (runner/volumes.py)
-        self.not_played: list[dict] = []     # every part of the scene not played, with why
+        self.volumes: list[dict] = []  # volumes played as iso-surface bodies (runner/volumes.py)
+        self.not_played: list[dict] = []  # every part of the scene not played, with why
         pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
         self._build()
 
@@ -130,8 +149,12 @@ class SimWorld(EngineNeutral, WorldState):
             mine = []
             for kind, objs in (("vehicle", m.vehicles),):
                 for o in objs:
-                    self._warn(f"runner-{kind.replace(' ', '-')}", f"{o.identifier}: {kind}s are not played by the "
-                               "PyBullet runner; skipped", o, "play this object in AMBF itself")
+                    self._warn(
+                        f"runner-{kind.replace(' ', '-')}",
+                        f"{o.identifier}: {kind}s are not played by the PyBullet runner; skipped",
+                        o,
+                        "play this object in AMBF itself",
+                    )
             for b in m.bodies:
                 sb = make_sim_body(merge_namespace(ns, b.namespace) + b.identifier, b, m)
                 sb.cid = self.cid
@@ -149,7 +172,7 @@ class SimWorld(EngineNeutral, WorldState):
                 local.items[sb.key] = sb
             for j in m.joints:
                 if self.soft is not None and self.soft.claim(m, j):
-                    continue   # joins a soft body: anchors, made with the soft bodies
+                    continue  # joins a soft body: anchors, made with the soft bodies
                 kind = joint_kind(j.type)
                 if kind is None:
                     self._warn("runner-joint-type", f"{j.identifier}: unknown joint type {j.type!r}; skipped", j)
@@ -206,8 +229,12 @@ class SimWorld(EngineNeutral, WorldState):
                 kind_c = kind
             if kind is JointKind.PRISMATIC and not (parent.articulation and child.articulation):
                 # PyBullet slides only between multibody links (btMultiBodySliderConstraint)
-                self._warn("runner-prismatic-loop", f"{j.identifier}: a prismatic joint closing a loop through "
-                           "a maximal-coordinate body is not supported by PyBullet's constraints; built as fixed", j)
+                self._warn(
+                    "runner-prismatic-loop",
+                    f"{j.identifier}: a prismatic joint closing a loop through "
+                    "a maximal-coordinate body is not supported by PyBullet's constraints; built as fixed",
+                    j,
+                )
                 kind_c = JointKind.FIXED
             try:
                 made = make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5)
@@ -218,12 +245,14 @@ class SimWorld(EngineNeutral, WorldState):
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
         self.springs = SpringSet(springs, self.cid)
         from .volumes import build_volumes
+
         build_volumes(self, models)
         for m in models:
             self._build_ghosts(m)
             self._build_actuators(m)
             self._build_sensors(m)
         from .cameras import build_cameras
+
         self.cameras = build_cameras(self)
         self._floor_z = self._floor()
         self.ground_z = None
@@ -246,8 +275,9 @@ class SimWorld(EngineNeutral, WorldState):
                 groups.setdefault(sb.uid, []).append(sb)
         out = []
         for uid, sbs in groups.items():
-            out.append((uid, [sb.link for sb in sbs], sbs,
-                        [(sb.mass * (sb.gravity - self.gravity)).tolist() for sb in sbs]))
+            out.append(
+                (uid, [sb.link for sb in sbs], sbs, [(sb.mass * (sb.gravity - self.gravity)).tolist() for sb in sbs])
+            )
         return out
 
     def _add_ground(self) -> None:
@@ -263,7 +293,7 @@ class SimWorld(EngineNeutral, WorldState):
             shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=self.cid)
             vis = egl.plane_visual(self.cid, (0, 0, 1), 0.0) if self.renderer == "egl" else -1
             self.ground_uid = pb.createMultiBody(0.0, shape, vis, [0.0, 0.0, self.ground_z], physicsClientId=self.cid)
-        else:   # soft bodies stop centimetres above a static plane: a thick slab instead
+        else:  # soft bodies stop centimetres above a static plane: a thick slab instead
             self.ground_uid = self.soft.ground_slab(self.ground_z)
         self._floor_z = self.ground_z
 
@@ -280,8 +310,14 @@ class SimWorld(EngineNeutral, WorldState):
 
     def _plane_visual(self, parts, col: int, vis: int) -> int:
         """The EGL plugin's crash on a lone PLANE without a visual, avoided (runner/egl.py)."""
-        if (self.renderer == "egl" and vis == -1 and col != -1 and parts is not None
-                and parts.plane is not None and not parts.types):
+        if (
+            self.renderer == "egl"
+            and vis == -1
+            and col != -1
+            and parts is not None
+            and parts.plane is not None
+            and not parts.types
+        ):
             return egl.plane_visual(self.cid, *parts.plane)
         return vis
 
@@ -291,8 +327,7 @@ class SimWorld(EngineNeutral, WorldState):
         if sb._parts is not None and sb._parts.plane is not None and not sb.static:
             self._warn("runner-plane", f"{sb.key}: a PLANE shape on a dynamic body; made static", sb.body)
             sb.mass = 0.0
-        sb.uid = pb.createMultiBody(sb.mass, col, vis, pos, orn, useMaximalCoordinates=True,
-                                    physicsClientId=self.cid)
+        sb.uid = pb.createMultiBody(sb.mass, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid)
         sb.link = -1
         set_dynamics(sb)
 
@@ -311,14 +346,14 @@ class SimWorld(EngineNeutral, WorldState):
                 pb.setCollisionFilterGroupMask(sb.uid, sb.link, mask, mask, physicsClientId=self.cid)
             else:
                 pb.setCollisionFilterGroupMask(sb.uid, sb.link, allbits, allbits, physicsClientId=self.cid)
-        for j, kind, parent, child in records:
+        for j, _kind, parent, child in records:
             if j.ignore_inter_collision is not False:
                 self._no_collision(parent, child)
         for m in self.scene.all_models():
             if m.ignore_inter_collision:
                 mine = self._model_bodies.get(id(m), [])
                 for i, a in enumerate(mine):
-                    for b in mine[i + 1:]:
+                    for b in mine[i + 1 :]:
                         self._no_collision(a, b)
 
     def _no_collision(self, a: SimBody, b: SimBody) -> None:
@@ -347,8 +382,11 @@ class SimWorld(EngineNeutral, WorldState):
         if key is None and ref:
             key, hit = self.registry.find(ns + ref)
         if key is None:
-            self._warn("runner-parent", f"{obj.identifier}: parent {ref!r} not found"
-                       + (f" (matches: {', '.join(hit)})" if hit else ""), obj)
+            self._warn(
+                "runner-parent",
+                f"{obj.identifier}: parent {ref!r} not found" + (f" (matches: {', '.join(hit)})" if hit else ""),
+                obj,
+            )
             return None
         return hit
 
@@ -363,7 +401,9 @@ class SimWorld(EngineNeutral, WorldState):
             loc = pose_to_matrix(pose_or_identity(gh.location))
             rel = invert(parent.com_in_body) @ loc if parent is not None else loc
             col = create_collision(parts, self.cid, gh, self.diagnostics)
-            vis = create_visual(m, gh, np.eye(4), gh.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
+            vis = (
+                create_visual(m, gh, np.eye(4), gh.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
+            )
             vis = self._plane_visual(parts, col, vis)
             world = (self._frame(parent) @ rel) if parent is not None else rel
             pos, orn = matrix_to_pq(world)
@@ -373,8 +413,9 @@ class SimWorld(EngineNeutral, WorldState):
             friction = any(w in name for w in self.opt.hole_ghost_words)
             key = self.registry.add(merge_namespace(ns, gh.namespace) + gh.identifier, None)
             moves = parent is not None and not parent.static
-            self.ghosts.append(SimGhost(key, gh, uid, parent, rel, friction, pq_in_parent=matrix_to_pq(rel),
-                                        moves=moves))
+            self.ghosts.append(
+                SimGhost(key, gh, uid, parent, rel, friction, pq_in_parent=matrix_to_pq(rel), moves=moves)
+            )
 
     def _build_actuators(self, m) -> None:
         ns = m.namespace or ""
@@ -387,15 +428,19 @@ class SimWorld(EngineNeutral, WorldState):
                 continue
             imp = a.max_impulse if a.max_impulse is not None else DEFAULT_ACTUATOR_MAX_IMPULSE
             key = merge_namespace(ns, a.namespace) + a.identifier
-            self.actuators.append(SimActuator(key, a, parent, pose_to_matrix(pose_or_identity(a.location)),
-                                              imp / self.dt))
+            self.actuators.append(
+                SimActuator(key, a, parent, pose_to_matrix(pose_or_identity(a.location)), imp / self.dt)
+            )
 
     def _build_sensors(self, m) -> None:
         ns = m.namespace or ""
         for s in m.sensors:
             if SENSOR_TYPES.get(s.type) != "proximity" or not s.array:
-                self._warn("runner-sensor", f"{s.identifier}: only proximity sensors with an `array` of rays "
-                           "are played; skipped", s)
+                self._warn(
+                    "runner-sensor",
+                    f"{s.identifier}: only proximity sensors with an `array` of rays are played; skipped",
+                    s,
+                )
                 continue
             parent = self._parent(s.parent, ns, s)
             if parent is None:
@@ -404,8 +449,9 @@ class SimWorld(EngineNeutral, WorldState):
             starts = np.array([r.offset or (0, 0, 0) for r in s.array], dtype=float)
             dirs = np.array([r.direction or (1, 0, 0) for r in s.array], dtype=float)
             key = merge_namespace(ns, s.namespace) + s.identifier
-            self.sensors.append(SimSensor(key, s, parent, pose_to_matrix(pose_or_identity(s.location)),
-                                          starts, starts + dirs * rng))
+            self.sensors.append(
+                SimSensor(key, s, parent, pose_to_matrix(pose_or_identity(s.location)), starts, starts + dirs * rng)
+            )
 
     def _frame(self, sb: SimBody) -> np.ndarray:
         """World pose of the PyBullet frame of a body."""
@@ -449,13 +495,19 @@ class SimWorld(EngineNeutral, WorldState):
         """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors."""
         cdt = self.dt * self.opt.control_substeps
         cid = self.cid
-        for uid, links, sbs, forces in self._gravity_overrides:
+        for uid, links, _sbs, forces in self._gravity_overrides:
             if links == [-1]:
                 coms = [pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0]]
             else:
-                coms = [pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0] if k < 0 else s[0]
-                        for k, s in zip(links, pb.getLinkStates(uid, [max(k, 0) for k in links],
-                                                                computeForwardKinematics=1, physicsClientId=cid))]
+                coms = [
+                    pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0] if k < 0 else s[0]
+                    for k, s in zip(
+                        links,
+                        pb.getLinkStates(
+                            uid, [max(k, 0) for k in links], computeForwardKinematics=1, physicsClientId=cid
+                        ),
+                    )
+                ]
             for k, f, at in zip(links, forces, coms):
                 pb.applyExternalForce(uid, k, f, at, pb.WORLD_FRAME, physicsClientId=cid)
         self.springs.apply(cdt)
@@ -472,7 +524,7 @@ class SimWorld(EngineNeutral, WorldState):
             pb.stepSimulation(physicsClientId=self.cid)
         self.steps += n * sub
         self.sim_time = self.steps * self.dt
-        if self.sim_time >= self._next_stability_check:   # NaN or a flung body, caught as it happens
+        if self.sim_time >= self._next_stability_check:  # NaN or a flung body, caught as it happens
             self._next_stability_check = self.sim_time + stability.CHECK_EVERY_S
             stability.check_pybullet(self, self.watch)
         self.wall_time += time.perf_counter() - t0
@@ -484,7 +536,7 @@ class SimWorld(EngineNeutral, WorldState):
         per nearby body, and the PSMs' finger ghosts are only read when grasping."""
         if self.gui:
             self.place_ghosts()
-        parents: dict[int, tuple] = {}   # hole ghosts share their parent (the phantom): read it once
+        parents: dict[int, tuple] = {}  # hole ghosts share their parent (the phantom): read it once
         cid = self.cid
         for g in self._friction_ghosts:
             if g.moves:
@@ -570,15 +622,25 @@ class SimWorld(EngineNeutral, WorldState):
         for e in (np.zeros(3), np.array([GRASP_SPAN, 0, 0]), np.array([0, GRASP_SPAN, 0])):
             pa = fa[:3, :3] @ e + fa[:3, 3]
             pbv = fb[:3, :3] @ e + fb[:3, 3]
-            c = pb.createConstraint(actuator.parent.uid, actuator.parent.link, target.uid, target.link,
-                                    pb.JOINT_POINT2POINT, [0, 0, 0], pa.tolist(), pbv.tolist(),
-                                    physicsClientId=self.cid)
+            c = pb.createConstraint(
+                actuator.parent.uid,
+                actuator.parent.link,
+                target.uid,
+                target.link,
+                pb.JOINT_POINT2POINT,
+                [0, 0, 0],
+                pa.tolist(),
+                pbv.tolist(),
+                physicsClientId=self.cid,
+            )
             pb.changeConstraint(c, maxForce=actuator.max_force, physicsClientId=self.cid)
             ids.append(c)
         actuator.constraint, actuator.target = ids, target
-        for link in self._links(actuator.parent):   # the closed jaws would push the held body out
+        for link in self._links(actuator.parent):  # the closed jaws would push the held body out
             if not self._pair_off(actuator.parent.uid, link, target):
-                pb.setCollisionFilterPair(actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid)
+                pb.setCollisionFilterPair(
+                    actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid
+                )
 
     def _pair_off(self, uid: int, link: int, b: SimBody) -> bool:
         return frozenset(((uid, link), (b.uid, b.link))) in getattr(self, "_pairs_off", ())
@@ -587,18 +649,26 @@ class SimWorld(EngineNeutral, WorldState):
         art = sb.articulation
         return range(-1, len(art.records)) if art is not None else [sb.link]
 
-
     def release(self, actuator: SimActuator) -> None:
         if actuator.constraint is not None:
             for c in actuator.constraint:
                 pb.removeConstraint(c, physicsClientId=self.cid)
             t = actuator.target
             for link in self._links(actuator.parent):
-                if not self._pair_off(actuator.parent.uid, link, t):   # set_collision's choice stays
+                if not self._pair_off(actuator.parent.uid, link, t):  # set_collision's choice stays
                     pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
         actuator.constraint, actuator.target = None, None
 
     # ---- measures -----------------------------------------------------------------------
+    def contacts(self, sb: SimBody) -> list:
+        """[(other SimBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
+        out = []
+        for c in pb.getContactPoints(bodyA=sb.uid, linkIndexA=sb.link, physicsClientId=self.cid) or ():
+            other = self._lookup.get((c[2], c[4]))
+            if other is not None and other is not sb:
+                out.append((other, float(c[9]), c[5]))
+        return out
+
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of any joint (constraints and springs
         with a locked linear range); multibody joints are exact."""
@@ -607,7 +677,7 @@ class SimWorld(EngineNeutral, WorldState):
             a = self._frame(parent)
             b = self._frame(child)
             gap = (a[:3, :3] @ pa + a[:3, 3]) - (b[:3, :3] @ pbv + b[:3, 3])
-            if axis is not None:   # a slider: only the gap across its axis is an error
+            if axis is not None:  # a slider: only the gap across its axis is an error
                 u = a[:3, :3] @ axis
                 gap = gap - np.dot(gap, u) * u
             worst = max(worst, float(np.linalg.norm(gap)))
@@ -634,18 +704,34 @@ class SimWorld(EngineNeutral, WorldState):
         soft = self.soft.report(self._floor_z) if self.soft is not None else ([], [], [], [])
         nan, fast, fell = nan + soft[1], fast + soft[2], fell + soft[3]
         return {
-            "bodies": len(self.bodies), "skipped_bodies": self.skipped, "soft_bodies": soft[0],
-            "joints": len(self.joint_names), "multibodies": len(self.articulations),
-            "constraints": len(self.constraints), "spring_joints": len(self.springs.joints),
-            "ghosts": len(self.ghosts), "sensors": len(self.sensors), "actuators": len(self.actuators),
-            "cameras": [c.name for c in self.cameras], "renderer": self.renderer,
+            "bodies": len(self.bodies),
+            "skipped_bodies": self.skipped,
+            "soft_bodies": soft[0],
+            "joints": len(self.joint_names),
+            "multibodies": len(self.articulations),
+            "constraints": len(self.constraints),
+            "spring_joints": len(self.springs.joints),
+            "ghosts": len(self.ghosts),
+            "sensors": len(self.sensors),
+            "actuators": len(self.actuators),
+            "cameras": [c.name for c in self.cameras],
+            "renderer": self.renderer,
             **({"renderer_note": self.renderer_note} if self.renderer_note else {}),
-            "steps": self.steps, "physics_hz": self.opt.physics_hz, "control_substeps": self.opt.control_substeps,
-            "simulated_time_s": self.sim_time, "wall_time_s": self.wall_time,
+            "steps": self.steps,
+            "physics_hz": self.opt.physics_hz,
+            "control_substeps": self.opt.control_substeps,
+            "simulated_time_s": self.sim_time,
+            "wall_time_s": self.wall_time,
             "real_time_factor": self.sim_time / self.wall_time if self.wall_time else None,
-            "max_constraint_error_m": self.constraint_error(), "ground_plane_z": self.ground_z,
-            "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
-            **self.watch.report(), "volumes": self.volumes, "not_played": self.not_played,
+            "max_constraint_error_m": self.constraint_error(),
+            "ground_plane_z": self.ground_z,
+            "fell_through_floor": fell,
+            "exploded": fast,
+            "nan": nan,
+            "without_collision_shape": shapeless,
+            **self.watch.report(),
+            "volumes": self.volumes,
+            "not_played": self.not_played,
         }
 
     def mj_view(self):
@@ -653,6 +739,7 @@ class SimWorld(EngineNeutral, WorldState):
         built on the first picture."""
         if self._mj_view is None:
             from .mjview import MjView
+
             self._mj_view = MjView(self)
         return self._mj_view
 

@@ -3,6 +3,7 @@ write metrics.json, trajectory.png, cameraL.gif and (with ``record``) the datase
 
 ``run_episode`` is what `adfkit suture` runs and what a Ray fan-out or a Gymnasium wrapper calls.
 """
+
 from __future__ import annotations
 
 import json
@@ -15,8 +16,13 @@ import numpy as np
 from .metrics import SutureObserver, finite
 from .suture import SutureError, SutureTask
 
-GIF_EVERY_S = 1.0      # simulated seconds between GIF frames
-GIF_WIDTH = 200        # pixels
+GIF_EVERY_S = 1.0  # simulated seconds between GIF frames
+GIF_WIDTH = 320  # pixels: the GIF is a preview; cameraL.mp4 has the camera's own resolution
+VIDEO_EVERY_S = 0.2  # simulated seconds between video frames (played at 5 fps: real time)
+#: Bullet solver iterations for the suture: at AMBF's 10 the needle-thread joint stretches up to
+#: 9 mm while the needle is carried and the thread can miss the hole the needle went through
+#: (2 of 10 seeds of pair 1); at 50 the thread follows (docs/suture.md has the figures)
+SOLVER_ITERATIONS = 50
 
 
 def _left_camera(world):
@@ -31,8 +37,11 @@ def _left_camera(world):
 def _poses(task) -> dict:
     out = {}
     for name, psm in task.psms.items():
-        out[name] = {"T_world_ee": (psm.base_in_world() @ psm.measured_cp()).tolist(),
-                     "jp": [float(v) for v in psm.measured_jp()], "jaw": psm.measured_jaw()}
+        out[name] = {
+            "T_world_ee": (psm.base_in_world() @ psm.measured_cp()).tolist(),
+            "jp": [float(v) for v in psm.measured_jp()],
+            "jaw": psm.measured_jaw(),
+        }
     return {"needle": task.needle_pose(), "psms": out}
 
 
@@ -42,10 +51,16 @@ class _Bar:
     def __init__(self, enabled: bool) -> None:
         self.bar = None
         if enabled and sys.stderr.isatty():
-            from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
             from rich.console import Console
-            self.bar = Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
-                                console=Console(file=sys.stderr), transient=True)
+            from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+            self.bar = Progress(
+                SpinnerColumn(),
+                TextColumn("{task.description}"),
+                TimeElapsedColumn(),
+                console=Console(file=sys.stderr),
+                transient=True,
+            )
             self.bar.start()
             self.id = self.bar.add_task("suture")
 
@@ -58,16 +73,23 @@ class _Bar:
             self.bar.stop()
 
 
-def play_task(world, task, out: Path | None = None, record: bool = False, every: int = 10,
-              gif: bool = True, progress: bool = True) -> tuple[dict, SutureObserver, list]:
+def play_task(
+    world, task, out: Path | None = None, record: bool = False, every: int = 10, gif: bool = True, progress: bool = True
+) -> tuple[dict, SutureObserver, list]:
     """Drive ``task`` on ``world`` to its end (or failure); returns (metrics, observer, GIF frames)."""
     obs = SutureObserver(task)
     writer = None
     if record and out is not None:
         from ..dataset.writer import DatasetWriter
+
         writer = DatasetWriter(world, Path(out) / "dataset")
     cam = _left_camera(world) if gif else None
-    gif_every = max(1, int(round(GIF_EVERY_S / (world.dt * world.opt.control_substeps))))
+    cdt = world.dt * world.opt.control_substeps
+    gif_every = max(1, int(round(GIF_EVERY_S / cdt)))
+    video_every = max(1, int(round(VIDEO_EVERY_S / cdt)))
+    video = (
+        _Video(Path(out) / "cameraL.mp4", 1.0 / (video_every * cdt)) if cam is not None and out is not None else None
+    )
     frames = []
     bar = _Bar(progress)
     failure = None
@@ -85,8 +107,12 @@ def play_task(world, task, out: Path | None = None, record: bool = False, every:
             n += 1
             if writer is not None and n % every == 0:
                 writer.write(n, _poses(task), phase)
-            if cam is not None and n % gif_every == 0:
-                frames.append(_small(cam.render(world)["rgb"]))
+            if cam is not None and (n % gif_every == 0 or (video is not None and n % video_every == 0)):
+                rgb = cam.render(world)["rgb"]
+                if video is not None and n % video_every == 0:
+                    video.add(rgb)
+                if n % gif_every == 0:
+                    frames.append(_small(rgb))
             spent["render_s"] += clock() - b
             if n % 25 == 0:
                 rtf = world.sim_time / (time.perf_counter() - t0)
@@ -97,17 +123,64 @@ def play_task(world, task, out: Path | None = None, record: bool = False, every:
         bar.close()
         if writer is not None:
             writer.close()
+        if video is not None:
+            video.close()
     metrics = obs.metrics(time.perf_counter() - t0, failure)
     spent["physics_s"] = world.wall_time
     spent["planning_and_servo_s"] = metrics["episode_wall_time_s"] - sum(spent.values())
     metrics["where_the_time_goes"] = spent
+    if video is not None and video.frames:
+        h, w = cam.height, cam.width
+        metrics["video"] = {
+            "file": video.path.name,
+            "frames": video.frames,
+            "fps": round(video.fps, 3),
+            "width": w,
+            "height": h,
+            "camera": cam.name,
+        }
     if writer is not None:
         metrics["dataset"] = {"dir": "dataset", "frames": writer.frames, "every_control_steps": every}
     return metrics, obs, frames
 
 
+class _Video:
+    """Camera L at its own resolution as an H.264 MP4 (imageio's ffmpeg plugin), written as the
+    frames come (not held in memory) to a temporary file renamed when complete."""
+
+    def __init__(self, path: Path, fps: float) -> None:
+        self.path, self.fps = path, fps
+        self.tmp = path.with_name(path.stem + ".part.mp4")
+        self.w = None
+        self.frames = 0
+
+    def add(self, rgb: np.ndarray) -> None:
+        if self.w is None:
+            import imageio.v2 as imageio
+
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.w = imageio.get_writer(
+                self.tmp,
+                format="FFMPEG",
+                fps=self.fps,
+                codec="libx264",
+                quality=7,
+                macro_block_size=2,
+                pixelformat="yuv420p",
+            )
+        self.w.append_data(np.ascontiguousarray(rgb))
+        self.frames += 1
+
+    def close(self) -> None:
+        if self.w is not None:
+            self.w.close()
+            self.w = None
+            self.tmp.replace(self.path)
+
+
 def _small(rgb: np.ndarray) -> np.ndarray:
     from PIL import Image
+
     h, w = rgb.shape[:2]
     return np.asarray(Image.fromarray(rgb).resize((GIF_WIDTH, max(1, round(h * GIF_WIDTH / w)))))
 
@@ -116,6 +189,7 @@ def tissue_outline(task):
     """The tissue's collision-mesh vertices in the world (for the plot), or None."""
     from ..adf.paths import collision_mesh_path
     from .needle import obj_vertices
+
     for sb in task.tissue():
         path = collision_mesh_path(sb.model, sb.body)
         if path is not None and path.is_file() and path.suffix.lower() == ".obj":
@@ -125,16 +199,18 @@ def tissue_outline(task):
     return None
 
 
-def plot_trajectory(obs: SutureObserver, task, path: Path) -> None:
-    """Tip trajectory over the phantom with the holes, top (x-y) and side (x-z) views."""
+def plot_trajectory(obs: SutureObserver, task, path: Path, verdicts: list | None = None) -> None:
+    """Tip trajectory over the phantom with the holes, top (x-y) and side (x-z) views; with
+    ``verdicts`` (metrics' pairs) each pair is marked passed or failed with its rule."""
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     tip = np.array(obs.tip_path) if obs.tip_path else np.zeros((0, 4))
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), dpi=90)
     tissue = tissue_outline(task)
-    holes = [(p.index, task.world.ghost_pose(p.entry)[:3, 3], task.world.ghost_pose(p.exit)[:3, 3])
-             for p in task.pairs]
+    holes = [(p.index, task.world.ghost_pose(p.entry)[:3, 3], task.world.ghost_pose(p.exit)[:3, 3]) for p in task.pairs]
     for ax, (i, j), title in ((axes[0], (0, 1), "top view"), (axes[1], (0, 2), "side view")):
         if tissue is not None:
             ax.scatter(tissue[:, i], tissue[:, j], s=1, c="#e8b4a8", label="phantom")
@@ -144,6 +220,18 @@ def plot_trajectory(obs: SutureObserver, task, path: Path) -> None:
             ax.plot(e[i], e[j], "o", mfc="none", mec="tab:blue", ms=9)
             ax.plot(x[i], x[j], "s", mfc="none", mec="tab:red", ms=9)
             ax.annotate(str(k), (e[i], e[j]), textcoords="offset points", xytext=(-12, 4), fontsize=8)
+            v = next((p for p in verdicts or [] if p.get("pair") == k), None)
+            if v is not None and i == 0 and j == 1:
+                ok = v.get("passed")
+                ax.annotate(
+                    "\u2713 passed" if ok else f"\u2717 {v.get('rule') or 'failed'}",
+                    (x[i], x[j]),
+                    textcoords="offset points",
+                    xytext=(10, -3),
+                    fontsize=8,
+                    color="tab:green" if ok else "tab:red",
+                    weight="bold",
+                )
         if holes:
             pts = np.array([h[1] for h in holes] + [h[2] for h in holes])
             lo, hi = pts.min(axis=0) - 0.03, pts.max(axis=0) + 0.03
@@ -165,31 +253,52 @@ def plot_trajectory(obs: SutureObserver, task, path: Path) -> None:
 
 def write_outputs(out: Path, metrics: dict, obs, task, frames) -> list[str]:
     from ..adf import atomic_write_text
+
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "metrics.json", json.dumps(finite(metrics), indent=2, allow_nan=False))
     written = ["metrics.json"]
-    plot_trajectory(obs, task, out / "trajectory.png")
+    plot_trajectory(obs, task, out / "trajectory.png", metrics.get("pairs"))
     written.append("trajectory.png")
     if frames:
         import imageio.v2 as imageio
-        imageio.mimsave(out / "cameraL.gif", frames, duration=GIF_EVERY_S, loop=0)
+
+        tmp = out / "cameraL.part.gif"
+        imageio.mimsave(tmp, frames, duration=GIF_EVERY_S, loop=0)
+        tmp.replace(out / "cameraL.gif")
         written.append("cameraL.gif")
+    if metrics.get("video"):
+        written.append(metrics["video"]["file"])
     return written
 
 
-def run_episode(launch, indices=None, pairs=(1,), seed: int = 0, out=None, record: bool = False,
-                gui: bool = False, progress: bool = True, every: int = 10, gif: bool = True,
-                options=None, engine: str = "pybullet") -> dict:
+def run_episode(
+    launch,
+    indices=None,
+    pairs=(1,),
+    seed: int = 0,
+    out=None,
+    record: bool = False,
+    gui: bool = False,
+    progress: bool = True,
+    every: int = 10,
+    gif: bool = True,
+    options=None,
+    engine: str = "pybullet",
+) -> dict:
     """Play one scripted suture of hole ``pairs`` on the scene; returns the metrics (also written
     with the pictures to ``out`` when given)."""
     from ..adf import load_scene, parse_indices
     from ..runner.world import Options, SimWorld
+
     diags: list = []
     scene = load_scene(Path(launch), parse_indices(indices) if isinstance(indices, str) else indices, diags)
     # many frames (the dataset, the GIF): the fastest renderer that works here (cameras.choose_renderer)
-    options = options or Options(renderer="auto" if record or (gif and out is not None) else "tiny")
+    options = options or Options(
+        renderer="auto" if record or (gif and out is not None) else "tiny", solver_iterations=SOLVER_ITERATIONS
+    )
     if engine == "mujoco":
         from ..runner.mj.world import MjWorld
+
         world = MjWorld(scene, options, gui=gui)
     else:
         world = SimWorld(scene, options, gui=gui)
@@ -198,14 +307,25 @@ def run_episode(launch, indices=None, pairs=(1,), seed: int = 0, out=None, recor
             task = SutureTask(world, list(pairs), seed=seed)
         except (SutureError, KeyError, ValueError) as exc:
             return {"pairs": [], "all_passed": False, "failure": f"setup: {exc}", "seed": seed}
-        metrics, obs, frames = play_task(world, task, Path(out) if out else None, record, every,
-                                         gif and out is not None, progress)
-        metrics.update({"seed": seed, "scene": str(launch), "indices": indices if isinstance(indices, str) else None,
-                        "setup_joint_moves_m": getattr(task, "base_moves", {}),
-                        "driver": getattr(task, "driver", None), "puller": getattr(task, "puller", None)})
+        metrics, obs, frames = play_task(
+            world, task, Path(out) if out else None, record, every, gif and out is not None, progress
+        )
+        metrics.update(
+            {
+                "seed": seed,
+                "scene": str(launch),
+                "indices": indices if isinstance(indices, str) else None,
+                "setup_joint_moves_m": getattr(task, "base_moves", {}),
+                "driver": getattr(task, "driver", None),
+                "puller": getattr(task, "puller", None),
+                "engine": engine,
+                "solver_iterations": options.solver_iterations if engine != "mujoco" else None,
+            }
+        )
         if out is not None:
             metrics["files"] = write_outputs(Path(out), metrics, obs, task, frames)
             from ..adf import atomic_write_text
+
             atomic_write_text(Path(out) / "metrics.json", json.dumps(finite(metrics), indent=2, allow_nan=False))
         return finite(metrics)
     finally:

@@ -16,6 +16,7 @@ the needle in the tool frame and plans tool poses from needle poses.
 step (the phase name); whoever drives it steps the world after each yield (run_episode,
 a Gymnasium env, an expert policy).
 """
+
 from __future__ import annotations
 
 import math
@@ -28,18 +29,19 @@ from ..adf.paths import collision_mesh_path
 from ..runner.psm import PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
+from .holes import hole_frame
 from .needle import fit_needle, obj_vertices
 
-JAW_DEPTH = 0.01      # m from the end effector to the point between the jaws (LND: along z_E)
-BACK_OFF = 0.012      # m along -z_E before a grasp and after a release
-LIFT = 0.015          # m the needle is lifted when carried between the phantom and a hole
-APPROACH = math.radians(15)    # the tip starts this far before the entry on its arc
-MAX_GRASP = math.radians(25)   # the grasps sit at most this far from the tip / the tail ...
-CLEAR = math.radians(10)       # ... and at least this far outside the tissue
-MAX_BITE = math.radians(65)    # the arc between entry and exit; wider bites aim inside the holes
-HOLE_MARGIN = 0.0008           # m kept from a hole ghost's side when aiming inside it
+JAW_DEPTH = 0.01  # m from the end effector to the point between the jaws (LND: along z_E)
+BACK_OFF = 0.012  # m along -z_E before a grasp and after a release
+LIFT = 0.015  # m the needle is lifted when carried between the phantom and a hole
+APPROACH = math.radians(15)  # the tip starts this far before the entry on its arc
+MAX_GRASP = math.radians(25)  # the grasps sit at most this far from the tip / the tail ...
+CLEAR = math.radians(10)  # ... and at least this far outside the tissue
+MAX_BITE = math.radians(65)  # the arc between entry and exit; wider bites aim inside the holes
+HOLE_MARGIN = 0.0008  # m kept from a hole ghost's side when aiming inside it
 TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
-CLIP_TOLERANCE = 0.15          # rad (m for the insertion) a set-point may pass a limit and be clipped
+CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
 
 
@@ -50,7 +52,7 @@ class SutureError(RuntimeError):
 @dataclass
 class HolePair:
     index: int
-    entry: object           # SimGhost
+    entry: object  # SimGhost
     exit: object
     entry_name: str
     exit_name: str
@@ -95,8 +97,15 @@ def hole_pairs(world) -> list[HolePair]:
     for k in sorted(found):
         d = found[k]
         if "entry" in d and "exit" in d:
-            out.append(HolePair(k, d["entry"], d["exit"], d["entry"].ghost.name or d["entry"].ghost.identifier,
-                                d["exit"].ghost.name or d["exit"].ghost.identifier))
+            out.append(
+                HolePair(
+                    k,
+                    d["entry"],
+                    d["exit"],
+                    d["entry"].ghost.name or d["entry"].ghost.identifier,
+                    d["exit"].ghost.name or d["exit"].ghost.identifier,
+                )
+            )
     return out
 
 
@@ -119,6 +128,7 @@ def find_needle(world):
 @dataclass
 class Grasp:
     """Where a PSM holds the needle: the end effector's pose in the needle frame."""
+
     ee_in_needle: np.ndarray
     margin: float
 
@@ -126,9 +136,18 @@ class Grasp:
 class SutureTask:
     """The scripted suture on a SimWorld with two PSMs (see the module docstring)."""
 
-    def __init__(self, world, pairs: list[int], seed: int = 0, psm_names=("psm1", "psm2"),
-                 speed: float = 1.0) -> None:
+    def __init__(
+        self,
+        world,
+        pairs: list[int],
+        seed: int = 0,
+        psm_names=("psm1", "psm2"),
+        speed: float = 1.0,
+        tools_collide_with_tissue: bool = False,
+    ) -> None:
         self.world = world
+        self.tools_collide_with_tissue = tools_collide_with_tissue
+        self.switched_off: list[str] = []  # what of the physics the task does not carry out (reported)
         self.rng = np.random.default_rng(seed)
         self.speed = speed
         self.cdt = world.dt * world.opt.control_substeps
@@ -141,9 +160,9 @@ class SutureTask:
         self.pairs = [all_pairs[k] for k in pairs]
         self.psms = {n: PSM(world, n) for n in psm_names}
         self.phase = "start"
-        self.clipped = 0                                # set-points clipped to the joint limits
-        self.phase_log: list[tuple[str, float]] = []   # (phase, simulated start time)
-        self.holder: str | None = None                  # the PSM holding the needle
+        self.clipped = 0  # set-points clipped to the joint limits
+        self.phase_log: list[tuple[str, float]] = []  # (phase, simulated start time)
+        self.holder: str | None = None  # the PSM holding the needle
         self.held_ee_in_needle: np.ndarray | None = None
         # seeded variation of the plan
         self.grasp_jitter = self.rng.uniform(-0.04, 0.04, 2)
@@ -163,9 +182,10 @@ class SutureTask:
 
         The needle's circle goes through an aim point in each hole: the hole's centre, or,
         where the holes are farther apart than a bite of MAX_BITE, a point inside each hole
-        ghost toward the other one (the tip still passes through both ghosts)."""
-        e = self.world.ghost_pose(pair.entry)
-        x = self.world.ghost_pose(pair.exit)
+        ghost toward the other one (the tip still passes through both ghosts). A hole is where
+        its boundary body is (holes.hole_frame), the ghost only where there is none."""
+        e = hole_frame(self.world, pair.entry)
+        x = hole_frame(self.world, pair.exit)
         pe, px = e[:3, 3], x[:3, 3]
         up = e[:3, 2] + x[:3, 2]
         if up[2] < 0:
@@ -181,8 +201,10 @@ class SutureTask:
             pe, px = pe + inset * dn, px - inset * dn
             dist -= 2 * inset
         if dist >= 2 * r * 0.98:
-            raise SutureError(f"entry and exit of pair {pair.index} are {dist * 1000:.1f} mm apart; "
-                              f"the needle spans {2 * r * 1000:.1f} mm")
+            raise SutureError(
+                f"entry and exit of pair {pair.index} are {dist * 1000:.1f} mm apart; "
+                f"the needle spans {2 * r * 1000:.1f} mm"
+            )
         w = up - np.dot(up, dn) * dn
         w /= np.linalg.norm(w)
         c = (pe + px) / 2 + math.sqrt(r * r - dist * dist / 4) * w
@@ -193,10 +215,12 @@ class SutureTask:
         b[:3, :3] = np.c_[xa, np.cross(za, xa), za]
         b[:3, 3] = c
         psi_x = math.acos(float(np.clip(np.dot(xa, (px - c) / r), -1, 1)))
-        free = self.geom.span - psi_x          # arc outside the tissue when the bite is full
+        free = self.geom.span - psi_x  # arc outside the tissue when the bite is full
         if free < 2 * CLEAR + math.radians(16):
-            raise SutureError(f"pair {pair.index}: the needle's arc ({math.degrees(self.geom.span):.0f}°) leaves "
-                              f"{math.degrees(free):.0f}° outside a {math.degrees(psi_x):.0f}° bite; too little to hold it")
+            raise SutureError(
+                f"pair {pair.index}: the needle's arc ({math.degrees(self.geom.span):.0f}°) leaves "
+                f"{math.degrees(free):.0f}° outside a {math.degrees(psi_x):.0f}° bite; too little to hold it"
+            )
         g = min(MAX_GRASP, free / 2 - CLEAR - math.radians(2))
         g_tip, g_tail = g + self.grasp_jitter[0] * g / MAX_GRASP, g + self.grasp_jitter[1] * g / MAX_GRASP
         beyond = (g_tip + CLEAR + free - g_tail - CLEAR) / 2
@@ -245,8 +269,9 @@ class SutureTask:
         lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
         return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo)))
 
-    def choose_grasp(self, psm: PSM, phi: float, needle_poses: list, down_at: np.ndarray | None = None,
-                     what: str = "") -> Grasp:
+    def choose_grasp(
+        self, psm: PSM, phi: float, needle_poses: list, down_at: np.ndarray | None = None, what: str = ""
+    ) -> Grasp:
         """The candidate grasp reachable at every needle pose with the widest joint margin
         (with ``down_at``: the jaws must point down at that needle pose, to come from above)."""
         best = None
@@ -294,7 +319,7 @@ class SutureTask:
         through an unreachable orientation on the way)."""
         try:
             q = psm.kin.ik(invert(psm.base_in_world()) @ goal)
-        except JointLimitError as exc:   # a little past a limit: go as near as the joints allow
+        except JointLimitError as exc:  # a little past a limit: go as near as the joints allow
             lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
             if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
                 raise
@@ -337,19 +362,21 @@ class SutureTask:
         psm.servo_jaw(0.8)
         yield from self.move(psm, above, 0.8)
         yield from self.move(psm, goal, 0.5, settle=0.2)
-        psm.servo_jaw(0.25)      # the jaws close on the wire ...
+        psm.servo_jaw(0.25)  # the jaws close on the wire ...
         yield from self.wait(0.1)
         ee = psm.base_in_world() @ psm.measured_cp()
         jaw = ee[:3, 3] + JAW_DEPTH * ee[:3, 2]
-        wire = (self.needle_pose() @ grasp.ee_in_needle)[:3, 3] + JAW_DEPTH * (self.needle_pose() @ grasp.ee_in_needle)[:3, 2]
+        wire = (self.needle_pose() @ grasp.ee_in_needle)[:3, 3] + JAW_DEPTH * (self.needle_pose() @ grasp.ee_in_needle)[
+            :3, 2
+        ]
         miss = float(np.linalg.norm(jaw - wire))
         if miss > 0.004:
             raise SutureError(f"{name} missed the needle by {miss * 1000:.1f} mm ({self.phase})")
         act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
-        self.world.actuate(act, self.needle)   # ... the actuator holds it (and the jaws no longer push it) ...
+        self.world.actuate(act, self.needle)  # ... the actuator holds it (and the jaws no longer push it) ...
         self.holder = name
         self.held_ee_in_needle = invert(self.needle_pose()) @ ee
-        psm.servo_jaw(0.0)                      # ... and they close fully
+        psm.servo_jaw(0.0)  # ... and they close fully
         yield from self.wait(0.15)
 
     def let_go(self, name: str):
@@ -376,8 +403,11 @@ class SutureTask:
         """Where a PSM's remote centre of motion is farther from the holes than the tool reaches
         (the corpus set: 0.26 m against 0.24 m of insertion), slide its base toward them, as a
         surgeon places the arm on its setup joints. Returns {psm: metres moved}."""
-        target = np.mean([self.world.ghost_pose(g)[:3, 3] for p in self.pairs for g in (p.entry, p.exit)]
-                         + [self.needle_pose()[:3, 3]], axis=0)
+        target = np.mean(
+            [self.world.ghost_pose(g)[:3, 3] for p in self.pairs for g in (p.entry, p.exit)]
+            + [self.needle_pose()[:3, 3]],
+            axis=0,
+        )
         moved = {}
         for name, psm in self.psms.items():
             rcm = psm.base_in_world()[:3, 3]
@@ -406,16 +436,23 @@ class SutureTask:
             insertion = [self.lifted(self.needle_at(b, -self.approach), LIFT)]
             insertion += [self.needle_at(b, psi) for psi in np.linspace(-self.approach, psi_end, 7)]
             if k == 0:
-                self.drive_grasps.append(self.choose_grasp(
-                    self.psms[self.driver], -self.geom.span + g_tail, [n0, self.lifted(n0, LIFT)] + insertion,
-                    down_at=n0, what=f"pair {p.index}, driving"))
+                self.drive_grasps.append(
+                    self.choose_grasp(
+                        self.psms[self.driver],
+                        -self.geom.span + g_tail,
+                        [n0, self.lifted(n0, LIFT)] + insertion,
+                        down_at=n0,
+                        what=f"pair {p.index}, driving",
+                    )
+                )
             else:
                 self.drive_grasps.append(self.hand_back(k, g_tail, insertion))
             done = psi_x + self.geom.span + TAIL_CLEAR
             out = self.lifted(self.needle_at(b, done), 2 * LIFT)
             pull = [self.needle_at(b, psi) for psi in np.linspace(psi_end, done, 7)] + [out]
-            self.pull_grasps.append(self.choose_grasp(self.psms[self.puller], -g_tip, pull,
-                                                      what=f"pair {p.index}, pulling"))
+            self.pull_grasps.append(
+                self.choose_grasp(self.psms[self.puller], -g_tip, pull, what=f"pair {p.index}, pulling")
+            )
             self.out_poses.append(out)
 
     def hand_back(self, k: int, g_tail: float, insertion: list) -> Grasp:
@@ -436,45 +473,40 @@ class SutureTask:
                 continue
             self.handbacks.append(h)
             return g
-        raise SutureError(f"{self.driver}/{self.puller}: no pose over pair {self.pairs[k].index} where both "
-                          "arms can hand the needle over")
-
-    def _tissue_pass_through(self) -> None:
-        """The needle passes through the phantom's bodies (its collision hull covers the holes;
-        the hole ghosts' friction is what holds an inserted needle) and the thread through the
-        tissue body."""
-        m = self.needle.model
-        for sb in self.world.bodies:
-            name = (sb.body.name or sb.body.identifier).lower()
-            if sb is self.needle or sb.model is not m or not (
-                    "phantom" in name or re.search(r"(entry|exit)\s*\d+$", name)):
-                continue
-            self.world.set_collision(self.needle, sb, False)
-        for t in self.tissue():
-            for sb in self.world.bodies:
-                if sb.model is m and "thread" in (sb.body.name or sb.body.identifier).lower():
-                    self.world.set_collision(t, sb, False)
+        raise SutureError(
+            f"{self.driver}/{self.puller}: no pose over pair {self.pairs[k].index} where both "
+            "arms can hand the needle over"
+        )
 
     def tissue(self):
         m = self.needle.model
-        return [sb for sb in self.world.bodies
-                if sb.model is m and sb.static and "phantom" in (sb.body.name or sb.body.identifier).lower()]
+        return [
+            sb
+            for sb in self.world.bodies
+            if sb.model is m and sb.static and "phantom" in (sb.body.name or sb.body.identifier).lower()
+        ]
 
-    def _soft_tissue_for_tools(self) -> None:
-        """The tools' jaws reach the wire lying on the tissue: they press into it (and the pad
-        under it) rather than push the arm off its set-point (the phantom is soft; its collision
-        shape is a hull). The two arms, brought closer on their setup joints, do not collide
-        with each other's links either (their links are coarse primitives)."""
-        m = self.needle.model
-        static = [sb for sb in self.world.bodies if sb.model is m and sb.static]
+    def _arms_apart(self) -> None:
+        """The two arms, brought closer on their setup joints, do not collide with each other's
+        links (their links are coarse primitives). Everything else collides: the needle and the
+        thread with the phantom and the hole boundaries at every step. The tools collide with the
+        tissue when ``tools_collide_with_tissue`` (a touch is then recorded by the observer as an
+        event with its force); otherwise that is switched off and named in the metrics."""
         arms = {n: [sb for sb in self.world.bodies if sb.articulation is psm.art] for n, psm in self.psms.items()}
-        for links in arms.values():
-            for sb in links:
-                for t in static:
-                    self.world.set_collision(t, sb, False)
+        if not self.tools_collide_with_tissue:
+            m = self.needle.model
+            static = [sb for sb in self.world.bodies if sb.model is m and sb.static]
+            for links in arms.values():
+                for sb in links:
+                    for t in static:
+                        self.world.set_collision(t, sb, False)
+            self.switched_off.append(
+                "tool-tissue collisions (the scripted regrasp presses the puller's jaws "
+                "on the exit's boundary; see docs/suture.md)"
+            )
         names = list(arms)
         for i, a in enumerate(names):
-            for b in names[i + 1:]:
+            for b in names[i + 1 :]:
                 for x in arms[a]:
                     for y in arms[b]:
                         self.world.set_collision(x, y, False)
@@ -495,11 +527,14 @@ class SutureTask:
         for name in self.psms:
             self.psms[name].servo_jaw(0.8)
         self.base_moves = self.setup_joints()
-        self._soft_tissue_for_tools()
+        self._arms_apart()
         yield from self.jitter()
         self.plan()
         d, p = self.psms[self.driver], self.psms[self.puller]
-        park = {n: np.clip(self.psms[n].setpoint_jp(), self.psms[n].kin.lower_limits[:6], self.psms[n].kin.upper_limits[:6]) for n in self.psms}
+        park = {
+            n: np.clip(self.psms[n].setpoint_jp(), self.psms[n].kin.lower_limits[:6], self.psms[n].kin.upper_limits[:6])
+            for n in self.psms
+        }
         self._set_phase("pick up")
         yield from self.take(self.driver, self.drive_grasps[0])
         for k, pair in enumerate(self.pairs):
@@ -514,7 +549,6 @@ class SutureTask:
             yield from self.carry(lambda s: interpolate(over, start, _smooth(s)), 0.8)
             yield from self.wait(0.2)
             self._set_phase(f"insert {pair.index}")
-            self._tissue_pass_through()
             psi_end = psi_x + beyond
             a0 = -self.approach
             yield from self.carry(lambda s: self.needle_at(b, a0 + (psi_end - a0) * s), (psi_end - a0) / 0.5)
@@ -526,8 +560,7 @@ class SutureTask:
             self.holder = self.puller
             self._set_phase(f"pull {pair.index}")
             done = psi_x + self.geom.span + TAIL_CLEAR
-            yield from self.carry(lambda s: self.needle_at(b, psi_end + (done - psi_end) * s),
-                                  (done - psi_end) / 0.6)
+            yield from self.carry(lambda s: self.needle_at(b, psi_end + (done - psi_end) * s), (done - psi_end) / 0.6)
             out = self.needle_at(b, done)
             high = self.lifted(out, 2 * LIFT)
             yield from self.carry(lambda s: interpolate(out, high, _smooth(s)), 1.0)

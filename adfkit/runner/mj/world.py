@@ -4,6 +4,7 @@ place_ghosts, ghosts/actuators/sensors/cameras/articulations, joint_state/reset_
 report, constraint_error, close. The model comes from build.py; docs/mujoco.md says
 what is approximated.
 """
+
 from __future__ import annotations
 
 import math
@@ -14,24 +15,28 @@ import numpy as np
 
 from ...diagnostics import Diagnostic, warning
 from ...model.semantics import (
-    DEFAULT_ACTUATOR_MAX_IMPULSE, DEFAULT_GRAVITY, DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, effective_mass,
+    DEFAULT_ACTUATOR_MAX_IMPULSE,
+    DEFAULT_GRAVITY,
+    DEFAULT_JOINT_MAX_MOTOR_IMPULSE,
+    JointKind,
+    effective_mass,
     inertial_offset,
 )
 from ...model.tree import ONE_DOF
 from .. import stability
-from ..neutral import EngineNeutral
 from ..names import Registry
+from ..neutral import EngineNeutral
 from ..rotations import invert, matrix_to_quat, pose_matrix, pose_to_matrix
 from .build import EXCLUDE_SPARE, build_plan, compile_spec
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 
-DRIVE_BANDWIDTH = 0.25    # ω·dt of the joint position servos (explicit stiffness is stable below 2)
+DRIVE_BANDWIDTH = 0.25  # ω·dt of the joint position servos (explicit stiffness is stable below 2)
 SOLVER_TOLERANCE = 1e-6
-WAKE_FORCE = 1e-12        # N
+WAKE_FORCE = 1e-12  # N
 # MuJoCo's 1e-3 puts a mm-scale chain to sleep 2 mm short of its rest pose, 3e-4 0.6 mm short;
 # at 1e-4 the suturing thread lying on the phantom never sleeps (its contacts jitter above it)
 SLEEP_TOLERANCE = 3e-4
-SPRING_LIMIT = 0.25       # k ≤ SPRING_LIMIT·M_ii/dt²: the PyBullet runner's clamp for explicit springs
+SPRING_LIMIT = 0.25  # k ≤ SPRING_LIMIT·M_ii/dt²: the PyBullet runner's clamp for explicit springs
 
 
 class MjWorld(EngineNeutral):
@@ -41,6 +46,7 @@ class MjWorld(EngineNeutral):
         """``sleep``: MuJoCo's island sleeping (resting trees are not integrated until a contact,
         a force or a constraint with an awake tree wakes them; driven trees never sleep)."""
         from ..options import Options
+
         if gui:
             raise ValueError("the MuJoCo engine plays headless only (use --engine pybullet for --gui)")
         self.scene = scene
@@ -56,12 +62,12 @@ class MjWorld(EngineNeutral):
         self.sim_time = 0.0
         self.wall_time = 0.0
         self.watch = stability.Watch()
-        self.engine_warnings: list[str] = []     # MuJoCo's other warnings, with their time
-        self.volumes: list[dict] = []            # (volumes are played by the PyBullet world only)
-        self.not_played: list[dict] = []         # every part of the scene not played, with why
+        self.engine_warnings: list[str] = []  # MuJoCo's other warnings, with their time
+        self.volumes: list[dict] = []  # (volumes are played by the PyBullet world only)
+        self.not_played: list[dict] = []  # every part of the scene not played, with why
         stability.install_mujoco_handler()
         self.skipped: list[str] = []
-        self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")   # MuJoCo 4's island sleeping
+        self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")  # MuJoCo 4's island sleeping
         self._render = None
         self._vel6 = np.zeros(6)
         self._runtime_excludes: set[int] = set()
@@ -91,6 +97,7 @@ class MjWorld(EngineNeutral):
         if self.opt.solver_iterations:
             spec.option.iterations = max(self.opt.solver_iterations, 1)
         from .render import prepare_cameras
+
         cams = prepare_cameras(self, plan)
         ground = self.opt.ground and self.scene.world is None and self.scene.environment is None
         self.model = compile_spec(self, spec)
@@ -100,8 +107,9 @@ class MjWorld(EngineNeutral):
         self.ground_z = None
         if ground and plan.bodies:
             self.ground_z = self._lowest_point() - 1e-3
-            spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1], pos=[0, 0, self.ground_z],
-                                    name="adfkit:ground")
+            spec.worldbody.add_geom(
+                type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1], pos=[0, 0, self.ground_z], name="adfkit:ground"
+            )
             self.model = compile_spec(self, spec)
             self.data = mujoco.MjData(self.model)
             mujoco.mj_forward(self.model, self.data)
@@ -112,11 +120,21 @@ class MjWorld(EngineNeutral):
         for bp in plan.bodies:
             bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, bp.mjname)
             mass = effective_mass(bp.body)
-            sb = MjBody(bp.key, bp.body, bp.model, max(mass, 0.0), pose_to_matrix(inertial_offset(bp.body)),
-                        pose_to_matrix(bp.link.frame_in_body), bid, self)
-            sb.has_collision = bool(np.any((m.geom_bodyid == bid) & ((m.geom_contype != 0) | (m.geom_conaffinity != 0))))
+            sb = MjBody(
+                bp.key,
+                bp.body,
+                bp.model,
+                max(mass, 0.0),
+                pose_to_matrix(inertial_offset(bp.body)),
+                pose_to_matrix(bp.link.frame_in_body),
+                bid,
+                self,
+            )
+            sb.has_collision = bool(
+                np.any((m.geom_bodyid == bid) & ((m.geom_contype != 0) | (m.geom_conaffinity != 0)))
+            )
             if bid > 0 and m.body_weldid[bid] == 0:
-                sb.mass = 0.0     # welded to the world: static whatever the file says
+                sb.mass = 0.0  # welded to the world: static whatever the file says
             self.registry.items[bp.key] = sb
             self.bodies.append(sb)
             by_plan[id(bp)] = sb
@@ -139,22 +157,41 @@ class MjWorld(EngineNeutral):
         for key, a, parent, weld in plan.actuators:
             imp = a.max_impulse if a.max_impulse is not None else DEFAULT_ACTUATOR_MAX_IMPULSE
             from ...model.semantics import pose_or_identity
-            self.actuators.append(MjActuator(key, a, by_plan[id(parent)], mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, weld),
-                                             pose_to_matrix(pose_or_identity(a.location)), imp / self.dt))
+
+            self.actuators.append(
+                MjActuator(
+                    key,
+                    a,
+                    by_plan[id(parent)],
+                    mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, weld),
+                    pose_to_matrix(pose_or_identity(a.location)),
+                    imp / self.dt,
+                )
+            )
         from ...model.semantics import DEFAULT_SENSOR_RANGE, pose_or_identity
+
         self.sensors = []
         for key, sn, parent in plan.sensors:
             rng = sn.range if sn.range is not None else DEFAULT_SENSOR_RANGE
             starts = np.array([r.offset or (0, 0, 0) for r in sn.array], dtype=float)
             dirs = np.array([r.direction or (1, 0, 0) for r in sn.array], dtype=float)
-            self.sensors.append(MjSensor(key, sn, by_plan[id(parent)], pose_to_matrix(pose_or_identity(sn.location)),
-                                         starts, starts + dirs * rng))
+            self.sensors.append(
+                MjSensor(
+                    key,
+                    sn,
+                    by_plan[id(parent)],
+                    pose_to_matrix(pose_or_identity(sn.location)),
+                    starts,
+                    starts + dirs * rng,
+                )
+            )
         # rays see collision geoms (groups 0 and 3), not visuals (1) or ghosts (4)
         self._ray_groups = np.array([1, 0, 1, 1, 0, 0], dtype=np.uint8)
         self._ray_hit = np.zeros(1, dtype=np.int32)
         self._body_of_id = {sb.id: sb for sb in self.bodies}
-        self.constraints = [(j.identifier, None, by_plan[id(p)], by_plan[id(c)], pa, pb_, None)
-                            for j, kind, p, c, pa, pb_ in plan.loops]
+        self.constraints = [
+            (j.identifier, None, by_plan[id(p)], by_plan[id(c)], pa, pb_, None) for j, kind, p, c, pa, pb_ in plan.loops
+        ]
         self.springs_count = plan.springs
         # the bodies the hole ghosts and grasps look for: dynamic ones with collision geoms
         dyn = [i for i, sb in enumerate(self.bodies) if not sb.static and sb.has_collision]
@@ -179,7 +216,7 @@ class MjWorld(EngineNeutral):
         plan.tmp.cleanup()
 
     def _lowest_point(self) -> float:
-        m, d = self.model, self.data
+        m = self.model
         z = [self._geom_bottom(g) for g in range(m.ngeom) if m.geom_group[g] != 4 and m.geom_rbound[g] > 0]
         return min(z) if z else 0.0
 
@@ -197,7 +234,7 @@ class MjWorld(EngineNeutral):
         for j, kind, p, c, jn in plan.joints:
             kids.setdefault(id(p), []).append((j, kind, p, c, jn))
         has_dof = set()
-        for j, kind, p, c, jn in plan.joints:
+        for _j, kind, p, _c, _jn in plan.joints:
             if kind in ONE_DOF:
                 has_dof.add(id(p))
         self.articulations = []
@@ -229,12 +266,12 @@ class MjWorld(EngineNeutral):
         """Servo gains from each joint's effective inertia (the diagonal of M at the initial
         pose): kp = (DRIVE_BANDWIDTH/dt)²·M_ii, critically damped (implicit in velocity), force
         capped at AMBF's max motor impulse / dt; spring stiffness clamped like the PyBullet runner's."""
-        m, d, dt = self.model, self.data, self.dt
-        diag = np.array(m.dof_M0)     # the diagonal of M at qpos0, armature included
+        m, dt = self.model, self.dt
+        diag = np.array(m.dof_M0)  # the diagonal of M at qpos0, armature included
         w = DRIVE_BANDWIDTH / dt
         by_joint = {}
         for art in self.articulations:
-            for (j, kind, p, c), vadr, act in zip(art.records, art.vadr, art.act):
+            for (j, _kind, _p, _c), vadr, act in zip(art.records, art.vadr, art.act):
                 if act < 0:
                     continue
                 mii = diag[vadr]
@@ -251,13 +288,17 @@ class MjWorld(EngineNeutral):
         for j in range(m.njnt):
             if m.jnt_stiffness[j] > 0:
                 v = m.jnt_dofadr[j]
-                cap = SPRING_LIMIT * diag[v] / dt ** 2
+                cap = SPRING_LIMIT * diag[v] / dt**2
                 if m.jnt_stiffness[j] > cap:
                     clamped.append(m.joint(j).name)
                     m.jnt_stiffness[j] = cap
         if clamped:
-            self._warn("runner-spring-clamp", f"{len(clamped)} spring axes stiffer than an explicit {dt * 1e3:g} ms "
-                       f"step keeps stable were softened to 0.25·M/dt² (e.g. {clamped[0]})", None)
+            self._warn(
+                "runner-spring-clamp",
+                f"{len(clamped)} spring axes stiffer than an explicit {dt * 1e3:g} ms "
+                f"step keeps stable were softened to 0.25·M/dt² (e.g. {clamped[0]})",
+                None,
+            )
 
     def _gravity_overrides(self) -> None:
         d = self.data
@@ -276,8 +317,7 @@ class MjWorld(EngineNeutral):
             b = m.geom_bodyid[g]
             if m.body_weldid[b] != 0 or not (m.geom_contype[g] or m.geom_conaffinity[g]):
                 continue
-            zs.append(d.geom_xpos[g][2] if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE
-                      else self._geom_bottom(g))
+            zs.append(d.geom_xpos[g][2] if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE else self._geom_bottom(g))
         return min(zs) if zs else -math.inf
 
     # ---- queries -------------------------------------------------------------------------
@@ -327,8 +367,8 @@ class MjWorld(EngineNeutral):
         if not len(fg) or not len(cg):
             return
         m, d = self.model, self.data
-        gx = self._geom_xpos            # views into MjData/MjModel, made once (attribute access costs)
-        if self.sleep:     # a sleeping body does not move: no friction to apply
+        gx = self._geom_xpos  # views into MjData/MjModel, made once (attribute access costs)
+        if self.sleep:  # a sleeping body does not move: no friction to apply
             idx = np.flatnonzero(self._body_awake[self._cand_geom_bodyid] == self._AWAKE)
         else:
             idx = self._all_cand
@@ -368,7 +408,7 @@ class MjWorld(EngineNeutral):
             self.control()
             mujoco.mj_step(m, d, sub)
             d.xfrc_applied[:] = base
-            if stability.mujoco_pending():     # a warning: NaN and a state reset, a singular inertia...
+            if stability.mujoco_pending():  # a warning: NaN and a state reset, a singular inertia...
                 self.sim_time = (self.steps + (k + 1) * sub) * self.dt
                 stability.drain_mujoco(self, self.watch)
         self.steps += n * sub
@@ -420,7 +460,6 @@ class MjWorld(EngineNeutral):
         mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, sb.id, v, 0)
         return v[3:].copy()
 
-
     def actuate(self, actuator: MjActuator, target: MjBody) -> None:
         """Weld ``target`` to the actuator's parent at their current relative pose; the jaws'
         own geoms stop colliding with it meanwhile (they would push the held body out)."""
@@ -433,7 +472,7 @@ class MjWorld(EngineNeutral):
         rel = invert(ta) @ tb
         q = matrix_to_quat(rel[:3, :3])
         m.eq_obj2id[e] = b
-        m.eq_data[e, :3] = 0.0                       # anchor: body2's origin
+        m.eq_data[e, :3] = 0.0  # anchor: body2's origin
         m.eq_data[e, 3:6] = rel[:3, 3]
         m.eq_data[e, 6:10] = (q[3], q[0], q[1], q[2])
         m.eq_data[e, 10] = 1.0
@@ -447,7 +486,7 @@ class MjWorld(EngineNeutral):
             for gid in np.nonzero(m.geom_bodyid == sb.id)[0]:
                 if m.geom_contype[gid] or m.geom_conaffinity[gid]:
                     actuator.constraint.append((int(gid), int(m.geom_contype[gid]), int(m.geom_conaffinity[gid])))
-        for gid, _, _ in actuator.constraint:   # only the links near the held body matter; all is simplest
+        for gid, _, _ in actuator.constraint:  # only the links near the held body matter; all is simplest
             if np.linalg.norm(d.geom_xpos[gid] - d.xpos[b]) < 0.05:
                 m.geom_contype[gid] = m.geom_conaffinity[gid] = 0
 
@@ -462,7 +501,7 @@ class MjWorld(EngineNeutral):
         m = self.model
         lo, hi = sorted((int(a.id), int(b.id)))
         sig = (lo << 16) + hi
-        sigs = np.array(m.exclude_signature[:m.nexclude])
+        sigs = np.array(m.exclude_signature[: m.nexclude])
         if enabled:
             if sig not in self._runtime_excludes:
                 return
@@ -473,12 +512,15 @@ class MjWorld(EngineNeutral):
                 return
             free = np.flatnonzero(sigs == 0)
             if not free.size:
-                self._warn("runner-collision-pairs", f"more than {EXCLUDE_SPARE} body pairs turned off at run "
-                           f"time; {a.key} and {b.key} keep colliding", None)
+                self._warn(
+                    "runner-collision-pairs",
+                    f"more than {EXCLUDE_SPARE} body pairs turned off at run time; {a.key} and {b.key} keep colliding",
+                    None,
+                )
                 return
             sigs[free[0]] = sig
             self._runtime_excludes.add(sig)
-        m.exclude_signature[:m.nexclude] = np.sort(sigs)
+        m.exclude_signature[: m.nexclude] = np.sort(sigs)
 
     def move_base(self, sb: MjBody, body_world: np.ndarray) -> None:
         """Put a body without joints (a PSM's base, as its setup joints would) at a new world
@@ -515,6 +557,23 @@ class MjWorld(EngineNeutral):
         actuator.target, actuator.constraint = None, None
 
     # ---- measures -----------------------------------------------------------------------
+    def contacts(self, sb: MjBody) -> list:
+        """[(other MjBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
+        m, d = self.model, self.data
+        out = []
+        f = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
+            if sb.id not in (b1, b2):
+                continue
+            other = self._body_of_id.get(b2 if b1 == sb.id else b1)
+            if other is None or other is sb:
+                continue
+            mujoco.mj_contactForce(m, d, i, f)
+            out.append((other, abs(float(f[0])), tuple(float(v) for v in c.pos)))
+        return out
+
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of a loop-closing joint (tree joints are exact)."""
         worst = 0.0
@@ -542,21 +601,37 @@ class MjWorld(EngineNeutral):
             if np.linalg.norm(v) > 10.0:
                 fast.append(sb.key)
         return {
-            "engine": "mujoco", "awake_trees": int(getattr(self.data, "ntree_awake", self.model.ntree)),
+            "engine": "mujoco",
+            "awake_trees": int(getattr(self.data, "ntree_awake", self.model.ntree)),
             "trees": int(self.model.ntree),
-            "bodies": len(self.bodies), "skipped_bodies": self.skipped,
-            "joints": len(self.joint_names), "multibodies": len(self.articulations),
-            "constraints": len(self.constraints), "spring_joints": self.springs_count,
-            "ghosts": len(self.ghosts), "sensors": len(self.sensors), "actuators": len(self.actuators),
-            "cameras": [c.name for c in self.cameras], "renderer": "mujoco",
-            "steps": self.steps, "physics_hz": self.opt.physics_hz, "control_substeps": self.opt.control_substeps,
-            "simulated_time_s": self.sim_time, "wall_time_s": self.wall_time,
+            "bodies": len(self.bodies),
+            "skipped_bodies": self.skipped,
+            "joints": len(self.joint_names),
+            "multibodies": len(self.articulations),
+            "constraints": len(self.constraints),
+            "spring_joints": self.springs_count,
+            "ghosts": len(self.ghosts),
+            "sensors": len(self.sensors),
+            "actuators": len(self.actuators),
+            "cameras": [c.name for c in self.cameras],
+            "renderer": "mujoco",
+            "steps": self.steps,
+            "physics_hz": self.opt.physics_hz,
+            "control_substeps": self.opt.control_substeps,
+            "simulated_time_s": self.sim_time,
+            "wall_time_s": self.wall_time,
             "real_time_factor": self.sim_time / self.wall_time if self.wall_time else None,
-            "max_constraint_error_m": self.constraint_error(), "ground_plane_z": self.ground_z,
-            "fell_through_floor": fell, "exploded": fast, "nan": nan, "without_collision_shape": shapeless,
-            "soft_bodies": [],   # not played by this engine (a runner-soft-body warning names each)
-            **self.watch.report(), "engine_warnings": self.engine_warnings,
-            "volumes": self.volumes, "not_played": self.not_played,
+            "max_constraint_error_m": self.constraint_error(),
+            "ground_plane_z": self.ground_z,
+            "fell_through_floor": fell,
+            "exploded": fast,
+            "nan": nan,
+            "without_collision_shape": shapeless,
+            "soft_bodies": [],  # not played by this engine (a runner-soft-body warning names each)
+            **self.watch.report(),
+            "engine_warnings": self.engine_warnings,
+            "volumes": self.volumes,
+            "not_played": self.not_played,
         }
 
     def _renderer(self):
@@ -564,6 +639,7 @@ class MjWorld(EngineNeutral):
         when no headless OpenGL opens; the reason stays in ``camera_problem``)."""
         if self._render is None:
             from .render import CameraUnavailable, _Renderer
+
             if self.camera_problem:
                 raise CameraUnavailable(self.camera_problem)
             try:

@@ -1,0 +1,96 @@
+"""A hole of the phantom as the pass test sees it: its frame (the boundary body's, z out of the
+tissue along the needle's path), its real opening (the free square inside the boundary
+body's capsules, not the ghost's box) and the crossings of its plane by a point or a chain.
+
+Pure geometry on the ADF model and 4x4 poses (numpy only), so that the verdict rules can be
+tested on exact numbers as well as on a simulation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: opening half-width used when a hole body has no capsule boundary (m)
+DEFAULT_HALF_OPENING = 0.0024
+
+
+def has_boundary(body) -> bool:
+    """Whether a hole body is framed by capsule boundary bodies (the bundled scene's holes; the
+    corpus's are meshes)."""
+    return any((s.shape or "").lower() == "capsule" for s in getattr(body, "compound_collision_shape", None) or [])
+
+
+def boundary_body(ghost):
+    """The capsule-framed hole body a hole ghost sits on, or None."""
+    parent = getattr(ghost, "parent", None)
+    return parent if parent is not None and has_boundary(parent.body) else None
+
+
+def hole_frame(world, ghost) -> np.ndarray:
+    """World pose of a hole: its boundary body's frame where it has one (the ghost may sit
+    off the hole: the needle must go through the hole), else the ghost's."""
+    b = boundary_body(ghost)
+    return b.world_matrix() if b is not None else world.ghost_pose(ghost)
+
+
+def opening_half_extents(body) -> np.ndarray:
+    """Half-widths (x, y), m, of the free opening inside a hole body's boundary: per in-plane
+    axis, the nearest capsule lying across that axis, less its radius. A body without
+    capsules gets DEFAULT_HALF_OPENING on both axes."""
+    half = [np.inf, np.inf]
+    scale = getattr(body, "scale", None) or 1.0
+    for s in getattr(body, "compound_collision_shape", None) or []:
+        if (s.shape or "").lower() != "capsule" or s.geometry is None:
+            continue
+        off = s.offset.position if s.offset is not None and s.offset.position is not None else None
+        if off is None:
+            continue
+        r = float(s.geometry.radius or 0.0)
+        axis = (s.geometry.axis or "z").lower()
+        if axis == "x":  # a capsule along x bounds the opening in y
+            half[1] = min(half[1], abs(off.y) - r)
+        elif axis == "y":
+            half[0] = min(half[0], abs(off.x) - r)
+    out = np.array([h if np.isfinite(h) else DEFAULT_HALF_OPENING for h in half]) * scale
+    return out
+
+
+@dataclass
+class Crossing:
+    """The tip crossing a hole's plane between two control steps."""
+
+    t: float
+    inward: bool  # from the +z side (outside the tissue at an entry) to the -z side
+    at: np.ndarray  # (x, y) in the hole frame where it crossed
+    outside_by: float  # m beyond the opening (0 when inside it)
+    tip_leading: bool  # the wire's tangent at the tip points the way the tip moved
+
+
+def plane_crossing(prev_local: np.ndarray, local: np.ndarray, half: np.ndarray):
+    """Where the segment prev -> now (hole frame) crosses z = 0, and how far outside the
+    opening that is (m, 0 inside); None when it does not cross."""
+    if (prev_local[2] > 0) == (local[2] > 0):
+        return None
+    s = prev_local[2] / (prev_local[2] - local[2])
+    at = prev_local + s * (local - prev_local)
+    beyond = np.maximum(np.abs(at[:2]) - half, 0.0)
+    return at[:2], float(np.linalg.norm(beyond))
+
+
+def chain_crossing(points_local: np.ndarray, half: np.ndarray, tolerance: float) -> int | None:
+    """Index i of the first segment (i, i+1) of a chain (points in the hole frame) that crosses
+    the hole's plane inside its opening (+ tolerance); None when none does."""
+    for i in range(len(points_local) - 1):
+        hit = plane_crossing(points_local[i], points_local[i + 1], half + tolerance)
+        if hit is not None and hit[1] == 0.0:
+            return i
+    return None
+
+
+def tip_leading(tangent_local: np.ndarray, prev_local: np.ndarray, local: np.ndarray) -> bool:
+    """True when the needle went tip first: its tangent at the tip (tail -> tip) points along
+    the tip's motion across the plane."""
+    motion = local - prev_local
+    return float(np.dot(tangent_local, motion)) > 0.0

@@ -1,0 +1,192 @@
+"""The verdict on one hole pair and, when it fails, a reason a phantom modeller can act on.
+
+A pair passes when, from the physics: the tip went in through entry k and out through exit k
+inside each hole's real opening (the free square inside its boundary capsules), tip first,
+overlapping each hole's ghost as it crossed (so the ghost's friction acted there); the thread
+followed through both holes by the end of the pull; the needle did not slip more than
+SLIP_LIMIT in the grasp while one arm held it; no tool pressed on the tissue harder than
+TOOL_HIT_N; and the planner reached every pose of the pair. The first rule broken is the
+verdict's ``rule`` and ``reason`` (rules in the order below).
+"""
+
+from __future__ import annotations
+
+#: N: a tool pressing on the tissue at least this hard fails the pair. None: touches are recorded
+#: (metrics' tool_tissue_events, each pair's tool_tissue_max_n) but do not fail it yet: the
+#: scripted regrasp presses the puller's jaws on the exit's boundary (about 130 N in PyBullet)
+TOOL_HIT_N: float | None = None
+
+RULES = (
+    "not-tried",
+    "reach",
+    "blocked-at-entry",
+    "entry-missed",
+    "entry-outside-opening",
+    "entry-not-tip-first",
+    "entry-ghost-off-hole",
+    "left-boundary",
+    "exit-missed",
+    "exit-outside-opening",
+    "exit-not-tip-first",
+    "exit-ghost-off-hole",
+    "thread-not-through",
+    "slip",
+    "tool-hit-tissue",
+)
+
+
+def _mm(m: float) -> str:
+    return f"{m * 1000:.1f} mm"
+
+
+def in_pair(phase: str | None, k: int, first: bool) -> bool:
+    """Whether a phase belongs to pair k (the pick-up belongs to the first pair)."""
+    if not phase:
+        return False
+    return phase.endswith(f" {k}") or (first and phase in ("pick up", "settle"))
+
+
+def _label(hole) -> str:
+    """A hole's name in a reason: its boundary body's (Entry1), else its ghost's."""
+    return getattr(hole, "label", None) or hole.name
+
+
+def _hole(obs, k: int, kind: str):
+    return next(h for h in obs.holes if h.pair == k and h.kind == kind)
+
+
+def _blocked_reason(obs, k: int, entry) -> tuple[str, str]:
+    """What stopped the tip at entry k: the bodies the tip pressed on (else the needle), with
+    their contact forces, and a boundary narrower than the wire."""
+    label = _label(entry)
+    width = 2 * float(min(entry.half)) if entry.half is not None else None
+    narrow = ""
+    if width is not None and width < 2 * obs.wire_radius:
+        narrow = f"; its opening ({_mm(width)}) is narrower than the needle's wire ({_mm(2 * obs.wire_radius)})"
+    at_tip = getattr(obs, "tip_contacts", {}).get(f"insert {k}", {})
+    forces = at_tip or obs.needle_contacts.get(f"insert {k}", {})
+    if forces:
+        who = "the tip" if at_tip else "the needle"
+        hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forces.items(), key=lambda kv: -kv[1]) if f >= 0.05)
+        return "blocked-at-entry", (
+            f"blocked at {label}: {who} pressed on {hits or 'the tissue'} and came no "
+            f"nearer than {_mm(entry.closest)} to the opening{narrow}"
+        )
+    return "entry-missed", f"the tip never went through {label} (nearest {_mm(entry.closest)} from its opening){narrow}"
+
+
+def _crossing_fault(c: dict, hole, side: str) -> tuple[str, str] | None:
+    if c["outside_opening_m"] > 0:
+        return f"{side}-outside-opening", (
+            f"the tip crossed {_label(hole)}'s plane {_mm(c['outside_opening_m'])} "
+            f"outside its opening (at {c['at_mm'][0]:.1f}, {c['at_mm'][1]:.1f} mm)"
+        )
+    if not c["tip_leading"]:
+        return f"{side}-not-tip-first", f"the needle went through {_label(hole)} backwards (tail first)"
+    if not c["ghost_overlap"]:
+        g = hole.ghost.ghost
+        return f"{side}-ghost-off-hole", (
+            f"the tip went through {_label(hole)}'s opening but not through its ghost "
+            f"{g.name or g.identifier}, whose centre is {_mm(hole.ghost_offset)} off "
+            "the hole: no friction holds the needle there; put the ghost on the hole"
+        )
+    return None
+
+
+def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: bool, out: dict):
+    k = pair.index
+    entry, exit_ = _hole(obs, k, "entry"), _hole(obs, k, "exit")
+    failed_here = failure is not None and in_pair(failure_phase, k, first)
+    log = [name for name, _ in obs.task.phase_log]
+    if log and not any(in_pair(name, k, first) for name in log):
+        return "not-tried", f"not tried: the episode stopped before it ({failure or 'no failure recorded'})"
+    ins = [c for c in entry.crossings if c["inward"]]
+    if not ins:
+        if failed_here and not (failure_phase or "").startswith(("insert", "regrasp")):
+            return "reach", failure
+        return _blocked_reason(obs, k, entry)
+    c_in = ins[0]
+    if c_in["outside_opening_m"] > 0 and obs.needle_contacts.get(f"insert {k}"):
+        # deflected by the tissue: the tip crossed the hole's plane beside the opening, not through it
+        rule, reason = _blocked_reason(obs, k, entry)
+        return rule, (
+            f"{reason}; the tip was pushed across {_label(entry)}'s plane "
+            f"{_mm(c_in['outside_opening_m'])} outside the opening"
+        )
+    out["entry_passed_s"] = c_in["t"]
+    fault = _crossing_fault(c_in, entry, "entry")
+    if fault:
+        return fault
+    outs = [c for c in exit_.crossings if not c["inward"] and c["t"] > c_in["t"]]
+    back = [
+        c for c in entry.crossings if not c["inward"] and c["t"] > c_in["t"] and (not outs or c["t"] < outs[0]["t"])
+    ]
+    if back:
+        return "left-boundary", (
+            f"the needle left the boundary of {_label(entry)}: the tip came back out at "
+            f"t = {back[0]['t']:.2f} s before reaching {_label(exit_)}"
+        )
+    if not outs:
+        if failed_here:
+            return "reach", failure
+        return "exit-missed", f"exit missed by {_mm(exit_.closest)}: the tip never came out through {_label(exit_)}"
+    out["exit_passed_s"] = outs[0]["t"]
+    fault = _crossing_fault(outs[0], exit_, "exit")
+    if fault:
+        return fault
+    th = obs.thread_by_pair.get(k)
+    if th is None and f"pull {k}" not in log and not failed_here:
+        pass  # a task that does not pull the thread (a Gymnasium pair): the tip's pass is the test
+    elif th is None:
+        if failed_here:
+            return "reach", failure
+        return "thread-not-through", "the pull of the thread never finished"
+    if th is not None:
+        out["thread_through_m"] = th["length_m"]
+    if th is not None and not (th["through_entry"] and th["through_exit"]):
+        miss = " and ".join(
+            n for n, ok in ((_label(entry), th["through_entry"]), (_label(exit_), th["through_exit"])) if not ok
+        )
+        return "thread-not-through", f"the thread did not follow the needle through {miss}"
+    for s in obs.slips:
+        if in_pair(s["phase"], k, first):
+            return "slip", (
+                f"the needle slipped {_mm(s['slip_m'])} in {s['arm']}'s grasp during {s['phase']} "
+                f"(limit {_mm(obs_slip_limit())} while one arm holds)"
+            )
+    for e in obs.tool_events:
+        if TOOL_HIT_N is not None and in_pair(e["phase"], k, first) and e["max_force_n"] >= TOOL_HIT_N:
+            return "tool-hit-tissue", (
+                f"{e['arm']}'s {e['link']} hit {e['tissue']} with {e['max_force_n']:.1f} N "
+                f"during {e['phase']} (t = {e['t_start']:.2f} s)"
+            )
+    if failed_here:
+        return "reach", failure
+    return None
+
+
+def obs_slip_limit() -> float:
+    from .metrics import SLIP_LIMIT
+
+    return SLIP_LIMIT
+
+
+def pair_verdict(obs, pair, failure: str | None = None, failure_phase: str | None = None) -> dict:
+    """The verdict on ``pair`` from what the observer recorded (see the module docstring)."""
+    first = obs.task.pairs[0] is pair
+    out = {
+        "pair": pair.index,
+        "entry": pair.entry_name,
+        "exit": pair.exit_name,
+        "entry_passed_s": None,
+        "exit_passed_s": None,
+        "thread_through_m": None,
+    }
+    fault = _judge(obs, pair, failure, failure_phase, first, out)
+    out["tool_tissue_max_n"] = max(
+        (e["max_force_n"] for e in obs.tool_events if in_pair(e["phase"], pair.index, first)), default=0.0
+    )
+    out["passed"] = fault is None
+    out["verdict"] = "passed" if fault is None else "failed"
+    out["rule"], out["reason"] = (None, None) if fault is None else fault
+    return out

@@ -1,0 +1,259 @@
+"""The suture's per-pair verdicts (adfkit/tasks/verdicts.py, holes.py): exact rules on exact
+numbers (fast), and negative controls built from the bundled scene that must fail at their
+pair with the matching reason while the unmodified scene passes (slow: physics runs)."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from adfkit.scenes.suturing.phantom import build_phantom
+from adfkit.tasks.holes import chain_crossing, opening_half_extents, plane_crossing, tip_leading
+from adfkit.tasks.metrics import SLIP_LIMIT
+from adfkit.tasks.verdicts import pair_verdict
+
+ROOT = Path(__file__).resolve().parents[1]
+BUNDLED = ROOT / "sample_scenes" / "suturing"
+
+
+def test_opening_is_the_free_square_inside_the_boundary_capsules():
+    entry1 = next(b for b in build_phantom().bodies if b.name == "Entry1")
+    # capsule centre lines 3 mm from the hole's centre, radius 0.6 mm: 2.4 mm of free half-width
+    assert opening_half_extents(entry1) == pytest.approx([0.0024, 0.0024], abs=1e-9)
+
+
+def test_a_crossing_outside_the_opening_is_measured_and_backwards_is_not_tip_first():
+    half = np.array([0.0024, 0.0024])
+    at, outside = plane_crossing(np.array([0.001, 0.0, 0.001]), np.array([0.001, 0.0, -0.001]), half)
+    assert at == pytest.approx([0.001, 0.0]) and outside == 0.0
+    # 3.4 mm off centre in x: 1.0 mm beyond the 2.4 mm opening (the ghost box's +-3 mm would pass it)
+    _, outside = plane_crossing(np.array([0.0034, 0.0, 0.001]), np.array([0.0034, 0.0, -0.001]), half)
+    assert outside == pytest.approx(0.001)
+    assert plane_crossing(np.array([0.0, 0.0, 0.002]), np.array([0.0, 0.0, 0.001]), half) is None
+    down = (np.array([0.0, 0.0, 0.001]), np.array([0.0, 0.0, -0.001]))
+    assert tip_leading(np.array([0.0, 0.0, -1.0]), *down)
+    assert not tip_leading(np.array([0.0, 0.0, 1.0]), *down)  # the tail leads: backwards
+
+
+def test_chain_crossing_finds_the_segment_inside_the_opening_only():
+    z = np.linspace(0.005, -0.005, 11)
+    inside = np.c_[np.zeros(11), np.zeros(11), z]
+    assert chain_crossing(inside, np.array([0.0024, 0.0024]), 0.001) == 4  # z from +1 mm to -1 mm... (4 -> 5)
+    outside = inside + [0.005, 0.0, 0.0]
+    assert chain_crossing(outside, np.array([0.0024, 0.0024]), 0.001) is None
+
+
+def _record(entry_crossing: dict | None, exit_crossing: dict | None, slips=(), thread=None):
+    """What a SutureObserver holds after one pair (the verdict reads nothing else)."""
+    half = np.array([0.0024, 0.0024])
+    ghost = SimpleNamespace(ghost=SimpleNamespace(name="ghostEntry1", identifier="GHOST ghostEntry1"))
+    hole = lambda kind, name, c: SimpleNamespace(
+        pair=1,
+        kind=kind,
+        name=name,
+        half=half,
+        closest=0.004,  # noqa: E731
+        ghost=ghost,
+        ghost_offset=0.0,
+        crossings=[c] if c else [],
+    )
+    pair = SimpleNamespace(index=1, entry_name="ghostEntry1", exit_name="ghostExit1")
+    task = SimpleNamespace(pairs=[pair], phase_log=[("pick up", 0.0), ("insert 1", 4.0), ("pull 1", 9.0)])
+    obs = SimpleNamespace(
+        task=task,
+        holes=[hole("entry", "ghostEntry1", entry_crossing), hole("exit", "ghostExit1", exit_crossing)],
+        needle_contacts={"insert 1": {"Phantom": 3.2}},
+        wire_radius=0.0006,
+        thread_by_pair={1: thread or {"through_entry": True, "through_exit": True, "length_m": 0.04}},
+        slips=list(slips),
+        tool_events=[],
+    )
+    return obs, pair
+
+
+def _c(t, inward, outside=0.0, leading=True, ghost=True):
+    return {
+        "t": t,
+        "phase": "insert 1",
+        "inward": inward,
+        "at_mm": [0.0, 0.0],
+        "outside_opening_m": outside,
+        "ghost_overlap": ghost,
+        "tip_leading": leading,
+    }
+
+
+def test_verdict_rules_on_exact_records():
+    ok = pair_verdict(*_record(_c(5.0, True), _c(8.0, False)))
+    assert ok["passed"] and ok["rule"] is None and ok["thread_through_m"] == 0.04
+    obs, pair = _record(_c(5.0, True, outside=0.001), _c(8.0, False))
+    obs.needle_contacts = {}
+    v = pair_verdict(obs, pair)
+    assert v["rule"] == "entry-outside-opening" and "1.0 mm outside" in v["reason"]
+    v = pair_verdict(*_record(_c(5.0, True, outside=0.001), _c(8.0, False)))  # pushed there by the tissue
+    assert v["rule"] == "blocked-at-entry" and "1.0 mm outside the opening" in v["reason"]
+    v = pair_verdict(*_record(_c(5.0, True, leading=False), _c(8.0, False)))
+    assert v["rule"] == "entry-not-tip-first" and not v["passed"]
+    v = pair_verdict(*_record(_c(5.0, True, ghost=False), _c(8.0, False)))
+    assert v["rule"] == "entry-ghost-off-hole"
+    v = pair_verdict(*_record(None, None))
+    assert v["rule"] == "blocked-at-entry" and "Phantom (3.2 N)" in v["reason"]
+    v = pair_verdict(*_record(_c(5.0, True), None))
+    assert v["rule"] == "exit-missed" and "4.0 mm" in v["reason"]
+    v = pair_verdict(
+        *_record(_c(5.0, True), _c(8.0, False), thread={"through_entry": True, "through_exit": False, "length_m": 0.0})
+    )
+    assert v["rule"] == "thread-not-through" and "ghostExit1" in v["reason"]
+    # 5 mm of slip while one arm holds fails the pair's phase; the limit is 2 mm
+    assert SLIP_LIMIT == 0.002
+    v = pair_verdict(
+        *_record(_c(5.0, True), _c(8.0, False), slips=[{"phase": "pull 1", "t": 10.0, "arm": "psm2", "slip_m": 0.005}])
+    )
+    assert v["rule"] == "slip" and "5.0 mm" in v["reason"] and "pull 1" in v["reason"]
+
+
+# ---- negative controls on the physics (each ~15 s of one pair) --------------------------------
+def _scene(tmp_path: Path, edit) -> Path:
+    dst = tmp_path / "suturing"
+    shutil.copytree(BUNDLED, dst)
+    edit(dst)
+    return dst / "launch.yaml"
+
+
+def _edit(path: Path, fn) -> None:
+    path.write_text(fn(path.read_text(encoding="utf-8")), encoding="utf-8")
+
+
+def _fill_hole_1(d: Path) -> None:
+    """A box in the ridge's gap at pair 1 (y = 36 mm): the channel is closed."""
+    box = (
+        "  - shape: Box\n    geometry: {x: 0.021, y: 0.0056, z: 0.006}\n    offset:\n"
+        "      position: {x: 0.0, y: 0.036, z: 0.019}\n      orientation: {r: 0.0, p: 0.0, y: 0.0}\n"
+    )
+    _edit(
+        d / "phantom" / "phantom.yaml",
+        lambda s: s.replace(
+            "BODY Phantom:\n  name: Phantom\n  mesh: Phantom.OBJ\n  use material: true\n  compound collision shape:\n",
+            "BODY Phantom:\n  name: Phantom\n  mesh: Phantom.OBJ\n  use material: true\n"
+            "  compound collision shape:\n" + box,
+            1,
+        ),
+    )
+
+
+def _narrow_entry_1(d: Path) -> None:
+    """Entry1's capsules 0.9 mm from its centre: a 0.6 mm opening for a 1.2 mm wire."""
+
+    def fn(s: str) -> str:
+        a = s.index("BODY Entry1:")
+        b = s.index("\nBODY ", a + 1)
+        block = re.sub(r"(\b[xy]): (-?)0\.003\b", r"\1: \g<2>0.0009", s[a:b])
+        return s[:a] + block + s[b:]
+
+    _edit(d / "phantom" / "phantom.yaml", fn)
+
+
+def _move_ghost_entry_1(d: Path) -> None:
+    """ghostEntry1 5 mm along its hole's x, off the hole."""
+
+    def fn(s: str) -> str:
+        a = s.index("GHOST ghostEntry1:")
+        b = s.index("position: {x: 0.0,", a)
+        return s[:b] + "position: {x: 0.005," + s[b + len("position: {x: 0.0,") :]
+
+    _edit(d / "phantom" / "ghosts.yaml", fn)
+
+
+def _pair_1(launch: Path) -> dict:
+    from adfkit.tasks.episode import run_episode
+
+    m = run_episode(launch, pairs=(1,), seed=0, progress=False, gif=False)
+    return m["pairs"][0]
+
+
+@pytest.mark.slow
+def test_unmodified_scene_passes_pair_1_with_everything_colliding(tmp_path):
+    p = _pair_1(_scene(tmp_path, lambda d: None))
+    assert p["passed"] and p["rule"] is None
+    assert 0 < p["thread_through_m"] <= 0.0986
+
+
+@pytest.mark.slow
+def test_filled_hole_is_blocked_at_its_entry(tmp_path):
+    p = _pair_1(_scene(tmp_path, _fill_hole_1))
+    assert not p["passed"] and p["rule"] == "blocked-at-entry"
+    assert "blocked at Entry1: the tip pressed on" in p["reason"] and "Phantom (" in p["reason"]
+    assert "narrower" not in p["reason"]
+
+
+@pytest.mark.slow
+def test_hole_narrower_than_the_wire_is_blocked_by_its_boundary(tmp_path):
+    p = _pair_1(_scene(tmp_path, _narrow_entry_1))
+    assert not p["passed"] and p["rule"] == "blocked-at-entry"
+    assert "narrower than the needle's wire" in p["reason"] and "0.6 mm" in p["reason"]
+
+
+@pytest.mark.slow
+def test_ghost_off_its_hole_fails_with_that_reason(tmp_path):
+    p = _pair_1(_scene(tmp_path, _move_ghost_entry_1))
+    assert not p["passed"] and p["rule"] == "entry-ghost-off-hole"
+    assert "5.0 mm off" in p["reason"]
+
+
+def test_filled_hole_blocks_the_insertion_fast(tmp_path):
+    """The default run's check that the physics can say no: the insertion of pair 1 alone
+    (stopped when the regrasp begins) into the phantom with hole 1 filled."""
+    from adfkit.adf import load_scene
+    from adfkit.runner.world import Options, SimWorld
+    from adfkit.tasks.metrics import SutureObserver
+    from adfkit.tasks.suture import SutureTask
+
+    world = SimWorld(load_scene(_scene(tmp_path, _fill_hole_1)), Options(renderer="tiny"))
+    try:
+        task = SutureTask(world, [1], seed=0)
+        obs = SutureObserver(task)
+        for phase in task.steps():
+            if phase == "regrasp 1":
+                break
+            world.step(1)
+            obs.observe()
+        (v,) = obs.pair_results()
+        assert v["rule"] == "blocked-at-entry" and "Phantom (" in v["reason"]
+        assert v["entry_passed_s"] is None
+    finally:
+        world.close()
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_contacts_name_the_body_and_the_force_in_both_engines(engine):
+    """world.contacts(body), what the verdicts read: the needle pushed onto the phantom
+    (0.5 N down, awake in MuJoCo) touches Phantom with at least its weight's share."""
+    from adfkit.adf import load_scene
+    from adfkit.runner.world import Options, SimWorld
+
+    scene = load_scene(BUNDLED / "launch.yaml")
+    if engine == "mujoco":
+        from adfkit.runner.mj.world import MjWorld
+
+        world = MjWorld(scene, Options())
+    else:
+        world = SimWorld(scene, Options())
+    try:
+        world.step(50)
+        needle = world.body("Needle")
+        for _ in range(5):
+            needle.force([0.0, 0.0, -0.5], list(needle.com_position()))
+            world.step(1)
+        per_body: dict = {}
+        for other, f, at in world.contacts(needle):
+            per_body[other.body.name] = per_body.get(other.body.name, 0.0) + f
+            assert len(at) == 3 and abs(at[2] - 0.016) < 0.002  # on the slab's top (16 mm)
+        assert set(per_body) == {"Phantom"}
+        assert 0.5 < per_body["Phantom"] < 50.0
+    finally:
+        world.close()
