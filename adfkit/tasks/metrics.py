@@ -22,9 +22,8 @@ from .holes import (
     plane_crossing,
     tip_leading,
 )
-from .verdicts import pair_verdict
+from .verdicts import SLIP_LIMIT, pair_verdict
 
-SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
 TOOL_TOUCH_N = 0.05  # N: a tool-tissue contact at least this strong is recorded as an event
 NEAR_HOLE = 0.005  # m: a crossing of a hole's plane farther than this beside its opening is not an attempt at it
 TIP_CONTACT = 0.002  # m: a contact this near the tip is the tip's

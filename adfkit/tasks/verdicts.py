@@ -16,6 +16,7 @@ from __future__ import annotations
 #: scripted regrasp presses the puller's jaws on the exit's boundary (about 130 N in PyBullet)
 TOOL_HIT_N: float | None = None
 
+SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
 RULES = (
     "not-tried",
     "reach",
@@ -166,8 +167,6 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
 
 
 def obs_slip_limit() -> float:
-    from .metrics import SLIP_LIMIT
-
     return SLIP_LIMIT
 
 
