@@ -24,6 +24,7 @@ class Part:
     vertices: np.ndarray  # (n, 3) float32, object frame, metres
     faces: np.ndarray  # (m, 3) uint32
     colour: tuple  # (r, g, b, a) in 0..1
+    textured: trimesh.Trimesh | None = None  # the same mesh with its texture, when its file has one
 
 
 def primitive(kind: ShapeKind, g, scale: float = 1.0) -> trimesh.Trimesh | None:
@@ -73,6 +74,30 @@ def _mesh_file(model, path, scale: float) -> trimesh.Trimesh | None:
         return None
 
 
+def _textured(model, path, scale: float) -> trimesh.Trimesh | None:
+    """An OBJ visual mesh with its material's texture (the MTL and the image beside it), scaled;
+    None when it has none. The OBJ goes through the input policy; trimesh reads its MTL and
+    image from the OBJ's own folder."""
+    from .. import inputs
+    from ..diagnostics import AdfError
+
+    try:
+        p = inputs.check_mesh(path, tree=getattr(model, "tree", None))
+    except AdfError:
+        return None
+    if p.suffix.lower() != ".obj":
+        return None
+    try:
+        mesh = trimesh.load(str(p), force="mesh", process=False)
+    except Exception:  # noqa: BLE001 - drawn untextured (load_mesh says why if it cannot read it at all)
+        return None
+    visual = getattr(mesh, "visual", None)
+    if getattr(visual, "kind", None) != "texture" or getattr(getattr(visual, "material", None), "image", None) is None:
+        return None
+    mesh.apply_scale(scale)
+    return mesh
+
+
 def _mesh_colour(mesh: trimesh.Trimesh):
     try:
         c = np.asarray(mesh.visual.main_color, dtype=float) / 255.0
@@ -104,6 +129,8 @@ def visual_parts(model, obj) -> list[Part]:
     path = visual_mesh_path(model, obj)
     mesh = _mesh_file(model, path, scale) if path is not None else None
     part = _part(mesh, colour or (_mesh_colour(mesh) if mesh is not None else DEFAULT_COLOUR))
+    if part is not None and colour is None:
+        part.textured = _textured(model, path, scale)
     return [part] if part is not None else []
 
 

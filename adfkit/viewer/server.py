@@ -169,6 +169,10 @@ class Viewer:
             surface = getattr(sb, "surface", None)  # a volume's iso-surface (runner/volumes.py)
             parts = [geometry.Part(*surface)] if surface is not None else geometry.visual_parts(sb.model, sb.body)
             for k, part in enumerate(parts):
+                if part.textured is not None:
+                    h = scene.add_mesh_trimesh(f"/bodies/b{i}/visual{k}", part.textured)
+                    h.on_click(lambda _e, sb=sb: panels.show_body(self, sb))
+                    continue
                 h = scene.add_mesh_simple(
                     f"/bodies/b{i}/visual{k}",
                     part.vertices,
