@@ -3,6 +3,7 @@ runner and MJCF. Corpus tests (sb/cloth.yaml, cloth2.yaml) skip when the corpus 
 
 from __future__ import annotations
 
+import json
 import shutil
 import struct
 
@@ -638,3 +639,27 @@ def test_soft_body_mesh_outside_the_tree_or_unnameable_is_not_read(tmp_path, mon
     finally:
         fuzzkit._OPENED = None
     assert not [p for p in opened if "secret" in p]
+
+
+def test_a_soft_body_is_in_rgb_depth_and_segmentation_with_its_own_label(tmp_path):
+    """The soft phantom's skin, drawn by the camera: labelled after the rigid bodies (soft body k
+    is label len(bodies) + k), with depth where it is seen, and named in a dataset's labels."""
+    from adfkit.adf import load_scene
+    from adfkit.dataset.writer import DatasetWriter
+    from adfkit.scenes import write_soft_phantom
+
+    launch = write_soft_phantom(tmp_path / "scene")
+    world = SimWorld(load_scene(launch), Options())
+    try:
+        world.run(0.1)
+        frame = world.cameras[0].render(world)
+        skin = frame["segmentation"] == len(world.bodies)
+        assert skin.mean() > 0.05 and np.isfinite(frame["depth"][skin]).all()
+        r, g, b = frame["rgb"][skin].reshape(-1, 3).astype(float).mean(axis=0)
+        assert r > g + 20 and r > b + 20  # drawn in its tissue colour, not the floor's grey
+        writer = DatasetWriter(world, tmp_path / "ds")
+        writer.close()
+        labels = json.loads((tmp_path / "ds" / "labels.json").read_text())
+        assert labels[str(len(world.bodies))] == world.soft.items[0].key
+    finally:
+        world.close()

@@ -207,9 +207,10 @@ def test_textured_visual_meshes_keep_their_texture():
     """The bundled phantom's OBJ names a texture: the viewer sends it, not a flat colour."""
     from adfkit.adf import load_scene
     from adfkit.viewer.geometry import visual_parts
+
     scene = load_scene(BUNDLED)
     phantom = next((m, b) for m in scene.all_models() for b in m.bodies if b.name == "Phantom")
     (part,) = visual_parts(*phantom)
     assert part.textured is not None and part.textured.visual.kind == "texture"
     assert part.textured.visual.material.image.size[0] >= 64
-    assert len(part.textured.vertices) >= len(part.vertices)   # UV seams split vertices
+    assert len(part.textured.vertices) >= len(part.vertices)  # UV seams split vertices

@@ -60,9 +60,9 @@ class DatasetWriter:
         self.world, self.root = world, Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
         self.cameras = [c for c in world.cameras if cameras is None or c.name in cameras]
-        (self.root / "labels.json").write_text(
-            json.dumps({str(i): sb.key for i, sb in enumerate(world.bodies)}, indent=1)
-        )
+        keys = [sb.key for sb in world.bodies]
+        keys += [s.key for s in getattr(getattr(world, "soft", None), "items", []) or []]  # after the bodies
+        (self.root / "labels.json").write_text(json.dumps({str(i): k for i, k in enumerate(keys)}, indent=1))
         (self.root / "cameras.json").write_text(
             json.dumps(
                 {

@@ -123,19 +123,22 @@ def choose_renderer(wanted: str, cid: int, has_cameras: bool, soft: bool, gui: b
 
 def label_table(world) -> np.ndarray:
     """[uid, link + 1] -> index of the body in ``world.bodies`` (-1: none), built once per body
-    count: a segmentation image is then labelled by one numpy lookup."""
+    count: a segmentation image is then labelled by one numpy lookup. Soft bodies follow the
+    bodies: soft body k of the report's ``soft_bodies`` is label ``len(world.bodies) + k``."""
     bodies = world.bodies
+    soft = list(getattr(getattr(world, "soft", None), "items", []) or [])
     cached = getattr(world, "_seg_label_table", None)
-    if cached is not None and cached[0] == len(bodies):
+    if cached is not None and cached[0] == (len(bodies), len(soft)):
         return cached[1]
     ids = [(sb.uid, sb.link, i) for i, sb in enumerate(bodies) if sb.uid is not None and sb.uid >= 0]
+    ids += [(s.uid, -1, len(bodies) + k) for k, s in enumerate(soft) if s.uid is not None and s.uid >= 0]
     if ids:
         uids, links, index = (np.array(c) for c in zip(*ids))
         table = np.full((uids.max() + 1, links.max() + 2), -1, dtype=np.int32)
         table[uids, links + 1] = index  # as a dict would: the last body of a (uid, link) wins
     else:
         table = np.full((1, 1), -1, dtype=np.int32)
-    world._seg_label_table = (len(bodies), table)
+    world._seg_label_table = ((len(bodies), len(soft)), table)
     return table
 
 
