@@ -214,3 +214,19 @@ def test_textured_visual_meshes_keep_their_texture():
     assert part.textured is not None and part.textured.visual.kind == "texture"
     assert part.textured.visual.material.image.size[0] >= 64
     assert len(part.textured.vertices) >= len(part.vertices)  # UV seams split vertices
+
+
+def test_clicking_a_body_shows_its_adf_facts():
+    from adfkit.viewer import panels
+    v, _ = _serve()
+    try:
+        needle = v.world.body("Needle")
+        panels.show_body(v, needle)
+        text = v.selected.content
+        where = needle.body.where()
+        assert "**BODY Needle**" in text and f"{where.file}:{where.line}" in text
+        assert f"mass: {needle.mass:g} kg" in text and "inertia: ix " in text
+        panels.show_body(v, v.world.body("Phantom"))              # the same panel, updated
+        assert "**BODY Phantom**" in v.selected.content and "mass: 0 kg" in v.selected.content
+    finally:
+        v.close()
