@@ -218,6 +218,7 @@ def test_textured_visual_meshes_keep_their_texture():
 
 def test_clicking_a_body_shows_its_adf_facts():
     from adfkit.viewer import panels
+
     v, _ = _serve()
     try:
         needle = v.world.body("Needle")
@@ -226,7 +227,7 @@ def test_clicking_a_body_shows_its_adf_facts():
         where = needle.body.where()
         assert "**BODY Needle**" in text and f"{where.file}:{where.line}" in text
         assert f"mass: {needle.mass:g} kg" in text and "inertia: ix " in text
-        panels.show_body(v, v.world.body("Phantom"))              # the same panel, updated
+        panels.show_body(v, v.world.body("Phantom"))  # the same panel, updated
         assert "**BODY Phantom**" in v.selected.content and "mass: 0 kg" in v.selected.content
     finally:
         v.close()
