@@ -21,10 +21,10 @@ def main() -> int:
     from adfkit.adf import load_scene
     from adfkit.dataset import load
     from adfkit.dataset.writer import DatasetWriter
+    from adfkit.runner import open_world
     from adfkit.runner.options import Options
-    from adfkit.runner.world import SimWorld
 
-    world = SimWorld(load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml"), Options(renderer="auto"))
+    world = open_world(load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml"), Options(renderer="auto"))
     with tempfile.TemporaryDirectory() as tmp:
         try:
             writer = DatasetWriter(world, Path(tmp) / "ds")

@@ -36,12 +36,12 @@ def _timed(fn) -> tuple[float, float]:
 def measure(scene, kw: dict, seconds: float, rounds: int) -> dict:
     import pybullet as pb
 
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
     full, bare = [], []
     for _ in range(rounds):
         for kind in ("full", "bare"):
-            world = SimWorld(scene, Options(visuals=False, **kw))
+            world = open_world(scene, Options(visuals=False, **kw))
             try:
                 world.run(0.05)  # settle: the first steps wake everything up
                 n = int(round(seconds / (world.dt * world.opt.control_substeps)))
@@ -53,7 +53,7 @@ def measure(scene, kw: dict, seconds: float, rounds: int) -> dict:
                     bare.append(_timed(lambda: [pb.stepSimulation(physicsClientId=cid) for _ in range(n)]))
             finally:
                 world.close()
-    world = SimWorld(scene, Options(visuals=False, **kw))
+    world = open_world(scene, Options(visuals=False, **kw))
     try:
         world.run(0.05)
         cdt = world.dt * world.opt.control_substeps

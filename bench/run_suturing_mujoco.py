@@ -1,5 +1,5 @@
 """The suturing set (launch indices 6-11) in the MuJoCo engine, headless at 1 kHz physics:
-real-time factor of MjWorld.run, the bare mj_step floor of the same compiled model from the
+real-time factor of MujocoWorld.run, the bare mj_step floor of the same compiled model from the
 same state, where the time goes (MuJoCo's own timers), and the stereo frame time (cameraL +
 cameraR, each RGB + depth + segmentation) with MuJoCo's renderer. Figures only, no asserts."""
 
@@ -24,9 +24,9 @@ def main() -> int:
     import numpy as np
 
     from adfkit.adf import load_scene
-    from adfkit.runner.mj.render import CameraUnavailable
-    from adfkit.runner.mj.world import MjWorld
-    from adfkit.runner.world import Options
+    from adfkit.runner import Options
+    from adfkit.runner.mujoco.render import CameraUnavailable
+    from adfkit.runner.mujoco.world import MujocoWorld
 
     launch = CORPUS / "src" / "launch.yaml"
     if not launch.is_file():
@@ -34,7 +34,7 @@ def main() -> int:
         return 2
     scene = load_scene(launch, [6, 7, 8, 9, 10, 11])
     t0 = time.perf_counter()
-    world = MjWorld(scene, Options())
+    world = MujocoWorld(scene, Options())
     build = time.perf_counter() - t0
     m, d = world.model, world.data
     print(
@@ -48,7 +48,7 @@ def main() -> int:
     r = world.report()
     rtf = (world.sim_time - s0) / (world.wall_time - w0)
     print(
-        f"MjWorld.run: {first:.2f}x real time over the first {args.seconds:g} s (the thread settling, "
+        f"MujocoWorld.run: {first:.2f}x real time over the first {args.seconds:g} s (the thread settling, "
         f"awake), {rtf:.2f}x over the next {args.seconds:g} s ({r['awake_trees']} of {r['trees']} trees awake); "
         f"unstable bodies {len(r['nan']) + len(r['exploded']) + len(r['fell_through_floor'])}"
     )
@@ -63,7 +63,7 @@ def main() -> int:
         f"bare mj_step floor from there {floor:.2f}x (ratio {rtf / floor:.2f}); contacts {d.ncon}, "
         f"constraint rows {d.nefc}"
     )
-    asleep = MjWorld(scene, Options(), sleep=False)
+    asleep = MujocoWorld(scene, Options(), sleep=False)
     asleep.run(args.seconds)
     w1, s1 = asleep.wall_time, asleep.sim_time
     asleep.run(args.seconds)

@@ -126,17 +126,17 @@ def bench_validate(quick: bool) -> list[dict]:
 
 def _world(engine: str, path: Path):
     from adfkit.adf import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
     scene = load_scene(path)
     # no gravity and no sleeping: the chain holds still, so every size does the same work per
     # body (a falling chain whips, and its cost would follow the motion, not the size)
     opt = Options(ground=False, gravity=(0.0, 0.0, 0.0))
     if engine == "mujoco":
-        from adfkit.runner.mj.world import MjWorld
+        from adfkit.runner.mujoco.world import MujocoWorld
 
-        return MjWorld(scene, opt, sleep=False)
-    return SimWorld(scene, opt)
+        return MujocoWorld(scene, opt, sleep=False)
+    return open_world(scene, opt)
 
 
 def bench_run(quick: bool, tmp: Path) -> list[dict]:
@@ -277,10 +277,10 @@ def bench_suture(tmp: Path) -> list[dict]:
 
 def bench_record(quick: bool) -> list[dict]:
     from adfkit.adf import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
     scene = load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml")
-    world = SimWorld(scene, Options(renderer="auto"))
+    world = open_world(scene, Options(renderer="auto"))
     try:
         cams = list(world.cameras)
         for cam in cams:  # the renderer's start-up (GL context, mirror) apart

@@ -27,10 +27,10 @@ BODY table:
 
 def play(path: Path, seconds: float, ground: bool = True):
     from adfkit.adf import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
     t0 = time.perf_counter()
-    world = SimWorld(load_scene(path, None, []), Options(visuals=False, ground=ground))
+    world = open_world(load_scene(path, None, []), Options(visuals=False, ground=ground))
     build = time.perf_counter() - t0
     world.run(seconds)
     rep = world.report()

@@ -49,10 +49,10 @@ def pybullet_loop(scene, seconds: float, rounds: int) -> tuple[float, float]:
 def mujoco_loop(scene, seconds: float) -> tuple[float, float, float]:
     import mujoco
 
-    from adfkit.runner.mj.world import MjWorld
-    from adfkit.runner.world import Options
+    from adfkit.runner import Options
+    from adfkit.runner.mujoco.world import MujocoWorld
 
-    world = MjWorld(scene, Options())
+    world = MujocoWorld(scene, Options())
     try:
         world.run(seconds)
         first = world.sim_time / world.wall_time
@@ -97,11 +97,11 @@ def one_pass_ms(scene, frames: int) -> float | str:
     import mujoco
     import numpy as np
 
-    from adfkit.runner.mj.world import MjWorld
+    from adfkit.runner.mujoco.world import MujocoWorld
     from adfkit.runner.options import Options
 
     try:
-        world = MjWorld(scene, Options())
+        world = MujocoWorld(scene, Options())
         world.run(0.1)
         r = world._renderer()
     except Exception as exc:  # noqa: BLE001 - a table cell, not a crash
@@ -166,8 +166,8 @@ def main() -> int:
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--frames", type=int, default=10)
     args = ap.parse_args()
-    from adfkit.runner.mj.world import MjWorld
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
+    from adfkit.runner.mujoco.world import MujocoWorld
 
     scene, label = scene_and_label()
     print(f"scene: {label}; {args.seconds:g} s windows, {args.rounds} rounds, {args.frames} frames")
@@ -194,11 +194,11 @@ def main() -> int:
         rows.append(
             (
                 f"stereo frame, PyBullet world, renderer={renderer}",
-                stereo_ms(lambda: SimWorld(scene, Options(renderer=renderer)), args.frames),
+                stereo_ms(lambda: open_world(scene, Options(renderer=renderer)), args.frames),
                 "<= 60 ms",
             )
         )
-    engine_frame = stereo_ms(lambda: MjWorld(scene, Options()), args.frames)
+    engine_frame = stereo_ms(lambda: MujocoWorld(scene, Options()), args.frames)
     rows.append(("stereo frame (RGB + depth + seg), MuJoCo engine", engine_frame, "<= 15 ms"))
     one = one_pass_ms(scene, args.frames)
     if isinstance(one, float) and _ms(engine_frame) is not None:

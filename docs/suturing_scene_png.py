@@ -14,14 +14,14 @@ from PIL import Image
 
 from adfkit.adf import load_scene
 from adfkit.runner.psm import PSM
-from adfkit.runner.world import SimWorld
+from adfkit.runner import open_world
 from adfkit.scenes.suturing import layout
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    world = SimWorld(load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml", None, []))
+    world = open_world(load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml", None, []))
     try:
         psm = PSM(world, "psm1")
         needle = world.body("Needle").world_matrix()

@@ -42,7 +42,7 @@ def require_renderer(name: str) -> str:
     import pytest
 
     if name == "egl":
-        from adfkit.runner import egl
+        from adfkit.runner.pybullet import egl
 
         ok, why = egl.available()
         if not ok:

@@ -201,10 +201,10 @@ def test_authored_model_with_every_element_exports_clean(addon, scene, tmp_path)
     assert doc.lights[0].direction == pytest.approx((0, 0, -1), abs=1e-6) and doc.lights[0].shadow_quality == 3
     try:
         from adfkit.adf import load_scene
-        from adfkit.runner import SimWorld
+        from adfkit.runner import open_world
     except ImportError:
         return
-    world = SimWorld(load_scene(res.path))
+    world = open_world(load_scene(res.path))
     try:
         world.run(2.0)
         rep = world.report()

@@ -347,7 +347,7 @@ def _adf_to_urdf_against_runner(client, name: str, tmp_path, configs: int) -> tu
     differ; a body is compared when both reach it through joints both trees hold (the
     `tree.fk` test above covers every body). Returns (bodies compared, largest error)."""
     from adfkit.adf import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
     scene = load_scene(ROBOTS / name)
     (model,) = scene.all_models()
@@ -358,7 +358,7 @@ def _adf_to_urdf_against_runner(client, name: str, tmp_path, configs: int) -> tu
     urdf_joint = {
         pb.getJointInfo(uid, j, physicsClientId=client)[1].decode(): (j, info) for j, info in _movable(client, uid)
     }
-    sim = SimWorld(scene, Options(visuals=False, gravity=(0.0, 0.0, 0.0)))
+    sim = open_world(scene, Options(visuals=False, gravity=(0.0, 0.0, 0.0)))
     try:
         tree = build_tree(model)
         tree_path, runner_path, runner_joint = {}, {}, {}

@@ -30,9 +30,9 @@ def test_write_and_load_round_trip(tmp_path):
         pytest.skip("sample_scenes/suturing is not in this checkout")
     from adfkit.adf import load_scene
     from adfkit.dataset.writer import DatasetWriter
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
-    world = SimWorld(load_scene(BUNDLED), Options())
+    world = open_world(load_scene(BUNDLED), Options())
     try:
         writer = DatasetWriter(world, tmp_path / "ds", cameras=[world.cameras[0].name])
         needle = world.body("Needle")
@@ -86,9 +86,9 @@ def test_a_recorded_frame_reads_back_as_rendered(tmp_path):
         pytest.skip("sample_scenes/suturing is not in this checkout")
     from adfkit.adf import load_scene
     from adfkit.dataset.writer import DEPTH_UNIT_M, DatasetWriter
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
-    world = SimWorld(load_scene(BUNDLED), Options())
+    world = open_world(load_scene(BUNDLED), Options())
     try:
         world.step(5)
         cam = world.cameras[0]

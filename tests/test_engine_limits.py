@@ -58,14 +58,14 @@ def test_constraint_algebra_follows_the_inertia_matrix(tmp_path):
     import mujoco
 
     from adfkit.adf import load_scene
-    from adfkit.runner.mj.world import MjWorld
-    from adfkit.runner.world import Options
+    from adfkit.runner import Options
+    from adfkit.runner.mujoco.world import MujocoWorld
 
     hinged = tmp_path / "hinged.yaml"
     hinged.write_text(_chain(80))
     p2p = tmp_path / "p2p.yaml"
     p2p.write_text(_chain(80).replace("type: revolute", "type: p2p"))
-    worlds = [MjWorld(load_scene(f), Options(ground=False)) for f in (hinged, p2p)]
+    worlds = [MujocoWorld(load_scene(f), Options(ground=False)) for f in (hinged, p2p)]
     try:
         assert [w.model.opt.jacobian for w in worlds] == [
             mujoco.mjtJacobian.mjJAC_DENSE,

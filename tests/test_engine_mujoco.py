@@ -17,11 +17,12 @@ mujoco = pytest.importorskip("mujoco")
 pytest.importorskip("pybullet")
 
 from adfkit.adf import load_scene  # noqa: E402
-from adfkit.runner.mj.world import MjWorld  # noqa: E402
+from adfkit.runner import Options  # noqa: E402
+from adfkit.runner.mujoco.world import MujocoWorld  # noqa: E402
 from adfkit.runner.psm import PSM  # noqa: E402
-from adfkit.runner.world import Options, SimWorld  # noqa: E402
+from adfkit.runner.pybullet.world import PyBulletWorld  # noqa: E402
 
-ENGINES = [MjWorld, SimWorld]
+ENGINES = [MujocoWorld, PyBulletWorld]
 G = 9.81
 
 
@@ -112,7 +113,7 @@ def test_pendulum_period_and_positions_agree_in_both_engines(tmp_path):
         assert _period(samples) == pytest.approx(expected, rel=5e-3), name
         amplitude = max(abs(s[1]) for s in samples[-200:])
         assert amplitude == pytest.approx(THETA0, abs=0.01), name  # no numerical damping to speak of
-    gap = max(np.linalg.norm(a[2] - b[2]) for a, b in zip(runs["MjWorld"], runs["SimWorld"]))
+    gap = max(np.linalg.norm(a[2] - b[2]) for a, b in zip(runs["MujocoWorld"], runs["PyBulletWorld"]))
     assert gap < 5e-3
 
 
@@ -196,7 +197,11 @@ def test_thread_hangs_to_its_static_equilibrium():
     with tempfile.TemporaryDirectory() as d:
         scene = _model(Path(d), thread_model())
         opt = Options(gravity=(0, 0, -G), ground=False, visuals=False)
-        for engine, tol in ((lambda s, o: MjWorld(s, o, sleep=False), 2e-4), (MjWorld, 1e-3), (SimWorld, None)):
+        for engine, tol in (
+            (lambda s, o: MujocoWorld(s, o, sleep=False), 2e-4),
+            (MujocoWorld, 1e-3),
+            (PyBulletWorld, None),
+        ):
             world = engine(scene, opt)
             try:
                 world.run(4.0)
@@ -253,7 +258,7 @@ def test_psm_tracks_a_joint_trajectory_in_both_engines():
             tips[engine.__name__] = np.array(tip)
         finally:
             world.close()
-    assert np.linalg.norm(tips["MjWorld"] - tips["SimWorld"], axis=1).max() < 3e-3
+    assert np.linalg.norm(tips["MujocoWorld"] - tips["PyBulletWorld"], axis=1).max() < 3e-3
 
 
 # ---- grasp ---------------------------------------------------------------------------------
@@ -312,7 +317,7 @@ def test_grasp_weld_carries_the_body_and_release_drops_it(tmp_path):
     """MuJoCo: the finger ghost finds the needle 2 cm under the tool; grasp switches the weld
     on: the needle hangs on the tool and follows a 5 cm slide with under 0.5 mm drift;
     release switches it off and the needle falls freely (Δz = -g·t²/2 within 5 %)."""
-    world = MjWorld(_model(tmp_path, GRASP), Options(gravity=(0, 0, -G), visuals=False, ground=False))
+    world = MujocoWorld(_model(tmp_path, GRASP), Options(gravity=(0, 0, -G), visuals=False, ground=False))
     try:
         tool, needle = world.body("tool"), world.body("needle")
         assert world.overlapping(world.ghosts[0]) == [needle]
@@ -375,7 +380,7 @@ SENSOR ray:
 def test_proximity_sensor_rays_see_what_is_in_range(tmp_path):
     """A sensor 1 cm up on a static body, two rays along +x, 10 cm long: the box at 6 cm is
     hit by the lower ray, the one at 20 cm by neither; the sensor's own body is never reported."""
-    world = MjWorld(_model(tmp_path, SENSOR), Options(gravity=(0, 0, 0), ground=False))
+    world = MujocoWorld(_model(tmp_path, SENSOR), Options(gravity=(0, 0, 0), ground=False))
     try:
         world.step(1)
         assert [b.name for b in world.sensors[0].sensed] == ["near"]
@@ -385,9 +390,9 @@ def test_proximity_sensor_rays_see_what_is_in_range(tmp_path):
 
 # ---- cameras and CLI -------------------------------------------------------------------------
 def test_mujoco_camera_depth_segmentation_rgb(tmp_path):
-    from adfkit.runner.mj.render import CameraUnavailable
+    from adfkit.runner.mujoco.render import CameraUnavailable
 
-    world = MjWorld(_model(tmp_path, box_camera_model()), Options(gravity=(0, 0, 0)))
+    world = MujocoWorld(_model(tmp_path, box_camera_model()), Options(gravity=(0, 0, 0)))
     try:
         cam = world.cameras[0]
         assert cam.intrinsics()[1, 1] == pytest.approx(24 / math.tan(0.35))
@@ -439,7 +444,7 @@ def test_suturing_set_grasp_in_mujoco():
     the weld fixes it; a 5 cm Cartesian move through the IK carries it with <= 1 mm drift;
     opening the jaws drops it. Nothing NaN, exploded or fell through the floor meanwhile."""
     require_corpus()
-    world = MjWorld(load_scene(CORPUS / "src" / "launch.yaml", [6, 7, 8, 9, 10, 11]), Options())
+    world = MujocoWorld(load_scene(CORPUS / "src" / "launch.yaml", [6, 7, 8, 9, 10, 11]), Options())
     try:
         psm = PSM(world, "psm1")
         psm.move_cp(psm.kin.fk([0.0, 0.0, 0.12, 0.0, 0.0, 0.0]), 0.3)
@@ -514,10 +519,10 @@ def test_both_engines_answer_the_same_public_api(tmp_path):
             reports[engine.__name__] = world.report()
         finally:
             world.close()
-    assert set(reports["SimWorld"]) <= set(reports["MjWorld"])
-    assert set(reports["MjWorld"]) - set(reports["SimWorld"]) == {"engine", "awake_trees", "trees", "engine_warnings"}
-    assert reports["MjWorld"]["instabilities"] == reports["SimWorld"]["instabilities"] == []
-    p_mj, p_pb = reports["MjWorld"]["ground_plane_z"], reports["SimWorld"]["ground_plane_z"]
+    assert set(reports["PyBulletWorld"]) <= set(reports["MujocoWorld"])
+    assert set(reports["MujocoWorld"]) - set(reports["PyBulletWorld"]) == {"awake_trees", "trees", "engine_warnings"}
+    assert reports["MujocoWorld"]["instabilities"] == reports["PyBulletWorld"]["instabilities"] == []
+    p_mj, p_pb = reports["MujocoWorld"]["ground_plane_z"], reports["PyBulletWorld"]["ground_plane_z"]
     assert p_mj == pytest.approx(p_pb, abs=1e-6)  # the same floor 1 mm under the box
 
 
@@ -550,7 +555,7 @@ BODY box:
   collision shape: BOX
   collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
 """
-    world = MjWorld(_model(tmp_path, text), Options(gravity=(0, 0, -G), ground=False))
+    world = MujocoWorld(_model(tmp_path, text), Options(gravity=(0, 0, -G), ground=False))
     try:
         rules = sorted({d.rule for d in world.diagnostics})
         assert rules == ["runner-flat-mesh", "runner-mesh"]
@@ -616,7 +621,7 @@ def test_task_api_set_collision_move_base_ghost_pose(tmp_path, engine):
 
 
 def test_set_collision_turned_on_again_collides(tmp_path):
-    world = MjWorld(_model(tmp_path, BOX_ON_FLOOR), Options())
+    world = MujocoWorld(_model(tmp_path, BOX_ON_FLOOR), Options())
     try:
         floor, box = world.body("floor"), world.body("box")
         world.set_collision(floor, box, False)

@@ -165,9 +165,9 @@ def test_suture_expert_passes_pair_1():
 def test_mujoco_engine_is_a_clear_error_or_works():
     _need_scene()
     try:
-        from adfkit.runner.mj.world import MjWorld
+        from adfkit.runner.mujoco.world import MujocoWorld
 
-        complete = all(hasattr(MjWorld, m) for m in scenes.NEEDS)
+        complete = all(hasattr(MujocoWorld, m) for m in scenes.NEEDS)
     except ImportError:
         complete = False
     if not complete:

@@ -112,3 +112,54 @@ def test_the_core_does_not_import_the_edges():
     edges = _edges(_modules("adfkit"))
     up = sorted(f"{m} -> {t}" for m, ts in edges.items() if m.startswith(CORE) for t in ts if t.startswith(EDGES))
     assert up == []
+
+
+# the runner: an engine-neutral core and two back ends of the same layout, side by side
+BACK_ENDS = ("adfkit.runner.pybullet", "adfkit.runner.mujoco")
+
+
+def _in(m: str, pkg: str) -> bool:
+    return m == pkg or m.startswith(pkg + ".")
+
+
+def test_the_two_back_ends_do_not_import_each_other():
+    edges = _edges(_modules("adfkit"))
+    across = sorted(
+        f"{m} -> {t}"
+        for a in BACK_ENDS
+        for b in BACK_ENDS
+        if a != b
+        for m, ts in edges.items()
+        if _in(m, a)
+        for t in ts
+        if _in(t, b)
+    )
+    assert across == []
+
+
+def test_the_runner_core_does_not_import_a_back_end():
+    """Only ``runner.engines`` (which opens a world on either) and the package's lazy names know them."""
+    edges = _edges(_modules("adfkit"))
+    core = [m for m in edges if _in(m, "adfkit.runner") and not any(_in(m, b) for b in BACK_ENDS)]
+    up = sorted(
+        f"{m} -> {t}"
+        for m in core
+        if m not in ("adfkit.runner", "adfkit.runner.engines")
+        for t in edges[m]
+        if any(_in(t, b) for b in BACK_ENDS)
+    )
+    assert up == []
+
+
+def test_the_back_ends_have_the_same_layout_and_small_files():
+    runner = ROOT / "adfkit" / "runner"
+    layout = {b: {f.name for f in (runner / b.rsplit(".", 1)[1]).glob("*.py")} for b in BACK_ENDS}
+    shared = {"__init__.py", "world.py", "assemble.py", "interact.py", "stability.py"}
+    for b, files in layout.items():
+        assert shared <= files, f"{b} lacks {sorted(shared - files)}"
+    long = sorted(
+        f"{f.relative_to(ROOT)}: {n} lines"
+        for f in runner.rglob("*.py")
+        if (n := len(f.read_text(encoding="utf-8").splitlines())) > 400
+    )
+    assert long == []

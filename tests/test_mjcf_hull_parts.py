@@ -33,10 +33,10 @@ def test_the_bundled_needle_collides_as_its_eight_hulls_in_mujoco():
     import mujoco
 
     from adfkit.adf import load_scene
-    from adfkit.runner.mj.world import MjWorld
-    from adfkit.runner.world import Options
+    from adfkit.runner import Options
+    from adfkit.runner.mujoco.world import MujocoWorld
 
-    w = MjWorld(load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml"), Options())
+    w = MujocoWorld(load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml"), Options())
     try:
         m = w.model
         needle = w.body("Needle")

@@ -111,11 +111,11 @@ def test_spring_from_a_free_body_to_a_multibody_link_is_built(tmp_path):
     """The class behind `createConstraint failed` on the springy PSM/ECM/MTM models: PyBullet
     joins a multibody link and a maximal-coordinate body only with the link as body A."""
     from adfkit.adf.scene import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
     f = tmp_path / "springy.yaml"
     f.write_text(SPRING_MODEL)
-    world = SimWorld(load_scene(f, None, []), Options())
+    world = open_world(load_scene(f, None, []), Options())
     try:
         names = [c[0] for c in world.constraints]
         assert names == ["JOINT spring"]

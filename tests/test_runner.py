@@ -12,8 +12,8 @@ from conftest import CORPUS, box_camera_model, require_corpus, require_renderer
 pb = pytest.importorskip("pybullet")
 
 from adfkit.adf import load_scene  # noqa: E402
+from adfkit.runner import Options, open_world  # noqa: E402
 from adfkit.runner.psm import PSM  # noqa: E402
-from adfkit.runner.world import Options, SimWorld  # noqa: E402
 
 SUTURING = [6, 7, 8, 9, 10, 11]
 
@@ -22,7 +22,7 @@ SUTURING = [6, 7, 8, 9, 10, 11]
 def suturing():
     require_corpus()
     scene = load_scene(CORPUS / "src" / "launch.yaml", SUTURING)
-    world = SimWorld(scene, Options(visuals=False))
+    world = open_world(scene, Options(visuals=False))
     yield scene, world
     world.close()
 
@@ -47,7 +47,7 @@ def test_suturing_plays_stable_and_thread_holds(suturing):
 @pytest.mark.slow
 def test_suturing_plays_10_seconds_stable():
     require_corpus()
-    world = SimWorld(load_scene(CORPUS / "src" / "launch.yaml", SUTURING), Options(visuals=False))
+    world = open_world(load_scene(CORPUS / "src" / "launch.yaml", SUTURING), Options(visuals=False))
     try:
         _check_suturing_play(world, 10.0)
     finally:
@@ -88,7 +88,7 @@ BOX_CAMERA = box_camera_model()
 
 @pytest.mark.parametrize("renderer", ["tiny", "egl", "mujoco"])
 def test_camera_depth_segmentation_rgb(tmp_path, renderer):
-    world = SimWorld(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0), renderer=require_renderer(renderer)))
+    world = open_world(_model(tmp_path, BOX_CAMERA), Options(gravity=(0, 0, 0), renderer=require_renderer(renderer)))
     try:
         assert world.renderer == renderer and world.report()["renderer"] == renderer
         cam = world.cameras[0]
@@ -126,7 +126,7 @@ GHOST hole:
 
 def test_ghost_viscous_friction_matches_exponential(tmp_path):
     k = 0.5
-    world = SimWorld(_model(tmp_path, GHOST), Options(gravity=(0, 0, 0), hole_friction=k, visuals=False))
+    world = open_world(_model(tmp_path, GHOST), Options(gravity=(0, 0, 0), hole_friction=k, visuals=False))
     try:
         needle = world.body("needle")
         pb.resetBaseVelocity(needle.uid, [0.1, 0, 0], [0, 0, 0], physicsClientId=world.cid)
@@ -170,7 +170,7 @@ GHOST finger:
 def test_a_carried_ghost_senses_where_its_parent_has_taken_it(tmp_path):
     """A ghost without friction is placed on its moving parent when asked (not every step):
     it finds the probe only once the carrier has brought it there, 5 cm along x."""
-    world = SimWorld(_model(tmp_path, CARRIED_GHOST), Options(gravity=(0, 0, 0), visuals=False))
+    world = open_world(_model(tmp_path, CARRIED_GHOST), Options(gravity=(0, 0, 0), visuals=False))
     try:
         g = world.ghosts[0]
         carrier, probe = world.body("carrier"), world.body("probe")
@@ -194,7 +194,7 @@ def test_grasp_moves_needle_with_tool_and_release_drops_it():
     the jaws close, the actuator fixes it; a 5 cm Cartesian move through the closed-form IK
     carries it along (drift <= 1 mm); opening the jaws drops it."""
     require_corpus()
-    world = SimWorld(load_scene(CORPUS / "src" / "launch.yaml", SUTURING), Options(visuals=False))
+    world = open_world(load_scene(CORPUS / "src" / "launch.yaml", SUTURING), Options(visuals=False))
     try:
         psm = PSM(world, "psm1")
         psm.move_cp(psm.kin.fk([0.0, 0.0, 0.12, 0.0, 0.0, 0.0]), 0.3)  # tool out of the cannula
@@ -263,7 +263,7 @@ def test_prismatic_joint_closing_a_loop_slides(tmp_path):
     """A prismatic joint between two links of one multibody is a slider (PyBullet's multibody
     slider constraint), not a fixed joint: one end moves 5 cm along the axis while the other
     stays, and nothing opens across the axis."""
-    world = SimWorld(_model(tmp_path, SLIDER_LOOP), Options(gravity=(0, 0, 0), visuals=False, ground=False))
+    world = open_world(_model(tmp_path, SLIDER_LOOP), Options(gravity=(0, 0, 0), visuals=False, ground=False))
     try:
         assert not [d for d in world.diagnostics if d.rule == "runner-prismatic-loop"]
         (art,) = world.articulations

@@ -11,7 +11,7 @@ pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
 from conftest import CORPUS, require_corpus  # noqa: E402
 
 from adfkit.adf import load_scene  # noqa: E402
-from adfkit.runner.world import Options, SimWorld  # noqa: E402
+from adfkit.runner import Options, open_world  # noqa: E402
 
 MB = "ambf/ambf_models/descriptions/multi-bodies"
 WITH_MESHES = [  # MANIFEST.md: models whose meshes and textures are in the corpus
@@ -51,7 +51,7 @@ def _play(rel: str, seconds: float) -> dict:
     path = CORPUS / rel
     diags: list = []
     scene = load_scene(path, None, diags)
-    world = SimWorld(scene, Options(visuals=False))
+    world = open_world(scene, Options(visuals=False))
     try:
         assert world.skipped == [], f"bodies the runner could not build: {world.skipped}"
         world.run(seconds)
@@ -120,7 +120,7 @@ def test_soft_body_is_played_and_its_approximations_reported(rel):
     details); what the runner cannot map is said, never dropped silently."""
     require_corpus()
     scene = load_scene(CORPUS / rel, None, [])
-    world = SimWorld(scene, Options(visuals=False))
+    world = open_world(scene, Options(visuals=False))
     try:
         assert [s.node_count for s in world.soft.items] == [386]
         rules = {d.rule for d in world.diagnostics}
@@ -140,7 +140,7 @@ SPRINGY = [f"{MB}/robots/blender-{r}-springy.yaml" for r in ("psm", "ecm", "mtm"
 def _build_and_play(rel: str, seconds: float) -> dict:
     require_corpus()
     scene = load_scene(CORPUS / rel, None, [])
-    world = SimWorld(scene, Options(visuals=False))
+    world = open_world(scene, Options(visuals=False))
     try:
         assert not [d for d in world.diagnostics if d.rule == "runner-constraint"], rel
         world.run(seconds)

@@ -12,15 +12,15 @@ pytest.importorskip("pybullet")
 from test_run_bad_inputs import SPRING_MODEL  # noqa: E402
 
 from adfkit.adf.scene import load_scene  # noqa: E402
-from adfkit.runner.cameras import label_image  # noqa: E402
-from adfkit.runner.world import Options, SimWorld  # noqa: E402
+from adfkit.runner import Options, open_world  # noqa: E402
+from adfkit.runner.pybullet.cameras import label_image  # noqa: E402
 
 
 @pytest.fixture
 def springy_world(tmp_path):
     f = tmp_path / "springy.yaml"
     f.write_text(SPRING_MODEL)
-    world = SimWorld(load_scene(f, None, []), Options())
+    world = open_world(load_scene(f, None, []), Options())
     yield world
     world.close()
 

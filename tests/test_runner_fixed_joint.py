@@ -12,7 +12,7 @@ import pytest
 pytest.importorskip("pybullet")
 
 from adfkit.adf import load_scene  # noqa: E402
-from adfkit.runner.world import SimWorld  # noqa: E402
+from adfkit.runner import open_world  # noqa: E402
 
 MODEL = """
 bodies: [BODY a, BODY b]
@@ -49,7 +49,7 @@ JOINT a-b:
 def test_fixed_joint_keeps_the_relative_pose(tmp_path):
     p = tmp_path / "model.yaml"
     p.write_text(textwrap.dedent(MODEL))
-    world = SimWorld(load_scene(p, None, []))
+    world = open_world(load_scene(p, None, []))
     try:
         a, b = world.body("BODY a"), world.body("BODY b")
         rel0 = np.linalg.inv(a.world_matrix()) @ b.world_matrix()  # the file's pose: the joint's own

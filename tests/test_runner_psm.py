@@ -13,10 +13,10 @@ from conftest import CORPUS, require_corpus
 pb = pytest.importorskip("pybullet")
 
 from adfkit.adf import load_scene  # noqa: E402
+from adfkit.runner import Options, open_world  # noqa: E402
 from adfkit.runner.psm import PSM, PSMModelError, hand_eye  # noqa: E402
 from adfkit.runner.psm_kinematics import pose_error  # noqa: E402
 from adfkit.runner.rotations import invert  # noqa: E402
-from adfkit.runner.world import Options, SimWorld  # noqa: E402
 
 PSM1 = "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml"
 
@@ -24,7 +24,7 @@ PSM1 = "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml"
 @pytest.fixture(scope="module")
 def psm():
     require_corpus()
-    world = SimWorld(load_scene(CORPUS / PSM1), Options(visuals=False, ground=False))
+    world = open_world(load_scene(CORPUS / PSM1), Options(visuals=False, ground=False))
     yield PSM(world, "psm1")
     world.close()
 
@@ -149,7 +149,7 @@ def test_a_model_that_is_not_a_psm_is_refused(tmp_path):
     )
     assert bent != text
     (tmp_path / "psm1.yaml").write_text(bent)
-    world = SimWorld(load_scene(tmp_path / "psm1.yaml"), Options(visuals=False, ground=False))
+    world = open_world(load_scene(tmp_path / "psm1.yaml"), Options(visuals=False, ground=False))
     try:
         with pytest.raises(PSMModelError, match=r"residual"):
             PSM(world, "psm1")

@@ -16,7 +16,7 @@ import pytest
 from conftest import require_renderer
 
 from adfkit.adf import load_scene
-from adfkit.runner.world import Options, SimWorld
+from adfkit.runner import Options, open_world
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -92,7 +92,7 @@ def test_renderer_agrees_with_tinyrenderer_on_the_suturing_pad(renderer):
     scene = load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml")
     frames = {}
     for name in (renderer, "tiny"):
-        world = SimWorld(scene, Options(renderer=name))
+        world = open_world(scene, Options(renderer=name))
         try:
             assert world.renderer == name and world.cameras
             world.run(0.05)
@@ -114,7 +114,7 @@ def test_mujoco_renderer_draws_a_resized_copy_of_a_camera():
     from dataclasses import replace
 
     require_renderer("mujoco")
-    world = SimWorld(load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"), Options(renderer="mujoco"))
+    world = open_world(load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"), Options(renderer="mujoco"))
     try:
         full = world.cameras[0].render(world)
         small = replace(world.cameras[0], width=64, height=48).render(world)

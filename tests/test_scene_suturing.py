@@ -31,9 +31,9 @@ def built(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def world(built):
-    from adfkit.runner.world import SimWorld
+    from adfkit.runner import open_world
 
-    w = SimWorld(load_scene(built / "launch.yaml", None, []))
+    w = open_world(load_scene(built / "launch.yaml", None, []))
     yield w
     w.close()
 
@@ -131,10 +131,10 @@ def test_a_short_play_is_stable(world):
 def test_psm1_picks_the_needle_up_from_above(built):
     """IK to the needle's start pose from above, jaws open, down, grasp through the actuator,
     lift 2 cm: the needle (not a thread element) comes along, held within a millimetre."""
+    from adfkit.runner import open_world
     from adfkit.runner.psm import PSM
-    from adfkit.runner.world import SimWorld
 
-    world = SimWorld(load_scene(built / "launch.yaml", None, []))
+    world = open_world(load_scene(built / "launch.yaml", None, []))
     try:
         psm = PSM(world, "psm1")
         needle = world.body("Needle")
@@ -236,11 +236,11 @@ def test_the_needle_turns_through_every_pair_without_touching(built):
 
     import pybullet as pb
 
+    from adfkit.runner import open_world
     from adfkit.runner.rotations import matrix_to_pq
-    from adfkit.runner.world import SimWorld
     from adfkit.scenes.suturing.frames import rot_z
 
-    world = SimWorld(load_scene(built / "launch.yaml", None, []))
+    world = open_world(load_scene(built / "launch.yaml", None, []))
     try:
         needle = world.body("Needle")
         statics = [b for b in world.bodies if b.static]
@@ -272,9 +272,9 @@ def test_demo_plays_the_bundled_suturing_scene_by_default(tmp_path, capsys):
 def test_ten_seconds_of_play_stay_still(built):
     """Left alone for 10 s the scene stays where it was built: arms at home, needle flat on
     the slab, the thread lying on it with its pivots together."""
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
-    world = SimWorld(load_scene(built / "launch.yaml", None, []), Options(visuals=False))
+    world = open_world(load_scene(built / "launch.yaml", None, []), Options(visuals=False))
     try:
         needle = world.body("Needle")
         start = needle.world_matrix()

@@ -281,7 +281,7 @@ def test_fixed_nodes_rule_on_the_corpus_cloth(tmp_path):
 pb = pytest.importorskip("pybullet", reason="pybullet (sim extra) is not installed")
 from adfkit.adf import load_scene  # noqa: E402
 from adfkit.cli import main  # noqa: E402
-from adfkit.runner.world import Options, SimWorld  # noqa: E402
+from adfkit.runner import Options, open_world  # noqa: E402
 
 BOX_UNDER_CLOTH = """bodies: [BODY table]
 BODY table:
@@ -296,7 +296,7 @@ BODY table:
 
 
 def _world(path, seconds: float, **opt):
-    world = SimWorld(load_scene(path, None, []), Options(visuals=False, **opt))
+    world = open_world(load_scene(path, None, []), Options(visuals=False, **opt))
     world.run(seconds)
     return world
 
@@ -649,7 +649,7 @@ def test_a_soft_body_is_in_rgb_depth_and_segmentation_with_its_own_label(tmp_pat
     from adfkit.scenes import write_soft_phantom
 
     launch = write_soft_phantom(tmp_path / "scene")
-    world = SimWorld(load_scene(launch), Options())
+    world = open_world(load_scene(launch), Options())
     try:
         world.run(0.1)
         frame = world.cameras[0].render(world)

@@ -99,10 +99,10 @@ def test_metrics_json_and_pictures(one_pair):
 @pytest.mark.slow
 def test_needle_held_while_carried_and_released_when_the_jaws_open():
     from adfkit.adf import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
     from adfkit.tasks.suture import SutureTask
 
-    world = SimWorld(load_scene(_bundled()), Options())
+    world = open_world(load_scene(_bundled()), Options())
     try:
         task = SutureTask(world, [1], seed=0)
         run = lambda gen: [world.step(1) for _ in gen]  # noqa: E731

@@ -209,11 +209,11 @@ def test_filled_hole_blocks_the_insertion_fast(tmp_path):
     """The default run's check that the physics can say no: the insertion of pair 1 alone
     (stopped when the regrasp begins) into the phantom with hole 1 filled."""
     from adfkit.adf import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
     from adfkit.tasks.metrics import SutureObserver
     from adfkit.tasks.suture import SutureTask
 
-    world = SimWorld(load_scene(_scene(tmp_path, _fill_hole_1)), Options(renderer="tiny"))
+    world = open_world(load_scene(_scene(tmp_path, _fill_hole_1)), Options(renderer="tiny"))
     try:
         task = SutureTask(world, [1], seed=0)
         obs = SutureObserver(task)
@@ -234,15 +234,15 @@ def test_contacts_name_the_body_and_the_force_in_both_engines(engine):
     """world.contacts(body), what the verdicts read: the needle pushed onto the phantom
     (0.5 N down, awake in MuJoCo) touches Phantom with at least its weight's share."""
     from adfkit.adf import load_scene
-    from adfkit.runner.world import Options, SimWorld
+    from adfkit.runner import Options, open_world
 
     scene = load_scene(BUNDLED / "launch.yaml")
     if engine == "mujoco":
-        from adfkit.runner.mj.world import MjWorld
+        from adfkit.runner.mujoco.world import MujocoWorld
 
-        world = MjWorld(scene, Options())
+        world = MujocoWorld(scene, Options())
     else:
-        world = SimWorld(scene, Options())
+        world = open_world(scene, Options())
     try:
         world.step(50)
         needle = world.body("Needle")

@@ -108,10 +108,10 @@ def _record_episode(folder):
     while psm1 turns its yaw, and a metrics.json with one verdict."""
     from adfkit.adf import load_scene
     from adfkit.dataset.writer import DatasetWriter
+    from adfkit.runner import Options, open_world
     from adfkit.runner.psm import PSM
-    from adfkit.runner.world import Options, SimWorld
 
-    world = SimWorld(load_scene(BUNDLED), Options())
+    world = open_world(load_scene(BUNDLED), Options())
     try:
         psm = PSM(world, "psm1")
         writer = DatasetWriter(world, folder / "dataset", cameras=[world.cameras[0].name])

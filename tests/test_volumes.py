@@ -57,10 +57,10 @@ def test_the_drilling_scene_validates_clean_and_plays_with_its_volume(drilling, 
     rep = json.loads((out / "report.json").read_text())
     (vol,) = rep["volumes"]
     assert vol["object"] == "VOLUME Bone" and vol["triangles"] > 1000 and rep["not_played"] == []
+    from adfkit.runner import open_world
     from adfkit.runner.options import Options
-    from adfkit.runner.world import SimWorld
 
-    world = SimWorld(load_scene(drilling), Options())
+    world = open_world(load_scene(drilling), Options())
     try:
         label = next(i for i, sb in enumerate(world.bodies) if sb.key.endswith("VOLUME Bone"))
         frame = world.cameras[0].render(world)

@@ -50,11 +50,11 @@ def run(args) -> int:
     if any(d.severity >= Severity.ERROR for d in diags):
         return 2
 
+    from ..runner import Options, open_world
     from ..runner.play import play, summary, unstable
-    from ..runner.world import Options, SimWorld
 
     out = Path(args.out)
-    world = SimWorld(scene, Options())
+    world = open_world(scene, Options())
     try:
         report = play(world, args.seconds, out, True, str(launch))
     finally:

@@ -65,8 +65,8 @@ def run(args) -> int:
     from ..adf import load_scene, parse_indices
     from ..diagnostics import AdfError, Severity, error
     from ..report import print_diagnostics
+    from ..runner import Options, open_world
     from ..runner.play import play, summary, unstable
-    from ..runner.world import Options, SimWorld
 
     args.path = inputs.scene_file(args.path)  # a folder: its launch.yaml
     inputs.check_file(args.path, what="ADF file")  # a regular file (adfkit.inputs), located errors
@@ -125,12 +125,7 @@ def run(args) -> int:
         ground=not args.no_ground,
         renderer="tiny" if args.no_frames else args.renderer,
     )
-    if args.engine == "mujoco":
-        from ..runner.mj.world import MjWorld
-
-        world = MjWorld(scene, opt)
-    else:
-        world = SimWorld(scene, opt, gui=args.gui)
+    world = open_world(scene, opt, gui=args.gui and args.engine == "pybullet", engine=args.engine)
     try:
         print_diagnostics(world.diagnostics, sys.stderr)
         report = play(world, args.seconds, Path(args.out) if args.out else None, not args.no_frames, str(args.path))

@@ -1,8 +1,8 @@
 """Gymnasium environments on the suturing scene (Gymnasium >= 1.0 API).
 
-One SimWorld per environment, built once; ``reset`` restores a snapshot taken after the scene
-settled (SimWorld.save_state/restore_state) and places the needle, with its thread, at a seeded
-offset. The environments talk to the world only through SimWorld's public methods and drive
+One world per environment, built once; ``reset`` restores a snapshot taken after the scene
+settled (World.save_state/restore_state) and places the needle, with its thread, at a seeded
+offset. The environments talk to the world only through the World interface and drive
 the arms through adfkit.runner.PSM (servo_cp through the closed-form IK, servo_jaw, grasp).
 
 Action, per arm (``arms``: psm1, or psm1 then psm2), 7 values in [-1, 1]: a translation of the

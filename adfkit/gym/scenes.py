@@ -125,27 +125,23 @@ def _soft_tissue(world, psms, needle) -> None:
 
 
 def _world(model, engine: str, visuals: bool):
-    from ..runner.world import Options
+    from ..runner import Options
 
     if engine == "mujoco":
-        try:
-            from ..runner.mj.world import MjWorld  # the MuJoCo back end (its own branch)
-        except ImportError:
-            raise NotImplementedError(
-                "engine='mujoco': this adfkit has no MuJoCo back end (adfkit.runner.mj); use engine='pybullet'"
-            ) from None
-        missing = [m for m in NEEDS if not hasattr(MjWorld, m)]
+        from ..runner.mujoco.world import MujocoWorld
+
+        missing = [m for m in NEEDS if not hasattr(MujocoWorld, m)]
         if missing:
             raise NotImplementedError(
                 "engine='mujoco': the MuJoCo back end lacks what the environments use: "
                 + ", ".join(missing)
                 + "; use engine='pybullet'"
             )
-        return MjWorld(model, Options(visuals=visuals))
-    from ..runner.world import SimWorld
+        return MujocoWorld(model, Options(visuals=visuals))
+    from ..runner import open_world
 
     # image observations: a frame every step, so the fastest renderer that works (cameras.choose_renderer)
-    return SimWorld(model, Options(visuals=visuals, renderer="auto" if visuals else "tiny"))
+    return open_world(model, Options(visuals=visuals, renderer="auto" if visuals else "tiny"))
 
 
 def _unique(world, text: str) -> bool:

@@ -1,18 +1,26 @@
-"""Play an ADF scene: the PyBullet reference runner (SimWorld; the only package that imports
-pybullet) and the MuJoCo engine (MjWorld, runner/mj/), behind one public API."""
+"""Play an ADF scene. One engine-neutral core (the :class:`World` interface in world.py, the
+scene resolved once in plan.py and springs.py, cameras, grasping, stability, options) and two
+back ends of the same layout, ``pybullet/`` (the reference runner) and ``mujoco/``, each
+translating the plan into its engine; :func:`open_world` opens either."""
 
 from __future__ import annotations
 
+from .engines import ENGINES, open_world
+from .options import Options
+from .world import World
+
+__all__ = ["ENGINES", "Options", "World", "open_world", "PyBulletWorld", "MujocoWorld", "PSM", "PSMModelError"]
+
 
 def __getattr__(name):
-    if name in ("SimWorld", "Options"):
-        from . import world
+    if name == "PyBulletWorld":
+        from .pybullet.world import PyBulletWorld
 
-        return getattr(world, name)
-    if name == "MjWorld":
-        from .mj.world import MjWorld
+        return PyBulletWorld
+    if name == "MujocoWorld":
+        from .mujoco.world import MujocoWorld
 
-        return MjWorld
+        return MujocoWorld
     if name in ("PSM", "PSMModelError"):
         from . import psm
 

@@ -7,6 +7,9 @@ body off at hundreds of metres a second before it settles somewhere. So each wor
 while it steps and keeps every event, with the simulated time and the body, for the report,
 ``metrics.json`` and Gymnasium's ``info``; any event makes the run unstable.
 
+Each engine's watch lives with its back end (``pybullet/stability.py``, ``mujoco/stability.py``);
+this module holds what they share: the event, the watch and the thresholds.
+
 - MuJoCo: its warning counters (``MjData.warning``) for NaN/Inf/huge values in the positions,
   velocities and accelerations (after which MuJoCo resets the state) and for a singular
   inertia, read at every control step through MuJoCo's warning callback, which this module
@@ -19,8 +22,6 @@ while it steps and keeps every event, with the simulated time and the body, for 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-
-import numpy as np
 
 #: Simulated seconds between two PyBullet checks (each reads every dynamic body's state once).
 CHECK_EVERY_S = 0.02
@@ -63,98 +64,3 @@ class Watch:
             "instabilities": [e.as_dict() for e in self.events],
             **({"instabilities_not_listed": self.dropped} if self.dropped else {}),
         }
-
-
-# ---- MuJoCo -----------------------------------------------------------------------------------
-_MJ_MESSAGES: list[str] = []
-_MJ_HANDLER_SET = False
-
-
-def install_mujoco_handler() -> None:
-    """Route MuJoCo's warnings into this module (once per process): each world drains them at
-    its next control step. Without a handler MuJoCo appends them to ./MUJOCO_LOG.TXT."""
-    global _MJ_HANDLER_SET
-    if _MJ_HANDLER_SET:
-        return
-    import mujoco
-
-    mujoco.set_mju_user_warning(_MJ_MESSAGES.append)
-    _MJ_HANDLER_SET = True
-
-
-def mujoco_pending() -> bool:
-    return bool(_MJ_MESSAGES)
-
-
-def drain_mujoco(world, watch: Watch) -> None:
-    """Turn the warnings MuJoCo raised since the last call into events of ``world``: the kind and
-    the body from the warning counters (``lastinfo`` is the DOF), the text from the callback."""
-    import mujoco
-
-    messages = list(_MJ_MESSAGES)
-    _MJ_MESSAGES.clear()
-    _m, d = world.model, world.data
-    w = mujoco.mjtWarning
-    kinds = {
-        w.mjWARN_BADQPOS: ("state-reset", "positions", "QPOS"),
-        w.mjWARN_BADQVEL: ("state-reset", "velocities", "QVEL"),
-        w.mjWARN_BADQACC: ("state-reset", "accelerations", "QACC"),
-        w.mjWARN_INERTIA: ("singular-inertia", None, "inertia"),
-    }
-    seen = getattr(world, "_warnings_seen", {})
-    found = False
-    for code, (kind, what, word) in kinds.items():
-        stat = d.warning[int(code)]
-        if stat.number > seen.get(code, 0):
-            seen[code] = stat.number
-            found = True
-            body = _body_of_dof(world, int(stat.lastinfo))
-            text = next((x for x in messages if word.lower() in x.lower()), None)
-            if kind == "state-reset":
-                message = (
-                    f"MuJoCo met NaN, Inf or a huge value in the {what} (DOF {stat.lastinfo}) and reset "
-                    "the whole state to the initial pose"
-                )
-            else:
-                message = f"MuJoCo found a singular inertia at DOF {stat.lastinfo}"
-            watch.add(Instability(world.sim_time, body, kind, message + (f" ({text.strip()})" if text else "")))
-    world._warnings_seen = seen
-    if not found:
-        for text in messages:  # another warning (contact buffer full, ...): reported, not an instability
-            world.engine_warnings.append(f"t = {world.sim_time:.3f} s: {text.strip()}")
-
-
-def _body_of_dof(world, dof: int) -> str | None:
-    m = world.model
-    if not 0 <= dof < m.nv:
-        return None
-    bid = int(m.dof_bodyid[dof])
-    sb = world._body_of_id.get(bid) if hasattr(world, "_body_of_id") else None
-    return sb.key if sb is not None else None
-
-
-# ---- PyBullet ---------------------------------------------------------------------------------
-def check_pybullet(world, watch: Watch) -> None:
-    """NaN/Inf or a flung body among the world's dynamic bodies, now."""
-    for sb in world.bodies:
-        if sb.static:
-            continue
-        p, _, v, _ = sb.state()
-        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(v))):
-            if not any(e.body == sb.key and e.kind == "nan" for e in watch.events):
-                watch.add(
-                    Instability(
-                        world.sim_time, sb.key, "nan", "PyBullet gives the body a NaN or Inf position or velocity"
-                    )
-                )
-            continue
-        speed = float(np.linalg.norm(v))
-        if speed > FLUNG_SPEED and not any(e.body == sb.key and e.kind == "flung" for e in watch.events):
-            watch.add(
-                Instability(
-                    world.sim_time,
-                    sb.key,
-                    "flung",
-                    f"the solver flung the body at {speed:.3g} m/s (more than {FLUNG_SPEED:g} m/s)",
-                )
-            )

@@ -288,7 +288,7 @@ def run_episode(
     """Play one scripted suture of hole ``pairs`` on the scene; returns the metrics (also written
     with the pictures to ``out`` when given)."""
     from ..adf import load_scene, parse_indices
-    from ..runner.world import Options, SimWorld
+    from ..runner import Options, open_world
 
     diags: list = []
     scene = load_scene(Path(launch), parse_indices(indices) if isinstance(indices, str) else indices, diags)
@@ -296,12 +296,7 @@ def run_episode(
     options = options or Options(
         renderer="auto" if record or (gif and out is not None) else "tiny", solver_iterations=SOLVER_ITERATIONS
     )
-    if engine == "mujoco":
-        from ..runner.mj.world import MjWorld
-
-        world = MjWorld(scene, options, gui=gui)
-    else:
-        world = SimWorld(scene, options, gui=gui)
+    world = open_world(scene, options, gui=gui, engine=engine)
     try:
         try:
             task = SutureTask(world, list(pairs), seed=seed)

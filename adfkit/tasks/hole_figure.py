@@ -53,12 +53,12 @@ def draw(launch: Path, pair: int, out: Path) -> None:
     from matplotlib.patches import Circle, Polygon, Rectangle
 
     from ..adf import load_scene
-    from ..runner.world import Options, SimWorld
+    from ..runner import Options, open_world
     from .holes import opening_half_extents
     from .metrics import wire_radius
     from .suture import SutureTask
 
-    world = SimWorld(load_scene(launch), Options(renderer="tiny"))
+    world = open_world(load_scene(launch), Options(renderer="tiny"))
     try:
         task = SutureTask(world, [pair], seed=0)
         p = task.pairs[0]

@@ -1,5 +1,5 @@
 """The scripted suture: phases and planner over the CRTK-style PSM API (adfkit.runner.psm.PSM)
-and the closed-form IK, engine-neutral (SimWorld's public methods only).
+and the closed-form IK, engine-neutral (the runner's World interface only).
 
 One PSM (the driver, on the entry side) picks the needle up near its tail, carries it to
 entry hole k and drives the tip along the needle's own arc (a rotation about the needle's

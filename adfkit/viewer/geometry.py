@@ -13,8 +13,8 @@ import trimesh
 
 from ..adf.paths import collision_mesh_path, visual_mesh_path
 from ..model.semantics import ShapeKind, collision_primitives, shape_kind
+from ..runner.plan import rgba
 from ..runner.rotations import pose_to_matrix
-from ..runner.shapes import rgba
 
 DEFAULT_COLOUR = (0.8, 0.8, 0.8, 1.0)
 

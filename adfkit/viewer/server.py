@@ -97,16 +97,10 @@ class Viewer:
             self.world = None
 
     def _make_world(self):
+        from ..runner import open_world
         from ..runner.options import Options
 
-        opt = Options(renderer="auto")
-        if self.engine == "mujoco":
-            from ..runner.mj.world import MjWorld
-
-            return MjWorld(self.scene, opt)
-        from ..runner.world import SimWorld
-
-        return SimWorld(self.scene, opt)
+        return open_world(self.scene, Options(renderer="auto"), engine=self.engine)
 
     def reset(self) -> None:
         """Build the world again from the scene (both engines, whatever was changed)."""
@@ -218,7 +212,7 @@ class Viewer:
         if soft is None:
             return
         from ..geometry.softmesh import placed_soft_mesh
-        from ..runner.shapes import rgba
+        from ..runner.plan import rgba
 
         for n, s in enumerate(soft.items):
             try:

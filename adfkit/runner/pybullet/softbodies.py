@@ -32,12 +32,12 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 
-from ..diagnostics import AdfError
-from ..geometry.softmesh import DEFAULT_SOFT_MASS, link_stiffness, placed_soft_mesh, write_obj
-from ..model.semantics import pose_or_identity
-from .names import merge_namespace
-from .rotations import pose_to_matrix
-from .shapes import rgba
+from ...diagnostics import AdfError
+from ...geometry.softmesh import DEFAULT_SOFT_MASS, link_stiffness, placed_soft_mesh, write_obj
+from ...model.semantics import pose_or_identity
+from ..names import merge_namespace
+from ..plan import rgba
+from ..rotations import pose_to_matrix
 
 DEFAULT_MARGIN = 0.001  # adf-format.md §7.4
 CL_SELF = 0x40  # btSoftBody::fCollision::CL_SELF
@@ -215,7 +215,7 @@ class SoftBodies:
         out = []
         cfg = sb.config
         if cfg is not None:
-            from ..model.spec import adf_fields
+            from ...model.spec import adf_fields
 
             for f in adf_fields(cfg):
                 key = f.metadata["adf_key"]

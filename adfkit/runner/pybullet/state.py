@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from .rotations import matrix_to_pq
+from ..rotations import matrix_to_pq
 
 
 class WorldState:

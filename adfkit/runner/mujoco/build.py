@@ -23,18 +23,12 @@ import numpy as np
 
 from ...converters.mjcf_write import to_mjcf
 from ...converters.urdf import _material
-from ...diagnostics import AdfError, SourceLocation, error
 from ...model.semantics import JointKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
+from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
 from ..rotations import matrix_to_quat, pose_to_matrix
+from .spec import _parse_spec, _resolve_meshes
 
-SPRING_KINDS = (
-    JointKind.SIX_DOF,
-    JointKind.SIX_DOF_SPRING,
-    JointKind.CONE_TWIST,
-    JointKind.LINEAR_SPRING,
-    JointKind.TORSION_SPRING,
-)
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
 GHOST_GROUP = 4
 # the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. A weld's
@@ -46,7 +40,7 @@ WELD_DAMPING_RATIO = 1.0
 
 @dataclass
 class BodyPlan:
-    key: str  # namespace + identifier, as SimWorld keys it
+    key: str  # namespace + identifier, as every engine keys it
     body: object  # ADF Body
     model: object  # ADF ModelFile
     mjname: str  # MJCF body name ("world" for ADF's world stand-in)
@@ -54,7 +48,7 @@ class BodyPlan:
     spring: tuple | None = None  # (joint, kind) of a six-dof-family joint to its parent
 
 
-EXCLUDE_SPARE = 512  # run-time excluded pairs (MjWorld.set_collision); the suture turns off ~300
+EXCLUDE_SPARE = 512  # run-time excluded pairs (MujocoWorld.set_collision); the suture turns off ~300
 
 
 @dataclass
@@ -72,18 +66,18 @@ class Plan:
     spec: object
     bodies: list[BodyPlan]
     ghosts: list[GhostPlan]
-    actuators: list[tuple]  # (key, ADF actuator, parent BodyPlan, weld name)
+    actuators: list[tuple]  # (plan.Grasper with a BodyPlan parent, weld name)
     joints: list[tuple]  # (ADF joint, kind, parent BodyPlan, child BodyPlan, MJCF joint names)
     loops: list[tuple]  # (ADF joint, kind, parent BodyPlan, child BodyPlan, pivot in parent link, pivot in child link)
     springs: int = 0
     losses: list = field(default_factory=list)
     tmp: object = None
-    sensors: list = field(default_factory=list)  # (key, ADF sensor, parent BodyPlan)
+    sensors: list = field(default_factory=list)  # plan.SensorRays with BodyPlan parents
 
 
 def _spring_axes(joint, kind):
     """[(slide|hinge, axis index, low, high, stiffness, damping, equilibrium)] of a six-dof-family joint."""
-    from ..joints import spring_joint
+    from ..springs import spring_joint
 
     sj = spring_joint(joint, kind, None, None, np.eye(4), np.eye(4))
     out = []
@@ -154,19 +148,9 @@ def build_plan(world) -> Plan:
     registry: Registry = world.registry
     plans_by_model = []
     losses = []
+    not_played(world, scene.all_models(), "mujoco")
     for i, m in enumerate(scene.all_models()):
         ns = m.namespace or ""
-        for kind, objs in (("soft body", m.soft_bodies), ("vehicle", m.vehicles), ("volume", m.volumes)):
-            for o in objs:
-                world._warn(
-                    f"runner-{kind.replace(' ', '-')}",
-                    f"{o.identifier}: {kind}s are not played by the MuJoCo engine; skipped",
-                    o,
-                    "play it with --engine pybullet",
-                )
-                world.not_played.append(
-                    {"object": o.identifier, "what": kind, "why": f"{kind}s are not played by the MuJoCo engine"}
-                )
         mine = {}
         if m.bodies:
             names: dict = {}
@@ -244,44 +228,25 @@ def build_plan(world) -> Plan:
     for m, _mine, _tree in plans_by_model:
         ns = m.namespace or ""
         for gh in m.ghost_objects:
-            parent = _parent(world, gh.parent, ns, gh) if gh.parent else None
+            parent = resolve_parent(world, gh.parent, ns, gh, BodyPlan) if gh.parent else None
             loc = location = pose_to_matrix(pose_or_identity(gh.location))
             if parent is not None:
                 loc = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body)) @ loc
-            key = registry.add(merge_namespace(ns, gh.namespace) + gh.identifier, None)
+            key = registry.add(key_of(ns, gh), None)
             body_el = spec.worldbody if parent is None or parent.mjname == "world" else spec.body(parent.mjname)
-            name = (gh.name or gh.identifier).lower()
             gp = GhostPlan(
                 key,
                 gh,
                 parent,
                 _ghost_geoms(body_el, gh, loc, f"ghost:{key}", world._warn),
-                any(w in name for w in opt.hole_ghost_words),
+                is_hole(gh, opt),
                 location,
             )
             if gp.geoms:
                 ghosts.append(gp)
-        from ...model.semantics import ACTUATOR_TYPES, SENSOR_TYPES
-
-        for sn in m.sensors:
-            if SENSOR_TYPES.get(sn.type) != "proximity" or not sn.array:
-                world._warn(
-                    "runner-sensor",
-                    f"{sn.identifier}: only proximity sensors with an `array` of rays are played; skipped",
-                    sn,
-                )
-                continue
-            parent = _parent(world, sn.parent, ns, sn)
-            if parent is not None:
-                sensors.append((merge_namespace(ns, sn.namespace) + sn.identifier, sn, parent))
-        for a in m.actuators:
-            if ACTUATOR_TYPES.get(a.type) != "constraint":
-                world._warn("runner-actuator", f"{a.identifier}: actuator type {a.type!r} not supported; skipped", a)
-                continue
-            parent = _parent(world, a.parent, ns, a)
-            if parent is None:
-                continue
-            key = merge_namespace(ns, a.namespace) + a.identifier
+        sensors += played_sensors(world, m, BodyPlan)
+        for g in played_actuators(world, m, BodyPlan):
+            parent, key = g.parent, g.key
             weld = f"grasp:{key}"
             spec.add_equality(
                 type=mujoco.mjtEq.mjEQ_WELD,
@@ -292,36 +257,12 @@ def build_plan(world) -> Plan:
                 active=False,
                 solref=[WELD_TIMECONST_STEPS * world.dt, WELD_DAMPING_RATIO],
             )
-            actuators.append((key, a, parent, weld))
+            actuators.append((g, weld))
     for _j, kind, _pa, _ch, jn in joints:
         if kind in ONE_DOF and jn:
             act = spec.add_actuator(name=f"motor:{jn[0]}", target=jn[0], trntype=mujoco.mjtTrn.mjTRN_JOINT)
             act.set_to_position(kp=1.0, kv=0.0)  # gains are set per joint once the model is compiled
     return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors)
-
-
-def _resolve_meshes(world, child, out_dir: Path, model) -> None:
-    """Absolute mesh paths; a mesh file that is not there drops its geoms, with a warning."""
-    missing, missing_paths = {}, {}
-    for mesh in list(child.meshes):
-        path = (out_dir / mesh.file).resolve()
-        if path.is_file():
-            mesh.file = str(path)
-            # inertials are explicit; shell inertia lets flat meshes (a floor, a backdrop) compile
-            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
-        else:
-            missing[mesh.name] = mesh
-            missing_paths[mesh.name] = path
-    if not missing:
-        return
-    for g in list(child.geoms):
-        if g.meshname in missing:
-            child.delete(g)
-    for name, mesh in missing.items():
-        world._warn(
-            "runner-mesh", f"{model.name}: mesh file {missing_paths[name]} not found; its shapes are left out", model
-        )
-        child.delete(mesh)
 
 
 def _world_lights(world, spec) -> None:
@@ -335,7 +276,7 @@ def _world_lights(world, spec) -> None:
     for light in w.lights if w is not None else []:
         el, to_link = spec.worldbody, np.eye(4)
         if light.parent:
-            parent = _parent(world, light.parent, w.namespace or "", light)
+            parent = resolve_parent(world, light.parent, w.namespace or "", light, BodyPlan)
             if parent is None:
                 continue
             to_link = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body))
@@ -352,20 +293,6 @@ def _world_lights(world, spec) -> None:
             exponent=light.spot_exponent if light.spot_exponent is not None else ADF_SPOT_EXPONENT,
             castshadow=False,
         )
-
-
-def _parent(world, ref, ns, obj):
-    key, hit = world.registry.find(ref)
-    if key is None and ref:
-        key, hit = world.registry.find(ns + ref)
-    if key is None or not isinstance(hit, BodyPlan):
-        world._warn(
-            "runner-parent",
-            f"{obj.identifier}: parent {ref!r} not found" + (f" (matches: {', '.join(hit)})" if hit else ""),
-            obj,
-        )
-        return None
-    return hit
 
 
 def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
@@ -414,81 +341,3 @@ def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
     # that turns a pair off at run time fills a world-world placeholder (a pair that never collides)
     for _ in range(EXCLUDE_SPARE):
         spec.add_exclude(bodyname1="world", bodyname2="world")
-
-
-def compile_spec(world, spec):
-    """spec.compile(), replacing a collision mesh MuJoCo cannot hull (flat: coplanar vertices)
-    by a box around its vertices (at least 1 mm thick), with a warning."""
-    import re
-
-    for _ in range(100):
-        try:
-            return spec.compile()
-        except ValueError as e:
-            hit = re.search(r"mesh '([^']+)' has coplanar vertices", str(e))
-            if hit is None:
-                raise
-            mesh = spec.mesh(hit.group(1))
-            lo, hi = _obj_bounds(Path(mesh.file), np.array(mesh.scale, float))
-            for g in list(spec.geoms):
-                if g.meshname != mesh.name:
-                    continue
-                body = g.parent
-                box = body.add_geom(
-                    type=mujoco.mjtGeom.mjGEOM_BOX,
-                    size=np.maximum((hi - lo) / 2, 5e-4),
-                    contype=g.contype,
-                    conaffinity=g.conaffinity,
-                    group=g.group,
-                    friction=g.friction,
-                    rgba=g.rgba,
-                    name=(g.name or "") + "#box",
-                )
-                r = _quat_matrix(np.array(g.quat, float))
-                box.pos = np.array(g.pos, float) + r @ ((lo + hi) / 2)
-                box.quat = g.quat
-                spec.delete(g)
-            world._warn(
-                "runner-flat-mesh",
-                f"{Path(mesh.file).name}: a flat mesh has no convex hull for MuJoCo; it collides as its bounding box",
-                None,
-            )
-            spec.delete(mesh)
-    return spec.compile()
-
-
-def _obj_bounds(path: Path, scale: np.ndarray):
-    vs = []
-    with open(path, encoding="utf-8", errors="replace") as f:
-        for line in f:
-            if line.startswith("v "):
-                vs.append([float(x) for x in line.split()[1:4]])
-    v = np.array(vs) * scale if vs else np.zeros((1, 3))
-    return v.min(axis=0), v.max(axis=0)
-
-
-def _quat_matrix(q: np.ndarray) -> np.ndarray:
-    from ..rotations import quat_to_matrix
-
-    return quat_to_matrix(np.array([q[1], q[2], q[3], q[0]]))
-
-
-def _parse_spec(text: str, model) -> mujoco.MjSpec:
-    """MuJoCo's spec of one model's MJCF. MuJoCo parses MJCF with tinyxml2, which stops at 500
-    nested elements: a chain of about 500 bodies joined by revolute or prismatic joints (each
-    a <body> inside its parent's) cannot be loaded; that is a located error, not a traceback."""
-    try:
-        return mujoco.MjSpec.from_string(text)
-    except ValueError as exc:
-        if "DEPTH" not in str(exc).upper():
-            raise
-        where = model.source or SourceLocation(str(model.path) if model.path else "<model>", 1, 1)
-        raise AdfError(
-            error(
-                "mujoco-tree-too-deep",
-                "MuJoCo cannot load this model: its kinematic tree nests bodies deeper than "
-                "MuJoCo's MJCF parser allows (about 500 levels)",
-                where,
-                "play it with --engine pybullet, or split the chain with p2p joints",
-            )
-        ) from None

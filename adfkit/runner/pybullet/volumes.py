@@ -11,13 +11,13 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from ..diagnostics import AdfError
-from ..model import Body
-from ..model.semantics import pose_or_identity
+from ...diagnostics import AdfError
+from ...model import Body
+from ...model.semantics import pose_or_identity
+from ..names import merge_namespace
+from ..plan import rgba
+from ..rotations import matrix_to_pq, pose_to_matrix
 from .bodies import make_sim_body
-from .names import merge_namespace
-from .rotations import matrix_to_pq, pose_to_matrix
-from .shapes import rgba
 
 BONE = [0.93, 0.89, 0.78, 1.0]
 
@@ -45,7 +45,7 @@ def not_played_parts(vol) -> list[dict]:
 
 def build_volumes(world, models) -> None:
     """Add each model's volumes to ``world`` (a SimWorld) as static iso-surface bodies."""
-    from ..geometry.volume import iso_surface, load_volume
+    from ...geometry.volume import iso_surface, load_volume
 
     for m in models:
         ns = m.namespace or ""

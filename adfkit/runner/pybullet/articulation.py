@@ -8,8 +8,8 @@ from collections import defaultdict, deque
 import numpy as np
 import pybullet as pb
 
-from ..model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, joint_frames
-from .rotations import invert, matrix_to_pq, pose_matrix
+from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, joint_frames
+from ..rotations import invert, matrix_to_pq, pose_matrix
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC)
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..model.semantics import (
+from ...model.semantics import (
     DEFAULT_ANGULAR_DAMPING,
     DEFAULT_FRICTION_ROLLING,
     DEFAULT_FRICTION_STATIC,
@@ -17,7 +17,7 @@ from ..model.semantics import (
     effective_mass,
     inertial_offset,
 )
-from .rotations import pose_to_matrix
+from ..rotations import pose_to_matrix
 
 
 @dataclass(eq=False)
@@ -70,7 +70,7 @@ class SimBody:
 
     def world_matrix(self) -> np.ndarray:
         """Pose of the ADF body frame (the mesh origin) in the world, 4×4."""
-        from .rotations import invert, pose_matrix
+        from ..rotations import invert, pose_matrix
 
         p, q, _, _ = self.state(velocity=False)
         return pose_matrix(p, q) @ invert(self.com_in_body)
@@ -85,7 +85,7 @@ class SimBody:
 def make_sim_body(key: str, body, model) -> SimBody:
     mass = effective_mass(body)
     com = pose_to_matrix(inertial_offset(body))
-    from ..model.semantics import pose_or_identity
+    from ...model.semantics import pose_or_identity
 
     return SimBody(
         key=key,

@@ -17,20 +17,20 @@ import dataclasses
 
 import numpy as np
 
-from .rotations import quat_to_matrix
+from ..rotations import quat_to_matrix
 
 
 def _wxyz_to_matrix(q: np.ndarray) -> np.ndarray:
     return quat_to_matrix(np.column_stack([q[:, 1], q[:, 2], q[:, 3], q[:, 0]]))
 
 
-class MjView:
+class MjMirror:
     def __init__(self, world) -> None:
-        from .mj.world import MjWorld
+        from .world import MujocoWorld
 
         self.world = world
         opt = dataclasses.replace(world.opt, renderer="tiny")
-        self.mj = mj = MjWorld(world.scene, opt, sleep=False)
+        self.mj = mj = MujocoWorld(world.scene, opt, sleep=False)
         m = mj.model
         sim_index = {sb.key: i for i, sb in enumerate(world.bodies)}
         matched = [(mb, sim_index[mb.key]) for mb in mj.bodies if mb.id > 0 and mb.key in sim_index]

@@ -15,12 +15,12 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 
-from .. import inputs
-from ..adf.paths import collision_mesh_path, visual_mesh_path
-from ..diagnostics import AdfError, Diagnostic, warning
-from ..geometry.meshcheck import mesh_problem
-from ..model.pose import Pose, Quat, Vec3
-from ..model.semantics import (
+from ... import inputs
+from ...adf.paths import collision_mesh_path, visual_mesh_path
+from ...diagnostics import Diagnostic, warning
+from ...geometry.meshcheck import mesh_problem
+from ...model.pose import Pose, Quat, Vec3
+from ...model.semantics import (
     CollisionMeshType,
     Primitive,
     ShapeKind,
@@ -29,9 +29,9 @@ from ..model.semantics import (
     shape_kind,
     shortest_arc,
 )
-from .rotations import invert, matrix_to_pq, pose_to_matrix
-
-MESH_SUFFIXES = {".obj", ".stl"}  # what PyBullet's GEOM_MESH reads from a file
+from ..plan import rgba
+from ..rotations import invert, matrix_to_pq, pose_to_matrix
+from .meshfiles import MESH_SUFFIXES, mesh_refusal, pybullet_mesh
 
 
 @dataclass
@@ -138,64 +138,6 @@ def _missing_dimension(prim: Primitive) -> str | None:
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
             return name
     return None
-
-
-def mesh_refusal(model, path: Path) -> str | None:
-    """Why the input policy (adfkit.inputs) keeps PyBullet from reading this mesh, or None:
-    missing, not a regular file, over the size cap, outside the model's tree."""
-    try:
-        inputs.check_file(path, "mesh", tree=getattr(model, "tree", None), what="mesh file")
-    except AdfError as exc:
-        d = exc.diagnostics[0]
-        return f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
-    return None
-
-
-_STL_DIR: str | None = None
-_STL_CACHE: dict[tuple[str, int, int], tuple[str | None, str | None]] = {}
-
-
-def pybullet_mesh(model, path: Path) -> tuple[Path | None, str | None]:
-    """The file to hand PyBullet for a mesh, or (None, why not).
-
-    PyBullet reads only binary STL, and crashes (SIGSEGV) on an ASCII or malformed STL, or on
-    NaN vertices: an STL that is not a consistent binary STL with finite vertices is read with
-    trimesh (as AMBF's assimp would) and handed over as a temporary binary STL; one trimesh
-    cannot read either is refused like a missing mesh."""
-    refused = mesh_refusal(model, path)
-    if refused is not None:
-        return None, refused
-    if path.suffix.lower() != ".stl":
-        return path, None
-    st = path.stat()
-    key = (str(path), st.st_size, st.st_mtime_ns)
-    if key not in _STL_CACHE:
-        _STL_CACHE[key] = _checked_stl(path, st.st_size)
-    done, why = _STL_CACHE[key]
-    return (Path(done) if done else None), why
-
-
-def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
-    with open(path, "rb") as fh:
-        head = fh.read(84)
-        count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
-        if count > 0 and size == 84 + 50 * count and not head.lstrip().startswith(b"solid"):
-            records = np.frombuffer(fh.read(), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", 9), ("a", "<u2")]))
-            if np.isfinite(records["v"]).all():
-                return str(path), None
-            return None, f"{inputs.shown(path)} has NaN or infinite vertices"
-    from ..geometry.meshio import load_mesh  # trimesh: only for meshes PyBullet cannot take as they are
-
-    try:
-        mesh = load_mesh(path)
-    except AdfError as exc:
-        return None, f"{inputs.shown(path)} is not a readable mesh ({exc.diagnostics[0].message})"
-    global _STL_DIR
-    if _STL_DIR is None:
-        _STL_DIR = tempfile.mkdtemp(prefix="adfkit-stl-")
-    out = os.path.join(_STL_DIR, f"mesh_{len(_STL_CACHE)}.stl")
-    mesh.export(out, file_type="stl")
-    return out, None
 
 
 def collision_parts(
@@ -330,21 +272,6 @@ def _create_collision(parts: ShapeParts, cid: int) -> int:
         arrays["collisionFrameOrientations"].append(kw.get("collisionFrameOrientation", [0, 0, 0, 1]))
         arrays["flags"].append(kw.get("flags", 0))
     return pb.createCollisionShapeArray(shapeTypes=parts.types, physicsClientId=cid, **arrays)
-
-
-def rgba(obj) -> list[float] | None:
-    """Colour of §7.3: `color rgba`, then `color components` (diffuse + transparency), else None."""
-    if obj.use_material is False:
-        return None
-    c = obj.color_rgba
-    if c is not None and None not in (c.r, c.g, c.b, c.a):
-        return [c.r, c.g, c.b, c.a]
-    cc = obj.color_components
-    if cc is not None:
-        d = cc.diffuse
-        col = [d.r or 0.0, d.g or 0.0, d.b or 0.0] if d is not None else [0.7, 0.7, 0.7]
-        return col + [cc.transparency if cc.transparency is not None else 1.0]
-    return None
 
 
 def create_visual(model, obj, frame_in_body, scale: float, cid: int, diags: list[Diagnostic]) -> int:

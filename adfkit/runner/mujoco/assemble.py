@@ -1,0 +1,269 @@
+"""How the MuJoCo world builds the scene (the Assembly half of MujocoWorld): the MjSpec from
+build.py compiled, the engine's bodies, articulations with servo gains from the joints'
+inertia, ghosts, actuators, sensors, cameras and the floor."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, effective_mass, inertial_offset
+from ...model.tree import ONE_DOF
+from ..rotations import pose_to_matrix
+from .build import build_plan
+from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
+from .spec import compile_spec
+
+DRIVE_BANDWIDTH = 0.25  # ω·dt of the joint position servos (explicit stiffness is stable below 2)
+SOLVER_TOLERANCE = 1e-6
+WAKE_FORCE = 1e-12  # N
+# MuJoCo's 1e-3 puts a mm-scale chain to sleep 2 mm short of its rest pose, 3e-4 0.6 mm short;
+# at 1e-4 the suturing thread lying on the phantom never sleeps (its contacts jitter above it)
+SLEEP_TOLERANCE = 3e-4
+SPRING_LIMIT = 0.25  # k ≤ SPRING_LIMIT·M_ii/dt²: the PyBullet runner's clamp for explicit springs
+
+
+class Assembly:
+    def _build(self) -> None:
+        plan = build_plan(self)
+        spec = plan.spec
+        spec.option.timestep = self.dt
+        spec.option.gravity = self.gravity
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        # Newton stops at a 1e-6 relative improvement (MuJoCo's 1e-8 costs 1.8x the time here);
+        # dense or sparse algebra: jacobian_for, once the model is compiled
+        spec.option.tolerance = SOLVER_TOLERANCE
+        # elliptic friction cones (Coulomb's, as Bullet's friction): Newton converges in fewer
+        # iterations on the thread lying on the phantom than with the pyramidal default, so the
+        # settling seconds play 1.4x faster (bench/speed.py) and the thread sleeps as early
+        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+        if self.sleep:
+            spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
+            spec.option.sleep_tolerance = SLEEP_TOLERANCE
+        if self.opt.solver_iterations:
+            spec.option.iterations = max(self.opt.solver_iterations, 1)
+        from .render import prepare_cameras
+
+        cams = prepare_cameras(self, plan)
+        ground = self.opt.ground and self.scene.world is None and self.scene.environment is None
+        self.model = compile_spec(self, spec)
+        self.model.opt.jacobian = jacobian_for(self.model)
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
+        self.ground_z = None
+        if ground and plan.bodies:
+            self.ground_z = self._lowest_point() - 1e-3
+            spec.worldbody.add_geom(
+                type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1], pos=[0, 0, self.ground_z], name="adfkit:ground"
+            )
+            self.model = compile_spec(self, spec)
+            self.data = mujoco.MjData(self.model)
+            mujoco.mj_forward(self.model, self.data)
+        self._plan = plan
+        m, d = self.model, self.data
+        self.bodies: list[MjBody] = []
+        by_plan = {}
+        for bp in plan.bodies:
+            bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, bp.mjname)
+            mass = effective_mass(bp.body)
+            sb = MjBody(
+                bp.key,
+                bp.body,
+                bp.model,
+                max(mass, 0.0),
+                pose_to_matrix(inertial_offset(bp.body)),
+                pose_to_matrix(bp.link.frame_in_body),
+                bid,
+                self,
+            )
+            sb.has_collision = bool(
+                np.any((m.geom_bodyid == bid) & ((m.geom_contype != 0) | (m.geom_conaffinity != 0)))
+            )
+            if bid > 0 and m.body_weldid[bid] == 0:
+                sb.mass = 0.0  # welded to the world: static whatever the file says
+            self.registry.items[bp.key] = sb
+            self.bodies.append(sb)
+            by_plan[id(bp)] = sb
+        self._by_plan = by_plan
+        self.joint_names = [j.identifier for j, *_ in plan.joints] + [j.identifier for j, *_ in plan.loops]
+        self._build_articulations(plan, by_plan)
+        self._tune_gains(plan)
+        self._gravity_overrides()
+        self._base_xfrc = np.array(d.xfrc_applied)
+        self.ghosts = []
+        for gp in plan.ghosts:
+            ids = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in gp.geoms])
+            parent = by_plan.get(id(gp.parent)) if gp.parent is not None else None
+            self.ghosts.append(MjGhost(gp.key, gp.ghost, parent, ids, gp.friction, pose_in_parent=gp.location))
+            self.registry.items[gp.key] = None
+        self._friction_ghosts = [g for g in self.ghosts if g.friction]
+        self._friction_geoms = np.array([gid for g in self._friction_ghosts for gid in g.geoms], dtype=int)
+        self._friction_owner = [g for g in self._friction_ghosts for _ in g.geoms]
+        self.actuators = [
+            MjActuator(
+                g.key,
+                g.actuator,
+                by_plan[id(g.parent)],
+                mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, weld),
+                g.location,
+                g.max_impulse / self.dt,
+            )
+            for g, weld in plan.actuators
+        ]
+        self.sensors = [
+            MjSensor(r.key, r.sensor, by_plan[id(r.parent)], r.location, r.starts, r.ends) for r in plan.sensors
+        ]
+        # rays see collision geoms (groups 0 and 3), not visuals (1) or ghosts (4)
+        self._ray_groups = np.array([1, 0, 1, 1, 0, 0], dtype=np.uint8)
+        self._ray_hit = np.zeros(1, dtype=np.int32)
+        self._body_of_id = {sb.id: sb for sb in self.bodies}
+        self.constraints = [
+            (j.identifier, None, by_plan[id(p)], by_plan[id(c)], pa, pb_, None) for j, kind, p, c, pa, pb_ in plan.loops
+        ]
+        self.springs_count = plan.springs
+        # the bodies the hole ghosts and grasps look for: dynamic ones with collision geoms
+        dyn = [i for i, sb in enumerate(self.bodies) if not sb.static and sb.has_collision]
+        self._cand_bodies = [self.bodies[i] for i in dyn]
+        gids = [g for g in range(m.ngeom) if (m.geom_contype[g] or m.geom_conaffinity[g])]
+        body_of = {sb.id: sb for sb in self._cand_bodies}
+        self._cand_geoms = np.array([g for g in gids if m.geom_bodyid[g] in body_of], dtype=int)
+        self._cand_geom_body = [body_of[m.geom_bodyid[g]] for g in self._cand_geoms]
+        self._cand_rbound = np.array(m.geom_rbound[self._cand_geoms])
+        self._cand_geom_bodyid = np.array(m.geom_bodyid[self._cand_geoms], dtype=int)
+        self._all_cand = np.arange(len(self._cand_geoms))
+        self._geom_xpos, self._body_awake = d.geom_xpos, d.body_awake
+        self._AWAKE = int(mujoco.mjtSleepState.mjS_AWAKE)
+        self._fg_rbound = np.array(m.geom_rbound[self._friction_geoms])[:, None]
+        self._geom_label = np.full(m.ngeom, -1, dtype=np.int32)
+        for i, sb in enumerate(self.bodies):
+            if sb.id > 0:
+                self._geom_label[m.geom_bodyid == sb.id] = i
+        self._floor_z = self._floor()
+        self.cameras = cams.finish(self)
+        self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
+        plan.tmp.cleanup()
+
+    def _lowest_point(self) -> float:
+        m = self.model
+        z = [self._geom_bottom(g) for g in range(m.ngeom) if m.geom_group[g] != 4 and m.geom_rbound[g] > 0]
+        return min(z) if z else 0.0
+
+    def _geom_bottom(self, g: int) -> float:
+        """Lowest z of a geom's world bounding box (its local AABB turned into the world)."""
+        m, d = self.model, self.data
+        r = d.geom_xmat[g].reshape(3, 3)
+        c, h = m.geom_aabb[g, :3], m.geom_aabb[g, 3:]
+        return float((r @ c + d.geom_xpos[g])[2] - np.abs(r[2]) @ h)
+
+    def _build_articulations(self, plan, by_plan) -> None:
+        """Roots of one-DOF trees and their fixed/revolute/prismatic descendants, as SimWorld groups them."""
+        m = self.model
+        kids: dict[int, list] = {}
+        for j, kind, p, c, jn in plan.joints:
+            kids.setdefault(id(p), []).append((j, kind, p, c, jn))
+        has_dof = set()
+        for _j, kind, p, _c, _jn in plan.joints:
+            if kind in ONE_DOF:
+                has_dof.add(id(p))
+        self.articulations = []
+        child_ids = {id(c) for _, k, _, c, _ in plan.joints if k in ONE_DOF or k is JointKind.FIXED}
+        for bp in plan.bodies:
+            if id(bp) in child_ids or id(bp) not in has_dof:
+                continue
+            recs, stack = [], list(reversed(kids.get(id(bp), [])))
+            while stack:
+                j, kind, p, c, jn = stack.pop()
+                if kind not in ONE_DOF and kind is not JointKind.FIXED:
+                    continue
+                if kind is JointKind.FIXED and effective_mass(c.body) == 0.0:
+                    continue
+                jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, jn[0]) if jn else -1
+                aid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"motor:{jn[0]}") if jn else -1
+                recs.append((j, kind, by_plan[id(p)], by_plan[id(c)], jid, aid))
+                stack.extend(reversed(kids.get(id(c), [])))
+            if any(r[1] in ONE_DOF for r in recs):
+                art = MjArticulation(self, by_plan[id(bp)], [r for r in recs])
+                art.records = [r[:4] for r in recs]
+                by_plan[id(bp)].articulation = art
+                for r in recs:
+                    r[3].articulation = art
+                self.articulations.append(art)
+                art.drive()
+
+    def _tune_gains(self, plan) -> None:
+        """Servo gains from each joint's effective inertia (the diagonal of M at the initial
+        pose): kp = (DRIVE_BANDWIDTH/dt)²·M_ii, critically damped (implicit in velocity), force
+        capped at AMBF's max motor impulse / dt; spring stiffness clamped like the PyBullet runner's."""
+        m, dt = self.model, self.dt
+        diag = np.array(m.dof_M0)  # the diagonal of M at qpos0, armature included
+        w = DRIVE_BANDWIDTH / dt
+        by_joint = {}
+        for art in self.articulations:
+            for (j, _kind, _p, _c), vadr, act in zip(art.records, art.vadr, art.act):
+                if act < 0:
+                    continue
+                mii = diag[vadr]
+                kp = w * w * mii
+                kv = 2.0 * w * mii
+                m.actuator_gainprm[act, 0] = kp
+                m.actuator_biasprm[act, 1] = -kp
+                m.actuator_biasprm[act, 2] = -kv
+                imp = j.max_motor_impulse if j.max_motor_impulse is not None else DEFAULT_JOINT_MAX_MOTOR_IMPULSE
+                m.actuator_forcelimited[act] = 1
+                m.actuator_forcerange[act] = (-imp / dt, imp / dt)
+                by_joint[id(j)] = True
+        clamped = []
+        for j in range(m.njnt):
+            if m.jnt_stiffness[j] > 0:
+                v = m.jnt_dofadr[j]
+                cap = SPRING_LIMIT * diag[v] / dt**2
+                if m.jnt_stiffness[j] > cap:
+                    clamped.append(m.joint(j).name)
+                    m.jnt_stiffness[j] = cap
+        if clamped:
+            self._warn(
+                "runner-spring-clamp",
+                f"{len(clamped)} spring axes stiffer than an explicit {dt * 1e3:g} ms "
+                f"step keeps stable were softened to 0.25·M/dt² (e.g. {clamped[0]})",
+                None,
+            )
+
+    def _gravity_overrides(self) -> None:
+        d = self.data
+        for sb in self.bodies:
+            if sb.static:
+                continue
+            g = sb.body.gravity if sb.body.mass is not None and sb.body.gravity is not None else sb.model.gravity
+            if g is not None and not np.allclose(g, self.gravity):
+                sb.gravity = np.array(g, float)
+                d.xfrc_applied[sb.id][:3] += self.model.body_mass[sb.id] * (sb.gravity - self.gravity)
+
+    def _floor(self) -> float:
+        m, d = self.model, self.data
+        zs = []
+        for g in range(m.ngeom):
+            b = m.geom_bodyid[g]
+            if m.body_weldid[b] != 0 or not (m.geom_contype[g] or m.geom_conaffinity[g]):
+                continue
+            zs.append(d.geom_xpos[g][2] if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE else self._geom_bottom(g))
+        return min(zs) if zs else -math.inf
+
+
+def _xyzw(wxyz) -> np.ndarray:
+    return np.array([wxyz[1], wxyz[2], wxyz[3], wxyz[0]])
+
+
+def jacobian_for(model) -> int:
+    """Dense or sparse constraint algebra, from how full the joint-space inertia matrix is.
+
+    A 40-element thread is a 120-dof chain: its mass matrix and contact Jacobians are dense,
+    and dense algebra is faster for it than MuJoCo's sparse default above 60 dofs (the bundled
+    suturing scene: 139 dofs, the matrix 79 % filled). Many shallow trees (free bodies joined
+    by p2p joints) leave it nearly empty, and dense algebra there grows with the square of the
+    size: a chain of 300 p2p-joined bodies steps 19x faster sparse (bench/scaling.py)."""
+    full = model.nv * (model.nv + 1) // 2
+    if model.nv < 60 or model.nM >= 0.5 * full:
+        return mujoco.mjtJacobian.mjJAC_DENSE
+    return mujoco.mjtJacobian.mjJAC_SPARSE

@@ -1,0 +1,165 @@
+"""What the MuJoCo world does between steps (the Interaction half of MujocoWorld): hole ghosts
+sensing what is inside them and applying viscous friction, ray sensors, the grasp's weld,
+collision switches at run time, contacts."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ..plan import viscous_impulse_force
+from ..rotations import invert, matrix_to_quat, pose_matrix
+from .assemble import WAKE_FORCE, _xyzw
+from .build import EXCLUDE_SPARE
+from .objects import MjActuator, MjBody, MjGhost, MjSensor
+
+
+class Interaction:
+    def _sense(self, s: MjSensor) -> None:
+        m, d = self.model, self.data
+        t = s.parent.world_matrix() @ s.location
+        a = s.starts @ t[:3, :3].T + t[:3, 3]
+        b = s.ends @ t[:3, :3].T + t[:3, 3]
+        s.sensed = []
+        for p, q in zip(a, b):
+            x = mujoco.mj_ray(m, d, p, q - p, self._ray_groups, 1, s.parent.id, self._ray_hit)
+            if 0.0 <= x <= 1.0 and self._ray_hit[0] >= 0:
+                sb = self._body_of_id.get(int(m.geom_bodyid[self._ray_hit[0]]))
+                if sb is not None and sb not in s.sensed:
+                    s.sensed.append(sb)
+
+    def place_ghosts(self) -> None:
+        """Ghost geoms ride on their parent bodies: nothing to move."""
+
+    def overlapping(self, g: MjGhost) -> list[MjBody]:
+        """The dynamic bodies inside ghost ``g`` now (bounding spheres first, then MuJoCo's
+        exact geom distance); also kept in ``g.overlapping``."""
+        m, d = self.model, self.data
+        cg = self._cand_geoms
+        found = []
+        if len(cg):
+            gx = d.geom_xpos
+            near = np.zeros(len(cg), dtype=bool)
+            for gid in g.geoms:
+                dist = np.linalg.norm(gx[cg] - gx[gid], axis=1)
+                near |= dist <= m.geom_rbound[cg] + m.geom_rbound[gid]
+            seen = set()
+            for k in np.nonzero(near)[0]:
+                sb = self._cand_geom_body[k]
+                if id(sb) in seen or sb is g.parent:
+                    continue
+                for gid in g.geoms:
+                    if mujoco.mj_geomDistance(m, d, int(gid), int(cg[k]), 0.0, None) <= 0.0:
+                        found.append(sb)
+                        seen.add(id(sb))
+                        break
+        g.overlapping = found
+        return found
+
+    def _viscous(self, g: MjGhost, found) -> None:
+        """F = -K·(v_body - v_phantom) on every body inside a hole ghost (held for a control
+        step as the exact exp(-K·t/m) decay, as in the PyBullet runner)."""
+        k = self.opt.hole_friction
+        cdt = self.dt * self.opt.control_substeps
+        v_ref = self._com_velocity(g.parent) if g.parent is not None and not g.parent.static else 0.0
+        xf = self.data.xfrc_applied
+        for sb in found:
+            xf[sb.id, :3] += viscous_impulse_force(sb.mass, self._com_velocity(sb) - v_ref, k, cdt)
+
+    def _com_velocity(self, sb: MjBody) -> np.ndarray:
+        v = self._vel6
+        mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, sb.id, v, 0)
+        return v[3:].copy()
+
+    def actuate(self, actuator: MjActuator, target: MjBody) -> None:
+        """Weld ``target`` to the actuator's parent at their current relative pose; the jaws'
+        own geoms stop colliding with it meanwhile (they would push the held body out)."""
+        self.release(actuator)
+        m, d = self.model, self.data
+        e = actuator.eq
+        a, b = actuator.parent.id, target.id
+        ta = pose_matrix(d.xpos[a], _xyzw(d.xquat[a]))
+        tb = pose_matrix(d.xpos[b], _xyzw(d.xquat[b]))
+        rel = invert(ta) @ tb
+        q = matrix_to_quat(rel[:3, :3])
+        m.eq_obj2id[e] = b
+        m.eq_data[e, :3] = 0.0  # anchor: body2's origin
+        m.eq_data[e, 3:6] = rel[:3, 3]
+        m.eq_data[e, 6:10] = (q[3], q[0], q[1], q[2])
+        m.eq_data[e, 10] = 1.0
+        d.eq_active[e] = 1
+        self.wake(target)
+        actuator.target = target
+        art = actuator.parent.articulation
+        links = [r[3] for r in art.records] + [art.root] if art is not None else [actuator.parent]
+        actuator.constraint = []
+        for sb in links:
+            for gid in np.nonzero(m.geom_bodyid == sb.id)[0]:
+                if m.geom_contype[gid] or m.geom_conaffinity[gid]:
+                    actuator.constraint.append((int(gid), int(m.geom_contype[gid]), int(m.geom_conaffinity[gid])))
+        for gid, _, _ in actuator.constraint:  # only the links near the held body matter; all is simplest
+            if np.linalg.norm(d.geom_xpos[gid] - d.xpos[b]) < 0.05:
+                m.geom_contype[gid] = m.geom_conaffinity[gid] = 0
+
+    def ghost_pose(self, g: MjGhost) -> np.ndarray:
+        """World pose (4x4) of a ghost's frame, following its parent."""
+        loc = g.pose_in_parent if g.pose_in_parent is not None else np.eye(4)
+        return g.parent.world_matrix() @ loc if g.parent is not None else np.array(loc)
+
+    def set_collision(self, a: MjBody, b: MjBody, enabled: bool) -> None:
+        """Let two bodies collide or pass through each other, as SimWorld.set_collision: an
+        excluded body pair written into one of the spare slots the build reserved."""
+        m = self.model
+        lo, hi = sorted((int(a.id), int(b.id)))
+        sig = (lo << 16) + hi
+        sigs = np.array(m.exclude_signature[: m.nexclude])
+        if enabled:
+            if sig not in self._runtime_excludes:
+                return
+            self._runtime_excludes.discard(sig)
+            sigs[np.flatnonzero(sigs == sig)[0]] = 0
+        else:
+            if sig in sigs or lo == hi:
+                return
+            free = np.flatnonzero(sigs == 0)
+            if not free.size:
+                self._warn(
+                    "runner-collision-pairs",
+                    f"more than {EXCLUDE_SPARE} body pairs turned off at run time; {a.key} and {b.key} keep colliding",
+                    None,
+                )
+                return
+            sigs[free[0]] = sig
+            self._runtime_excludes.add(sig)
+        m.exclude_signature[: m.nexclude] = np.sort(sigs)
+
+    def wake(self, sb: MjBody) -> None:
+        """Wake the sleeping tree of ``sb`` (MuJoCo wakes a tree a force is applied to: a
+        1e-12 N force at the COM for one control step does it and nothing else)."""
+        if self.sleep and sb.id > 0:
+            self.data.xfrc_applied[sb.id, 2] += WAKE_FORCE
+
+    def release(self, actuator: MjActuator) -> None:
+        if actuator.target is not None:
+            self.wake(actuator.target)
+            self.data.eq_active[actuator.eq] = 0
+            for gid, ct, ca in actuator.constraint or ():
+                self.model.geom_contype[gid], self.model.geom_conaffinity[gid] = ct, ca
+        actuator.target, actuator.constraint = None, None
+
+    def contacts(self, sb: MjBody) -> list:
+        """[(other MjBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
+        m, d = self.model, self.data
+        out = []
+        f = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
+            if sb.id not in (b1, b2):
+                continue
+            other = self._body_of_id.get(b2 if b1 == sb.id else b1)
+            if other is None or other is sb:
+                continue
+            mujoco.mj_contactForce(m, d, i, f)
+            out.append((other, abs(float(f[0])), tuple(float(v) for v in c.pos)))
+        return out

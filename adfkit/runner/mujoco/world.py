@@ -1,0 +1,183 @@
+"""MujocoWorld: an ADF scene played in MuJoCo behind the same World interface as the PyBullet
+back end (runner/world.py): step, run, body(name) with world_matrix/com_position/state/force/
+torque, grasp, overlapping, place_ghosts, ghosts/actuators/sensors/cameras/articulations,
+joint_state/reset_joints, report, constraint_error, close. The model comes from build.py, is
+built into the world by assemble.py and acted on between steps by interact.py;
+docs/mujoco.md says what is approximated.
+"""
+
+from __future__ import annotations
+
+import time
+
+import mujoco
+import numpy as np
+
+from ..options import Options
+from ..rotations import invert, matrix_to_quat
+from ..world import World
+from . import stability as mj_stability
+from .assemble import Assembly
+from .interact import Interaction
+from .objects import MjBody
+
+
+class MujocoWorld(World, Assembly, Interaction):
+    engine = "mujoco"
+    body_type = MjBody
+
+    def __init__(self, scene, options: Options | None = None, gui: bool = False, sleep: bool = True) -> None:
+        """``sleep``: MuJoCo's island sleeping (resting trees are not integrated until a contact,
+        a force or a constraint with an awake tree wakes them; driven trees never sleep)."""
+        if gui:
+            raise ValueError("the MuJoCo engine plays headless only (use --engine pybullet for --gui)")
+        self._setup(scene, options, False)
+        self.engine_warnings: list[str] = []  # MuJoCo's other warnings, with their time
+        mj_stability.install_mujoco_handler()
+        self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")  # MuJoCo 4's island sleeping
+        self._render = None
+        self._vel6 = np.zeros(6)
+        self._runtime_excludes: set[int] = set()
+        self.camera_problem = ""
+        self._build()
+
+    def joint_state(self, art, idxs) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities of joints ``idxs`` (record indices) of an articulation."""
+        d = self.data
+        return (np.array([d.qpos[art.qadr[i]] for i in idxs]), np.array([d.qvel[art.vadr[i]] for i in idxs]))
+
+    def reset_joints(self, art, idxs, positions, velocities=None) -> None:
+        """Put joints ``idxs`` at ``positions`` (and ``velocities``, default 0) now; poses follow."""
+        d = self.data
+        vel = velocities if velocities is not None else [0.0] * len(idxs)
+        for i, p, v in zip(idxs, positions, vel):
+            d.qpos[art.qadr[i]] = p
+            d.qvel[art.vadr[i]] = v
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_comPos(self.model, d)
+
+    def control(self) -> None:
+        """Per-control-step forces and senses: proximity sensors' rays, hole ghosts' viscous friction.
+        One bounding-sphere test of every hole-ghost geom against every candidate geom, then
+        MuJoCo's exact distance only for the pairs that pass."""
+        for s in self.sensors:
+            self._sense(s)
+        fg = self._friction_geoms
+        cg = self._cand_geoms
+        if not len(fg) or not len(cg):
+            return
+        m, d = self.model, self.data
+        gx = self._geom_xpos  # views into MjData/MjModel, made once (attribute access costs)
+        if self.sleep:  # a sleeping body does not move: no friction to apply
+            idx = np.flatnonzero(self._body_awake[self._cand_geom_bodyid] == self._AWAKE)
+        else:
+            idx = self._all_cand
+        diff = gx[cg[idx]][None, :, :] - self._fg_pos(gx)
+        reach = (self._cand_rbound[idx][None, :] + self._fg_rbound) ** 2
+        near = np.einsum("ijk,ijk->ij", diff, diff) <= reach
+        if not near.any():
+            for g in self._friction_ghosts:
+                g.overlapping = []
+            return
+        cg = cg[idx]
+        body_of = [self._cand_geom_body[i] for i in idx]
+        hits: dict[int, list] = {}
+        for i, k in zip(*np.nonzero(near)):
+            g = self._friction_owner[i]
+            sb = body_of[k]
+            lst = hits.setdefault(id(g), [])
+            if sb in lst or sb is g.parent:
+                continue
+            if mujoco.mj_geomDistance(m, d, int(fg[i]), int(cg[k]), 0.0, None) <= 0.0:
+                lst.append(sb)
+        for g in self._friction_ghosts:
+            g.overlapping = hits.get(id(g), [])
+            if g.overlapping:
+                self._viscous(g, g.overlapping)
+
+    def _fg_pos(self, gx) -> np.ndarray:
+        return gx[self._friction_geoms][:, None, :]
+
+    def step(self, n: int = 1) -> None:
+        """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
+        t0 = time.perf_counter()
+        sub = self.opt.control_substeps
+        m, d = self.model, self.data
+        base = self._base_xfrc
+        for k in range(n):
+            self.control()
+            mujoco.mj_step(m, d, sub)
+            d.xfrc_applied[:] = base
+            if mj_stability.mujoco_pending():  # a warning: NaN and a state reset, a singular inertia...
+                self.sim_time = (self.steps + (k + 1) * sub) * self.dt
+                mj_stability.drain_mujoco(self, self.watch)
+        self.steps += n * sub
+        self.sim_time = self.steps * self.dt
+        self.wall_time += time.perf_counter() - t0
+
+    def move_base(self, sb: MjBody, body_world: np.ndarray) -> None:
+        """Put a body without joints (a PSM's base, as its setup joints would) at a new world
+        pose of its ADF body frame; what hangs from it follows."""
+        m, d = self.model, self.data
+        parent = int(m.body_parentid[sb.id])
+        tp = np.eye(4)
+        tp[:3, :3], tp[:3, 3] = d.xmat[parent].reshape(3, 3), d.xpos[parent]
+        local = invert(tp) @ body_world @ sb.link_in_body
+        q = matrix_to_quat(local[:3, :3])
+        m.body_pos[sb.id] = local[:3, 3]
+        m.body_quat[sb.id] = (q[3], q[0], q[1], q[2])
+        # with island sleeping on, MuJoCo computes the frames of bodies welded to the world once;
+        # one forward pass without it puts them (and what hangs from them) where they now are
+        flags = m.opt.enableflags
+        m.opt.enableflags = flags & ~int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
+        try:
+            mujoco.mj_forward(m, d)
+        finally:
+            m.opt.enableflags = flags
+
+    def constraint_error(self) -> float:
+        """Largest distance, m, between the two pivots of a loop-closing joint (tree joints are exact)."""
+        worst = 0.0
+        d = self.data
+        for _, _, parent, child, pa, pbv, _ in self.constraints:
+            xa = d.xmat[parent.id].reshape(3, 3) @ pa + d.xpos[parent.id]
+            xb = d.xmat[child.id].reshape(3, 3) @ pbv + d.xpos[child.id]
+            worst = max(worst, float(np.linalg.norm(xa - xb)))
+        return worst
+
+    def render_camera(self, cam) -> dict:
+        return self._renderer().render(cam)
+
+    def _shapeless(self, sb) -> bool:
+        return not sb.has_collision
+
+    def _engine_report(self, rep: dict) -> dict:
+        return {
+            "engine": "mujoco",
+            "awake_trees": int(getattr(self.data, "ntree_awake", self.model.ntree)),
+            "trees": int(self.model.ntree),
+            "spring_joints": self.springs_count,
+            "renderer": "mujoco",
+            "soft_bodies": [],  # not played by this engine (a runner-soft-body warning names each)
+            "engine_warnings": self.engine_warnings,
+        }
+
+    def _renderer(self):
+        """MuJoCo's offscreen renderer, made on the first picture (render.CameraUnavailable
+        when no headless OpenGL opens; the reason stays in ``camera_problem``)."""
+        if self._render is None:
+            from .render import CameraUnavailable, _Renderer
+
+            if self.camera_problem:
+                raise CameraUnavailable(self.camera_problem)
+            try:
+                self._render = _Renderer(self)
+            except CameraUnavailable as e:
+                self.camera_problem = str(e)
+                raise
+        return self._render
+
+    def close(self) -> None:
+        if self._render is not None:
+            self._render.close()
+            self._render = None

@@ -1,0 +1,168 @@
+"""The scene resolved once, the same way for every engine: the ADF rules that decide what is
+built (which world gravity, which body a ghost, sensor, actuator or camera hangs on, which
+sensors and actuators are played, which ghosts are holes with viscous friction, what an engine
+does not play and why). The back ends (pybullet/, mujoco/) only translate what this module
+decides into their engine; the geometry and joint rules live in ``model.semantics`` and
+``springs.py``."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.semantics import (
+    ACTUATOR_TYPES,
+    DEFAULT_ACTUATOR_MAX_IMPULSE,
+    DEFAULT_GRAVITY,
+    DEFAULT_SENSOR_RANGE,
+    SENSOR_TYPES,
+    JointKind,
+    pose_or_identity,
+)
+from .names import merge_namespace
+from .rotations import pose_to_matrix
+
+#: joints of the six-dof family: springs and limits per axis (springs.py)
+SPRING_KINDS = (
+    JointKind.SIX_DOF,
+    JointKind.SIX_DOF_SPRING,
+    JointKind.CONE_TWIST,
+    JointKind.LINEAR_SPRING,
+    JointKind.TORSION_SPRING,
+)
+
+#: sections of a model each engine does not play (each is warned about and listed in the report)
+NOT_PLAYED = {
+    "pybullet": (("vehicle", "vehicles"),),
+    "mujoco": (("soft body", "soft_bodies"), ("vehicle", "vehicles"), ("volume", "volumes")),
+}
+
+
+def world_gravity(scene, opt) -> np.ndarray:
+    """The options' gravity, else the world file's, else AMBF's default."""
+    w = scene.world
+    g = opt.gravity or (tuple(w.gravity) if w is not None and w.gravity is not None else DEFAULT_GRAVITY)
+    return np.array(g, dtype=float)
+
+
+def not_played(world, models, engine: str) -> None:
+    """Warn about and list (``world.not_played``) every object of a section ``engine`` skips."""
+    other = "pybullet" if engine == "mujoco" else None
+    for m in models:
+        for kind, attr in NOT_PLAYED[engine]:
+            for o in getattr(m, attr):
+                why = f"{kind}s are not played by the {'MuJoCo engine' if engine == 'mujoco' else 'PyBullet runner'}"
+                world._warn(
+                    f"runner-{kind.replace(' ', '-')}",
+                    f"{o.identifier}: {why}; skipped",
+                    o,
+                    f"play it with --engine {other}" if other else "play this object in AMBF itself",
+                )
+                world.not_played.append({"object": o.identifier, "what": kind, "why": why})
+
+
+def resolve_parent(world, ref: str | None, ns: str, obj, body_type=None):
+    """The body ``ref`` names for ``obj`` (a ghost, sensor, actuator), found as written or in the
+    model's namespace; None with a located ``runner-parent`` warning when no unique body matches."""
+    key, hit = world.registry.find(ref)
+    if key is None and ref:
+        key, hit = world.registry.find(ns + ref)
+    if key is None or (body_type is not None and not isinstance(hit, body_type)):
+        world._warn(
+            "runner-parent",
+            f"{obj.identifier}: parent {ref!r} not found" + (f" (matches: {', '.join(hit)})" if hit else ""),
+            obj,
+        )
+        return None
+    return hit
+
+
+def is_hole(ghost, opt) -> bool:
+    """A ghost whose name says it is an entry or exit hole applies viscous friction."""
+    name = (ghost.name or ghost.identifier).lower()
+    return any(w in name for w in opt.hole_ghost_words)
+
+
+def key_of(ns: str, obj) -> str:
+    return merge_namespace(ns, obj.namespace) + obj.identifier
+
+
+@dataclass
+class SensorRays:
+    key: str
+    sensor: object
+    parent: object  # the engine's body
+    location: np.ndarray  # 4x4 in the parent's ADF body frame
+    starts: np.ndarray  # (n, 3) ray starts in the sensor frame
+    ends: np.ndarray
+
+
+@dataclass
+class Grasper:
+    key: str
+    actuator: object
+    parent: object
+    location: np.ndarray  # 4x4 in the parent's ADF body frame
+    max_impulse: float
+
+
+def played_sensors(world, m, body_type=None) -> list[SensorRays]:
+    """The model's proximity sensors with rays, parents resolved; the others warned about."""
+    ns = m.namespace or ""
+    out = []
+    for s in m.sensors:
+        if SENSOR_TYPES.get(s.type) != "proximity" or not s.array:
+            world._warn(
+                "runner-sensor",
+                f"{s.identifier}: only proximity sensors with an `array` of rays are played; skipped",
+                s,
+            )
+            continue
+        parent = resolve_parent(world, s.parent, ns, s, body_type)
+        if parent is None:
+            continue
+        rng = s.range if s.range is not None else DEFAULT_SENSOR_RANGE
+        starts = np.array([r.offset or (0, 0, 0) for r in s.array], dtype=float)
+        dirs = np.array([r.direction or (1, 0, 0) for r in s.array], dtype=float)
+        loc = pose_to_matrix(pose_or_identity(s.location))
+        out.append(SensorRays(key_of(ns, s), s, parent, loc, starts, starts + dirs * rng))
+    return out
+
+
+def played_actuators(world, m, body_type=None) -> list[Grasper]:
+    """The model's constraint actuators, parents resolved; other types warned about."""
+    ns = m.namespace or ""
+    out = []
+    for a in m.actuators:
+        if ACTUATOR_TYPES.get(a.type) != "constraint":
+            world._warn("runner-actuator", f"{a.identifier}: actuator type {a.type!r} not supported; skipped", a)
+            continue
+        parent = resolve_parent(world, a.parent, ns, a, body_type)
+        if parent is None:
+            continue
+        imp = a.max_impulse if a.max_impulse is not None else DEFAULT_ACTUATOR_MAX_IMPULSE
+        out.append(Grasper(key_of(ns, a), a, parent, pose_to_matrix(pose_or_identity(a.location)), imp))
+    return out
+
+
+def viscous_impulse_force(mass: float, v_rel: np.ndarray, k: float, cdt: float) -> np.ndarray:
+    """F = -K·v_rel held for a control step ``cdt`` as the exact exp(-K·t/m) decay of
+    dv/dt = -K·v/m (the paper's needle friction in the hole ghosts), never overshooting."""
+    return -mass * v_rel * (1.0 - math.exp(-k * cdt / mass)) / cdt
+
+
+def rgba(obj) -> list[float] | None:
+    """Colour of §7.3: `color rgba`, then `color components` (diffuse + transparency), else None."""
+    if obj.use_material is False:
+        return None
+    c = obj.color_rgba
+    if c is not None and None not in (c.r, c.g, c.b, c.a):
+        return [c.r, c.g, c.b, c.a]
+    cc = obj.color_components
+    if cc is not None:
+        d = cc.diffuse
+        col = [d.r or 0.0, d.g or 0.0, d.b or 0.0] if d is not None else [0.7, 0.7, 0.7]
+        return col + [cc.transparency if cc.transparency is not None else 1.0]
+    return None

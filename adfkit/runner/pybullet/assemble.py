@@ -1,0 +1,274 @@
+"""How the PyBullet world builds the scene (the Assembly half of PyBulletWorld): bodies as
+maximal-coordinate bodies or multibody links (articulation.py), the joints that close loops as
+constraints plus per-step spring forces (joints.py), collision filters, soft bodies, volumes,
+ghosts, actuators, sensors and cameras, and the floor."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pybullet as pb
+
+from ...model.semantics import JointKind, joint_frames, joint_kind, pose_or_identity
+from ..cameras import build_cameras
+from ..names import Registry, merge_namespace
+from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
+from ..rotations import invert, matrix_to_pq, pose_to_matrix
+from . import articulation, egl
+from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
+from .interact import SimActuator, SimGhost, SimSensor
+from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
+from .shapes import collision_parts, create_collision, create_visual
+from .volumes import build_volumes
+
+
+class Assembly:
+    def _build(self) -> None:
+        models = self.scene.all_models()
+        records = []
+        not_played(self, models, "pybullet")
+        self._model_bodies: dict[int, list[SimBody]] = {}
+        for m in models:
+            ns = m.namespace or ""
+            mine = []
+            for b in m.bodies:
+                sb = make_sim_body(merge_namespace(ns, b.namespace) + b.identifier, b, m)
+                sb.cid = self.cid
+                sb.gravity = body_gravity(b, m, self.gravity)
+                sb._parts = collision_parts(m, b, sb.ref_in_body, b.scale or 1.0, sb.static, self.diagnostics)
+                if sb._parts is None:
+                    self.skipped.append(sb.key)
+                    continue
+                sb.key = self.registry.add(sb.key, sb)
+                mine.append(sb)
+                self.bodies.append(sb)
+            self._model_bodies[id(m)] = mine
+            local = Registry()
+            for sb in mine:
+                local.items[sb.key] = sb
+            for j in m.joints:
+                if self.soft is not None and self.soft.claim(m, j):
+                    continue  # joins a soft body: anchors, made with the soft bodies
+                kind = joint_kind(j.type)
+                if kind is None:
+                    self._warn("runner-joint-type", f"{j.identifier}: unknown joint type {j.type!r}; skipped", j)
+                    continue
+                jns = merge_namespace(ns, j.namespace)
+                ends = []
+                for ref in (j.parent, j.child):
+                    key, hit = local.find(ref)
+                    if key is None:
+                        key, hit = local.find(jns + (ref or ""))
+                    if key is None:
+                        key, hit = self.registry.find(jns + (ref or ""))
+                    if key is None:
+                        key, hit = self.registry.find(ref)
+                    ends.append(hit if key is not None else None)
+                if None in ends:
+                    self._warn("runner-joint-body", f"{j.identifier}: parent or child body not found; skipped", j)
+                    continue
+                records.append((j, kind, ends[0], ends[1]))
+        trees, leftover = articulation.components(records)
+        in_tree = set()
+        for root, recs in trees:
+            in_tree.add(id(root))
+            in_tree.update(id(r[3]) for r in recs)
+        for sb in self.bodies:
+            if id(sb) not in in_tree:
+                self._create_free(sb)
+        for root, recs in trees:
+            self_coll = not all(r[3].model.ignore_inter_collision for r in recs)
+            art = articulation.build(root, recs, self._shapes_for, self.dt, self.cid, self_coll)
+            self.articulations.append(art)
+            self.joint_names.extend(art.joint_names)
+            for sb in [root] + [r[3] for r in recs]:
+                set_dynamics(sb)
+        self._collision_filters(records)
+        if self.soft is not None:
+            self.soft.build(models)
+        springs = []
+        for j, kind, parent, child in leftover:
+            ps = parent.body.scale or 1.0
+            cs = child.body.scale or 1.0
+            a, b = joint_frames(j, ps, cs)
+            fa = invert(parent.com_in_body) @ pose_to_matrix(a)
+            fb = invert(child.com_in_body) @ pose_to_matrix(b)
+            self.joint_names.append(j.identifier)
+            sj = None
+            if kind in SPRING_KINDS:
+                sj = spring_joint(j, kind, parent, child, fa, fb)
+                springs.append(sj)
+                if not sj.linear_constrained:
+                    continue
+                kind_c = JointKind.P2P
+            else:
+                kind_c = kind
+            if kind is JointKind.PRISMATIC and not (parent.articulation and child.articulation):
+                # PyBullet slides only between multibody links (btMultiBodySliderConstraint)
+                self._warn(
+                    "runner-prismatic-loop",
+                    f"{j.identifier}: a prismatic joint closing a loop through "
+                    "a maximal-coordinate body is not supported by PyBullet's constraints; built as fixed",
+                    j,
+                )
+                kind_c = JointKind.FIXED
+            try:
+                made = make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5)
+            except ConstraintRefused as exc:
+                self._warn("runner-constraint", f"{j.identifier}: {exc}; the joint is left out", j)
+                continue
+            for c, pa, pbv, axis in made:
+                self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
+        self.springs = SpringSet(springs, self.cid)
+        build_volumes(self, models)
+        for m in models:
+            self._build_ghosts(m)
+            self._build_actuators(m)
+            self._build_sensors(m)
+        self.cameras = build_cameras(self)
+        self._floor_z = self._floor()
+        self.ground_z = None
+        if self.scene.world is None and self.scene.environment is None:
+            if self.opt.ground:
+                self._add_ground()
+            else:  # --no-ground: nothing to fall through
+                self._floor_z = -math.inf
+        self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
+        self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
+        self._gravity_overrides = self._group_gravity_overrides()
+        self._friction_ghosts = [g for g in self.ghosts if g.friction]
+
+    def _group_gravity_overrides(self):
+        """Bodies whose gravity differs from the world's, grouped per multibody so each control
+        step reads their COMs with one getLinkStates call: [(uid, links, bodies, forces)]."""
+        groups: dict[int, list] = {}
+        for sb in self.bodies:
+            if sb.gravity is not None and not sb.static:
+                groups.setdefault(sb.uid, []).append(sb)
+        out = []
+        for uid, sbs in groups.items():
+            out.append(
+                (uid, [sb.link for sb in sbs], sbs, [(sb.mass * (sb.gravity - self.gravity)).tolist() for sb in sbs])
+            )
+        return out
+
+    def _add_ground(self) -> None:
+        """A model played without a world gets what AMBF's worlds give it: a floor, here a
+        static plane 1 mm below the lowest point of every body."""
+        lows = [pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2] for sb in self.bodies if sb.uid is not None]
+        if self.soft is not None and self.soft.items:
+            lows.append(self.soft.lowest_z())
+        if not lows:
+            return
+        self.ground_z = min(lows) - 1e-3
+        if self.soft is None:
+            shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=self.cid)
+            vis = egl.plane_visual(self.cid, (0, 0, 1), 0.0) if self.renderer == "egl" else -1
+            self.ground_uid = pb.createMultiBody(0.0, shape, vis, [0.0, 0.0, self.ground_z], physicsClientId=self.cid)
+        else:  # soft bodies stop centimetres above a static plane: a thick slab instead
+            self.ground_uid = self.soft.ground_slab(self.ground_z)
+        self._floor_z = self.ground_z
+
+    def _shapes_for(self, sb: SimBody, frame_in_body) -> tuple[int, int]:
+        b, m = sb.body, sb.model
+        if frame_in_body is not sb.ref_in_body or sb._parts is None:
+            sb._parts = collision_parts(m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics)
+        col = create_collision(sb._parts, self.cid, b, self.diagnostics) if sb._parts is not None else -1
+        vis = create_visual(m, b, frame_in_body, b.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
+        return col, self._plane_visual(sb._parts, col, vis)
+
+    def _plane_visual(self, parts, col: int, vis: int) -> int:
+        """The EGL plugin's crash on a lone PLANE without a visual, avoided (runner/egl.py)."""
+        if (
+            self.renderer == "egl"
+            and vis == -1
+            and col != -1
+            and parts is not None
+            and parts.plane is not None
+            and not parts.types
+        ):
+            return egl.plane_visual(self.cid, *parts.plane)
+        return vis
+
+    def _create_free(self, sb: SimBody) -> None:
+        col, vis = self._shapes_for(sb, sb.ref_in_body)
+        pos, orn = matrix_to_pq(sb.body_world_matrix @ sb.ref_in_body)
+        if sb._parts is not None and sb._parts.plane is not None and not sb.static:
+            self._warn("runner-plane", f"{sb.key}: a PLANE shape on a dynamic body; made static", sb.body)
+            sb.mass = 0.0
+        sb.uid = pb.createMultiBody(sb.mass, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid)
+        sb.link = -1
+        set_dynamics(sb)
+
+    def _collision_filters(self, records) -> None:
+        groups = sorted({g for sb in self.bodies for g in (sb.body.collision_groups or []) if 0 <= g <= 999})
+        bit = {g: 1 << (i % 30) for i, g in enumerate(groups)}
+        if len(groups) > 30:
+            self._warn("runner-groups", "more than 30 collision groups: groups share mask bits", None)
+        allbits = (1 << 31) - 1
+        for sb in self.bodies:
+            gs = [g for g in (sb.body.collision_groups or []) if 0 <= g <= 999]
+            if gs:
+                mask = 0
+                for g in gs:
+                    mask |= bit[g]
+                pb.setCollisionFilterGroupMask(sb.uid, sb.link, mask, mask, physicsClientId=self.cid)
+            else:
+                pb.setCollisionFilterGroupMask(sb.uid, sb.link, allbits, allbits, physicsClientId=self.cid)
+        for j, _kind, parent, child in records:
+            if j.ignore_inter_collision is not False:
+                self._no_collision(parent, child)
+        for m in self.scene.all_models():
+            if m.ignore_inter_collision:
+                mine = self._model_bodies.get(id(m), [])
+                for i, a in enumerate(mine):
+                    for b in mine[i + 1 :]:
+                        self._no_collision(a, b)
+
+    def _no_collision(self, a: SimBody, b: SimBody) -> None:
+        pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, 0, physicsClientId=self.cid)
+
+    def _build_ghosts(self, m) -> None:
+        ns = m.namespace or ""
+        for gh in m.ghost_objects:
+            parts = collision_parts(m, gh, np.eye(4), gh.scale or 1.0, True, self.diagnostics)
+            if parts is None or (not parts.types and parts.plane is None):
+                self._warn("runner-ghost", f"{gh.identifier}: no collision geometry; ghost skipped", gh)
+                continue
+            parent = resolve_parent(self, gh.parent, ns, gh) if gh.parent else None
+            loc = pose_to_matrix(pose_or_identity(gh.location))
+            rel = invert(parent.com_in_body) @ loc if parent is not None else loc
+            col = create_collision(parts, self.cid, gh, self.diagnostics)
+            vis = (
+                create_visual(m, gh, np.eye(4), gh.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
+            )
+            vis = self._plane_visual(parts, col, vis)
+            world = (self._frame(parent) @ rel) if parent is not None else rel
+            pos, orn = matrix_to_pq(world)
+            uid = pb.createMultiBody(0, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid)
+            pb.setCollisionFilterGroupMask(uid, -1, 0, 0, physicsClientId=self.cid)
+            friction = is_hole(gh, self.opt)
+            key = self.registry.add(key_of(ns, gh), None)
+            moves = parent is not None and not parent.static
+            self.ghosts.append(
+                SimGhost(key, gh, uid, parent, rel, friction, pq_in_parent=matrix_to_pq(rel), moves=moves)
+            )
+
+    def _build_actuators(self, m) -> None:
+        for g in played_actuators(self, m):
+            self.actuators.append(SimActuator(g.key, g.actuator, g.parent, g.location, g.max_impulse / self.dt))
+
+    def _build_sensors(self, m) -> None:
+        for r in played_sensors(self, m):
+            self.sensors.append(SimSensor(r.key, r.sensor, r.parent, r.location, r.starts, r.ends))
+
+    def _floor(self) -> float:
+        zs = []
+        for sb in self.bodies:
+            if sb.static:
+                if sb._parts is not None and sb._parts.plane is not None:
+                    zs.append(sb.body_world_matrix[2, 3] + sb._parts.plane[1])
+                else:
+                    zs.append(pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2])
+        return min(zs) if zs else -math.inf

@@ -1,0 +1,201 @@
+"""What the PyBullet world does between steps (the Interaction half of PyBulletWorld): hole
+ghosts sensing what is inside them and applying viscous friction, ray sensors, the grasp's
+constraint actuator, collision switches, contacts."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as pb
+
+from ..plan import viscous_impulse_force
+from ..rotations import invert
+from .bodies import SimBody
+
+GRASP_SPAN = 0.005  # m between the three point constraints of a grasp (PyBulletWorld.actuate)
+
+
+@dataclass(eq=False)
+class SimGhost:
+    key: str
+    ghost: object
+    uid: int
+    parent: SimBody | None
+    pose_in_parent: np.ndarray  # ghost COM frame in the parent's PyBullet frame (or world)
+    friction: bool = False
+    overlapping: list = field(default_factory=list)
+    pq_in_parent: tuple = ()  # pose_in_parent as PyBullet (position, quaternion)
+    moves: bool = False  # a dynamic parent: the ghost follows it every step
+
+
+@dataclass(eq=False)
+class SimActuator:
+    key: str
+    actuator: object
+    parent: SimBody
+    location: np.ndarray  # in the parent body frame
+    max_force: float
+    constraint: list | None = None  # the grasp's constraint ids (see PyBulletWorld.actuate)
+    target: SimBody | None = None
+
+
+@dataclass(eq=False)
+class SimSensor:
+    key: str
+    sensor: object
+    parent: SimBody
+    location: np.ndarray
+    starts: np.ndarray
+    ends: np.ndarray
+    sensed: list = field(default_factory=list)
+
+
+class Interaction:
+    def set_collision(self, a: SimBody, b: SimBody, enabled: bool) -> None:
+        """Let two bodies collide or pass through each other (a task's choice, e.g. a needle
+        through a tissue whose collision shape is a convex hull over its holes)."""
+        pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, int(enabled), physicsClientId=self.cid)
+        pair = frozenset(((a.uid, a.link), (b.uid, b.link)))
+        self._pairs_off = getattr(self, "_pairs_off", set())
+        (self._pairs_off.discard if enabled else self._pairs_off.add)(pair)
+
+    def ghost_pose(self, g: SimGhost) -> np.ndarray:
+        """World pose (4x4) of a ghost, following its parent."""
+        return self._frame(g.parent) @ g.pose_in_parent if g.parent is not None else np.array(g.pose_in_parent)
+
+    def _update_ghosts(self) -> None:
+        """Hole ghosts (the ones with viscous friction) sense every control step; the others
+        only when asked (overlapping()): a moving ghost costs a pose reset and a distance query
+        per nearby body, and the PSMs' finger ghosts are only read when grasping."""
+        if self.gui:
+            self.place_ghosts()
+        parents: dict[int, tuple] = {}  # hole ghosts share their parent (the phantom): read it once
+        cid = self.cid
+        for g in self._friction_ghosts:
+            if g.moves:
+                pq = parents.get(id(g.parent))
+                if pq is None:
+                    pq = parents[id(g.parent)] = g.parent.state(velocity=False)[:2]
+                pos, orn = pb.multiplyTransforms(pq[0], pq[1], *g.pq_in_parent)
+                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=cid)
+            found = self._overlap(g)
+            if found:
+                self._viscous(g, found)
+
+    def place_ghosts(self) -> None:
+        """Move every ghost with a moving parent to it (before a picture is taken)."""
+        for g in self.ghosts:
+            self._place(g)
+
+    def _place(self, g: SimGhost) -> None:
+        if g.moves:
+            p, q, _, _ = g.parent.state(velocity=False)
+            pos, orn = pb.multiplyTransforms(p, q, *g.pq_in_parent)
+            pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=self.cid)
+
+    def overlapping(self, g: SimGhost) -> list[SimBody]:
+        """The dynamic bodies inside ghost ``g`` now (moved to its parent first); also kept in
+        ``g.overlapping``."""
+        self._place(g)
+        return self._overlap(g)
+
+    def _overlap(self, g: SimGhost) -> list[SimBody]:
+        """``overlapping`` with the ghost already where its parent is."""
+        cid = self.cid
+        lo, hi = pb.getAABB(g.uid, -1, physicsClientId=cid)
+        found = []
+        lookup = self._lookup
+        for uid, link in pb.getOverlappingObjects(lo, hi, physicsClientId=cid) or ():
+            sb = lookup.get((uid, link))
+            if sb is None or sb.static or sb is g.parent:
+                continue
+            if pb.getClosestPoints(g.uid, uid, 0.0, -1, link, physicsClientId=cid):
+                found.append(sb)
+        g.overlapping = found
+        return found
+
+    def _viscous(self, g: SimGhost, found) -> None:
+        """F = -K·(v_body - v_phantom) on every body inside a hole ghost (the paper's needle friction)."""
+        k = self.opt.hole_friction
+        cdt = self.dt * self.opt.control_substeps
+        v_ref = np.array(g.parent.state()[2]) if g.parent is not None and not g.parent.static else np.zeros(3)
+        for sb in found:
+            f = viscous_impulse_force(sb.mass, np.array(sb.state()[2]) - v_ref, k, cdt)
+            sb.force(f.tolist(), list(sb.com_position()))
+
+    def _sense(self, s: SimSensor) -> None:
+        t = self._frame(s.parent) @ invert(s.parent.com_in_body) @ s.location
+        a = (t[:3, :3] @ s.starts.T).T + t[:3, 3]
+        b = (t[:3, :3] @ s.ends.T).T + t[:3, 3]
+        hits = pb.rayTestBatch(a.tolist(), b.tolist(), physicsClientId=self.cid)
+        lookup = self._lookup
+        s.sensed = []
+        for h in hits:
+            sb = lookup.get((h[0], h[1]))
+            if sb is not None and sb is not s.parent and sb not in s.sensed:
+                s.sensed.append(sb)
+
+    def actuate(self, actuator: SimActuator, target: SimBody) -> None:
+        """Fix ``target`` to the actuator's parent at their current relative pose.
+
+        Three POINT2POINT constraints at non-collinear points (the actuator location and
+        GRASP_SPAN along its x and y axes) rather than one JOINT_FIXED: PyBullet's fixed constraint
+        between a multibody link and a maximal body drives the pair to a wrong relative
+        orientation (measured: 120° off within 20 ms on the suturing PSM), while point pivots are
+        exact, and three of them lock all six degrees of freedom."""
+        self.release(actuator)
+        pw = self._frame(actuator.parent)
+        tw = self._frame(target)
+        at_world = pw @ invert(actuator.parent.com_in_body) @ actuator.location
+        fa = invert(pw) @ at_world
+        fb = invert(tw) @ at_world
+        ids = []
+        for e in (np.zeros(3), np.array([GRASP_SPAN, 0, 0]), np.array([0, GRASP_SPAN, 0])):
+            pa = fa[:3, :3] @ e + fa[:3, 3]
+            pbv = fb[:3, :3] @ e + fb[:3, 3]
+            c = pb.createConstraint(
+                actuator.parent.uid,
+                actuator.parent.link,
+                target.uid,
+                target.link,
+                pb.JOINT_POINT2POINT,
+                [0, 0, 0],
+                pa.tolist(),
+                pbv.tolist(),
+                physicsClientId=self.cid,
+            )
+            pb.changeConstraint(c, maxForce=actuator.max_force, physicsClientId=self.cid)
+            ids.append(c)
+        actuator.constraint, actuator.target = ids, target
+        for link in self._links(actuator.parent):  # the closed jaws would push the held body out
+            if not self._pair_off(actuator.parent.uid, link, target):
+                pb.setCollisionFilterPair(
+                    actuator.parent.uid, target.uid, link, target.link, 0, physicsClientId=self.cid
+                )
+
+    def _pair_off(self, uid: int, link: int, b: SimBody) -> bool:
+        return frozenset(((uid, link), (b.uid, b.link))) in getattr(self, "_pairs_off", ())
+
+    def _links(self, sb: SimBody):
+        art = sb.articulation
+        return range(-1, len(art.records)) if art is not None else [sb.link]
+
+    def release(self, actuator: SimActuator) -> None:
+        if actuator.constraint is not None:
+            for c in actuator.constraint:
+                pb.removeConstraint(c, physicsClientId=self.cid)
+            t = actuator.target
+            for link in self._links(actuator.parent):
+                if not self._pair_off(actuator.parent.uid, link, t):  # set_collision's choice stays
+                    pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
+        actuator.constraint, actuator.target = None, None
+
+    def contacts(self, sb: SimBody) -> list:
+        """[(other SimBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
+        out = []
+        for c in pb.getContactPoints(bodyA=sb.uid, linkIndexA=sb.link, physicsClientId=self.cid) or ():
+            other = self._lookup.get((c[2], c[4]))
+            if other is not None and other is not sb:
+                out.append((other, float(c[9]), c[5]))
+        return out

@@ -1,0 +1,73 @@
+"""Which mesh files PyBullet is given as they are, which are converted first (trimesh), and which
+are refused with a reason (too large, unreadable, a binary STL whose size lies)."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ... import inputs
+from ...diagnostics import AdfError
+
+MESH_SUFFIXES = {".obj", ".stl"}  # what PyBullet's GEOM_MESH reads from a file
+
+
+def mesh_refusal(model, path: Path) -> str | None:
+    """Why the input policy (adfkit.inputs) keeps PyBullet from reading this mesh, or None:
+    missing, not a regular file, over the size cap, outside the model's tree."""
+    try:
+        inputs.check_file(path, "mesh", tree=getattr(model, "tree", None), what="mesh file")
+    except AdfError as exc:
+        d = exc.diagnostics[0]
+        return f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
+    return None
+
+
+_STL_DIR: str | None = None
+_STL_CACHE: dict[tuple[str, int, int], tuple[str | None, str | None]] = {}
+
+
+def pybullet_mesh(model, path: Path) -> tuple[Path | None, str | None]:
+    """The file to hand PyBullet for a mesh, or (None, why not).
+
+    PyBullet reads only binary STL, and crashes (SIGSEGV) on an ASCII or malformed STL, or on
+    NaN vertices: an STL that is not a consistent binary STL with finite vertices is read with
+    trimesh (as AMBF's assimp would) and handed over as a temporary binary STL; one trimesh
+    cannot read either is refused like a missing mesh."""
+    refused = mesh_refusal(model, path)
+    if refused is not None:
+        return None, refused
+    if path.suffix.lower() != ".stl":
+        return path, None
+    st = path.stat()
+    key = (str(path), st.st_size, st.st_mtime_ns)
+    if key not in _STL_CACHE:
+        _STL_CACHE[key] = _checked_stl(path, st.st_size)
+    done, why = _STL_CACHE[key]
+    return (Path(done) if done else None), why
+
+
+def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
+    with open(path, "rb") as fh:
+        head = fh.read(84)
+        count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+        if count > 0 and size == 84 + 50 * count and not head.lstrip().startswith(b"solid"):
+            records = np.frombuffer(fh.read(), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", 9), ("a", "<u2")]))
+            if np.isfinite(records["v"]).all():
+                return str(path), None
+            return None, f"{inputs.shown(path)} has NaN or infinite vertices"
+    from ...geometry.meshio import load_mesh  # trimesh: only for meshes PyBullet cannot take as they are
+
+    try:
+        mesh = load_mesh(path)
+    except AdfError as exc:
+        return None, f"{inputs.shown(path)} is not a readable mesh ({exc.diagnostics[0].message})"
+    global _STL_DIR
+    if _STL_DIR is None:
+        _STL_DIR = tempfile.mkdtemp(prefix="adfkit-stl-")
+    out = os.path.join(_STL_DIR, f"mesh_{len(_STL_CACHE)}.stl")
+    mesh.export(out, file_type="stl")
+    return out, None

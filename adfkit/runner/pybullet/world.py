@@ -1,0 +1,192 @@
+"""PyBulletWorld: an ADF scene (adfkit.model.Scene) built in PyBullet and stepped.
+
+Bodies joined by revolute/prismatic trees become multibodies (exact joints, native limits and
+position motors); every other body is a maximal-coordinate rigid body and every other joint a
+createConstraint plus per-step forces (joints.py). docs/runner.md says why. The world is three
+parts: building (assemble.py), what happens between steps (interact.py) and, here, stepping,
+state and the report; what is engine-neutral is in runner/world.py and runner/plan.py.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+
+import numpy as np
+import pybullet as pb
+
+from ..options import Options
+from ..rotations import matrix_to_pq, pose_matrix
+from ..stability import CHECK_EVERY_S
+from ..world import World
+from . import egl
+from . import stability as pb_stability
+from .assemble import Assembly
+from .bodies import SimBody
+from .cameras import choose_renderer, render
+from .interact import Interaction
+from .softbodies import SoftBodies, enable_deformable_world
+from .softbodies import in_scene as soft_in_scene
+from .state import WorldState
+
+
+class PyBulletWorld(World, Assembly, Interaction, WorldState):
+    engine = "pybullet"
+    body_type = SimBody
+
+    def __init__(self, scene, options: Options | None = None, gui: bool = False, mirror=None) -> None:
+        """``mirror``: a callable making the MuJoCo mirror that draws the cameras with
+        ``renderer="mujoco"`` (runner.open_world passes it); without one that renderer is not chosen."""
+        self._setup(scene, options, gui)
+        self.mirror = mirror
+        self.cid = pb.connect(pb.GUI if gui else pb.DIRECT)
+        self.soft = SoftBodies(self) if soft_in_scene(scene) else None  # soft bodies: a deformable world
+        if self.soft is not None:
+            enable_deformable_world(self.cid)
+        has_cameras = bool(scene.world is not None and scene.world.cameras) or any(
+            m.cameras for m in scene.all_models()
+        )
+        self._mj_view = None
+        self.renderer, self.renderer_note = choose_renderer(
+            self.opt.renderer, self.cid, has_cameras, self.soft is not None, gui, mirror is not None
+        )
+        w = scene.world
+        self.max_substeps = w.max_iterations if w is not None and w.max_iterations else 10
+        pb.setGravity(*self.gravity, physicsClientId=self.cid)
+        # PyBullet: each stepSimulation advances fixedTimeStep, split into numSubSteps internal steps
+        params = dict(fixedTimeStep=self.dt * self.opt.control_substeps, numSubSteps=self.opt.control_substeps)
+        if self.opt.solver_iterations:
+            params["numSolverIterations"] = self.opt.solver_iterations
+        if self.opt.contact_threshold is not None:
+            # AABBs grow by it and contact points are made within (a size-scaled share of) it;
+            # a millimetre-sized scene plays ~1.4x faster at 0.001 (bench/run_suturing.py)
+            params["contactBreakingThreshold"] = self.opt.contact_threshold
+        pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
+        # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
+        self._next_stability_check = 0.0
+        pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
+        self._build()
+
+    def move_base(self, sb: SimBody, body_world: np.ndarray) -> None:
+        """Put the root of a multibody (e.g. a PSM's base, as its setup joints would) at a new
+        world pose of its ADF body frame; its links follow."""
+        pos, orn = matrix_to_pq(body_world @ sb.com_in_body)
+        pb.resetBasePositionAndOrientation(sb.uid, pos, orn, physicsClientId=self.cid)
+
+    def _frame(self, sb: SimBody) -> np.ndarray:
+        """World pose of the PyBullet frame of a body."""
+        p, q, _, _ = sb.state(velocity=False)
+        return pose_matrix(p, q)
+
+    def joint_state(self, art, idxs) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities of joints ``idxs`` (record indices) of an articulation."""
+        st = pb.getJointStates(art.uid, list(idxs), physicsClientId=self.cid)
+        return np.array([s[0] for s in st]), np.array([s[1] for s in st])
+
+    def reset_joints(self, art, idxs, positions, velocities=None) -> None:
+        """Put joints ``idxs`` of an articulation at ``positions`` (and ``velocities``, default 0) now."""
+        vel = velocities if velocities is not None else [0.0] * len(idxs)
+        for i, p, v in zip(idxs, positions, vel):
+            pb.resetJointState(art.uid, i, float(p), float(v), physicsClientId=self.cid)
+
+    def by_uid(self):
+        """{(PyBullet uid, link): SimBody}"""
+        return self._lookup
+
+    def control(self) -> None:
+        """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors."""
+        cdt = self.dt * self.opt.control_substeps
+        cid = self.cid
+        for uid, links, _sbs, forces in self._gravity_overrides:
+            if links == [-1]:
+                coms = [pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0]]
+            else:
+                coms = [
+                    pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0] if k < 0 else s[0]
+                    for k, s in zip(
+                        links,
+                        pb.getLinkStates(
+                            uid, [max(k, 0) for k in links], computeForwardKinematics=1, physicsClientId=cid
+                        ),
+                    )
+                ]
+            for k, f, at in zip(links, forces, coms):
+                pb.applyExternalForce(uid, k, f, at, pb.WORLD_FRAME, physicsClientId=cid)
+        self.springs.apply(cdt)
+        self._update_ghosts()
+        for s in self.sensors:
+            self._sense(s)
+
+    def step(self, n: int = 1) -> None:
+        """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
+        t0 = time.perf_counter()
+        sub = self.opt.control_substeps
+        for _ in range(n):
+            self.control()
+            pb.stepSimulation(physicsClientId=self.cid)
+        self.steps += n * sub
+        self.sim_time = self.steps * self.dt
+        if self.sim_time >= self._next_stability_check:  # NaN or a flung body, caught as it happens
+            self._next_stability_check = self.sim_time + CHECK_EVERY_S
+            pb_stability.check_pybullet(self, self.watch)
+        self.wall_time += time.perf_counter() - t0
+
+    def constraint_error(self) -> float:
+        """Largest distance, m, between the two pivots of any joint (constraints and springs
+        with a locked linear range); multibody joints are exact."""
+        worst = 0.0
+        for _, _, parent, child, pa, pbv, axis in self.constraints:
+            a = self._frame(parent)
+            b = self._frame(child)
+            gap = (a[:3, :3] @ pa + a[:3, 3]) - (b[:3, :3] @ pbv + b[:3, 3])
+            if axis is not None:  # a slider: only the gap across its axis is an error
+                u = a[:3, :3] @ axis
+                gap = gap - np.dot(gap, u) * u
+            worst = max(worst, float(np.linalg.norm(gap)))
+        return worst
+
+    def render_camera(self, cam) -> dict:
+        return render(self, cam)
+
+    def _shapeless(self, sb) -> bool:
+        parts = getattr(sb, "_parts", None)
+        return parts is not None and not parts.types and parts.plane is None
+
+    def _engine_report(self, rep: dict) -> dict:
+        soft = self.soft.report(self._floor_z) if self.soft is not None else ([], [], [], [])
+        return {
+            "engine": "pybullet",
+            "soft_bodies": soft[0],
+            "nan": rep["nan"] + soft[1],
+            "exploded": rep["exploded"] + soft[2],
+            "fell_through_floor": rep["fell_through_floor"] + soft[3],
+            "spring_joints": len(self.springs.joints),
+            "renderer": self.renderer,
+            **({"renderer_note": self.renderer_note} if self.renderer_note else {}),
+        }
+
+    def mj_view(self):
+        """The MuJoCo mirror that draws the cameras with ``renderer="mujoco"``, built on the first
+        picture by the ``mirror`` this world was given (runner/engines.py gives
+        runner/mujoco/mirror.py's; this back end does not import the other)."""
+        if self._mj_view is None:
+            if self.mirror is None:
+                raise RuntimeError("no MuJoCo mirror was given to this world (open it with runner.open_world)")
+            self._mj_view = self.mirror(self)
+        return self._mj_view
+
+    def fall_back_to_tiny(self, why: str) -> None:
+        """The renderer chosen could not start (MuJoCo could not build or open the scene):
+        TinyRenderer from now on, the reason in the report and a warning."""
+        self._warn("runner-renderer", f"{self.renderer} renderer unavailable ({why}); TinyRenderer instead", None)
+        self.renderer, self.renderer_note = "tiny", why
+
+    def close(self) -> None:
+        if self._mj_view is not None:
+            self._mj_view.close()
+            self._mj_view = None
+        if self.soft is not None:
+            self.soft.close()
+        if pb.isConnected(self.cid):
+            with egl.quiet_stdout() if self.renderer == "egl" else contextlib.nullcontext():
+                pb.disconnect(self.cid)
