@@ -13,8 +13,8 @@ import numpy as np
 from PIL import Image
 
 from adfkit.adf import load_scene
-from adfkit.runner.psm import PSM
 from adfkit.runner import open_world
+from adfkit.runner.psm import PSM
 from adfkit.scenes.suturing import layout
 
 ROOT = Path(__file__).resolve().parents[1]
