@@ -18,6 +18,19 @@ from .options import Options
 from .plan import world_gravity
 
 
+class EngineBody:
+    """What every engine's body answers alike (mixed into each back end's body dataclass, which
+    has ``body`` (the ADF Body) and ``mass``)."""
+
+    @property
+    def static(self) -> bool:
+        return self.mass == 0.0
+
+    @property
+    def name(self) -> str:
+        return self.body.name or self.body.identifier
+
+
 class World:
     engine = ""
     body_type: type = object  # the engine's body class (what ``body()`` answers)

@@ -10,10 +10,11 @@ import mujoco
 import numpy as np
 
 from ..rotations import invert, matrix_to_quat
+from ..world import EngineBody
 
 
 @dataclass(eq=False)
-class MjBody:
+class MjBody(EngineBody):
     """One ADF body in MuJoCo; the same queries as the PyBullet SimBody."""
 
     key: str
@@ -30,14 +31,6 @@ class MjBody:
 
     def __post_init__(self) -> None:
         self._body_in_link = invert(self.link_in_body)
-
-    @property
-    def static(self) -> bool:
-        return self.mass == 0.0
-
-    @property
-    def name(self) -> str:
-        return self.body.name or self.body.identifier
 
     def world_matrix(self) -> np.ndarray:
         """Pose of the ADF body frame in the world, 4×4."""

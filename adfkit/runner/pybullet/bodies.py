@@ -18,10 +18,11 @@ from ...model.semantics import (
     inertial_offset,
 )
 from ..rotations import pose_to_matrix
+from ..world import EngineBody
 
 
 @dataclass(eq=False)
-class SimBody:
+class SimBody(EngineBody):
     """One ADF body as PyBullet holds it: (uid, link); link -1 is a base or a free body."""
 
     key: str
@@ -38,14 +39,6 @@ class SimBody:
     articulation: object = None
     body_world_matrix: np.ndarray = None  # the file's `location`
     extra_force: list = field(default_factory=list)
-
-    @property
-    def static(self) -> bool:
-        return self.mass == 0.0
-
-    @property
-    def name(self) -> str:
-        return self.body.name or self.body.identifier
 
     def state(self, velocity: bool = True):
         """(position, quaternion, linear velocity, angular velocity) of the COM frame; the

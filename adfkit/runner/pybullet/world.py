@@ -64,7 +64,9 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self._next_stability_check = 0.0
-        pb.setPhysicsEngineParameter(enableFileCaching=1, physicsClientId=self.cid)
+        # the broadphase keeps its overlapping pairs sorted: a restored snapshot (restore_state) then
+        # meets its contact caches in the same order, and the same seed and actions replay exactly
+        pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
         self._build()
 
     def move_base(self, sb: SimBody, body_world: np.ndarray) -> None:
