@@ -26,13 +26,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..adf.paths import collision_mesh_path
-from ..runner.psm import PSM
+from ..runner.psm import JAW_OPEN, PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
+from .clearance import Tissue, ToolShape, clearances
 from .holes import hole_frame
 from .needle import fit_needle, obj_vertices
 
 JAW_DEPTH = 0.01  # m from the end effector to the point between the jaws (LND: along z_E)
+#: m from the end effector to where the wire is held: 1 mm short of the fingers' ends (11.5 mm), so
+#: that the jaws reach no farther than the wire's far side (a needle lying on the tissue is taken
+#: from above without the fingers pressing into the tissue)
+GRASP_DEPTH = 0.0105
 BACK_OFF = 0.012  # m along -z_E before a grasp and after a release
 LIFT = 0.015  # m the needle is lifted when carried between the phantom and a hole
 APPROACH = math.radians(15)  # the tip starts this far before the entry on its arc
@@ -43,6 +48,15 @@ HOLE_MARGIN = 0.0008  # m kept from a hole ghost's side when aiming inside it
 TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
+TOOL_CLEARANCE = 0.0015  # m the planner keeps the tool's shapes from the tissue's where it can
+#: rad between the jaws as they come onto the wire: a 3.9 mm gap at the wire for its 1.2 mm, and
+#: fingers 2.5 mm to each side instead of the 5.6 mm of a fully opened jaw, beside the tissue
+JAW_APPROACH = 0.35
+GRASP_STEP = math.radians(6)  # the planner tries grasps this far apart along the wire ...
+MIN_GRASP = math.radians(8)  # ... from this far from the tip or the tail (the jaws' width)
+GOOD_MARGIN = 0.05  # of each joint's range: a grasp's joint margin counts up to this against its clearance
+PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
+CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
 
 
 class SutureError(RuntimeError):
@@ -131,6 +145,7 @@ class Grasp:
 
     ee_in_needle: np.ndarray
     margin: float
+    clearance: float = math.inf  # m the tool keeps from the tissue where the plan checked it
 
 
 class SutureTask:
@@ -143,7 +158,7 @@ class SutureTask:
         seed: int = 0,
         psm_names=("psm1", "psm2"),
         speed: float = 1.0,
-        tools_collide_with_tissue: bool = False,
+        tools_collide_with_tissue: bool = True,
     ) -> None:
         self.world = world
         self.tools_collide_with_tissue = tools_collide_with_tissue
@@ -257,9 +272,21 @@ class SutureTask:
                     z = math.sin(turn) * x0 + math.cos(turn) * z0
                     m = np.eye(4)
                     m[:3, :3] = np.c_[x, np.cross(z, x), z]
-                    m[:3, 3] = p - JAW_DEPTH * z
+                    m[:3, 3] = p - GRASP_DEPTH * z
                     out.append((m, abs(float(turn))))
         return out
+
+    def _along_wire(self, phi: float, clear_at: tuple):
+        """Candidates at phi and, where the tool's clearance is checked, at other places of the
+        same end of the wire (from MIN_GRASP up to phi), nearest to phi first."""
+        yield from self.grasp_candidates(phi)
+        if not clear_at:
+            return
+        tail_end = phi < -self.geom.span / 2
+        end = -self.geom.span if tail_end else 0.0
+        room = abs(phi - end) - MIN_GRASP
+        for d in np.arange(GRASP_STEP, room + 1e-9, GRASP_STEP):
+            yield from self.grasp_candidates(phi - d if tail_end else phi + d)
 
     def _margin(self, psm: PSM, ee_world: np.ndarray) -> float:
         try:
@@ -270,22 +297,53 @@ class SutureTask:
         return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo)))
 
     def choose_grasp(
-        self, psm: PSM, phi: float, needle_poses: list, down_at: np.ndarray | None = None, what: str = ""
+        self,
+        psm: PSM,
+        phi: float,
+        needle_poses: list,
+        down_at: np.ndarray | None = None,
+        what: str = "",
+        clear_at: tuple = (),
     ) -> Grasp:
-        """The candidate grasp reachable at every needle pose with the widest joint margin
-        (with ``down_at``: the jaws must point down at that needle pose, to come from above)."""
-        best = None
-        for ee_in_n, turn in self.grasp_candidates(phi):
-            if down_at is not None and (down_at @ ee_in_n)[2, 2] > -0.5:
-                continue
-            worst = math.inf
+        """The candidate grasp reachable at every needle pose that keeps the tool farthest from
+        the tissue (up to TOOL_CLEARANCE) at the needle poses ``clear_at`` (the first one also
+        on the approach along the jaw axis), then with the widest joint margin (with
+        ``down_at``: the jaws must point down at that needle pose, to come from above)."""
+        cands = [
+            (m, turn) for m, turn in self._along_wire(phi, clear_at) if down_at is None or (down_at @ m)[2, 2] <= -0.5
+        ]
+        if not cands:
+            raise SutureError(f"{psm.name}: no grasp of the needle from above ({what})")
+        ee_in_n = np.array([m for m, _ in cands])
+        clear = np.full(len(cands), TOOL_CLEARANCE)
+        tool = self.tools[psm.name]
+        for i, pose in enumerate(clear_at):
+            ee = pose[None] @ ee_in_n
+            clear = np.minimum(clear, clearances(self.tissue_shapes, tool, ee, TOOL_CLEARANCE))
+            if i == 0:  # and on the way in, along the jaw axis
+                back = ee.copy()
+                back[:, :3, 3] -= BACK_OFF * ee[:, :3, 2]
+                clear = np.minimum(clear, clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE))
+        # the score: the clearance (up to TOOL_CLEARANCE) counts twice as much as the joint margin
+        # (up to GOOD_MARGIN); beyond both, the wider margin
+        clear_term = clear / TOOL_CLEARANCE
+        best, best_key = None, None
+        for i in np.argsort(-clear_term, kind="stable"):
+            if best_key is not None and clear_term[i] + 0.5 < best_key[0]:
+                break  # the rest come nearer the tissue than a wider margin could make up for
+            m, turn = cands[i]
+            first = needle_poses[0] @ m
+            back = first.copy()
+            back[:3, 3] -= BACK_OFF * first[:3, 2]
+            worst = self._margin(psm, back)  # the jaws come onto the wire along their axis
             for pose in needle_poses:
-                worst = min(worst, self._margin(psm, pose @ ee_in_n))
                 if worst <= 0:
                     break
-            score = worst - 0.02 * turn
-            if worst > 0 and (best is None or score > best.margin):
-                best = Grasp(ee_in_n, score)
+                worst = min(worst, self._margin(psm, pose @ m))
+            margin = worst - 0.02 * turn
+            key = (float(clear_term[i]) + 0.5 * min(margin, GOOD_MARGIN) / GOOD_MARGIN, margin)
+            if worst > 0 and (best_key is None or key > best_key):
+                best, best_key = Grasp(m, margin, float(clear[i])), key
         if best is None:
             raise SutureError(f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})")
         return best
@@ -352,38 +410,35 @@ class SutureTask:
         """The holder takes the needle to a pose through joint space."""
         yield from self.move(self.psms[self.holder], goal @ self.held_ee_in_needle, seconds, settle=0.0)
 
-    def take(self, name: str, grasp: Grasp):
-        """``name`` opens its jaws, comes down along its jaw axis onto the grasp (on the needle
-        where it is now) and holds the needle."""
+    def take(self, name: str, grasp: Grasp, opening: float = JAW_APPROACH):
+        """``name`` opens its jaws (``opening`` rad), comes down along its jaw axis onto the
+        grasp (on the needle where it is now) and holds the needle."""
         psm = self.psms[name]
         goal = self.needle_pose() @ grasp.ee_in_needle
         above = goal.copy()
         above[:3, 3] -= BACK_OFF * goal[:3, 2]
-        psm.servo_jaw(0.8)
+        psm.servo_jaw(opening)
         yield from self.move(psm, above, 0.8)
         yield from self.move(psm, goal, 0.5, settle=0.2)
-        psm.servo_jaw(0.25)  # the jaws close on the wire ...
-        yield from self.wait(0.1)
         ee = psm.base_in_world() @ psm.measured_cp()
-        jaw = ee[:3, 3] + JAW_DEPTH * ee[:3, 2]
-        wire = (self.needle_pose() @ grasp.ee_in_needle)[:3, 3] + JAW_DEPTH * (self.needle_pose() @ grasp.ee_in_needle)[
-            :3, 2
-        ]
-        miss = float(np.linalg.norm(jaw - wire))
+        miss = float(np.linalg.norm(ee[:3, 3] - (self.needle_pose() @ grasp.ee_in_needle)[:3, 3]))
         if miss > 0.004:
             raise SutureError(f"{name} missed the needle by {miss * 1000:.1f} mm ({self.phase})")
+        # the wire lies between the open jaws: the actuator holds it where it is (and the jaws
+        # no longer collide with it), then the jaws close on it; closing them first would
+        # squeeze the wire out toward their tips (measured: 3.6 mm and 26 degrees off the plan)
         act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
-        self.world.actuate(act, self.needle)  # ... the actuator holds it (and the jaws no longer push it) ...
+        self.world.actuate(act, self.needle)
         self.holder = name
         self.held_ee_in_needle = invert(self.needle_pose()) @ ee
-        psm.servo_jaw(0.0)  # ... and they close fully
+        psm.servo_jaw(0.0)
         yield from self.wait(0.15)
 
     def let_go(self, name: str):
         psm = self.psms[name]
         act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
         self.world.release(act)
-        psm.servo_jaw(0.8)
+        psm.servo_jaw(JAW_APPROACH)
         yield from self.wait(0.15)
         here = self.setpoint_world(psm)
         back = here.copy()
@@ -428,13 +483,21 @@ class SutureTask:
         the puller's (along the pull and the lift)."""
         n0 = self.needle_pose()
         self.driver, self.puller = self._sides()
+        static = [sb for sb in self.world.bodies if sb.model is self.needle.model and sb.static]
+        centres = [
+            (hole_frame(self.world, p.entry)[:3, 3] + hole_frame(self.world, p.exit)[:3, 3]) / 2 for p in self.pairs
+        ]
+        self.tissue_shapes = Tissue(static, centres)
+        self.tools = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
         self.frames = {p.index: self.arc_frame(p) for p in self.pairs}
         self.drive_grasps, self.pull_grasps, self.out_poses, self.handbacks = [], [], [], []
+        self.pulls: list[tuple[float, list, tuple]] = []  # per pair: the grasp's angle, the poses, where clear
         for k, p in enumerate(self.pairs):
             b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
             psi_end = psi_x + beyond
             insertion = [self.lifted(self.needle_at(b, -self.approach), LIFT)]
             insertion += [self.needle_at(b, psi) for psi in np.linspace(-self.approach, psi_end, 7)]
+            along = self.along_arc(b, -self.approach, psi_end)
             if k == 0:
                 self.drive_grasps.append(
                     self.choose_grasp(
@@ -443,6 +506,7 @@ class SutureTask:
                         [n0, self.lifted(n0, LIFT)] + insertion,
                         down_at=n0,
                         what=f"pair {p.index}, driving",
+                        clear_at=(n0, insertion[0], *along),
                     )
                 )
             else:
@@ -450,10 +514,30 @@ class SutureTask:
             done = psi_x + self.geom.span + TAIL_CLEAR
             out = self.lifted(self.needle_at(b, done), 2 * LIFT)
             pull = [self.needle_at(b, psi) for psi in np.linspace(psi_end, done, 7)] + [out]
+            clear = (*self.along_arc(b, psi_end, done), out)
+            self.pulls.append((-g_tip, pull, clear))
             self.pull_grasps.append(
-                self.choose_grasp(self.psms[self.puller], -g_tip, pull, what=f"pair {p.index}, pulling")
+                self.choose_grasp(self.psms[self.puller], -g_tip, pull, what=f"pair {p.index}, pulling", clear_at=clear)
             )
             self.out_poses.append(out)
+
+    def along_arc(self, b: np.ndarray, psi0: float, psi1: float) -> tuple:
+        """Needle poses from psi0 to psi1 on its arc in frame b, CHECK_STEP apart (where the
+        planner checks the tool's clearance)."""
+        n = max(2, int(math.ceil(abs(psi1 - psi0) / CHECK_STEP)) + 1)
+        return tuple(self.needle_at(b, psi) for psi in np.linspace(psi0, psi1, n))
+
+    def pull_grasp_now(self, k: int) -> Grasp:
+        """The puller's grasp for pair k chosen again on the needle where it is (the tissue
+        holds it a little off the planned arc), reaching the rest of the pull and the hand-back
+        pose the plan has; the planned grasp where none does."""
+        phi, pull, clear = self.pulls[k]
+        now = self.needle_pose()
+        poses = [now, *pull[1:]] + self.handbacks[k : k + 1]
+        try:
+            return self.choose_grasp(self.psms[self.puller], phi, poses, clear_at=(now, *clear[1:]))
+        except SutureError:
+            return self.pull_grasps[k]
 
     def hand_back(self, k: int, g_tail: float, insertion: list) -> Grasp:
         """Where the puller, done with pair k-1, gives the needle back: over pair k, lifted,
@@ -467,8 +551,14 @@ class SutureTask:
             h = self.lifted(self.needle_at(b, psi), 2 * LIFT)
             if self._margin(puller, h @ prev.ee_in_needle) <= 0:
                 continue
+            b_k, psi_x, beyond, _, _ = self.frames[self.pairs[k].index]
             try:
-                g = self.choose_grasp(self.psms[self.driver], -self.geom.span + g_tail, [h] + insertion)
+                g = self.choose_grasp(
+                    self.psms[self.driver],
+                    -self.geom.span + g_tail,
+                    [h] + insertion,
+                    clear_at=(h, insertion[0], *self.along_arc(b_k, -self.approach, psi_x + beyond)),
+                )
             except SutureError:
                 continue
             self.handbacks.append(h)
@@ -500,16 +590,23 @@ class SutureTask:
                 for sb in links:
                     for t in static:
                         self.world.set_collision(t, sb, False)
-            self.switched_off.append(
-                "tool-tissue collisions (the scripted regrasp presses the puller's jaws "
-                "on the exit's boundary; see docs/suture.md)"
-            )
+            self.switched_off.append("tool-tissue collisions (asked for: SutureTask(tools_collide_with_tissue=False))")
         names = list(arms)
         for i, a in enumerate(names):
             for b in names[i + 1 :]:
                 for x in arms[a]:
                     for y in arms[b]:
                         self.world.set_collision(x, y, False)
+
+    @staticmethod
+    def parked(psm: PSM) -> np.ndarray:
+        """Where an arm waits while the other holds the needle: its joints as they are, the tool
+        drawn PARK_RETRACT back along its shaft, out of the needle's and the thread's way (the
+        carried needle hit a waiting tool's jaws with 28 N and moved 5 mm in the other grasp)."""
+        lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+        q = np.clip(psm.setpoint_jp(), lo, hi)
+        q[2] = max(lo[2], q[2] - PARK_RETRACT)
+        return q
 
     def jitter(self, seconds: float = 0.05):
         """Seeded initial-pose jitter: a small random horizontal push on the needle."""
@@ -525,18 +622,17 @@ class SutureTask:
         """The whole suture, one yield per control step."""
         self._set_phase("settle")
         for name in self.psms:
-            self.psms[name].servo_jaw(0.8)
+            self.psms[name].servo_jaw(JAW_APPROACH)  # as they come onto the wire (tool_points)
         self.base_moves = self.setup_joints()
         self._arms_apart()
         yield from self.jitter()
         self.plan()
         d, p = self.psms[self.driver], self.psms[self.puller]
-        park = {
-            n: np.clip(self.psms[n].setpoint_jp(), self.psms[n].kin.lower_limits[:6], self.psms[n].kin.upper_limits[:6])
-            for n in self.psms
-        }
+        park = {n: self.parked(self.psms[n]) for n in self.psms}
         self._set_phase("pick up")
-        yield from self.take(self.driver, self.drive_grasps[0])
+        # a needle lying on the tissue is taken with the jaws wide open (0.8 rad): narrower,
+        # a finger landing beside the wire shoves it (3.4 mm, 22 degrees at 0.35 rad)
+        yield from self.take(self.driver, self.drive_grasps[0], opening=JAW_OPEN)
         for k, pair in enumerate(self.pairs):
             b, psi_x, beyond, _, _ = self.frames[pair.index]
             n_from = self.needle_pose()
@@ -554,7 +650,7 @@ class SutureTask:
             yield from self.carry(lambda s: self.needle_at(b, a0 + (psi_end - a0) * s), (psi_end - a0) / 0.5)
             yield from self.wait(0.2)
             self._set_phase(f"regrasp {pair.index}")
-            yield from self.take(self.puller, self.pull_grasps[k])
+            yield from self.take(self.puller, self.pull_grasp_now(k))
             yield from self.let_go(self.driver)
             yield from self.move_jp(d, park[self.driver], 0.8, settle=0.0)
             self.holder = self.puller

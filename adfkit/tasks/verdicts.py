@@ -11,10 +11,11 @@ verdict's ``rule`` and ``reason`` (rules in the order below).
 
 from __future__ import annotations
 
-#: N: a tool pressing on the tissue at least this hard fails the pair. None: touches are recorded
-#: (metrics' tool_tissue_events, each pair's tool_tissue_max_n) but do not fail it yet: the
-#: scripted regrasp presses the puller's jaws on the exit's boundary (about 130 N in PyBullet)
-TOOL_HIT_N: float | None = None
+#: N: a tool pressing on the tissue at least this hard fails the pair. Every touch is recorded
+#: (metrics' tool_tissue_events, each pair's tool_tissue_max_n); a jaw brushing a hole's boundary
+#: as it takes the needle beside it gives about 20 N in PyBullet's stiff contacts, a wrist driven
+#: into the tissue thousands
+TOOL_HIT_N: float | None = 50.0
 
 SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
 RULES = (
@@ -122,6 +123,14 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     back = [
         c for c in entry.crossings if not c["inward"] and c["t"] > c_in["t"] and (not outs or c["t"] < outs[0]["t"])
     ]
+    at_tip = {b: f for b, f in getattr(obs, "tip_contacts", {}).get(f"insert {k}", {}).items() if f >= 0.05}
+    if back and at_tip:
+        # in through the opening and pushed back out by what the tip ran into: the channel is closed
+        hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(at_tip.items(), key=lambda kv: -kv[1]))
+        return "blocked-at-entry", (
+            f"blocked past {_label(entry)}: the tip went in through its opening at t = {c_in['t']:.2f} s, "
+            f"pressed on {hits} and came back out at t = {back[0]['t']:.2f} s before reaching {_label(exit_)}"
+        )
     if back:
         return "left-boundary", (
             f"the needle left the boundary of {_label(entry)}: the tip came back out at "
