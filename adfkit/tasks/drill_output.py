@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..adf import atomic_write_text, write_file
+from ..adf import atomic_write_bytes, atomic_write_text, write_file
 from ..model import ModelFile
 from ..model.objects import VolumeImages
 
@@ -34,19 +34,6 @@ PALETTE = [
 PROTECTED = (230, 60, 60)
 REMOVED = (70, 35, 35)
 BURR = (255, 200, 40)
-
-
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def write_slices(values: np.ndarray, full_scale: float, folder: Path, prefix: str) -> list[Path]:

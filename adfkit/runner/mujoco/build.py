@@ -157,7 +157,7 @@ def build_plan(world) -> Plan:
         mine = {}
         if m.bodies:
             names: dict = {}
-            text, ls = to_mjcf(m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names)
+            text, ls = to_mjcf(m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names, volumes=False)
             losses += ls
             for loss in ls:  # the MJCF writer already made a flat collision mesh a thin box (engine_fit)
                 if loss.feature == "collision mesh" and "flat" in loss.reason:
