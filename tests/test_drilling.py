@@ -165,3 +165,21 @@ def test_the_drilled_slices_read_back_and_validate(scene, tmp_path, capsys):
     assert 0 < m["surface"]["blocks_remeshed"] < 27  # 4³ blocks in all: only those it touched
     gif = Image.open(out / "drilling.gif")
     assert gif.size == (486, 240) and gif.n_frames >= 2
+
+
+def test_a_bad_labels_file_or_out_folder_is_a_located_error(scene, tmp_path, capsys):
+    copy = tmp_path / "scene"
+    shutil.copytree(scene.parent, copy)
+    (copy / "slices" / "labels.yaml").write_text("bone: [150, 255]\ncanal: [x, 120]\n")
+    assert main(["drill", str(copy), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "labels.yaml:2:8: error[drill-labels]:" in err and "hint:" in err
+    (copy / "slices" / "labels.yaml").write_text("bone: [150, 255]\nprotected: [nerve]\n")
+    assert main(["drill", str(copy), "--out", str(tmp_path / "o")]) == 2
+    assert "labels.yaml:2:13: error[drill-labels]: protected tissue 'nerve'" in capsys.readouterr().err
+    (copy / "slices" / "labels.yaml").unlink()  # defaults: bone and soft tissue, nothing protected
+    assert main(["drill", str(copy), "--out", str(tmp_path / "o"), "--protect", "canal"]) == 2
+    assert "error[bad-option]: --protect 'canal' is not a tissue" in capsys.readouterr().err
+    (tmp_path / "file").write_text("")
+    assert main(["drill", str(copy), "--out", str(tmp_path / "file")]) == 2
+    assert "error[drill-out]" in capsys.readouterr().err

@@ -74,6 +74,8 @@ def _scene(args):
 def _check_out(out: Path, inputs_files) -> None:
     from ..diagnostics import AdfError, error
 
+    if out.exists() and not out.is_dir():
+        raise AdfError(error("drill-out", f"--out {out} is a file, not a folder", None, "name a folder to write into"))
     slices = (out / "slices").resolve()
     mine = {Path(f).resolve() for f in inputs_files}
     if any(f.parent == slices for f in mine) or (out / "volume.yaml").resolve() in mine:
@@ -176,11 +178,23 @@ def run(args) -> int:
         "wall_s": {"drilling_per_step": step_s / max(1, st.steps), "remesh_total": remesh_s},
     }
     prefix = ds.volume.images.prefix
-    outp.write_slices(vol.values, ds.data.full_scale, out / "slices", prefix)
-    outp.write_volume_model(ds.volume, ds.model, vol.values.shape[0], prefix, out / "volume.yaml")
-    outp.write_surface(verts, faces, out / "surface.stl")
-    outp.write_metrics(metrics, out / "metrics.json")
-    outp.write_gif(frames, out / "drilling.gif")
+    try:
+        outp.write_slices(vol.values, ds.data.full_scale, out / "slices", prefix)
+        outp.write_volume_model(ds.volume, ds.model, vol.values.shape[0], prefix, out / "volume.yaml")
+        outp.write_surface(verts, faces, out / "surface.stl")
+        outp.write_metrics(metrics, out / "metrics.json")
+        outp.write_gif(frames, out / "drilling.gif")
+    except OSError as exc:
+        from ..diagnostics import AdfError, error
+
+        raise AdfError(
+            error(
+                "drill-out",
+                f"cannot write into {out}: {exc.strerror or type(exc).__name__}",
+                None,
+                "check the folder's permissions and free space",
+            )
+        ) from None
     where = ds.volume.where("images") or ds.volume.source
     warns = [
         warning(
