@@ -101,6 +101,7 @@ def test_the_mujoco_engine_plays_the_volume_in_its_images_and_segmentation(drill
         label = next(i for i, sb in enumerate(world.bodies) if sb.key.endswith("VOLUME Bone"))
         sb = world.bodies[label]
         assert sb.static and sb.has_collision
+        assert len(sb.surface[1]) == len(faces)  # what the viewer draws of it
         assert np.allclose(sb.world_matrix()[:3, 3], [0, 0, 0.02])  # at the volume's location
         m = world.model
         (g,) = np.nonzero(m.geom_bodyid == sb.id)[0]
