@@ -202,7 +202,7 @@ def run(args) -> int:
             f"the burr touched protected tissue '{name}': {h['voxels_touched']} voxels, first at "
             f"t = {h['first_time_s']:.3f} s with the burr at ({', '.join(f'{x:.4f}' for x in h['first_burr_m'])}) m",
             where,
-            "keep the tool path away from it, or lower --depth",
+            "keep the tool path away from it" + ("" if args.path else ", or lower --depth"),
         )
         for name, h in protected_hits.items()
     ]
