@@ -353,6 +353,9 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
             parts = sorted((c for c in o.children if c.adf.kind == "COLLISION_MESH"), key=lambda c: c.name)
             o.adf.collision_hash = meshes.digest([meshes.mesh_arrays(c) for c in parts])
     _scene_snapshot(scene, doc)
+    from .volumes import import_volumes
+
+    import_volumes(doc, scene, diags)  # pictures of the volumes (kind NONE: export keeps them as written)
     diags.extend(_UNREADABLE)
     _UNREADABLE.clear()
     return made, diags

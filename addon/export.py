@@ -245,7 +245,7 @@ def rebase_paths(model: ModelFile, source_dir: Path, out_dir: Path) -> list[tupl
         im = getattr(obj, "images", None)
         if im is not None and im.count and im.prefix is not None and im.format:
             names = [f"{im.prefix}{i}.{str(im.format).lstrip('.')}" for i in range(min(int(im.count), 4096))]
-            im.path = rebase(im.path, names)
+            im.path = rebase(im.path, [*names, "labels.yaml"])  # the tissues `adfkit drill` reads, when there
     if getattr(model, "shaders", None) is not None:
         model.shaders.path = rebase(model.shaders.path, shader_files(model.shaders))
     return copies

@@ -71,17 +71,51 @@ def test_the_drilling_scene_validates_clean_and_plays_with_its_volume(drilling, 
         world.close()
 
 
-def test_the_mujoco_engine_names_the_volume_it_does_not_play(drilling, tmp_path, capsys):
+def test_the_mujoco_engine_plays_the_volume_in_its_images_and_segmentation(drilling, tmp_path, capsys):
     pytest.importorskip("mujoco")
+    from adfkit.geometry.volume import iso_surface, load_volume
+    from adfkit.runner import open_world
+    from adfkit.runner.options import Options
+
     out = tmp_path / "mj"
     assert (
         main(["run", str(drilling), "--engine", "mujoco", "--seconds", "0.05", "--no-frames", "--out", str(out)]) == 0
     )
     rep = json.loads((out / "report.json").read_text())
+    scene = load_scene(drilling)
+    model = scene.models[0]
+    _, faces = iso_surface(load_volume(model, model.volumes[0]), 0.5)
+    (vol,) = rep["volumes"]  # the same iso-surface as the PyBullet runner's
+    assert vol["object"] == "VOLUME Bone" and vol["triangles"] == len(faces) and vol["voxels"] == [48, 48, 48]
+    # played now; what MuJoCo cannot do of it (a concave collision) is named
     assert rep["not_played"] == [
-        {"object": "VOLUME Bone", "what": "volume", "why": "volumes are not played by the MuJoCo engine"}
+        {
+            "object": "VOLUME Bone",
+            "what": "concave collision",
+            "why": "MuJoCo collides a mesh as its convex hull: the volume's cavities are solid to contacts",
+        }
     ]
-    assert "runner-volume" in capsys.readouterr().err
+    assert "runner-volume" not in capsys.readouterr().err
+    world = open_world(scene, Options(), engine="mujoco")
+    try:
+        label = next(i for i, sb in enumerate(world.bodies) if sb.key.endswith("VOLUME Bone"))
+        sb = world.bodies[label]
+        assert sb.static and sb.has_collision
+        assert len(sb.surface[1]) == len(faces)  # what the viewer draws of it
+        assert np.allclose(sb.world_matrix()[:3, 3], [0, 0, 0.02])  # at the volume's location
+        m = world.model
+        (g,) = np.nonzero(m.geom_bodyid == sb.id)[0]
+        r = world.data.geom_xmat[g].reshape(3, 3)  # MuJoCo turns a mesh to its principal axes
+        top = (r @ m.geom_aabb[g, :3] + world.data.geom_xpos[g])[2] + np.abs(r[2]) @ m.geom_aabb[g, 3:]
+        assert top == pytest.approx(0.02 + 0.3 * 0.04, abs=0.04 / 48)  # the bone's top face
+        frame = world.cameras[0].render(world)
+        seen = frame["segmentation"] == label
+        assert seen.mean() > 0.02  # the bone is in the picture, labelled
+        assert np.isfinite(frame["depth"][seen]).all()
+        bone = frame["rgb"][seen].mean(axis=0)
+        assert bone[0] > bone[2] + 10  # ivory, the volume's colour, not the grey floor
+    finally:
+        world.close()
 
 
 def _volume_findings(scene_dir) -> list:

@@ -187,10 +187,39 @@ def atomic_write_text(path: str | Path, text: str) -> None:
         raise
 
 
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """:func:`atomic_write_text` for bytes (a mesh, a picture)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, _mode_for(path))
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
 def write_file(doc: AdfFile, path: str | Path) -> Path:
     path = Path(path)
     atomic_write_text(path, dumps(doc))
     return path
 
 
-__all__ = ["dumps", "write_file", "atomic_write_text", "file_to_plain", "node_to_plain", "Pose", "Vec3"]
+__all__ = [
+    "dumps",
+    "write_file",
+    "atomic_write_text",
+    "atomic_write_bytes",
+    "file_to_plain",
+    "node_to_plain",
+    "Pose",
+    "Vec3",
+]

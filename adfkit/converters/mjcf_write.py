@@ -35,6 +35,7 @@ from .engine_fit import MeshFiles, flat_box, joint_range, split_objects, usable_
 from .losses import Loss
 from .mjcf_cameras import write_cameras_lights
 from .mjcf_soft import write_soft_bodies
+from .mjcf_volumes import write_mjcf_volumes
 from .safexml import to_text
 from .urdf import (
     _AXIS_TO_Z,
@@ -61,7 +62,6 @@ _LOSSY_OBJECTS = (
     ("sensors", "sensor"),
     ("actuators", "actuator"),
     ("vehicles", "vehicle"),
-    ("volumes", "volume"),
 )
 
 
@@ -307,16 +307,25 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
 
 
 def to_mjcf(
-    model: ModelFile, out_dir: Path, name: str | None = None, *, tree_kinds=None, names_out: dict | None = None
+    model: ModelFile,
+    out_dir: Path,
+    name: str | None = None,
+    *,
+    tree_kinds=None,
+    names_out: dict | None = None,
+    volumes: bool = True,
 ) -> tuple[str, list[Loss]]:
     """MJCF text and losses. ``tree_kinds``: joint kinds that join the tree (default revolute,
     prismatic, fixed); a link joined by another kind is written welded to its parent, for the
     caller to add its joints (the MuJoCo runner's six-dof springs). ``names_out`` receives
-    {body identifier: (MJCF body name, tree Link)}; the key "" holds the KinematicTree."""
+    {body identifier: (MJCF body name, tree Link)}; the key "" holds the KinematicTree.
+    ``volumes``: write each volume as its iso-surface mesh (volume_mesh.py); False leaves them
+    out, for a caller that places them itself (the MuJoCo runner)."""
     losses: list[Loss] = []
     model = usable_scales(model, losses)
     tree = build_tree(model) if tree_kinds is None else build_tree(model, tree_kinds)
-    if not tree.roots and not any(sb.defined for sb in model.soft_bodies):
+    has_volume = volumes and any(v.defined for v in model.volumes)
+    if not tree.roots and not any(sb.defined for sb in model.soft_bodies) and not has_volume:
         raise AdfError(
             error(
                 "convert-empty",
@@ -393,6 +402,8 @@ def to_mjcf(
         root.append(eq)
     write_cameras_lights(model, tree, elements, world, used, losses)
     write_soft_bodies(model, world, used, losses)
+    if volumes:
+        write_mjcf_volumes(model, world, assets, name or model.name, used, losses)
     for j in tree.unresolved:
         losses.append(Loss(j.identifier, "joint", "unknown type or parent/child body not in this file"))
     for attr, label in _LOSSY_OBJECTS:

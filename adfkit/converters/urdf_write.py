@@ -7,7 +7,6 @@ is welded to a `world` link by a fixed joint that carries its `location`."""
 from __future__ import annotations
 
 import math
-import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -30,6 +29,8 @@ from . import inertia as inertia_math
 from .engine_fit import MeshFiles, joint_range, usable_scales
 from .losses import Loss
 from .safexml import to_text
+from .urdf_volumes import write_urdf_volumes
+from .urdf_xml import _material, _mesh_element, _mesh_ref, _num, _origin, _unique, _vec  # noqa: F401 - re-exported
 
 # --- writing ------------------------------------------------------------------------------
 
@@ -64,23 +65,7 @@ _LOSSY_OBJECTS = (
     ("lights", "light"),
     ("soft_bodies", "soft body"),
     ("vehicles", "vehicle"),
-    ("volumes", "volume"),
 )
-
-
-def _num(v: float) -> str:
-    v = 0.0 if abs(v) < 1e-15 else float(v)
-    return repr(v)
-
-
-def _vec(v) -> str:
-    return " ".join(_num(x) for x in v)
-
-
-def _origin(parent: ET.Element, pose: Pose) -> None:
-    if pose.position.norm() < 1e-15 and pose.orientation.angle_to(Quat(0.0, 0.0, 0.0, 1.0)) < 1e-15:
-        return
-    ET.SubElement(parent, "origin", xyz=_vec(pose.position), rpy=_vec(pose.rpy()))
 
 
 def _link_name(body: Body) -> str:
@@ -89,19 +74,6 @@ def _link_name(body: Body) -> str:
 
 def _joint_name(joint: Joint) -> str:
     return joint.name or joint.identifier.removeprefix("JOINT ").strip()
-
-
-def _unique(name: str, used: set[str]) -> str:
-    out, n = name, 1
-    while out in used:
-        n += 1
-        out = f"{name}_{n}"
-    used.add(out)
-    return out
-
-
-def _mesh_ref(mesh: Path, out_dir: Path) -> str:
-    return Path(os.path.relpath(mesh.resolve(), out_dir.resolve())).as_posix()
 
 
 def _primitive_geometry(kind: ShapeKind, g: Geometry, el: ET.Element) -> list[tuple[ET.Element, Pose]] | None:
@@ -132,28 +104,6 @@ def _primitive_geometry(kind: ShapeKind, g: Geometry, el: ET.Element) -> list[tu
             out.append((geo, turn * Pose(Vec3(0.0, 0.0, s * body_len / 2))))
         return out
     return None
-
-
-def _material(body: Body) -> tuple[float, float, float, float] | None:
-    if body.color_rgba is not None:
-        c = body.color_rgba
-        return (c.r or 0.0, c.g or 0.0, c.b or 0.0, 1.0 if c.a is None else c.a)
-    cc = body.color_components
-    if cc is not None and cc.diffuse is not None:
-        d = cc.diffuse
-        a = cc.transparency if cc.transparency is not None else 1.0  # chai3d: 1 = opaque
-        return (d.r or 0.0, d.g or 0.0, d.b or 0.0, a)
-    return None
-
-
-def _mesh_element(link_el: ET.Element, tag: str, pose: Pose, mesh: Path, scale: float, out_dir: Path) -> ET.Element:
-    """A <visual> or <collision> holding a mesh at ``pose`` in the link frame."""
-    el = ET.SubElement(link_el, tag)
-    _origin(el, pose)
-    m = ET.SubElement(ET.SubElement(el, "geometry"), "mesh", filename=_mesh_ref(mesh, out_dir))
-    if scale != 1.0:
-        m.set("scale", _vec((scale,) * 3))
-    return el
 
 
 def _write_link(
@@ -301,6 +251,8 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     name = robot_name or model.name
     robot = ET.Element("robot", name=name)
     roots = [r for r in tree.roots]
+    if not roots and any(v.defined for v in model.volumes):
+        return _volumes_only(model, robot, out_dir, name, losses)
     if not roots:
         raise AdfError(
             error(
@@ -354,6 +306,9 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
     for lk in order:
         if lk.parent is not None:
             _write_joint(robot, lk, _unique(_joint_name(lk.joint), used), names[id(lk.parent)], names[id(lk)], losses)
+    # every root's link frame is the world frame (a world link, a bare root at the origin, or a
+    # floating root moved there by _root_frame_at_world): volumes hang from it at their location
+    write_urdf_volumes(model, robot, world if static_root else names[id(main)], out_dir, name, used, losses)
     for j, kind, _p, _c in tree.loops:
         why = (
             "closes a loop; URDF is a tree"
@@ -368,6 +323,17 @@ def to_urdf(model: ModelFile, out_dir: Path, robot_name: str | None = None) -> t
             losses.append(Loss(obj.identifier, label, "URDF has no element for it"))
     text = '<?xml version="1.0"?>\n' + to_text(robot) + "\n"
     return text, sorted(set(losses))
+
+
+def _volumes_only(model: ModelFile, robot: ET.Element, out_dir: Path, name: str, losses: list[Loss]):
+    """A model file with volumes and no body: a `world` link holding the volumes' meshes."""
+    used = {"world"}
+    ET.SubElement(robot, "link", name="world")
+    write_urdf_volumes(model, robot, "world", out_dir, name, used, losses)
+    for attr, label in _LOSSY_OBJECTS:
+        for obj in getattr(model, attr):
+            losses.append(Loss(obj.identifier, label, "URDF has no element for it"))
+    return '<?xml version="1.0"?>\n' + to_text(robot) + "\n", sorted(set(losses))
 
 
 def _root_frame_at_world(root: Link) -> None:

@@ -32,6 +32,7 @@ class VolumeData:
     voxels: np.ndarray  # (count, height, width) float32 in 0..1: slice, row, column
     dimensions: np.ndarray  # (3,) metres along x (columns), y (rows), z (slices), scale applied
     files: list[Path]
+    full_scale: float = 1.0  # the slice value that reads as 1.0 (255 for 8-bit slices)
 
 
 def _where(vol, key: str | None = None) -> SourceLocation:
@@ -139,7 +140,7 @@ def load_volume(model, vol) -> VolumeData:
             "give a size in metres",
             "dimensions",
         )
-    return VolumeData(voxels, dims, files)
+    return VolumeData(voxels, dims, files, peak)
 
 
 def iso_surface(data: VolumeData, level: float | None = None) -> tuple[np.ndarray, np.ndarray]:

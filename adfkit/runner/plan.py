@@ -36,7 +36,7 @@ SPRING_KINDS = (
 #: sections of a model each engine does not play (each is warned about and listed in the report)
 NOT_PLAYED = {
     "pybullet": (("vehicle", "vehicles"),),
-    "mujoco": (("soft body", "soft_bodies"), ("vehicle", "vehicles"), ("volume", "volumes")),
+    "mujoco": (("soft body", "soft_bodies"), ("vehicle", "vehicles")),
 }
 
 

@@ -65,12 +65,24 @@ def bone_voxels(p: DrillingParams) -> np.ndarray:
     return vol.astype(np.uint8)
 
 
+LABELS_YAML = f"""\
+# The tissue each range of slice values stands for (8-bit values), read by `adfkit drill`;
+# the burr must not touch a protected tissue.
+bone: [150, 255]   # {BONE - 19}..{BONE}
+canal: [60, 120]   # {CANAL}
+protected: [canal]
+"""
+
+
 def write_slices(vox: np.ndarray, folder: Path, prefix: str = "bone_") -> None:
     from PIL import Image
+
+    from ..adf import atomic_write_text
 
     folder.mkdir(parents=True, exist_ok=True)
     for i, s in enumerate(vox):
         Image.fromarray(s).save(folder / f"{prefix}{i}.png", optimize=True)
+    atomic_write_text(folder / "labels.yaml", LABELS_YAML)
 
 
 def build_drill_model(p: DrillingParams) -> ModelFile:
@@ -187,7 +199,8 @@ def build_world(p: DrillingParams) -> World:
 
 
 def write_drilling(out_dir: str | Path, p: DrillingParams | None = None) -> Path:
-    """Write launch.yaml, world.yaml, floor.yaml, drill.yaml (the volume and the drill), slices/bone_*.png,
+    """Write launch.yaml, world.yaml, floor.yaml, drill.yaml (the volume and the drill), slices/bone_*.png
+    with slices/labels.yaml (bone, and the canal as a protected tissue),
     input_devices.yaml and colors.yaml into ``out_dir``; returns the launch file path."""
     p = p or DrillingParams()
     out = Path(out_dir)

@@ -86,6 +86,14 @@ class Assembly:
             self.registry.items[bp.key] = sb
             self.bodies.append(sb)
             by_plan[id(bp)] = sb
+        for vs, name in plan.volumes:  # static iso-surface bodies (build._volumes)
+            key = self.registry.add(vs.key, None)
+            bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+            sb = MjBody(key, vs.body, vs.model, 0.0, np.eye(4), np.eye(4), bid, self)
+            sb.surface = vs.surface  # what a viewer draws of it (its own frame)
+            self.registry.items[key] = sb
+            self.bodies.append(sb)
+            self.volumes.append(vs.report)
         self._by_plan = by_plan
         self.joint_names = [j.identifier for j, *_ in plan.joints] + [j.identifier for j, *_ in plan.loops]
         self._build_articulations(plan, by_plan)

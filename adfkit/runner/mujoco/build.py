@@ -9,7 +9,8 @@ runner adds (docs/mujoco.md):
   the file's initial value);
 - ghost objects as contact-free geoms (contype = conaffinity = 0, group 4, never drawn);
 - one inactive weld equality per constraint actuator (the grasp), re-targeted when grasping;
-- collision groups as contype/conaffinity bits, `ignore inter collision` as excluded pairs.
+- collision groups as contype/conaffinity bits, `ignore inter collision` as excluded pairs;
+- each volume's iso-surface (runner/volumes.py) as a static mesh geom on a body of its own.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from ...model.semantics import JointKind, collision_primitives, joint_frames, po
 from ...model.tree import ONE_DOF
 from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
 from ..rotations import matrix_to_quat, pose_to_matrix
+from ..volumes import volume_surfaces
 from .spec import _parse_spec, _resolve_meshes
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
@@ -73,6 +75,7 @@ class Plan:
     losses: list = field(default_factory=list)
     tmp: object = None
     sensors: list = field(default_factory=list)  # plan.SensorRays with BodyPlan parents
+    volumes: list = field(default_factory=list)  # (runner.volumes.VolumeSurface, MJCF body name)
 
 
 def _spring_axes(joint, kind):
@@ -154,7 +157,7 @@ def build_plan(world) -> Plan:
         mine = {}
         if m.bodies:
             names: dict = {}
-            text, ls = to_mjcf(m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names)
+            text, ls = to_mjcf(m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names, volumes=False)
             losses += ls
             for loss in ls:  # the MJCF writer already made a flat collision mesh a thin box (engine_fit)
                 if loss.feature == "collision mesh" and "flat" in loss.reason:
@@ -262,7 +265,39 @@ def build_plan(world) -> Plan:
         if kind in ONE_DOF and jn:
             act = spec.add_actuator(name=f"motor:{jn[0]}", target=jn[0], trntype=mujoco.mjtTrn.mjTRN_JOINT)
             act.set_to_position(kp=1.0, kv=0.0)  # gains are set per joint once the model is compiled
-    return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors)
+    volumes = _volumes(world, spec, scene.all_models())
+    return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors, volumes)
+
+
+def _volumes(world, spec, models) -> list[tuple]:
+    """Each playable volume as a static body holding its iso-surface as one mesh geom, drawn
+    and colliding with every body (as a body without collision groups does). MuJoCo collides a
+    mesh as its convex hull, so what is concave in the volume (a canal, a drilled hole) is solid
+    to contacts: listed in ``not_played``."""
+    out = []
+    for i, vs in enumerate(volume_surfaces(world, models)):
+        name = f"adfkit:volume{i}"
+        spec.add_mesh(name=name, uservert=vs.vertices.astype(float).ravel(), userface=vs.faces.astype(int).ravel())
+        q = matrix_to_quat(vs.pose[:3, :3])
+        body = spec.worldbody.add_body(name=name, pos=vs.pose[:3, 3], quat=[q[3], q[0], q[1], q[2]])
+        body.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_MESH,
+            meshname=name,
+            name=name,
+            rgba=list(vs.rgba),
+            group=0,
+            contype=(1 << 31) - 1,
+            conaffinity=(1 << 31) - 1,
+        )
+        world.not_played.append(
+            {
+                "object": vs.volume.identifier,
+                "what": "concave collision",
+                "why": "MuJoCo collides a mesh as its convex hull: the volume's cavities are solid to contacts",
+            }
+        )
+        out.append((vs, name))
+    return out
 
 
 def _world_lights(world, spec) -> None:

@@ -1,0 +1,157 @@
+"""What `adfkit drill` reads besides the scene: a tool path file and a volume's labels file.
+
+Tool path file (text, UTF-8): one waypoint per line, ``x y z`` in metres in the world frame,
+separated by spaces, tabs or commas; ``#`` starts a comment; blank lines are skipped. The burr
+starts where the scene puts it and moves through the waypoints in order, in straight lines.
+
+Labels file (``labels.yaml`` in the volume's slice folder, optional): the tissue each range of
+slice values stands for, in the slices' own units (0..255 for 8-bit slices), and which tissues
+the burr must not touch::
+
+    bone: [150, 255]
+    canal: [60, 120]
+    protected: [canal]
+
+Without one, voxels at or above the iso-surface value are ``bone`` and the voxels below it that
+are not empty are ``soft tissue``.
+
+Either file, when wrong, is a located error (``file:line:col``) with a hint.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .. import inputs
+from ..diagnostics import AdfError, SourceLocation, error
+
+MAX_WAYPOINTS = 100_000
+MAX_COORD = 10.0  # m: a drill path further than this from the origin is a unit mistake
+_SPLIT = re.compile(r"[^\s,]+")
+
+
+def _path_error(path, line: int, col: int, message: str, hint: str) -> AdfError:
+    return AdfError(error("drill-path", message, SourceLocation(inputs.shown(path), line, col), hint))
+
+
+def read_path_file(path: str | Path) -> np.ndarray:
+    """The waypoints of a tool path file, (n, 3) metres; any bad line is a located error."""
+    text = inputs.read_text(path, "text", what="tool path file")
+    points: list[list[float]] = []
+    for ln, line in enumerate(text.splitlines(), start=1):
+        body = line.split("#", 1)[0]
+        tokens = [(m.group(0), m.start() + 1) for m in _SPLIT.finditer(body)]
+        if not tokens:
+            continue
+        if len(tokens) != 3:
+            col = tokens[3][1] if len(tokens) > 3 else len(body.rstrip()) + 1
+            raise _path_error(
+                path,
+                ln,
+                col,
+                f"a waypoint is three numbers x y z; this line has {len(tokens)}",
+                "write one waypoint per line: x y z in metres, e.g. 0.0 0.0 0.03",
+            )
+        xyz = []
+        for tok, col in tokens:
+            try:
+                v = float(tok)
+            except ValueError:
+                raise _path_error(
+                    path, ln, col, f"'{tok[:40]}' is not a number", "coordinates are decimal numbers in metres"
+                ) from None
+            if not math.isfinite(v) or abs(v) > MAX_COORD:
+                raise _path_error(
+                    path,
+                    ln,
+                    col,
+                    f"{tok[:40]} m is not a coordinate within {MAX_COORD:g} m of the origin",
+                    "coordinates are in metres (a millimetre value is 1000x too large)",
+                )
+            xyz.append(v)
+        points.append(xyz)
+        if len(points) > MAX_WAYPOINTS:
+            raise _path_error(
+                path, ln, 1, f"more than {MAX_WAYPOINTS:,} waypoints", "thin the path: the burr moves in straight lines"
+            )
+    if not points:
+        raise _path_error(path, 1, 1, "the tool path file has no waypoint", "write one waypoint per line: x y z")
+    return np.array(points, dtype=float)
+
+
+def default_labels(iso: float) -> tuple[list[str], list[tuple[float, float]], set[str]]:
+    return ["bone", "soft tissue"], [(iso, math.inf), (1e-12, iso)], set()
+
+
+def read_labels(path: Path, full_scale: float, tree) -> tuple[list[str], list[tuple[float, float]], set[str]]:
+    """Names, value ranges (0..1 of full scale, inclusive) and protected names of a labels file."""
+    import yaml
+
+    from ..adf.yamlnodes import compose
+
+    text = inputs.read_text(path, "text", tree=tree, what="labels file")
+    shown = inputs.shown(path)
+    root = compose(text, shown)
+
+    def at(node) -> SourceLocation:
+        return SourceLocation(shown, node.start_mark.line + 1, node.start_mark.column + 1)
+
+    def bad(node, message: str, hint: str) -> AdfError:
+        return AdfError(error("drill-labels", message, at(node), hint))
+
+    if not isinstance(root, yaml.MappingNode):
+        raise AdfError(
+            error(
+                "drill-labels",
+                "a labels file is a mapping of tissue names to value ranges",
+                SourceLocation(shown, 1, 1),
+                "e.g. bone: [150, 255]",
+            )
+        )
+    names, ranges, protected_nodes = [], [], []
+    for k, v in root.value:
+        if k.value == "protected":
+            if not isinstance(v, yaml.SequenceNode) or not all(isinstance(x, yaml.ScalarNode) for x in v.value):
+                raise bad(v, "`protected` is a list of tissue names", "e.g. protected: [canal]")
+            protected_nodes = v.value
+            continue
+        ok = isinstance(v, yaml.SequenceNode) and len(v.value) == 2
+        try:
+            lo, hi = (float(x.value) for x in v.value) if ok else (0.0, -1.0)
+        except (ValueError, TypeError, AttributeError):
+            ok = False
+        if not ok or not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi or hi < 0:
+            raise bad(
+                v,
+                f"tissue '{k.value[:40]}' needs a range [low, high] of slice values, low <= high",
+                "e.g. bone: [150, 255] (the slices' own units)",
+            )
+        if len(names) >= 254:
+            raise bad(k, "more than 254 tissues", "merge tissues")
+        names.append(str(k.value))
+        ranges.append((max(lo, 0.0) / full_scale, hi / full_scale))
+    if not names:
+        raise bad(root, "the labels file names no tissue", "e.g. bone: [150, 255]")
+    protected = set()
+    for node in protected_nodes:
+        if node.value not in names:
+            raise bad(node, f"protected tissue '{node.value[:40]}' is not one of {names}", "name a tissue of this file")
+        protected.add(node.value)
+    return names, ranges, protected
+
+
+def label_array(values: np.ndarray, ranges: list[tuple[float, float]]) -> np.ndarray:
+    """uint8 label id per voxel: 1 + the first range holding its value, 0 for none (or empty)."""
+    out = np.zeros(values.shape, dtype=np.uint8)
+    eps = 0.5 / 65535.0  # a value written as an integer and normalised may sit this far off
+    for i in range(len(ranges) - 1, -1, -1):
+        lo, hi = ranges[i]
+        out[(values >= lo - eps) & (values <= hi + eps) & (values > 0)] = i + 1
+    return out
+
+
+__all__ = ["MAX_WAYPOINTS", "default_labels", "label_array", "read_labels", "read_path_file"]
