@@ -157,6 +157,7 @@ class ADF_PT_sidebar(bpy.types.Panel):
         box.prop(sc, "precision")
         box.prop(sc, "apply_modifiers")
         box.prop(sc, "low_res_ratio")
+        box.prop(sc, "mesh_format")
         col = lay.column(align=True)
         col.operator("adf.estimate_all")
         col.operator("adf.estimate_gains")

@@ -169,6 +169,12 @@ _RULES = [
         "`mesh: part.stl` that is 300 random bytes, or an OBJ with no `f` lines",
     ),
     Rule(
+        "mesh-format",
+        W,
+        "A mesh file in a format AMBF does not load: CHAI3D reads OBJ, 3DS and STL only (AMBF skips the mesh)",
+        "`mesh: part.PLY`",
+    ),
+    Rule(
         "missing-texture",
         W,
         "A material library or texture named by an OBJ/MTL is not found",

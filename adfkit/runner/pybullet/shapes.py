@@ -203,9 +203,10 @@ def collision_parts(
         diags.append(
             warning(
                 "runner-mesh-format",
-                f"{obj.identifier}: {path.suffix} meshes are not readable by PyBullet; no collision shape",
-                obj.source,
-                "convert the mesh to OBJ or STL",
+                f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: PyBullet reads OBJ and STL meshes, "
+                f"not {path.suffix or 'files without a suffix'}; no collision shape",
+                obj.where("collision mesh") or obj.where("mesh") or obj.source,
+                "export the mesh as OBJ or STL",
             )
         )
         return parts
@@ -327,6 +328,15 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int, diags: list
         )
         return -1
     if suffix not in MESH_SUFFIXES:
+        diags.append(
+            warning(
+                "runner-mesh-format",
+                f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: PyBullet reads OBJ and STL meshes, "
+                f"not {path.suffix or 'files without a suffix'}; the body is drawn without it",
+                obj.where("mesh") or obj.source,
+                "export the mesh as OBJ or STL",
+            )
+        )
         return -1
     kw = dict(base)
     if rgba(obj) is None:
