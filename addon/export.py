@@ -15,7 +15,7 @@ from adfkit.adf.writer import atomic_write_text
 from adfkit.diagnostics import Diagnostic, Severity, error
 from adfkit.model import ModelFile
 
-from . import fields, gather, meshes
+from . import fields, gather, meshes, namespaces
 
 HASH_FILE = ".adfkit-meshes.json"
 
@@ -108,6 +108,7 @@ def gather_model(scene, objects=None, mesh_format: str | None = None) -> gather.
         elif k in gather.GATHER:
             key, fn = gather.GATHER[k]
             other[key].append(fn(o, out))
+    out.diagnostics += namespaces.findings(objs)
     doc.bodies = _ordered(bodies, order.get("bodies", []))
     doc.soft_bodies = _ordered(softs, order.get("soft bodies", []))
     doc.ghost_objects = _ordered(ghosts, order.get("ghost objects", []))

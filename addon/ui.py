@@ -54,6 +54,9 @@ def draw_object(layout, obj) -> None:
                 layout.prop(s, "height")
                 layout.prop(s, "axis")
         return
+    if adf.kind == "COLLISION_MESH":
+        layout.operator("adf.collision_to_body_origin")
+        layout.operator("adf.collision_use_current_location")
     if pg is None:
         return
     table = fields.TABLES[adf.kind][1]
@@ -170,6 +173,7 @@ class ADF_PT_sidebar(bpy.types.Panel):
         row.operator("adf.show_collision", text="Show collision").show = True
         row.operator("adf.show_collision", text="Hide collision").show = False
         col.operator("adf.rename_joints")
+        col.operator("adf.strip_namespaces")
         col.operator("adf.cleanup")
         col.operator("adf.strip")
         box = lay.box()
