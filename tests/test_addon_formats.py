@@ -179,3 +179,27 @@ def test_blend_export_takes_the_mesh_format(addon, scene, tmp_path, capsys):
         main(["blend-export", str(blend), str(tmp_path / "x"), "--mesh-format", "fbx"])
     assert exc.value.code == 2 and not (tmp_path / "x").exists()
     assert "invalid choice: 'FBX'" in capsys.readouterr().err
+
+
+def test_a_mesh_over_the_3ds_object_limits_is_split_but_a_soft_bodys_is_refused(addon, scene, tmp_path):
+    from test_geometry_mesh3ds import spec_read
+
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=256, y_subdivisions=256, size=0.2)
+    sheet = bpy.context.active_object
+    sheet.name = "Sheet"
+    assert len(sheet.data.vertices) == 66049  # over 65535
+    addon.authoring.mark(sheet, "SOFT_BODY")
+    res = addon.export.export_scene(scene, tmp_path / "soft", mesh_format="3DS")
+    assert not res.ok and not (tmp_path / "soft").exists()
+    (d,) = [d for d in res.diagnostics if d.rule == "mesh-format-limit"]
+    assert d.message == (
+        "soft body 'Sheet' has 66049 vertices and 131072 triangles; a 3DS object holds at most 65535 of each, "
+        "and a soft body's mesh cannot be split (its node numbers)"
+    )
+    sheet.adf.kind = "BODY"
+    sheet.adf.body.use_mass, sheet.adf.body.mass = True, 0.0
+    res = addon.export.export_scene(scene, tmp_path / "rigid", mesh_format="3DS")
+    assert res.ok, [str(d) for d in res.diagnostics]
+    objects = spec_read((tmp_path / "rigid/meshes/high_res/Sheet.3DS").read_bytes())["objects"]
+    assert [o[0] for o in objects] == ["Sheet_0", "Sheet_1", "Sheet_2"]
+    assert sum(len(o[2]) for o in objects) == 131072 and max(len(o[1]) for o in objects) <= 65535
