@@ -71,3 +71,17 @@ def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
     out = os.path.join(_STL_DIR, f"mesh_{len(_STL_CACHE)}.stl")
     mesh.export(out, file_type="stl")
     return out, None
+
+
+def is_convex(path: Path, rel: float = 1e-3) -> bool:
+    """True when the mesh encloses its own convex hull (volumes within ``rel``): a convex hull of
+    it collides exactly as its triangles do. False for open, concave or unreadable meshes."""
+    from ...geometry.meshio import load_mesh  # trimesh: only for a static concave mesh beside soft bodies
+
+    try:
+        mesh = load_mesh(path)
+        if not mesh.is_volume:
+            return False
+        return abs(mesh.convex_hull.volume - mesh.volume) <= rel * mesh.convex_hull.volume
+    except (AdfError, ValueError):
+        return False

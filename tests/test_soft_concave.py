@@ -1,0 +1,94 @@
+"""A soft pad resting on a static tray whose collision is a triangle mesh (AMBF's default
+`collision mesh type` for a static body). PyBullet's soft bodies cannot collide with a triangle
+mesh: Bullet's sparse SDF gives every point a distance 0 to a non-convex shape, so the pad's
+nodes near the tray were flung up to 10 cm and the camera drew it in fragments. In a world with
+soft bodies the runner plays a static concave mesh as convex hulls (exact for the box tray), and
+warns when that fills a hollow. Real PyBullet, TinyRenderer."""
+
+from __future__ import annotations
+
+import json
+import textwrap
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pybullet")
+trimesh = pytest.importorskip("trimesh")
+Image = pytest.importorskip("PIL.Image")
+
+from adfkit.cli import main  # noqa: E402
+from adfkit.geometry.softmesh import load_soft_mesh  # noqa: E402
+
+PAD_BOTTOM, PAD_TOP = 0.046, 0.05
+
+
+def _scene(tmp, tray: trimesh.Trimesh) -> str:
+    pad = trimesh.creation.box(extents=(0.1, 0.1, PAD_TOP - PAD_BOTTOM)).subdivide_to_size(0.0125)
+    pad.apply_translation((0, 0, (PAD_TOP + PAD_BOTTOM) / 2))
+    pad.export(tmp / "pad.obj")
+    tray.export(tmp / "tray.obj")
+    nodes = load_soft_mesh(tmp / "pad.obj").nodes
+    rim = [int(i) for i in np.flatnonzero(np.abs(nodes[:, :2]).max(axis=1) > 0.05 - 1e-6)]
+    (tmp / "scene.yaml").write_text(
+        textwrap.dedent(f"""\
+        bodies: [BODY Tray]
+        soft bodies: [SOFT Pad]
+        cameras: [CAMERA cam]
+        BODY Tray:
+          name: Tray
+          mass: 0.0
+          mesh: tray.obj
+          color rgba: {{r: 0.3, g: 0.3, b: 0.3, a: 1.0}}
+        SOFT Pad:
+          name: Pad
+          mass: 0.04
+          mesh: pad.obj
+          color rgba: {{r: 0.9, g: 0.2, b: 0.2, a: 1.0}}
+          config:
+            fixed nodes: {rim}
+        CAMERA cam:
+          name: cam
+          location: {{x: 0.0, y: -0.12, z: 0.25}}
+          look at: {{x: 0.0, y: 0.0, z: 0.048}}
+          up: {{x: 0.0, y: 0.0, z: 1.0}}
+          clipping plane: {{near: 0.01, far: 10.0}}
+          field view angle: 0.7
+          publish image resolution: {{width: 64, height: 48}}
+        """)
+    )
+    return str(tmp / "scene.yaml")
+
+
+def _box_tray() -> trimesh.Trimesh:
+    tray = trimesh.creation.box(extents=(0.16, 0.16, 0.02))
+    tray.apply_translation((0, 0, PAD_BOTTOM - 0.01))  # its top touches the pad's bottom face
+    return tray
+
+
+def test_a_soft_pad_on_a_triangle_mesh_tray_rests_whole_and_is_drawn_whole(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["run", _scene(tmp_path, _box_tray()), "--seconds", "0.1", "--out", str(out)]) == 0
+    said = capsys.readouterr()
+    (pad,) = json.loads((out / "report.json").read_text())["soft_bodies"]
+    # the pad keeps its size (it grew from 0.141 m to 0.19 m, nodes flung 8 cm, on the triangle mesh)
+    assert pad["size_m"] == pytest.approx(pad["rest_size_m"], rel=0.01)
+    assert PAD_BOTTOM - 0.002 < pad["lowest_z"] < PAD_BOTTOM + 0.001
+    assert "runner-soft-concave" not in said.out + said.err  # a box: its hull is exact, nothing to say
+    # seen from above, the middle of the picture is the pad's red top, not fragments of the tray
+    rgb = np.asarray(Image.open(out / "cam_rgb.png")).astype(int)
+    middle = rgb[18:30, 24:40].reshape(-1, 3)
+    assert (middle[:, 0] > middle[:, 1] + 60).all(), middle[:4]
+
+
+def test_a_concave_tray_beside_a_soft_body_is_played_as_hulls_and_said(tmp_path, capsys):
+    floor = trimesh.creation.box(extents=(0.16, 0.16, 0.01))
+    floor.apply_translation((0, 0, PAD_BOTTOM - 0.005))
+    wall = trimesh.creation.box(extents=(0.16, 0.01, 0.04))
+    wall.apply_translation((0, 0.075, PAD_BOTTOM + 0.015))
+    tray = trimesh.util.concatenate([floor, wall])  # an L: its convex hull fills the corner
+    path = _scene(tmp_path, tray)
+    assert main(["run", path, "--seconds", "0.02", "--no-frames", "--out", str(tmp_path / "out")]) == 0
+    printed = "".join(capsys.readouterr())
+    assert "warning[runner-soft-concave]: BODY Tray: concave collision mesh tray.obj played as convex hulls" in printed
+    assert "scene.yaml:7:" in printed  # the `mesh:` line that names it
