@@ -92,3 +92,45 @@ def test_a_concave_tray_beside_a_soft_body_is_played_as_hulls_and_said(tmp_path,
     printed = "".join(capsys.readouterr())
     assert "warning[runner-soft-concave]: BODY Tray: concave collision mesh tray.obj played as convex hulls" in printed
     assert "scene.yaml:7:" in printed  # the `mesh:` line that names it
+
+
+def test_a_pad_authored_in_blender_on_a_mesh_tray_plays_whole(tmp_path):
+    """The modeller's case: grid + Solidify soft body, border fixed, resting on a cube tray that
+    exports as a mesh (a static body: a triangle mesh), through the add-on, then `adfkit run`."""
+    bpy = pytest.importorskip("bpy")
+    from adfkit.commands.blend_import import load_addon
+
+    addon = load_addon()[1]
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=12, y_subdivisions=12, size=0.1, location=(0, 0, PAD_TOP))
+    pad = bpy.context.active_object
+    pad.name = "Pad"
+    pad.modifiers.new("Solidify", "SOLIDIFY").thickness = PAD_TOP - PAD_BOTTOM
+    addon.authoring.mark(pad, "SOFT_BODY")
+    for v in pad.data.vertices:
+        v.select = max(abs(v.co.x), abs(v.co.y)) > 0.05 - 1e-6
+    addon.authoring.fix_selected_nodes(pad)
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0, 0, PAD_BOTTOM - 0.01), scale=(0.16, 0.16, 0.02))
+    tray = bpy.context.active_object
+    tray.name = "Tray"
+    addon.authoring.mark(tray, "BODY")
+    tray.adf.body.mass = 0.0
+    cam = bpy.data.objects.new("Cam", bpy.data.cameras.new("Cam"))
+    bpy.context.scene.collection.objects.link(cam)
+    cam.location = (0.0, -0.12, 0.25)
+    cam.rotation_euler = (0.45, 0.0, 0.0)
+    addon.authoring.mark(cam, "CAMERA")
+    cam.parent = tray
+    cam.matrix_parent_inverse = tray.matrix_world.inverted()
+    bpy.context.view_layer.update()
+    res = addon.export.export_scene(bpy.context.scene, tmp_path / "model", "pad")
+    assert res.ok, [str(d) for d in res.diagnostics]
+    out = tmp_path / "out"
+    assert main(["run", str(res.path), "--seconds", "0.1", "--out", str(out)]) == 0
+    rep = json.loads((out / "report.json").read_text())
+    (sb,) = rep["soft_bodies"]
+    assert sb["nodes"] == 2 * 13 * 13 and sb["fixed_nodes"] == 2 * 48  # the shell, its rim fixed on both faces
+    assert sb["size_m"] == pytest.approx(sb["rest_size_m"], rel=0.01)  # was 0.19 m against 0.141 m
+    assert PAD_BOTTOM - 0.002 < sb["lowest_z"] < PAD_BOTTOM + 0.001
+    seg = np.load(out / "Cam_seg.npy")
+    assert (seg == 1).sum() > 0.05 * seg.size  # the pad (label 1, after the tray) is in the picture
