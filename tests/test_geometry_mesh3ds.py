@@ -123,3 +123,17 @@ def test_stl_and_ply_are_written_by_trimesh_and_read_back(tmp_path, suffix):
     if suffix == ".PLY":  # the vertex list as given (a soft body's node numbering depends on it)
         assert np.allclose(back.vertices, np.vstack([TET_V, TET_V + [0, 0, 1.0]]))
     assert not list(tmp_path.glob(".*tmp"))  # written beside the target, then renamed
+
+
+def test_the_validator_says_where_a_3ds_mesh_is_broken(tmp_path):
+    from adfkit.validator import validate_file
+
+    good = encode_3ds([("Tet", TET_V, TET_F)])
+    (tmp_path / "tet.3ds").write_bytes(good[:-10])  # cut short: the last chunk overruns its parent
+    model = tmp_path / "m.yaml"
+    model.write_text("bodies: [BODY t]\nBODY t:\n  name: t\n  mass: 0.0\n  mesh: tet.3ds\n")
+    (d,) = [d for d in validate_file(model).diagnostics if d.rule == "mesh-unreadable"]
+    assert "mesh tet.3ds of 'BODY t': corrupt 3DS chunk 0x4d4d at byte 0" in d.message
+    assert (d.location.line, d.location.column) == (5, 9)
+    (tmp_path / "tet.3ds").write_bytes(good)
+    assert [d for d in validate_file(model).diagnostics if d.rule == "mesh-unreadable"] == []

@@ -165,7 +165,7 @@ _RULES = [
     Rule(
         "mesh-unreadable",
         W,
-        "An STL/OBJ mesh holds no triangles or is not a valid file (AMBF skips the body)",
+        "An STL/OBJ/3DS mesh holds no triangles or is not a valid file (AMBF skips the body)",
         "`mesh: part.stl` that is 300 random bytes, or an OBJ with no `f` lines",
     ),
     Rule(
