@@ -203,12 +203,21 @@ def write_obj(parts: list[MeshArrays], directory: Path, filename: str) -> list[P
     return written
 
 
+MESH_SUFFIXES = (".OBJ", ".STL", ".PLY", ".3DS", ".DAE", ".OFF", ".GLB", ".GLTF", ".FBX")
+
+
 def with_format(name: str, fmt: str) -> str:
-    """The mesh file name with the suffix of ``fmt`` ('OBJ', 'STL', 'PLY', '3DS')."""
+    """The mesh file name with the suffix of ``fmt`` ('OBJ', 'STL', 'PLY', '3DS'): a name that
+    has it is kept, another mesh suffix is replaced, anything else (an object name such as
+    'Tray.001' or '/ambf/env/base') gets the suffix after its last part."""
     from adfkit.geometry.meshwrite import SUFFIXES
 
     suffix = SUFFIXES[fmt]
-    return name if Path(name).suffix.upper() == suffix else Path(name).stem + suffix
+    if Path(name).suffix.upper() == suffix:
+        return name
+    if Path(name).suffix.upper() in MESH_SUFFIXES:
+        return Path(name).stem + suffix
+    return name.rsplit("/", 1)[-1] + suffix
 
 
 def write_mesh(parts: list[MeshArrays], directory: Path, filename: str, split: bool = True) -> list[Path]:

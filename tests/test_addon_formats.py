@@ -203,3 +203,13 @@ def test_a_mesh_over_the_3ds_object_limits_is_split_but_a_soft_bodys_is_refused(
     objects = spec_read((tmp_path / "rigid/meshes/high_res/Sheet.3DS").read_bytes())["objects"]
     assert [o[0] for o in objects] == ["Sheet_0", "Sheet_1", "Sheet_2"]
     assert sum(len(o[2]) for o in objects) == 131072 and max(len(o[1]) for o in objects) <= 65535
+
+
+def test_mesh_file_names_take_the_formats_suffix(addon):
+    import importlib
+
+    with_format = importlib.import_module(addon.__name__ + ".meshes").with_format
+    assert with_format("Tray.001", "STL") == "Tray.001.STL"  # Blender's numbered copy is not a suffix
+    assert with_format("Tray.STL", "OBJ") == "Tray.OBJ"
+    assert with_format("sub/Tray.OBJ", "OBJ") == "sub/Tray.OBJ"  # as the file names it
+    assert with_format("/ambf/env/base", "3DS") == "base.3DS"  # a namespace is no folder
