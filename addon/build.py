@@ -58,14 +58,25 @@ def _import_file(path: Path, scene) -> list:
     the importer refuses (garbage, truncated) gives no object and a warning, never an exception."""
     before = set(scene.objects)
     op = _IMPORTERS.get(path.suffix.lower())
-    if op is None:
+    if op is None and path.suffix.lower() != ".3ds":
+        _UNREADABLE.append(
+            warning(
+                "mesh-unreadable",
+                f"no importer for the mesh {path.name} (OBJ, STL, PLY and 3DS are read); imported without it",
+                SourceLocation(shown(path)),
+                "convert the mesh to OBJ or STL",
+            )
+        )
         return []
     try:
+        if op is None:
+            return meshes.objects_from_3ds(path, scene)
         getattr(bpy.ops.wm, op)(filepath=str(path), forward_axis="Y", up_axis="Z")
-    except RuntimeError as exc:  # Blender's operators report a failed read this way
+    except (RuntimeError, AdfError) as exc:  # Blender's operators report a failed read this way
         for o in [o for o in scene.objects if o not in before]:
             bpy.data.objects.remove(o, do_unlink=True)
-        reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else "unreadable"
+        text = exc.diagnostics[0].message if isinstance(exc, AdfError) else str(exc).strip()
+        reason = text.splitlines()[-1] if text else "unreadable"
         _UNREADABLE.append(
             warning(
                 "mesh-unreadable",

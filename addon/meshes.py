@@ -53,6 +53,23 @@ def mesh_arrays(obj, name: str | None = None, evaluated: bool = False) -> MeshAr
     return _arrays(obj, obj.data, name)
 
 
+def objects_from_3ds(path: Path, scene) -> list:
+    """A mesh object holding the triangles of a .3DS file (Blender 4.2+ has no 3DS importer;
+    adfkit.geometry.softmesh reads the chunks, vertices as stored). Raises AdfError for a
+    broken file."""
+    import bpy
+
+    from adfkit.geometry.softmesh import read_3ds
+
+    verts, faces = read_3ds(path)
+    me = bpy.data.meshes.new(path.stem)
+    me.from_pydata(verts.tolist(), [], faces.tolist())
+    me.update()
+    obj = bpy.data.objects.new(path.stem, me)
+    scene.collection.objects.link(obj)
+    return [obj]
+
+
 def decimated_arrays(obj, ratio: float) -> MeshArrays:
     """The object's evaluated mesh decimated (Blender's Decimate modifier, collapse, added
     last for the moment) to ``ratio`` of its faces: a low-resolution collision mesh."""

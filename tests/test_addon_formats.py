@@ -213,3 +213,32 @@ def test_mesh_file_names_take_the_formats_suffix(addon):
     assert with_format("Tray.STL", "OBJ") == "Tray.OBJ"
     assert with_format("sub/Tray.OBJ", "OBJ") == "sub/Tray.OBJ"  # as the file names it
     assert with_format("/ambf/env/base", "3DS") == "base.3DS"  # a namespace is no folder
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_meshes_in_each_format_import_back_into_blender(addon, scene, tmp_path, fmt):
+    tray_and_lid(addon)
+    res = addon.export.export_scene(scene, tmp_path / "out", "tray", mesh_format=fmt)
+    assert res.ok
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    made, diags = addon.build.import_model(res.path)
+    assert [d for d in diags if d.rule == "mesh-unreadable"] == []
+    tray = bpy.data.objects["Tray"]
+    assert tray.type == "MESH" and len(tray.data.polygons) == (6 if fmt == "OBJ" else 12)  # OBJ keeps quads
+    co = np.array([tray.matrix_world @ v.co for v in tray.data.vertices])
+    assert np.allclose([co.min(0), co.max(0)], [[-0.05, -0.05, 0.0], [0.05, 0.05, 0.1]], atol=1e-6)
+    lid_parts = [o for o in bpy.data.objects if o.parent is bpy.data.objects["Lid"] and o.type == "MESH"]
+    # two cubes: quads in OBJ (the STL and PLY exports keep the lid's parts as OBJ), triangles in 3DS
+    assert sum(len(o.data.polygons) for o in lid_parts) == (24 if fmt == "3DS" else 12)
+
+
+def test_a_broken_3ds_mesh_imports_without_it_and_says_so(addon, scene, tmp_path):
+    tray_and_lid(addon)
+    res = addon.export.export_scene(scene, tmp_path / "out", "tray", mesh_format="3DS")
+    mesh = tmp_path / "out/meshes/high_res/Tray.3DS"
+    mesh.write_bytes(mesh.read_bytes()[:40])
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    _, diags = addon.build.import_model(res.path)
+    (d,) = [d for d in diags if d.rule == "mesh-unreadable" and "Tray.3DS" in d.message]
+    assert "Blender could not import the mesh Tray.3DS: corrupt 3DS chunk 0x4d4d at byte 0" in d.message
+    assert bpy.data.objects["Tray"].type == "EMPTY"
