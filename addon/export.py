@@ -15,7 +15,7 @@ from adfkit.adf.writer import atomic_write_text
 from adfkit.diagnostics import Diagnostic, Severity, error
 from adfkit.model import ModelFile
 
-from . import fields, gather, meshes, namespaces
+from . import fields, gather, gather_soft, meshes, namespaces
 
 HASH_FILE = ".adfkit-meshes.json"
 
@@ -97,7 +97,7 @@ def gather_model(scene, objects=None, mesh_format: str | None = None) -> gather.
                 for attr in ("high_resolution_path", "low_resolution_path"):
                     setattr(b, attr, None)  # per-body folders are folded into the model folders
         elif k == "SOFT_BODY":
-            softs.append(gather.gather_soft_body(o, out, (hi, lo)))
+            softs.append(gather_soft.gather_soft_body(o, out, (hi, lo)))
             softs[-1].high_resolution_path = softs[-1].low_resolution_path = None
         elif k == "GHOST":
             ghosts.append(gather.gather_ghost(o, out, (hi, lo)))
