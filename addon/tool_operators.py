@@ -25,16 +25,28 @@ class ADF_OT_strip_namespaces(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _collision_meshes(objs) -> list:
+    """The selected collision meshes, and those of the selected bodies (AMBF's add-on acted on
+    the active body's collision mesh)."""
+    out = []
+    for o in objs:
+        kids = [o] if o.adf.kind == "COLLISION_MESH" else []
+        if o.adf.kind in ("BODY", "GHOST", "SOFT_BODY"):
+            kids = sorted((c for c in o.children if c.adf.kind == "COLLISION_MESH"), key=lambda c: c.name)
+        out += [k for k in kids if k not in out]
+    return out
+
+
 class _CollisionPlacement:
     @classmethod
     def poll(cls, context):
-        return any(o.adf.kind == "COLLISION_MESH" for o in context.selected_objects)
+        return bool(_collision_meshes(context.selected_objects))
 
     def execute(self, context):
         from . import collision_place
 
         done = []
-        for o in [o for o in context.selected_objects if o.adf.kind == "COLLISION_MESH"]:
+        for o in _collision_meshes(context.selected_objects):
             try:
                 getattr(collision_place, self.action)(o)
             except AdfError as exc:
@@ -49,7 +61,9 @@ class _CollisionPlacement:
 class ADF_OT_collision_to_body_origin(_CollisionPlacement, bpy.types.Operator):
     bl_idname = "adf.collision_to_body_origin"
     bl_label = "Move collision mesh to body origin"
-    bl_description = "Put the selected collision meshes on their body's origin, where AMBF reads them"
+    bl_description = (
+        "Put the selected collision meshes (or the selected bodies' ones) on their body's origin, where AMBF reads them"
+    )
     action = "move_to_body_origin"
 
 
@@ -57,8 +71,8 @@ class ADF_OT_collision_use_current_location(_CollisionPlacement, bpy.types.Opera
     bl_idname = "adf.collision_use_current_location"
     bl_label = "Use current location of collision mesh"
     bl_description = (
-        "Keep the selected collision meshes where they are: their offset goes into their vertices and "
-        "their origin onto the body's"
+        "Keep the selected collision meshes (or the selected bodies' ones) where they are: their offset goes "
+        "into their vertices and their origin onto the body's"
     )
     action = "use_current_location"
 

@@ -54,7 +54,7 @@ def draw_object(layout, obj) -> None:
                 layout.prop(s, "height")
                 layout.prop(s, "axis")
         return
-    if adf.kind == "COLLISION_MESH":
+    if adf.kind == "COLLISION_MESH" or any(c.adf.kind == "COLLISION_MESH" for c in obj.children):
         layout.operator("adf.collision_to_body_origin")
         layout.operator("adf.collision_use_current_location")
     if pg is None:

@@ -152,7 +152,7 @@ def test_use_current_location_keeps_the_collision_mesh_where_it_is_seen(addon, s
 
 def test_move_to_body_origin_puts_the_collision_mesh_where_ambf_reads_it(addon, scene, tmp_path):
     body, part = _body_with_offset_part(addon)
-    _select(part)
+    _select(body)  # the body selected: its collision meshes move, as AMBF's add-on did it from the body
     assert bpy.ops.adf.collision_to_body_origin() == {"FINISHED"}
     bpy.context.view_layer.update()
     assert np.allclose(part.matrix_world.translation[:], (0.0, 0.0, 0.5), atol=1e-6)
