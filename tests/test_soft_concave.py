@@ -96,7 +96,8 @@ def test_a_concave_tray_beside_a_soft_body_is_played_as_hulls_and_said(tmp_path,
 
 def test_a_pad_authored_in_blender_on_a_mesh_tray_plays_whole(tmp_path):
     """The modeller's case: grid + Solidify soft body, border fixed, resting on a cube tray that
-    exports as a mesh (a static body: a triangle mesh), through the add-on, then `adfkit run`."""
+    exports as a mesh (a static body: a triangle mesh), through the add-on, then `adfkit run`: the
+    pad whole, resting on the tray, and drawn in its material's colour."""
     bpy = pytest.importorskip("bpy")
     from adfkit.commands.blend_import import load_addon
 
@@ -106,6 +107,12 @@ def test_a_pad_authored_in_blender_on_a_mesh_tray_plays_whole(tmp_path):
     pad = bpy.context.active_object
     pad.name = "Pad"
     pad.modifiers.new("Solidify", "SOLIDIFY").thickness = PAD_TOP - PAD_BOTTOM
+    tissue = bpy.data.materials.new("Tissue")
+    if tissue.node_tree is None:  # Blender before 5.0 made node trees on request
+        tissue.use_nodes = True
+    bsdf = next(n for n in tissue.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    bsdf.inputs["Base Color"].default_value = (0.9, 0.25, 0.2, 1.0)
+    pad.data.materials.append(tissue)
     addon.authoring.mark(pad, "SOFT_BODY")
     for v in pad.data.vertices:
         v.select = max(abs(v.co.x), abs(v.co.y)) > 0.05 - 1e-6
@@ -133,4 +140,8 @@ def test_a_pad_authored_in_blender_on_a_mesh_tray_plays_whole(tmp_path):
     assert sb["size_m"] == pytest.approx(sb["rest_size_m"], rel=0.01)  # was 0.19 m against 0.141 m
     assert PAD_BOTTOM - 0.002 < sb["lowest_z"] < PAD_BOTTOM + 0.001
     seg = np.load(out / "Cam_seg.npy")
-    assert (seg == 1).sum() > 0.05 * seg.size  # the pad (label 1, after the tray) is in the picture
+    pad_pixels = seg == 1  # the pad: label 1, after the tray
+    assert pad_pixels.sum() > 0.05 * seg.size
+    # drawn in its material's colour (the MTL's Kd: the file has no `color rgba`), not white on the white floor
+    r, g, b = np.asarray(Image.open(out / "Cam_rgb.png"))[pad_pixels].reshape(-1, 3).astype(float).mean(axis=0)
+    assert r > g + 60 and r > b + 60, (r, g, b)

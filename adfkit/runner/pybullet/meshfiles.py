@@ -85,3 +85,37 @@ def is_convex(path: Path, rel: float = 1e-3) -> bool:
         return abs(mesh.convex_hull.volume - mesh.volume) <= rel * mesh.convex_hull.volume
     except (AdfError, ValueError):
         return False
+
+
+def obj_colour(path: Path, tree=None) -> list[float] | None:
+    """RGBA of the first material an OBJ file uses (its MTL's `Kd` and `d`), or None: how a soft
+    body without `color rgba` gets its colour (AMBF's mesh loader reads the MTL; PyBullet's
+    soft bodies are loaded from a plain copy of the nodes and would be drawn white)."""
+    if path.suffix.lower() != ".obj":
+        return None
+    try:
+        text = inputs.read_text(path, "mesh", tree=tree, what="mesh file")
+        libs = [ln.split(None, 1)[1].strip() for ln in text.splitlines() if ln.startswith("mtllib ")]
+        used = next((ln.split(None, 1)[1].strip() for ln in text.splitlines() if ln.startswith("usemtl ")), None)
+        if not libs:
+            return None
+        mtl = inputs.read_text(path.parent / libs[0], "mesh", tree=tree, what="material file")
+    except (AdfError, IndexError):
+        return None
+    current, kd, alpha = None, {}, {}
+    for line in mtl.splitlines():
+        parts = line.split()
+        if len(parts) >= 2 and parts[0] == "newmtl":
+            current = parts[1]
+        elif len(parts) >= 4 and parts[0] == "Kd" and current is not None:
+            kd[current] = parts[1:4]
+        elif len(parts) >= 2 and parts[0] == "d" and current is not None:
+            alpha[current] = parts[1]
+    name = used if used in kd else next(iter(kd), None)
+    if name is None:
+        return None
+    try:
+        rgba = [float(c) for c in kd[name]] + [float(alpha.get(name, 1.0))]
+    except ValueError:
+        return None
+    return rgba if all(np.isfinite(rgba)) else None
