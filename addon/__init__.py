@@ -8,16 +8,18 @@ from __future__ import annotations
 
 
 def register() -> None:
-    from . import operators, properties, ui
+    from . import operators, properties, tool_operators, ui
 
     properties.register()
     operators.register()
+    tool_operators.register()
     ui.register()
 
 
 def unregister() -> None:
-    from . import operators, properties, ui
+    from . import operators, properties, tool_operators, ui
 
     ui.unregister()
+    tool_operators.unregister()
     operators.unregister()
     properties.unregister()

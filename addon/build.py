@@ -11,14 +11,13 @@ from mathutils import Matrix, Quaternion, Vector
 
 from adfkit.adf import collision_mesh_path, read_file, visual_mesh_path
 from adfkit.adf.writer import file_to_plain
-from adfkit.diagnostics import AdfError, Diagnostic, Severity, SourceLocation, warning
-from adfkit.inputs import shown
+from adfkit.diagnostics import AdfError, Diagnostic, Severity, warning
 from adfkit.model import ModelFile, Pose
 from adfkit.model.files import ObjectList
 from adfkit.model.semantics import JointKind, collision_primitives, joint_frames, joint_kind
 from adfkit.model.spec import adf_fields
 
-from . import fields, gather, meshes
+from . import fields, gather, mesh_import, meshes
 from .properties import GROUP_OF, write_group
 
 RBC_TYPE = {
@@ -46,60 +45,6 @@ def _link(scene, obj):
 def ensure_rigidbody_world(scene) -> None:
     if scene.rigidbody_world is None:
         bpy.ops.rigidbody.world_add()
-
-
-#: meshes Blender's importers refused during the current import_model (drained into its diagnostics)
-_UNREADABLE: list[Diagnostic] = []
-_IMPORTERS = {".obj": "obj_import", ".stl": "stl_import", ".ply": "ply_import"}
-
-
-def _import_file(path: Path, scene) -> list:
-    """Objects created by Blender's own importer for ``path``, axes left as in the file. A file
-    the importer refuses (garbage, truncated) gives no object and a warning, never an exception."""
-    before = set(scene.objects)
-    op = _IMPORTERS.get(path.suffix.lower())
-    if op is None:
-        return []
-    try:
-        getattr(bpy.ops.wm, op)(filepath=str(path), forward_axis="Y", up_axis="Z")
-    except RuntimeError as exc:  # Blender's operators report a failed read this way
-        for o in [o for o in scene.objects if o not in before]:
-            bpy.data.objects.remove(o, do_unlink=True)
-        reason = str(exc).strip().splitlines()[-1] if str(exc).strip() else "unreadable"
-        _UNREADABLE.append(
-            warning(
-                "mesh-unreadable",
-                f"Blender could not import the mesh {path.name}: {reason}; imported without it",
-                SourceLocation(shown(path)),
-                "check the mesh file (adfkit validate says why)",
-            )
-        )
-        return []
-    return sorted((o for o in scene.objects if o not in before), key=lambda o: o.name)
-
-
-def _join(objs, scene):
-    if len(objs) == 1:
-        return objs[0]
-    for o in scene.objects:
-        o.select_set(False)
-    for o in objs:
-        o.select_set(True)
-    bpy.context.view_layer.objects.active = objs[0]
-    bpy.ops.object.join()
-    return objs[0]
-
-
-def _mesh_object(name: str, path: Path | None, scene):
-    if path is not None and path.is_file():
-        made = _import_file(path, scene)
-        if made:
-            obj = _join(made, scene)
-            obj.name = name
-            obj.data.name = name
-            obj.matrix_world = Matrix.Identity(4)
-            return obj
-    return _link(scene, bpy.data.objects.new(name, None))
 
 
 def _snapshot(obj, x) -> None:
@@ -141,7 +86,7 @@ def _geometry(obj, x, doc, scene) -> None:
     col = collision_mesh_path(doc, x) if (x.collision_mesh or x.mesh) else None
     if col is None or not col.is_file() or (vis is not None and col.resolve() == vis.resolve()):
         return
-    parts = _import_file(col, scene)
+    parts = mesh_import.import_file(col, scene)
     for i, c in enumerate(parts):
         c.name = f"{obj.name}.collision{i}"
         c.adf.kind = "COLLISION_MESH"
@@ -159,7 +104,7 @@ def _body(b, doc, scene, diags):
         diags.append(
             warning("missing-mesh", f"mesh {vis} of '{b.identifier}' not found; imported as an empty", b.where("mesh"))
         )
-    obj = _mesh_object(b.name or b.identifier, vis, scene)
+    obj = mesh_import.mesh_object(b.name or b.identifier, vis, scene)
     obj.adf.kind = "BODY"
     if obj.type == "MESH":
         obj.adf.mesh_source = str(vis)
@@ -172,13 +117,13 @@ def _soft_mesh_object(name: str, path: Path | None, scene):
     """A soft body's mesh built from the nodes AMBF makes of its file (vertex i = node i, so
     `fixed nodes` index the Blender vertices); Blender's importer when that reader is missing."""
     if path is None or not path.is_file():
-        return _mesh_object(name, path, scene)
+        return mesh_import.mesh_object(name, path, scene)
     try:
         from adfkit.geometry.softmesh import load_soft_mesh
 
         sm = load_soft_mesh(path)
     except (ImportError, AdfError):
-        return _mesh_object(name, path, scene)
+        return mesh_import.mesh_object(name, path, scene)
     me = bpy.data.meshes.new(name)
     me.from_pydata(sm.nodes.tolist(), [], sm.triangles.tolist())
     me.update()
@@ -262,7 +207,7 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     errors = [d for d in diags if d.severity >= Severity.ERROR]
     if errors:
         raise AdfError(errors)
-    _UNREADABLE.clear()
+    mesh_import.UNREADABLE.clear()
     bodies: dict[str, object] = {}
     made = []
     for b in doc.bodies:
@@ -283,7 +228,7 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
             _geometry(bodies[b.identifier], b, doc, scene)
     for g in doc.ghost_objects:
         vis = visual_mesh_path(doc, g) if g.mesh else None
-        obj = _mesh_object(g.name or g.identifier, vis, scene)
+        obj = mesh_import.mesh_object(g.name or g.identifier, vis, scene)
         obj.adf.kind = "GHOST"
         if obj.type == "MESH":
             obj.adf.mesh_source = str(vis)
@@ -356,8 +301,8 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     from .volumes import import_volumes
 
     import_volumes(doc, scene, diags)  # pictures of the volumes (kind NONE: export keeps them as written)
-    diags.extend(_UNREADABLE)
-    _UNREADABLE.clear()
+    diags.extend(mesh_import.UNREADABLE)
+    mesh_import.UNREADABLE.clear()
     return made, diags
 
 

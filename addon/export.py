@@ -15,7 +15,7 @@ from adfkit.adf.writer import atomic_write_text
 from adfkit.diagnostics import Diagnostic, Severity, error
 from adfkit.model import ModelFile
 
-from . import fields, gather, meshes
+from . import fields, gather, gather_soft, meshes, namespaces
 
 HASH_FILE = ".adfkit-meshes.json"
 
@@ -76,12 +76,14 @@ def _ordered(objs, order: list[str]):
     return sorted(objs, key=lambda o: (rank.get(o.identifier, len(rank)), o.identifier))
 
 
-def gather_model(scene, objects=None) -> gather.Gathered:
+def gather_model(scene, objects=None, mesh_format: str | None = None) -> gather.Gathered:
     doc, order = _model_level(scene)
     hi, lo = _mesh_paths(doc)
     sp = scene.adf
+    fmt = (mesh_format or sp.mesh_format).upper()
     out = gather.Gathered(
-        doc, options=gather.Options(apply_modifiers=sp.apply_modifiers, low_res_ratio=sp.low_res_ratio)
+        doc,
+        options=gather.Options(apply_modifiers=sp.apply_modifiers, low_res_ratio=sp.low_res_ratio, mesh_format=fmt),
     )
     fields.PRECISION["digits"] = sp.precision
     objs = sorted(objects if objects is not None else scene.objects, key=lambda o: o.name)
@@ -95,7 +97,7 @@ def gather_model(scene, objects=None) -> gather.Gathered:
                 for attr in ("high_resolution_path", "low_resolution_path"):
                     setattr(b, attr, None)  # per-body folders are folded into the model folders
         elif k == "SOFT_BODY":
-            softs.append(gather.gather_soft_body(o, out, (hi, lo)))
+            softs.append(gather_soft.gather_soft_body(o, out, (hi, lo)))
             softs[-1].high_resolution_path = softs[-1].low_resolution_path = None
         elif k == "GHOST":
             ghosts.append(gather.gather_ghost(o, out, (hi, lo)))
@@ -106,6 +108,7 @@ def gather_model(scene, objects=None) -> gather.Gathered:
         elif k in gather.GATHER:
             key, fn = gather.GATHER[k]
             other[key].append(fn(o, out))
+    out.diagnostics += namespaces.findings(objs)
     doc.bodies = _ordered(bodies, order.get("bodies", []))
     doc.soft_bodies = _ordered(softs, order.get("soft bodies", []))
     doc.ghost_objects = _ordered(ghosts, order.get("ghost objects", []))
@@ -176,10 +179,15 @@ def check_scene(scene) -> list[Diagnostic]:
     )
 
 
-def export_scene(scene, out_dir: str | Path, name: str = "model", objects=None) -> ExportResult:
+def export_scene(
+    scene, out_dir: str | Path, name: str = "model", objects=None, mesh_format: str | None = None
+) -> ExportResult:
+    """Gather, validate, then write the meshes and last the model file. ``mesh_format`` ('OBJ',
+    'STL', 'PLY', '3DS'; default: the scene's export option) is the format of the meshes
+    written; meshes imported and left unchanged are copied in their own format."""
     out_dir = Path(out_dir)
     target = out_dir / f"{name}.yaml"
-    g = gather_model(scene, objects)
+    g = gather_model(scene, objects, mesh_format)
     result = ExportResult(None, list(g.diagnostics))
     if any(d.severity >= Severity.ERROR for d in result.diagnostics):
         return result
@@ -266,7 +274,7 @@ def _run_jobs(jobs, out_dir: Path, result: ExportResult) -> None:
         if job.source is not None and job.parts is None:
             result.written += meshes.copy_mesh_file(job.source, dst.parent, job.filename)
         else:
-            result.written += meshes.write_obj(job.parts, dst.parent, job.filename)
+            result.written += meshes.write_mesh(job.parts, dst.parent, job.filename, split=not job.whole)
         known[rel] = job.digest
     if jobs:
         atomic_write_text(hashes_path, json.dumps(known, indent=1, sort_keys=True))

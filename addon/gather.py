@@ -19,7 +19,7 @@ from adfkit.model.common import Geometry, ShapeEntry
 from adfkit.model.objects import Ray, SoftBody
 from adfkit.model.pose import Quat, Vec3
 
-from . import fields, joint_frames, meshes
+from . import fields, joint_frames, meshes, meshformat
 from .properties import read_group
 
 MESH_DIRS = ("meshes/high_res/", "meshes/low_res/")
@@ -32,12 +32,14 @@ class MeshJob:
     digest: str
     parts: list | None = None  # MeshArrays to write, or None to copy ``source``
     source: Path | None = None
+    whole: bool = False  # a soft body's mesh: never split into several 3DS objects (its node numbering)
 
 
 @dataclass
 class Options:
     apply_modifiers: bool = True  # export the evaluated mesh (depsgraph)
     low_res_ratio: float = 1.0  # decimate collision meshes made from the visual one
+    mesh_format: str = "OBJ"  # format of the meshes written ('OBJ', 'STL', 'PLY', '3DS')
 
 
 @dataclass
@@ -164,14 +166,15 @@ def _gather_geometry(obj, b, out: Gathered, paths: tuple[str, str]) -> None:
         # a soft body's nodes are the vertices written (its fixed nodes index the same mesh)
         arr = meshes.mesh_arrays(obj, evaluated=out.options.apply_modifiers)
         digest = meshes.digest([arr])
-        name = b.mesh if b.mesh else f"{obj.name}.OBJ"
+        fmt = out.options.mesh_format
+        name = b.mesh if b.mesh else meshes.with_format(obj.name, fmt)
         src = Path(obj.adf.mesh_source) if obj.adf.mesh_source else None
         if digest == obj.adf.mesh_hash and src is not None and src.is_file():
             job = MeshJob(hi, name, digest, source=src)
         else:
-            if Path(name).suffix.lower() != ".obj":
-                name = Path(name).stem + ".OBJ"
-            job = MeshJob(hi, name, digest, parts=[arr])
+            name = meshes.with_format(name, fmt)
+            job = MeshJob(hi, name, digest, parts=[arr], whole=isinstance(b, SoftBody))
+            out.diagnostics += meshformat.findings(obj, arr, fmt, soft=isinstance(b, SoftBody))
         b.mesh = name
         out.jobs.append(job)
         visual = job
@@ -229,15 +232,15 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
                 a.co = co.astype(np.float32)
             arrays.append(a)
         digest = meshes.digest(arrays)
+        fmt = meshformat.collision_format(obj, len(arrays), out)
         name = b.collision_mesh or (
-            first_name if first_name and obj.adf.collision_source else f"{obj.name}_collision.OBJ"
+            first_name if first_name and obj.adf.collision_source else meshes.with_format(f"{obj.name}_collision", fmt)
         )
         src = Path(obj.adf.collision_source) if obj.adf.collision_source else None
         if digest == obj.adf.collision_hash and src is not None and src.is_file():
             out.jobs.append(MeshJob(lo, name, digest, source=src))
         else:
-            if Path(name).suffix.lower() != ".obj":
-                name = Path(name).stem + ".OBJ"
+            name = meshes.with_format(name, fmt)
             out.jobs.append(MeshJob(lo, name, digest, parts=arrays))
             if b.collision_mesh_type is None:
                 b.collision_mesh_type = "CONVEX_HULL" if len(arrays) > 1 else None
@@ -250,8 +253,8 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
         ratio = out.options.low_res_ratio
         if ratio < 1.0 and obj.type == "MESH" and b.collision_mesh is None and not isinstance(b, SoftBody):
             low = meshes.decimated_arrays(obj, ratio)
-            if Path(name).suffix.lower() != ".obj":
-                name = Path(name).stem + ".OBJ"
+            if name != meshes.with_format(name, out.options.mesh_format):
+                name = meshes.with_format(name, out.options.mesh_format)
                 b.collision_mesh = name
             out.jobs.append(MeshJob(lo, name, meshes.digest([low]), parts=[low]))
             return
@@ -456,70 +459,6 @@ def gather_light(obj, out: Gathered) -> Light:
             )
         )
     return li
-
-
-# --- soft bodies ----------------------------------------------------------------------------
-
-
-def fixed_nodes(obj, evaluated: bool = False) -> list[int] | None:
-    """Node indices of the vertices in the soft body's fixed-node vertex group (None: no group),
-    counted on the mesh export writes: with ``evaluated``, the one its modifiers make (a
-    Solidify copies the group to the new shell's vertices, so both faces of a fixed rim stay)."""
-    grp = obj.vertex_groups.get(obj.adf.soft.fixed_group) if obj.type == "MESH" else None
-    if grp is None:
-        return None
-    eo = me = None
-    if evaluated and len(obj.modifiers):
-        import bpy
-
-        eo = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-        me = eo.to_mesh()
-    try:
-        data = me if me is not None else obj.data
-        members = [v.index for v in data.vertices if any(g.group == grp.index and g.weight > 0 for g in v.groups)]
-        if not members:
-            return []
-        from adfkit.geometry.softmesh import nodes_at, unique_nodes
-
-        co = np.empty(len(data.vertices) * 3, np.float32)
-        data.vertices.foreach_get("co", co)
-        co = co.reshape(-1, 3).astype(np.float64)
-        # AMBF's numbering: unique vertex positions in order of first appearance
-        return nodes_at(unique_nodes(co, np.zeros((0, 3), dtype=np.int64)), co[members])
-    finally:
-        if eo is not None:
-            eo.to_mesh_clear()
-
-
-def gather_soft_body(obj, out: Gathered, paths: tuple[str, str]) -> SoftBody:
-    from adfkit.model.objects import SoftBodyConfig
-
-    sb = fields.from_snapshot(SoftBody, obj.adf.snapshot, f"blender:{obj.name}")
-    sb.identifier = identifier(obj)
-    if sb.name is None:
-        sb.name = obj.name
-    try:
-        fields.merge(sb, fields.SOFT, read_group(obj.adf.soft, fields.SOFT))
-    except ValueError as exc:
-        out.diagnostics.append(error("body-value", f"soft body '{obj.name}': {exc}", where(obj)))
-    _pose_and_scale(obj, sb)
-    _gather_geometry(obj, sb, out, paths)
-    fixed = fixed_nodes(obj, evaluated=out.options.apply_modifiers)
-    old = sb.config.fixed_nodes if sb.config is not None else None
-    if fixed is not None and sorted(set(old or [])) != fixed and not (fixed == [] and old is None):
-        if sb.config is None:
-            sb.config = SoftBodyConfig()
-        sb.config.fixed_nodes = fixed
-    if obj.type != "MESH" and not sb.mesh:
-        out.diagnostics.append(
-            error(
-                "soft-body-mesh",
-                f"soft body '{obj.name}' has no mesh",
-                where(obj),
-                "a soft body's nodes are its mesh's vertices: make it a mesh object",
-            )
-        )
-    return sb
 
 
 GATHER = {

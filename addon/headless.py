@@ -29,10 +29,11 @@ def import_to_blend(model: Path, out_blend: Path):
     return made, diags
 
 
-def export_blend(blend: Path, out_dir, name: str):
-    """Open a .blend file and export its ADF objects; returns the export result."""
+def export_blend(blend: Path, out_dir, name: str, mesh_format: str | None = None):
+    """Open a .blend file and export its ADF objects (meshes in ``mesh_format``, default the
+    file's export option); returns the export result."""
     from . import export
 
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     ensure_registered()
-    return export.export_scene(bpy.context.scene, out_dir, name)
+    return export.export_scene(bpy.context.scene, out_dir, name, mesh_format=mesh_format)

@@ -1,4 +1,5 @@
-"""Blender meshes to files: OBJ + MTL (base-colour texture, normal map) and content hashes.
+"""Blender meshes to files: OBJ + MTL (base-colour texture, normal map), or STL, PLY, 3DS
+(adfkit.geometry.meshwrite), and content hashes.
 
 ``mesh_arrays`` is the only Blender-level function; the OBJ/MTL text writers are plain
 Python over NumPy arrays, so exports of unchanged meshes can be skipped by hash.
@@ -13,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from adfkit.adf.writer import atomic_write_text
+
 
 @dataclass
 class MeshArrays:
@@ -24,6 +27,7 @@ class MeshArrays:
     uv: np.ndarray | None = None  # (m, 2) float32 per corner
     material_index: np.ndarray | None = None
     materials: list = field(default_factory=list)  # [MaterialInfo]
+    tris: np.ndarray | None = None  # (t, 3) int32 vertex indices: Blender's triangulation of the faces
 
 
 @dataclass
@@ -47,6 +51,23 @@ def mesh_arrays(obj, name: str | None = None, evaluated: bool = False) -> MeshAr
         finally:
             eo.to_mesh_clear()
     return _arrays(obj, obj.data, name)
+
+
+def objects_from_3ds(path: Path, scene) -> list:
+    """A mesh object holding the triangles of a .3DS file (Blender 4.2+ has no 3DS importer;
+    adfkit.geometry.softmesh reads the chunks, vertices as stored). Raises AdfError for a
+    broken file."""
+    import bpy
+
+    from adfkit.geometry.softmesh import read_3ds
+
+    verts, faces = read_3ds(path)
+    me = bpy.data.meshes.new(path.stem)
+    me.from_pydata(verts.tolist(), [], faces.tolist())
+    me.update()
+    obj = bpy.data.objects.new(path.stem, me)
+    scene.collection.objects.link(obj)
+    return [obj]
 
 
 def decimated_arrays(obj, ratio: float) -> MeshArrays:
@@ -84,7 +105,10 @@ def _arrays(obj, me, name: str | None) -> MeshArrays:
     mi = np.empty(f, np.int32)
     me.polygons.foreach_get("material_index", mi)
     mats = [material_info(s.material) for s in obj.material_slots if s.material is not None]
-    return MeshArrays(name or obj.name, co.reshape(-1, 3), loops, start, total, uv, mi, mats)
+    me.calc_loop_triangles()  # Blender's own triangulation (right for concave n-gons too)
+    tris = np.empty(len(me.loop_triangles) * 3, np.int32)
+    me.loop_triangles.foreach_get("vertices", tris)
+    return MeshArrays(name or obj.name, co.reshape(-1, 3), loops, start, total, uv, mi, mats, tris.reshape(-1, 3))
 
 
 def material_info(mat) -> MaterialInfo:
@@ -189,11 +213,38 @@ def write_obj(parts: list[MeshArrays], directory: Path, filename: str) -> list[P
                     if not dst.exists() or dst.stat().st_size != Path(src).stat().st_size:
                         shutil.copyfile(src, dst)
                     written.append(dst)
-        (directory / mtl).write_text(mtl_text(list(mats.values()), tex), encoding="utf-8")
+        atomic_write_text(directory / mtl, mtl_text(list(mats.values()), tex))
         written.append(directory / mtl)
-    (directory / filename).write_text(obj_text(parts, mtl), encoding="utf-8")
+    atomic_write_text(directory / filename, obj_text(parts, mtl))
     written.append(directory / filename)
     return written
+
+
+MESH_SUFFIXES = (".OBJ", ".STL", ".PLY", ".3DS", ".DAE", ".OFF", ".GLB", ".GLTF", ".FBX")
+
+
+def with_format(name: str, fmt: str) -> str:
+    """The mesh file name with the suffix of ``fmt`` ('OBJ', 'STL', 'PLY', '3DS'): a name that
+    has it is kept, another mesh suffix is replaced, anything else (an object name such as
+    'Tray.001' or '/ambf/env/base') gets the suffix after its last part."""
+    from adfkit.geometry.meshwrite import SUFFIXES
+
+    suffix = SUFFIXES[fmt]
+    if Path(name).suffix.upper() == suffix:
+        return name
+    if Path(name).suffix.upper() in MESH_SUFFIXES:
+        return Path(name).stem + suffix
+    return name.rsplit("/", 1)[-1] + suffix
+
+
+def write_mesh(parts: list[MeshArrays], directory: Path, filename: str, split: bool = True) -> list[Path]:
+    """Write the parts in the format the file name's suffix names: OBJ (+ MTL), else STL, PLY
+    or 3DS through adfkit.geometry.meshwrite (triangles only, no materials)."""
+    if Path(filename).suffix.lower() == ".obj":
+        return write_obj(parts, directory, filename)
+    from adfkit.geometry.meshwrite import write_parts
+
+    return [write_parts(directory / filename, [(p.name, p.co, p.tris) for p in parts], split=split)]
 
 
 def copy_mesh_file(src: Path, directory: Path, filename: str) -> list[Path]:

@@ -8,7 +8,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, St
 from adfkit.diagnostics import AdfError
 
 from . import authoring
-from .properties import KINDS, SHAPES
+from .properties import KINDS, MESH_FORMATS, SHAPES
 
 
 def _report(op, exc: AdfError):
@@ -28,6 +28,11 @@ class ADF_OT_export(bpy.types.Operator):
         default=False,
         description="export the selected ADF objects only (joints need both bodies selected)",
     )
+    mesh_format: EnumProperty(
+        name="Mesh format",
+        items=MESH_FORMATS + (("SCENE", "Scene setting", "the format chosen in the sidebar's Export options"),),
+        default="SCENE",
+    )
 
     def invoke(self, context, event):
         context.window_manager.fileselect_add(self)
@@ -37,7 +42,8 @@ class ADF_OT_export(bpy.types.Operator):
         from .export import export_scene
 
         objects = list(context.selected_objects) if self.use_selection else None
-        res = export_scene(context.scene, self.directory, self.model_name, objects)
+        fmt = None if self.mesh_format == "SCENE" else self.mesh_format
+        res = export_scene(context.scene, self.directory, self.model_name, objects, mesh_format=fmt)
         context.scene.adf.findings = "\n".join(f"{d.severity.name}: {d.message}" for d in res.diagnostics)
         if not res.ok:
             self.report(

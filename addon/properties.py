@@ -33,6 +33,12 @@ KINDS = (
     ("COLLISION_SHAPE", "Collision primitive", "A primitive of its parent body's collision"),
     ("COLLISION_MESH", "Collision mesh", "A (convex) collision mesh part of its parent body"),
 )
+MESH_FORMATS = (
+    ("OBJ", "OBJ", "Wavefront OBJ with its MTL: materials, textures, several collision parts (AMBF, PyBullet, MuJoCo)"),
+    ("STL", "STL", "Binary STL: triangles only (AMBF, PyBullet, MuJoCo)"),
+    ("PLY", "PLY", "Binary PLY: triangles only, as AMBF's own add-on offered (AMBF, PyBullet, MuJoCo do not read it)"),
+    ("3DS", "3DS", "3D Studio: triangles, one object per part (AMBF; PyBullet and MuJoCo do not read it)"),
+)
 SHAPES = ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE")
 
 
@@ -222,6 +228,12 @@ class AdfSceneProps(bpy.types.PropertyGroup):
     )
     apply_modifiers: BoolProperty(
         name="Apply modifiers", default=True, description="export the evaluated mesh (modifiers applied) of each body"
+    )
+    mesh_format: EnumProperty(
+        name="Mesh format",
+        items=MESH_FORMATS,
+        default="OBJ",
+        description="file format of the meshes export writes (meshes imported and left unchanged are copied as they are)",
     )
     low_res_ratio: FloatProperty(
         name="Low-res ratio",

@@ -54,6 +54,9 @@ def draw_object(layout, obj) -> None:
                 layout.prop(s, "height")
                 layout.prop(s, "axis")
         return
+    if adf.kind == "COLLISION_MESH" or any(c.adf.kind == "COLLISION_MESH" for c in obj.children):
+        layout.operator("adf.collision_to_body_origin")
+        layout.operator("adf.collision_use_current_location")
     if pg is None:
         return
     table = fields.TABLES[adf.kind][1]
@@ -157,6 +160,7 @@ class ADF_PT_sidebar(bpy.types.Panel):
         box.prop(sc, "precision")
         box.prop(sc, "apply_modifiers")
         box.prop(sc, "low_res_ratio")
+        box.prop(sc, "mesh_format")
         col = lay.column(align=True)
         col.operator("adf.estimate_all")
         col.operator("adf.estimate_gains")
@@ -169,6 +173,7 @@ class ADF_PT_sidebar(bpy.types.Panel):
         row.operator("adf.show_collision", text="Show collision").show = True
         row.operator("adf.show_collision", text="Hide collision").show = False
         col.operator("adf.rename_joints")
+        col.operator("adf.strip_namespaces")
         col.operator("adf.cleanup")
         col.operator("adf.strip")
         box = lay.box()

@@ -10,6 +10,14 @@ def add_arguments(parser) -> None:
     parser.add_argument("blend", help=".blend file authored with the adfkit add-on")
     parser.add_argument("out_dir", help="folder for MODEL.yaml and its meshes")
     parser.add_argument("--name", default=None, help="model file name without .yaml (default: the .blend name)")
+    parser.add_argument(
+        "--mesh-format",
+        type=str.upper,
+        choices=("OBJ", "STL", "PLY", "3DS"),
+        default=None,
+        help="format of the meshes written (default: the .blend's export option, OBJ unless changed); "
+        "AMBF loads OBJ, STL and 3DS, PyBullet and MuJoCo OBJ and STL",
+    )
 
 
 def run(args) -> int:
@@ -27,7 +35,7 @@ def run(args) -> int:
             )
         )
     _, addon = load_addon()
-    res = addon.headless.export_blend(blend, args.out_dir, args.name or blend.stem)
+    res = addon.headless.export_blend(blend, args.out_dir, args.name or blend.stem, mesh_format=args.mesh_format)
     if res.diagnostics:
         print_diagnostics(res.diagnostics)
     if not res.ok:

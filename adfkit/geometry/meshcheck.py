@@ -1,10 +1,11 @@
-"""A cheap structural read of the mesh files physics engines take (STL, OBJ): does the file
+"""A cheap structural read of the mesh files physics engines take (STL, OBJ) and AMBF's 3DS: does the file
 hold triangles at all? Used by the validator (before a run) and by the runner (before
 PyBullet, which crashes on an OBJ without faces and reads random bytes as an STL).
 
 No trimesh here: the validator imports this, and it must stay fast. A binary STL is its
 80-byte header, a triangle count and 50 bytes per triangle; an ASCII STL has ``facet`` and
-``vertex`` lines; an OBJ has ``v`` and ``f`` lines. Other formats get no opinion (None).
+``vertex`` lines; an OBJ has ``v`` and ``f`` lines; a 3DS file's chunks must nest and hold a
+triangle object. Other formats get no opinion (None).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ def mesh_problem(path: str | os.PathLike) -> str | None:
 @lru_cache(maxsize=4096)
 def _problem(path: str, size: int, _mtime: int) -> str | None:
     suffix = os.path.splitext(path)[1].lower()
-    if suffix not in (".stl", ".obj"):
+    if suffix not in (".stl", ".obj", ".3ds"):
         return None
     try:
         data = inputs.read_bytes(path, "mesh", what="mesh file")
@@ -42,7 +43,19 @@ def _problem(path: str, size: int, _mtime: int) -> str | None:
         return None
     if suffix == ".stl":
         return _stl_problem(data)
+    if suffix == ".3ds":
+        return _3ds_problem(path)
     return _obj_problem(data)
+
+
+def _3ds_problem(path: str) -> str | None:
+    from .softmesh import read_3ds  # numpy only: the chunk walk
+
+    try:
+        read_3ds(path)
+    except AdfError as exc:
+        return exc.diagnostics[0].message
+    return None
 
 
 def _stl_problem(data: bytes) -> str | None:

@@ -16,7 +16,7 @@ from .. import inputs
 from ..diagnostics import AdfError, SourceLocation, error
 
 #: Suffixes we hand to trimesh (lower case). DAE needs pycollada; trimesh says so if absent.
-MESH_SUFFIXES = (".stl", ".obj", ".ply", ".dae", ".off", ".glb", ".gltf")
+MESH_SUFFIXES = (".stl", ".obj", ".ply", ".3ds", ".dae", ".off", ".glb", ".gltf")
 
 
 def _fail(rule: str, message: str, path: str | os.PathLike, hint: str) -> AdfError:
@@ -53,7 +53,7 @@ def _as_single_mesh(loaded, path) -> trimesh.Trimesh:
 def load_mesh(
     path: str | os.PathLike, scale: float = 1.0, tree: inputs.Tree | None = None, referrer: SourceLocation | None = None
 ) -> trimesh.Trimesh:
-    """Load STL/OBJ/PLY/DAE (whatever trimesh reads) as one triangle mesh, times ``scale``.
+    """Load STL/OBJ/PLY/DAE (whatever trimesh reads) or 3DS as one triangle mesh, times ``scale``.
 
     ``scale`` multiplies vertex coordinates about the mesh origin, as ADF's per-body
     ``scale`` does for visual and collision meshes (adf-format.md §12.3). Multi-object
@@ -75,9 +75,16 @@ def load_mesh(
         )
     suffix = p.suffix.lower()
     try:
-        loaded = trimesh.load(
-            str(p), file_type=suffix.lstrip(".") or None, force=None, process=False, skip_materials=True
-        )
+        if suffix == ".3ds":  # trimesh has no 3DS reader; softmesh has (CHAI3D's reading: vertices as stored)
+            from .softmesh import read_3ds
+
+            loaded = trimesh.Trimesh(*read_3ds(p), process=False)
+        else:
+            loaded = trimesh.load(
+                str(p), file_type=suffix.lstrip(".") or None, force=None, process=False, skip_materials=True
+            )
+    except AdfError:
+        raise
     except Exception as exc:  # trimesh raises many types for bad input
         raise _fail(
             "mesh-unreadable",

@@ -17,6 +17,7 @@ from ..model.objects import Body, Ghost, SoftBody
 from . import softbody_rules, volume_rules
 from .rules import RULES
 
+AMBF_MESH_SUFFIXES = (".obj", ".stl", ".3ds")  # what CHAI3D's cMultiMesh::loadFromFile reads for AMBF
 TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")
 
 
@@ -127,6 +128,16 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
             if path is None or str(path) in seen:
                 continue
             seen.add(str(path))
+            if path.suffix.lower() not in AMBF_MESH_SUFFIXES:
+                out.append(
+                    _d(
+                        "mesh-format",
+                        f"mesh {inputs.shown(path.name)} of '{obj.identifier}': AMBF loads OBJ, 3DS and STL "
+                        f"meshes, not {path.suffix or 'files without a suffix'}",
+                        obj.where(key),
+                        "export the mesh as OBJ, STL or 3DS",
+                    )
+                )
             if not _present(path):
                 out.append(
                     _d(

@@ -165,8 +165,14 @@ _RULES = [
     Rule(
         "mesh-unreadable",
         W,
-        "An STL/OBJ mesh holds no triangles or is not a valid file (AMBF skips the body)",
+        "An STL/OBJ/3DS mesh holds no triangles or is not a valid file (AMBF skips the body)",
         "`mesh: part.stl` that is 300 random bytes, or an OBJ with no `f` lines",
+    ),
+    Rule(
+        "mesh-format",
+        W,
+        "A mesh file in a format AMBF does not load: CHAI3D reads OBJ, 3DS and STL only (AMBF skips the mesh)",
+        "`mesh: part.PLY`",
     ),
     Rule(
         "missing-texture",

@@ -162,6 +162,8 @@ def build_plan(world) -> Plan:
             for loss in ls:  # the MJCF writer already made a flat collision mesh a thin box (engine_fit)
                 if loss.feature == "collision mesh" and "flat" in loss.reason:
                     world._warn("runner-flat-mesh", f"{loss.element}: {loss.reason}", m.body(loss.element))
+                elif loss.feature == "mesh" and "is not read by" in loss.reason:  # PLY, 3DS: converted or left out
+                    world._warn("runner-mesh-format", f"{loss.element}: {loss.reason}", m.body(loss.element))
             child = _parse_spec(text, m)
             _resolve_meshes(world, child, out_dir, m)
             prefix = f"m{i}/"

@@ -36,7 +36,9 @@ class Assembly:
                 sb = make_sim_body(merge_namespace(ns, b.namespace) + b.identifier, b, m)
                 sb.cid = self.cid
                 sb.gravity = body_gravity(b, m, self.gravity)
-                sb._parts = collision_parts(m, b, sb.ref_in_body, b.scale or 1.0, sb.static, self.diagnostics)
+                sb._parts = collision_parts(
+                    m, b, sb.ref_in_body, b.scale or 1.0, sb.static, self.diagnostics, self.soft is not None
+                )
                 if sb._parts is None:
                     self.skipped.append(sb.key)
                     continue
@@ -173,7 +175,9 @@ class Assembly:
     def _shapes_for(self, sb: SimBody, frame_in_body) -> tuple[int, int]:
         b, m = sb.body, sb.model
         if frame_in_body is not sb.ref_in_body or sb._parts is None:
-            sb._parts = collision_parts(m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics)
+            sb._parts = collision_parts(
+                m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics, self.soft is not None
+            )
         col = create_collision(sb._parts, self.cid, b, self.diagnostics) if sb._parts is not None else -1
         vis = create_visual(m, b, frame_in_body, b.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
         return col, self._plane_visual(sb._parts, col, vis)

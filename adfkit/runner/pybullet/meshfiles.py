@@ -71,3 +71,51 @@ def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
     out = os.path.join(_STL_DIR, f"mesh_{len(_STL_CACHE)}.stl")
     mesh.export(out, file_type="stl")
     return out, None
+
+
+def is_convex(path: Path, rel: float = 1e-3) -> bool:
+    """True when the mesh encloses its own convex hull (volumes within ``rel``): a convex hull of
+    it collides exactly as its triangles do. False for open, concave or unreadable meshes."""
+    from ...geometry.meshio import load_mesh  # trimesh: only for a static concave mesh beside soft bodies
+
+    try:
+        mesh = load_mesh(path)
+        if not mesh.is_volume:
+            return False
+        return abs(mesh.convex_hull.volume - mesh.volume) <= rel * mesh.convex_hull.volume
+    except (AdfError, ValueError):
+        return False
+
+
+def obj_colour(path: Path, tree=None) -> list[float] | None:
+    """RGBA of the first material an OBJ file uses (its MTL's `Kd` and `d`), or None: how a soft
+    body without `color rgba` gets its colour (AMBF's mesh loader reads the MTL; PyBullet's
+    soft bodies are loaded from a plain copy of the nodes and would be drawn white)."""
+    if path.suffix.lower() != ".obj":
+        return None
+    try:
+        text = inputs.read_text(path, "mesh", tree=tree, what="mesh file")
+        libs = [ln.split(None, 1)[1].strip() for ln in text.splitlines() if ln.startswith("mtllib ")]
+        used = next((ln.split(None, 1)[1].strip() for ln in text.splitlines() if ln.startswith("usemtl ")), None)
+        if not libs:
+            return None
+        mtl = inputs.read_text(path.parent / libs[0], "mesh", tree=tree, what="material file")
+    except (AdfError, IndexError):
+        return None
+    current, kd, alpha = None, {}, {}
+    for line in mtl.splitlines():
+        parts = line.split()
+        if len(parts) >= 2 and parts[0] == "newmtl":
+            current = parts[1]
+        elif len(parts) >= 4 and parts[0] == "Kd" and current is not None:
+            kd[current] = parts[1:4]
+        elif len(parts) >= 2 and parts[0] == "d" and current is not None:
+            alpha[current] = parts[1]
+    name = used if used in kd else next(iter(kd), None)
+    if name is None:
+        return None
+    try:
+        rgba = [float(c) for c in kd[name]] + [float(alpha.get(name, 1.0))]
+    except ValueError:
+        return None
+    return rgba if all(np.isfinite(rgba)) else None

@@ -31,7 +31,7 @@ from ...model.semantics import (
 )
 from ..plan import rgba
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
-from .meshfiles import MESH_SUFFIXES, mesh_refusal, pybullet_mesh
+from .meshfiles import MESH_SUFFIXES, is_convex, mesh_refusal, pybullet_mesh
 
 
 @dataclass
@@ -141,9 +141,13 @@ def _missing_dimension(prim: Primitive) -> str | None:
 
 
 def collision_parts(
-    model, obj, frame_in_body, scale: float, static: bool, diags: list[Diagnostic]
+    model, obj, frame_in_body, scale: float, static: bool, diags: list[Diagnostic], deformable: bool = False
 ) -> ShapeParts | None:
-    """The collision shape of a body or ghost, or None when AMBF would skip the object."""
+    """The collision shape of a body or ghost, or None when AMBF would skip the object.
+    ``deformable``: the world has soft bodies, which cannot collide with a triangle mesh
+    (Bullet's sparse SDF gives every point a distance 0 to a non-convex shape, so the nodes
+    near one are pushed away): a static concave mesh is played as convex hulls, one per OBJ
+    object, with a warning unless the mesh is convex anyway."""
     parts = ShapeParts()
     margin = obj.collision_margin if obj.collision_margin is not None else 0.001
     body_to_com = invert(frame_in_body)
@@ -203,16 +207,29 @@ def collision_parts(
         diags.append(
             warning(
                 "runner-mesh-format",
-                f"{obj.identifier}: {path.suffix} meshes are not readable by PyBullet; no collision shape",
-                obj.source,
-                "convert the mesh to OBJ or STL",
+                f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: PyBullet reads OBJ and STL meshes, "
+                f"not {path.suffix or 'files without a suffix'}; no collision shape",
+                obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
+                "export the mesh as OBJ or STL",
             )
         )
         return parts
     kind, _ = collision_mesh_type(obj.collision_mesh_type)
     pos, orn = matrix_to_pq(body_to_com)
     kw = dict(fileName=str(path), meshScale=[scale] * 3, collisionFramePosition=pos, collisionFrameOrientation=orn)
-    if kind is CollisionMeshType.CONCAVE_MESH and static:
+    if kind is CollisionMeshType.CONCAVE_MESH and static and deformable:
+        if not is_convex(path):
+            diags.append(
+                warning(
+                    "runner-soft-concave",
+                    f"{obj.identifier}: concave collision mesh {inputs.shown(path.name)} played as convex hulls "
+                    "(one per OBJ object): PyBullet's soft bodies cannot collide with a triangle mesh and are "
+                    "torn apart near one",
+                    obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
+                    "decompose the mesh (the add-on's Generate convex collision) to keep its hollows",
+                )
+            )
+    elif kind is CollisionMeshType.CONCAVE_MESH and static:
         kw["flags"] = pb.GEOM_FORCE_CONCAVE_TRIMESH  # exact triangles: only static bodies in PyBullet
     # Dynamic concave meshes: PyBullet builds one convex hull per OBJ sub-mesh (documented approximation).
     parts.add(pb.GEOM_MESH, **kw)
@@ -327,6 +344,15 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int, diags: list
         )
         return -1
     if suffix not in MESH_SUFFIXES:
+        diags.append(
+            warning(
+                "runner-mesh-format",
+                f"{obj.identifier}: visual mesh {inputs.shown(path.name)}: PyBullet reads OBJ and STL meshes, "
+                f"not {path.suffix or 'files without a suffix'}; the body is drawn without it",
+                obj.where("mesh") or obj.source,
+                "export the mesh as OBJ or STL",
+            )
+        )
         return -1
     kw = dict(base)
     if rgba(obj) is None:

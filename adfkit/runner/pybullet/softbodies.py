@@ -32,12 +32,14 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 
+from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import AdfError
 from ...geometry.softmesh import DEFAULT_SOFT_MASS, link_stiffness, placed_soft_mesh, write_obj
 from ...model.semantics import pose_or_identity
 from ..names import merge_namespace
 from ..plan import rgba
 from ..rotations import pose_to_matrix
+from .meshfiles import obj_colour
 
 DEFAULT_MARGIN = 0.001  # adf-format.md §7.4
 CL_SELF = 0x40  # btSoftBody::fCollision::CL_SELF
@@ -155,6 +157,10 @@ class SoftBodies:
             w._warn("runner-soft-body", f"{sb.identifier}: PyBullet could not load the soft body; skipped", sb)
             return None
         colour = rgba(sb)
+        if colour is None and getattr(sb, "use_material", None) is not False:  # its mesh's material, as AMBF
+            for where in (visual_mesh_path(m, sb), collision_mesh_path(m, sb)):
+                if colour is None and where is not None:
+                    colour = obj_colour(where, getattr(m, "tree", None))
         if colour is not None:
             pb.changeVisualShape(uid, -1, rgbaColor=colour, physicsClientId=w.cid)
         span = mesh.nodes.max(axis=0) - mesh.nodes.min(axis=0)
