@@ -54,7 +54,7 @@ TOOL_CLEARANCE = 0.0015  # m the planner keeps the tool's shapes from the tissue
 JAW_APPROACH = 0.35
 GRASP_STEP = math.radians(6)  # the planner tries grasps this far apart along the wire ...
 MIN_GRASP = math.radians(8)  # ... from this far from the tip or the tail (the jaws' width)
-GOOD_MARGIN = 0.05  # of each joint's range: a grasp's joint margin counts up to this against its clearance
+GUARD_N = 5.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
 
@@ -324,13 +324,13 @@ class SutureTask:
                 back = ee.copy()
                 back[:, :3, 3] -= BACK_OFF * ee[:, :3, 2]
                 clear = np.minimum(clear, clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE))
-        # the score: the clearance (up to TOOL_CLEARANCE) counts twice as much as the joint margin
-        # (up to GOOD_MARGIN); beyond both, the wider margin
-        clear_term = clear / TOOL_CLEARANCE
+        # the choice: the clearance (up to TOOL_CLEARANCE, in tenths of a millimetre), then the
+        # wider joint margin
+        clear_q = np.round(clear / 1e-4)
         best, best_key = None, None
-        for i in np.argsort(-clear_term, kind="stable"):
-            if best_key is not None and clear_term[i] + 0.5 < best_key[0]:
-                break  # the rest come nearer the tissue than a wider margin could make up for
+        for i in np.argsort(-clear_q, kind="stable"):
+            if best_key is not None and clear_q[i] < best_key[0]:
+                break  # the rest come nearer the tissue
             m, turn = cands[i]
             first = needle_poses[0] @ m
             back = first.copy()
@@ -341,7 +341,7 @@ class SutureTask:
                     break
                 worst = min(worst, self._margin(psm, pose @ m))
             margin = worst - 0.02 * turn
-            key = (float(clear_term[i]) + 0.5 * min(margin, GOOD_MARGIN) / GOOD_MARGIN, margin)
+            key = (float(clear_q[i]), margin)
             if worst > 0 and (best_key is None or key > best_key):
                 best, best_key = Grasp(m, margin, float(clear[i])), key
         if best is None:
@@ -398,6 +398,21 @@ class SutureTask:
         for _ in range(self._steps(seconds)):
             yield self.phase
 
+    def line(self, psm: PSM, a: np.ndarray, b: np.ndarray, seconds: float, guarded: bool = False):
+        """The end effector from pose a to pose b along a straight line (Cartesian). Guarded: it
+        stops where the tool first presses on the tissue with GUARD_N (and stays there), as a
+        hand stops on touching; the plan keeps the tools off the tissue, but a few tenths of a
+        millimetre of clearance leave no room for the servo's overshoot."""
+        n = self._steps(seconds)
+        links = [sb for sb in self.world.bodies if sb.articulation is psm.art] if guarded else []
+        tissue = {id(sb) for sb in self.world.bodies if sb.model is self.needle.model and sb.static}
+        for i in range(1, n + 1):
+            self.servo_world(psm, interpolate(a, b, _smooth(i / n)))
+            yield self.phase
+            if links and any(f >= GUARD_N for sb in links for o, f, _ in self.world.contacts(sb) if id(o) in tissue):
+                self.servo_world(psm, self.setpoint_world(psm) @ invert(psm.setpoint_cp()) @ psm.measured_cp())
+                return
+
     def carry(self, path, seconds: float):
         """The holder moves the needle through needle poses path(s), s in [0, 1] (Cartesian)."""
         psm = self.psms[self.holder]
@@ -419,7 +434,8 @@ class SutureTask:
         above[:3, 3] -= BACK_OFF * goal[:3, 2]
         psm.servo_jaw(opening)
         yield from self.move(psm, above, 0.8)
-        yield from self.move(psm, goal, 0.5, settle=0.2)
+        yield from self.line(psm, above, goal, 0.5, guarded=True)  # along the jaw axis, as the plan checked it
+        yield from self.wait(0.2)
         ee = psm.base_in_world() @ psm.measured_cp()
         miss = float(np.linalg.norm(ee[:3, 3] - (self.needle_pose() @ grasp.ee_in_needle)[:3, 3]))
         if miss > 0.004:
@@ -477,7 +493,7 @@ class SutureTask:
             moved[name] = float(np.linalg.norm(shift))
         return moved
 
-    def plan(self):
+    def plan(self, tools: dict | None = None):
         """Needle poses of the whole suture and, per pair, the grasps that reach them: the
         driver's (from where it takes the needle, over the approach, along the insertion) and
         the puller's (along the pull and the lift)."""
@@ -488,7 +504,7 @@ class SutureTask:
             (hole_frame(self.world, p.entry)[:3, 3] + hole_frame(self.world, p.exit)[:3, 3]) / 2 for p in self.pairs
         ]
         self.tissue_shapes = Tissue(static, centres)
-        self.tools = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
+        self.tools = tools or {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
         self.frames = {p.index: self.arc_frame(p) for p in self.pairs}
         self.drive_grasps, self.pull_grasps, self.out_poses, self.handbacks = [], [], [], []
         self.pulls: list[tuple[float, list, tuple]] = []  # per pair: the grasp's angle, the poses, where clear
@@ -622,11 +638,19 @@ class SutureTask:
         """The whole suture, one yield per control step."""
         self._set_phase("settle")
         for name in self.psms:
-            self.psms[name].servo_jaw(JAW_APPROACH)  # as they come onto the wire (tool_points)
+            self.psms[name].servo_jaw(JAW_OPEN)
         self.base_moves = self.setup_joints()
         self._arms_apart()
         yield from self.jitter()
-        self.plan()
+        # the tools' shapes as the jaws come onto the wire: wide open (the pick-up), then
+        # at JAW_APPROACH (the fingers reach 0.8 mm farther along the jaw axis)
+        tools = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
+        for name in self.psms:
+            self.psms[name].servo_jaw(JAW_APPROACH)
+        yield from self.wait(0.3)
+        for n, psm in self.psms.items():
+            tools[n].add_jaws(ToolShape(self.world, psm))
+        self.plan(tools)
         d, p = self.psms[self.driver], self.psms[self.puller]
         park = {n: self.parked(self.psms[n]) for n in self.psms}
         self._set_phase("pick up")

@@ -18,6 +18,7 @@ from __future__ import annotations
 TOOL_HIT_N: float | None = 50.0
 
 SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
+BLOCK_N = 1.0  # N: a carried needle pressing on the tissue this hard on its way to a hole is blocked there
 RULES = (
     "not-tried",
     "reach",
@@ -57,16 +58,17 @@ def _hole(obs, k: int, kind: str):
     return next(h for h in obs.holes if h.pair == k and h.kind == kind)
 
 
-def _blocked_reason(obs, k: int, entry) -> tuple[str, str]:
-    """What stopped the tip at entry k: the bodies the tip pressed on (else the needle), with
-    their contact forces, and a boundary narrower than the wire."""
+def _blocked_reason(obs, k: int, entry, phase: str = "") -> tuple[str, str]:
+    """What stopped the tip at entry k: the bodies the tip pressed on (else the needle) in
+    ``phase`` (the insertion), with their contact forces, and a boundary narrower than the wire."""
+    phase = phase or f"insert {k}"
     label = _label(entry)
     width = 2 * float(min(entry.half)) if entry.half is not None else None
     narrow = ""
     if width is not None and width < 2 * obs.wire_radius:
         narrow = f"; its opening ({_mm(width)}) is narrower than the needle's wire ({_mm(2 * obs.wire_radius)})"
-    at_tip = getattr(obs, "tip_contacts", {}).get(f"insert {k}", {})
-    forces = at_tip or obs.needle_contacts.get(f"insert {k}", {})
+    at_tip = getattr(obs, "tip_contacts", {}).get(phase, {})
+    forces = at_tip or obs.needle_contacts.get(phase, {})
     if forces:
         who = "the tip" if at_tip else "the needle"
         hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forces.items(), key=lambda kv: -kv[1]) if f >= 0.05)
@@ -104,6 +106,15 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         return "not-tried", f"not tried: the episode stopped before it ({failure or 'no failure recorded'})"
     ins = [c for c in entry.crossings if c["inward"]]
     if not ins:
+        approach = f"carry {k}"
+        if (
+            failed_here
+            and failure_phase == approach
+            and any(f >= BLOCK_N for f in obs.needle_contacts.get(approach, {}).values())
+        ):
+            # stopped on the way to the hole with the needle pressing on the tissue: what is there blocks it
+            rule, reason = _blocked_reason(obs, k, entry, approach)
+            return rule, f"{reason}, before the insertion (the planner stopped: {failure})"
         if failed_here and not (failure_phase or "").startswith(("insert", "regrasp")):
             return "reach", failure
         return _blocked_reason(obs, k, entry)
