@@ -80,7 +80,7 @@ def _add_texture(spec, name: str, image: Path, tree) -> None:
 
     from PIL import Image
 
-    data = inputs.read_bytes(image, "mesh", tree=tree, what="texture image")
+    data = inputs.read_bytes(image, "image", tree=tree, what="texture image")
     with Image.open(BytesIO(data)) as im:
         rgb = np.asarray(im.convert("RGB"), dtype=np.uint8)
     tex = spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D)
