@@ -15,7 +15,7 @@ from adfkit.adf.writer import atomic_write_text
 from adfkit.diagnostics import Diagnostic, Severity, error
 from adfkit.model import ModelFile
 
-from . import fields, gather, gather_soft, meshes, namespaces
+from . import fields, gather, gather_soft, meshes, namespaces, volumes
 
 HASH_FILE = ".adfkit-meshes.json"
 
@@ -113,6 +113,7 @@ def gather_model(scene, objects=None, mesh_format: str | None = None) -> gather.
     doc.soft_bodies = _ordered(softs, order.get("soft bodies", []))
     doc.ghost_objects = _ordered(ghosts, order.get("ghost objects", []))
     doc.joints = _ordered(joints, order.get("joints", []))
+    doc.volumes = [*doc.volumes, *volumes.gather_authored(objs)]  # those authored here, where they stand
     for key, items in other.items():
         setattr(doc, key, _ordered(items, order.get(key, [])))
     seen: dict[str, str] = {}
@@ -173,10 +174,9 @@ def check_scene(scene) -> list[Diagnostic]:
     g = gather_model(scene)
     if any(d.severity >= Severity.ERROR for d in g.diagnostics):
         return g.diagnostics
-    return merge_findings(
-        list(g.diagnostics),
-        validate(dumps(g.model), Path("model.yaml"), {Path(j.directory) / j.filename for j in g.jobs}),
-    )
+    found = validate(dumps(g.model), Path("model.yaml"), {Path(j.directory) / j.filename for j in g.jobs})
+    source = json.loads(scene.adf.snapshot).get("source_dir") if scene.adf.snapshot else None
+    return merge_findings(list(g.diagnostics), volumes.read_where_they_are(found, g.model, source))
 
 
 def export_scene(
@@ -193,6 +193,7 @@ def export_scene(
         return result
     source = json.loads(scene.adf.snapshot).get("source_dir") if scene.adf.snapshot else None
     copies = rebase_paths(g.model, Path(source), out_dir) if source else []
+    copies += rebase_authored(g.model, objects if objects is not None else scene.objects, out_dir)
     text = dumps(g.model)
     pending = {out_dir / j.directory / j.filename for j in g.jobs}
     # the folder exists while the text is validated (paths through it, such as ../x, resolve);
@@ -256,6 +257,21 @@ def rebase_paths(model: ModelFile, source_dir: Path, out_dir: Path) -> list[tupl
             im.path = rebase(im.path, [*names, "labels.yaml"])  # the tissues `adfkit drill` reads, when there
     if getattr(model, "shaders", None) is not None:
         model.shaders.path = rebase(model.shaders.path, shader_files(model.shaders))
+    return copies
+
+
+def rebase_authored(model: ModelFile, objs, out_dir: Path) -> list[tuple[Path, Path]]:
+    """The slice folders of the volumes authored in Blender (absolute, addon/volumes.py) written
+    as :func:`rebase_paths` writes an imported volume's: relative to the new file when inside
+    its tree, else the slices copied beside it. Returns the copies to make."""
+    ids = {o[volumes.VOLUME_KEY] for o in objs if volumes.AUTHORED_KEY in o}
+    copies: list[tuple[Path, Path]] = []
+    for vol in model.volumes:
+        im = vol.images
+        if vol.identifier in ids and im is not None and im.path and os.path.isabs(im.path):
+            folder = Path(im.path)
+            im.path = folder.name + "/"
+            copies += rebase_paths(ModelFile(volumes=[vol]), folder.parent, out_dir)
     return copies
 
 

@@ -9,6 +9,7 @@ from adfkit.diagnostics import AdfError
 
 from . import authoring
 from .properties import KINDS, MESH_FORMATS, SHAPES
+from .volumes import ADF_OT_add_volume
 
 
 def _report(op, exc: AdfError):
@@ -351,6 +352,7 @@ CLASSES = (
     ADF_OT_fix_nodes,
     ADF_OT_show_collision,
     ADF_OT_rename_joints,
+    ADF_OT_add_volume,
 )
 
 

@@ -11,6 +11,8 @@ import pytest
 bpy = pytest.importorskip("bpy")
 pytest.importorskip("skimage", reason="scikit-image (geometry extra) is not installed")
 
+from conftest import ROOT  # noqa: E402
+
 from adfkit.adf import read_file  # noqa: E402
 from adfkit.adf.writer import file_to_plain  # noqa: E402
 from adfkit.diagnostics import Severity  # noqa: E402
@@ -74,3 +76,120 @@ def test_a_volume_whose_slices_are_gone_is_not_shown_and_not_exported(addon, dri
     res = addon.export.export_scene(bpy.context.scene, drilling, "drill_back")
     assert not res.ok and [d.rule for d in res.diagnostics if d.severity >= Severity.ERROR] == ["volume-slice-missing"]
     assert not (drilling / "drill_back.yaml").exists()
+
+
+# ---- a volume authored from a folder of slices ----------------------------------------------
+SAMPLE = ROOT / "sample_scenes" / "drilling"
+
+
+def _author(tmp_path, folder, **kw):
+    """The Add volume operator, as the sidebar runs it; returns its result."""
+    args = dict(
+        directory=str(folder),
+        volume_name="Bone",
+        dimensions=(0.04, 0.04, 0.04),
+        iso_value=0.5,
+        use_colour=True,
+        colour=(0.93, 0.89, 0.78, 1.0),
+    )
+    return bpy.ops.adf.add_volume(**{**args, **kw})
+
+
+def test_a_volume_authored_from_slices_exports_as_the_sample_has_it(addon, tmp_path):
+    """The drilling sample's slices authored into an empty scene, exported into another folder:
+    `adfkit validate` accepts the file, its volume has the sample's keys and values (the slices
+    copied beside it, as the folder lies outside the new file's tree)."""
+    from adfkit.cli import main
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    assert _author(tmp_path, SAMPLE / "slices") == {"FINISHED"}
+    (obj,) = [o for o in bpy.context.scene.objects if o.get(addon.volumes.VOLUME_KEY) == "VOLUME Bone"]
+    obj.location = (0.0, 0.0, 0.02)  # moved where the sample has it: the export takes it from here
+    bpy.context.view_layer.update()
+    sample, _ = read_file(SAMPLE / "drill.yaml")
+    from adfkit.geometry.volume import iso_surface, load_volume
+
+    _, faces = iso_surface(load_volume(sample, sample.volumes[0]), 0.5)
+    assert len(obj.data.polygons) == len(faces) > 1000  # the iso-surface in the viewport
+    assert tuple(round(c, 3) for c in obj.color) == (0.93, 0.89, 0.78, 1.0)
+    out = tmp_path / "out"
+    res = addon.export.export_scene(bpy.context.scene, out, "bone")
+    assert res.ok, [d.message for d in res.diagnostics]
+    assert main(["validate", str(res.path)]) == 0
+    back, _ = read_file(res.path)
+    assert file_to_plain(back)["volumes"] == ["VOLUME Bone"]
+    assert file_to_plain(back)["VOLUME Bone"] == file_to_plain(sample)["VOLUME Bone"]
+    assert sorted(p.name for p in (out / "slices").iterdir()) == sorted(p.name for p in (SAMPLE / "slices").iterdir())
+
+
+def test_an_authored_volume_inside_the_tree_is_written_relative_to_the_file(addon, tmp_path):
+    """Slices beside the exported file are named where they are, not copied."""
+    shutil.copytree(SAMPLE / "slices", tmp_path / "scan" / "ct")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    assert _author(tmp_path, tmp_path / "scan" / "ct", use_colour=False) == {"FINISHED"}
+    res = addon.export.export_scene(bpy.context.scene, tmp_path / "model", "m")
+    assert res.ok, [d.message for d in res.diagnostics]
+    vol = read_file(res.path)[0].volumes[0]
+    assert (vol.images.path, vol.images.prefix, vol.images.format, vol.images.count) == (
+        "../scan/ct/",
+        "bone_",
+        "png",
+        48,
+    )
+    assert vol.color_rgba is None and not (tmp_path / "model" / "ct").exists()
+
+
+def test_check_reads_the_slices_where_they_are(addon, tmp_path):
+    """The Check operator (nothing written yet) reads an authored volume's slices from its
+    folder and an imported one's beside its file: no finding; a slice taken away is one."""
+    shutil.copytree(SAMPLE / "slices", tmp_path / "ct")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    assert _author(tmp_path, tmp_path / "ct") == {"FINISHED"}
+    assert addon.authoring.problems(bpy.context.scene) == []
+    (tmp_path / "ct" / "bone_7.png").unlink()
+    (found,) = addon.authoring.problems(bpy.context.scene)
+    assert found.startswith("ERROR: volume 'VOLUME Bone': no such slice 7") and "bone_7.png" in found
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon.build.import_model(SAMPLE / "drill.yaml")
+    assert addon.authoring.problems(bpy.context.scene) == []
+
+
+def test_a_folder_with_a_gap_is_refused_with_a_reason(addon, tmp_path):
+    """(every kind of bad folder: tests/test_volume_folder.py)"""
+    from PIL import Image
+
+    from adfkit.diagnostics import AdfError
+
+    folder = tmp_path / "slices"
+    folder.mkdir()
+    for i in (0, 1, 3):
+        Image.new("L", (8, 8), 255).save(folder / f"ct_{i}.png")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    with pytest.raises(AdfError) as exc:
+        addon.volumes.author_volume(bpy.context.scene, folder, "Bone", (0.04, 0.04, 0.04), 0.5)
+    (d,) = exc.value.diagnostics
+    assert d.rule == "volume-slice-gap" and "ct_2.png missing" in d.message and str(folder) in d.message, d
+    # the operator says it in the UI (Blender raises it to a script as a RuntimeError), nothing added
+    with pytest.raises(RuntimeError, match=r"has gaps: ct_2.png missing .* — number the slices 0, 1, 2"):
+        _author(tmp_path, folder)
+    assert not list(bpy.context.scene.objects)
+
+
+def test_bad_settings_and_a_taken_name_are_refused(addon, tmp_path):
+    from adfkit.diagnostics import AdfError
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    for kw, rule in (
+        (dict(dimensions=(0.04, 0.0, 0.04)), "volume-dimensions"),
+        (dict(iso=1.0), "volume-iso"),
+        (dict(name=" "), "volume-name"),
+    ):
+        args = {"folder": SAMPLE / "slices", "name": "Bone", "dimensions": (0.04, 0.04, 0.04), "iso": 0.5, **kw}
+        with pytest.raises(AdfError) as exc:
+            addon.volumes.author_volume(scene, **args)
+        assert exc.value.diagnostics[0].rule == rule
+    addon.volumes.author_volume(scene, SAMPLE / "slices", "Bone", (0.04, 0.04, 0.04), 0.5)
+    with pytest.raises(AdfError) as exc:
+        addon.volumes.author_volume(scene, SAMPLE / "slices", "Bone", (0.04, 0.04, 0.04), 0.5)
+    assert exc.value.diagnostics[0].rule == "volume-name-taken"

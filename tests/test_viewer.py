@@ -231,3 +231,67 @@ def test_clicking_a_body_shows_its_adf_facts():
         assert "**BODY Phantom**" in v.selected.content and "mass: 0 kg" in v.selected.content
     finally:
         v.close()
+
+
+def _parented_camera_scene(folder):
+    """box_camera_model's camera riding on its box, the box turned."""
+    from conftest import box_camera_model
+
+    text = box_camera_model(mass=1.0, z=0.5)
+    text = text.replace(
+        "z: 0.5}, orientation: {r: 0.0, p: 0.0, y: 0.0}", "z: 0.5}, orientation: {r: 0.0, p: 0.0, y: 0.6}"
+    )
+    text = text.replace("  name: cam\n", "  name: cam\n  parent: BODY box\n")
+    assert "y: 0.6" in text and "parent: BODY box" in text
+    path = folder / "model.yaml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("scene", ["drilling", "parented"])
+def test_the_mujoco_engine_serves_its_cameras(scene, tmp_path):
+    """`adfkit view --engine mujoco` on a scene with cameras: the page opens looking as the first
+    camera looks, and the Cameras panel draws an image, through the same calls as for PyBullet
+    (``view`` where the MJCF camera is, ``render``, a resized copy as the Gymnasium envs make)."""
+    import dataclasses
+
+    from conftest import require_renderer
+
+    from adfkit.viewer.server import Viewer
+
+    require_renderer("mujoco")
+    path = (
+        ROOT / "sample_scenes" / "drilling" / "launch.yaml" if scene == "drilling" else _parented_camera_scene(tmp_path)
+    )
+    v = Viewer(path, None, "mujoco", "127.0.0.1", _free_port())
+    v.load()
+    assert v.world is not None, v.findings
+    v.start()
+    try:
+        w = v.world
+        names = [c.name for c in w.cameras]
+        assert names == (["cameraL_left", "cameraL_right"] if scene == "drilling" else ["cam"])
+        with v.lock:
+            w.run(0.1)
+        for cam in w.cameras:
+            eye, target, up = (np.array(x) for x in cam.view(w))
+            fwd = (target - eye) / np.linalg.norm(target - eye)
+            # where MuJoCo draws it from: the MJCF camera looks along its -z
+            assert eye == pytest.approx(w.data.cam_xpos[cam.cam_id], abs=1e-9)
+            assert fwd == pytest.approx(-w.data.cam_xmat[cam.cam_id].reshape(3, 3)[:, 2], abs=1e-9)
+        if scene == "parented":
+            (cam,) = w.cameras  # 1 m ahead of the box and 0.5 m up, the box turned 0.6 rad (resting on the ground)
+            box = w.body("box").world_matrix()[:3, 3]
+            expected = box + [np.cos(0.6), np.sin(0.6), 0.5]
+            assert cam.view(w)[0] == pytest.approx(expected, abs=2e-3)
+        else:  # the page opened where the left eye is
+            eye0, _, _ = w.cameras[0].view(w)
+            assert v.server.initial_camera.position == pytest.approx(eye0, abs=1e-3)
+        v.draw_camera()
+        img = np.asarray(v.camera_image.image)
+        assert img.shape == (w.cameras[0].height, w.cameras[0].width, 3) and img.std() > 5
+        assert v.camera_image.label.startswith(names[0] + " · RGB")
+        small = dataclasses.replace(w.cameras[0], width=32, height=24).render(w)
+        assert small["rgb"].shape == (24, 32, 3) and small["segmentation"].shape == (24, 32)
+    finally:
+        v.close()

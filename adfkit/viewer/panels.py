@@ -240,6 +240,7 @@ def camera_panel(v) -> None:
         image.label = f"{cam.name} · {mode.value} · t = {v.world.sim_time:.2f} s"
 
     draw.on_click(render)
+    v.camera_image, v.draw_camera = image, render  # what the Draw button shows, and draws
 
 
 def show_body(v, sb) -> None:

@@ -75,6 +75,8 @@ class Viewer:
         self.episode = None
         self.server = None
         self.rtf = 0.0
+        self.camera_image = None  # the Cameras panel's image and its Draw (panels.camera_panel)
+        self.draw_camera = None
 
     # ---- the scene --------------------------------------------------------------------------
     def load(self) -> None:

@@ -30,6 +30,7 @@ from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, 
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
 from .spec import _parse_spec, _resolve_meshes
+from .textures import apply_textures
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
 GHOST_GROUP = 4
@@ -229,6 +230,7 @@ def build_plan(world) -> Plan:
                 )
     _world_lights(world, spec)
     _collision_filters(world, spec, bodies, joints, plans_by_model)
+    apply_textures(world, spec, bodies)
     ghosts, actuators, sensors = [], [], []
     for m, _mine, _tree in plans_by_model:
         ns = m.namespace or ""

@@ -2,7 +2,7 @@
 ``adfkit run --renderer mujoco``).
 
 The scene is built once more as the MuJoCo engine builds it (runner/mj: the same meshes,
-colours, cameras and lights, stereo pairs included), without stepping it: before each picture
+colours, textures, cameras and lights, stereo pairs included), without stepping it: before each picture
 every MuJoCo body is put where PyBullet has the same ADF body (matched by key), the geoms',
 cameras' and lights' world poses follow from their fixed offsets on their bodies (numpy, no
 kinematics), and MuJoCo's offscreen renderer draws RGB, depth and per-body segmentation

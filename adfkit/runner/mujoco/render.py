@@ -9,11 +9,14 @@ are listed but render() raises CameraUnavailable with the reason (world.camera_p
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
+from ..cameras import Camera
 from ..glcontext import gl_context_class as _gl_context_class
 from ..rotations import invert, matrix_to_quat, pose_to_matrix
 
@@ -22,17 +25,21 @@ class CameraUnavailable(RuntimeError):
     """No headless OpenGL context could be made for MuJoCo's renderer."""
 
 
-class MjCamera:
-    def __init__(self, world, sim_camera, cam_id: int):
-        c = sim_camera
-        self.world, self.cam_id = world, cam_id
-        self.name, self.key, self.camera = c.name, c.key, c.camera
-        self.fov, self.near, self.far, self.width, self.height = c.fov, c.near, c.far, c.width, c.height
-        self.parent = world._by_plan.get(id(c.parent)) if c.parent is not None else None
+@dataclass(eq=False)
+class MjCamera(Camera):
+    """An ADF camera (runner/cameras.py) placed as an MJCF camera: the same interface as the
+    PyBullet world's cameras (``view``, ``intrinsics``, ``render``; ``dataclasses.replace``
+    gives a copy with another image size), its ``parent`` the MuJoCo body and ``cam_id`` the
+    MJCF camera it is drawn from."""
 
-    def intrinsics(self) -> np.ndarray:
-        fy = (self.height / 2) / math.tan(self.fov / 2)
-        return np.array([[fy, 0, self.width / 2], [0, fy, self.height / 2], [0, 0, 1.0]])
+    world: object = None
+    cam_id: int = -1
+
+    @classmethod
+    def placed(cls, world, sim_camera: Camera, cam_id: int) -> MjCamera:
+        parent = world._by_plan.get(id(sim_camera.parent)) if sim_camera.parent is not None else None
+        fields = {f.name: getattr(sim_camera, f.name) for f in dataclasses.fields(Camera)}
+        return cls(**{**fields, "parent": parent}, world=world, cam_id=cam_id)
 
     def render(self, world=None) -> dict:
         """{'rgb': H×W×3 uint8, 'depth': H×W float32 m (inf where nothing), 'segmentation': H×W int32}."""
@@ -124,7 +131,8 @@ class _Pending:
             m.vis.map.znear = near / m.stat.extent
             m.vis.map.zfar = far / m.stat.extent
         return [
-            MjCamera(world, c, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_CAMERA, n)) for c, n in zip(self.sims, self.ids)
+            MjCamera.placed(world, c, mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_CAMERA, n))
+            for c, n in zip(self.sims, self.ids)
         ]
 
 
