@@ -139,11 +139,15 @@ def test_a_tool_pressing_on_the_tissue_fails_its_pair_and_a_touch_does_not():
     assert TOOL_HIT_N == 50.0
     touch = {"phase": "regrasp 1", "arm": "psm1", "link": "tool gripper1 simple", "tissue": "Exit1", "t_start": 10.7}
     obs, pair = _record(_c(5.0, True), _c(8.0, False))
-    obs.tool_events = [dict(touch, max_force_n=20.3)]
+    obs.tool_events = [dict(touch, max_force_n=20.3, sustained_force_n=4.1)]
     assert pair_verdict(obs, pair)["passed"]
-    obs.tool_events = [dict(touch, max_force_n=15943.9, link="tool pitch link simple", tissue="Phantom")]
+    # a one-step spike as a guarded approach stops is a touch; the same force held is a hit
+    obs.tool_events = [dict(touch, max_force_n=57.7, sustained_force_n=11.5)]
+    assert pair_verdict(obs, pair)["passed"]
+    held = dict(touch, max_force_n=15943.9, sustained_force_n=12011.0, link="tool pitch link simple", tissue="Phantom")
+    obs.tool_events = [held]
     v = pair_verdict(obs, pair)
-    assert v["rule"] == "tool-hit-tissue" and "tool pitch link simple hit Phantom with 15943.9 N" in v["reason"]
+    assert v["rule"] == "tool-hit-tissue" and "tool pitch link simple hit Phantom with 12011.0 N held" in v["reason"]
 
 
 # ---- negative controls on the physics (each ~15 s of one pair) --------------------------------

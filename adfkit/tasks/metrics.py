@@ -22,9 +22,10 @@ from .holes import (
     plane_crossing,
     tip_leading,
 )
-from .verdicts import SLIP_LIMIT, pair_verdict
+from .verdicts import SLIP_LIMIT, SLIP_SETTLE_S, pair_verdict
 
 TOOL_TOUCH_N = 0.05  # N: a tool-tissue contact at least this strong is recorded as an event
+SUSTAIN_STEPS = 5  # control steps (20 ms at 250 Hz) over which a touch's force is held (sustained_force_n)
 NEAR_HOLE = 0.005  # m: a crossing of a hole's plane farther than this beside its opening is not an attempt at it
 TIP_CONTACT = 0.002  # m: a contact this near the tip is the tip's
 THREAD_TOLERANCE = 0.001  # m beyond a hole's opening a thread element's centre line may cross
@@ -120,6 +121,7 @@ class SutureObserver:
         self.tip_contacts: dict[str, dict[str, float]] = {}  # the same, within TIP_CONTACT of the tip
         self.tool_events: list[dict] = []
         self._open_touch: dict[tuple, dict] = {}
+        self._recent: dict[tuple, list[float]] = {}  # the last forces of each open touch
         self._in_ghost: dict[str, bool] = {}
         self._last_phase = None
         self._slip_base = None
@@ -202,13 +204,22 @@ class SutureObserver:
                     "link": key[1],
                     "tissue": key[2],
                     "max_force_n": f,
+                    "sustained_force_n": 0.0,
                 }
                 self.tool_events.append(ev)
+                self._recent[key] = []
             ev["t_end"] = t
             ev["max_force_n"] = max(ev["max_force_n"], f)
+            recent = self._recent[key]
+            recent.append(f)
+            del recent[:-SUSTAIN_STEPS]
+            # held over SUSTAIN_STEPS control steps (a step not yet touching counts 0): a stiff
+            # contact's one-step spike as a guarded tool stops is not the tool pressing on it
+            ev["sustained_force_n"] = max(ev["sustained_force_n"], sum(recent) / SUSTAIN_STEPS)
         for key in list(self._open_touch):
             if key not in touching:
                 del self._open_touch[key]
+                self._recent.pop(key, None)
 
     def observe(self) -> None:
         t = self.world.sim_time
@@ -236,15 +247,17 @@ class SutureObserver:
             kind = phase.split()[0]
             self.drift_by_phase[kind] = max(self.drift_by_phase.get(kind, 0.0), drift)
             self.drift_samples += 1
-            # slip: how far the needle moved in the grasp since one arm alone holds it (while two
-            # hold, the other arm's grasp may shift it; that is not this grasp slipping)
+            # slip: how far the needle sits from where this grasp took it, while one arm alone
+            # holds it, once the grasp has settled after the other arm let go (while two hold,
+            # the other arm's grasp strains this one; the strain relaxing is not a slip)
             holders = self._holders()
             key = (id(self.task.held_ee_in_needle), holders)
             if holders != 1:
                 self._slip_base = None
             elif self._slip_base is None or self._slip_base[0] != key:
-                self._slip_base = (key, offset)
-            slip = float(np.linalg.norm(offset - self._slip_base[1])) if self._slip_base is not None else 0.0
+                self._slip_base = (key, t)
+            settled = self._slip_base is not None and t - self._slip_base[1] >= SLIP_SETTLE_S
+            slip = drift if settled else 0.0
             if slip > SLIP_LIMIT and not any(s["phase"] == phase for s in self.slips):
                 self.slips.append({"phase": phase, "t": t, "arm": self.task.holder, "slip_m": slip})
             for s in self.slips:

@@ -450,12 +450,19 @@ class SutureTask:
         psm.servo_jaw(0.0)
         yield from self.wait(0.15)
 
-    def let_go(self, name: str):
+    def let_go(self, name: str, holder: str | None = None):
+        """``name`` releases the needle and backs off. ``holder``, the arm that keeps it, is then
+        put where the needle settled (once): freed from the other grasp, the needle settles where
+        the tissue holds it, up to 2.7 mm from where both grasps had it, and a grasp that stayed
+        put would stay strained by that much."""
         psm = self.psms[name]
         act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
         self.world.release(act)
         psm.servo_jaw(JAW_APPROACH)
         yield from self.wait(0.15)
+        if holder is not None:
+            keep = self.psms[holder]
+            yield from self.line(keep, self.setpoint_world(keep), self.needle_pose() @ self.held_ee_in_needle, 0.2)
         here = self.setpoint_world(psm)
         back = here.copy()
         back[:3, 3] -= BACK_OFF * here[:3, 2]
@@ -675,13 +682,18 @@ class SutureTask:
             yield from self.wait(0.2)
             self._set_phase(f"regrasp {pair.index}")
             yield from self.take(self.puller, self.pull_grasp_now(k))
-            yield from self.let_go(self.driver)
+            yield from self.let_go(self.driver, holder=self.puller)
             yield from self.move_jp(d, park[self.driver], 0.8, settle=0.0)
             self.holder = self.puller
             self._set_phase(f"pull {pair.index}")
             done = psi_x + self.geom.span + TAIL_CLEAR
-            yield from self.carry(lambda s: self.needle_at(b, psi_end + (done - psi_end) * s), (done - psi_end) / 0.6)
-            out = self.needle_at(b, done)
+            # the pull turns the needle about its own centre from where the tissue holds it (a
+            # few tenths of a millimetre off the plan), so that it follows its own channel
+            b_now = self.needle_pose() @ self.geom.arc_in_needle @ _rot_z(-psi_end)
+            yield from self.carry(
+                lambda s: self.needle_at(b_now, psi_end + (done - psi_end) * s), (done - psi_end) / 0.6
+            )
+            out = self.needle_at(b_now, done)
             high = self.lifted(out, 2 * LIFT)
             yield from self.carry(lambda s: interpolate(out, high, _smooth(s)), 1.0)
             yield from self.wait(0.2)
@@ -690,7 +702,7 @@ class SutureTask:
                 yield from self.carry_to(self.handbacks[k], 1.2)
                 yield from self.wait(0.2)
                 yield from self.take(self.driver, self.drive_grasps[k + 1])
-                yield from self.let_go(self.puller)
+                yield from self.let_go(self.puller, holder=self.driver)
                 yield from self.move_jp(p, park[self.puller], 0.8, settle=0.0)
                 self.holder = self.driver
         self._set_phase("done")

@@ -11,13 +11,15 @@ verdict's ``rule`` and ``reason`` (rules in the order below).
 
 from __future__ import annotations
 
-#: N: a tool pressing on the tissue at least this hard fails the pair. Every touch is recorded
-#: (metrics' tool_tissue_events, each pair's tool_tissue_max_n); a jaw brushing a hole's boundary
-#: as it takes the needle beside it gives about 20 N in PyBullet's stiff contacts, a wrist driven
-#: into the tissue thousands
+#: N: a tool pressing on the tissue at least this hard, held over 20 ms (a touch's
+#: sustained_force_n), fails the pair. Every touch is recorded (metrics' tool_tissue_events, each
+#: pair's tool_tissue_max_n); a jaw brushing a hole's boundary as it takes the needle beside it
+#: peaks at 15-60 N for a step in PyBullet's stiff contacts, a wrist driven into the tissue holds
+#: thousands
 TOOL_HIT_N: float | None = 50.0
 
 SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
+SLIP_SETTLE_S = 0.25  # s a grasp is given to settle after the other arm let go
 BLOCK_N = 1.0  # N: a carried needle pressing on the tissue this hard on its way to a hole is blocked there
 RULES = (
     "not-tried",
@@ -176,10 +178,12 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
                 f"(limit {_mm(obs_slip_limit())} while one arm holds)"
             )
     for e in obs.tool_events:
-        if TOOL_HIT_N is not None and in_pair(e["phase"], k, first) and e["max_force_n"] >= TOOL_HIT_N:
+        pressed = e.get("sustained_force_n", e["max_force_n"])
+        if TOOL_HIT_N is not None and in_pair(e["phase"], k, first) and pressed >= TOOL_HIT_N:
             return "tool-hit-tissue", (
-                f"{e['arm']}'s {e['link']} hit {e['tissue']} with {e['max_force_n']:.1f} N "
-                f"during {e['phase']} (t = {e['t_start']:.2f} s)"
+                f"{e['arm']}'s {e['link']} hit {e['tissue']} with {pressed:.1f} N held over 20 ms "
+                f"(peak {e['max_force_n']:.1f} N) during {e['phase']} (t = {e['t_start']:.2f} s): "
+                "the tool cannot reach the needle there without pressing on the tissue"
             )
     if failed_here:
         return "reach", failure
