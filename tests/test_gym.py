@@ -215,6 +215,22 @@ def test_sparse_reward_and_image_observations():
     assert not [d for d in world.diagnostics if d.rule == "runner-renderer"]
 
 
+def test_image_observations_replay_bit_for_bit_and_the_view_is_built_once():
+    env = make(
+        "adfkit/NeedleReach-v0", obs_mode="rgbd", reward_type="sparse", image_size=(32, 24), render_mode="rgb_array"
+    )
+    actions = _actions(env, 3)
+    a = _play(env, 2, actions)
+    view = env.unwrapped.world._mj_view
+    b = _play(env, 2, actions)
+    for i, (x, y) in enumerate(zip(a, b)):
+        for k in x:
+            assert np.array_equal(x[k], y[k]), (i, k)
+    assert a[-1]["cameraL_rgb"].std() > 0  # a picture, not a blank
+    if env.unwrapped.world.renderer == "mujoco":  # the MuJoCo view passed from world to world
+        assert view is not None and env.unwrapped.world._mj_view is view and view.world is env.unwrapped.world
+
+
 def _solve(env_id, seeds):
     env = make(env_id)
     expert = expert_for(env)

@@ -114,10 +114,12 @@ class SuturingEnv(gym.Env):
         the task's objects, the arms' links not colliding with the needle (the grasp is the
         actuator's). Every call makes the same world in the same order, so a snapshot of one
         restores exactly into the next (World.restore_state)."""
-        if self.world is not None:
-            self.world.close()
+        old = self.world
         self.built = b = scenes.build(self._model, self._engine, self.arms, self._visuals, self._setup_joints)
         self.world, self.psms, self.needle = b.world, b.psms, b.needle
+        if old is not None:
+            self.world.adopt(old)  # its renderer's view of the scene, built once
+            old.close()
         w, h = (int(v) for v in self._image_size)
         self._cameras = [replace(c, width=w, height=h) for c in self.world.cameras]
         w, h = (int(v) for v in self._render_size)
