@@ -135,7 +135,7 @@ class SuturingEnv(gym.Env):
         super().reset(seed=seed)
         # a fresh world restored from the snapshot: the same seed and actions then give the same
         # observations bit for bit; exact_reset=False restores the world in place (~2 ms instead of
-        # ~0.15 s), which keeps its contact order and repeats only to ~1e-7 m
+        # ~0.1 s), which keeps its contact order and repeats only to ~1e-8 m
         if self.exact_reset:
             self._open()
         self.world.restore_state(self._snapshot)

@@ -7,7 +7,7 @@ restore a state once one has (a grasp toggles the pairs between the jaws and wha
 the snapshot also keeps every body's and joint's state, restored one by one in that case (contacts
 then start afresh). Either way the world keeps state that no restore brings back (the order of
 its contact manifolds, which sets the solver's order), so the same steps after two restores
-differ by ~1e-7 m. Into a fresh world built from the same scene with the same set-up (the
+differ by ~1e-8 m. Into a fresh world built from the same scene with the same set-up (the
 same bodies, collision filters and constraints, made in the same order): the snapshot's Bullet
 file (``saveBullet``), contact points included; a fresh world holds nothing else, so two such
 restores followed by the same steps agree bit for bit.

@@ -64,8 +64,8 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self._next_stability_check = 0.0
-        # the broadphase keeps its overlapping pairs sorted: a restored snapshot (restore_state) then
-        # meets its contact caches in the same order, and the same seed and actions replay exactly
+        # the broadphase keeps its overlapping pairs sorted, so a snapshot restored in place
+        # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact
         pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
         self._build()
 
