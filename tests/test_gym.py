@@ -3,6 +3,8 @@ play without NaN, resets from the world's snapshot, and the scripted experts."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -47,15 +49,17 @@ def _close_envs():
 IDS = ["adfkit/NeedleReach-v0", "adfkit/NeedlePick-v0", "adfkit/SutureOnePair-v0"]
 
 
-def _check(env_id):
+def _check(env_id, **kw):
+    """Gymnasium's checker, its warning that the same seed and actions gave observations, rewards
+    or infos that are only close (not equal) turned into an error. The spec stays, so the checker
+    compares two seeded resets (it does only for a registered, deterministic env); the close
+    check (it builds a second copy from the spec) is left out."""
     from gymnasium.utils.env_checker import check_env
 
-    env = make(env_id).unwrapped
-    spec, env.spec = env.spec, None  # else check_env builds a second copy from the spec
-    try:
-        check_env(env, skip_render_check=True)
-    finally:
-        env.spec = spec
+    env = make(env_id, **kw).unwrapped
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message=".*(not equal although similar|non-deterministic)")
+        check_env(env, skip_render_check=True, skip_close_check=True)
     assert env.action_space.shape == (7 * len(env.arms),)
 
 
@@ -108,9 +112,90 @@ def test_reset_restores_the_snapshot():
     b, _ = env.reset(seed=11)
     assert not env.unwrapped.holding()
     for k in a:
-        assert np.allclose(a[k], b[k], atol=1e-6), k
+        assert np.array_equal(a[k], b[k]), k
     c, _ = env.reset(seed=12)
     assert not np.allclose(a["psm1_pose"][:3], c["psm1_pose"][:3], atol=1e-4)  # seeds differ
+
+
+def _play(env, seed: int, actions) -> list:
+    """The observations after reset(seed=seed) and after each of ``actions``."""
+    obs, _ = env.reset(seed=seed)
+    out = [obs]
+    for a in actions:
+        obs, *_ = env.step(a)
+        out.append(obs)
+    return out
+
+
+def _worst(a: list, b: list, key: str) -> float:
+    return max(float(np.abs(x[key].astype(float) - y[key].astype(float)).max()) for x, y in zip(a, b))
+
+
+def _actions(env, n: int, seed: int = 3) -> list:
+    rng = np.random.default_rng(seed)
+    return [rng.uniform(-1, 1, env.action_space.shape).astype(np.float32) for _ in range(n)]
+
+
+@pytest.mark.parametrize("kw", [{}, {"randomize_needle": 0.004}], ids=["arms", "arms-and-needle"])
+def test_the_same_seed_and_actions_give_the_same_observations_bit_for_bit(kw):
+    env = make("adfkit/NeedleReach-v0", **kw)
+    actions = _actions(env, 12)
+    first = _play(env, 5, actions)
+    for _ in range(2):  # a third run too: nothing of an earlier episode carries over
+        again = _play(env, 5, actions)
+        for i, (x, y) in enumerate(zip(first, again)):
+            for k in x:
+                assert np.array_equal(x[k], y[k]), (i, k, float(np.abs(x[k] - y[k]).max()))
+    other = _play(env, 6, actions)
+    assert _worst(first[:1], other[:1], "psm1_pose") > 1e-4  # another seed starts elsewhere
+    if kw:
+        assert _worst(first[:1], other[:1], "needle_pose") > 1e-4
+    else:
+        assert np.array_equal(first[0]["needle_pose"], other[0]["needle_pose"])
+
+
+def test_a_grasp_and_lift_replay_bit_for_bit():
+    """The expert's actions (grasp, lift) replayed after the same seeded reset: the grasp's
+    constraint and collision filters are gone with the world, nothing of them stays."""
+    env = make("adfkit/NeedlePick-v0")
+    expert = expert_for(env)
+    obs, _ = env.reset(seed=4)
+    expert.reset()
+    actions = []
+    for _ in range(30):
+        actions.append(expert(obs))
+        obs, *_ = env.step(actions[-1])
+    assert env.unwrapped.holding()
+    a, b = _play(env, 4, actions), _play(env, 4, actions)
+    for i, (x, y) in enumerate(zip(a, b)):
+        for k in x:
+            assert np.array_equal(x[k], y[k]), (i, k)
+    assert a[-1]["needle_pose"][2] > a[0]["needle_pose"][2] + 0.005  # it was lifted
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("env_id", IDS[1:])
+def test_the_same_seed_and_actions_replay_bit_for_bit_in_every_env(env_id):
+    env = make(env_id)
+    actions = _actions(env, 20)
+    a, b, other = _play(env, 8, actions), _play(env, 8, actions), _play(env, 9, actions)
+    for i, (x, y) in enumerate(zip(a, b)):
+        for k in x:
+            assert np.array_equal(x[k], y[k]), (i, k)
+    for name in env.unwrapped.arms:
+        assert _worst(a[:1], other[:1], f"{name}_pose") > 1e-4
+
+
+def test_a_reset_in_place_is_only_close():
+    """The negative control: exact_reset=False restores the snapshot into the same world, which
+    keeps its contact order, so the same seed and actions drift apart (by far less than a
+    micrometre) and the checker's warning, made an error, fires."""
+    env = make("adfkit/NeedleReach-v0", exact_reset=False)
+    actions = _actions(env, 12)
+    a, b = _play(env, 5, actions), _play(env, 5, actions)
+    assert 0.0 < _worst(a, b, "needle_pose") < 1e-5
+    with pytest.raises(UserWarning, match="not equal although similar"):
+        _check("adfkit/NeedleReach-v0", exact_reset=False)
 
 
 def test_sparse_reward_and_image_observations():
@@ -128,6 +213,22 @@ def test_sparse_reward_and_image_observations():
     assert env.render().ndim == 3
     world = env.unwrapped.world  # the resized cameras drew with the renderer chosen, no fall-back
     assert not [d for d in world.diagnostics if d.rule == "runner-renderer"]
+
+
+def test_image_observations_replay_bit_for_bit_and_the_view_is_built_once():
+    env = make(
+        "adfkit/NeedleReach-v0", obs_mode="rgbd", reward_type="sparse", image_size=(32, 24), render_mode="rgb_array"
+    )
+    actions = _actions(env, 3)
+    a = _play(env, 2, actions)
+    view = env.unwrapped.world._mj_view
+    b = _play(env, 2, actions)
+    for i, (x, y) in enumerate(zip(a, b)):
+        for k in x:
+            assert np.array_equal(x[k], y[k]), (i, k)
+    assert a[-1]["cameraL_rgb"].std() > 0  # a picture, not a blank
+    if env.unwrapped.world.renderer == "mujoco":  # the MuJoCo view passed from world to world
+        assert view is not None and env.unwrapped.world._mj_view is view and view.world is env.unwrapped.world
 
 
 def _solve(env_id, seeds):

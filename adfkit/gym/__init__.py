@@ -9,8 +9,9 @@
 
 Keyword arguments (SuturingEnv): obs_mode "state"|"rgb"|"rgbd", reward_type "dense"|"sparse",
 render_mode "rgb_array", engine "pybullet"|"mujoco", scene/indices (a launch file; default the
-project's suturing scene), image_size, control_steps, randomize. Scripted experts for
-demonstrations: adfkit.gym.experts.
+project's suturing scene), image_size, control_steps, randomize, exact_reset (False: resets in
+place, faster, repeat a seed only to ~1e-8 m). Scripted experts for demonstrations:
+adfkit.gym.experts.
 """
 
 from __future__ import annotations

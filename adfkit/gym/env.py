@@ -1,9 +1,11 @@
 """Gymnasium environments on the suturing scene (Gymnasium >= 1.0 API).
 
-One world per environment, built once; ``reset`` restores a snapshot taken after the scene
-settled (World.save_state/restore_state) and places the needle, with its thread, at a seeded
-offset. The environments talk to the world only through the World interface and drive
-the arms through adfkit.runner.PSM (servo_cp through the closed-form IK, servo_jaw, grasp).
+The scene is read once per environment and its world built, settled and snapshotted
+(World.save_state); ``reset`` builds the world afresh from the scene model, restores the snapshot
+into it (World.restore_state: a fresh world holds no history, so the same seed and actions give
+the same observations bit for bit) and starts the arms, and with ``randomize_needle`` the needle
+and its thread, at a seeded offset. The environments talk to the world only through the World
+interface and drive the arms through adfkit.runner.PSM (servo_cp through the closed-form IK, servo_jaw, grasp).
 
 Action, per arm (``arms``: psm1, or psm1 then psm2), 7 values in [-1, 1]: a translation of the
 end-effector set-point along the world axes (x MAX_STEP m), a turn about the world axes at the
@@ -62,6 +64,7 @@ class SuturingEnv(gym.Env):
         randomize_needle: float = 0.0,
         settle_seconds: float = 0.5,
         setup_joints: bool = True,
+        exact_reset: bool = True,
     ) -> None:
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode {obs_mode!r}: choose one of {', '.join(OBS_MODES)}")
@@ -71,30 +74,23 @@ class SuturingEnv(gym.Env):
             raise ValueError(f"render_mode {render_mode!r}: only 'rgb_array' (or None)")
         self.obs_mode, self.reward_type, self.render_mode = obs_mode, reward_type, render_mode
         self.control_steps, self.randomize = int(control_steps), float(randomize)
-        self.randomize_needle = float(randomize_needle)
-        self.built = b = scenes.build(
-            scene, indices, engine, self.arms, obs_mode != "state" or render_mode is not None, setup_joints
-        )
-        self.world, self.psms, self.needle = b.world, b.psms, b.needle
-        self._cameras = [replace(c, width=int(image_size[0]), height=int(image_size[1])) for c in self.world.cameras]
-        self._render_camera = (
-            replace(self.world.cameras[0], width=int(render_size[0]), height=int(render_size[1]))
-            if self.world.cameras
-            else None
-        )
+        self.randomize_needle, self.exact_reset = float(randomize_needle), bool(exact_reset)
+        self._image_size, self._render_size = tuple(image_size), tuple(render_size)
+        self._visuals, self._setup_joints = obs_mode != "state" or render_mode is not None, setup_joints
+        if engine not in ("pybullet", "mujoco"):
+            raise ValueError(f"engine {engine!r}: choose 'pybullet' or 'mujoco'")
+        self._engine, self._model = engine, scenes.load(scene, indices)
+        self.world = None
+        self._open()
         if obs_mode != "state" and not self._cameras:
             raise ValueError(f"obs_mode {obs_mode!r}: the scene has no camera")
-        self._task_setup()
-        for body in self.world.bodies:  # the grasp is the actuator's; the fingers never shove the needle
-            if any(body.articulation is self.psms[n].art for n in self.arms):
-                self.world.set_collision(body, self.needle, False)
         self.world.run(settle_seconds)
         self._ready()
         self.world.run(settle_seconds)
         self._home = {n: p.setpoint_cp() for n, p in self.psms.items()}
         self._home_jaw = {n: p.measured_jaw() for n, p in self.psms.items()}
         self._snapshot = self.world.save_state()
-        self._rest = [(b, b.world_matrix()) for b in [self.needle] + b.carried]
+        self._rest = [b.world_matrix() for b in [self.needle] + self.built.carried]
         self.action_space = spaces.Box(-1.0, 1.0, (7 * len(self.arms),), np.float32)
         obs = {}
         for n in self.psms:
@@ -113,9 +109,35 @@ class SuturingEnv(gym.Env):
         self._setpoint: dict = {}
         self._closed: dict = {}
 
+    def _open(self) -> None:
+        """(Re)build the world from the scene model with the environment's set-up: the arms,
+        the task's objects, the arms' links not colliding with the needle (the grasp is the
+        actuator's). Every call makes the same world in the same order, so a snapshot of one
+        restores exactly into the next (World.restore_state)."""
+        old = self.world
+        self.built = b = scenes.build(self._model, self._engine, self.arms, self._visuals, self._setup_joints)
+        self.world, self.psms, self.needle = b.world, b.psms, b.needle
+        if old is not None:
+            self.world.adopt(old)  # its renderer's view of the scene, built once
+            old.close()
+        w, h = (int(v) for v in self._image_size)
+        self._cameras = [replace(c, width=w, height=h) for c in self.world.cameras]
+        w, h = (int(v) for v in self._render_size)
+        cam0 = self.world.cameras[0] if self.world.cameras else None
+        self._render_camera = replace(cam0, width=w, height=h) if cam0 is not None else None
+        self._task_setup()
+        for body in self.world.bodies:  # the grasp is the actuator's; the fingers never shove the needle
+            if any(body.articulation is self.psms[n].art for n in self.arms):
+                self.world.set_collision(body, self.needle, False)
+
     # ---- Gymnasium API ------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
+        # a fresh world restored from the snapshot: the same seed and actions then give the same
+        # observations bit for bit; exact_reset=False restores the world in place (~2 ms instead of
+        # ~0.1 s), which keeps its contact order and repeats only to ~1e-8 m
+        if self.exact_reset:
+            self._open()
         self.world.restore_state(self._snapshot)
         self._setpoint = {n: self._home[n].copy() for n in self.arms}
         if self.randomize > 0:
@@ -134,7 +156,7 @@ class SuturingEnv(gym.Env):
                     pass
         if self.randomize_needle > 0:
             dx, dy = self.np_random.uniform(-self.randomize_needle, self.randomize_needle, size=2)
-            for body, rest in self._rest:
+            for body, rest in zip([self.needle] + self.built.carried, self._rest):
                 pose = rest.copy()
                 pose[:3, 3] += (dx, dy, 0.0)
                 self.world.place_body(body, pose)
@@ -272,7 +294,8 @@ class SuturingEnv(gym.Env):
 
     # ---- task hooks -----------------------------------------------------------------------
     def _task_setup(self) -> None:
-        """Once, before the scene settles and the snapshot is taken."""
+        """Whenever the world is built (before the scene settles and the snapshot is taken, and on
+        each reset): the task's own objects on the world."""
 
     def _task_reset(self) -> None:
         """After each reset."""

@@ -71,16 +71,11 @@ class Built:
     setup_moves: dict  # name -> metres the setup joints moved the PSM base
 
 
-def build(
-    scene: str | Path | None, indices: str | None, engine: str, arms, visuals: bool, setup_joints: bool = True
-) -> Built:
-    """Load the scene, build its world on ``engine`` and the PSMs; find the needle, its thread and
-    the grasp point (the needle's surface nearest its centre of mass: mid-arc on a curved needle)."""
+def load(scene: str | Path | None, indices: str | None = None):
+    """The scene model (adfkit.model.Scene) of the launch file ``scene`` (default: default_scene())."""
     from ..adf import load_scene, parse_indices
     from ..diagnostics import AdfError, Severity
 
-    if engine not in ("pybullet", "mujoco"):
-        raise ValueError(f"engine {engine!r}: choose 'pybullet' or 'mujoco'")
     if scene is None:
         scene, default_indices = default_scene()
         indices = indices if indices is not None else default_indices
@@ -89,6 +84,15 @@ def build(
     errors = [d for d in diags if d.severity >= Severity.ERROR]
     if errors:
         raise AdfError(errors)
+    return model
+
+
+def build(model, engine: str, arms, visuals: bool, setup_joints: bool = True) -> Built:
+    """Build the scene model's world on ``engine`` and the PSMs; find the needle, its thread and
+    the grasp point (the needle's surface nearest its centre of mass: mid-arc on a curved needle).
+    The same model gives the same world, made in the same order, every time."""
+    if engine not in ("pybullet", "mujoco"):
+        raise ValueError(f"engine {engine!r}: choose 'pybullet' or 'mujoco'")
     world = _world(model, engine, visuals)
     from ..runner.psm import PSM
 

@@ -122,6 +122,11 @@ class World:
         self.actuate(act, found[0])
         return found[0]
 
+    def adopt(self, old) -> None:
+        """Take over what ``old``, a world built from the same scene, built once and can share
+        (a renderer's view of the scene), so that a world rebuilt on every reset does not build
+        it again; ``old`` is closed next. Nothing to share by default."""
+
     # ---- the report ----------------------------------------------------------------------
     def _shapeless(self, sb) -> bool:
         """The body has nothing to collide with (it falls freely under gravity, in AMBF too)."""

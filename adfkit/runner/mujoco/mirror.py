@@ -56,7 +56,19 @@ class MjMirror:
         # MuJoCo body id -> (PyBullet SimBody, MuJoCo link frame in the ADF body frame), for the
         # bodies something is drawn on (only their poses are read from PyBullet)
         drawn = set(self._geom_body.tolist()) | set(self._cam_body.tolist()) | set(self._light_body.tolist())
-        self.pairs = [(mb.id, world.bodies[i], mb.link_in_body) for mb, i in matched if mb.id in drawn]
+        self._drawn = [(mb.id, i, mb.key, mb.link_in_body) for mb, i in matched if mb.id in drawn]
+        self.pairs = [(bid, world.bodies[i], link_in_body) for bid, i, _, link_in_body in self._drawn]
+
+    def rebind(self, world) -> None:
+        """Draw ``world`` from now on: a PyBullet world built afresh from the same scene (the same
+        bodies in the same order, as a Gymnasium reset builds it), so the view is not built again."""
+        keys = [sb.key for sb in world.bodies]
+        if any(i >= len(keys) or keys[i] != key for _, i, key, _ in self._drawn) or [c.name for c in world.cameras] != [
+            c.name for c in self.cameras
+        ]:
+            raise ValueError("the world has other bodies or cameras than the one this view was built for")
+        self.world = world
+        self.pairs = [(bid, world.bodies[i], link_in_body) for bid, i, _, link_in_body in self._drawn]
 
     def _sync(self) -> None:
         """MuJoCo's drawn frames from PyBullet's bodies."""

@@ -1,13 +1,24 @@
 """Snapshots and placement of a SimWorld (a mixin of world.SimWorld): fast resets for tasks
 and Gymnasium environments, and the small queries they need.
 
-restore_state uses Bullet's restoreState (exact, contact caches included) while no collision
-filter pair has changed since the snapshot; PyBullet cannot restore a state once one has (a
-grasp toggles the pairs between the jaws and what they hold), so the snapshot also keeps every
-body's and joint's state, restored one by one in that case (contacts then start afresh).
+A snapshot is restored two ways. Into the world that took it: Bullet's restoreState (contact
+caches included) while no collision filter pair has changed since the snapshot; PyBullet cannot
+restore a state once one has (a grasp toggles the pairs between the jaws and what they hold), so
+the snapshot also keeps every body's and joint's state, restored one by one in that case (contacts
+then start afresh). Either way the world keeps state that no restore brings back (the order of
+its contact manifolds, which sets the solver's order), so the same steps after two restores
+differ by ~1e-8 m. Into a fresh world built from the same scene with the same set-up (the
+same bodies, collision filters and constraints, made in the same order): the snapshot's Bullet
+file (``saveBullet``), contact points included; a fresh world holds nothing else, so two such
+restores followed by the same steps agree bit for bit.
 """
 
 from __future__ import annotations
+
+import os
+import tempfile
+import weakref
+from dataclasses import dataclass
 
 import numpy as np
 import pybullet as pb
@@ -15,11 +26,26 @@ import pybullet as pb
 from ..rotations import matrix_to_pq
 
 
+@dataclass(eq=False)
+class Snapshot:
+    """What save_state took: every free body's and multibody base's pose and velocity, every
+    joint's position and velocity, the joint motors' targets, the clock, Bullet's in-memory state
+    (``state_id``, valid in the world that took it: ``world``, a weak reference) and its Bullet
+    file (``bullet``, bytes, restorable in a fresh world of the same scene)."""
+
+    world: weakref.ref
+    bases: list
+    joints: list
+    targets: list
+    steps: int
+    state_id: int
+    bullet: bytes
+
+
 class WorldState:
-    def save_state(self) -> int:
-        """Snapshot the simulation in memory (Bullet's saveState, and every free body's and
-        multibody base's pose and velocity, every joint's position, velocity and motor target,
-        the clock); returns an id for restore_state."""
+    def save_state(self) -> Snapshot:
+        """Snapshot the simulation (see Snapshot) for restore_state, in this world or in a fresh
+        world built from the same scene with the same set-up."""
         cid = self.cid
         bases = []
         for sb in self.bodies:
@@ -32,32 +58,58 @@ class WorldState:
             n = len(art.records)
             states = pb.getJointStates(art.uid, list(range(n)), physicsClientId=cid) if n else []
             joints.append([(s[0], s[1]) for s in states])
-        self._snapshots = getattr(self, "_snapshots", [])
-        bullet = pb.saveState(physicsClientId=cid)
-        self._snapshots.append((bases, joints, [list(a.targets) for a in self.articulations], self.steps, bullet))
-        return len(self._snapshots) - 1
+        with tempfile.TemporaryDirectory(prefix="adfkit-state-") as tmp:
+            path = os.path.join(tmp, "state.bullet")
+            pb.saveBullet(path, physicsClientId=cid)
+            with open(path, "rb") as f:
+                bullet = f.read()
+        state_id = pb.saveState(physicsClientId=cid)
+        targets = [list(a.targets) for a in self.articulations]
+        return Snapshot(weakref.ref(self), bases, joints, targets, self.steps, state_id, bullet)
 
-    def restore_state(self, sid: int) -> None:
-        """Put the world back to snapshot ``sid``: every grasp released, bodies and joints at
-        their saved states, the joint motors at their saved targets, the clock at its time."""
-        cid = self.cid
+    def restore_state(self, snap: Snapshot) -> None:
+        """Put the world back to ``snap``: every grasp released, bodies and joints at their saved
+        states, the joint motors at their saved targets, the clock at its time. ``snap`` may come
+        from another world built from the same scene with the same set-up, as long as this world
+        has not been stepped (restored exactly, see the module docstring); a world that does not
+        match it is a ValueError."""
         for a in self.actuators:
             self.release(a)
-        bases, joints, targets, steps, bullet = self._snapshots[sid]
-        try:  # exact, contact caches too, while no collision pair changed since the snapshot
-            pb.restoreState(stateId=bullet, physicsClientId=cid)
-            bases, joints = [], [[] for _ in self.articulations]
+        if snap.world() is self:
+            self._restore_own(snap)
+        else:
+            self._restore_file(snap)
+        for art, t in zip(self.articulations, snap.targets):
+            art.targets[:] = t
+            art.drive()
+        self.steps, self.sim_time = snap.steps, snap.steps * self.dt
+
+    def _restore_own(self, snap: Snapshot) -> None:
+        cid = self.cid
+        bases, joints = snap.bases, snap.joints
+        try:  # contact caches too, while no collision pair changed since the snapshot
+            pb.restoreState(stateId=snap.state_id, physicsClientId=cid)
+            bases, joints = [], []
         except pb.error:  # Bullet refuses once a collision filter pair changed (a grasp): per body
             pass
         for uid, p, q, v, w in bases:
             pb.resetBasePositionAndOrientation(uid, p, q, physicsClientId=cid)
             pb.resetBaseVelocity(uid, v, w, physicsClientId=cid)
-        for art, states, t in zip(self.articulations, joints, targets):
+        for art, states in zip(self.articulations, joints):
             for i, (q, v) in enumerate(states):
                 pb.resetJointState(art.uid, i, q, v, physicsClientId=cid)
-            art.targets[:] = t
-            art.drive()
-        self.steps, self.sim_time = steps, steps * self.dt
+
+    def _restore_file(self, snap: Snapshot) -> None:
+        if len(snap.bases) != sum(1 for sb in self.bodies if sb.link < 0 and sb.uid is not None and sb.uid >= 0):
+            raise ValueError("the snapshot was taken in a world with other bodies")
+        with tempfile.TemporaryDirectory(prefix="adfkit-state-") as tmp:
+            path = os.path.join(tmp, "state.bullet")
+            with open(path, "wb") as f:
+                f.write(snap.bullet)
+            try:
+                pb.restoreState(fileName=path, physicsClientId=self.cid)
+            except pb.error as exc:
+                raise ValueError(f"the snapshot does not fit this world (Bullet: {exc})") from None
 
     def place_body(self, sb, pose: np.ndarray) -> None:
         """Move a free body (its ADF body frame to the 4x4 world ``pose``), at rest; a

@@ -64,8 +64,8 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self._next_stability_check = 0.0
-        # the broadphase keeps its overlapping pairs sorted: a restored snapshot (restore_state) then
-        # meets its contact caches in the same order, and the same seed and actions replay exactly
+        # the broadphase keeps its overlapping pairs sorted, so a snapshot restored in place
+        # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact
         pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
         self._build()
 
@@ -176,6 +176,15 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
                 raise RuntimeError("no MuJoCo mirror was given to this world (open it with runner.open_world)")
             self._mj_view = self.mirror(self)
         return self._mj_view
+
+    def adopt(self, old) -> None:
+        """Take over ``old``'s MuJoCo view (the ``renderer="mujoco"`` mirror, ~0.2 s to build)
+        when this world draws with it too."""
+        view = getattr(old, "_mj_view", None)
+        if view is None or self._mj_view is not None or self.renderer != "mujoco" or old.renderer != "mujoco":
+            return
+        view.rebind(self)
+        self._mj_view, old._mj_view = view, None
 
     def fall_back_to_tiny(self, why: str) -> None:
         """The renderer chosen could not start (MuJoCo could not build or open the scene):
