@@ -248,10 +248,6 @@ class ToolShape:
         n = int(self.SHAFT_CHECKED / 0.002) + 1
         self.along = np.linspace(0.0, self.SHAFT_CHECKED, n) if shaft else np.zeros(0)
 
-    def add_jaws(self, other: ToolShape) -> None:
-        """Take in the jaws of ``other`` (the same tool sampled at another opening)."""
-        self.ee_pts = np.concatenate([self.ee_pts, other.ee_pts])
-
     def points(self, ee: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World points (C, K, 3) of the tool at end-effector poses (C, 4, 4), and the radius
         of each (K,): a point's clearance is the tissue's distance less its radius."""

@@ -54,7 +54,8 @@ TOOL_CLEARANCE = 0.0015  # m the planner keeps the tool's shapes from the tissue
 JAW_APPROACH = 0.35
 GRASP_STEP = math.radians(6)  # the planner tries grasps this far apart along the wire ...
 MIN_GRASP = math.radians(8)  # ... from this far from the tip or the tail (the jaws' width)
-GUARD_N = 5.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard
+GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
+GUARD_BACK = 0.0005  # m ... and draws back this far the way it came
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
 
@@ -316,14 +317,16 @@ class SutureTask:
             raise SutureError(f"{psm.name}: no grasp of the needle from above ({what})")
         ee_in_n = np.array([m for m, _ in cands])
         clear = np.full(len(cands), TOOL_CLEARANCE)
-        tool = self.tools[psm.name]
         for i, pose in enumerate(clear_at):
+            # the jaws as they come onto the wire there: wide open onto a needle lying on the tissue
+            tool = self.tools_wide[psm.name] if i == 0 and down_at is not None else self.tools[psm.name]
             ee = pose[None] @ ee_in_n
             clear = np.minimum(clear, clearances(self.tissue_shapes, tool, ee, TOOL_CLEARANCE))
             if i == 0:  # and on the way in, along the jaw axis
-                back = ee.copy()
-                back[:, :3, 3] -= BACK_OFF * ee[:, :3, 2]
-                clear = np.minimum(clear, clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE))
+                for f in (1.0, 2 / 3, 1 / 3):
+                    back = ee.copy()
+                    back[:, :3, 3] -= f * BACK_OFF * ee[:, :3, 2]
+                    clear = np.minimum(clear, clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE))
         # the choice: the clearance (up to TOOL_CLEARANCE, in tenths of a millimetre), then the
         # wider joint margin
         clear_q = np.round(clear / 1e-4)
@@ -410,7 +413,11 @@ class SutureTask:
             self.servo_world(psm, interpolate(a, b, _smooth(i / n)))
             yield self.phase
             if links and any(f >= GUARD_N for sb in links for o, f, _ in self.world.contacts(sb) if id(o) in tissue):
-                self.servo_world(psm, self.setpoint_world(psm) @ invert(psm.setpoint_cp()) @ psm.measured_cp())
+                stop = psm.base_in_world() @ psm.measured_cp()
+                stop[:3, 3] -= (
+                    GUARD_BACK * (b[:3, 3] - a[:3, 3]) / max(float(np.linalg.norm(b[:3, 3] - a[:3, 3])), 1e-9)
+                )
+                self.servo_world(psm, stop)  # where it touched, a little back the way it came
                 return
 
     def carry(self, path, seconds: float):
@@ -500,7 +507,7 @@ class SutureTask:
             moved[name] = float(np.linalg.norm(shift))
         return moved
 
-    def plan(self, tools: dict | None = None):
+    def plan(self):
         """Needle poses of the whole suture and, per pair, the grasps that reach them: the
         driver's (from where it takes the needle, over the approach, along the insertion) and
         the puller's (along the pull and the lift)."""
@@ -511,7 +518,9 @@ class SutureTask:
             (hole_frame(self.world, p.entry)[:3, 3] + hole_frame(self.world, p.exit)[:3, 3]) / 2 for p in self.pairs
         ]
         self.tissue_shapes = Tissue(static, centres)
-        self.tools = tools or {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
+        self.tools = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
+        if not hasattr(self, "tools_wide"):  # planned without steps(): the jaws as they are
+            self.tools_wide = self.tools
         self.frames = {p.index: self.arc_frame(p) for p in self.pairs}
         self.drive_grasps, self.pull_grasps, self.out_poses, self.handbacks = [], [], [], []
         self.pulls: list[tuple[float, list, tuple]] = []  # per pair: the grasp's angle, the poses, where clear
@@ -649,15 +658,13 @@ class SutureTask:
         self.base_moves = self.setup_joints()
         self._arms_apart()
         yield from self.jitter()
-        # the tools' shapes as the jaws come onto the wire: wide open (the pick-up), then
-        # at JAW_APPROACH (the fingers reach 0.8 mm farther along the jaw axis)
-        tools = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
+        # the tools' shapes as the jaws come onto the wire: wide open (the pick-up), then at
+        # JAW_APPROACH (every other grasp)
+        self.tools_wide = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
         for name in self.psms:
             self.psms[name].servo_jaw(JAW_APPROACH)
         yield from self.wait(0.3)
-        for n, psm in self.psms.items():
-            tools[n].add_jaws(ToolShape(self.world, psm))
-        self.plan(tools)
+        self.plan()
         d, p = self.psms[self.driver], self.psms[self.puller]
         park = {n: self.parked(self.psms[n]) for n in self.psms}
         self._set_phase("pick up")
