@@ -81,3 +81,22 @@ CAMERA cam:
   field view angle: 0.7
   publish image resolution: {{width: 64, height: 48}}
 """
+
+
+@pytest.fixture(scope="module")
+def addon():
+    """The Blender add-on loaded into the headless ``bpy`` (once per test module)."""
+    pytest.importorskip("bpy")
+    from adfkit.commands.blend_import import load_addon
+
+    _, mod = load_addon()
+    return mod
+
+
+@pytest.fixture()
+def scene(addon):
+    """A fresh, empty Blender scene."""
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return bpy.context.scene

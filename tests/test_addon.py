@@ -13,6 +13,7 @@ import pytest
 from conftest import CORPUS, require_corpus
 
 bpy = pytest.importorskip("bpy")
+from blender_fixtures import cube  # noqa: E402
 
 from adfkit.adf import read_file  # noqa: E402
 from adfkit.diagnostics import AdfError, Severity  # noqa: E402
@@ -32,27 +33,6 @@ JOINT_TYPES = (
     "six dof",
     "six dof spring",
 )
-
-
-@pytest.fixture(scope="module")
-def addon():
-    from adfkit.commands.blend_import import load_addon
-
-    _, mod = load_addon()
-    return mod
-
-
-@pytest.fixture()
-def scene(addon):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    return bpy.context.scene
-
-
-def _cube(name, size=0.05, location=(0, 0, 0)):
-    bpy.ops.mesh.primitive_cube_add(size=size, location=location)
-    o = bpy.context.active_object
-    o.name = o.data.name = name
-    return o
 
 
 def _image(tmp: Path, name: str, color) -> bpy.types.Image:
@@ -83,14 +63,14 @@ def _textured(o, tmp: Path) -> None:
 def build_everything(addon, tmp: Path) -> dict:
     """A model with every element kind, built the way a user would (through authoring.*)."""
     a = addon.authoring
-    base = _cube("Base", 0.2)
+    base = cube("Base", 0.2)
     a.mark(base, "BODY")
     base.adf.body.mass = 0.0
     for x in (-0.05, 0.05):
         a.add_collision_primitive(
             base, "BOX", size=(0.1, 0.2, 0.2), offset=__import__("mathutils").Matrix.Translation((x, 0, 0))
         )
-    skin = _cube("Skin", 0.05, (0.0, 0.0, 0.2))
+    skin = cube("Skin", 0.05, (0.0, 0.0, 0.2))
     bpy.ops.object.mode_set(mode="OBJECT")
     _textured(skin, tmp)
     a.mark(skin, "BODY")
@@ -110,7 +90,7 @@ def build_everything(addon, tmp: Path) -> dict:
     for i, t in enumerate(JOINT_TYPES):
         if t in joints:
             continue
-        child = _cube(f"Link {t}", 0.02, (-0.3, 0.1 * i, 0.0))
+        child = cube(f"Link {t}", 0.02, (-0.3, 0.1 * i, 0.0))
         a.mark(child, "BODY")
         child.adf.body.mass = 0.02
         child.adf.body.use_inertia, child.adf.body.inertia = True, (1e-6, 1e-6, 1e-6)
@@ -285,7 +265,7 @@ def test_corpus_import_export(addon, scene, tmp_path, path, listed_twice, folder
 
 
 def test_body_without_mass_is_refused_and_nothing_written(addon, scene, tmp_path):
-    o = _cube("Lump")
+    o = cube("Lump")
     addon.authoring.mark(o, "BODY")
     o.adf.body.use_mass = False
     res = addon.export.export_scene(scene, tmp_path / "out")
@@ -295,7 +275,7 @@ def test_body_without_mass_is_refused_and_nothing_written(addon, scene, tmp_path
 
 
 def test_joint_to_missing_object_is_refused(addon, scene, tmp_path):
-    a, b = _cube("A"), _cube("B", location=(0, 0, 0.1))
+    a, b = cube("A"), cube("B", location=(0, 0, 0.1))
     for o in (a, b):
         addon.authoring.mark(o, "BODY")
     j = addon.authoring.add_joint(a, b, "revolute", name="J")
@@ -400,7 +380,7 @@ def test_every_geometry_operator_on_a_degenerate_mesh_finishes_or_says_why(addon
 
 
 def test_an_imported_joint_whose_child_is_cleared_is_refused_and_an_external_one_kept(addon, scene, tmp_path):
-    a, b = _cube("A"), _cube("B", location=(0, 0, 0.1))
+    a, b = cube("A"), cube("B", location=(0, 0, 0.1))
     for o in (a, b):
         addon.authoring.mark(o, "BODY")
     addon.authoring.add_joint(a, b, "revolute", name="J")

@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 
 bpy = pytest.importorskip("bpy")
+from blender_fixtures import cube  # noqa: E402
+
 trimesh = pytest.importorskip("trimesh")
 
 from adfkit.adf import read_file  # noqa: E402
@@ -17,27 +19,6 @@ from adfkit.cli import main  # noqa: E402
 from adfkit.geometry.softmesh import load_soft_mesh, read_3ds  # noqa: E402
 
 FORMATS = ("OBJ", "STL", "PLY", "3DS")
-
-
-@pytest.fixture(scope="module")
-def addon():
-    from adfkit.commands.blend_import import load_addon
-
-    _, mod = load_addon()
-    return mod
-
-
-@pytest.fixture()
-def scene(addon):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    return bpy.context.scene
-
-
-def _cube(name, size, location):
-    bpy.ops.mesh.primitive_cube_add(size=size, location=location)
-    o = bpy.context.active_object
-    o.name = o.data.name = name
-    return o
 
 
 def _red(o) -> None:
@@ -52,13 +33,13 @@ def _red(o) -> None:
 def tray_and_lid(addon):
     """A 10 cm red tray on the floor, and a lid above it whose collision is two box parts."""
     a = addon.authoring
-    tray = _cube("Tray", 0.1, (0.0, 0.0, 0.05))
+    tray = cube("Tray", 0.1, (0.0, 0.0, 0.05))
     _red(tray)
     a.mark(tray, "BODY")
-    lid = _cube("Lid", 0.04, (0.0, 0.0, 0.2))
+    lid = cube("Lid", 0.04, (0.0, 0.0, 0.2))
     a.mark(lid, "BODY")
     for i, x in enumerate((-0.01, 0.01)):
-        part = _cube(f"LidPart{i}", 0.02, (x, 0.0, 0.2))
+        part = cube(f"LidPart{i}", 0.02, (x, 0.0, 0.2))
         part.parent = lid
         part.matrix_parent_inverse = lid.matrix_world.inverted()
         a.mark(part, "COLLISION_MESH")

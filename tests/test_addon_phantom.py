@@ -11,6 +11,7 @@ import pytest
 from conftest import CORPUS, ROOT, corpus_files, corpus_id, require_corpus
 
 bpy = pytest.importorskip("bpy")
+from blender_fixtures import cube  # noqa: E402
 
 from adfkit.adf import read_file  # noqa: E402
 from adfkit.adf.writer import file_to_plain  # noqa: E402
@@ -22,20 +23,6 @@ SAMPLES = sorted(
 )
 
 
-@pytest.fixture(scope="module")
-def addon():
-    from adfkit.commands.blend_import import load_addon
-
-    _, mod = load_addon()
-    return mod
-
-
-@pytest.fixture()
-def scene(addon):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    return bpy.context.scene
-
-
 def _export(addon, scene, out: Path, name="model"):
     res = addon.export.export_scene(scene, out, name)
     assert res.ok, [d.message for d in res.diagnostics if d.severity >= Severity.ERROR]
@@ -43,10 +30,7 @@ def _export(addon, scene, out: Path, name="model"):
 
 
 def _cube(name, size=0.04, location=(0, 0, 0)):
-    bpy.ops.mesh.primitive_cube_add(size=size, location=location)
-    o = bpy.context.active_object
-    o.name = o.data.name = name
-    return o
+    return cube(name, size, location)
 
 
 def _key_paths(plain, prefix=()) -> set[tuple]:

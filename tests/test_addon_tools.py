@@ -10,31 +10,12 @@ import numpy as np
 import pytest
 
 bpy = pytest.importorskip("bpy")
+from blender_fixtures import cube  # noqa: E402
+
 trimesh = pytest.importorskip("trimesh")
 
 from adfkit.adf import read_file  # noqa: E402
 from adfkit.diagnostics import Severity  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def addon():
-    from adfkit.commands.blend_import import load_addon
-
-    _, mod = load_addon()
-    return mod
-
-
-@pytest.fixture()
-def scene(addon):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    return bpy.context.scene
-
-
-def _cube(name, size=0.05, location=(0, 0, 0)):
-    bpy.ops.mesh.primitive_cube_add(size=size, location=location)
-    o = bpy.context.active_object
-    o.name = o.data.name = name
-    return o
 
 
 def _namespaces(addon):
@@ -54,12 +35,12 @@ def _select(*objs):
 
 def test_strip_namespaces_moves_the_shared_namespace_to_the_model(addon, scene, tmp_path):
     a = addon.authoring
-    base = _cube("/ambf/env/psm/base", 0.1)
-    link = _cube("/ambf/env/psm/link1", 0.05, (0.0, 0.0, 0.1))
+    base = cube("/ambf/env/psm/base", 0.1)
+    link = cube("/ambf/env/psm/link1", 0.05, (0.0, 0.0, 0.1))
     for o in (base, link):
         a.mark(o, "BODY")
     a.add_joint(base, link, "revolute", name="/ambf/env/psm/base-link1")
-    plain = _cube("Table", 0.2, (0.5, 0.0, 0.0))
+    plain = cube("Table", 0.2, (0.5, 0.0, 0.0))
     a.mark(plain, "BODY")
     # before: export says what AMBF would make of such a name
     before = [d for d in addon.export.check_scene(scene) if d.rule == "namespace-in-name"]
@@ -87,7 +68,7 @@ def test_strip_namespaces_moves_the_shared_namespace_to_the_model(addon, scene, 
 
 def test_strip_namespaces_says_which_namespaces_it_dropped_when_they_differ(addon, scene):
     for name in ("/left/arm", "/right/arm"):
-        addon.authoring.mark(_cube(name), "BODY")
+        addon.authoring.mark(cube(name), "BODY")
     said = _namespaces(addon).strip_namespaces(scene)
     # both are 'arm' now: Blender gives the second one a number, and that is said too
     assert said == [
@@ -112,11 +93,11 @@ def test_split_name_follows_ambfs_rule(addon):
 def _body_with_offset_part(addon):
     """A body turned 90° about Z at z = 0.5, and a 2 cm collision cube 10 cm from it along world
     X, which is the body's -Y."""
-    body = _cube("Body", 0.1, (0.0, 0.0, 0.5))
+    body = cube("Body", 0.1, (0.0, 0.0, 0.5))
     body.rotation_euler = (0.0, 0.0, math.pi / 2)
     bpy.context.view_layer.update()
     addon.authoring.mark(body, "BODY")
-    part = _cube("Part", 0.02, (0.1, 0.0, 0.5))
+    part = cube("Part", 0.02, (0.1, 0.0, 0.5))
     part.parent = body
     part.matrix_parent_inverse = body.matrix_world.inverted()
     addon.authoring.mark(part, "COLLISION_MESH")
@@ -160,7 +141,7 @@ def test_move_to_body_origin_puts_the_collision_mesh_where_ambf_reads_it(addon, 
 
 
 def test_collision_placement_without_a_body_says_why(addon, scene):
-    stray = _cube("Stray", 0.02)
+    stray = cube("Stray", 0.02)
     addon.authoring.mark(stray, "COLLISION_MESH")
     _select(stray)
     with pytest.raises(RuntimeError) as exc:
