@@ -170,8 +170,9 @@ def atomic_write_text(path: str | Path, text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
 
 
-def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Write bytes beside the target, then rename: a failure leaves the old file as it was."""
+def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write bytes beside the target, then rename: a failure leaves the old file as it was.
+    Returns the path written."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -190,6 +191,7 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
         except FileNotFoundError:
             pass
         raise
+    return path
 
 
 def write_file(doc: AdfFile, path: str | Path) -> Path:

@@ -16,12 +16,11 @@ why a part of it was changed or left out:
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from dataclasses import replace
 from pathlib import Path
 
 from .. import inputs
+from ..adf.writer import atomic_write_bytes
 from ..diagnostics import AdfError
 from .losses import Loss
 
@@ -51,20 +50,6 @@ def usable_scales(model, losses: list[Loss]):
         )
     swap = {id(b): replace(b, scale=None) for b in bad}
     return replace(model, bodies=[swap.get(id(b), b) for b in model.bodies])
-
-
-def _write_bytes(path: Path, data: bytes) -> None:
-    """Atomic: a temporary file beside the target, then a rename."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def joint_range(joint, losses: list[Loss]) -> tuple[float, float] | None:
@@ -148,7 +133,7 @@ class MeshFiles:
                         n += 1
                         out = self.folder / f"{path.stem}_{n}.stl"
                     self.folder.mkdir(parents=True, exist_ok=True)
-                    _write_bytes(out, mesh.export(file_type="stl"))
+                    atomic_write_bytes(out, mesh.export(file_type="stl"))
                     losses.append(
                         Loss(
                             who,
@@ -204,7 +189,7 @@ def split_objects(path: Path, folder: Path) -> list[Path]:
         text = "".join(f"v {' '.join(x)}\n" for x in v) + "".join(
             "f " + " ".join(str(i + 1) for i in face) + "\n" for face in f
         )
-        _write_bytes(p, text.encode())
+        atomic_write_bytes(p, text.encode())
         out.append(p)
     return out
 

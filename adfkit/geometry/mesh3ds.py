@@ -23,10 +23,11 @@ from __future__ import annotations
 
 import os
 import struct
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from ..adf.writer import atomic_write_bytes
 
 MAIN, VERSION, EDITOR, MESH_VERSION, OBJECT, TRIMESH, VERTICES, FACES = (
     0x4D4D,
@@ -134,18 +135,3 @@ def write_3ds(path: str | os.PathLike, parts: list[tuple[str, np.ndarray, np.nda
     """Write :func:`encode_3ds` atomically (a temporary file beside the target, then renamed)."""
     data = encode_3ds(parts, split=split)
     return atomic_write_bytes(path, data)
-
-
-def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .mesh3ds import TooLarge, atomic_write_bytes, encode_3ds
+from ..adf.writer import atomic_write_bytes
+from .mesh3ds import TooLarge, encode_3ds
 
 #: The formats a mesh can be exported in, with the suffix written (AMBF's add-on wrote capitals).
 SUFFIXES = {"OBJ": ".OBJ", "STL": ".STL", "PLY": ".PLY", "3DS": ".3DS"}
