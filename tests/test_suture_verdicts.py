@@ -133,6 +133,16 @@ def test_a_tip_pushed_back_out_of_the_entry_is_blocked_or_has_left_the_boundary(
     assert v["rule"] == "left-boundary" and "t = 6.00 s" in v["reason"]
 
 
+def test_a_tip_forced_between_the_holes_is_blocked_in_the_channel():
+    obs, pair = _record(_c(5.0, True), _c(8.0, False))
+    obs.tip_contacts = {"insert 1": {"Entry1": 4.2}}  # brushing the boundary, as in a free channel
+    assert pair_verdict(obs, pair)["passed"]
+    obs.tip_contacts = {"insert 1": {"Phantom": 531.2, "Exit1": 343.5, "Entry1": 4.2}}
+    v = pair_verdict(obs, pair)
+    assert v["rule"] == "blocked-in-channel" and not v["passed"]
+    assert "Phantom (531.2 N), Exit1 (343.5 N)" in v["reason"] and "Entry1 (4.2 N)" not in v["reason"]
+
+
 def test_a_tool_pressing_on_the_tissue_fails_its_pair_and_a_touch_does_not():
     from adfkit.tasks.verdicts import TOOL_HIT_N
 
@@ -177,6 +187,16 @@ def _fill_hole_1(d: Path) -> None:
             1,
         ),
     )
+
+
+def _fill_exit_1(d: Path) -> None:
+    """A box in the ridge's gap between the middle of pair 1's channel and Exit1 only."""
+    box = (
+        "  - shape: Box\n    geometry: {x: 0.006, y: 0.0056, z: 0.006}\n    offset:\n"
+        "      position: {x: 0.0075, y: 0.036, z: 0.019}\n      orientation: {r: 0.0, p: 0.0, y: 0.0}\n"
+    )
+    head = "BODY Phantom:\n  name: Phantom\n  mesh: Phantom.OBJ\n  use material: true\n  compound collision shape:\n"
+    _edit(d / "phantom" / "phantom.yaml", lambda s: s.replace(head, head + box, 1))
 
 
 def _narrow_entry_1(d: Path) -> None:
@@ -236,6 +256,15 @@ def test_ghost_off_its_hole_fails_with_that_reason(tmp_path):
     p = _pair_1(_scene(tmp_path, _move_ghost_entry_1))
     assert not p["passed"] and p["rule"] == "entry-ghost-off-hole"
     assert "5.0 mm off" in p["reason"]
+
+
+@pytest.mark.slow
+def test_a_channel_closed_before_the_exit_fails_as_forced_through(tmp_path):
+    """The driver can push the needle through a box by force (the tip on Phantom with hundreds of
+    newtons, where a free channel takes under 5 N): the pair fails, and says the channel is closed."""
+    p = _pair_1(_scene(tmp_path, _fill_exit_1))
+    assert not p["passed"] and p["rule"] == "blocked-in-channel"
+    assert "Phantom (" in p["reason"] and "the channel is closed" in p["reason"]
 
 
 def test_filled_hole_blocks_the_insertion_fast(tmp_path):

@@ -20,6 +20,7 @@ TOOL_HIT_N: float | None = 50.0
 
 SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
 SLIP_SETTLE_S = 0.25  # s a grasp is given to settle after the other arm let go
+TIP_FORCE_N = 20.0  # N: the tip pressing this hard on the tissue between a pair's holes was forced through
 BLOCK_N = 1.0  # N: a carried needle pressing on the tissue this hard on its way to a hole is blocked there
 RULES = (
     "not-tried",
@@ -30,6 +31,7 @@ RULES = (
     "entry-not-tip-first",
     "entry-ghost-off-hole",
     "left-boundary",
+    "blocked-in-channel",
     "exit-missed",
     "exit-outside-opening",
     "exit-not-tip-first",
@@ -148,6 +150,15 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         return "left-boundary", (
             f"the needle left the boundary of {_label(entry)}: the tip came back out at "
             f"t = {back[0]['t']:.2f} s before reaching {_label(exit_)}"
+        )
+    forced = {b: f for b, f in at_tip.items() if f >= TIP_FORCE_N}
+    if forced:
+        # through a free channel the tip brushes the holes' boundaries with a few newtons: this much
+        # means the driver forced it through what should have stopped it
+        hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forced.items(), key=lambda kv: -kv[1]))
+        return "blocked-in-channel", (
+            f"the needle was forced from {_label(entry)} toward {_label(exit_)}: the tip pressed on {hits} "
+            f"(a free channel lets it through with under {TIP_FORCE_N:.0f} N); the channel is closed there"
         )
     if not outs:
         if failed_here:
