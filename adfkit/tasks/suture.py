@@ -27,18 +27,19 @@ import numpy as np
 
 from ..adf.paths import collision_mesh_path
 from ..runner.psm import JAW_OPEN, PSM
-from ..runner.psm_kinematics import JointLimitError
-from ..runner.rotations import invert, rotation_exp, rotation_log
-from .clearance import Tissue, ToolShape, clearances
+from ..runner.rotations import invert
+from .clearance import Tissue, ToolShape
+from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError are the task's too
+    JAW_APPROACH,
+    JAW_DEPTH,
+    Grasp,
+    GraspChoice,
+    SutureError,
+)
 from .holes import hole_frame
+from .motions import Motions, interpolate, smooth
 from .needle import fit_needle, obj_vertices
 
-JAW_DEPTH = 0.01  # m from the end effector to the point between the jaws (LND: along z_E)
-#: m from the end effector to where the wire is held: 1 mm short of the fingers' ends (11.5 mm), so
-#: that the jaws reach no farther than the wire's far side (a needle lying on the tissue is taken
-#: from above without the fingers pressing into the tissue)
-GRASP_DEPTH = 0.0105
-BACK_OFF = 0.012  # m along -z_E before a grasp and after a release
 LIFT = 0.015  # m the needle is lifted when carried between the phantom and a hole
 APPROACH = math.radians(15)  # the tip starts this far before the entry on its arc
 MAX_GRASP = math.radians(25)  # the grasps sit at most this far from the tip / the tail ...
@@ -46,22 +47,9 @@ CLEAR = math.radians(10)  # ... and at least this far outside the tissue
 MAX_BITE = math.radians(65)  # the arc between entry and exit; wider bites aim inside the holes
 HOLE_MARGIN = 0.0008  # m kept from a hole ghost's side when aiming inside it
 TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
-CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
-TOOL_CLEARANCE = 0.0015  # m the planner keeps the tool's shapes from the tissue's where it can
-#: rad between the jaws as they come onto the wire: a 3.9 mm gap at the wire for its 1.2 mm, and
-#: fingers 2.5 mm to each side instead of the 5.6 mm of a fully opened jaw, beside the tissue
-JAW_APPROACH = 0.35
-GRASP_STEP = math.radians(6)  # the planner tries grasps this far apart along the wire ...
-MIN_GRASP = math.radians(8)  # ... from this far from the tip or the tail (the jaws' width)
-GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
-GUARD_BACK = 0.0005  # m ... and draws back this far the way it came
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
-
-
-class SutureError(RuntimeError):
-    """The planner cannot go on (no reachable grasp, a lost needle, ...)."""
 
 
 @dataclass
@@ -78,18 +66,6 @@ def _rot_z(a: float) -> np.ndarray:
     t = np.eye(4)
     t[:2, :2] = [[c, -s], [s, c]]
     return t
-
-
-def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
-    """Pose between a and b: straight line, rotation about one axis."""
-    t = np.eye(4)
-    t[:3, :3] = a[:3, :3] @ rotation_exp(s * rotation_log(a[:3, :3].T @ b[:3, :3]))
-    t[:3, 3] = (1 - s) * a[:3, 3] + s * b[:3, 3]
-    return t
-
-
-def _smooth(s: float) -> float:
-    return s * s * (3 - 2 * s)
 
 
 def _in_plane_room(ghost, direction) -> float:
@@ -140,16 +116,7 @@ def find_needle(world):
     return needle, fit_needle(v, hint)
 
 
-@dataclass
-class Grasp:
-    """Where a PSM holds the needle: the end effector's pose in the needle frame."""
-
-    ee_in_needle: np.ndarray
-    margin: float
-    clearance: float = math.inf  # m the tool keeps from the tissue where the plan checked it
-
-
-class SutureTask:
+class SutureTask(GraspChoice, Motions):
     """The scripted suture on a SimWorld with two PSMs (see the module docstring)."""
 
     def __init__(
@@ -251,231 +218,6 @@ class SutureTask:
         out[2, 3] += dz
         return out
 
-    # ---- grasp selection ---------------------------------------------------------------
-    def grasp_candidates(self, phi: float):
-        """End-effector poses in the needle frame that hold the wire at arc angle phi between
-        the jaws (the wire across the opening direction y_E): around the wire in 15° steps,
-        both ways, the wire square to the jaws or turned up to 45° about y_E. Each comes with
-        its turn (rad), which the choice penalises slightly."""
-        g = self.geom
-        a = g.arc_in_needle
-        p = g.point(phi)
-        t = a[:3, :3] @ np.array([-math.sin(phi), math.cos(phi), 0.0])
-        radial = a[:3, :3] @ np.array([math.cos(phi), math.sin(phi), 0.0])
-        n = a[:3, 2]
-        out = []
-        for turn in np.radians([0.0, 25.0, -25.0, 45.0, -45.0]):
-            for sign in (1.0, -1.0):
-                for beta in np.radians(np.arange(0, 360, 15)):
-                    z0 = math.cos(beta) * -radial + math.sin(beta) * n
-                    x0 = sign * t
-                    x = math.cos(turn) * x0 - math.sin(turn) * z0
-                    z = math.sin(turn) * x0 + math.cos(turn) * z0
-                    m = np.eye(4)
-                    m[:3, :3] = np.c_[x, np.cross(z, x), z]
-                    m[:3, 3] = p - GRASP_DEPTH * z
-                    out.append((m, abs(float(turn))))
-        return out
-
-    def _along_wire(self, phi: float, clear_at: tuple):
-        """Candidates at phi and, where the tool's clearance is checked, at other places of the
-        same end of the wire (from MIN_GRASP up to phi), nearest to phi first."""
-        yield from self.grasp_candidates(phi)
-        if not clear_at:
-            return
-        tail_end = phi < -self.geom.span / 2
-        end = -self.geom.span if tail_end else 0.0
-        room = abs(phi - end) - MIN_GRASP
-        for d in np.arange(GRASP_STEP, room + 1e-9, GRASP_STEP):
-            yield from self.grasp_candidates(phi - d if tail_end else phi + d)
-
-    def _margin(self, psm: PSM, ee_world: np.ndarray) -> float:
-        try:
-            q = psm.kin.ik(invert(psm.base_in_world()) @ ee_world)
-        except ValueError:
-            return -1.0
-        lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
-        return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo)))
-
-    def choose_grasp(
-        self,
-        psm: PSM,
-        phi: float,
-        needle_poses: list,
-        down_at: np.ndarray | None = None,
-        what: str = "",
-        clear_at: tuple = (),
-    ) -> Grasp:
-        """The candidate grasp reachable at every needle pose that keeps the tool farthest from
-        the tissue (up to TOOL_CLEARANCE) at the needle poses ``clear_at`` (the first one also
-        on the approach along the jaw axis), then with the widest joint margin (with
-        ``down_at``: the jaws must point down at that needle pose, to come from above)."""
-        cands = [
-            (m, turn) for m, turn in self._along_wire(phi, clear_at) if down_at is None or (down_at @ m)[2, 2] <= -0.5
-        ]
-        if not cands:
-            raise SutureError(f"{psm.name}: no grasp of the needle from above ({what})")
-        ee_in_n = np.array([m for m, _ in cands])
-        clear = np.full(len(cands), TOOL_CLEARANCE)
-        for i, pose in enumerate(clear_at):
-            # the jaws as they come onto the wire there: wide open onto a needle lying on the tissue
-            tool = self.tools_wide[psm.name] if i == 0 and down_at is not None else self.tools[psm.name]
-            ee = pose[None] @ ee_in_n
-            clear = np.minimum(clear, clearances(self.tissue_shapes, tool, ee, TOOL_CLEARANCE))
-            if i == 0:  # and on the way in, along the jaw axis
-                for f in (1.0, 2 / 3, 1 / 3):
-                    back = ee.copy()
-                    back[:, :3, 3] -= f * BACK_OFF * ee[:, :3, 2]
-                    clear = np.minimum(clear, clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE))
-        # the choice: the clearance (up to TOOL_CLEARANCE, in tenths of a millimetre), then the
-        # wider joint margin
-        clear_q = np.round(clear / 1e-4)
-        best, best_key = None, None
-        for i in np.argsort(-clear_q, kind="stable"):
-            if best_key is not None and clear_q[i] < best_key[0]:
-                break  # the rest come nearer the tissue
-            m, turn = cands[i]
-            first = needle_poses[0] @ m
-            back = first.copy()
-            back[:3, 3] -= BACK_OFF * first[:3, 2]
-            worst = self._margin(psm, back)  # the jaws come onto the wire along their axis
-            for pose in needle_poses:
-                if worst <= 0:
-                    break
-                worst = min(worst, self._margin(psm, pose @ m))
-            margin = worst - 0.02 * turn
-            key = (float(clear_q[i]), margin)
-            if worst > 0 and (best_key is None or key > best_key):
-                best, best_key = Grasp(m, margin, float(clear[i])), key
-        if best is None:
-            raise SutureError(f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})")
-        return best
-
-    # ---- motion primitives (generators: one yield per control step) ----------------------
-    def _set_phase(self, name: str):
-        self.phase = name
-        self.phase_log.append((name, self.world.sim_time))
-
-    def _steps(self, seconds: float) -> int:
-        return max(1, int(round(seconds / self.speed / self.cdt)))
-
-    def servo_world(self, psm: PSM, ee_world: np.ndarray) -> None:
-        """Cartesian set-point in the world; a pose a little past a joint limit (the grasp
-        as measured differs from the planned one by a few degrees) is servoed with the joints
-        clipped to their limits, and counted."""
-        try:
-            psm.servo_cp(invert(psm.base_in_world()) @ ee_world)
-        except JointLimitError as exc:
-            lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
-            if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
-                raise
-            psm.servo_jp(np.clip(exc.q, lo, hi))
-            self.clipped += 1
-
-    def setpoint_world(self, psm: PSM) -> np.ndarray:
-        return psm.base_in_world() @ psm.setpoint_cp()
-
-    def move(self, psm: PSM, goal: np.ndarray, seconds: float, settle: float = 0.15):
-        """Free-space move: the IK at the goal, joints interpolated (the wrist never passes
-        through an unreachable orientation on the way)."""
-        try:
-            q = psm.kin.ik(invert(psm.base_in_world()) @ goal)
-        except JointLimitError as exc:  # a little past a limit: go as near as the joints allow
-            lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
-            if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
-                raise
-            q = np.clip(exc.q, lo, hi)
-            self.clipped += 1
-        yield from self.move_jp(psm, q, seconds, settle)
-
-    def move_jp(self, psm: PSM, q1, seconds: float, settle: float = 0.15):
-        q0 = psm.setpoint_jp()
-        q1 = np.asarray(q1, dtype=float)
-        n = self._steps(seconds)
-        for i in range(1, n + 1):
-            psm.servo_jp(q0 + (q1 - q0) * _smooth(i / n))
-            yield self.phase
-        yield from self.wait(settle)
-
-    def wait(self, seconds: float):
-        for _ in range(self._steps(seconds)):
-            yield self.phase
-
-    def line(self, psm: PSM, a: np.ndarray, b: np.ndarray, seconds: float, guarded: bool = False):
-        """The end effector from pose a to pose b along a straight line (Cartesian). Guarded: it
-        stops where the tool first presses on the tissue with GUARD_N (and stays there), as a
-        hand stops on touching; the plan keeps the tools off the tissue, but a few tenths of a
-        millimetre of clearance leave no room for the servo's overshoot."""
-        n = self._steps(seconds)
-        links = [sb for sb in self.world.bodies if sb.articulation is psm.art] if guarded else []
-        tissue = {id(sb) for sb in self.world.bodies if sb.model is self.needle.model and sb.static}
-        for i in range(1, n + 1):
-            self.servo_world(psm, interpolate(a, b, _smooth(i / n)))
-            yield self.phase
-            if links and any(f >= GUARD_N for sb in links for o, f, _ in self.world.contacts(sb) if id(o) in tissue):
-                stop = psm.base_in_world() @ psm.measured_cp()
-                stop[:3, 3] -= (
-                    GUARD_BACK * (b[:3, 3] - a[:3, 3]) / max(float(np.linalg.norm(b[:3, 3] - a[:3, 3])), 1e-9)
-                )
-                self.servo_world(psm, stop)  # where it touched, a little back the way it came
-                return
-
-    def carry(self, path, seconds: float):
-        """The holder moves the needle through needle poses path(s), s in [0, 1] (Cartesian)."""
-        psm = self.psms[self.holder]
-        n = self._steps(seconds)
-        for i in range(1, n + 1):
-            self.servo_world(psm, path(i / n) @ self.held_ee_in_needle)
-            yield self.phase
-
-    def carry_to(self, goal: np.ndarray, seconds: float):
-        """The holder takes the needle to a pose through joint space."""
-        yield from self.move(self.psms[self.holder], goal @ self.held_ee_in_needle, seconds, settle=0.0)
-
-    def take(self, name: str, grasp: Grasp, opening: float = JAW_APPROACH):
-        """``name`` opens its jaws (``opening`` rad), comes down along its jaw axis onto the
-        grasp (on the needle where it is now) and holds the needle."""
-        psm = self.psms[name]
-        goal = self.needle_pose() @ grasp.ee_in_needle
-        above = goal.copy()
-        above[:3, 3] -= BACK_OFF * goal[:3, 2]
-        psm.servo_jaw(opening)
-        yield from self.move(psm, above, 0.8)
-        yield from self.line(psm, above, goal, 0.5, guarded=True)  # along the jaw axis, as the plan checked it
-        yield from self.wait(0.2)
-        ee = psm.base_in_world() @ psm.measured_cp()
-        miss = float(np.linalg.norm(ee[:3, 3] - (self.needle_pose() @ grasp.ee_in_needle)[:3, 3]))
-        if miss > 0.004:
-            raise SutureError(f"{name} missed the needle by {miss * 1000:.1f} mm ({self.phase})")
-        # the wire lies between the open jaws: the actuator holds it where it is (and the jaws
-        # no longer collide with it), then the jaws close on it; closing them first would
-        # squeeze the wire out toward their tips (measured: 3.6 mm and 26 degrees off the plan)
-        act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
-        self.world.actuate(act, self.needle)
-        self.holder = name
-        self.held_ee_in_needle = invert(self.needle_pose()) @ ee
-        psm.servo_jaw(0.0)
-        yield from self.wait(0.15)
-
-    def let_go(self, name: str, holder: str | None = None):
-        """``name`` releases the needle and backs off. ``holder``, the arm that keeps it, is then
-        put where the needle settled (once): freed from the other grasp, the needle settles where
-        the tissue holds it, up to 2.7 mm from where both grasps had it, and a grasp that stayed
-        put would stay strained by that much."""
-        psm = self.psms[name]
-        act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
-        self.world.release(act)
-        psm.servo_jaw(JAW_APPROACH)
-        yield from self.wait(0.15)
-        if holder is not None:
-            keep = self.psms[holder]
-            yield from self.line(keep, self.setpoint_world(keep), self.needle_pose() @ self.held_ee_in_needle, 0.2)
-        here = self.setpoint_world(psm)
-        back = here.copy()
-        back[:3, 3] -= BACK_OFF * here[:3, 2]
-        back[2, 3] += 0.01
-        yield from self.move(psm, back, 0.5, settle=0.0)
-
     # ---- the task ------------------------------------------------------------------------
     def _sides(self):
         """Driver: the PSM whose base lies on the entry side of the first pair."""
@@ -576,20 +318,20 @@ class SutureTask:
         turned in its plane as little as both arms allow (the driver's grasp must reach it and
         the whole next insertion; the puller's grasp must reach it). Returns the driver's grasp
         and records the pose in self.handbacks."""
-        b, _, _, _, _ = self.frames[self.pairs[k].index]
+        b, psi_x, beyond, _, _ = self.frames[self.pairs[k].index]
         puller = self.psms[self.puller]
         prev = self.pull_grasps[k - 1]
+        along = self.along_arc(b, -self.approach, psi_x + beyond)
         for psi in np.radians(np.arange(-15, 250, 15)) - self.approach:
             h = self.lifted(self.needle_at(b, psi), 2 * LIFT)
             if self._margin(puller, h @ prev.ee_in_needle) <= 0:
                 continue
-            b_k, psi_x, beyond, _, _ = self.frames[self.pairs[k].index]
             try:
                 g = self.choose_grasp(
                     self.psms[self.driver],
                     -self.geom.span + g_tail,
                     [h] + insertion,
-                    clear_at=(h, insertion[0], *self.along_arc(b_k, -self.approach, psi_x + beyond)),
+                    clear_at=(h, insertion[0], *along),
                 )
             except SutureError:
                 continue
@@ -677,10 +419,10 @@ class SutureTask:
             start = self.needle_at(b, -self.approach)
             self._set_phase(f"carry {pair.index}")
             up = self.lifted(n_from, LIFT)
-            yield from self.carry(lambda s: interpolate(n_from, up, _smooth(s)), 0.6)
+            yield from self.carry(lambda s: interpolate(n_from, up, smooth(s)), 0.6)
             yield from self.carry_to(self.lifted(start, LIFT), 1.2)
             over = self.lifted(start, LIFT)
-            yield from self.carry(lambda s: interpolate(over, start, _smooth(s)), 0.8)
+            yield from self.carry(lambda s: interpolate(over, start, smooth(s)), 0.8)
             yield from self.wait(0.2)
             self._set_phase(f"insert {pair.index}")
             psi_end = psi_x + beyond
@@ -702,7 +444,7 @@ class SutureTask:
             )
             out = self.needle_at(b_now, done)
             high = self.lifted(out, 2 * LIFT)
-            yield from self.carry(lambda s: interpolate(out, high, _smooth(s)), 1.0)
+            yield from self.carry(lambda s: interpolate(out, high, smooth(s)), 1.0)
             yield from self.wait(0.2)
             if k + 1 < len(self.pairs):
                 self._set_phase(f"hand back {pair.index}")

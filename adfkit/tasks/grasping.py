@@ -1,0 +1,142 @@
+"""Where a PSM takes the needle: grasp candidates around and along the wire, each scored by how
+far it keeps the tool from the tissue along the plan (adfkit/tasks/clearance.py), then by the
+closed-form IK's joint margin. A mixin of SutureTask (it reads the task's needle geometry,
+arms, tissue and tool shapes)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..runner.psm import PSM
+from ..runner.rotations import invert
+from .clearance import clearances
+
+JAW_DEPTH = 0.01  # m from the end effector to the point between the jaws (LND: along z_E)
+#: m from the end effector to where the wire is held: 1 mm short of the fingers' ends (11.5 mm), so
+#: that the jaws reach no farther than the wire's far side (a needle lying on the tissue is taken
+#: from above without the fingers pressing into the tissue)
+GRASP_DEPTH = 0.0105
+BACK_OFF = 0.012  # m along -z_E before a grasp and after a release
+TOOL_CLEARANCE = 0.0015  # m the planner keeps the tool's shapes from the tissue's where it can
+#: rad between the jaws as they come onto the wire: a 3.9 mm gap at the wire for its 1.2 mm, and
+#: fingers 2.5 mm to each side instead of the 5.6 mm of a fully opened jaw, beside the tissue
+JAW_APPROACH = 0.35
+GRASP_STEP = math.radians(6)  # the planner tries grasps this far apart along the wire ...
+MIN_GRASP = math.radians(8)  # ... from this far from the tip or the tail (the jaws' width)
+
+
+class SutureError(RuntimeError):
+    """The planner cannot go on (no reachable grasp, a lost needle, ...)."""
+
+
+@dataclass
+class Grasp:
+    """Where a PSM holds the needle: the end effector's pose in the needle frame."""
+
+    ee_in_needle: np.ndarray
+    margin: float
+    clearance: float = math.inf  # m the tool keeps from the tissue where the plan checked it
+
+
+class GraspChoice:
+    def grasp_candidates(self, phi: float):
+        """End-effector poses in the needle frame that hold the wire at arc angle phi between
+        the jaws (the wire across the opening direction y_E): around the wire in 15° steps,
+        both ways, the wire square to the jaws or turned up to 45° about y_E. Each comes with
+        its turn (rad), which the choice penalises slightly."""
+        g = self.geom
+        a = g.arc_in_needle
+        p = g.point(phi)
+        t = a[:3, :3] @ np.array([-math.sin(phi), math.cos(phi), 0.0])
+        radial = a[:3, :3] @ np.array([math.cos(phi), math.sin(phi), 0.0])
+        n = a[:3, 2]
+        out = []
+        for turn in np.radians([0.0, 25.0, -25.0, 45.0, -45.0]):
+            for sign in (1.0, -1.0):
+                for beta in np.radians(np.arange(0, 360, 15)):
+                    z0 = math.cos(beta) * -radial + math.sin(beta) * n
+                    x0 = sign * t
+                    x = math.cos(turn) * x0 - math.sin(turn) * z0
+                    z = math.sin(turn) * x0 + math.cos(turn) * z0
+                    m = np.eye(4)
+                    m[:3, :3] = np.c_[x, np.cross(z, x), z]
+                    m[:3, 3] = p - GRASP_DEPTH * z
+                    out.append((m, abs(float(turn))))
+        return out
+
+    def _along_wire(self, phi: float, clear_at: tuple):
+        """Candidates at phi and, where the tool's clearance is checked, at other places of the
+        same end of the wire (from MIN_GRASP up to phi), nearest to phi first."""
+        yield from self.grasp_candidates(phi)
+        if not clear_at:
+            return
+        tail_end = phi < -self.geom.span / 2
+        end = -self.geom.span if tail_end else 0.0
+        room = abs(phi - end) - MIN_GRASP
+        for d in np.arange(GRASP_STEP, room + 1e-9, GRASP_STEP):
+            yield from self.grasp_candidates(phi - d if tail_end else phi + d)
+
+    def _margin(self, psm: PSM, ee_world: np.ndarray) -> float:
+        try:
+            q = psm.kin.ik(invert(psm.base_in_world()) @ ee_world)
+        except ValueError:
+            return -1.0
+        lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+        return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo)))
+
+    def choose_grasp(
+        self,
+        psm: PSM,
+        phi: float,
+        needle_poses: list,
+        down_at: np.ndarray | None = None,
+        what: str = "",
+        clear_at: tuple = (),
+    ) -> Grasp:
+        """The candidate grasp reachable at every needle pose that keeps the tool farthest from
+        the tissue (up to TOOL_CLEARANCE) at the needle poses ``clear_at`` (the first one also
+        on the approach along the jaw axis), then with the widest joint margin (with
+        ``down_at``: the jaws must point down at that needle pose, to come from above)."""
+        cands = [
+            (m, turn) for m, turn in self._along_wire(phi, clear_at) if down_at is None or (down_at @ m)[2, 2] <= -0.5
+        ]
+        if not cands:
+            raise SutureError(f"{psm.name}: no grasp of the needle from above ({what})")
+        ee_in_n = np.array([m for m, _ in cands])
+        clear = np.full(len(cands), TOOL_CLEARANCE)
+        for i, pose in enumerate(clear_at):
+            # the jaws as they come onto the wire there: wide open onto a needle lying on the tissue
+            tool = self.tools_wide[psm.name] if i == 0 and down_at is not None else self.tools[psm.name]
+            ee = pose[None] @ ee_in_n
+            clear = np.minimum(clear, clearances(self.tissue_shapes, tool, ee, TOOL_CLEARANCE))
+            if i == 0:  # and on the way in, along the jaw axis
+                for f in (1.0, 2 / 3, 1 / 3):
+                    back = ee.copy()
+                    back[:, :3, 3] -= f * BACK_OFF * ee[:, :3, 2]
+                    clear = np.minimum(clear, clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE))
+        # the choice: the clearance (up to TOOL_CLEARANCE, in tenths of a millimetre), then the
+        # wider joint margin
+        clear_q = np.round(clear / 1e-4)
+        best, best_key = None, None
+        for i in np.argsort(-clear_q, kind="stable"):
+            if best_key is not None and clear_q[i] < best_key[0]:
+                break  # the rest come nearer the tissue
+            m, turn = cands[i]
+            first = needle_poses[0] @ m
+            back = first.copy()
+            back[:3, 3] -= BACK_OFF * first[:3, 2]
+            worst = self._margin(psm, back)  # the jaws come onto the wire along their axis
+            for pose in needle_poses:
+                if worst <= 0:
+                    break
+                worst = min(worst, self._margin(psm, pose @ m))
+            margin = worst - 0.02 * turn
+            key = (float(clear_q[i]), margin)
+            if worst > 0 and (best_key is None or key > best_key):
+                best, best_key = Grasp(m, margin, float(clear[i])), key
+        if best is None:
+            raise SutureError(f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})")
+        return best

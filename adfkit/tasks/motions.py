@@ -1,0 +1,154 @@
+"""The suture's motion primitives, generators that yield once per control step: Cartesian and
+joint-space moves of a PSM, carrying the needle, taking it (a guarded approach along the jaw
+axis, then the constraint actuator) and letting it go. A mixin of SutureTask."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..runner.psm import PSM
+from ..runner.psm_kinematics import JointLimitError
+from ..runner.rotations import invert, rotation_exp, rotation_log
+from .grasping import BACK_OFF, JAW_APPROACH, Grasp, SutureError
+
+CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
+GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
+GUARD_BACK = 0.0005  # m ... and draws back this far the way it came
+
+
+def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
+    """Pose between a and b: straight line, rotation about one axis."""
+    t = np.eye(4)
+    t[:3, :3] = a[:3, :3] @ rotation_exp(s * rotation_log(a[:3, :3].T @ b[:3, :3]))
+    t[:3, 3] = (1 - s) * a[:3, 3] + s * b[:3, 3]
+    return t
+
+
+def smooth(s: float) -> float:
+    return s * s * (3 - 2 * s)
+
+
+class Motions:
+    def _set_phase(self, name: str):
+        self.phase = name
+        self.phase_log.append((name, self.world.sim_time))
+
+    def _steps(self, seconds: float) -> int:
+        return max(1, int(round(seconds / self.speed / self.cdt)))
+
+    def servo_world(self, psm: PSM, ee_world: np.ndarray) -> None:
+        """Cartesian set-point in the world; a pose a little past a joint limit (the grasp
+        as measured differs from the planned one by a few degrees) is servoed with the joints
+        clipped to their limits, and counted."""
+        try:
+            psm.servo_cp(invert(psm.base_in_world()) @ ee_world)
+        except JointLimitError as exc:
+            lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+            if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
+                raise
+            psm.servo_jp(np.clip(exc.q, lo, hi))
+            self.clipped += 1
+
+    def setpoint_world(self, psm: PSM) -> np.ndarray:
+        return psm.base_in_world() @ psm.setpoint_cp()
+
+    def move(self, psm: PSM, goal: np.ndarray, seconds: float, settle: float = 0.15):
+        """Free-space move: the IK at the goal, joints interpolated (the wrist never passes
+        through an unreachable orientation on the way)."""
+        try:
+            q = psm.kin.ik(invert(psm.base_in_world()) @ goal)
+        except JointLimitError as exc:  # a little past a limit: go as near as the joints allow
+            lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+            if np.max(np.maximum(lo - exc.q, exc.q - hi)) > CLIP_TOLERANCE:
+                raise
+            q = np.clip(exc.q, lo, hi)
+            self.clipped += 1
+        yield from self.move_jp(psm, q, seconds, settle)
+
+    def move_jp(self, psm: PSM, q1, seconds: float, settle: float = 0.15):
+        q0 = psm.setpoint_jp()
+        q1 = np.asarray(q1, dtype=float)
+        n = self._steps(seconds)
+        for i in range(1, n + 1):
+            psm.servo_jp(q0 + (q1 - q0) * smooth(i / n))
+            yield self.phase
+        yield from self.wait(settle)
+
+    def wait(self, seconds: float):
+        for _ in range(self._steps(seconds)):
+            yield self.phase
+
+    def line(self, psm: PSM, a: np.ndarray, b: np.ndarray, seconds: float, guarded: bool = False):
+        """The end effector from pose a to pose b along a straight line (Cartesian). Guarded: it
+        stops where the tool first presses on the tissue with GUARD_N (and stays there), as a
+        hand stops on touching; the plan keeps the tools off the tissue, but a few tenths of a
+        millimetre of clearance leave no room for the servo's overshoot."""
+        n = self._steps(seconds)
+        links = [sb for sb in self.world.bodies if sb.articulation is psm.art] if guarded else []
+        tissue = {id(sb) for sb in self.world.bodies if sb.model is self.needle.model and sb.static}
+        for i in range(1, n + 1):
+            self.servo_world(psm, interpolate(a, b, smooth(i / n)))
+            yield self.phase
+            if links and any(f >= GUARD_N for sb in links for o, f, _ in self.world.contacts(sb) if id(o) in tissue):
+                stop = psm.base_in_world() @ psm.measured_cp()
+                stop[:3, 3] -= (
+                    GUARD_BACK * (b[:3, 3] - a[:3, 3]) / max(float(np.linalg.norm(b[:3, 3] - a[:3, 3])), 1e-9)
+                )
+                self.servo_world(psm, stop)  # where it touched, a little back the way it came
+                return
+
+    def carry(self, path, seconds: float):
+        """The holder moves the needle through needle poses path(s), s in [0, 1] (Cartesian)."""
+        psm = self.psms[self.holder]
+        n = self._steps(seconds)
+        for i in range(1, n + 1):
+            self.servo_world(psm, path(i / n) @ self.held_ee_in_needle)
+            yield self.phase
+
+    def carry_to(self, goal: np.ndarray, seconds: float):
+        """The holder takes the needle to a pose through joint space."""
+        yield from self.move(self.psms[self.holder], goal @ self.held_ee_in_needle, seconds, settle=0.0)
+
+    def take(self, name: str, grasp: Grasp, opening: float = JAW_APPROACH):
+        """``name`` opens its jaws (``opening`` rad), comes down along its jaw axis onto the
+        grasp (on the needle where it is now) and holds the needle."""
+        psm = self.psms[name]
+        goal = self.needle_pose() @ grasp.ee_in_needle
+        above = goal.copy()
+        above[:3, 3] -= BACK_OFF * goal[:3, 2]
+        psm.servo_jaw(opening)
+        yield from self.move(psm, above, 0.8)
+        yield from self.line(psm, above, goal, 0.5, guarded=True)  # along the jaw axis, as the plan checked it
+        yield from self.wait(0.2)
+        ee = psm.base_in_world() @ psm.measured_cp()
+        miss = float(np.linalg.norm(ee[:3, 3] - (self.needle_pose() @ grasp.ee_in_needle)[:3, 3]))
+        if miss > 0.004:
+            raise SutureError(f"{name} missed the needle by {miss * 1000:.1f} mm ({self.phase})")
+        # the wire lies between the open jaws: the actuator holds it where it is (and the jaws
+        # no longer collide with it), then the jaws close on it; closing them first would
+        # squeeze the wire out toward their tips (measured: 3.6 mm and 26 degrees off the plan)
+        act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
+        self.world.actuate(act, self.needle)
+        self.holder = name
+        self.held_ee_in_needle = invert(self.needle_pose()) @ ee
+        psm.servo_jaw(0.0)
+        yield from self.wait(0.15)
+
+    def let_go(self, name: str, holder: str | None = None):
+        """``name`` releases the needle and backs off. ``holder``, the arm that keeps it, is then
+        put where the needle settled (once): freed from the other grasp, the needle settles where
+        the tissue holds it, up to 2.7 mm from where both grasps had it, and a grasp that stayed
+        put would stay strained by that much."""
+        psm = self.psms[name]
+        act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
+        self.world.release(act)
+        psm.servo_jaw(JAW_APPROACH)
+        yield from self.wait(0.15)
+        if holder is not None:
+            keep = self.psms[holder]
+            yield from self.line(keep, self.setpoint_world(keep), self.needle_pose() @ self.held_ee_in_needle, 0.2)
+        here = self.setpoint_world(psm)
+        back = here.copy()
+        back[:3, 3] -= BACK_OFF * here[:3, 2]
+        back[2, 3] += 0.01
+        yield from self.move(psm, back, 0.5, settle=0.0)
