@@ -62,15 +62,20 @@ def _hole(obs, k: int, kind: str):
     return next(h for h in obs.holes if h.pair == k and h.kind == kind)
 
 
+def _narrower_than_wire(obs, hole) -> str:
+    """ "<hole>'s opening (w) is narrower than the needle's wire (d)" when it is, else ""."""
+    width = 2 * float(min(hole.half)) if hole.half is not None else None
+    if width is None or width >= 2 * obs.wire_radius:
+        return ""
+    return f"{_label(hole)}'s opening ({_mm(width)}) is narrower than the needle's wire ({_mm(2 * obs.wire_radius)})"
+
+
 def _blocked_reason(obs, k: int, entry, phase: str = "") -> tuple[str, str]:
     """What stopped the tip at entry k: the bodies the tip pressed on (else the needle) in
     ``phase`` (the insertion), with their contact forces, and a boundary narrower than the wire."""
     phase = phase or f"insert {k}"
     label = _label(entry)
-    width = 2 * float(min(entry.half)) if entry.half is not None else None
-    narrow = ""
-    if width is not None and width < 2 * obs.wire_radius:
-        narrow = f"; its opening ({_mm(width)}) is narrower than the needle's wire ({_mm(2 * obs.wire_radius)})"
+    narrow = _narrower_than_wire(obs, entry).replace(f"{label}'s opening", "; its opening", 1)
     at_tip = getattr(obs, "tip_contacts", {}).get(phase, {})
     forces = at_tip or obs.needle_contacts.get(phase, {})
     if forces:
@@ -156,9 +161,11 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         # through a free channel the tip brushes the holes' boundaries with a few newtons: this much
         # means the driver forced it through what should have stopped it
         hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forced.items(), key=lambda kv: -kv[1]))
+        narrow = _narrower_than_wire(obs, exit_)
         return "blocked-in-channel", (
             f"the needle was forced from {_label(entry)} toward {_label(exit_)}: the tip pressed on {hits} "
-            f"(a free channel lets it through with under {TIP_FORCE_N:.0f} N); the channel is closed there"
+            f"(a free channel lets it through with under {TIP_FORCE_N:.0f} N); "
+            + (narrow or "the channel is closed there")
         )
     if not outs:
         if failed_here:
