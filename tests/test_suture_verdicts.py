@@ -199,50 +199,33 @@ def _fill_exit_1(d: Path) -> None:
     _edit(d / "phantom" / "phantom.yaml", lambda s: s.replace(head, head + box, 1))
 
 
-def _narrow_entry_1(d: Path) -> None:
-    """Entry1's capsules 0.9 mm from its centre: a 0.6 mm opening for a 1.2 mm wire."""
+def _narrow(body: str):
+    """An edit: ``body``'s capsules 0.9 mm from its centre, a 0.6 mm opening for a 1.2 mm wire."""
 
-    def fn(s: str) -> str:
-        a = s.index("BODY Entry1:")
-        b = s.index("\nBODY ", a + 1)
-        block = re.sub(r"(\b[xy]): (-?)0\.003\b", r"\1: \g<2>0.0009", s[a:b])
-        return s[:a] + block + s[b:]
+    def edit(d: Path) -> None:
+        def fn(s: str) -> str:
+            a = s.index(f"BODY {body}:")
+            b = s.index("\nBODY ", a + 1)
+            block = re.sub(r"(\b[xy]): (-?)0\.003\b", r"\1: \g<2>0.0009", s[a:b])
+            return s[:a] + block + s[b:]
 
-    _edit(d / "phantom" / "phantom.yaml", fn)
+        _edit(d / "phantom" / "phantom.yaml", fn)
 
-
-def _narrow_exit_1(d: Path) -> None:
-    """Exit1's capsules 0.9 mm from its centre: a 0.6 mm opening for a 1.2 mm wire."""
-
-    def fn(s: str) -> str:
-        a = s.index("BODY Exit1:")
-        b = s.index("\nBODY ", a + 1)
-        block = re.sub(r"(\b[xy]): (-?)0\.003\b", r"\1: \g<2>0.0009", s[a:b])
-        return s[:a] + block + s[b:]
-
-    _edit(d / "phantom" / "phantom.yaml", fn)
+    return edit
 
 
-def _move_ghost_exit_1(d: Path) -> None:
-    """ghostExit1 5 mm along its hole's x, off the hole."""
+def _move_ghost(ghost: str):
+    """An edit: ``ghost`` 5 mm along its hole's x, off the hole."""
 
-    def fn(s: str) -> str:
-        a = s.index("GHOST ghostExit1:")
-        b = s.index("position: {x: 0.0,", a)
-        return s[:b] + "position: {x: 0.005," + s[b + len("position: {x: 0.0,") :]
+    def edit(d: Path) -> None:
+        def fn(s: str) -> str:
+            a = s.index(f"GHOST {ghost}:")
+            b = s.index("position: {x: 0.0,", a)
+            return s[:b] + "position: {x: 0.005," + s[b + len("position: {x: 0.0,") :]
 
-    _edit(d / "phantom" / "ghosts.yaml", fn)
+        _edit(d / "phantom" / "ghosts.yaml", fn)
 
-
-def _move_ghost_entry_1(d: Path) -> None:
-    """ghostEntry1 5 mm along its hole's x, off the hole."""
-
-    def fn(s: str) -> str:
-        a = s.index("GHOST ghostEntry1:")
-        b = s.index("position: {x: 0.0,", a)
-        return s[:b] + "position: {x: 0.005," + s[b + len("position: {x: 0.0,") :]
-
-    _edit(d / "phantom" / "ghosts.yaml", fn)
+    return edit
 
 
 def _pair_1(launch: Path) -> dict:
@@ -269,14 +252,14 @@ def test_filled_hole_is_blocked_at_its_entry(tmp_path):
 
 @pytest.mark.slow
 def test_hole_narrower_than_the_wire_is_blocked_by_its_boundary(tmp_path):
-    p = _pair_1(_scene(tmp_path, _narrow_entry_1))
+    p = _pair_1(_scene(tmp_path, _narrow("Entry1")))
     assert not p["passed"] and p["rule"] == "blocked-at-entry"
     assert "narrower than the needle's wire" in p["reason"] and "0.6 mm" in p["reason"]
 
 
 @pytest.mark.slow
 def test_ghost_off_its_hole_fails_with_that_reason(tmp_path):
-    p = _pair_1(_scene(tmp_path, _move_ghost_entry_1))
+    p = _pair_1(_scene(tmp_path, _move_ghost("ghostEntry1")))
     assert not p["passed"] and p["rule"] == "entry-ghost-off-hole"
     assert "5.0 mm off" in p["reason"]
 
@@ -292,14 +275,14 @@ def test_a_channel_closed_before_the_exit_fails_as_forced_through(tmp_path):
 
 @pytest.mark.slow
 def test_an_exit_narrower_than_the_wire_fails_at_the_exit(tmp_path):
-    p = _pair_1(_scene(tmp_path, _narrow_exit_1))
+    p = _pair_1(_scene(tmp_path, _narrow("Exit1")))
     assert not p["passed"] and p["rule"] == "blocked-in-channel"
     assert "Exit1's opening (0.6 mm) is narrower than the needle's wire (1.2 mm)" in p["reason"]
 
 
 @pytest.mark.slow
 def test_an_exit_ghost_off_its_hole_fails_with_that_reason(tmp_path):
-    p = _pair_1(_scene(tmp_path, _move_ghost_exit_1))
+    p = _pair_1(_scene(tmp_path, _move_ghost("ghostExit1")))
     assert not p["passed"] and p["rule"] == "exit-ghost-off-hole"
     assert "ghostExit1" in p["reason"] and "5.0 mm off" in p["reason"]
 
