@@ -104,15 +104,22 @@ def test_tool_shape_follows_the_simulated_tool_at_any_configuration(world):
 
 
 def test_the_planned_grasps_keep_the_tools_off_the_tissue(world):
-    """On the bundled scene the planner finds, for every pair after the first, grasps whose
-    tool stays at least 0.9 mm off the tissue along the whole insertion and pull; the first
-    pair's exit leaves less room (about 0.4 mm) but never a grasp inside the tissue."""
-    from adfkit.tasks.suture import JAW_APPROACH, SutureTask
+    """On the bundled scene the planner finds, for every pair after the first, driving grasps
+    whose tool stays at least 0.9 mm off the tissue along the whole insertion; every pull keeps
+    the puller SURE_CLEARANCE off it. Pairs 2-4 pull the tail 25 degrees beyond the exit; at
+    pair 1 the wrist, turning with the needle, would bring the jaws within 0.4 mm of the tissue
+    there, so that pull ends sooner."""
+    import math
+
+    from adfkit.tasks.suture import JAW_APPROACH, SURE_CLEARANCE, SutureTask
 
     task = SutureTask(world, [1, 2, 3, 4], seed=0)
     for psm in task.psms.values():
         psm.servo_jaw(JAW_APPROACH)  # as the task opens them before it plans
     world.step(300)
     task.plan()
-    assert [round(g.clearance, 4) >= 0.0 for g in task.drive_grasps + task.pull_grasps] == [True] * 8
-    assert min(g.clearance for g in task.drive_grasps[1:] + task.pull_grasps[1:]) >= 0.0009
+    assert [round(g.clearance, 4) >= 0.0 for g in task.drive_grasps] == [True] * 4
+    assert min(g.clearance for g in task.drive_grasps[1:]) >= 0.0009
+    assert min(g.clearance for g in task.pull_grasps) >= SURE_CLEARANCE
+    assert [round(math.degrees(a)) for a in task.tail_clears[1:]] == [25, 25, 25]
+    assert math.degrees(task.tail_clears[0]) < 25

@@ -21,6 +21,10 @@ JAW_DEPTH = 0.01  # m from the end effector to the point between the jaws (LND: 
 GRASP_DEPTH = 0.0105
 BACK_OFF = 0.012  # m along -z_E before a grasp and after a release
 TOOL_CLEARANCE = 0.0015  # m the planner keeps the tool's shapes from the tissue's where it can
+#: m of clearance, read from the tissue's distance field, that leaves the tool off the tissue for
+#: sure: more than the field's largest overstatement (its trilinear reading between nodes 1.5 mm
+#: apart overstated a hole capsule's distance by up to 0.6 mm, measured at Exit1)
+SURE_CLEARANCE = 0.0007
 #: rad between the jaws as they come onto the wire: a 3.9 mm gap at the wire for its 1.2 mm, and
 #: fingers 2.5 mm to each side instead of the 5.6 mm of a fully opened jaw, beside the tissue
 JAW_APPROACH = 0.35

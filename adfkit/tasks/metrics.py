@@ -360,7 +360,24 @@ class SutureObserver:
             "instabilities": rep.get("instabilities", []),  # runner/stability.py: time, body, kind, message
             "control_steps": self.n,
             "clipped_setpoints": self.task.clipped,
+            "plan": self._plan(),
         }
+
+    def _plan(self) -> list[dict]:
+        """Per planned pair: how far the chosen grasps keep the tools off the tissue (by the
+        planner's distance field) and how far beyond the exit the pull takes the tail."""
+        t = self.task
+        drive, pull = getattr(t, "drive_grasps", []), getattr(t, "pull_grasps", [])
+        tails = getattr(t, "tail_clears", [])
+        return [
+            {
+                "pair": p.index,
+                "drive_clearance_m": finite(drive[k].clearance) if k < len(drive) else None,
+                "pull_clearance_m": finite(pull[k].clearance) if k < len(pull) else None,
+                "pull_tail_beyond_exit_deg": math.degrees(tails[k]) if k < len(tails) else None,
+            }
+            for k, p in enumerate(getattr(t, "pairs", []))
+        ]
 
 
 def finite(obj):

@@ -32,6 +32,7 @@ from .clearance import Tissue, ToolShape
 from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError are the task's too
     JAW_APPROACH,
     JAW_DEPTH,
+    SURE_CLEARANCE,
     Grasp,
     GraspChoice,
     SutureError,
@@ -46,8 +47,13 @@ MAX_GRASP = math.radians(25)  # the grasps sit at most this far from the tip / t
 CLEAR = math.radians(10)  # ... and at least this far outside the tissue
 MAX_BITE = math.radians(65)  # the arc between entry and exit; wider bites aim inside the holes
 HOLE_MARGIN = 0.0008  # m kept from a hole ghost's side when aiming inside it
-TAIL_CLEAR = math.radians(25)  # the pull ends with the tail this far beyond the exit
+#: the pull ends with the tail this far beyond the exit: the first of these at which the puller
+#: keeps SURE_CLEARANCE from the tissue (SutureTask.plan_pull)
+TAIL_CLEARS = tuple(math.radians(a) for a in (25, 20, 15, 10))
 JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
+#: s the puller takes to carry the needle over the next pair: the thread, through the earlier
+#: pairs, drags behind it (in 1.2 s the needle slipped 2.1-2.5 mm in the grasp on 2 of 10 seeds)
+HAND_BACK_S = 2.4
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
 
@@ -264,7 +270,7 @@ class SutureTask(GraspChoice, Motions):
         if not hasattr(self, "tools_wide"):  # planned without steps(): the jaws as they are
             self.tools_wide = self.tools
         self.frames = {p.index: self.arc_frame(p) for p in self.pairs}
-        self.drive_grasps, self.pull_grasps, self.out_poses, self.handbacks = [], [], [], []
+        self.drive_grasps, self.pull_grasps, self.handbacks, self.tail_clears = [], [], [], []
         self.pulls: list[tuple[float, list, tuple]] = []  # per pair: the grasp's angle, the poses, where clear
         for k, p in enumerate(self.pairs):
             b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
@@ -285,15 +291,36 @@ class SutureTask(GraspChoice, Motions):
                 )
             else:
                 self.drive_grasps.append(self.hand_back(k, g_tail, insertion))
-            done = psi_x + self.geom.span + TAIL_CLEAR
+            self.plan_pull(p, b, psi_x, psi_end, g_tip)
+
+    def plan_pull(self, p: HolePair, b: np.ndarray, psi_x: float, psi_end: float, g_tip: float) -> None:
+        """The puller's grasp for pair p and how far its pull turns the needle: the tail
+        25 degrees beyond the exit (the thread drawn through; less, and the next hand-back drags
+        it through the channel and the needle slips), or less where the wrist, turning with the
+        needle, would bring the jaws nearer the tissue than SURE_CLEARANCE (measured at Exit1 of
+        the bundled scene: 0.2-0.4 mm at 25 degrees, 0.8-1.4 mm at 12)."""
+        best = None
+        for tail in TAIL_CLEARS:
+            done = psi_x + self.geom.span + tail
             out = self.lifted(self.needle_at(b, done), 2 * LIFT)
             pull = [self.needle_at(b, psi) for psi in np.linspace(psi_end, done, 7)] + [out]
             clear = (*self.along_arc(b, psi_end, done), out)
-            self.pulls.append((-g_tip, pull, clear))
-            self.pull_grasps.append(
-                self.choose_grasp(self.psms[self.puller], -g_tip, pull, what=f"pair {p.index}, pulling", clear_at=clear)
-            )
-            self.out_poses.append(out)
+            try:
+                g = self.choose_grasp(
+                    self.psms[self.puller], -g_tip, pull, what=f"pair {p.index}, pulling", clear_at=clear
+                )
+            except SutureError:
+                if tail == TAIL_CLEARS[-1] and best is None:
+                    raise
+                continue
+            if best is None or g.clearance > best[0].clearance:
+                best = (g, tail, (-g_tip, pull, clear))
+            if g.clearance >= SURE_CLEARANCE:
+                break
+        g, tail, pull_plan = best
+        self.pull_grasps.append(g)
+        self.tail_clears.append(tail)
+        self.pulls.append(pull_plan)
 
     def along_arc(self, b: np.ndarray, psi0: float, psi1: float) -> tuple:
         """Needle poses from psi0 to psi1 on its arc in frame b, CHECK_STEP apart (where the
@@ -435,7 +462,7 @@ class SutureTask(GraspChoice, Motions):
             yield from self.move_jp(d, park[self.driver], 0.8, settle=0.0)
             self.holder = self.puller
             self._set_phase(f"pull {pair.index}")
-            done = psi_x + self.geom.span + TAIL_CLEAR
+            done = psi_x + self.geom.span + self.tail_clears[k]
             # the pull turns the needle about its own centre from where the tissue holds it (a
             # few tenths of a millimetre off the plan), so that it follows its own channel
             b_now = self.needle_pose() @ self.geom.arc_in_needle @ _rot_z(-psi_end)
@@ -448,7 +475,7 @@ class SutureTask(GraspChoice, Motions):
             yield from self.wait(0.2)
             if k + 1 < len(self.pairs):
                 self._set_phase(f"hand back {pair.index}")
-                yield from self.carry_to(self.handbacks[k], 1.2)
+                yield from self.carry_to(self.handbacks[k], HAND_BACK_S)
                 yield from self.wait(0.2)
                 yield from self.take(self.driver, self.drive_grasps[k + 1])
                 yield from self.let_go(self.puller, holder=self.driver)
