@@ -23,7 +23,7 @@ from ...model.semantics import JointKind
 from ..rotations import euler_xyz, matrix_to_pq, pose_matrix, quat_to_matrix
 from ..springs import SpringJoint, spring_joint  # noqa: F401 - built here for PyBullet
 
-FIXED_SPAN = 0.005  # m between the three p2p pivots of a fixed joint outside a multibody
+FIXED_SPAN = 0.005  # m: the pivots' span of a fixed joint whose origin is at the child's centre of mass
 HINGE_HALF_SPAN = 0.01  # m: the two p2p constraints of a loop-closing hinge sit ±this along the axis
 
 
@@ -120,7 +120,7 @@ def make_constraint(
         # PyBullet's fixed constraint ignores both frame orientations and holds the two
         # inertial frames parallel (measured: the corpus needle's thread turns 90 degrees off
         # the needle in 0.1 s); point pivots keep the file's relative pose exactly.
-        for e in (np.zeros(3), np.array([FIXED_SPAN, 0.0, 0.0]), np.array([0.0, FIXED_SPAN, 0.0])):
+        for e in fixed_pivots(frame_b):
             add(pb.JOINT_POINT2POINT, frame_a[:3, :3] @ e + frame_a[:3, 3], frame_b[:3, :3] @ e + frame_b[:3, 3])
     elif kind is JointKind.PRISMATIC:
         # between multibody links only (the caller checks): btMultiBodySliderConstraint, its
@@ -135,6 +135,23 @@ def make_constraint(
     else:
         add(pb.JOINT_POINT2POINT, frame_a[:3, 3], frame_b[:3, 3])
     return out
+
+
+def fixed_pivots(frame_b: np.ndarray) -> list[np.ndarray]:
+    """The three pivots of a fixed joint, in the joint frame: its origin, the point as far beyond
+    the child's centre of mass (the child's far end: where a chain hung from it pulls) and that
+    point moved as far again across. Pivots spanning the child hold it where its load comes in:
+    pivots 5 mm to the side of the joint origin, off a 2.4 mm thread element, let Bullet's
+    solver leave the element 27° off the needle as the thread hung from it (its 50 iterations
+    do not converge a 40-element chain, whose joint impulses start from zero every step), and
+    the joint 2.3 mm open at those pivots; spanning the element: under 3°."""
+    com = -frame_b[:3, :3].T @ frame_b[:3, 3]  # the child's centre of mass in the joint frame
+    reach = 2.0 * float(np.linalg.norm(com))
+    if reach < 1e-4:  # the joint at the child's centre of mass: any span will do
+        return [np.zeros(3), np.array([FIXED_SPAN, 0.0, 0.0]), np.array([0.0, FIXED_SPAN, 0.0])]
+    far = 2.0 * com
+    across = np.cross(far, np.eye(3)[int(np.argmin(np.abs(far)))])
+    return [np.zeros(3), far, far + reach * across / np.linalg.norm(across)]
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
