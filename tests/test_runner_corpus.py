@@ -163,12 +163,9 @@ def test_springy_and_knot_models_play(rel):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="builds and plays, but its 1 g tool roll and pitch links, joined by a "
-    "force-driven linear spring, reach > 10 m/s within 0.1 s: the explicit "
-    "spring emulation is unstable for such light links (open)",
-)
 def test_springy_psm_stays_stable():
+    """Its 1 g tool roll and pitch links, joined by a force-driven linear spring, reached > 10 m/s
+    within 0.1 s while the springs were explicit (gains clamped to what an explicit step keeps
+    stable); integrated implicitly they stay put."""
     rep = _build_and_play(SPRINGY[0], 0.5)
-    assert rep["exploded"] == []
+    assert rep["exploded"] == [] and rep["nan"] == []

@@ -80,6 +80,11 @@ def test_metrics_json_and_pictures(one_pair):
     assert len(j["needle_final_pose"]["position"]) == 3
     assert np.linalg.norm(j["needle_final_pose"]["orientation"]) == pytest.approx(1.0, abs=1e-6)
     assert 0 <= j["max_constraint_error_m"] < 0.01 and j["real_time_factor"] > 0
+    # every joint closed to 1 mm in every phase (the needle-thread joint opened 2.3 mm while the
+    # needle was carried, with its pivots 5 mm beside the thread), the fixed joint within 5 degrees
+    errors, angles = j["constraint_error_by_phase_m"], j["joint_angle_error_by_phase_deg"]
+    assert set(errors) == set(angles) >= {"settle", "pick", "carry", "insert", "regrasp", "pull"}
+    assert max(errors.values()) <= 1e-3 and max(angles.values()) < 5.0, (errors, angles)
     assert j["thread_length_through_tissue_m"] >= 0 and j["exploded"] is False
     from PIL import Image
 
@@ -130,13 +135,37 @@ def test_needle_held_while_carried_and_released_when_the_jaws_open():
         world.close()
 
 
+def test_corpus_set_needle_stays_right_side_up_while_the_scene_settles():
+    """The corpus set's needle turned over in its first 0.1 s: its phantom's collision mesh (one
+    object of eleven materials) was one hull, which lay 1.8 mm over the thread and 5.2 mm over
+    the needle; pushed out, the thread element next to the needle spun at 316 rad/s and the
+    thread's springs threw the needle over. Hulled per material, as AMBF does, it stays up."""
+    require_corpus()
+    from adfkit.adf import load_scene, parse_indices
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.episode import SOLVER_ITERATIONS
+
+    scene = load_scene(CORPUS / "src" / "launch.yaml", parse_indices("6-11"), [])
+    world = open_world(scene, Options(solver_iterations=SOLVER_ITERATIONS, visuals=False))
+    try:
+        needle = world.body("BODY Needle")
+        up = []
+        for _ in range(10):
+            world.run(0.1)
+            up.append(needle.world_matrix()[2, 2])
+        assert min(up) > 0.9, up
+    finally:
+        world.close()
+
+
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="the corpus set's needle turns over while the scene settles (its z axis "
-    "from +1 to -1 within 0.5 s, whatever the seed; with the Needle-Thread joint as three point pivots "
-    "since 93dbfab) and the planner picks up only a needle lying right side up: psm2 finds no grasp "
-    "reachable along the whole plan. The project's bundled scene is not affected.",
+    reason="the needle stays right side up and is picked up, carried and inserted through Entry1, "
+    "then presses on the Phantom with 68 N in the channel toward Exit1 (blocked-in-channel) and the "
+    "puller misses the needle by 16 mm at the regrasp. PyBullet gives every mesh hull a 1 mm "
+    "collision margin that a body of several hulls cannot have changed (the files say 0.1 mm): the "
+    "corpus needle and phantom are both meshes, the bundled phantom is boxes and capsules",
 )
 def test_corpus_set_pair_1(tmp_path):
     require_corpus()

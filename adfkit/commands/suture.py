@@ -174,10 +174,13 @@ def run(args) -> int:
     if m.get("failure"):
         print(f"stopped: {m['failure']}", file=sys.stderr)
     rtf = m.get("real_time_factor")
+    angles = (m.get("joint_angle_error_by_phase_deg") or {}).values()
     print(
         f"simulated {m.get('simulated_time_s', 0):.2f} s, {rtf:.2f}x real time, thread through tissue "
         f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm, max constraint error "
-        f"{(m.get('max_constraint_error_m') or 0) * 1000:.2f} mm" + (", EXPLODED" if m.get("exploded") else "")
+        f"{(m.get('max_constraint_error_m') or 0) * 1000:.2f} mm"
+        + (f" (fixed joints {max(angles):.1f}° off)" if angles else "")
+        + (", EXPLODED" if m.get("exploded") else "")
     )
     print(f"metrics: {(out / 'metrics.json').resolve()}")
     for e in m.get("instabilities", []):

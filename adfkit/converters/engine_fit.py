@@ -149,34 +149,18 @@ class MeshFiles:
 
 
 def obj_objects(text: str) -> list[tuple[list, list]]:
-    """The objects (``o``) of a Wavefront OBJ text, each as (vertices, faces with indices into
-    its own vertices); one entry when the file has no or one object."""
-    verts, objects, faces = [], [], []
-    for line in text.splitlines():
-        if line.startswith("v "):
-            verts.append(line.split()[1:4])
-        elif line.startswith("o ") and faces:
-            objects.append(faces)
-            faces = []
-        elif line.startswith("f "):
-            idx = []
-            for tok in line.split()[1:]:
-                i = int(tok.split("/")[0])
-                idx.append(i - 1 if i > 0 else len(verts) + i)
-            faces.append(idx)
-    if faces:
-        objects.append(faces)
-    out = []
-    for fs in objects:
-        used = sorted({i for f in fs for i in f})
-        remap = {old: new for new, old in enumerate(used)}
-        out.append(([verts[i] for i in used], [[remap[i] for i in f] for f in fs]))
-    return out
+    """The sub-meshes of a Wavefront OBJ text that collide as hulls of their own: each object's
+    faces of each material (``adfkit.geometry.objpieces``), each as (vertices, faces with indices
+    into its own vertices); one entry when the file has one object and one material."""
+    from ..geometry.objpieces import obj_pieces
+
+    return obj_pieces(text)
 
 
 def split_objects(path: Path, folder: Path) -> list[Path]:
-    """An OBJ file of several objects (a convex decomposition: one hull per object) as one OBJ
-    per object in ``folder``; [path] itself when it holds one object or is no OBJ."""
+    """An OBJ file of several sub-meshes (a convex decomposition: one hull per object; or one
+    object of several materials) as one OBJ per sub-mesh in ``folder``; [path] itself when it
+    holds one or is no OBJ."""
     if path.suffix.lower() != ".obj" or not path.is_file():
         return [path]
     objs = obj_objects(path.read_text(encoding="utf-8", errors="replace"))

@@ -4,7 +4,7 @@ The planner asks this before it commits to a grasp, so that the jaws and the wri
 phantom while the tools collide with it (nothing is switched off to make the plan work). It is
 answered from the scene's own collision shapes, not from the engine: primitives of the tissue
 bodies (boxes, capsules, spheres, cylinders, planes) and the convex pieces of their collision
-meshes (one hull per object of an OBJ file, as the engines build them), against points sampled
+meshes (one hull per sub-mesh of an OBJ file, as the engines build them), against points sampled
 on the tool's collision primitives near its end effector.
 """
 
@@ -29,17 +29,13 @@ def _num(v, default: float = 0.0) -> float:
 
 
 def _obj_groups(path: Path) -> list[np.ndarray]:
-    """Vertices of each object (``o``/``g``) of an OBJ file; one group when it has none."""
-    groups: list[list[list[float]]] = [[]]
+    """Vertices of each convex piece of an OBJ collision mesh as the engines build them (each
+    object's faces of each material, ``adfkit.geometry.objpieces``)."""
+    from ..geometry.objpieces import obj_pieces
+
     with open(path, encoding="utf-8", errors="replace") as f:
-        for line in f:
-            if line.startswith(("o ", "g ")) and groups[-1]:
-                groups.append([])
-            elif line.startswith("v "):
-                parts = line.split()[1:4]
-                if len(parts) == 3:
-                    groups[-1].append([float(x) for x in parts])
-    return [np.array(g) for g in groups if len(g) >= 4]
+        pieces = obj_pieces(f.read())
+    return [np.array(v, dtype=float) for v, _ in pieces if len(v) >= 4]
 
 
 def _hull_planes(v: np.ndarray):

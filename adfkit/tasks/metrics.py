@@ -91,6 +91,7 @@ class SutureObserver:
         self.tip_path: list[list[float]] = []  # [t, x, y, z]
         self.max_constraint_error = 0.0
         self.error_by_phase: dict[str, float] = {}
+        self.angle_by_phase: dict[str, float] = {}  # fixed joints' angle off their pose, rad
         self.max_drift = 0.0
         self.drift_samples = 0
         self.drift_by_phase: dict[str, float] = {}
@@ -237,6 +238,9 @@ class SutureObserver:
             self.max_constraint_error = max(self.max_constraint_error, e)
             kind = phase.split()[0]
             self.error_by_phase[kind] = max(self.error_by_phase.get(kind, 0.0), e)
+            angle = getattr(self.world, "joint_angle_error", None)  # PyBullet's fixed joints
+            if angle is not None:
+                self.angle_by_phase[kind] = max(self.angle_by_phase.get(kind, 0.0), angle())
         if self.n % self.drift_every == 0 and self.task.holder is not None and self.task.held_ee_in_needle is not None:
             psm = getattr(self.task, "psms", {})[self.task.holder]
             ee = psm.base_in_world() @ psm.measured_cp()
@@ -346,6 +350,7 @@ class SutureObserver:
             "needle_tissue_contact_n": self.needle_contacts,
             "tip_tissue_contact_n": self.tip_contacts,
             "constraint_error_by_phase_m": self.error_by_phase,
+            "joint_angle_error_by_phase_deg": {k: float(np.degrees(a)) for k, a in self.angle_by_phase.items()},
             "needle_wire_radius_m": self.wire_radius,
             "max_constraint_error_m": max(self.max_constraint_error, rep["max_constraint_error_m"]),
             "simulated_time_s": self.world.sim_time,

@@ -90,6 +90,7 @@ class Assembly:
         if self.soft is not None:
             self.soft.build(models)
         springs = []
+        self.fixed_frames = []  # (joint name, parent, child, joint frame rotation in each)
         for j, kind, parent, child in leftover:
             ps = parent.body.scale or 1.0
             cs = child.body.scale or 1.0
@@ -122,6 +123,8 @@ class Assembly:
                 continue
             for c, pa, pbv, axis in made:
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
+            if kind_c is JointKind.FIXED:  # its relative orientation is held too (joint_angle_error)
+                self.fixed_frames.append((j.identifier, parent, child, fa[:3, :3], fb[:3, :3]))
         self.springs = SpringSet(springs, self.cid)
         build_volumes(self, models)
         for m in models:

@@ -73,6 +73,44 @@ def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
     return out, None
 
 
+_HULL_CACHE: dict[tuple[str, int, int], Path] = {}
+
+
+def hull_pieces(path: Path, tree=None) -> Path:
+    """The OBJ to hand PyBullet for convex hulls. PyBullet makes one hull per OBJ object, AMBF
+    one per sub-mesh, of which its mesh loader makes one for each material of an object
+    (``adfkit.geometry.objpieces``): an OBJ whose objects have faces of several materials (the
+    corpus suturing set's needle and phantom collision meshes, one object each) is handed over
+    as a copy with each sub-mesh an object of its own, vertex positions only; any other file as
+    it is."""
+    if path.suffix.lower() != ".obj":
+        return path
+    st = path.stat()
+    key = (str(path), st.st_size, st.st_mtime_ns)
+    if key not in _HULL_CACHE:
+        _HULL_CACHE[key] = _split_hulls(path, tree)
+    return _HULL_CACHE[key]
+
+
+def _split_hulls(path: Path, tree) -> Path:
+    from ...geometry.objpieces import obj_pieces, pieces_obj_text
+
+    try:
+        text = inputs.read_text(path, "mesh", tree=tree, what="mesh file")
+        pieces = obj_pieces(text)
+    except (AdfError, ValueError, IndexError):
+        return path  # PyBullet reads it as it is (or refuses it) as before
+    objects = {ln.strip() for ln in text.splitlines() if ln.startswith(("o ", "g "))}
+    if len(pieces) <= max(len(objects), 1):
+        return path  # one material per object: PyBullet's hulls are AMBF's
+    global _STL_DIR
+    if _STL_DIR is None:
+        _STL_DIR = tempfile.mkdtemp(prefix="adfkit-stl-")
+    out = Path(_STL_DIR) / f"hulls_{len(_HULL_CACHE)}.obj"
+    out.write_text(pieces_obj_text(pieces), encoding="utf-8")
+    return out
+
+
 def is_convex(path: Path, rel: float = 1e-3) -> bool:
     """True when the mesh encloses its own convex hull (volumes within ``rel``): a convex hull of
     it collides exactly as its triangles do. False for open, concave or unreadable meshes."""

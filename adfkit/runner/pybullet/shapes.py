@@ -31,7 +31,7 @@ from ...model.semantics import (
 )
 from ..plan import rgba
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
-from .meshfiles import MESH_SUFFIXES, is_convex, mesh_refusal, pybullet_mesh
+from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, mesh_refusal, pybullet_mesh
 
 
 @dataclass
@@ -231,7 +231,8 @@ def collision_parts(
             )
     elif kind is CollisionMeshType.CONCAVE_MESH and static:
         kw["flags"] = pb.GEOM_FORCE_CONCAVE_TRIMESH  # exact triangles: only static bodies in PyBullet
-    # Dynamic concave meshes: PyBullet builds one convex hull per OBJ sub-mesh (documented approximation).
+    if "flags" not in kw:  # hulls, one per sub-mesh as AMBF makes them (a dynamic concave mesh: an approximation)
+        kw["fileName"] = str(hull_pieces(path, getattr(model, "tree", None)))
     parts.add(pb.GEOM_MESH, **kw)
     return parts
 

@@ -147,6 +147,15 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
             worst = max(worst, float(np.linalg.norm(gap)))
         return worst
 
+    def joint_angle_error(self) -> float:
+        """Largest angle, rad, by which a fixed joint made of point pivots has turned its child
+        off the relative orientation the joint holds (the pivots' gaps are constraint_error)."""
+        worst = 0.0
+        for _, parent, child, ra, rb in self.fixed_frames:
+            rel = (self._frame(parent)[:3, :3] @ ra).T @ (self._frame(child)[:3, :3] @ rb)
+            worst = max(worst, float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0))))
+        return worst
+
     def render_camera(self, cam) -> dict:
         return render(self, cam)
 
