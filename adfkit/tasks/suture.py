@@ -54,6 +54,9 @@ JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
 #: s the puller takes to carry the needle over the next pair: the thread, through the earlier
 #: pairs, drags behind it (in 1.2 s the needle slipped 2.1-2.5 mm in the grasp on 2 of 10 seeds)
 HAND_BACK_S = 2.4
+#: rad/s the needle turns about its centre as the puller draws it out (at 0.6 the thread, through
+#: three pairs, dragged the needle 2.0 mm in the grasp during pull 4 on 1 of 10 seeds)
+PULL_RATE = 0.4
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
 
@@ -467,7 +470,7 @@ class SutureTask(GraspChoice, Motions):
             # few tenths of a millimetre off the plan), so that it follows its own channel
             b_now = self.needle_pose() @ self.geom.arc_in_needle @ _rot_z(-psi_end)
             yield from self.carry(
-                lambda s: self.needle_at(b_now, psi_end + (done - psi_end) * s), (done - psi_end) / 0.6
+                lambda s: self.needle_at(b_now, psi_end + (done - psi_end) * s), (done - psi_end) / PULL_RATE
             )
             out = self.needle_at(b_now, done)
             high = self.lifted(out, 2 * LIFT)
