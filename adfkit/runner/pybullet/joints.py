@@ -16,6 +16,8 @@ Spring and damping gains are clamped to what an explicit step keeps stable
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 import pybullet as pb
 
@@ -267,7 +269,7 @@ class SpringSet:
         self.pq = dict(zip(self._base_keys, poses))
         for uid, ks in self._links:  # computeLinkVelocity, computeForwardKinematics
             rows += [s[0] + s[1] + s[6] + s[7] for s in get_links(uid, ks, 1, 1, cid)]
-        a = np.array(rows)
+        a = np.fromiter(chain.from_iterable(rows), float, 13 * len(rows)).reshape(-1, 13)
         if not self._in_order:
             a = a[self._order]
         return (a[:, 0:3], quat_to_matrix(a[:, 3:7]), a[:, 7:10], a[:, 10:13])
