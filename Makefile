@@ -33,9 +33,13 @@ $(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check "uv==$(UV_VERSION)"
 
+# Bytecode compiled at install (uv does not by default): where Python may not write it
+# (PYTHONDONTWRITEBYTECODE, a read-only venv) every command would compile its imports again,
+# ~0.6 s of `adfkit validate`'s 1.3 s on the corpus.
 $(STAMP): $(LOCK) | $(UV)
-	$(UV) pip sync --quiet --python $(PY) --require-hashes $(LOCK)
+	$(UV) pip sync --quiet --python $(PY) --require-hashes --compile-bytecode $(LOCK)
 	$(UV) pip install --quiet --python $(PY) --no-deps --no-build-isolation -e .
+	$(PY) -m compileall -q -j 0 adfkit
 	@touch $(STAMP)
 
 run: $(STAMP)

@@ -144,6 +144,11 @@ class Assembly:
         self._geom_xpos, self._body_awake = d.geom_xpos, d.body_awake
         self._AWAKE = int(mujoco.mjtSleepState.mjS_AWAKE)
         self._fg_rbound = np.array(m.geom_rbound[self._friction_geoms])[:, None]
+        self._fg_key, self._awake_key, self._awake = None, None, None  # world.py's control() caches
+        self._fg_centre, self._fg_radius, self._overlaps_cleared = np.zeros(3), 0.0, False
+        self._fg_bodyid, self._fg_asleep = np.array(m.geom_bodyid[self._friction_geoms], dtype=int), False
+        g = np.asarray(self.gravity, dtype=float)
+        self._up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
         self._geom_label = np.full(m.ngeom, -1, dtype=np.int32)
         for i, sb in enumerate(self.bodies):
             if sb.id > 0:

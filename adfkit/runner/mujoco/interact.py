@@ -54,6 +54,7 @@ class Interaction:
                         seen.add(id(sb))
                         break
         g.overlapping = found
+        self._overlaps_cleared = False
         return found
 
     def _viscous(self, g: MjGhost, found) -> None:

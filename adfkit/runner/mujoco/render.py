@@ -92,24 +92,37 @@ class _Renderer:
         mujoco.mjr_readPixels(ids, z, rect, self.ctx)
         scn.flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = False
         scn.flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = False
-        # the depth buffer back to metres along the optical axis (reversed Z as mujoco.Renderer)
+        # the depth buffer back to metres along the optical axis (reversed Z as mujoco.Renderer),
+        # in float64 as before; every array turned upright (OpenGL's rows run bottom-up) by the
+        # copy that makes it anyway
         zf, zn = np.float32(self.far), np.float32(self.near)
-        cc = np.float32(-0.5) * (-(zf + zn) / (zf - zn)) - np.float32(0.5)
-        dc = np.float32(-0.5) * (-(np.float32(2) * zf * zn) / (zf - zn))
+        z64 = z[::-1].astype(np.float64)
         if self.ctx.readDepthMap == mujoco.mjtDepthMap.mjDEPTH_ZEROFAR:
-            depth = (dc / (z.astype(np.float64) + cc)).astype(np.float32)
+            cc = np.float32(-0.5) * (-(zf + zn) / (zf - zn)) - np.float32(0.5)
+            dc = np.float32(-0.5) * (-(np.float32(2) * zf * zn) / (zf - zn))
+            z64 += cc
+            np.divide(dc, z64, out=z64)
         else:  # 0 at the near plane, 1 at the far one
-            depth = (zn * zf / (zf - z.astype(np.float64) * (zf - zn))).astype(np.float32)
-        seg = ids[..., 0].astype(np.int32) | (ids[..., 1].astype(np.int32) << 8) | (ids[..., 2].astype(np.int32) << 16)
-        lut = np.full(scn.ngeom + 1, -1, dtype=np.int32)
+            z64 = zn * zf / (zf - z64 * (zf - zn))
+        depth = z64.astype(np.float32)
+        # segment ids: geom index + 1 in the red, green and blue bytes (0: nothing); with fewer
+        # than 255 geoms drawn only the red byte is ever set
+        up = ids[::-1]
+        if scn.ngeom < 255:
+            seg = up[..., 0]
+        else:
+            seg = up[..., 0].astype(np.int32) | (up[..., 1].astype(np.int32) << 8) | (up[..., 2].astype(np.int32) << 16)
+            np.minimum(seg, scn.ngeom, out=seg)
+        lut = np.full(max(scn.ngeom + 1, 256), -1, dtype=np.int32)
         labels = self.world._geom_label
         for n in range(scn.ngeom):
             g = scn.geoms[n]
             if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
                 lut[g.segid + 1] = labels[g.objid]
-        segmentation = lut[np.minimum(seg, scn.ngeom)]
+        lut[scn.ngeom + 1 :] = lut[scn.ngeom]  # an id past the last geom reads as the last (as clamped before)
+        segmentation = np.take(lut, seg)
         depth[seg == 0] = np.inf
-        return {"rgb": rgb[::-1].copy(), "depth": depth[::-1].copy(), "segmentation": segmentation[::-1].copy()}
+        return {"rgb": rgb[::-1].copy(), "depth": depth, "segmentation": segmentation}
 
     def close(self) -> None:
         try:

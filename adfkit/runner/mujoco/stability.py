@@ -25,6 +25,12 @@ def mujoco_pending() -> bool:
     return bool(_MJ_MESSAGES)
 
 
+def pending_messages() -> list[str]:
+    """The list MuJoCo's warnings land in (empty while there are none): a world's step loop
+    tests it directly, without a call per step."""
+    return _MJ_MESSAGES
+
+
 def drain_mujoco(world, watch: Watch) -> None:
     """Turn the warnings MuJoCo raised since the last call into events of ``world``: the kind and
     the body from the warning counters (``lastinfo`` is the DOF), the text from the callback."""

@@ -55,31 +55,51 @@ class MujocoWorld(World, Assembly, Interaction):
             d.qvel[art.vadr[i]] = v
         mujoco.mj_kinematics(self.model, d)
         mujoco.mj_comPos(self.model, d)
+        self._awake = None  # bodies moved by hand: control() looks at the hole ghosts again
 
     def control(self) -> None:
         """Per-control-step forces and senses: proximity sensors' rays, hole ghosts' viscous friction.
-        One bounding-sphere test of every hole-ghost geom against every candidate geom, then
-        MuJoCo's exact distance only for the pairs that pass."""
+        Only awake candidate geoms are looked at (a sleeping body does not move), first against
+        one sphere that holds every hole-ghost geom (kept while the ghosts' bodies sleep): all
+        of them above it along -gravity (instruments over the tissue: one product and a
+        comparison, all a resting scene costs), else all of them outside it, else a
+        bounding-sphere test of every hole-ghost geom against every candidate, then MuJoCo's
+        exact distance only for the pairs that pass. Each stage only rules out what the next
+        would, so the friction is what the exact test alone gives."""
         for s in self.sensors:
             self._sense(s)
         fg = self._friction_geoms
-        cg = self._cand_geoms
-        if not len(fg) or not len(cg):
+        if not len(fg) or not len(self._cand_geoms):
             return
         m, d = self.model, self.data
         gx = self._geom_xpos  # views into MjData/MjModel, made once (attribute access costs)
-        if self.sleep:  # a sleeping body does not move: no friction to apply
-            idx = np.flatnonzero(self._body_awake[self._cand_geom_bodyid] == self._AWAKE)
-        else:
-            idx = self._all_cand
-        diff = gx[cg[idx]][None, :, :] - self._fg_pos(gx)
+        key = self._body_awake.tobytes() if self.sleep else None
+        aw = self._awake
+        if aw is None or key != self._awake_key or not self._fg_asleep:
+            fgx = gx[fg]  # the hole ghosts move (or may have): their bounding sphere again if so
+            if fgx.tobytes() != self._fg_key:
+                self._ghost_sphere(fgx)
+            aw = self._awake if self._awake is not None and key == self._awake_key else self._awake_candidates(key)
+        idx, cgi, reach, above = aw
+        # every awake candidate above the ghosts' sphere (instruments over the tissue), else
+        # every awake candidate outside it, else the per-geom spheres
+        if not len(idx) or not (gx @ self._up <= above).any():
+            if not self._overlaps_cleared:
+                self._no_overlaps()
+            return
+        x = gx[cgi] - self._fg_centre
+        if not (np.einsum("ij,ij->i", x, x) <= reach).any():
+            if not self._overlaps_cleared:
+                self._no_overlaps()
+            return
+        diff = gx[cgi][None, :, :] - self._fg_pos(gx)
         reach = (self._cand_rbound[idx][None, :] + self._fg_rbound) ** 2
         near = np.einsum("ijk,ijk->ij", diff, diff) <= reach
         if not near.any():
-            for g in self._friction_ghosts:
-                g.overlapping = []
+            self._no_overlaps()
             return
-        cg = cg[idx]
+        cg = cgi
+        self._overlaps_cleared = False
         body_of = [self._cand_geom_body[i] for i in idx]
         hits: dict[int, list] = {}
         for i, k in zip(*np.nonzero(near)):
@@ -95,6 +115,46 @@ class MujocoWorld(World, Assembly, Interaction):
             if g.overlapping:
                 self._viscous(g, g.overlapping)
 
+    def _awake_candidates(self, key) -> tuple:
+        """(indices into the candidate geoms, their geom ids, their squared reach to the ghosts'
+        sphere, every geom's least height above it) for the candidates whose body is awake (a
+        sleeping body does not move: no friction to apply); kept while no body falls asleep or
+        wakes (``key``: the bodies' sleep states as bytes, None without sleeping). A geom is
+        above the sphere when its centre's height along ``_up`` exceeds the sphere's top by its
+        bounding radius (padded by a nanometre against rounding); -inf for the geoms not watched."""
+        if self.sleep:
+            idx = np.flatnonzero(self._body_awake[self._cand_geom_bodyid] == self._AWAKE)
+        else:
+            idx = self._all_cand
+        cgi = self._cand_geoms[idx]
+        rb = self._cand_rbound[idx]
+        # hole ghosts on sleeping bodies do not move while the sleep states stay (move_base and
+        # reset_joints, which move bodies by hand, drop what is kept here)
+        self._fg_asleep = self.sleep and not np.any(self._body_awake[self._fg_bodyid] == self._AWAKE)
+        above = np.full(len(self._geom_xpos), -np.inf)
+        above[cgi] = float(self._fg_centre @ self._up) + self._fg_radius + rb + 1e-9
+        self._awake = (idx, cgi, (self._fg_radius + rb) ** 2, above)
+        self._awake_key = key
+        return self._awake
+
+    def _no_overlaps(self) -> None:
+        """Nothing is inside a hole ghost (set once while it stays so)."""
+        if not self._overlaps_cleared:
+            for g in self._friction_ghosts:
+                g.overlapping = []
+            self._overlaps_cleared = True
+
+    def _ghost_sphere(self, fgx: np.ndarray) -> None:
+        """The sphere that holds every hole-ghost geom's bounding sphere (padded by a nanometre,
+        so that rounding never lets it miss what the per-geom test would find)."""
+        centre = fgx.mean(axis=0)
+        self._fg_centre = centre
+        self._fg_radius = (
+            float(np.max(np.linalg.norm(fgx - centre, axis=1) + self._fg_rbound[:, 0])) * (1 + 1e-9) + 1e-9
+        )
+        self._fg_key = fgx.tobytes()
+        self._awake = None  # the reach depends on the radius
+
     def _fg_pos(self, gx) -> np.ndarray:
         return gx[self._friction_geoms][:, None, :]
 
@@ -103,12 +163,13 @@ class MujocoWorld(World, Assembly, Interaction):
         t0 = time.perf_counter()
         sub = self.opt.control_substeps
         m, d = self.model, self.data
-        base = self._base_xfrc
+        base, xfrc, control, step = self._base_xfrc, d.xfrc_applied, self.control, mujoco.mj_step
+        pending = mj_stability.pending_messages()
         for k in range(n):
-            self.control()
-            mujoco.mj_step(m, d, sub)
-            d.xfrc_applied[:] = base
-            if mj_stability.mujoco_pending():  # a warning: NaN and a state reset, a singular inertia...
+            control()
+            step(m, d, sub)
+            xfrc[:] = base
+            if pending:  # a warning: NaN and a state reset, a singular inertia...
                 self.sim_time = (self.steps + (k + 1) * sub) * self.dt
                 mj_stability.drain_mujoco(self, self.watch)
         self.steps += n * sub
@@ -134,6 +195,7 @@ class MujocoWorld(World, Assembly, Interaction):
             mujoco.mj_forward(m, d)
         finally:
             m.opt.enableflags = flags
+        self._awake = None  # bodies moved by hand: control() looks at the hole ghosts again
 
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of a loop-closing joint (tree joints are exact)."""

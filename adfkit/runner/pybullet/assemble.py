@@ -141,6 +141,8 @@ class Assembly:
                 self._floor_z = -math.inf
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
         self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
+        self._dynamic_lookup = {k: sb for k, sb in self._lookup.items() if not sb.static}
+        self._pairs_epoch = 0  # counts changes of collision pairs and grasps (interact.py's distance answers)
         self._gravity_overrides = self._group_gravity_overrides()
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
 

@@ -30,6 +30,8 @@ class SimGhost:
     overlapping: list = field(default_factory=list)
     pq_in_parent: tuple = ()  # pose_in_parent as PyBullet (position, quaternion)
     moves: bool = False  # a dynamic parent: the ghost follows it every step
+    placed_at: tuple | None = None  # the parent's (position, quaternion) the ghost was last placed at
+    distances: dict = field(default_factory=dict)  # (uid, link) -> (placement, body pose, inside): _overlap
 
 
 @dataclass(eq=False)
@@ -59,6 +61,7 @@ class Interaction:
         """Let two bodies collide or pass through each other (a task's choice, e.g. a needle
         through a tissue whose collision shape is a convex hull over its holes)."""
         pb.setCollisionFilterPair(a.uid, b.uid, a.link, b.link, int(enabled), physicsClientId=self.cid)
+        self._pairs_epoch += 1
         pair = frozenset(((a.uid, a.link), (b.uid, b.link)))
         self._pairs_off = getattr(self, "_pairs_off", set())
         (self._pairs_off.discard if enabled else self._pairs_off.add)(pair)
@@ -67,22 +70,32 @@ class Interaction:
         """World pose (4x4) of a ghost, following its parent."""
         return self._frame(g.parent) @ g.pose_in_parent if g.parent is not None else np.array(g.pose_in_parent)
 
-    def _update_ghosts(self) -> None:
+    def _update_ghosts(self, poses: dict | None = None) -> None:
         """Hole ghosts (the ones with viscous friction) sense every control step; the others
         only when asked (overlapping()): a moving ghost costs a pose reset and a distance query
-        per nearby body, and the PSMs' finger ghosts are only read when grasping."""
+        per nearby body, and the PSMs' finger ghosts are only read when grasping.
+
+        ``poses``: {(uid, link): (position, quaternion)} of the bodies read since the last step
+        (control() passes the springs' and the gravity overrides'), used rather than read again.
+        A ghost whose parent has not moved since it was placed is not placed again, and a body
+        that has not moved since its distance to an unmoved ghost was measured is not measured
+        again (the same transforms give the same answer): a resting phantom costs no queries."""
         if self.gui:
             self.place_ghosts()
-        parents: dict[int, tuple] = {}  # hole ghosts share their parent (the phantom): read it once
+        poses = dict(poses) if poses else {}  # hole ghosts share parents: read each once
         cid = self.cid
         for g in self._friction_ghosts:
             if g.moves:
-                pq = parents.get(id(g.parent))
+                parent = g.parent
+                key = (parent.uid, parent.link)
+                pq = poses.get(key)
                 if pq is None:
-                    pq = parents[id(g.parent)] = g.parent.state(velocity=False)[:2]
-                pos, orn = pb.multiplyTransforms(pq[0], pq[1], *g.pq_in_parent)
-                pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=cid)
-            found = self._overlap(g)
+                    pq = poses[key] = parent.state(velocity=False)[:2]
+                if pq != g.placed_at:
+                    pos, orn = pb.multiplyTransforms(pq[0], pq[1], *g.pq_in_parent)
+                    pb.resetBasePositionAndOrientation(g.uid, pos, orn, cid)
+                    g.placed_at = pq
+            found = self._overlap(g, poses)
             if found:
                 self._viscous(g, found)
 
@@ -96,6 +109,7 @@ class Interaction:
             p, q, _, _ = g.parent.state(velocity=False)
             pos, orn = pb.multiplyTransforms(p, q, *g.pq_in_parent)
             pb.resetBasePositionAndOrientation(g.uid, pos, orn, physicsClientId=self.cid)
+            g.placed_at = (p, q)
 
     def overlapping(self, g: SimGhost) -> list[SimBody]:
         """The dynamic bodies inside ghost ``g`` now (moved to its parent first); also kept in
@@ -103,17 +117,29 @@ class Interaction:
         self._place(g)
         return self._overlap(g)
 
-    def _overlap(self, g: SimGhost) -> list[SimBody]:
-        """``overlapping`` with the ghost already where its parent is."""
+    def _overlap(self, g: SimGhost, poses: dict | None = None) -> list[SimBody]:
+        """``overlapping`` with the ghost already where its parent is. With ``poses`` (see
+        _update_ghosts), each answer is kept with the ghost's and the body's poses and reused
+        while both stay exactly where they were (and no collision pair or grasp has changed)."""
         cid = self.cid
-        lo, hi = pb.getAABB(g.uid, -1, physicsClientId=cid)
+        lo, hi = pb.getAABB(g.uid, -1, cid)
         found = []
-        lookup = self._lookup
-        for uid, link in pb.getOverlappingObjects(lo, hi, physicsClientId=cid) or ():
-            sb = lookup.get((uid, link))
-            if sb is None or sb.static or sb is g.parent:
+        dynamic, parent, closest = self._dynamic_lookup, g.parent, pb.getClosestPoints
+        at = (self._pairs_epoch, g.placed_at)
+        known = g.distances
+        for key in pb.getOverlappingObjects(lo, hi, cid) or ():
+            sb = dynamic.get(key)
+            if sb is None or sb is parent:
                 continue
-            if pb.getClosestPoints(g.uid, uid, 0.0, -1, link, physicsClientId=cid):
+            pose = poses.get(key) if poses else None
+            was = known.get(key) if pose is not None else None
+            if was is not None and was[0] == at and was[1] == pose:
+                inside = was[2]
+            else:
+                inside = bool(closest(g.uid, key[0], 0.0, -1, key[1], physicsClientId=cid))
+                if pose is not None:
+                    known[key] = (at, pose, inside)
+            if inside:
                 found.append(sb)
         g.overlapping = found
         return found
@@ -171,6 +197,7 @@ class Interaction:
             pb.changeConstraint(c, maxForce=actuator.max_force, erp=GRASP_ERP, physicsClientId=self.cid)
             ids.append(c)
         actuator.constraint, actuator.target = ids, target
+        self._pairs_epoch += 1
         for link in self._links(actuator.parent):  # the closed jaws would push the held body out
             if not self._pair_off(actuator.parent.uid, link, target):
                 pb.setCollisionFilterPair(
@@ -186,6 +213,7 @@ class Interaction:
 
     def release(self, actuator: SimActuator) -> None:
         if actuator.constraint is not None:
+            self._pairs_epoch += 1
             for c in actuator.constraint:
                 pb.removeConstraint(c, physicsClientId=self.cid)
             t = actuator.target

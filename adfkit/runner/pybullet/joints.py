@@ -18,6 +18,8 @@ than stop the joint's relative motion within the step.
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 import pybullet as pb
 
@@ -167,11 +169,19 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 class SpringSet:
-    """All force-driven joints, evaluated together with numpy each control step."""
+    """All force-driven joints, evaluated together with numpy each control step.
+
+    The per-step cost is mostly PyBullet's: one getBasePositionAndOrientation and one
+    getBaseVelocity per free body (PyBullet has no batched call for them) and one
+    applyExternalTorque per dynamic body. Everything that does not change between steps (the
+    joints' index subsets, gains, limits and incidence blocks) is sliced once here, and the
+    calls pass their arguments by position (keyword parsing is a tenth of a call's cost)."""
 
     def __init__(self, joints: list[SpringJoint], cid: int) -> None:
         self.joints = joints
         self.cid = cid
+        self.pq: dict[tuple, tuple] = {}  # (uid, -1) -> (position, quaternion) of each free body, as last read
+        self._order = None
         n = len(joints)
         if not n:
             return
@@ -223,6 +233,19 @@ class SpringSet:
         inv_i = np.array([0.0 if b.static else 1.0 / max(min(b.inertia), 1e-12) for b in bodies]) * deg
         self.m_eff = 1.0 / np.maximum(inv_m[self.ip] + inv_m[self.ic], 1e-12)
         self.i_eff = 1.0 / np.maximum(inv_i[self.ip] + inv_i[self.ic], 1e-12)
+        self.ang_active = self.ang_low <= self.ang_high
+        fl = self.free_lin
+        # the free-linear joints' constant blocks, sliced once (the same values every step)
+        self.fl_ip, self.fl_ic = self.ip[fl], self.ic[fl]
+        self.fl_pa = self.pa_in_p[fl][:, :, None]
+        self.fl_pb = self.pb_in_c[fl][:, :, None]
+        self.fl_eq, self.fl_low, self.fl_high = self.eq_lin[fl], self.lin_low[fl], self.lin_high[fl]
+        self.fl_k, self.fl_c = self.k_lin[fl], self.c_lin[fl]
+        self.fl_active = self.fl_low <= self.fl_high
+        self.fl_m = self.m_eff[fl][:, None]
+        self.fl_net = self.net[:, fl]
+        self.fl_child_t, self.fl_parent_t = self.to_child[fl].T, self.to_parent[fl].T
+        self.i_eff_col = self.i_eff[:, None]
         self._gains_dt = None
 
     def _gains(self, dt: float):
@@ -232,6 +255,7 @@ class SpringSet:
             i_eff, m_eff = self.i_eff[:, None], self.m_eff[:, None]
             self._den_ang = 1.0 + (self.c_ang * dt + self.k_ang * dt**2) / i_eff
             self._den_lin = 1.0 + (self.c_lin * dt + self.k_lin * dt**2) / m_eff
+            self._fl_den = self._den_lin[self.free_lin]
             self._gains_dt = dt
         return self._den_ang, self._den_lin
 
@@ -254,32 +278,29 @@ class SpringSet:
                 links.setdefault(b.uid, []).append((i, b.link))
         order = [i for i, _ in bases] + [i for group in links.values() for i, _ in group]
         self._bases = [uid for _, uid in bases]
+        self._base_keys = [(uid, -1) for uid in self._bases]
         self._links = [(uid, [k for _, k in group]) for uid, group in links.items()]
         self._order = np.argsort(np.array(order, dtype=int))  # read order -> body order
+        self._in_order = bool(np.array_equal(self._order, np.arange(len(order))))
         self._apply_ids = [(i, self.bodies[i].uid, self.bodies[i].link, bool(self.pushed[i])) for i in self.dynamic]
 
     def states(self):
-        """(positions, rotation matrices, linear and angular velocities) of every body's COM."""
-        if getattr(self, "_order", None) is None:
+        """(positions, rotation matrices, linear and angular velocities) of every body's COM;
+        the free bodies' (position, quaternion) stay in ``pq`` by (uid, -1) until the next read."""
+        if self._order is None:
             self._read_plan()
         cid = self.cid
+        bases = self._bases
         get_pose, get_vel, get_links = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getLinkStates
-        pos, orn, lv, av = [], [], [], []
-        for uid in self._bases:
-            p, q = get_pose(uid, physicsClientId=cid)
-            v, w = get_vel(uid, physicsClientId=cid)
-            pos.append(p)
-            orn.append(q)
-            lv.append(v)
-            av.append(w)
-        for uid, ks in self._links:
-            for s in get_links(uid, ks, computeLinkVelocity=1, computeForwardKinematics=1, physicsClientId=cid):
-                pos.append(s[0])
-                orn.append(s[1])
-                lv.append(s[6])
-                av.append(s[7])
-        o = self._order
-        return (np.array(pos)[o], quat_to_matrix(np.array(orn)[o]), np.array(lv)[o], np.array(av)[o])
+        poses = [get_pose(uid, cid) for uid in bases]
+        rows = [p + q + v + w for (p, q), (v, w) in zip(poses, [get_vel(uid, cid) for uid in bases])]
+        self.pq = dict(zip(self._base_keys, poses))
+        for uid, ks in self._links:  # computeLinkVelocity, computeForwardKinematics
+            rows += [s[0] + s[1] + s[6] + s[7] for s in get_links(uid, ks, 1, 1, cid)]
+        a = np.fromiter(chain.from_iterable(rows), float, 13 * len(rows)).reshape(-1, 13)
+        if not self._in_order:
+            a = a[self._order]
+        return (a[:, 0:3], quat_to_matrix(a[:, 3:7]), a[:, 7:10], a[:, 10:13])
 
     def apply(self, dt: float, erp: float = 0.2) -> None:
         if not self.joints:
@@ -293,43 +314,43 @@ class SpringSet:
         ang = euler_xyz(rel)
         w_rel = (rat @ (av[ic] - av[ip])[:, :, None])[..., 0]
         # angular springs and limits, in joint frame A, turned into the world
-        i_eff = self.i_eff[:, None]
+        i_eff = self.i_eff_col
         tau = self._spring(self.k_ang, self.c_ang, ang - self.eq_ang, w_rel, den_ang, dt)
-        tau += self._limit(ang, w_rel + tau * dt / i_eff, self.ang_low, self.ang_high, i_eff, dt, erp)
+        tau += self._limit(ang, w_rel + tau * dt / i_eff, self.ang_low, self.ang_high, i_eff, dt, erp, self.ang_active)
         torque = self.net @ (ra @ tau[:, :, None])[..., 0]
         force = None
         fl = self.free_lin
         if fl.size:
             # free linear axes: spring, damper and limits on the pivot offset in frame A; a
             # force at the pivot = the same force at the COM plus its moment about the COM
-            pa = pos[ip[fl]] + (rot[ip[fl]] @ self.pa_in_p[fl][:, :, None])[..., 0]
-            pbw = pos[ic[fl]] + (rot[ic[fl]] @ self.pb_in_c[fl][:, :, None])[..., 0]
+            fp, fc = self.fl_ip, self.fl_ic
+            pa = pos[fp] + (rot[fp] @ self.fl_pa)[..., 0]
+            pbw = pos[fc] + (rot[fc] @ self.fl_pb)[..., 0]
             raft = rat[fl]
             d = (raft @ (pbw - pa)[:, :, None])[..., 0]
-            v_rel = (raft @ (lv[ic[fl]] - lv[ip[fl]])[:, :, None])[..., 0]
-            m_eff = self.m_eff[fl][:, None]
-            f = self._spring(self.k_lin[fl], self.c_lin[fl], d - self.eq_lin[fl], v_rel, den_lin[fl], dt)
-            f += self._limit(d, v_rel + f * dt / m_eff, self.lin_low[fl], self.lin_high[fl], m_eff, dt, erp)
+            v_rel = (raft @ (lv[fc] - lv[fp])[:, :, None])[..., 0]
+            m_eff = self.fl_m
+            f = self._spring(self.fl_k, self.fl_c, d - self.fl_eq, v_rel, self._fl_den, dt)
+            f += self._limit(d, v_rel + f * dt / m_eff, self.fl_low, self.fl_high, m_eff, dt, erp, self.fl_active)
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
-            force = self.net[:, fl] @ f_w
-            torque += self.to_child[fl].T @ _cross(pbw - pos[ic[fl]], f_w) - self.to_parent[fl].T @ _cross(
-                pbw - pos[ip[fl]], f_w
-            )
+            force = self.fl_net @ f_w
+            torque += self.fl_child_t @ _cross(pbw - pos[fc], f_w) - self.fl_parent_t @ _cross(pbw - pos[fp], f_w)
         torque = torque.tolist()
         if force is not None:
             force, pos = force.tolist(), pos.tolist()
         cid, frame = self.cid, pb.WORLD_FRAME
         apply_torque, apply_force = pb.applyExternalTorque, pb.applyExternalForce
         for i, uid, link, pushed in self._apply_ids:
-            apply_torque(uid, link, torque[i], frame, physicsClientId=cid)
+            apply_torque(uid, link, torque[i], frame, cid)
             if pushed:
-                apply_force(uid, link, force[i], pos[i], frame, physicsClientId=cid)
+                apply_force(uid, link, force[i], pos[i], frame, cid)
 
     @staticmethod
-    def _limit(x, v, low, high, inertia, dt, erp):
+    def _limit(x, v, low, high, inertia, dt, erp, active=None):
         """Velocity-correcting force that keeps x within [low, high] (low > high: free, Bullet):
         it drives a violation back at -erp·err/dt and only ever pushes, never pulls."""
-        active = low <= high
+        if active is None:
+            active = low <= high
         over = active & (x > high)
         under = active & (x < low)
         if not (over.any() or under.any()):

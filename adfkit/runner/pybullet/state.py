@@ -75,6 +75,9 @@ class WorldState:
         match it is a ValueError."""
         for a in self.actuators:
             self.release(a)
+        for g in self.ghosts:  # a restore puts the ghosts back too: the next control step places them
+            g.placed_at = None
+        self._pairs_epoch += 1
         if snap.world() is self:
             self._restore_own(snap)
         else:

@@ -96,26 +96,25 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
         return self._lookup
 
     def control(self) -> None:
-        """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors."""
+        """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors.
+        PyBullet's calls take their arguments by position here (this runs every control step)."""
         cdt = self.dt * self.opt.control_substeps
         cid = self.cid
+        base_pose, link_states, push = pb.getBasePositionAndOrientation, pb.getLinkStates, pb.applyExternalForce
+        frame = pb.WORLD_FRAME
+        poses = {}  # (uid, link) -> (position, quaternion) read this control step: the ghosts use them
         for uid, links, _sbs, forces in self._gravity_overrides:
-            if links == [-1]:
-                coms = [pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0]]
-            else:
-                coms = [
-                    pb.getBasePositionAndOrientation(uid, physicsClientId=cid)[0] if k < 0 else s[0]
-                    for k, s in zip(
-                        links,
-                        pb.getLinkStates(
-                            uid, [max(k, 0) for k in links], computeForwardKinematics=1, physicsClientId=cid
-                        ),
-                    )
-                ]
+            coms = []
+            states = link_states(uid, [max(k, 0) for k in links], 0, 1, cid) if links != [-1] else [None]
+            for k, s in zip(links, states):  # getLinkStates: computeLinkVelocity 0, computeForwardKinematics 1
+                pq = base_pose(uid, cid) if k < 0 else (s[0], s[1])
+                poses[(uid, k)] = pq
+                coms.append(pq[0])
             for k, f, at in zip(links, forces, coms):
-                pb.applyExternalForce(uid, k, f, at, pb.WORLD_FRAME, physicsClientId=cid)
+                push(uid, k, f, at, frame, cid)
         self.springs.apply(cdt)
-        self._update_ghosts()
+        poses.update(self.springs.pq)
+        self._update_ghosts(poses)
         for s in self.sensors:
             self._sense(s)
 
