@@ -129,3 +129,20 @@ def test_mujoco_renderer_draws_a_resized_copy_of_a_camera():
         assert abs(float(small["depth"][24, 32]) - float(full["depth"][h // 2, w // 2])) < 5e-3
     finally:
         world.close()
+
+
+@pytest.mark.parametrize("renderer", ["tiny", "mujoco"])
+def test_a_picture_alone_is_the_same_rgb_in_one_pass(renderer):
+    """``rgb_only`` (the suture's video and GIF frames) gives the full frame's RGB, bit for bit,
+    and nothing else."""
+    require_renderer(renderer)
+    world = open_world(load_scene(ROOT / "sample_scenes" / "suturing_pad" / "launch.yaml"), Options(renderer=renderer))
+    try:
+        world.run(0.02)
+        cam = world.cameras[0]
+        full, picture = cam.render(world), cam.render(world, rgb_only=True)
+        assert set(picture) == {"rgb"}
+        assert picture["rgb"].shape == full["rgb"].shape and np.array_equal(picture["rgb"], full["rgb"])
+        assert picture["rgb"].std() > 5  # a picture, not a blank
+    finally:
+        world.close()

@@ -48,10 +48,11 @@ class Camera:
             eye, target = eye + self.eye_offset * right, target + self.eye_offset * right
         return eye.tolist(), target.tolist(), up.tolist()
 
-    def render(self, world) -> dict:
+    def render(self, world, rgb_only: bool = False) -> dict:
         """{'rgb': H×W×3 uint8, 'depth': H×W float32 m, 'segmentation': H×W int32 (body index, -1 none)},
-        drawn by the engine's renderer (``world.render_camera``)."""
-        return world.render_camera(self)
+        drawn by the engine's renderer (``world.render_camera``); with ``rgb_only`` only 'rgb'
+        (one pass instead of two where the renderer draws segmentation separately)."""
+        return world.render_camera(self, rgb_only)
 
 
 def _camera(world, cam, ns: str) -> list[Camera]:

@@ -108,7 +108,7 @@ def play_task(
             if writer is not None and n % every == 0:
                 writer.write(n, _poses(task), phase)
             if cam is not None and (n % gif_every == 0 or (video is not None and n % video_every == 0)):
-                rgb = cam.render(world)["rgb"]
+                rgb = cam.render(world, rgb_only=True)["rgb"]
                 if video is not None and n % video_every == 0:
                     video.add(rgb)
                 if n % gif_every == 0:

@@ -93,7 +93,7 @@ class MjMirror:
             d.light_xpos[:] = xpos[lb] + on(lb, self._light_pos)
             d.light_xdir[:] = on(lb, self._light_dir)
 
-    def render(self, camera) -> dict:
+    def render(self, camera, rgb_only: bool = False) -> dict:
         """The PyBullet world's ``camera`` now: one of ``world.cameras`` or a copy of one with
         another image size (the Gymnasium environments resize them)."""
         import copy
@@ -121,7 +121,7 @@ class MjMirror:
             cam = copy.copy(cam)
             cam.width, cam.height = camera.width, camera.height
         self._sync()
-        return self.mj._renderer().render(cam)
+        return self.mj._renderer().render(cam, rgb_only)
 
     def close(self) -> None:
         self.mj.close()

@@ -41,9 +41,9 @@ class MjCamera(Camera):
         fields = {f.name: getattr(sim_camera, f.name) for f in dataclasses.fields(Camera)}
         return cls(**{**fields, "parent": parent}, world=world, cam_id=cam_id)
 
-    def render(self, world=None) -> dict:
+    def render(self, world=None, rgb_only: bool = False) -> dict:
         """{'rgb': H×W×3 uint8, 'depth': H×W float32 m (inf where nothing), 'segmentation': H×W int32}."""
-        return self.world._renderer().render(self)
+        return self.world._renderer().render(self, rgb_only)
 
 
 class _Renderer:
@@ -72,7 +72,7 @@ class _Renderer:
         self.near = m.vis.map.znear * m.stat.extent
         self.far = m.vis.map.zfar * m.stat.extent
 
-    def render(self, c: MjCamera) -> dict:
+    def render(self, c: MjCamera, rgb_only: bool = False) -> dict:
         m, d = self.world.model, self.world.data
         self.gl.make_current()
         self.cam.fixedcamid = c.cam_id
@@ -84,6 +84,8 @@ class _Renderer:
         scn.flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = False
         mujoco.mjr_render(rect, scn, self.ctx)
         mujoco.mjr_readPixels(rgb, None, rect, self.ctx)
+        if rgb_only:  # a picture: no second (segmentation) pass
+            return {"rgb": rgb[::-1].copy()}
         ids = np.empty((c.height, c.width, 3), dtype=np.uint8)
         z = np.empty((c.height, c.width), dtype=np.float32)
         scn.flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = True

@@ -207,8 +207,8 @@ class MujocoWorld(World, Assembly, Interaction):
             worst = max(worst, float(np.linalg.norm(xa - xb)))
         return worst
 
-    def render_camera(self, cam) -> dict:
-        return self._renderer().render(cam)
+    def render_camera(self, cam, rgb_only: bool = False) -> dict:
+        return self._renderer().render(cam, rgb_only)
 
     def _shapeless(self, sb) -> bool:
         return not sb.has_collision

@@ -13,11 +13,12 @@ import pybullet as pb
 from . import egl
 
 
-def render(world, cam) -> dict:
-    """``cam`` (a runner.cameras.Camera) drawn now: RGB, linear depth and body-index segmentation."""
+def render(world, cam, rgb_only: bool = False) -> dict:
+    """``cam`` (a runner.cameras.Camera) drawn now: RGB, linear depth and body-index segmentation
+    (with ``rgb_only``: RGB alone)."""
     if world.renderer == "mujoco":
         try:
-            return world.mj_view().render(cam)
+            return world.mj_view().render(cam, rgb_only)
         except Exception as exc:  # noqa: BLE001 - another engine's build: whatever stops it, PyBullet's own renderer draws
             # MuJoCo could not build the scene or open a GL context: the frame from TinyRenderer
             world.fall_back_to_tiny(f"{type(exc).__name__}: {exc}")
@@ -39,6 +40,8 @@ def render(world, cam) -> dict:
             physicsClientId=world.cid,
         )
     rgb = np.reshape(np.asarray(rgba, dtype=np.uint8), (cam.height, cam.width, 4))[:, :, :3]
+    if rgb_only:
+        return {"rgb": rgb}
     z = np.reshape(np.asarray(zbuf, dtype=np.float64), (cam.height, cam.width))
     n, f = cam.near, cam.far
     depth = (f * n / (f - (f - n) * z)).astype(np.float32)  # linearised z-buffer

@@ -155,8 +155,8 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
             worst = max(worst, float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0))))
         return worst
 
-    def render_camera(self, cam) -> dict:
-        return render(self, cam)
+    def render_camera(self, cam, rgb_only: bool = False) -> dict:
+        return render(self, cam, rgb_only)
 
     def _shapeless(self, sb) -> bool:
         parts = getattr(sb, "_parts", None)
