@@ -343,5 +343,12 @@ def test_contacts_name_the_body_and_the_force_in_both_engines(engine):
             assert len(at) == 3 and abs(at[2] - 0.016) < 0.002  # on the slab's top (16 mm)
         assert set(per_body) == {"Phantom"}
         assert 0.5 < per_body["Phantom"] < 50.0
+        # contacts_among (the observer asks it of the tools, one query an arm): the same
+        # contacts as asking body by body, the thread's on the phantom among them
+        psm = next(a for a in world.articulations if len(a.records) > 3)
+        some = [needle, world.body("Phantom")] + [sb for sb in world.bodies if sb.articulation is psm]
+        by_body = sorted((sb.key, o.key, round(f, 9)) for sb in some for o, f, _ in world.contacts(sb))
+        among = sorted((sb.key, o.key, round(f, 9)) for sb, o, f, _ in world.contacts_among(some))
+        assert among == by_body and sum(k[0].endswith("Phantom") and "Thread" in k[1] for k in among) >= 5
     finally:
         world.close()

@@ -118,6 +118,7 @@ class SutureObserver:
             if getattr(task, "tools_collide_with_tissue", False)
             else {}
         )
+        self._tool_links = [sb for sb in self.world.bodies if id(sb) in self._tool]
         self.needle_contacts: dict[str, dict[str, float]] = {}  # phase -> {tissue body: max N}
         self.tip_contacts: dict[str, dict[str, float]] = {}  # the same, within TIP_CONTACT of the tip
         self.tool_events: list[dict] = []
@@ -128,13 +129,14 @@ class SutureObserver:
         self._slip_base = None
         g = task.geom
         self.tangent_in_needle = g.arc_in_needle[:3, :3] @ np.array([0.0, 1.0, 0.0])
+        self._tip_h = np.r_[g.tip, 1.0]
         self.wire_radius = wire_radius(task)
 
     def _holders(self) -> int:
         return sum(1 for a in self.world.actuators if getattr(a, "target", None) is not None)
 
-    def _watch_holes(self, t: float, tip: np.ndarray) -> None:
-        tangent = self.task.needle_pose()[:3, :3] @ self.tangent_in_needle
+    def _watch_holes(self, t: float, tip: np.ndarray, needle_pose: np.ndarray) -> None:
+        tangent = needle_pose[:3, :3] @ self.tangent_in_needle
         needle = self.task.needle
         tip_h = np.r_[tip, 1.0]
         for h in self.holes:
@@ -185,12 +187,11 @@ class SutureObserver:
             return
         touching = set()
         per_touch: dict[tuple, float] = {}
-        for sb in self.tissue:
-            for other, f, _ in w.contacts(sb):
-                arm = self._tool.get(id(other))
-                if arm is not None:
-                    key = (arm, _name(other), _name(sb))
-                    per_touch[key] = per_touch.get(key, 0.0) + f
+        # asked of the tools (a query an arm), not of the tissue, which the thread lies on
+        for link, other, f, _ in w.contacts_among(self._tool_links):
+            if id(other) in self._tissue_ids:
+                key = (self._tool[id(link)], _name(link), _name(other))
+                per_touch[key] = per_touch.get(key, 0.0) + f
         for key, f in per_touch.items():
             if f < TOOL_TOUCH_N:
                 continue
@@ -224,13 +225,14 @@ class SutureObserver:
 
     def observe(self) -> None:
         t = self.world.sim_time
-        tip = self.task.tip_world()
+        needle_pose = self.task.needle_pose()  # read once a step: the holes, the tip and the drift use it
+        tip = (needle_pose @ self._tip_h)[:3]
         self.tip_path.append([t, *map(float, tip)])
         phase = self.task.phase
         if self._last_phase is not None and phase != self._last_phase and self._last_phase.startswith("pull "):
             self._thread_at_end_of_pull(int(self._last_phase.split()[1]))
         self._last_phase = phase
-        self._watch_holes(t, tip)
+        self._watch_holes(t, tip, needle_pose)
         self._watch_contacts(t)
         self.n += 1
         if self.n % self.error_every == 0:
@@ -245,7 +247,7 @@ class SutureObserver:
             psm = getattr(self.task, "psms", {})[self.task.holder]
             ee = psm.base_in_world() @ psm.measured_cp()
             expected = ee @ invert(self.task.held_ee_in_needle)
-            offset = expected[:3, 3] - self.task.needle_pose()[:3, 3]
+            offset = expected[:3, 3] - needle_pose[:3, 3]
             drift = float(np.linalg.norm(offset))
             self.max_drift = max(self.max_drift, drift)
             kind = phase.split()[0]

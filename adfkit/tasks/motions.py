@@ -89,7 +89,7 @@ class Motions:
         for i in range(1, n + 1):
             self.servo_world(psm, interpolate(a, b, smooth(i / n)))
             yield self.phase
-            if links and any(f >= GUARD_N for sb in links for o, f, _ in self.world.contacts(sb) if id(o) in tissue):
+            if links and any(f >= GUARD_N for _, o, f, _ in self.world.contacts_among(links) if id(o) in tissue):
                 stop = psm.base_in_world() @ psm.measured_cp()
                 stop[:3, 3] -= (
                     GUARD_BACK * (b[:3, 3] - a[:3, 3]) / max(float(np.linalg.norm(b[:3, 3] - a[:3, 3])), 1e-9)

@@ -222,6 +222,25 @@ class Interaction:
                     pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
         actuator.constraint, actuator.target = None, None
 
+    def contacts_among(self, bodies) -> list:
+        """As World.contacts_among, one getContactPoints a multibody (all its links at once)."""
+        wanted: dict[int, dict[int, SimBody]] = {}
+        for sb in bodies:
+            wanted.setdefault(sb.uid, {})[sb.link] = sb
+        out = []
+        lookup = self._lookup
+        for uid, links in wanted.items():
+            one = next(iter(links)) if len(links) == 1 else None
+            query = {"bodyA": uid, "physicsClientId": self.cid}
+            if one is not None:
+                query["linkIndexA"] = one  # a free body, or a single link: only its contacts
+            for c in pb.getContactPoints(**query) or ():
+                sb = links.get(c[3])
+                other = lookup.get((c[2], c[4]))
+                if sb is not None and other is not None and other is not sb:
+                    out.append((sb, other, float(c[9]), c[5]))
+        return out
+
     def contacts(self, sb: SimBody) -> list:
         """[(other SimBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
         out = []

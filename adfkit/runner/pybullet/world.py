@@ -16,7 +16,7 @@ import numpy as np
 import pybullet as pb
 
 from ..options import Options
-from ..rotations import matrix_to_pq, pose_matrix
+from ..rotations import matrix_to_pq, pose_matrix, quat_to_matrix
 from ..stability import CHECK_EVERY_S
 from ..world import World
 from . import egl
@@ -132,28 +132,53 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
             pb_stability.check_pybullet(self, self.watch)
         self.wall_time += time.perf_counter() - t0
 
+    def _frames_of(self, bodies: list) -> np.ndarray:
+        """World poses (n, 4, 4) of the PyBullet frames of ``bodies``, each body read once."""
+        index: dict[int, int] = {}
+        for sb in bodies:
+            index.setdefault(id(sb), len(index))
+        unique = {id(sb): sb for sb in bodies}
+        states = [unique[k].state(velocity=False) for k in index]
+        frames = np.zeros((len(states), 4, 4))
+        frames[:, :3, :3] = quat_to_matrix(np.array([s[1] for s in states]))  # all at once
+        frames[:, :3, 3] = [s[0] for s in states]
+        frames[:, 3, 3] = 1.0
+        return frames[[index[id(sb)] for sb in bodies]]
+
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of any joint (constraints and springs
         with a locked linear range); multibody joints are exact."""
-        worst = 0.0
-        for _, _, parent, child, pa, pbv, axis in self.constraints:
-            a = self._frame(parent)
-            b = self._frame(child)
-            gap = (a[:3, :3] @ pa + a[:3, 3]) - (b[:3, :3] @ pbv + b[:3, 3])
-            if axis is not None:  # a slider: only the gap across its axis is an error
-                u = a[:3, :3] @ axis
-                gap = gap - np.dot(gap, u) * u
-            worst = max(worst, float(np.linalg.norm(gap)))
-        return worst
+        rows = self.constraints
+        if not rows:
+            return 0.0
+        key = tuple(id(r) for r in rows)
+        if getattr(self, "_error_rows", (None,))[0] != key:  # the pivots as arrays, once
+            pa = np.array([r[4] for r in rows], dtype=float)
+            pbv = np.array([r[5] for r in rows], dtype=float)
+            slide = [i for i, r in enumerate(rows) if r[6] is not None]
+            axes = np.array([rows[i][6] for i in slide], dtype=float).reshape(-1, 3)
+            self._error_rows = (key, pa, pbv, slide, axes)
+        _, pa, pbv, slide, axes = self._error_rows
+        f = self._frames_of([r[2] for r in rows] + [r[3] for r in rows])
+        a, b = f[: len(rows)], f[len(rows) :]
+        gap = np.einsum("nij,nj->ni", a[:, :3, :3], pa) + a[:, :3, 3] - np.einsum("nij,nj->ni", b[:, :3, :3], pbv)
+        gap -= b[:, :3, 3]
+        if slide:  # a slider: only the gap across its axis is an error
+            u = np.einsum("nij,nj->ni", a[slide, :3, :3], axes)
+            gap[slide] -= np.einsum("ni,ni->n", gap[slide], u)[:, None] * u
+        return float(np.sqrt(np.einsum("ni,ni->n", gap, gap)).max())
 
     def joint_angle_error(self) -> float:
         """Largest angle, rad, by which a fixed joint made of point pivots has turned its child
         off the relative orientation the joint holds (the pivots' gaps are constraint_error)."""
-        worst = 0.0
-        for _, parent, child, ra, rb in self.fixed_frames:
-            rel = (self._frame(parent)[:3, :3] @ ra).T @ (self._frame(child)[:3, :3] @ rb)
-            worst = max(worst, float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0))))
-        return worst
+        rows = self.fixed_frames
+        if not rows:
+            return 0.0
+        f = self._frames_of([r[1] for r in rows] + [r[2] for r in rows])
+        ra = f[: len(rows), :3, :3] @ np.array([r[3] for r in rows])
+        rb = f[len(rows) :, :3, :3] @ np.array([r[4] for r in rows])
+        trace = np.einsum("nij,nij->n", ra, rb)  # trace of ra^T rb
+        return float(np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0)).max())
 
     def render_camera(self, cam, rgb_only: bool = False) -> dict:
         return render(self, cam, rgb_only)
