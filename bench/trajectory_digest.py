@@ -77,6 +77,10 @@ def main() -> int:
     wall = time.perf_counter() - t0
     passed = [p.get("passed") for p in m.get("pairs", [])]
     print(f"digest {h.hexdigest()}  control steps {count['steps']}  wall {wall:.1f} s  pairs passed {passed}")
+    spent = m.get("where_the_time_goes")
+    if spent:
+        total = m["episode_wall_time_s"]
+        print("  where the time goes: " + ", ".join(f"{k[:-2]} {v:.1f} s ({v / total:.0%})" for k, v in spent.items()))
     return 0
 
 

@@ -10,7 +10,6 @@ on the tool's collision primitives near its end effector.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +20,13 @@ from ..runner.rotations import invert, pose_to_matrix
 
 FIELD_HALF = 0.045  # m: a distance field reaches this far each way from its centre ...
 FIELD_STEP = 0.0015  # m ... on a grid this fine (exact at its nodes, trilinear between them)
+FIELD_BLOCK = 8  # nodes a side of the blocks a field is computed in
+# m: a field's node is exact up to this distance from the tissue, and at least this far beyond.
+# Enough: a query (capped at TOOL_CLEARANCE, 1.5 mm) interpolates the 8 nodes of its cell, all
+# within a cell's diagonal (2.6 mm) of each other, as a distance is 1-Lipschitz; so a query
+# under 1.5 mm reads only nodes nearer than 4.1 mm, and one that reads a node of 10 mm or more
+# is at least 7.4 mm off the tissue and capped either way
+FIELD_EXACT = 0.010
 SAMPLE_EDGE = 0.004  # m: a tool shape longer than this along an axis is also sampled at its middle
 
 
@@ -49,6 +55,43 @@ def _hull_planes(v: np.ndarray):
     return h.equations[:, :3], h.equations[:, 3]
 
 
+class _Field:
+    """The tissue's signed distance on the nodes of a cube of FIELD_STEP around ``centre``,
+    computed a block of FIELD_BLOCK³ nodes at a time from the shapes near it, the first time a
+    query falls in it: the planner's queries stay near the tools' paths, so most of the cube is
+    never computed."""
+
+    def __init__(self, tissue: Tissue, centre: np.ndarray) -> None:
+        self.tissue, self.centre = tissue, centre
+        self.origin = centre - FIELD_HALF
+        self.n = n = int(round(2 * FIELD_HALF / FIELD_STEP)) + 1
+        self.axes = [self.origin[i] + FIELD_STEP * np.arange(n) for i in range(3)]
+        self.grid = np.zeros((n, n, n))
+        self.done = np.zeros((-(-n // FIELD_BLOCK),) * 3, dtype=bool)
+
+    def ensure(self, idx: np.ndarray) -> None:
+        """Compute every block holding a node that trilinear lookups at ``idx`` (3, M: fractional
+        node coordinates) read: the node below and the one above each, clamped to the cube."""
+        lo = np.clip(np.floor(idx).astype(int), 0, self.n - 1)
+        hi = np.minimum(lo + 1, self.n - 1)
+        b, nb = FIELD_BLOCK, self.done.shape[0]
+        wanted = np.zeros(self.done.size, dtype=bool)
+        for c in range(8):  # the 8 corners of each lookup's cell, as block numbers
+            i, j, k = ((hi if (c >> a) & 1 else lo)[a] // b for a in range(3))
+            wanted[(i * nb + j) * nb + k] = True
+        todo = np.flatnonzero(wanted & ~self.done.ravel())
+        for i, j, k in zip(*np.unravel_index(todo, self.done.shape)):
+            sl = tuple(slice(v * b, min((v + 1) * b, self.n)) for v in (i, j, k))
+            nodes = np.stack(np.meshgrid(*(ax[s] for ax, s in zip(self.axes, sl)), indexing="ij"), axis=-1)
+            pts = nodes.reshape(-1, 3)
+            mid = (pts[0] + pts[-1]) / 2
+            half = float(np.linalg.norm(pts[-1] - pts[0])) / 2
+            # the shapes within FIELD_EXACT of the block: a node farther than that from the
+            # tissue gets a value as far or farther, which no clearance query can tell apart
+            self.grid[sl] = self.tissue.exact(pts, mid, half + FIELD_EXACT).reshape(nodes.shape[:3])
+            self.done[i, j, k] = True
+
+
 class Tissue:
     """The collision shapes of the static tissue bodies, in the world, for distance queries."""
 
@@ -63,7 +106,7 @@ class Tissue:
         for sb in bodies:
             self._add(sb)
         self._stack()
-        self._fields: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self._fields: dict[tuple, _Field] = {}
         self.centres = np.array([tuple(np.round(c, 3)) for c in centres]).reshape(-1, 3)
 
     def _add(self, sb) -> None:
@@ -139,22 +182,15 @@ class Tissue:
             best = np.minimum(best, (pts @ normals.T + offsets).max(axis=1))
         return best
 
-    def field(self, near: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The signed distance on a grid of FIELD_STEP around the centre nearest to ``near``
-        (made once and kept): (the grid's first node, the distances)."""
+    def field(self, near: np.ndarray) -> _Field:
+        """The signed distance field on a grid of FIELD_STEP around the centre nearest to
+        ``near`` (made once and kept; its nodes computed a block at a time as queries need them)."""
         if len(self.centres):
             key = tuple(self.centres[int(np.argmin(np.linalg.norm(self.centres - near, axis=1)))])
         else:
             key = tuple(np.round(near, 2))
         if key not in self._fields:
-            origin = np.array(key) - FIELD_HALF
-            n = int(round(2 * FIELD_HALF / FIELD_STEP)) + 1
-            axes = [origin[i] + FIELD_STEP * np.arange(n) for i in range(3)]
-            nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-            reach = FIELD_HALF * math.sqrt(3)
-            chunks = np.array_split(nodes, max(1, len(nodes) // 16384))
-            d = np.concatenate([self.exact(c, np.array(key), reach) for c in chunks])
-            self._fields[key] = (origin, d.reshape(n, n, n))
+            self._fields[key] = _Field(self, np.array(key))
         return self._fields[key]
 
     def distances(self, pts: np.ndarray, radii: np.ndarray, near: np.ndarray) -> np.ndarray:
@@ -163,9 +199,10 @@ class Tissue:
         (trilinear between its nodes)."""
         from scipy.ndimage import map_coordinates
 
-        origin, grid = self.field(near)
-        idx = ((pts.reshape(-1, 3) - origin) / FIELD_STEP).T
-        d = map_coordinates(grid, idx, order=1, mode="nearest").reshape(pts.shape[0], -1)
+        f = self.field(near)
+        idx = ((pts.reshape(-1, 3) - f.origin) / FIELD_STEP).T
+        f.ensure(idx)
+        d = map_coordinates(f.grid, idx, order=1, mode="nearest").reshape(pts.shape[0], -1)
         return (d - radii).min(axis=1)
 
     def distance(self, pts: np.ndarray) -> float:
