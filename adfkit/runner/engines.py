@@ -15,6 +15,26 @@ def _mujoco_mirror(world):
     return MjMirror(world)
 
 
+def camera_recording(world, cam, video_path=None, fps: float = 5.0, gif_width: int = 320, process: bool = True):
+    """The pictures of ``cam`` over an episode (runner/recording.py's interface): drawn in a
+    process of its own beside the physics where a PyBullet world draws with the MuJoCo mirror
+    (its rigid bodies are all the mirror needs to know each frame), else between the steps here."""
+    from .recording import CameraRecording
+
+    if process and world.engine == "pybullet" and world.renderer == "mujoco" and not _deforms(world):
+        from .mujoco.recorder import MirrorRecording
+
+        return MirrorRecording(world, cam, video_path, fps, gif_width)
+    return CameraRecording(world, cam, video_path, fps, gif_width)
+
+
+def _deforms(world) -> bool:
+    """The world has shapes that change between frames (soft bodies, drilled volumes), which the
+    mirror in another process would not see."""
+    scene = world.scene
+    return bool(getattr(world, "volumes", None)) or any(getattr(m, "soft_bodies", None) for m in scene.all_models())
+
+
 def open_world(scene, options: Options | None = None, gui: bool = False, engine: str = "pybullet", **kw):
     """The scene built in ``engine`` ("pybullet", the reference runner, or "mujoco"), ready to step.
     ``kw``: the engine's own options (MuJoCo: ``sleep``)."""

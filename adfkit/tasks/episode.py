@@ -74,9 +74,18 @@ class _Bar:
 
 
 def play_task(
-    world, task, out: Path | None = None, record: bool = False, every: int = 10, gif: bool = True, progress: bool = True
+    world,
+    task,
+    out: Path | None = None,
+    record: bool = False,
+    every: int = 10,
+    gif: bool = True,
+    progress: bool = True,
+    render_process: bool = True,
 ) -> tuple[dict, SutureObserver, list]:
-    """Drive ``task`` on ``world`` to its end (or failure); returns (metrics, observer, GIF frames)."""
+    """Drive ``task`` on ``world`` to its end (or failure); returns (metrics, observer, GIF frames).
+    ``render_process``: camera L's frames drawn in a process of their own where the world
+    allows it (runner.engines.camera_recording), else between the steps."""
     obs = SutureObserver(task)
     writer = None
     if record and out is not None:
@@ -87,15 +96,19 @@ def play_task(
     cdt = world.dt * world.opt.control_substeps
     gif_every = max(1, int(round(GIF_EVERY_S / cdt)))
     video_every = max(1, int(round(VIDEO_EVERY_S / cdt)))
-    video = (
-        _Video(Path(out) / "cameraL.mp4", 1.0 / (video_every * cdt)) if cam is not None and out is not None else None
-    )
-    frames = []
-    bar = _Bar(progress)
-    failure = None
-    t0 = time.perf_counter()
     clock = time.perf_counter
     spent = {"observe_s": 0.0, "render_s": 0.0}
+    t0 = clock()
+    rec = None
+    if cam is not None:
+        from ..runner.engines import camera_recording
+
+        a = clock()
+        video_path = Path(out) / "cameraL.mp4" if out is not None else None
+        rec = camera_recording(world, cam, video_path, 1.0 / (video_every * cdt), GIF_WIDTH, process=render_process)
+        spent["render_s"] += clock() - a
+    bar = _Bar(progress)
+    failure = None
     n = 0
     try:
         for phase in task.steps():
@@ -107,12 +120,10 @@ def play_task(
             n += 1
             if writer is not None and n % every == 0:
                 writer.write(n, _poses(task), phase)
-            if cam is not None and (n % gif_every == 0 or (video is not None and n % video_every == 0)):
-                rgb = cam.render(world, rgb_only=True)["rgb"]
-                if video is not None and n % video_every == 0:
-                    video.add(rgb)
-                if n % gif_every == 0:
-                    frames.append(_small(rgb))
+            if rec is not None:
+                to_video, to_gif = rec.video_path is not None and n % video_every == 0, n % gif_every == 0
+                if to_video or to_gif:
+                    rec.frame(to_video, to_gif)
             spent["render_s"] += clock() - b
             if n % 25 == 0:
                 rtf = world.sim_time / (time.perf_counter() - t0)
@@ -123,66 +134,29 @@ def play_task(
         bar.close()
         if writer is not None:
             writer.close()
-        if video is not None:
-            video.close()
+        if rec is not None:
+            a = clock()
+            rec.close()  # the frames still being drawn elsewhere are waited for: they are the episode's time too
+            spent["render_s"] += clock() - a
     metrics = obs.metrics(time.perf_counter() - t0, failure)
     spent["physics_s"] = world.wall_time
     spent["planning_and_servo_s"] = metrics["episode_wall_time_s"] - sum(spent.values())
     metrics["where_the_time_goes"] = spent
-    if video is not None and video.frames:
-        h, w = cam.height, cam.width
+    if rec is not None and rec.video_path is not None and rec.video_frames:
         metrics["video"] = {
-            "file": video.path.name,
-            "frames": video.frames,
-            "fps": round(video.fps, 3),
-            "width": w,
-            "height": h,
+            "file": rec.video_path.name,
+            "frames": rec.video_frames,
+            "fps": round(rec.fps, 3),
+            "width": cam.width,
+            "height": cam.height,
             "camera": cam.name,
+            "drawn_in": rec.drawn_in,
         }
+    if rec is not None and rec.note:
+        metrics["pictures_note"] = rec.note
     if writer is not None:
         metrics["dataset"] = {"dir": "dataset", "frames": writer.frames, "every_control_steps": every}
-    return metrics, obs, frames
-
-
-class _Video:
-    """Camera L at its own resolution as an H.264 MP4 (imageio's ffmpeg plugin), written as the
-    frames come (not held in memory) to a temporary file renamed when complete."""
-
-    def __init__(self, path: Path, fps: float) -> None:
-        self.path, self.fps = path, fps
-        self.tmp = path.with_name(path.stem + ".part.mp4")
-        self.w = None
-        self.frames = 0
-
-    def add(self, rgb: np.ndarray) -> None:
-        if self.w is None:
-            import imageio.v2 as imageio
-
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self.w = imageio.get_writer(
-                self.tmp,
-                format="FFMPEG",
-                fps=self.fps,
-                codec="libx264",
-                quality=7,
-                macro_block_size=2,
-                pixelformat="yuv420p",
-            )
-        self.w.append_data(np.ascontiguousarray(rgb))
-        self.frames += 1
-
-    def close(self) -> None:
-        if self.w is not None:
-            self.w.close()
-            self.w = None
-            self.tmp.replace(self.path)
-
-
-def _small(rgb: np.ndarray) -> np.ndarray:
-    from PIL import Image
-
-    h, w = rgb.shape[:2]
-    return np.asarray(Image.fromarray(rgb).resize((GIF_WIDTH, max(1, round(h * GIF_WIDTH / w)))))
+    return metrics, obs, (rec.gif if rec is not None else [])
 
 
 def tissue_outline(task):
@@ -284,6 +258,7 @@ def run_episode(
     gif: bool = True,
     options=None,
     engine: str = "pybullet",
+    render_process: bool = True,
 ) -> dict:
     """Play one scripted suture of hole ``pairs`` on the scene; returns the metrics (also written
     with the pictures to ``out`` when given)."""
@@ -303,7 +278,7 @@ def run_episode(
         except (SutureError, KeyError, ValueError) as exc:
             return {"pairs": [], "all_passed": False, "failure": f"setup: {exc}", "seed": seed}
         metrics, obs, frames = play_task(
-            world, task, Path(out) if out else None, record, every, gif and out is not None, progress
+            world, task, Path(out) if out else None, record, every, gif and out is not None, progress, render_process
         )
         metrics.update(
             {
