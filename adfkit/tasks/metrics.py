@@ -95,6 +95,8 @@ class SutureObserver:
         self.max_drift = 0.0
         self.drift_samples = 0
         self.drift_by_phase: dict[str, float] = {}
+        # the same while one arm alone holds it, from SLIP_SETTLE_S after the other let go (as slip)
+        self.one_arm_drift_by_phase: dict[str, float] = {}
         self.slips: list[dict] = []  # phases where the needle slipped past SLIP_LIMIT
         self.thread = [
             sb
@@ -264,6 +266,9 @@ class SutureObserver:
                 self._slip_base = (key, t)
             settled = self._slip_base is not None and t - self._slip_base[1] >= SLIP_SETTLE_S
             slip = drift if settled else 0.0
+            if settled:  # the drift while one arm alone holds it, its hand-over strain relaxed
+                d = self.one_arm_drift_by_phase
+                d[kind] = max(d.get(kind, 0.0), drift)
             if slip > SLIP_LIMIT and not any(s["phase"] == phase for s in self.slips):
                 self.slips.append({"phase": phase, "t": t, "arm": self.task.holder, "slip_m": slip})
             for s in self.slips:
@@ -345,6 +350,7 @@ class SutureObserver:
             "thread_length_through_tissue_m": through,
             "grasp_drift_max_m": self.max_drift if self.drift_samples else None,
             "grasp_drift_by_phase_m": self.drift_by_phase,
+            "grasp_drift_one_arm_by_phase_m": self.one_arm_drift_by_phase,
             "slip_limit_m": SLIP_LIMIT,
             "switched_off": list(getattr(self.task, "switched_off", [])),
             "slips": self.slips,
