@@ -143,6 +143,7 @@ class Assembly:
         self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
         self._dynamic_lookup = {k: sb for k, sb in self._lookup.items() if not sb.static}
         self._pairs_epoch = 0  # counts changes of collision pairs and grasps (interact.py's distance answers)
+        self._parting: list = []  # (uid, link, body): a released grasp, collisions back once apart
         self._gravity_overrides = self._group_gravity_overrides()
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
 

@@ -198,6 +198,8 @@ class Interaction:
             ids.append(c)
         actuator.constraint, actuator.target = ids, target
         self._pairs_epoch += 1
+        uid = actuator.parent.uid
+        self._parting = [p for p in self._parting if not (p[0] == uid and p[2] is target)]
         for link in self._links(actuator.parent):  # the closed jaws would push the held body out
             if not self._pair_off(actuator.parent.uid, link, target):
                 pb.setCollisionFilterPair(
@@ -216,11 +218,27 @@ class Interaction:
             self._pairs_epoch += 1
             for c in actuator.constraint:
                 pb.removeConstraint(c, physicsClientId=self.cid)
-            t = actuator.target
-            for link in self._links(actuator.parent):
-                if not self._pair_off(actuator.parent.uid, link, t):  # set_collision's choice stays
-                    pb.setCollisionFilterPair(actuator.parent.uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
+            # the closed jaws lie in the body they held (they did not collide with it): each link
+            # collides with it again once it has come off it (parting, every control step), not
+            # while inside it, where it would throw the body out (the bundled needle: 9 N from
+            # the opening jaws for half a second, 3.5 degrees in the other arm's grasp)
+            t, uid = actuator.target, actuator.parent.uid
+            self._parting += [(uid, link, t) for link in self._links(actuator.parent)]
+            self.parting()
         actuator.constraint, actuator.target = None, None
+
+    def parting(self) -> None:
+        """Let each link that released a body collide with it again once they no longer overlap."""
+        still = []
+        for uid, link, t in self._parting:
+            if self._pair_off(uid, link, t):  # set_collision's choice stays
+                continue
+            if pb.getClosestPoints(uid, t.uid, 0.0, link, t.link, physicsClientId=self.cid):
+                still.append((uid, link, t))
+            else:
+                pb.setCollisionFilterPair(uid, t.uid, link, t.link, 1, physicsClientId=self.cid)
+                self._pairs_epoch += 1
+        self._parting = still
 
     def contacts_among(self, bodies) -> list:
         """As World.contacts_among, one getContactPoints a multibody (all its links at once)."""

@@ -117,6 +117,8 @@ class PyBulletWorld(World, Assembly, Interaction, WorldState):
         self._update_ghosts(poses)
         for s in self.sensors:
             self._sense(s)
+        if self._parting:
+            self.parting()
 
     def step(self, n: int = 1) -> None:
         """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
