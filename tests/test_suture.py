@@ -101,6 +101,37 @@ def test_metrics_json_and_pictures(one_pair):
     assert frame.shape == (v["height"], v["width"], 3) and v["width"] >= 640
 
 
+def test_servo_holds_the_roll_at_the_limit_it_met():
+    """A Cartesian set-point a little past the tool roll's limit (+3.054 rad) is clipped to that
+    limit. Past +pi the IK gives the roll near -pi, and clipped that was the other limit, a full
+    turn away: in the corpus set the tool spun 6 rad in 50 ms and threw the needle out."""
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.suture import SutureTask
+
+    world = open_world(load_scene(_bundled()), Options(visuals=False))
+    try:
+        task = SutureTask(world, [1], seed=0)
+        psm = task.psms["psm1"]
+        q = np.array([0.1, -0.1, 0.12, 3.0, 0.2, -0.1])
+        psm.servo_jp(q)
+        hi = psm.kin.upper_limits[3]
+        for roll in (3.10, math.pi + 0.05):  # past the limit; past +pi
+            past = q.copy()
+            past[3] = roll
+            task.servo_world(psm, psm.base_in_world() @ psm.kin.fk(past))
+            assert psm.setpoint_jp()[3] == pytest.approx(hi)
+            psm.servo_jp(q)
+        far = q.copy()
+        far[3] = hi + 0.2  # -3.03 as the IK gives it: inside the limits, a full turn away
+        with pytest.raises(ValueError):  # beyond what a set-point may be clipped by: refused
+            task.servo_world(psm, psm.base_in_world() @ psm.kin.fk(far))
+        assert psm.setpoint_jp()[3] == pytest.approx(3.0)
+        assert task.clipped == 2
+    finally:
+        world.close()
+
+
 @pytest.mark.slow
 def test_needle_held_while_carried_and_released_when_the_jaws_open():
     from adfkit.adf import load_scene

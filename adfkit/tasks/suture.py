@@ -290,6 +290,7 @@ class SutureTask(GraspChoice, Motions):
                         down_at=n0,
                         what=f"pair {p.index}, driving",
                         clear_at=(n0, insertion[0], *along),
+                        joint_moves=(2,),  # carry_to: from over the pick-up to over the entry
                     )
                 )
             else:
@@ -339,7 +340,9 @@ class SutureTask(GraspChoice, Motions):
         now = self.needle_pose()
         poses = [now, *pull[1:]] + self.handbacks[k : k + 1]
         try:
-            return self.choose_grasp(self.psms[self.puller], phi, poses, clear_at=(now, *clear[1:]))
+            return self.choose_grasp(
+                self.psms[self.puller], phi, poses, clear_at=(now, *clear[1:]), joint_moves=(len(pull),)
+            )
         except SutureError:
             return self.pull_grasps[k]
 
@@ -362,6 +365,7 @@ class SutureTask(GraspChoice, Motions):
                     -self.geom.span + g_tail,
                     [h] + insertion,
                     clear_at=(h, insertion[0], *along),
+                    joint_moves=(1,),  # carry_to: from over the pair before to over the entry
                 )
             except SutureError:
                 continue
