@@ -116,18 +116,25 @@ BODY link:
 
 def test_tool_shape_follows_the_simulated_tool_at_any_configuration(world):
     """ToolShape places the jaws, the wrist's pitch link and the shaft from the end effector's
-    pose alone: at random joint values they coincide with the simulated bodies' shapes."""
+    pose alone: at random joint values they coincide with the simulated bodies' shapes, whether
+    it was sampled with the tool inserted or drawn into its cannula."""
     from adfkit.runner.psm import PSM
     from adfkit.tasks.clearance import ToolShape, _primitive_points
 
     psm = PSM(world, "psm1")
     saved = world.joint_state(psm.art, psm.arm)
-    tool = ToolShape(world, psm)
+    inserted = ToolShape(world, psm)
     recs = psm.art.records
     rng = np.random.default_rng(3)
     lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
     try:
-        for _ in range(5):
+        # sampled with the tool drawn into its cannula too (the corpus PSMs start at insertion
+        # 0, under L_tool2rcm, where the palm points away from the remote centre): its wrist's
+        # points were then mirrored, 11-15 mm off, at every other pose
+        world.reset_joints(psm.art, psm.arm, np.zeros(6))
+        drawn_in = ToolShape(world, psm)
+        world.reset_joints(psm.art, psm.arm, *saved)
+        for tool in (inserted, drawn_in) * 3:
             world.reset_joints(psm.art, psm.arm, lo + (hi - lo) * (0.2 + 0.6 * rng.random(6)))
             ee = psm.base_in_world() @ psm.measured_cp()
             pts, radii = tool.points(ee[None])

@@ -254,6 +254,13 @@ class ToolShape:
         self.ee_radii = np.concatenate([r for _, r in moving])
         self.ee_pts = (invert(ee) @ np.c_[pts, np.ones(len(pts))].T).T[:, :3]
         palm = _palm_frames(ee[None], self.rcm, self.l_yaw2ctrl)[0]
+        frames = psm.kin.fk_all(psm.measured_jp())
+        pitch = (ee @ invert(frames[7]) @ frames[5])[:3, 3]  # on the wrist's pitch axis
+        if np.dot(pitch - palm[:3, 3], palm[:3, 1]) < 0:
+            # sampled with the tool drawn into its cannula (insertion under L_tool2rcm: the corpus
+            # PSMs start at 0), the palm points away from the remote centre; the plan's poses
+            # have it toward it (the wrist's points were 11-15 mm off, mirrored, at other poses)
+            palm = palm @ np.diag([1.0, -1.0, -1.0, 1.0])
         pts, self.palm_radii = _primitive_points(recs[psm.arm[4]][3])
         self.palm_pts = (invert(palm) @ np.c_[pts, np.ones(len(pts))].T).T[:, :3]
         shaft = [p for p in collision_primitives(recs[psm.arm[3]][3].body) or [] if p.geometry.radius]
