@@ -269,14 +269,11 @@ def test_needle_and_thread_go_through_four_pairs_on_eight_of_ten_seeds(four_pair
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="measured on `adfkit suture --pairs 4 --episodes 10` with the tools colliding: 5 of 10 "
-    "seeds pass every pair; the others fail pair 1's regrasp, where the puller's best grasp keeps "
-    "0.2-0.4 mm off the tissue beside Exit1 (2.1-3.0 mm of slip, or its jaws stopped short of the wire)",
-)
 def test_four_pairs_on_eight_of_ten_seeds(four_pairs_ten_seeds):
+    """Every pair passed, the tools colliding, and the joints within 1 mm (measured: 10 of 10
+    seeds, 0.21-0.69 mm; a strict xfail written at 5 of 10 seeds, which now passes)."""
     assert sum(m["all_passed"] for m in four_pairs_ten_seeds) >= 8
+    assert max(m["max_constraint_error_m"] for m in four_pairs_ten_seeds) < 1e-3
 
 
 def test_cli_bad_input_is_exit_2(tmp_path, capsys):
