@@ -43,9 +43,9 @@ class Motions:
 
         The IK gives the tool's roll in (-pi, pi], its limits are +-3.054 rad: a path that turns
         it past +pi comes back near -pi, inside the limits or, clipped, at the other limit, a
-        full turn from where it is (in the corpus set the tool spun 6 rad in 50 ms and threw the
-        needle out of the tissue). The roll is taken the way nearest the set-point, so that a
-        path past a limit stops at the limit it met, or is refused."""
+        full turn from where it is (in the corpus set the roll turned 5.2 rad in 60 ms toward
+        it and threw the needle out of the tissue). The roll is taken the way nearest the
+        set-point, so that a path past a limit stops at the limit it met, or is refused."""
         try:
             q = psm.kin.ik(invert(psm.base_in_world()) @ ee_world)
         except JointLimitError as exc:
