@@ -188,12 +188,13 @@ def test_the_same_seed_and_actions_replay_bit_for_bit_in_every_env(env_id):
 
 def test_a_reset_in_place_is_only_close():
     """The negative control: exact_reset=False restores the snapshot into the same world, which
-    keeps its contact order, so the same seed and actions drift apart (by far less than a
-    micrometre) and the checker's warning, made an error, fires."""
+    keeps its contact order, so the same seed and actions drift apart (by micrometres: the needle
+    22 um with its hulls' 0.1 mm collision margins, 1.4 um when PyBullet gave them 1 mm) and the
+    checker's warning, made an error, fires."""
     env = make("adfkit/NeedleReach-v0", exact_reset=False)
     actions = _actions(env, 12)
     a, b = _play(env, 5, actions), _play(env, 5, actions)
-    assert 0.0 < _worst(a, b, "needle_pose") < 1e-5
+    assert 0.0 < _worst(a, b, "needle_pose") < 1e-4
     with pytest.raises(UserWarning, match="not equal although similar"):
         _check("adfkit/NeedleReach-v0", exact_reset=False)
 

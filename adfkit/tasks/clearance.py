@@ -28,6 +28,7 @@ FIELD_BLOCK = 8  # nodes a side of the blocks a field is computed in
 # is at least 7.4 mm off the tissue and capped either way
 FIELD_EXACT = 0.010
 SAMPLE_EDGE = 0.004  # m: a tool shape longer than this along an axis is also sampled at its middle
+AXIS_STEP = 0.001  # m between the points along a capsule's axis (its surface within 0.04 mm at 3.5 mm radius)
 
 
 def _num(v, default: float = 0.0) -> float:
@@ -137,6 +138,8 @@ class Tissue:
                 a = axis_vector(g.axis)
                 u = m[:3, :3] @ np.array([a.x, a.y, a.z], dtype=float)
                 h = _num(g.height) / 2
+                if p.kind is ShapeKind.CAPSULE:  # its height includes the caps (adf-format.md §7.5)
+                    h = max(h - _num(g.radius), 0.0)
                 # a cylinder or cone lies inside the capsule of its radius along its axis
                 self.segments.append((c - h * u, c + h * u, _num(g.radius)))
             elif p.kind is ShapeKind.PLANE and g.normal is not None:
@@ -212,30 +215,43 @@ class Tissue:
         return float(self.exact(pts, centre, reach).min())
 
 
-def _primitive_points(sb) -> np.ndarray:
-    """Points on the corners (and the middles of long edges) of a body's collision primitives'
-    bounding boxes, in the world."""
+def _primitive_points(sb) -> tuple[np.ndarray, np.ndarray]:
+    """Points that stand for a body's collision primitives, in the world, each with a radius (a
+    point's clearance is the tissue's distance less its radius): a sphere's centre and points
+    along a capsule's axis, AXIS_STEP apart, with their radius (their surface: the corners of the
+    box around the corpus PSM's capsule wrist link stood up to 2.6 mm off it); the corners (and
+    the middles of long edges) of a box's, a cylinder's or a cone's bounding box."""
     t = sb.world_matrix()
-    out = []
+    out, radii = [], []
     for p in collision_primitives(sb.body) or []:
         g = p.geometry
+        m = t @ pose_to_matrix(p.pose)
+        if p.kind in (ShapeKind.SPHERE, ShapeKind.CAPSULE):
+            r = _num(g.radius)
+            u = np.zeros(3)
+            if p.kind is ShapeKind.CAPSULE:  # its height includes the caps (adf-format.md §7.5)
+                a = axis_vector(g.axis)
+                u = np.array([a.x, a.y, a.z], dtype=float) * max(_num(g.height) / 2 - r, 0.0)
+            n = int(math.ceil(2 * float(np.linalg.norm(u)) / AXIS_STEP)) + 1
+            local = np.linspace(-1.0, 1.0, n)[:, None] * u if n > 1 else np.zeros((1, 3))
+            out.append((m[:3, :3] @ local.T).T + m[:3, 3])
+            radii.append(np.full(len(local), r))
+            continue
         if p.kind is ShapeKind.BOX:
             half = np.array([_num(g.x), _num(g.y), _num(g.z)]) / 2
-        elif p.kind in (ShapeKind.CAPSULE, ShapeKind.CYLINDER, ShapeKind.CONE, ShapeKind.SPHERE):
-            r = _num(g.radius)
-            half = np.full(3, r)
-            if p.kind is not ShapeKind.SPHERE:
-                a = axis_vector(g.axis)
-                half[int(np.argmax(np.abs([a.x, a.y, a.z])))] = _num(g.height) / 2 + (
-                    r if p.kind is ShapeKind.CAPSULE else 0.0
-                )
+        elif p.kind in (ShapeKind.CYLINDER, ShapeKind.CONE):
+            half = np.full(3, _num(g.radius))
+            a = axis_vector(g.axis)
+            half[int(np.argmax(np.abs([a.x, a.y, a.z])))] = _num(g.height) / 2
         else:
             continue
-        m = t @ pose_to_matrix(p.pose)
         levels = [(-1.0, 0.0, 1.0) if 2 * h > SAMPLE_EDGE else (-1.0, 1.0) for h in half]
         grid = np.array([[x, y, z] for x in levels[0] for y in levels[1] for z in levels[2]])
         out.append((m[:3, :3] @ (grid * half).T).T + m[:3, 3])
-    return np.concatenate(out) if out else np.zeros((0, 3))
+        radii.append(np.zeros(len(grid)))
+    if not out:
+        return np.zeros((0, 3)), np.zeros(0)
+    return np.concatenate(out), np.concatenate(radii)
 
 
 def _palm_frames(ee: np.ndarray, rcm: np.ndarray, l_yaw2ctrl: float) -> np.ndarray:
@@ -270,11 +286,19 @@ class ToolShape:
         self.rcm = psm.base_in_world()[:3, 3]
         self.l_yaw2ctrl = float(psm.kin.l_yaw2ctrlpnt)
         self.l_pitch2yaw = float(psm.kin.l_pitch2yaw)
-        moving = [recs[psm.arm[5]][3]] + [recs[j][3] for j in psm.jaws]
-        pts = np.concatenate([_primitive_points(sb) for sb in moving])
+        moving = [_primitive_points(sb) for sb in [recs[psm.arm[5]][3]] + [recs[j][3] for j in psm.jaws]]
+        pts = np.concatenate([p for p, _ in moving])
+        self.ee_radii = np.concatenate([r for _, r in moving])
         self.ee_pts = (invert(ee) @ np.c_[pts, np.ones(len(pts))].T).T[:, :3]
         palm = _palm_frames(ee[None], self.rcm, self.l_yaw2ctrl)[0]
-        pts = _primitive_points(recs[psm.arm[4]][3])
+        frames = psm.kin.fk_all(psm.measured_jp())
+        pitch = (ee @ invert(frames[7]) @ frames[5])[:3, 3]  # on the wrist's pitch axis
+        if np.dot(pitch - palm[:3, 3], palm[:3, 1]) < 0:
+            # sampled with the tool drawn into its cannula (insertion under L_tool2rcm: the corpus
+            # PSMs start at 0), the palm points away from the remote centre; the plan's poses
+            # have it toward it (the wrist's points were 11-15 mm off, mirrored, at other poses)
+            palm = palm @ np.diag([1.0, -1.0, -1.0, 1.0])
+        pts, self.palm_radii = _primitive_points(recs[psm.arm[4]][3])
         self.palm_pts = (invert(palm) @ np.c_[pts, np.ones(len(pts))].T).T[:, :3]
         shaft = [p for p in collision_primitives(recs[psm.arm[3]][3].body) or [] if p.geometry.radius]
         self.shaft_radius = _num(shaft[0].geometry.radius) if shaft else 0.0
@@ -291,7 +315,7 @@ class ToolShape:
         d = self.rcm - pitch
         d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
         sh = pitch[:, None, :] + self.along[None, :, None] * d[:, None, :]
-        radii = np.r_[np.zeros(len(self.ee_pts) + len(self.palm_pts)), np.full(len(self.along), self.shaft_radius)]
+        radii = np.r_[self.ee_radii, self.palm_radii, np.full(len(self.along), self.shaft_radius)]
         return np.concatenate([e, p, sh], axis=1), radii
 
 

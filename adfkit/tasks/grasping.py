@@ -28,6 +28,9 @@ SURE_CLEARANCE = 0.0007
 #: rad between the jaws as they come onto the wire: a 3.9 mm gap at the wire for its 1.2 mm, and
 #: fingers 2.5 mm to each side instead of the 5.6 mm of a fully opened jaw, beside the tissue
 JAW_APPROACH = 0.35
+#: the tool's roll among q1..q6: its range (+-3.054 rad) is nearly a full turn, and the IK gives it
+#: in (-pi, pi], so a Cartesian path that turns it past +-pi shows as a jump of nearly 2 pi
+ROLL = 3
 GRASP_STEP = math.radians(6)  # the planner tries grasps this far apart along the wire ...
 MIN_GRASP = math.radians(8)  # ... from this far from the tip or the tail (the jaws' width)
 
@@ -84,12 +87,17 @@ class GraspChoice:
             yield from self.grasp_candidates(phi - d if tail_end else phi + d)
 
     def _margin(self, psm: PSM, ee_world: np.ndarray) -> float:
+        return self._reach(psm, ee_world)[0]
+
+    def _reach(self, psm: PSM, ee_world: np.ndarray) -> tuple[float, float]:
+        """(the joint margin at an end-effector pose, the tool's roll there); (-1, nan) where the
+        IK finds no solution within the limits."""
         try:
             q = psm.kin.ik(invert(psm.base_in_world()) @ ee_world)
         except ValueError:
-            return -1.0
+            return -1.0, math.nan
         lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
-        return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo)))
+        return float(np.min(np.minimum(q - lo, hi - q) / (hi - lo))), float(q[ROLL])
 
     def choose_grasp(
         self,
@@ -99,11 +107,19 @@ class GraspChoice:
         down_at: np.ndarray | None = None,
         what: str = "",
         clear_at: tuple = (),
+        joint_moves: tuple = (),
     ) -> Grasp:
         """The candidate grasp reachable at every needle pose that keeps the tool farthest from
         the tissue (up to TOOL_CLEARANCE) at the needle poses ``clear_at`` (the first one also
         on the approach along the jaw axis), then with the widest joint margin (with
-        ``down_at``: the jaws must point down at that needle pose, to come from above)."""
+        ``down_at``: the jaws must point down at that needle pose, to come from above).
+
+        The needle goes from one of ``needle_poses`` to the next along a Cartesian path, except
+        into the indices ``joint_moves`` (a move in joint space). On a Cartesian path the tool's
+        roll must not pass +-pi: that lies outside its limits, and the servo would hold it at one
+        limit while the needle turned on (a grasp of the corpus set's pair 1 asked for it at the
+        end of the insertion, and the roll, clipped, came back at the other limit a full turn
+        away and threw the needle out of the tissue)."""
         cands = [
             (m, turn) for m, turn in self._along_wire(phi, clear_at) if down_at is None or (down_at @ m)[2, 2] <= -0.5
         ]
@@ -133,10 +149,15 @@ class GraspChoice:
             back = first.copy()
             back[:3, 3] -= BACK_OFF * first[:3, 2]
             worst = self._margin(psm, back)  # the jaws come onto the wire along their axis
-            for pose in needle_poses:
+            roll = math.nan
+            for k, pose in enumerate(needle_poses):
                 if worst <= 0:
                     break
-                worst = min(worst, self._margin(psm, pose @ m))
+                margin, was = self._reach(psm, pose @ m)
+                worst = min(worst, margin)
+                if k > 0 and k not in joint_moves and abs(was - roll) > math.pi:
+                    worst = -1.0  # the roll would pass +-pi on the way from the previous pose
+                roll = was
             margin = worst - 0.02 * turn
             key = (float(clear_q[i]), margin)
             if worst > 0 and (best_key is None or key > best_key):

@@ -108,6 +108,11 @@ class SutureObserver:
             _Hole(self.world, p.index, "exit", p.exit_name, p.exit) for p in task.pairs
         ]
         self.tissue = [sb for sb in self.world.bodies if sb.model is task.needle.model and sb.static]
+        # and the bodies the hole ghosts sit on: the corpus set's holes are bodies of 0.2 kg on
+        # springs to the phantom, not static, and what presses on them presses on the tissue
+        for g in self.world.ghosts:
+            if g.friction and g.parent is not None and g.parent not in self.tissue:
+                self.tissue.append(g.parent)
         self._tissue_ids = {id(sb) for sb in self.tissue}
         # the tools' links, watched for touches when they collide with the tissue
         self._tool = (

@@ -236,14 +236,17 @@ class SutureTask(GraspChoice, Motions):
         return names[0], names[-1]
 
     def setup_joints(self, reach: float = 0.17) -> dict:
-        """Where a PSM's remote centre of motion is farther from the holes than the tool reaches
-        (the corpus set: 0.26 m against 0.24 m of insertion), slide its base toward them, as a
-        surgeon places the arm on its setup joints. Returns {psm: metres moved}."""
+        """Where a PSM's remote centre of motion is farther from the holes than ``reach`` (the
+        corpus set: 0.26 m against 0.24 m of insertion), slide its base across toward them, at
+        its height, until it is that near, as a surgeon places the arm on its setup joints.
+        Returns {psm: metres moved}."""
         target = np.mean(
             [self.world.ghost_pose(g)[:3, 3] for p in self.pairs for g in (p.entry, p.exit)]
             + [self.needle_pose()[:3, 3]],
             axis=0,
         )
+        up = -np.asarray(self.world.gravity, dtype=float)
+        up = up / np.linalg.norm(up) if np.linalg.norm(up) > 0 else np.array([0.0, 0.0, 1.0])
         moved = {}
         for name, psm in self.psms.items():
             rcm = psm.base_in_world()[:3, 3]
@@ -251,7 +254,15 @@ class SutureTask(GraspChoice, Motions):
             if d <= reach + 1e-6:
                 moved[name] = 0.0
                 continue
-            shift = (target - rcm) * (1 - reach / d)
+            # across, at the height the scene gives it, so that the arm's links below its remote
+            # centre stay as far above the tissue as the scene placed them: the corpus PSM's pitch
+            # end link reaches 80 mm below it; slid straight at the holes, 65 mm lower, that link
+            # came 20 mm over the phantom's Barrier (a static box level with the slab) and pressed
+            # on it with 730 kN as the arm pitched to hand the needle back over pair 2
+            rise = float(np.dot(target - rcm, up))
+            across = (target - rcm) - rise * up
+            room = math.sqrt(max(reach * reach - rise * rise, 0.0))
+            shift = across * max(0.0, 1 - room / max(float(np.linalg.norm(across)), 1e-12))
             t = psm.base.world_matrix()
             t[:3, 3] += shift
             self.world.move_base(psm.base, t)
@@ -290,6 +301,7 @@ class SutureTask(GraspChoice, Motions):
                         down_at=n0,
                         what=f"pair {p.index}, driving",
                         clear_at=(n0, insertion[0], *along),
+                        joint_moves=(2,),  # carry_to: from over the pick-up to over the entry
                     )
                 )
             else:
@@ -339,7 +351,9 @@ class SutureTask(GraspChoice, Motions):
         now = self.needle_pose()
         poses = [now, *pull[1:]] + self.handbacks[k : k + 1]
         try:
-            return self.choose_grasp(self.psms[self.puller], phi, poses, clear_at=(now, *clear[1:]))
+            return self.choose_grasp(
+                self.psms[self.puller], phi, poses, clear_at=(now, *clear[1:]), joint_moves=(len(pull),)
+            )
         except SutureError:
             return self.pull_grasps[k]
 
@@ -362,6 +376,7 @@ class SutureTask(GraspChoice, Motions):
                     -self.geom.span + g_tail,
                     [h] + insertion,
                     clear_at=(h, insertion[0], *along),
+                    joint_moves=(1,),  # carry_to: from over the pair before to over the entry
                 )
             except SutureError:
                 continue

@@ -161,6 +161,13 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         # through a free channel the tip brushes the holes' boundaries with a few newtons: this much
         # means the driver forced it through what should have stopped it
         hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forced.items(), key=lambda kv: -kv[1]))
+        narrow_in = _narrower_than_wire(obs, entry)
+        if narrow_in:
+            # the pointed tip fits an opening the wire behind it does not: the entry stops the needle
+            return "blocked-at-entry", (
+                f"blocked at {_label(entry)}: {narrow_in}; the tip went in at t = {c_in['t']:.2f} s and "
+                f"the needle was forced on, the tip pressing on {hits}"
+            )
         narrow = _narrower_than_wire(obs, exit_)
         return "blocked-in-channel", (
             f"the needle was forced from {_label(entry)} toward {_label(exit_)}: the tip pressed on {hits} "

@@ -31,6 +31,7 @@ from ...model.semantics import (
 )
 from ..plan import rgba
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
+from .margins import file_margin, give_margin
 from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, mesh_refusal, pybullet_mesh
 
 
@@ -41,6 +42,7 @@ class ShapeParts:
     types: list[int] = field(default_factory=list)
     kwargs: list[dict] = field(default_factory=list)
     plane: tuple[list[float], float] | None = None  # a lone PLANE (added directly, §7.4)
+    margin: float | None = None  # the file's collision margin, where PyBullet's 1 mm is not it (margins.py)
 
     def add(self, shape_type: int, **kw) -> None:
         self.types.append(shape_type)
@@ -79,7 +81,7 @@ def _axis_rotation(axis: Vec3) -> Quat:
     return shortest_arc(Vec3(0, 0, 1), axis)
 
 
-def _primitive(parts: ShapeParts, prim: Primitive, pose_in_com: np.ndarray, margin: float) -> None:
+def _primitive(parts: ShapeParts, prim: Primitive, pose_in_com: np.ndarray) -> None:
     g = prim.geometry
     rot = pose_in_com @ pose_to_matrix(Pose(Vec3(), _axis_rotation(prim.axis)))
     pos, orn = matrix_to_pq(rot)
@@ -148,8 +150,7 @@ def collision_parts(
     (Bullet's sparse SDF gives every point a distance 0 to a non-convex shape, so the nodes
     near one are pushed away): a static concave mesh is played as convex hulls, one per OBJ
     object, with a warning unless the mesh is convex anyway."""
-    parts = ShapeParts()
-    margin = obj.collision_margin if obj.collision_margin is not None else 0.001
+    parts = ShapeParts(margin=file_margin(obj))
     body_to_com = invert(frame_in_body)
     prims = collision_primitives(obj)
     if prims is not None:
@@ -175,7 +176,7 @@ def collision_parts(
                     )
                 )
                 continue
-            _primitive(parts, prim, body_to_com @ pose_to_matrix(prim.pose), margin)
+            _primitive(parts, prim, body_to_com @ pose_to_matrix(prim.pose))
         return parts
     path = collision_mesh_path(model, obj)
     if path is None:
@@ -238,10 +239,12 @@ def collision_parts(
 
 
 def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnostic] | None = None) -> int:
-    """Create the PyBullet collision shape; -1 for an empty one, or (with a warning located at
-    ``obj``) for one PyBullet refuses."""
+    """Create the PyBullet collision shape, its children given the file's margin; -1 for an
+    empty one, or (with a warning located at ``obj``) for one PyBullet refuses."""
     try:
-        return _create_collision(parts, cid)
+        col = _create_collision(parts, cid)
+        give_margin(col, parts.margin, cid)
+        return col
     except pb.error as exc:
         if diags is None:
             raise
