@@ -10,6 +10,7 @@ on the tool's collision primitives near its end effector.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
