@@ -52,8 +52,9 @@ HOLE_MARGIN = 0.0008  # m kept from a hole ghost's side when aiming inside it
 TAIL_CLEARS = tuple(math.radians(a) for a in (25, 20, 15, 10))
 JITTER_FORCE = 0.03  # N, the seeded push on the needle before the suture
 #: s the puller takes to carry the needle over the next pair: the thread, through the earlier
-#: pairs, drags behind it (in 1.2 s the needle slipped 2.1-2.5 mm in the grasp on 2 of 10 seeds)
-HAND_BACK_S = 2.4
+#: pairs, drags behind it and the carried needle turns in the grasp (in 1.2 s it slipped 2.1-2.5 mm
+#: on 2 of 10 seeds; in 2.4 s it turned up to 3 degrees, its far end 1.07 mm; in 3.0 s 0.94 mm)
+HAND_BACK_S = 3.0
 #: rad/s the needle turns about its centre as the puller draws it out (at 0.6 the thread, through
 #: three pairs, dragged the needle 2.0 mm in the grasp during pull 4 on 1 of 10 seeds)
 PULL_RATE = 0.4

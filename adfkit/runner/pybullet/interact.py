@@ -13,7 +13,11 @@ from ..plan import viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
 
-GRASP_SPAN = 0.005  # m between the three point constraints of a grasp (PyBulletWorld.actuate)
+# m between the three point constraints of a grasp (PyBulletWorld.actuate): the solver leaves each
+# pivot a fraction of a millimetre open under load, which turns the held body by gap/span; at 5 mm
+# the bundled needle turned 5° in the puller's jaws and its far end moved 1.3 mm (the thread
+# dragging through three pairs), at 20 mm (about the needle's size) 1.5° and 0.66 mm
+GRASP_SPAN = 0.02
 # error reduction of the grasp's constraints: the share of their gap closed per step (Bullet's 0.2 let
 # the thread's pull stretch a held needle 2 mm out of the jaws; 0.8 holds it within a fraction of that)
 GRASP_ERP = 0.8
