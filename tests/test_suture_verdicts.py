@@ -141,6 +141,17 @@ def test_a_tip_forced_between_the_holes_is_blocked_in_the_channel():
     v = pair_verdict(obs, pair)
     assert v["rule"] == "blocked-in-channel" and not v["passed"]
     assert "Phantom (531.2 N), Exit1 (343.5 N)" in v["reason"] and "Entry1 (4.2 N)" not in v["reason"]
+    # where the tip was first forced decides: nearer the exit, the channel is closed farther in
+    first = {"t": 6.1, "body": "Phantom", "force_n": 24.0, "from_entry_m": 0.008, "from_exit_m": 0.004}
+    obs.first_forced = {"insert 1": first}
+    assert pair_verdict(obs, pair)["rule"] == "blocked-in-channel"
+    # at the hole it went in by (a filled hole the driver forced the needle on through)
+    obs.first_forced = {"insert 1": dict(first, from_entry_m=0.0015, from_exit_m=0.011)}
+    v = pair_verdict(obs, pair)
+    assert v["rule"] == "blocked-at-entry" and v["reason"].startswith(
+        "blocked at ghostEntry1: the tip pressed on Phantom (24.0 N) 1.5 mm from its centre at t = 6.10 s"
+    )
+    obs.first_forced = {}
     # an entry narrower than the wire: the pointed tip got in, the wire behind it was forced on
     obs.holes[0].half = np.array([0.0003, 0.0003])
     obs.tip_contacts = {"insert 1": {"Entry1": 96.0}}

@@ -22,7 +22,7 @@ from .holes import (
     plane_crossing,
     tip_leading,
 )
-from .verdicts import SLIP_LIMIT, SLIP_SETTLE_S, pair_verdict
+from .verdicts import SLIP_LIMIT, SLIP_SETTLE_S, TIP_FORCE_N, pair_verdict
 
 TOOL_TOUCH_N = 0.05  # N: a tool-tissue contact at least this strong is recorded as an event
 SUSTAIN_STEPS = 5  # control steps (20 ms at 250 Hz) over which a touch's force is held (sustained_force_n)
@@ -128,6 +128,7 @@ class SutureObserver:
         self._tool_links = [sb for sb in self.world.bodies if id(sb) in self._tool]
         self.needle_contacts: dict[str, dict[str, float]] = {}  # phase -> {tissue body: max N}
         self.tip_contacts: dict[str, dict[str, float]] = {}  # the same, within TIP_CONTACT of the tip
+        self.first_forced: dict[str, dict] = {}  # insert phase -> where the tip was first forced (_forced)
         self.tool_events: list[dict] = []
         self._open_touch: dict[tuple, dict] = {}
         self._recent: dict[tuple, list[float]] = {}  # the last forces of each open touch
@@ -175,6 +176,20 @@ class SutureObserver:
                 }
             )
 
+    def _forced(self, phase: str, t: float, body: str, force: float, tip) -> None:
+        """Where the tip first pressed on the tissue hard enough to be forced (TIP_FORCE_N) in
+        an insertion: how far from the pair's entry and exit openings, so that a verdict can
+        tell a hole that stops the needle from a channel closed farther in."""
+        k = int(phase.split()[1])
+        near = {h.kind: float(np.linalg.norm(np.asarray(tip) - h.frame()[:3, 3])) for h in self.holes if h.pair == k}
+        self.first_forced[phase] = {
+            "t": t,
+            "body": body,
+            "force_n": float(force),
+            "from_entry_m": near.get("entry", math.inf),
+            "from_exit_m": near.get("exit", math.inf),
+        }
+
     def _watch_contacts(self, t: float) -> None:
         phase = self.task.phase
         w = self.world
@@ -187,6 +202,8 @@ class SutureObserver:
                 if tip is not None and f > 0 and math.dist(at, tip) < TIP_CONTACT:
                     d = self.tip_contacts.setdefault(phase, {})
                     d[n] = max(d.get(n, 0.0), f)
+                    if f >= TIP_FORCE_N and phase.startswith("insert ") and phase not in self.first_forced:
+                        self._forced(phase, t, n, f, tip)
         for n, f in per_body.items():
             d = self.needle_contacts.setdefault(phase, {})
             d[n] = max(d.get(n, 0.0), f)
@@ -362,6 +379,7 @@ class SutureObserver:
             "tool_tissue_events": self.tool_events,
             "needle_tissue_contact_n": self.needle_contacts,
             "tip_tissue_contact_n": self.tip_contacts,
+            "tip_first_forced": self.first_forced,
             "constraint_error_by_phase_m": self.error_by_phase,
             "joint_angle_error_by_phase_deg": {k: float(np.degrees(a)) for k, a in self.angle_by_phase.items()},
             "needle_wire_radius_m": self.wire_radius,

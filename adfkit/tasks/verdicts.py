@@ -168,6 +168,14 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
                 f"blocked at {_label(entry)}: {narrow_in}; the tip went in at t = {c_in['t']:.2f} s and "
                 f"the needle was forced on, the tip pressing on {hits}"
             )
+        first = getattr(obs, "first_forced", {}).get(f"insert {k}")
+        if first is not None and first["from_entry_m"] < first["from_exit_m"]:
+            # it met the tissue at the hole it went in by, and the driver forced it on from there
+            return "blocked-at-entry", (
+                f"blocked at {_label(entry)}: the tip pressed on {first['body']} ({first['force_n']:.1f} N) "
+                f"{_mm(first['from_entry_m'])} from its centre at t = {first['t']:.2f} s and the needle "
+                f"was forced on, the tip pressing on {hits}: the hole is closed there"
+            )
         narrow = _narrower_than_wire(obs, exit_)
         return "blocked-in-channel", (
             f"the needle was forced from {_label(entry)} toward {_label(exit_)}: the tip pressed on {hits} "
