@@ -5,8 +5,8 @@ runner adds (docs/mujoco.md):
 - six-dof-family joints (the thread, the phantom's hole bodies) join the kinematic tree and
   get one slide per free linear axis and one hinge per free angular axis, with the ADF
   stiffness, damping, equilibrium and limits as MuJoCo joint stiffness/damping/springref/range;
-- a position actuator on every revolute/prismatic tree joint (AMBF's joint motors, held at
-  the file's initial value);
+- a joint equality on every revolute/prismatic tree joint with a motor (AMBF's joint motors,
+  held at the file's initial value, re-targeted each control step);
 - ghost objects as contact-free geoms (contype = conaffinity = 0, group 4, never drawn);
 - one inactive weld equality per constraint actuator (the grasp), re-targeted when grasping;
 - collision groups as contype/conaffinity bits, `ignore inter collision` as excluded pairs;
@@ -29,6 +29,7 @@ from ...model.tree import ONE_DOF
 from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
+from .drives import add_drive, drive_limit
 from .spec import _parse_spec, _resolve_meshes
 from .textures import apply_textures
 
@@ -265,10 +266,9 @@ def build_plan(world) -> Plan:
                 solref=[WELD_TIMECONST_STEPS * world.dt, WELD_DAMPING_RATIO],
             )
             actuators.append((g, weld))
-    for _j, kind, _pa, _ch, jn in joints:
-        if kind in ONE_DOF and jn:
-            act = spec.add_actuator(name=f"motor:{jn[0]}", target=jn[0], trntype=mujoco.mjtTrn.mjTRN_JOINT)
-            act.set_to_position(kp=1.0, kv=0.0)  # gains are set per joint once the model is compiled
+    for j, kind, _pa, child, jn in joints:
+        if kind in ONE_DOF and jn and drive_limit(j) > 0:
+            add_drive(spec, jn[0], child.mjname, world.dt)
     volumes = _volumes(world, spec, scene.all_models())
     return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors, volumes)
 

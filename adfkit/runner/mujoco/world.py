@@ -165,10 +165,12 @@ class MujocoWorld(World, Assembly, Interaction):
         m, d = self.model, self.data
         base, xfrc, control, step = self._base_xfrc, d.xfrc_applied, self.control, mujoco.mj_step
         pending = mj_stability.pending_messages()
+        limits = self.drive_limits.check
         for k in range(n):
             control()
             step(m, d, sub)
             xfrc[:] = base
+            limits()
             if pending:  # a warning: NaN and a state reset, a singular inertia...
                 self.sim_time = (self.steps + (k + 1) * sub) * self.dt
                 mj_stability.drain_mujoco(self, self.watch)
