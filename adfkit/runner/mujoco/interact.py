@@ -73,8 +73,9 @@ class Interaction:
         return v[3:].copy()
 
     def actuate(self, actuator: MjActuator, target: MjBody) -> None:
-        """Weld ``target`` to the actuator's parent at their current relative pose; the jaws'
-        own geoms stop colliding with it meanwhile (they would push the held body out)."""
+        """Weld ``target`` to the actuator's parent at their current relative pose; the links of
+        the parent's arm stop colliding with it meanwhile (the closed jaws would push the held
+        body out), and only with it, as in the PyBullet runner: they still collide with the tissue."""
         self.release(actuator)
         m, d = self.model, self.data
         e = actuator.eq
@@ -93,14 +94,15 @@ class Interaction:
         actuator.target = target
         art = actuator.parent.articulation
         links = [r[3] for r in art.records] + [art.root] if art is not None else [actuator.parent]
-        actuator.constraint = []
+        actuator.constraint = []  # the pairs this grasp turned off (restored on release)
         for sb in links:
-            for gid in np.nonzero(m.geom_bodyid == sb.id)[0]:
-                if m.geom_contype[gid] or m.geom_conaffinity[gid]:
-                    actuator.constraint.append((int(gid), int(m.geom_contype[gid]), int(m.geom_conaffinity[gid])))
-        for gid, _, _ in actuator.constraint:  # only the links near the held body matter; all is simplest
-            if np.linalg.norm(d.geom_xpos[gid] - d.xpos[b]) < 0.05:
-                m.geom_contype[gid] = m.geom_conaffinity[gid] = 0
+            if sb.has_collision and self._pair_enabled(sb, target):
+                self.set_collision(sb, target, False)
+                actuator.constraint.append(sb)
+
+    def _pair_enabled(self, a: MjBody, b: MjBody) -> bool:
+        lo, hi = sorted((int(a.id), int(b.id)))
+        return ((lo << 16) + hi) not in self.model.exclude_signature[: self.model.nexclude]
 
     def ghost_pose(self, g: MjGhost) -> np.ndarray:
         """World pose (4x4) of a ghost's frame, following its parent."""
@@ -144,8 +146,8 @@ class Interaction:
         if actuator.target is not None:
             self.wake(actuator.target)
             self.data.eq_active[actuator.eq] = 0
-            for gid, ct, ca in actuator.constraint or ():
-                self.model.geom_contype[gid], self.model.geom_conaffinity[gid] = ct, ca
+            for sb in actuator.constraint or ():
+                self.set_collision(sb, actuator.target, True)
         actuator.target, actuator.constraint = None, None
 
     def contacts(self, sb: MjBody) -> list:
