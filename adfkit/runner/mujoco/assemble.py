@@ -13,6 +13,8 @@ from ...model.semantics import JointKind, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
 from ..rotations import pose_to_matrix
 from .build import build_plan
+from .contacts import set_contacts
+from .damping import BodyDamping
 from .drives import DriveLimits, drive_limit
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
@@ -63,6 +65,7 @@ class Assembly:
             mujoco.mj_forward(self.model, self.data)
         self._plan = plan
         m, d = self.model, self.data
+        set_contacts(m, self.dt)  # rigid, frictions combined as Bullet does (contacts.py)
         self.bodies: list[MjBody] = []
         by_plan = {}
         for bp in plan.bodies:
@@ -155,6 +158,7 @@ class Assembly:
                 self._geom_label[m.geom_bodyid == sb.id] = i
         self._floor_z = self._floor()
         self.cameras = cams.finish(self)
+        self.damping = BodyDamping(self)
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
         plan.tmp.cleanup()
 

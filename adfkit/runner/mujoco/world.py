@@ -58,7 +58,8 @@ class MujocoWorld(World, Assembly, Interaction):
         self._awake = None  # bodies moved by hand: control() looks at the hole ghosts again
 
     def control(self) -> None:
-        """Per-control-step forces and senses: proximity sensors' rays, hole ghosts' viscous friction.
+        """Per-control-step forces and senses: proximity sensors' rays, the bodies' velocity damping
+        (damping.py), hole ghosts' viscous friction.
         Only awake candidate geoms are looked at (a sleeping body does not move), first against
         one sphere that holds every hole-ghost geom (kept while the ghosts' bodies sleep): all
         of them above it along -gravity (instruments over the tissue: one product and a
@@ -68,6 +69,7 @@ class MujocoWorld(World, Assembly, Interaction):
         would, so the friction is what the exact test alone gives."""
         for s in self.sensors:
             self._sense(s)
+        self.damping.apply()
         fg = self._friction_geoms
         if not len(fg) or not len(self._cand_geoms):
             return
