@@ -52,6 +52,12 @@ class BodyPlan:
     spring: tuple | None = None  # (joint, kind) of a six-dof-family joint to its parent
 
 
+#: kg·m² added to each hinge of a six-dof spring: a thread element's turn about its own axis has
+#: 5e-10 kg·m² (the bundled suture's), the needle at its root 0.5 kg, and in one generalized mass
+#: matrix MuJoCo found it singular and reset the state as the thread was drawn through two holes;
+#: 1e-9 is 2 % of the last element's bending inertia about its joint (Bullet's maximal
+#: coordinates give each element its own inertia and never meet the span)
+SPRING_HINGE_ARMATURE = 1e-9
 EXCLUDE_SPARE = 512  # run-time excluded pairs (MujocoWorld.set_collision); the suture turns off ~300
 
 
@@ -210,6 +216,7 @@ def build_plan(world) -> Plan:
                         stiffness=k,
                         damping=c,
                         springref=eq,
+                        armature=SPRING_HINGE_ARMATURE if tag == "hinge" else 0.0,
                     )
                     if np.isfinite(lo) and np.isfinite(hi) and (tag == "slide" or hi - lo < 2 * np.pi):
                         j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
