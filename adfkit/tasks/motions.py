@@ -14,7 +14,10 @@ from .grasping import BACK_OFF, JAW_APPROACH, Grasp, SutureError
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
 GUARD_BACK = 0.0005  # m ... and draws back this far the way it came
-GUARD_JAW_BACK = 0.02  # rad jaws stopped on the tissue as they open close back (0.16 mm at the fingers' middle)
+#: rad the jaws close back from the finger that got least far, while they press on the tissue as
+#: they open (0.05 rad a finger, 0.4 mm at its middle: at 0.02 the finger stayed on the boundary
+#: with 50-60 N for 24 ms while the jaws closed a step at a time)
+GUARD_JAW_BACK = 0.1
 
 
 def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
