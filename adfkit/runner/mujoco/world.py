@@ -38,6 +38,7 @@ class MujocoWorld(World, Assembly, Interaction):
         self._render = None
         self._vel6 = np.zeros(6)
         self._runtime_excludes: set[int] = set()
+        self._contacts_key, self._contacts = None, ()  # interact._contact_table, once a step
         self.camera_problem = ""
         self._build()
 
@@ -200,6 +201,7 @@ class MujocoWorld(World, Assembly, Interaction):
         finally:
             m.opt.enableflags = flags
         self._awake = None  # bodies moved by hand: control() looks at the hole ghosts again
+        self._contacts_key = None  # and the forward pass found the contacts anew
 
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of a loop-closing joint (tree joints are exact)."""
