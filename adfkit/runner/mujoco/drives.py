@@ -67,18 +67,14 @@ class DriveLimits:
             self.names[eq] = name
         self.worst = np.zeros(m.neq)
         self.warned: set[int] = set()
-        self._eq = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 
     def check(self) -> None:
         d = self.world.data
-        n = d.nefc
-        if not n:
+        ne = d.ne  # MuJoCo puts the equality rows first
+        if not ne:
             return
-        rows = np.flatnonzero(d.efc_type[:n] == self._eq)
-        if not rows.size:
-            return
-        ids = d.efc_id[rows]
-        f = np.abs(d.efc_force[rows])
+        ids = d.efc_id[:ne]
+        f = np.abs(d.efc_force[:ne])
         np.maximum.at(self.worst, ids, f)
         over = ids[f > self.limit[ids]]
         for eq in set(over.tolist()) - self.warned:
