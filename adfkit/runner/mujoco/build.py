@@ -35,9 +35,11 @@ from .textures import apply_textures
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
 GHOST_GROUP = 4
-# the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. A weld's
-# stiffness scales with the held body's mass, so a light needle dragging its thread needs it: at
-# 4 steps the bundled suture's needle slid 13 mm in the jaws while carried and the regrasp missed
+# the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. With the
+# joint drives as constraints (drives.py) the grasp holds at 4 steps as well (the needle within
+# 0.13 mm of the jaws through pair 1, seed 0; the 13 mm slide measured there before was the
+# wrist's PD servos giving way, not the weld); at 10 it moved 1.1 mm and the pull left the
+# wrist's reach
 WELD_TIMECONST_STEPS = 2
 WELD_DAMPING_RATIO = 1.0
 
