@@ -177,6 +177,22 @@ def test_a_tool_pressing_on_the_tissue_fails_its_pair_and_a_touch_does_not():
     assert v["rule"] == "tool-hit-tissue" and "tool pitch link simple hit Phantom with 12011.0 N held" in v["reason"]
 
 
+def test_the_force_a_touch_held_over_20_ms():
+    """sustained_force_n, what tool-hit-tissue judges: the mean of the last five control steps
+    less the largest. A one-step spike as a guarded tool stops (MuJoCo's rigid contacts: 780 N)
+    holds nothing; the same force over 20 ms holds it; a tool chattering on the tissue every
+    other step holds half of it (the window outlives the gaps between its touches)."""
+    from adfkit.tasks.metrics import SutureObserver
+
+    obs = SutureObserver.__new__(SutureObserver)  # the window alone: no task, no world
+    obs._recent = {}
+    held = [obs._held("a", f) for f in (780.0, 0.0, 0.0, 0.0, 0.0, 0.0)]
+    assert max(held) == 0.0 and "a" not in obs._recent
+    assert max(obs._held("b", 60.0) for _ in range(5)) == pytest.approx(60.0)
+    chatter = [obs._held("c", f) for f in (400.0, 0.0, 400.0, 0.0, 400.0)]
+    assert max(chatter) == pytest.approx(200.0)
+
+
 # ---- negative controls on the physics (each ~15 s of one pair) --------------------------------
 def _scene(tmp_path: Path, edit) -> Path:
     dst = tmp_path / "suturing"

@@ -131,7 +131,7 @@ class SutureObserver:
         self.first_forced: dict[str, dict] = {}  # insert phase -> where the tip was first forced (_forced)
         self.tool_events: list[dict] = []
         self._open_touch: dict[tuple, dict] = {}
-        self._recent: dict[tuple, list[float]] = {}  # the last forces of each open touch
+        self._recent: dict[tuple, list[float]] = {}  # the last SUSTAIN_STEPS forces of each touch (0: none)
         self._in_ghost: dict[str, bool] = {}
         self._last_phase = None
         self._slip_base = None
@@ -233,19 +233,29 @@ class SutureObserver:
                     "sustained_force_n": 0.0,
                 }
                 self.tool_events.append(ev)
-                self._recent[key] = []
             ev["t_end"] = t
             ev["max_force_n"] = max(ev["max_force_n"], f)
-            recent = self._recent[key]
-            recent.append(f)
-            del recent[:-SUSTAIN_STEPS]
-            # held over SUSTAIN_STEPS control steps (a step not yet touching counts 0): a stiff
-            # contact's one-step spike as a guarded tool stops is not the tool pressing on it
-            ev["sustained_force_n"] = max(ev["sustained_force_n"], sum(recent) / SUSTAIN_STEPS)
+            ev["sustained_force_n"] = max(ev["sustained_force_n"], self._held(key, f))
         for key in list(self._open_touch):
             if key not in touching:
                 del self._open_touch[key]
-                self._recent.pop(key, None)
+        for key in list(self._recent):
+            if key not in touching:
+                self._held(key, 0.0)
+
+    def _held(self, key: tuple, f: float) -> float:
+        """The force a touch held over the last SUSTAIN_STEPS control steps: their mean, a step
+        without the touch counting 0 (the window outlives a gap, so a tool chattering on the
+        tissue is held), less the largest step: a rigid contact's one-step spike as a guarded
+        tool stops is not the tool pressing on it (MuJoCo's rigid contacts: 780 N for one
+        step where a guarded jaw touched the slab; PyBullet's: 15-60 N)."""
+        recent = self._recent.setdefault(key, [])
+        recent.append(f)
+        del recent[:-SUSTAIN_STEPS]
+        if not any(recent):
+            del self._recent[key]
+            return 0.0
+        return (sum(recent) - max(recent)) / (SUSTAIN_STEPS - 1)
 
     def observe(self) -> None:
         t = self.world.sim_time

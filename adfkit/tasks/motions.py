@@ -14,6 +14,10 @@ from .grasping import BACK_OFF, JAW_APPROACH, ROLL, Grasp, SutureError
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
 GUARD_BACK = 0.0005  # m ... and draws back this far the way it came
+#: rad the jaws close back from the finger that got least far, while they press on the tissue as
+#: they open (0.05 rad a finger, 0.4 mm at its middle: at 0.02 the finger stayed on the boundary
+#: with 50-60 N for 24 ms while the jaws closed a step at a time)
+GUARD_JAW_BACK = 0.1
 
 
 def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
@@ -145,6 +149,25 @@ class Motions:
         psm.servo_jaw(0.0)
         yield from self.wait(0.15)
 
+    def _pressing(self, psm: PSM) -> bool:
+        """The tool presses on the tissue with GUARD_N or more (after the last step)."""
+        tissue = {id(sb) for sb in self.world.bodies if sb.model is self.needle.model and sb.static}
+        links = [sb for sb in self.world.bodies if sb.articulation is psm.art]
+        return any(f >= GUARD_N for sb in links for o, f, _ in self.world.contacts(sb) if id(o) in tissue)
+
+    def opening(self, psm: PSM, seconds: float):
+        """Wait ``seconds`` while the jaws open; while they press on the tissue with GUARD_N they
+        close back to GUARD_JAW_BACK less than the finger that got least far, as the guarded
+        line stops on touching. The planner keeps the jaws off the tissue by its distance field, which can
+        overstate the room by 0.6 mm: at pair 1 of the bundled scene the driver's jaws, opened
+        to let go, came 0.15 mm into Entry1's boundary and, in MuJoCo's rigid contacts, pressed
+        on it with 130-260 N."""
+        for _ in range(self._steps(seconds)):
+            yield self.phase
+            if self._pressing(psm):  # the finger that got least far decides where both stop
+                fingers = self.world.joint_state(psm.art, psm.jaws)[0]
+                psm.servo_jaw(max(0.0, 2 * float(min(fingers)) - GUARD_JAW_BACK))
+
     def let_go(self, name: str, holder: str | None = None):
         """``name`` releases the needle and backs off. ``holder``, the arm that keeps it, is then
         put where the needle settled (once): freed from the other grasp, the needle settles where
@@ -154,7 +177,7 @@ class Motions:
         act = next(a for a in self.world.actuators if f"/{name}/" in a.key or f"/{name}/" in a.parent.key)
         self.world.release(act)
         psm.servo_jaw(JAW_APPROACH)
-        yield from self.wait(0.15)
+        yield from self.opening(psm, 0.15)
         if holder is not None:
             keep = self.psms[holder]
             yield from self.line(keep, self.setpoint_world(keep), self.needle_pose() @ self.held_ee_in_needle, 0.2)

@@ -12,9 +12,10 @@ verdict's ``rule`` and ``reason`` (rules in the order below).
 from __future__ import annotations
 
 #: N: a tool pressing on the tissue at least this hard, held over 20 ms (a touch's
-#: sustained_force_n), fails the pair. Every touch is recorded (metrics' tool_tissue_events, each
-#: pair's tool_tissue_max_n); a jaw brushing a hole's boundary as it takes the needle beside it
-#: peaks at 15-60 N for a step in PyBullet's stiff contacts, a wrist driven into the tissue holds
+#: sustained_force_n: the mean of five control steps less the largest), fails the pair. Every
+#: touch is recorded (metrics' tool_tissue_events, each pair's tool_tissue_max_n); a jaw brushing
+#: a hole's boundary as it takes the needle beside it peaks at 15-60 N for a step in PyBullet's
+#: stiff contacts and at up to 800 N in MuJoCo's rigid ones, a wrist driven into the tissue holds
 #: thousands
 TOOL_HIT_N: float | None = 50.0
 

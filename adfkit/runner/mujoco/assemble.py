@@ -1,6 +1,6 @@
 """How the MuJoCo world builds the scene (the Assembly half of MujocoWorld): the MjSpec from
-build.py compiled, the engine's bodies, articulations with servo gains from the joints'
-inertia, ghosts, actuators, sensors, cameras and the floor."""
+build.py compiled, the engine's bodies, articulations driven by joint equalities (drives.py),
+ghosts, actuators, sensors, cameras and the floor."""
 
 from __future__ import annotations
 
@@ -9,14 +9,16 @@ import math
 import mujoco
 import numpy as np
 
-from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, effective_mass, inertial_offset
+from ...model.semantics import JointKind, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
 from ..rotations import pose_to_matrix
 from .build import build_plan
+from .contacts import set_contacts
+from .damping import BodyDamping
+from .drives import DriveLimits, drive_limit
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
 
-DRIVE_BANDWIDTH = 0.25  # ω·dt of the joint position servos (explicit stiffness is stable below 2)
 SOLVER_TOLERANCE = 1e-6
 WAKE_FORCE = 1e-12  # N
 # MuJoCo's 1e-3 puts a mm-scale chain to sleep 2 mm short of its rest pose, 3e-4 0.6 mm short;
@@ -63,6 +65,7 @@ class Assembly:
             mujoco.mj_forward(self.model, self.data)
         self._plan = plan
         m, d = self.model, self.data
+        set_contacts(m, self.dt)  # rigid, frictions combined as Bullet does (contacts.py)
         self.bodies: list[MjBody] = []
         by_plan = {}
         for bp in plan.bodies:
@@ -97,7 +100,7 @@ class Assembly:
         self._by_plan = by_plan
         self.joint_names = [j.identifier for j, *_ in plan.joints] + [j.identifier for j, *_ in plan.loops]
         self._build_articulations(plan, by_plan)
-        self._tune_gains(plan)
+        self._drive_limits_and_springs()
         self._gravity_overrides()
         self._base_xfrc = np.array(d.xfrc_applied)
         self.ghosts = []
@@ -155,6 +158,7 @@ class Assembly:
                 self._geom_label[m.geom_bodyid == sb.id] = i
         self._floor_z = self._floor()
         self.cameras = cams.finish(self)
+        self.damping = BodyDamping(self)
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
         plan.tmp.cleanup()
 
@@ -193,8 +197,8 @@ class Assembly:
                 if kind is JointKind.FIXED and effective_mass(c.body) == 0.0:
                     continue
                 jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, jn[0]) if jn else -1
-                aid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"motor:{jn[0]}") if jn else -1
-                recs.append((j, kind, by_plan[id(p)], by_plan[id(c)], jid, aid))
+                eid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, f"drive:{jn[0]}") if jn else -1
+                recs.append((j, kind, by_plan[id(p)], by_plan[id(c)], jid, eid))
                 stack.extend(reversed(kids.get(id(c), [])))
             if any(r[1] in ONE_DOF for r in recs):
                 art = MjArticulation(self, by_plan[id(bp)], [r for r in recs])
@@ -205,28 +209,17 @@ class Assembly:
                 self.articulations.append(art)
                 art.drive()
 
-    def _tune_gains(self, plan) -> None:
-        """Servo gains from each joint's effective inertia (the diagonal of M at the initial
-        pose): kp = (DRIVE_BANDWIDTH/dt)²·M_ii, critically damped (implicit in velocity), force
-        capped at AMBF's max motor impulse / dt; spring stiffness clamped like the PyBullet runner's."""
+    def _drive_limits_and_springs(self) -> None:
+        """The drives' force limits (drives.DriveLimits); spring stiffness clamped like the
+        PyBullet runner's explicit springs (k ≤ SPRING_LIMIT·M_ii/dt², M at the initial pose)."""
         m, dt = self.model, self.dt
-        diag = np.array(m.dof_M0)  # the diagonal of M at qpos0, armature included
-        w = DRIVE_BANDWIDTH / dt
-        by_joint = {}
+        drives = []
         for art in self.articulations:
-            for (j, _kind, _p, _c), vadr, act in zip(art.records, art.vadr, art.act):
-                if act < 0:
-                    continue
-                mii = diag[vadr]
-                kp = w * w * mii
-                kv = 2.0 * w * mii
-                m.actuator_gainprm[act, 0] = kp
-                m.actuator_biasprm[act, 1] = -kp
-                m.actuator_biasprm[act, 2] = -kv
-                imp = j.max_motor_impulse if j.max_motor_impulse is not None else DEFAULT_JOINT_MAX_MOTOR_IMPULSE
-                m.actuator_forcelimited[act] = 1
-                m.actuator_forcerange[act] = (-imp / dt, imp / dt)
-                by_joint[id(j)] = True
+            for (j, _kind, _p, _c), e in zip(art.records, art.eqs):
+                if e >= 0:
+                    drives.append((int(e), j.identifier, drive_limit(j)))
+        self.drive_limits = DriveLimits(self, drives)
+        diag = np.array(m.dof_M0)  # the diagonal of M at qpos0, armature included
         clamped = []
         for j in range(m.njnt):
             if m.jnt_stiffness[j] > 0:

@@ -5,8 +5,8 @@ runner adds (docs/mujoco.md):
 - six-dof-family joints (the thread, the phantom's hole bodies) join the kinematic tree and
   get one slide per free linear axis and one hinge per free angular axis, with the ADF
   stiffness, damping, equilibrium and limits as MuJoCo joint stiffness/damping/springref/range;
-- a position actuator on every revolute/prismatic tree joint (AMBF's joint motors, held at
-  the file's initial value);
+- a joint equality on every revolute/prismatic tree joint with a motor (AMBF's joint motors,
+  held at the file's initial value, re-targeted each control step);
 - ghost objects as contact-free geoms (contype = conaffinity = 0, group 4, never drawn);
 - one inactive weld equality per constraint actuator (the grasp), re-targeted when grasping;
 - collision groups as contype/conaffinity bits, `ignore inter collision` as excluded pairs;
@@ -29,14 +29,17 @@ from ...model.tree import ONE_DOF
 from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
+from .drives import add_drive, drive_limit
 from .spec import _parse_spec, _resolve_meshes
 from .textures import apply_textures
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
 GHOST_GROUP = 4
-# the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. A weld's
-# stiffness scales with the held body's mass, so a light needle dragging its thread needs it: at
-# 4 steps the bundled suture's needle slid 13 mm in the jaws while carried and the regrasp missed
+# the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. With the
+# joint drives as constraints (drives.py) the grasp holds at 4 steps as well (the needle within
+# 0.13 mm of the jaws through pair 1, seed 0; the 13 mm slide measured there before was the
+# wrist's PD servos giving way, not the weld); at 10 it moved 1.1 mm and the pull left the
+# wrist's reach
 WELD_TIMECONST_STEPS = 2
 WELD_DAMPING_RATIO = 1.0
 
@@ -51,6 +54,12 @@ class BodyPlan:
     spring: tuple | None = None  # (joint, kind) of a six-dof-family joint to its parent
 
 
+#: kg·m² added to each hinge of a six-dof spring: a thread element's turn about its own axis has
+#: 5e-10 kg·m² (the bundled suture's), the needle at its root 0.5 kg, and in one generalized mass
+#: matrix MuJoCo found it singular and reset the state as the thread was drawn through two holes;
+#: 1e-9 is 2 % of the last element's bending inertia about its joint (Bullet's maximal
+#: coordinates give each element its own inertia and never meet the span)
+SPRING_HINGE_ARMATURE = 1e-9
 EXCLUDE_SPARE = 512  # run-time excluded pairs (MujocoWorld.set_collision); the suture turns off ~300
 
 
@@ -209,6 +218,7 @@ def build_plan(world) -> Plan:
                         stiffness=k,
                         damping=c,
                         springref=eq,
+                        armature=SPRING_HINGE_ARMATURE if tag == "hinge" else 0.0,
                     )
                     if np.isfinite(lo) and np.isfinite(hi) and (tag == "slide" or hi - lo < 2 * np.pi):
                         j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
@@ -265,10 +275,9 @@ def build_plan(world) -> Plan:
                 solref=[WELD_TIMECONST_STEPS * world.dt, WELD_DAMPING_RATIO],
             )
             actuators.append((g, weld))
-    for _j, kind, _pa, _ch, jn in joints:
-        if kind in ONE_DOF and jn:
-            act = spec.add_actuator(name=f"motor:{jn[0]}", target=jn[0], trntype=mujoco.mjtTrn.mjTRN_JOINT)
-            act.set_to_position(kp=1.0, kv=0.0)  # gains are set per joint once the model is compiled
+    for j, kind, _pa, child, jn in joints:
+        if kind in ONE_DOF and jn and drive_limit(j) > 0:
+            add_drive(spec, jn[0], child.mjname, world.dt)
     volumes = _volumes(world, spec, scene.all_models())
     return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors, volumes)
 

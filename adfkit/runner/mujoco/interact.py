@@ -73,8 +73,9 @@ class Interaction:
         return v[3:].copy()
 
     def actuate(self, actuator: MjActuator, target: MjBody) -> None:
-        """Weld ``target`` to the actuator's parent at their current relative pose; the jaws'
-        own geoms stop colliding with it meanwhile (they would push the held body out)."""
+        """Weld ``target`` to the actuator's parent at their current relative pose; the links of
+        the parent's arm stop colliding with it meanwhile (the closed jaws would push the held
+        body out), and only with it, as in the PyBullet runner: they still collide with the tissue."""
         self.release(actuator)
         m, d = self.model, self.data
         e = actuator.eq
@@ -93,14 +94,15 @@ class Interaction:
         actuator.target = target
         art = actuator.parent.articulation
         links = [r[3] for r in art.records] + [art.root] if art is not None else [actuator.parent]
-        actuator.constraint = []
+        actuator.constraint = []  # the pairs this grasp turned off (restored on release)
         for sb in links:
-            for gid in np.nonzero(m.geom_bodyid == sb.id)[0]:
-                if m.geom_contype[gid] or m.geom_conaffinity[gid]:
-                    actuator.constraint.append((int(gid), int(m.geom_contype[gid]), int(m.geom_conaffinity[gid])))
-        for gid, _, _ in actuator.constraint:  # only the links near the held body matter; all is simplest
-            if np.linalg.norm(d.geom_xpos[gid] - d.xpos[b]) < 0.05:
-                m.geom_contype[gid] = m.geom_conaffinity[gid] = 0
+            if sb.has_collision and self._pair_enabled(sb, target):
+                self.set_collision(sb, target, False)
+                actuator.constraint.append(sb)
+
+    def _pair_enabled(self, a: MjBody, b: MjBody) -> bool:
+        lo, hi = sorted((int(a.id), int(b.id)))
+        return ((lo << 16) + hi) not in self.model.exclude_signature[: self.model.nexclude]
 
     def ghost_pose(self, g: MjGhost) -> np.ndarray:
         """World pose (4x4) of a ghost's frame, following its parent."""
@@ -144,8 +146,8 @@ class Interaction:
         if actuator.target is not None:
             self.wake(actuator.target)
             self.data.eq_active[actuator.eq] = 0
-            for gid, ct, ca in actuator.constraint or ():
-                self.model.geom_contype[gid], self.model.geom_conaffinity[gid] = ct, ca
+            for sb in actuator.constraint or ():
+                self.set_collision(sb, actuator.target, True)
         actuator.target, actuator.constraint = None, None
 
     def contacts_among(self, bodies) -> list:
@@ -168,17 +170,41 @@ class Interaction:
 
     def contacts(self, sb: MjBody) -> list:
         """[(other MjBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
-        m, d = self.model, self.data
+        b1, b2, f, pos = self._contact_table()
         out = []
-        f = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
-            if sb.id not in (b1, b2):
-                continue
-            other = self._body_of_id.get(b2 if b1 == sb.id else b1)
+        for i in np.flatnonzero((b1 == sb.id) | (b2 == sb.id)):
+            other = self._body_of_id.get(int(b2[i] if b1[i] == sb.id else b1[i]))
             if other is None or other is sb:
                 continue
-            mujoco.mj_contactForce(m, d, i, f)
-            out.append((other, abs(float(f[0])), tuple(float(v) for v in c.pos)))
+            out.append((other, float(f[i]), tuple(float(v) for v in pos[i])))
         return out
+
+    def _contact_table(self) -> tuple:
+        """Every contact of the last step as arrays (body 1, body 2, normal force, point), made
+        once a step: the task and the observer ask for a dozen bodies' contacts every control
+        step, and a loop over MuJoCo's contacts for each cost 1-2 ms. With elliptic cones a
+        contact's normal force is its first constraint row's (what mj_contactForce returns);
+        an excluded contact has none."""
+        m, d = self.model, self.data
+        key = (self.steps, d.ncon, d.nefc)
+        if self._contacts_key == key:
+            return self._contacts
+        n = d.ncon
+        if n == 0:
+            z = np.zeros(0)
+            table = (z.astype(int), z.astype(int), z, np.zeros((0, 3)))
+        else:
+            c = d.contact
+            b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+            adr = np.array(c.efc_address)
+            if m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC:
+                f = np.where(adr >= 0, d.efc_force[np.maximum(adr, 0)], 0.0)
+            else:
+                f6 = np.zeros(6)
+                f = np.zeros(n)
+                for i in range(n):
+                    mujoco.mj_contactForce(m, d, i, f6)
+                    f[i] = f6[0]
+            table = (b1, b2, np.abs(f), np.array(c.pos))
+        self._contacts, self._contacts_key = table, key
+        return table

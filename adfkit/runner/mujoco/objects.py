@@ -66,7 +66,8 @@ class MjBody(EngineBody):
 
 class MjArticulation:
     """A tree of revolute/prismatic(/fixed) joints under one root, as PSM reads it: records
-    (joint, kind, parent, child) in depth-first order, position targets, drive()."""
+    (joint, kind, parent, child) in depth-first order, position targets, drive() (the joint
+    equalities of drives.py: q - qpos0 = eq_data[0])."""
 
     def __init__(self, world, root, records):
         self.world, self.root, self.records = world, root, records
@@ -76,17 +77,18 @@ class MjArticulation:
         m = world.model
         self.qadr = np.array([m.jnt_qposadr[r[4]] if r[4] >= 0 else -1 for r in records])
         self.vadr = np.array([m.jnt_dofadr[r[4]] if r[4] >= 0 else -1 for r in records])
-        self.act = np.array([r[5] for r in records])
+        self.eqs = np.array([r[5] for r in records])  # the drive equality of each joint, -1: none
+        driven = self.eqs >= 0
+        self._eq, self._q0 = self.eqs[driven], m.qpos0[self.qadr[driven]]
+        self._driven = np.flatnonzero(driven)
         self.targets = [float(world.data.qpos[a]) if a >= 0 else 0.0 for a in self.qadr]
 
     def joint_values(self) -> list[float]:
         return [float(self.world.data.qpos[a]) if a >= 0 else 0.0 for a in self.qadr]
 
     def drive(self) -> None:
-        ctrl = self.world.data.ctrl
-        for a, t in zip(self.act, self.targets):
-            if a >= 0:
-                ctrl[a] = t
+        t = np.asarray(self.targets, dtype=float)[self._driven]
+        self.world.model.eq_data[self._eq, 0] = t - self._q0
 
 
 @dataclass(eq=False)

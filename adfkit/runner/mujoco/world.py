@@ -38,6 +38,7 @@ class MujocoWorld(World, Assembly, Interaction):
         self._render = None
         self._vel6 = np.zeros(6)
         self._runtime_excludes: set[int] = set()
+        self._contacts_key, self._contacts = None, ()  # interact._contact_table, once a step
         self.camera_problem = ""
         self._build()
 
@@ -58,7 +59,8 @@ class MujocoWorld(World, Assembly, Interaction):
         self._awake = None  # bodies moved by hand: control() looks at the hole ghosts again
 
     def control(self) -> None:
-        """Per-control-step forces and senses: proximity sensors' rays, hole ghosts' viscous friction.
+        """Per-control-step forces and senses: proximity sensors' rays, the bodies' velocity damping
+        (damping.py), hole ghosts' viscous friction.
         Only awake candidate geoms are looked at (a sleeping body does not move), first against
         one sphere that holds every hole-ghost geom (kept while the ghosts' bodies sleep): all
         of them above it along -gravity (instruments over the tissue: one product and a
@@ -68,6 +70,7 @@ class MujocoWorld(World, Assembly, Interaction):
         would, so the friction is what the exact test alone gives."""
         for s in self.sensors:
             self._sense(s)
+        self.damping.apply()
         fg = self._friction_geoms
         if not len(fg) or not len(self._cand_geoms):
             return
@@ -165,10 +168,12 @@ class MujocoWorld(World, Assembly, Interaction):
         m, d = self.model, self.data
         base, xfrc, control, step = self._base_xfrc, d.xfrc_applied, self.control, mujoco.mj_step
         pending = mj_stability.pending_messages()
+        limits = self.drive_limits.check
         for k in range(n):
             control()
             step(m, d, sub)
             xfrc[:] = base
+            limits()
             if pending:  # a warning: NaN and a state reset, a singular inertia...
                 self.sim_time = (self.steps + (k + 1) * sub) * self.dt
                 mj_stability.drain_mujoco(self, self.watch)
@@ -196,6 +201,7 @@ class MujocoWorld(World, Assembly, Interaction):
         finally:
             m.opt.enableflags = flags
         self._awake = None  # bodies moved by hand: control() looks at the hole ghosts again
+        self._contacts_key = None  # and the forward pass found the contacts anew
 
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of a loop-closing joint (tree joints are exact)."""

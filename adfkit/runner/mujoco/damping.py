@@ -1,0 +1,87 @@
+"""ADF body damping (`damping: {linear, angular}`, velocity damping) in the MuJoCo world, which
+has none of its own: Bullet scales a rigid body's velocities by (1 - d)^dt each step, a decay at
+the rate -ln(1 - d) per second. The suturing thread's elements and the needle have 0.9 (2.3/s);
+without it MuJoCo's thread swung freely where AMBF's is drawn as through a viscous medium.
+
+Applied each control step as the force that gives the same decay over the step (the exact
+exp(-λ·t) of the velocity, as the hole ghosts' viscous friction), at the centre of mass, to the
+awake bodies outside a driven articulation (free bodies and six-dof-spring chains; a driven
+arm's joints hold it anyway, and a force would wake a sleeping body). A tree whose every joint
+moves slower than SLOW × MuJoCo's sleep tolerance is left alone, so that it can fall asleep (a
+force keeps a tree awake: applied down to rest, the corpus suturing set's thread never slept and
+its first 6 s played at 2.1x real time instead of 11-26x); the damping there is a 5e-4 N drag."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...model.semantics import DEFAULT_ANGULAR_DAMPING, DEFAULT_LINEAR_DAMPING
+
+SLOW = 10.0  # × the sleep tolerance: below it, in every dof of its tree, a body is not damped
+
+
+def _rate(d: float | None, default: float) -> float:
+    d = default if d is None else float(d)
+    return -math.log(1.0 - d) if 0.0 < d < 1.0 else 0.0
+
+
+class BodyDamping:
+    def __init__(self, world) -> None:
+        m = world.model
+        ids, lin, ang = [], [], []
+        for sb in world.bodies:
+            if sb.static or sb.articulation is not None or sb.id <= 0 or m.body_mass[sb.id] <= 0:
+                continue
+            dmp = sb.body.damping
+            a = _rate(getattr(dmp, "linear", None), DEFAULT_LINEAR_DAMPING)
+            b = _rate(getattr(dmp, "angular", None), DEFAULT_ANGULAR_DAMPING)
+            if a or b:
+                ids.append(sb.id)
+                lin.append(a)
+                ang.append(b)
+        self.world = world
+        self.ids = np.array(ids, dtype=int)
+        cdt = world.dt * world.opt.control_substeps
+        # F = m·v·(exp(-λ·cdt) - 1)/cdt: the velocity decays over the control step as exp(-λ·t)
+        self.k_lin = (np.exp(-np.array(lin) * cdt) - 1.0) / cdt
+        self.k_ang = (np.exp(-np.array(ang) * cdt) - 1.0) / cdt
+        if len(ids):
+            self.mass = np.array(m.body_mass[self.ids])
+            self.inertia = np.array(m.body_inertia[self.ids])
+            self.root = np.array(m.body_rootid[self.ids], dtype=int)
+            tree = np.array(m.body_treeid[self.ids], dtype=int)
+            self.trees, self.tree_of = np.unique(tree, return_inverse=True)
+            self.dofs = [np.arange(m.tree_dofadr[t], m.tree_dofadr[t] + m.tree_dofnum[t]) for t in self.trees]
+            self.slow = SLOW * float(getattr(m.opt, "sleep_tolerance", 0.0))
+
+    def apply(self) -> None:
+        """Add this control step's damping forces and torques to xfrc_applied."""
+        if not len(self.ids):
+            return
+        w = self.world
+        d = w.data
+        ids = self.ids
+        if w.sleep:
+            on = d.body_awake[ids] == w._AWAKE
+            if not on.any():
+                return
+            moving = np.zeros(len(self.trees), dtype=bool)
+            for t in set(self.tree_of[on].tolist()):  # the trees of the awake bodies only
+                moving[t] = np.abs(d.qvel[self.dofs[t]]).max(initial=0.0) >= self.slow
+            on &= moving[self.tree_of]
+            if not on.any():
+                return
+            ids, k = ids[on], on
+        else:
+            k = slice(None)
+        cvel = d.cvel[ids]  # [ω; v] in the world frame, v at the subtree centre of mass of the root
+        om = cvel[:, :3]
+        v = cvel[:, 3:] + np.cross(om, d.xipos[ids] - d.subtree_com[self.root[k]])
+        r = d.ximat[ids].reshape(-1, 3, 3)  # inertia frame in the world
+        om_local = np.einsum("nji,nj->ni", r, om)
+        torque = np.einsum("nij,nj->ni", r, self.inertia[k] * om_local)
+        xf = d.xfrc_applied
+        xf[ids, :3] += (self.mass[k] * self.k_lin[k])[:, None] * v
+        xf[ids, 3:] += self.k_ang[k][:, None] * torque
