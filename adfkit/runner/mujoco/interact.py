@@ -151,21 +151,17 @@ class Interaction:
         actuator.target, actuator.constraint = None, None
 
     def contacts_among(self, bodies) -> list:
-        """As World.contacts_among, in one pass over MuJoCo's contacts."""
-        m, d = self.model, self.data
+        """As World.contacts_among, from the step's contact table."""
+        b1, b2, f, pos = self._contact_table()
         mine = {sb.id: sb for sb in bodies}
+        ids = np.fromiter(mine, dtype=b1.dtype, count=len(mine))
         out = []
-        f = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            b1, b2 = int(m.geom_bodyid[c.geom1]), int(m.geom_bodyid[c.geom2])
-            for a, b in ((b1, b2), (b2, b1)):
+        for i in np.flatnonzero(np.isin(b1, ids) | np.isin(b2, ids)):
+            for a, b in ((int(b1[i]), int(b2[i])), (int(b2[i]), int(b1[i]))):
                 sb = mine.get(a)
                 other = self._body_of_id.get(b) if sb is not None else None
-                if other is None or other is sb:
-                    continue
-                mujoco.mj_contactForce(m, d, i, f)
-                out.append((sb, other, abs(float(f[0])), tuple(float(v) for v in c.pos)))
+                if other is not None and other is not sb:
+                    out.append((sb, other, float(f[i]), tuple(float(v) for v in pos[i])))
         return out
 
     def contacts(self, sb: MjBody) -> list:
