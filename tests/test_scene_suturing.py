@@ -168,7 +168,9 @@ def test_psm1_picks_the_needle_up_from_above(built):
         inside_steps = 0
         for _ in range(50):
             inside = any(  # a jaw 0.2 mm or more into the wire: lying in it, not touching it
-                c[8] < -2e-4 for b in links for c in pb.getClosestPoints(b.uid, needle.uid, 0.0, b.link, -1, physicsClientId=world.cid)
+                c[8] < -2e-4
+                for b in links
+                for c in pb.getClosestPoints(b.uid, needle.uid, 0.0, b.link, -1, physicsClientId=world.cid)
             )
             world.step(1)
             pushed = [f for _, o, f, _ in world.contacts_among(links) if o is needle and f > 0]
