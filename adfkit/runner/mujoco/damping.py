@@ -34,6 +34,8 @@ class BodyDamping:
         for sb in world.bodies:
             if sb.static or sb.articulation is not None or sb.id <= 0 or m.body_mass[sb.id] <= 0:
                 continue
+            if m.body_treeid[sb.id] < 0:  # welded to the world: it cannot move
+                continue
             dmp = sb.body.damping
             a = _rate(getattr(dmp, "linear", None), DEFAULT_LINEAR_DAMPING)
             b = _rate(getattr(dmp, "angular", None), DEFAULT_ANGULAR_DAMPING)
@@ -53,7 +55,12 @@ class BodyDamping:
             self.root = np.array(m.body_rootid[self.ids], dtype=int)
             tree = np.array(m.body_treeid[self.ids], dtype=int)
             self.trees, self.tree_of = np.unique(tree, return_inverse=True)
-            self.dofs = [np.arange(m.tree_dofadr[t], m.tree_dofadr[t] + m.tree_dofnum[t]) for t in self.trees]
+            # every damped tree's dofs one after the other, and where each tree's begin: one
+            # reduceat gives each tree's fastest dof
+            self.dofs = np.concatenate(
+                [np.arange(m.tree_dofadr[t], m.tree_dofadr[t] + m.tree_dofnum[t]) for t in self.trees]
+            )
+            self.starts = np.concatenate([[0], np.cumsum(m.tree_dofnum[self.trees])[:-1]])
             self.slow = SLOW * float(getattr(m.opt, "sleep_tolerance", 0.0))
 
     def apply(self) -> None:
@@ -64,15 +71,12 @@ class BodyDamping:
         d = w.data
         ids = self.ids
         if w.sleep:
-            on = d.body_awake[ids] == w._AWAKE
-            if not on.any():
+            # a sleeping tree's velocities are zero: the trees with a dof at SLOW or faster are
+            # the awake, moving ones
+            moving = np.maximum.reduceat(np.abs(d.qvel[self.dofs]), self.starts) >= self.slow
+            if not moving.any():
                 return
-            moving = np.zeros(len(self.trees), dtype=bool)
-            for t in set(self.tree_of[on].tolist()):  # the trees of the awake bodies only
-                moving[t] = np.abs(d.qvel[self.dofs[t]]).max(initial=0.0) >= self.slow
-            on &= moving[self.tree_of]
-            if not on.any():
-                return
+            on = moving[self.tree_of]
             ids, k = ids[on], on
         else:
             k = slice(None)
