@@ -133,6 +133,23 @@ def test_a_tip_pushed_back_out_of_the_entry_is_blocked_or_has_left_the_boundary(
     assert v["rule"] == "left-boundary" and "t = 6.00 s" in v["reason"]
 
 
+def test_a_tip_that_trembles_back_across_the_entry_and_goes_on_has_not_left_the_boundary():
+    """Out of the entry for one control step and in again through the opening, then out of the
+    exit: passed (MuJoCo's seed 5 failed pair 4 on it). Back out with no way in again, or in
+    again beside the opening: left-boundary, from the crossing that stayed."""
+    obs, pair = _record(_c(5.0, True), _c(8.0, False))
+    obs.holes[0].crossings += [_c(5.004, False, leading=False), _c(5.008, True)]
+    assert pair_verdict(obs, pair)["passed"]
+    obs, pair = _record(_c(5.0, True), None)
+    obs.holes[0].crossings += [_c(5.004, False, leading=False), _c(5.008, True), _c(6.0, False)]
+    v = pair_verdict(obs, pair)
+    assert v["rule"] == "left-boundary" and "t = 6.00 s" in v["reason"]
+    obs, pair = _record(_c(5.0, True), _c(8.0, False))
+    obs.holes[0].crossings += [_c(6.0, False), _c(6.5, True, outside=0.002)]
+    v = pair_verdict(obs, pair)
+    assert v["rule"] == "left-boundary" and "t = 6.00 s" in v["reason"]
+
+
 def test_a_tip_forced_between_the_holes_is_blocked_in_the_channel():
     obs, pair = _record(_c(5.0, True), _c(8.0, False))
     obs.tip_contacts = {"insert 1": {"Entry1": 4.2}}  # brushing the boundary, as in a free channel

@@ -11,6 +11,8 @@ verdict's ``rule`` and ``reason`` (rules in the order below).
 
 from __future__ import annotations
 
+import math
+
 #: N: a tool pressing on the tissue at least this hard, held over 20 ms (a touch's
 #: sustained_force_n: the mean of five control steps less the largest), fails the pair. Every
 #: touch is recorded (metrics' tool_tissue_events, each pair's tool_tissue_max_n); a jaw brushing
@@ -107,6 +109,23 @@ def _crossing_fault(c: dict, hole, side: str) -> tuple[str, str] | None:
     return None
 
 
+def _back_out(crossings: list[dict], t_in: float, t_exit: float) -> list[dict]:
+    """The tip's crossings back out of the entry, between going in (t_in) and out of the exit
+    (t_exit), that it did not undo: a tip that trembled back across the entry's plane for a
+    control step and went on in through the opening has not left the boundary (MuJoCo, seed 5,
+    pair 4: out for 4 ms, in again, out through the exit 2.9 s later); back in beside the
+    opening, it has."""
+    back: list[dict] = []
+    for c in crossings:
+        if not t_in < c["t"] < t_exit:
+            continue
+        if not c["inward"]:
+            back.append(c)
+        elif c["outside_opening_m"] <= 0.0:
+            back = []  # in again through the opening: it went on from there
+    return back
+
+
 def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: bool, out: dict):
     k = pair.index
     entry, exit_ = _hole(obs, k, "entry"), _hole(obs, k, "exit")
@@ -141,9 +160,7 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     if fault:
         return fault
     outs = [c for c in exit_.crossings if not c["inward"] and c["t"] > c_in["t"]]
-    back = [
-        c for c in entry.crossings if not c["inward"] and c["t"] > c_in["t"] and (not outs or c["t"] < outs[0]["t"])
-    ]
+    back = _back_out(entry.crossings, c_in["t"], outs[0]["t"] if outs else math.inf)
     at_tip = {b: f for b, f in getattr(obs, "tip_contacts", {}).get(f"insert {k}", {}).items() if f >= 0.05}
     if back and at_tip:
         # in through the opening and pushed back out by what the tip ran into: the channel is closed
