@@ -86,19 +86,19 @@ class MujocoWorld(World, Assembly, Interaction):
         idx, cgi, reach, above = aw
         # every awake candidate above the ghosts' sphere (instruments over the tissue), else
         # every awake candidate outside it, else the per-geom spheres
-        if not len(idx) or not (gx @ self._up <= above).any():
+        if not len(idx) or not np.count_nonzero(gx @ self._up <= above):
             if not self._overlaps_cleared:
                 self._no_overlaps()
             return
         x = gx[cgi] - self._fg_centre
-        if not (np.einsum("ij,ij->i", x, x) <= reach).any():
+        if not np.count_nonzero(np.einsum("ij,ij->i", x, x) <= reach):
             if not self._overlaps_cleared:
                 self._no_overlaps()
             return
         diff = gx[cgi][None, :, :] - self._fg_pos(gx)
         reach = (self._cand_rbound[idx][None, :] + self._fg_rbound) ** 2
         near = np.einsum("ijk,ijk->ij", diff, diff) <= reach
-        if not near.any():
+        if not np.count_nonzero(near):
             self._no_overlaps()
             return
         cg = cgi
