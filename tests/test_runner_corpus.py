@@ -94,6 +94,8 @@ def test_corpus_model_plays_5_seconds(rel, tmp_path):
     r = subprocess.run(
         [
             sys.executable,
+            "-X",
+            "faulthandler",  # a crash prints the Python stack (one unreproduced segfault, 1 in 80+ runs)
             "-m",
             "adfkit",
             "run",
