@@ -277,3 +277,75 @@ def test_prismatic_joint_closing_a_loop_slides(tmp_path):
         assert world.report()["max_constraint_error_m"] < 1e-4
     finally:
         world.close()
+
+
+def _bar(name: str, x: float, z: float, pitch: float, along: str) -> str:
+    size = {"x": "{x: 0.2, y: 0.01, z: 0.01}", "z": "{x: 0.01, y: 0.01, z: 0.1}"}[along]
+    return (
+        f"BODY {name}:\n  name: {name}\n  mass: 0.1\n  inertia: {{ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}}\n"
+        f"  location: {{position: {{x: {x}, y: 0.0, z: {z}}}, orientation: {{r: 0.0, p: {pitch}, y: 0.0}}}}\n"
+        f"  collision shape: BOX\n  collision geometry: {size}\n"
+    )
+
+
+def _hinge(parent: str, child: str, pp, cp, kind: str = "revolute") -> str:
+    v = lambda p: f"{{x: {p[0]}, y: 0.0, z: {p[1]}}}"  # noqa: E731
+    return (
+        f"JOINT {parent}-{child}:\n  name: {parent}-{child}\n  parent: BODY {parent}\n  child: BODY {child}\n"
+        f"  type: {kind}\n  parent pivot: {v(pp)}\n  child pivot: {v(cp)}\n"
+        "  parent axis: {x: 0.0, y: 1.0, z: 0.0}\n  child axis: {x: 0.0, y: 1.0, z: 0.0}\n"
+    )
+
+
+# a parallelogram hung from a fixed top bar, its sides 45 degrees up: l1 (top) - l2 (left side)
+# - l3 (bottom) - l4 (right side), and l1 - l4 closes the loop
+_S = math.sqrt(0.5) * 0.1
+FOUR_BAR = (
+    "bodies: [BODY world, BODY l1, BODY l2, BODY l3, BODY l4]\n"
+    "joints: [JOINT world-l1, JOINT l1-l2, JOINT l2-l3, JOINT l3-l4, JOINT l1-l4]\n"
+    "ignore inter-collision: true\n"
+    "BODY world:\n  name: world\n  mass: 0.0\n"
+    "  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
+    + _bar("l1", 0.1, 1.0, 0.0, "x")
+    + _bar("l2", -_S / 2, 1.0 - _S / 2, math.pi / 4, "z")
+    + _bar("l3", 0.1 - _S, 1.0 - _S, 0.0, "x")
+    + _bar("l4", 0.2 - _S / 2, 1.0 - _S / 2, math.pi / 4, "z")
+    + _hinge("world", "l1", (0.1, 1.0), (0.0, 0.0), "fixed")
+    + _hinge("l1", "l2", (-0.1, 0.0), (0.0, 0.05))
+    + _hinge("l2", "l3", (0.0, -0.05), (-0.1, 0.0))
+    + _hinge("l3", "l4", (0.1, 0.0), (0.0, -0.05))
+    + _hinge("l1", "l4", (0.1, 0.0), (0.0, 0.05))
+)
+
+
+def test_a_four_bar_welded_to_a_static_body_swings_with_no_constraint_on_that_body(tmp_path):
+    """A multibody held by point constraints to a static (mass 0) rigid body: PyBullet 3.2.7
+    builds those rows from freed memory (valgrind; a segfault in the first step, depending on
+    the heap): the weld holds the multibody's pivots in the world frame instead, where the static
+    body is. The parallelogram (its loop closed by a constraint between two of its links), its
+    motors off, moves as one: its sides swing down, the bottom bar stays level, every pivot
+    stays together."""
+    import pybullet as pb
+
+    world = open_world(_model(tmp_path, FOUR_BAR), Options(visuals=False, ground=False))
+    try:
+        cid = world.cid
+        static = {b.uid for b in world.bodies if b.static}
+        ends = [
+            pb.getConstraintInfo(pb.getConstraintUniqueId(i, physicsClientId=cid), physicsClientId=cid)[:3:2]
+            for i in range(pb.getNumConstraints(physicsClientId=cid))
+        ]
+        assert len(ends) == 3 + 2 and not [e for e in ends if set(e) & static], (ends, static)
+        assert sum(1 for a, b in ends if b == -1) == 3  # the weld's three pivots, in the world frame
+        (art,) = world.articulations
+        art.forces = [0.0] * len(art.forces)  # the joints free, no motors holding them
+        art.drive()
+        l3 = world.body("BODY l3")
+        z0 = l3.com_position()[2]
+        world.run(0.1)  # a quarter of its swing: from 45 degrees up through the bottom
+        assert l3.com_position()[2] < z0 - 0.015  # the sides swung down
+        level = l3.world_matrix()[:3, 0]
+        assert abs(level[2]) < 5e-3  # the bottom bar stays level, as a parallelogram's does
+        assert world.report()["max_constraint_error_m"] < 5e-4
+    finally:
+        world.close()

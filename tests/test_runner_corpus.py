@@ -82,10 +82,9 @@ def test_corpus_model_plays_briefly(rel):
 @pytest.mark.slow
 @pytest.mark.parametrize("rel", WITH_MESHES, ids=lambda r: str(r).rsplit("/", 1)[-1])
 def test_corpus_model_plays_5_seconds(rel, tmp_path):
-    """Each model in a process of its own, as `adfkit run` plays it: PyBullet 3.2.7 carries
-    something over from one world to the next in a process (parallel_structure.yaml played after
-    puzzle5.yaml or blender-psm.yaml in one process sometimes segfaults in stepSimulation or
-    ends 17 mm to 500 m apart, and plays to 0.08 mm on its own; docs/runner.md)."""
+    """Each model in a process of its own, as `adfkit run` plays it (parallel_structure.yaml
+    segfaulted in stepSimulation depending on the heap: a multibody welded to a static body,
+    whose constraint rows PyBullet 3.2.7 built from freed memory; docs/runner.md)."""
     import json
     import subprocess
     import sys
@@ -95,7 +94,7 @@ def test_corpus_model_plays_5_seconds(rel, tmp_path):
         [
             sys.executable,
             "-X",
-            "faulthandler",  # a crash prints the Python stack (one unreproduced segfault, 1 in 80+ runs)
+            "faulthandler",  # a crash prints the Python stack
             "-m",
             "adfkit",
             "run",

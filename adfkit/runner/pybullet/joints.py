@@ -72,43 +72,55 @@ def make_constraint(
             physicsClientId=cid,
         )
 
-    def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1), axis=None):
-        # PyBullet joins a multibody link to a free (maximal-coordinate) body only with the link
-        # first (btMultiBodyPoint2Point/btMultiBodyFixedConstraint take the multibody as body A):
-        # such a joint is made with its ends swapped, which is the same joint
-        swap = (
-            axis is None
-            and getattr(parent, "articulation", None) is None
-            and getattr(child, "articulation", None) is not None
-        )
+    def to_world(moving, mp, mo, static, sp, so, jtype):
+        # the static end's pivot in the world frame; the constraint holds the moving end there
+        pw, ow = matrix_to_pq(pose_matrix(*_static_frame(cid, static)) @ pose_matrix(sp, so))
         try:
-            c = (
-                create(child, parent, jtype, None, pb_, pa, ob, oa)
-                if swap
-                else create(parent, child, jtype, axis, pa, pb_, oa, ob)
+            return pb.createConstraint(
+                moving.uid,
+                moving.link,
+                -1,
+                -1,
+                jtype,
+                [0, 0, 0],
+                list(map(float, mp)),
+                list(map(float, pw)),
+                list(mo),
+                list(ow),
+                physicsClientId=cid,
             )
         except pb.error:
-            c = None
-        if c is None and getattr(parent, "static", False):
-            # PyBullet refuses e.g. a fixed constraint from a static (mass 0) body to a multibody
-            # base; a static parent never moves, so build it from the child to the world frame
-            pw, ow = matrix_to_pq(pose_matrix(*_static_frame(cid, parent)) @ pose_matrix(pa, oa))
+            return None
+
+    def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1), axis=None):
+        multibody = lambda b: getattr(b, "articulation", None) is not None  # noqa: E731
+        static = lambda b: getattr(b, "static", False)  # noqa: E731
+        if axis is None and static(parent) and multibody(child):
+            # A multibody held by a point constraint to a static (mass 0) rigid body: PyBullet
+            # 3.2.7 builds its rows reading freed memory (btMultiBodyConstraint::
+            # fillMultiBodyConstraint, valgrind), a segfault in the first step depending on the
+            # heap (the corpus's parallel_structure.yaml whenever its output went to a pipe). The
+            # static body never moves: the constraint holds the pivot in the world frame instead.
+            c = to_world(child, pb_, ob, parent, pa, oa, jtype)
+        elif axis is None and static(child) and multibody(parent):
+            c = to_world(parent, pa, oa, child, pb_, ob, jtype)
+        else:
+            # PyBullet joins a multibody link to a free (maximal-coordinate) body only with the
+            # link first (btMultiBodyPoint2Point/btMultiBodyFixedConstraint take the multibody as
+            # body A): such a joint is made with its ends swapped, which is the same joint
+            swap = axis is None and not multibody(parent) and multibody(child)
             try:
-                c = pb.createConstraint(
-                    child.uid,
-                    child.link,
-                    -1,
-                    -1,
-                    jtype,
-                    [0, 0, 0],
-                    list(map(float, pb_)),
-                    list(map(float, pw)),
-                    list(ob),
-                    list(ow),
-                    physicsClientId=cid,
+                c = (
+                    create(child, parent, jtype, None, pb_, pa, ob, oa)
+                    if swap
+                    else create(parent, child, jtype, axis, pa, pb_, oa, ob)
                 )
             except pb.error:
                 c = None
+            if c is None and static(parent):
+                # PyBullet refuses e.g. a fixed constraint from a static (mass 0) body to a
+                # multibody base; a static parent never moves: from the child to the world frame
+                c = to_world(child, pb_, ob, parent, pa, oa, jtype)
         if c is None:
             raise ConstraintRefused(
                 f"PyBullet refused a {_JTYPE_NAMES.get(jtype, jtype)} constraint between "
