@@ -16,6 +16,17 @@ import numpy as np
 DEFAULT_HALF_OPENING = 0.0024
 
 
+def tissue_bodies(world, model) -> list:
+    """What the needle and the tools press on: the static bodies of the needle's model, and the
+    bodies the hole ghosts sit on (the corpus set's holes are bodies of 0.2 kg on springs to
+    the phantom, not static, and what presses on them presses on the tissue)."""
+    out = [sb for sb in world.bodies if sb.model is model and sb.static]
+    for g in world.ghosts:
+        if g.friction and g.parent is not None and g.parent not in out:
+            out.append(g.parent)
+    return out
+
+
 def has_boundary(body) -> bool:
     """Whether a hole body is framed by capsule boundary bodies: the bundled scene's holes and the
     corpus set's (its Entry/Exit bodies have a mesh to draw and four capsules to collide, 2.5 mm

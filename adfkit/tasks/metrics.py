@@ -21,6 +21,7 @@ from .holes import (
     opening_half_extents,
     plane_crossing,
     tip_leading,
+    tissue_bodies,
 )
 from .verdicts import SLIP_LIMIT, SLIP_SETTLE_S, TIP_FORCE_N, pair_verdict
 
@@ -107,12 +108,7 @@ class SutureObserver:
         self.holes = [_Hole(self.world, p.index, "entry", p.entry_name, p.entry) for p in task.pairs] + [
             _Hole(self.world, p.index, "exit", p.exit_name, p.exit) for p in task.pairs
         ]
-        self.tissue = [sb for sb in self.world.bodies if sb.model is task.needle.model and sb.static]
-        # and the bodies the hole ghosts sit on: the corpus set's holes are bodies of 0.2 kg on
-        # springs to the phantom, not static, and what presses on them presses on the tissue
-        for g in self.world.ghosts:
-            if g.friction and g.parent is not None and g.parent not in self.tissue:
-                self.tissue.append(g.parent)
+        self.tissue = tissue_bodies(self.world, task.needle.model)
         self._tissue_ids = {id(sb) for sb in self.tissue}
         # the tools' links, watched for touches when they collide with the tissue
         self._tool = (

@@ -10,6 +10,7 @@ from ..runner.psm import PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
 from .grasping import BACK_OFF, JAW_APPROACH, ROLL, Grasp, SutureError
+from .holes import tissue_bodies
 
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
@@ -99,12 +100,11 @@ class Motions:
         hand stops on touching; the plan keeps the tools off the tissue, but a few tenths of a
         millimetre of clearance leave no room for the servo's overshoot."""
         n = self._steps(seconds)
-        links = [sb for sb in self.world.bodies if sb.articulation is psm.art] if guarded else []
-        tissue = {id(sb) for sb in self.world.bodies if sb.model is self.needle.model and sb.static}
+        touch = self._touch(psm) if guarded else None
         for i in range(1, n + 1):
             self.servo_world(psm, interpolate(a, b, smooth(i / n)))
             yield self.phase
-            if links and any(f >= GUARD_N for _, o, f, _ in self.world.contacts_among(links) if id(o) in tissue):
+            if touch is not None and self._pressing(*touch):
                 stop = psm.base_in_world() @ psm.measured_cp()
                 stop[:3, 3] -= (
                     GUARD_BACK * (b[:3, 3] - a[:3, 3]) / max(float(np.linalg.norm(b[:3, 3] - a[:3, 3])), 1e-9)
@@ -149,11 +149,14 @@ class Motions:
         psm.servo_jaw(0.0)
         yield from self.wait(0.15)
 
-    def _pressing(self, psm: PSM) -> bool:
-        """The tool presses on the tissue with GUARD_N or more (after the last step)."""
-        tissue = {id(sb) for sb in self.world.bodies if sb.model is self.needle.model and sb.static}
+    def _touch(self, psm: PSM) -> tuple[list, set[int]]:
+        """What a guard watches: the arm's links and the tissue (holes.tissue_bodies) they may press on."""
         links = [sb for sb in self.world.bodies if sb.articulation is psm.art]
-        return any(f >= GUARD_N for sb in links for o, f, _ in self.world.contacts(sb) if id(o) in tissue)
+        return links, {id(sb) for sb in tissue_bodies(self.world, self.needle.model)}
+
+    def _pressing(self, links: list, tissue: set[int]) -> bool:
+        """One of ``links`` presses on the tissue with GUARD_N or more (after the last step)."""
+        return any(f >= GUARD_N for _, o, f, _ in self.world.contacts_among(links) if id(o) in tissue)
 
     def opening(self, psm: PSM, seconds: float):
         """Wait ``seconds`` while the jaws open; while they press on the tissue with GUARD_N they
@@ -162,9 +165,10 @@ class Motions:
         overstate the room by 0.6 mm: at pair 1 of the bundled scene the driver's jaws, opened
         to let go, came 0.15 mm into Entry1's boundary and, in MuJoCo's rigid contacts, pressed
         on it with 130-260 N."""
+        touch = self._touch(psm)
         for _ in range(self._steps(seconds)):
             yield self.phase
-            if self._pressing(psm):  # the finger that got least far decides where both stop
+            if self._pressing(*touch):  # the finger that got least far decides where both stop
                 fingers = self.world.joint_state(psm.art, psm.jaws)[0]
                 psm.servo_jaw(max(0.0, 2 * float(min(fingers)) - GUARD_JAW_BACK))
 
