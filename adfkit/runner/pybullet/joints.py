@@ -38,6 +38,14 @@ def _static_frame(cid: int, body):
     return st[0], st[1]  # constraint pivots are in the link's inertial frame
 
 
+def _multibody(body) -> bool:
+    return getattr(body, "articulation", None) is not None
+
+
+def _static(body) -> bool:
+    return bool(getattr(body, "static", False))
+
+
 class ConstraintRefused(Exception):
     """PyBullet could not join the two bodies as asked (the world warns and skips the joint)."""
 
@@ -93,22 +101,20 @@ def make_constraint(
             return None
 
     def add(jtype, pa, pb_, oa=(0, 0, 0, 1), ob=(0, 0, 0, 1), axis=None):
-        multibody = lambda b: getattr(b, "articulation", None) is not None  # noqa: E731
-        static = lambda b: getattr(b, "static", False)  # noqa: E731
-        if axis is None and static(parent) and multibody(child):
+        if axis is None and _static(parent) and _multibody(child):
             # A multibody held by a point constraint to a static (mass 0) rigid body: PyBullet
             # 3.2.7 builds its rows reading freed memory (btMultiBodyConstraint::
             # fillMultiBodyConstraint, valgrind), a segfault in the first step depending on the
             # heap (the corpus's parallel_structure.yaml whenever its output went to a pipe). The
             # static body never moves: the constraint holds the pivot in the world frame instead.
             c = to_world(child, pb_, ob, parent, pa, oa, jtype)
-        elif axis is None and static(child) and multibody(parent):
+        elif axis is None and _static(child) and _multibody(parent):
             c = to_world(parent, pa, oa, child, pb_, ob, jtype)
         else:
             # PyBullet joins a multibody link to a free (maximal-coordinate) body only with the
             # link first (btMultiBodyPoint2Point/btMultiBodyFixedConstraint take the multibody as
             # body A): such a joint is made with its ends swapped, which is the same joint
-            swap = axis is None and not multibody(parent) and multibody(child)
+            swap = axis is None and not _multibody(parent) and _multibody(child)
             try:
                 c = (
                     create(child, parent, jtype, None, pb_, pa, ob, oa)
@@ -117,7 +123,7 @@ def make_constraint(
                 )
             except pb.error:
                 c = None
-            if c is None and static(parent):
+            if c is None and _static(parent):
                 # PyBullet refuses e.g. a fixed constraint from a static (mass 0) body to a
                 # multibody base; a static parent never moves: from the child to the world frame
                 c = to_world(child, pb_, ob, parent, pa, oa, jtype)
