@@ -261,6 +261,23 @@ def test_psm_tracks_a_joint_trajectory_in_both_engines():
     assert np.linalg.norm(tips["MujocoWorld"] - tips["PyBulletWorld"], axis=1).max() < 3e-3
 
 
+def _finger_and_grip(parent: str, pose: str, size: float) -> str:
+    """A finger ghost (a cube of ``size``) and a constraint actuator, both at ``pose`` on ``parent``."""
+    return f"""GHOST finger:
+  name: finger
+  parent: BODY {parent}
+  location: {pose}
+  collision shape: BOX
+  collision geometry: {{x: {size}, y: {size}, z: {size}}}
+ACTUATOR grip:
+  name: grip
+  type: Constraint
+  parent: BODY {parent}
+  location: {pose}
+  max impulse: 1.0
+"""
+
+
 # ---- grasp ---------------------------------------------------------------------------------
 GRASP = f"""
 bodies: [BODY base, BODY tool, BODY needle]
@@ -298,19 +315,7 @@ JOINT base-tool:
   child axis: {{x: 1.0, y: 0.0, z: 0.0}}
   joint limits: {{low: -0.2, high: 0.2}}
   max motor impulse: 1.0
-GHOST finger:
-  name: finger
-  parent: BODY tool
-  location: {_pose(z=-0.02)}
-  collision shape: BOX
-  collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
-ACTUATOR grip:
-  name: grip
-  type: Constraint
-  parent: BODY tool
-  location: {_pose(z=-0.02)}
-  max impulse: 1.0
-"""
+""" + _finger_and_grip("tool", _pose(z=-0.02), 0.02)
 
 
 def test_grasp_weld_carries_the_body_and_release_drops_it(tmp_path):
@@ -379,19 +384,7 @@ JOINT base-wrist:
   parent axis: {{x: 0.0, y: 1.0, z: 0.0}}
   child axis: {{x: 0.0, y: 1.0, z: 0.0}}
   max motor impulse: {impulse}
-GHOST finger:
-  name: finger
-  parent: BODY wrist
-  location: {_pose(x=0.015)}
-  collision shape: BOX
-  collision geometry: {{x: 0.01, y: 0.01, z: 0.01}}
-ACTUATOR grip:
-  name: grip
-  type: Constraint
-  parent: BODY wrist
-  location: {_pose(x=0.015)}
-  max impulse: 1.0
-"""
+""" + _finger_and_grip("wrist", _pose(x=0.015), 0.01)
 
 
 def _hold_the_needle(tmp_path, impulse: float):
