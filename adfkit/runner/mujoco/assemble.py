@@ -103,6 +103,9 @@ class Assembly:
         self._drive_limits_and_springs()
         self._gravity_overrides()
         self._base_xfrc = np.array(d.xfrc_applied)
+        # every writer of xfrc_applied beyond this base (damping, hole ghosts, wake, a body's
+        # force or torque) sets the flag; step() puts the base back after the physics only then
+        self._xfrc_dirty = False
         self.ghosts = []
         for gp in plan.ghosts:
             ids = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, n) for n in gp.geoms])

@@ -90,3 +90,4 @@ class BodyDamping:
         xf = d.xfrc_applied
         xf[ids, :3] += (self.mass[k] * self.k_lin[k])[:, None] * v
         xf[ids, 3:] += self.k_ang[k][:, None] * torque
+        w._xfrc_dirty = True

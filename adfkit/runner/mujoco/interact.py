@@ -66,6 +66,7 @@ class Interaction:
         xf = self.data.xfrc_applied
         for sb in found:
             xf[sb.id, :3] += viscous_impulse_force(sb.mass, self._com_velocity(sb) - v_ref, k, cdt)
+        self._xfrc_dirty = True
 
     def _com_velocity(self, sb: MjBody) -> np.ndarray:
         v = self._vel6
@@ -141,6 +142,7 @@ class Interaction:
         1e-12 N force at the COM for one control step does it and nothing else)."""
         if self.sleep and sb.id > 0:
             self.data.xfrc_applied[sb.id, 2] += WAKE_FORCE
+            self._xfrc_dirty = True
 
     def release(self, actuator: MjActuator) -> None:
         if actuator.target is not None:

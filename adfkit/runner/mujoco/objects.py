@@ -59,9 +59,11 @@ class MjBody(EngineBody):
         xf = self.world.data.xfrc_applied[self.id]
         xf[:3] += f
         xf[3:] += np.cross(np.asarray(at, float) - self.world.data.xipos[self.id], f)
+        self.world._xfrc_dirty = True
 
     def torque(self, t) -> None:
         self.world.data.xfrc_applied[self.id][3:] += np.asarray(t, float)
+        self.world._xfrc_dirty = True
 
 
 class MjArticulation:

@@ -172,7 +172,9 @@ class MujocoWorld(World, Assembly, Interaction):
         for k in range(n):
             control()
             step(m, d, sub)
-            xfrc[:] = base
+            if self._xfrc_dirty:  # something added forces for this control step
+                xfrc[:] = base
+                self._xfrc_dirty = False
             limits()
             if pending:  # a warning: NaN and a state reset, a singular inertia...
                 self.sim_time = (self.steps + (k + 1) * sub) * self.dt
