@@ -153,3 +153,28 @@ def test_collision_primitive_missing_a_dimension_is_a_located_warning(tmp_path, 
     err = capsys.readouterr().err
     assert rc in (0, 1) and "Traceback" not in err
     assert f"{f}:8:23: warning[runner-no-collision]: BODY a: collision box has no usable z" in err
+
+
+def test_a_mesh_whose_texture_is_missing_is_one_located_warning_not_pybullets_noise(tmp_path, capfd):
+    """The challenge's low-res phantom names its texture by an absolute path from its author's
+    machine: PyBullet's OBJ reader printed seven lines on standard output for it (every folder it
+    tried) each time it read the file. Now the visual mesh gets one located warning and the
+    process's standard output (file descriptor 1) carries nothing of PyBullet's."""
+    (tmp_path / "drape.mtl").write_text("newmtl drape\nKd 0.5 0.5 0.5\nmap_Kd /home/someone/drape.png\n")
+    (tmp_path / "t.obj").write_text(
+        "mtllib drape.mtl\nusemtl drape\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+    )
+    f = tmp_path / "m.yaml"
+    f.write_text(
+        "bodies: [BODY a, BODY b]\n"
+        + _body("a", mass=0.0, shape="  mesh: t.obj\n  collision mesh type: CONCAVE_MESH\n")
+        + _body("b", x=0.5, z=0.3, shape="  mesh: t.obj\n")
+    )
+    rc = main(["run", str(f), "--seconds", "0.02", "--no-frames", "--out", str(tmp_path / "out")])
+    out, err = capfd.readouterr()
+    assert rc == 0
+    assert "b3Warning" not in out + err and "drape.png" not in out
+    found = [ln for ln in err.splitlines() if "runner-missing-texture" in ln]
+    assert len(found) == 2  # each body's visual mesh, at its `mesh` key
+    assert all(ln.startswith(f"{f}:") and ":9: warning[runner-missing-texture]" in ln for ln in found)
+    assert "texture /home/someone/drape.png (in drape.mtl)" in found[0]

@@ -19,6 +19,7 @@ from . import articulation, egl
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .interact import SimActuator, SimGhost, SimSensor
 from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
+from .meshfiles import pybullet_reads_quietly
 from .shapes import collision_parts, create_collision, create_visual
 from .volumes import build_volumes
 
@@ -81,7 +82,8 @@ class Assembly:
                 self._create_free(sb)
         for root, recs in trees:
             self_coll = not all(r[3].model.ignore_inter_collision for r in recs)
-            art = articulation.build(root, recs, self._shapes_for, self.dt, self.cid, self_coll)
+            with pybullet_reads_quietly([(sb.model, sb.body) for sb in [root] + [r[3] for r in recs]]):
+                art = articulation.build(root, recs, self._shapes_for, self.dt, self.cid, self_coll)
             self.articulations.append(art)
             self.joint_names.extend(art.joint_names)
             for sb in [root] + [r[3] for r in recs]:
@@ -207,7 +209,10 @@ class Assembly:
         if sb._parts is not None and sb._parts.plane is not None and not sb.static:
             self._warn("runner-plane", f"{sb.key}: a PLANE shape on a dynamic body; made static", sb.body)
             sb.mass = 0.0
-        sb.uid = pb.createMultiBody(sb.mass, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid)
+        with pybullet_reads_quietly([(sb.model, sb.body)]):
+            sb.uid = pb.createMultiBody(
+                sb.mass, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid
+            )
         sb.link = -1
         set_dynamics(sb)
 
@@ -256,7 +261,8 @@ class Assembly:
             vis = self._plane_visual(parts, col, vis)
             world = (self._frame(parent) @ rel) if parent is not None else rel
             pos, orn = matrix_to_pq(world)
-            uid = pb.createMultiBody(0, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid)
+            with pybullet_reads_quietly([(m, gh)]):
+                uid = pb.createMultiBody(0, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid)
             pb.setCollisionFilterGroupMask(uid, -1, 0, 0, physicsClientId=self.cid)
             friction = is_hole(gh, self.opt)
             key = self.registry.add(key_of(ns, gh), None)

@@ -81,24 +81,28 @@ def load(cid: int) -> tuple[bool, str]:
 
 
 @contextlib.contextmanager
-def quiet_stdout():
+def quiet_stdout(discard: bool = False):
     """The plugin prints its OpenGL vendor and window messages on the process's standard output
     (C stdio); while it runs, file descriptor 1 goes to standard error, so that ``--json``
-    output and pipes stay clean."""
+    output and pipes stay clean. ``discard``: to /dev/null instead (what PyBullet prints is
+    said once by adfkit's own located warning)."""
     try:
         sys.stdout.flush()
         saved = os.dup(1)
+        target = os.open(os.devnull, os.O_WRONLY) if discard else 2
     except (OSError, ValueError, AttributeError):
         yield
         return
     try:
-        os.dup2(2, 1)
+        os.dup2(target, 1)
         yield
     finally:
         with contextlib.suppress(OSError, AttributeError):
             ctypes.CDLL(None).fflush(None)
         os.dup2(saved, 1)
         os.close(saved)
+        if discard:
+            os.close(target)
 
 
 def plane_visual(cid: int, normal, offset: float, half: float = 50.0) -> int:

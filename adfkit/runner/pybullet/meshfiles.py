@@ -3,6 +3,7 @@ are refused with a reason (too large, unreadable, a binary STL whose size lies).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 from pathlib import Path
@@ -10,7 +11,10 @@ from pathlib import Path
 import numpy as np
 
 from ... import inputs
+from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import AdfError
+from ...validator.paths_check import obj_material_problems
+from .egl import quiet_stdout
 
 MESH_SUFFIXES = {".obj", ".stl"}  # what PyBullet's GEOM_MESH reads from a file
 
@@ -157,3 +161,18 @@ def obj_colour(path: Path, tree=None) -> list[float] | None:
     except ValueError:
         return None
     return rgba if all(np.isfinite(rgba)) else None
+
+
+def untextured(files) -> bool:
+    """Whether an OBJ among ``files`` names a material file or texture that is not there (PyBullet
+    prints seven lines on standard output for each, one per folder it tried)."""
+    return any(str(f).lower().endswith(".obj") and obj_material_problems(str(f)) for f in files)
+
+
+def pybullet_reads_quietly(objs) -> contextlib.AbstractContextManager:
+    """Around the PyBullet call that reads the meshes of ``objs`` ((model, body or ghost) pairs):
+    createMultiBody, where PyBullet loads the mesh files its shapes name. When one of them names
+    a material or texture that is not there, PyBullet's seven lines for each are not printed
+    (adfkit says it once: ``runner-missing-texture``, validate's ``missing-texture``)."""
+    files = [p for m, o in objs for p in (visual_mesh_path(m, o), collision_mesh_path(m, o)) if p is not None]
+    return quiet_stdout(discard=True) if untextured(files) else contextlib.nullcontext()

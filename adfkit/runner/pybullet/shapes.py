@@ -6,6 +6,7 @@ frame. Primitive collision dimensions are not scaled; meshes are (§12.3).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import tempfile
@@ -29,10 +30,11 @@ from ...model.semantics import (
     shape_kind,
     shortest_arc,
 )
+from ...validator.paths_check import obj_material_problems
 from ..plan import rgba
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from .margins import file_margin, give_margin
-from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, mesh_refusal, pybullet_mesh
+from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, mesh_refusal, pybullet_mesh, quiet_stdout, untextured
 
 
 @dataclass
@@ -240,10 +242,13 @@ def collision_parts(
 
 def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnostic] | None = None) -> int:
     """Create the PyBullet collision shape, its children given the file's margin; -1 for an
-    empty one, or (with a warning located at ``obj``) for one PyBullet refuses."""
+    empty one, or (with a warning located at ``obj``) for one PyBullet refuses. A collision
+    mesh does not need its textures: PyBullet's words about missing ones are not printed."""
+    files = [kw["fileName"] for kw in parts.kwargs if "fileName" in kw]
     try:
-        col = _create_collision(parts, cid)
-        give_margin(col, parts.margin, cid)
+        with quiet_stdout(discard=True) if untextured(files) else contextlib.nullcontext():
+            col = _create_collision(parts, cid)
+            give_margin(col, parts.margin, cid)  # (a probe body: PyBullet reads the files there)
         return col
     except pb.error as exc:
         if diags is None:
@@ -361,7 +366,17 @@ def create_visual(model, obj, frame_in_body, scale: float, cid: int, diags: list
     kw = dict(base)
     if rgba(obj) is None:
         kw.pop("rgbaColor")
-    try:
+    missing = obj_material_problems(str(path)) if suffix == ".obj" else ()
+    for what in missing:
+        diags.append(
+            warning(
+                "runner-missing-texture",
+                f"{obj.identifier}: {what} of visual mesh {inputs.shown(path.name)} not found",
+                obj.where("mesh") or obj.source,
+                "the mesh is drawn without it; textures come from the mesh's own material (MTL) file",
+            )
+        )
+    try:  # (PyBullet reads the file in createMultiBody: pybullet_reads_quietly)
         return pb.createVisualShape(pb.GEOM_MESH, fileName=str(path), meshScale=[scale] * 3, **kw)
     except pb.error:
         diags.append(
