@@ -417,3 +417,34 @@ def test_auto_jobs_starts_processes_only_for_big_trees():
     files = [(Path(f"/x/{i}.yaml"), None) for i in range(10)]
     chunks = chunked(files, 4)
     assert [len(c) for c in chunks] == [3, 3, 3, 1] and sum(chunks, []) == files
+
+
+# --- a volume's labels.yaml (adfkit drill's, in the slice folder; not ADF) ----------------------
+
+
+def test_a_volumes_labels_file_is_checked_as_one_not_refused_as_an_unknown_kind(tmp_path):
+    """The drilling sample scene keeps its tissues in slices/labels.yaml: `validate` of the
+    project's own sample_scenes failed on it (unknown-kind). A labels file is now checked for
+    what it is; any other YAML file that is not ADF is still unknown-kind."""
+    good = tmp_path / "slices" / "labels.yaml"
+    good.parent.mkdir()
+    good.write_text("bone: [150, 255]\ncanal: [60, 120]\nprotected: [canal]\n", encoding="utf-8")
+    res = validate_file(good)
+    assert (res.kind, res.diagnostics) == ("volume-labels", [])
+    bad = tmp_path / "labels.yaml"
+    bad.write_text("bone: [150, 255]\nprotected: [nerve]\n", encoding="utf-8")
+    (hit,) = validate_file(bad).diagnostics
+    assert (hit.rule, hit.location.line, hit.location.column, str(hit.severity)) == ("drill-labels", 2, 13, "error")
+    assert "protected tissue 'nerve' is not one of ['bone']" in hit.message and hit.location.file == str(bad)
+    other = tmp_path / "other.yaml"
+    other.write_text("bone: [150, 255]\n", encoding="utf-8")
+    assert [d.rule for d in validate_file(other).diagnostics] == ["unknown-kind"]
+    assert validate_file(good, "model").kind == "model"  # --kind is obeyed
+
+
+def test_the_projects_own_sample_scenes_validate_without_errors():
+    root = Path(__file__).resolve().parent.parent / "sample_scenes"
+    results, problems = validate_paths([root])
+    errors = [str(d) for r in results for d in r.diagnostics if d.severity >= Severity.ERROR]
+    assert problems == [] and errors == []
+    assert any(r.kind == "volume-labels" for r in results)  # the drilling scene's slices/labels.yaml

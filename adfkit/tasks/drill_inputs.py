@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import inputs
+from ..adf.volume_labels import parse_labels
 from ..diagnostics import AdfError, SourceLocation, error
 
 MAX_WAYPOINTS = 100_000
@@ -88,60 +89,11 @@ def default_labels(iso: float) -> tuple[list[str], list[tuple[float, float]], se
 
 
 def read_labels(path: Path, full_scale: float, tree) -> tuple[list[str], list[tuple[float, float]], set[str]]:
-    """Names, value ranges (0..1 of full scale, inclusive) and protected names of a labels file."""
-    import yaml
-
-    from ..adf.yamlnodes import compose
-
+    """Names, value ranges (0..1 of full scale, inclusive) and protected names of a labels file
+    (its syntax: adf.volume_labels, which ``adfkit validate`` checks too)."""
     text = inputs.read_text(path, "text", tree=tree, what="labels file")
-    shown = inputs.shown(path)
-    root = compose(text, shown)
-
-    def at(node) -> SourceLocation:
-        return SourceLocation(shown, node.start_mark.line + 1, node.start_mark.column + 1)
-
-    def bad(node, message: str, hint: str) -> AdfError:
-        return AdfError(error("drill-labels", message, at(node), hint))
-
-    if not isinstance(root, yaml.MappingNode):
-        raise AdfError(
-            error(
-                "drill-labels",
-                "a labels file is a mapping of tissue names to value ranges",
-                SourceLocation(shown, 1, 1),
-                "e.g. bone: [150, 255]",
-            )
-        )
-    names, ranges, protected_nodes = [], [], []
-    for k, v in root.value:
-        if k.value == "protected":
-            if not isinstance(v, yaml.SequenceNode) or not all(isinstance(x, yaml.ScalarNode) for x in v.value):
-                raise bad(v, "`protected` is a list of tissue names", "e.g. protected: [canal]")
-            protected_nodes = v.value
-            continue
-        ok = isinstance(v, yaml.SequenceNode) and len(v.value) == 2
-        try:
-            lo, hi = (float(x.value) for x in v.value) if ok else (0.0, -1.0)
-        except (ValueError, TypeError, AttributeError):
-            ok = False
-        if not ok or not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi or hi < 0:
-            raise bad(
-                v,
-                f"tissue '{k.value[:40]}' needs a range [low, high] of slice values, low <= high",
-                "e.g. bone: [150, 255] (the slices' own units)",
-            )
-        if len(names) >= 254:
-            raise bad(k, "more than 254 tissues", "merge tissues")
-        names.append(str(k.value))
-        ranges.append((max(lo, 0.0) / full_scale, hi / full_scale))
-    if not names:
-        raise bad(root, "the labels file names no tissue", "e.g. bone: [150, 255]")
-    protected = set()
-    for node in protected_nodes:
-        if node.value not in names:
-            raise bad(node, f"protected tissue '{node.value[:40]}' is not one of {names}", "name a tissue of this file")
-        protected.add(node.value)
-    return names, ranges, protected
+    names, ranges, protected = parse_labels(text, inputs.shown(path))
+    return names, [(max(lo, 0.0) / full_scale, hi / full_scale) for lo, hi in ranges], set(protected)
 
 
 def label_array(values: np.ndarray, ranges: list[tuple[float, float]]) -> np.ndarray:

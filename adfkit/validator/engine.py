@@ -14,6 +14,7 @@ from pathlib import Path
 
 from .. import inputs
 from ..adf.reader import read_file
+from ..adf.volume_labels import is_labels_file, parse_labels
 from ..adf.yamlnodes import read_text
 from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation
 from ..model import FILE_KINDS, Launch, ModelFile, World
@@ -23,6 +24,7 @@ from .yamlcompat import repair
 
 KIND_OF = {cls: name for name, cls in FILE_KINDS.items()}
 YAML_SUFFIXES = (".yaml", ".yml")
+LABELS_KIND = "volume-labels"  # not an ADF kind: a volume's labels.yaml (adf.volume_labels)
 # Reader findings whose severity the validator sets from what AMBF does:
 # duplicate keys load in AMBF (it keeps the first value; sb/cloth.yaml), so a warning.
 SEVERITY_OVERRIDES = {"yaml-duplicate-key": Severity.WARNING}
@@ -97,6 +99,8 @@ def validate_file(
         roots: list = []
         doc, reader_diags, text, moved = _read_with_compat(path, kind, text, roots, tree, referrer)
     except AdfError as exc:
+        if kind is None and is_labels_file(path) and [d.rule for d in exc.diagnostics] == ["unknown-kind"]:
+            return _labels(res)
         res.diagnostics = [_inside(_adjust(d), res.text) for d in exc.diagnostics]
         return res
     res.doc, res.text = doc, text
@@ -110,6 +114,16 @@ def validate_file(
     diags += semantic.check(doc, context_models)
     diags += paths_check.check(doc)
     res.diagnostics = _unique(diags)
+    return res
+
+
+def _labels(res: FileResult) -> FileResult:
+    """A volume's labels.yaml (adfkit drill's, in the slice folder: not ADF), checked as one."""
+    res.kind = LABELS_KIND
+    try:
+        parse_labels(res.text or "", str(res.path))
+    except AdfError as exc:
+        res.diagnostics = [_inside(d, res.text) for d in exc.diagnostics]
     return res
 
 

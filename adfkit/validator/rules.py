@@ -52,6 +52,12 @@ _RULES = [
     Rule("not-a-mapping", E, "The top level is not a mapping", "`- bodies` (a list)"),
     Rule("unknown-kind", E, "Cannot tell launch/world/model/input-devices/colors apart", "a file with only `name: x`"),
     Rule(
+        "drill-labels",
+        E,
+        "A volume's labels.yaml (adfkit drill's tissues by slice value) is malformed",
+        "`bone: [255, 150]` (low above high)",
+    ),
+    Rule(
         "wrong-kind",
         E,
         "The file does not match --kind or the slot it is loaded into",
