@@ -405,3 +405,29 @@ def test_contacts_name_the_body_and_the_force_in_both_engines(engine):
         assert among == by_body and sum(k[0].endswith("Phantom") and "Thread" in k[1] for k in among) >= 5
     finally:
         world.close()
+
+
+def _move_exit_1(d: Path) -> None:
+    """Exit1 (its capsules and the ghost riding on it) 5 mm farther from Entry1."""
+
+    def fn(s: str) -> str:
+        a = s.index("BODY Exit1:")
+        b = s.index("\nBODY ", a + 1)
+        i = s.rindex("  location:", a, b)
+        old = "position: {x: 0.007,"
+        assert s.index(old, i) < b
+        return s[:i] + s[i:b].replace(old, "position: {x: 0.012,", 1) + s[b:]
+
+    _edit(d / "phantom" / "phantom.yaml", fn)
+
+
+def test_holes_too_far_apart_for_the_needle_fail_with_the_distance_it_can_drive(tmp_path):
+    """A modeller who moves an exit hole 5 mm out is told, before any motion, how far apart the
+    needle's bite would be and how far apart this needle can drive a pair."""
+    from adfkit.tasks.episode import run_episode
+
+    m = run_episode(_scene(tmp_path, _move_exit_1), pairs=(1,), seed=0, progress=False, gif=False)
+    (p,) = m["pairs"]
+    assert not p["passed"] and p["rule"] == "reach"
+    assert "the needle bites 15.6 mm from entry to exit" in p["reason"]
+    assert "can drive a pair at most 14.5 mm apart" in p["reason"]

@@ -209,10 +209,14 @@ class SutureTask(GraspChoice, Motions):
         b[:3, 3] = c
         psi_x = math.acos(float(np.clip(np.dot(xa, (px - c) / r), -1, 1)))
         free = self.geom.span - psi_x  # arc outside the tissue when the bite is full
-        if free < 2 * CLEAR + math.radians(16):
+        least = 2 * CLEAR + math.radians(16)  # two jaws' clearances and room for a grasp
+        if free < least:
+            farthest = 2 * r * math.sin(max(self.geom.span - least, 0.0) / 2)
             raise SutureError(
-                f"pair {pair.index}: the needle's arc ({math.degrees(self.geom.span):.0f}°) leaves "
-                f"{math.degrees(free):.0f}° outside a {math.degrees(psi_x):.0f}° bite; too little to hold it"
+                f"pair {pair.index}: the needle bites {dist * 1000:.1f} mm from entry to exit (between the "
+                f"holes' openings), {math.degrees(psi_x):.0f}° of its {math.degrees(self.geom.span):.0f}° arc: "
+                f"the {math.degrees(free):.0f}° left outside the tissue is too little to hold it "
+                f"(this needle, {r * 1000:.1f} mm radius, can drive a pair at most {farthest * 1000:.1f} mm apart)"
             )
         g = min(MAX_GRASP, free / 2 - CLEAR - math.radians(2))
         g_tip, g_tail = g + self.grasp_jitter[0] * g / MAX_GRASP, g + self.grasp_jitter[1] * g / MAX_GRASP
