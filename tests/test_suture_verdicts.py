@@ -431,3 +431,27 @@ def test_holes_too_far_apart_for_the_needle_fail_with_the_distance_it_can_drive(
     assert not p["passed"] and p["rule"] == "reach"
     assert "the needle bites 15.6 mm from entry to exit" in p["reason"]
     assert "can drive a pair at most 14.5 mm apart" in p["reason"]
+
+
+def test_a_pair_without_its_entry_ghost_is_named_with_what_it_lacks(tmp_path):
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.suture import SutureError, SutureTask
+
+    def drop_entry_2(d: Path) -> None:
+        def fn(s: str) -> str:
+            s = s.replace("- GHOST ghostEntry2\n", "")
+            return s[: s.index("GHOST ghostEntry2:")] + s[s.index("GHOST ghostEntry3:") :]
+
+        _edit(d / "phantom" / "ghosts.yaml", fn)
+
+    world = open_world(load_scene(_scene(tmp_path, drop_entry_2)), Options(renderer="tiny"))
+    try:
+        with pytest.raises(SutureError) as exc:
+            SutureTask(world, [1, 2, 5], seed=0)
+        assert str(exc.value) == (
+            "pair 2: ghostExit2 has no entry hole ghost (Entry2) beside it; "
+            "pair 5: no hole ghost named Entry5 or Exit5 (the scene's whole pairs: 1, 3, 4)"
+        )
+    finally:
+        world.close()

@@ -86,14 +86,31 @@ def _in_plane_room(ghost, direction) -> float:
     return min(geo.x, geo.y) / 2 * (ghost.ghost.scale or 1.0)
 
 
-def hole_pairs(world) -> list[HolePair]:
-    """Entry k / Exit k hole ghosts of the scene, by their number."""
+def hole_ghosts(world) -> dict[int, dict]:
+    """The hole ghosts (those with the viscous friction) named Entry k / Exit k: {k: {"entry":
+    ghost, "exit": ghost}}, either missing where the scene lacks it."""
     found: dict[int, dict] = {}
     for g in world.ghosts:
         name = (g.ghost.name or g.ghost.identifier).lower()
         m = re.search(r"(entry|exit)\D*(\d+)\s*$", name)
         if m and g.friction:
             found.setdefault(int(m.group(2)), {})[m.group(1)] = g
+    return found
+
+
+def _missing_pair(k: int, found: dict[int, dict]) -> str:
+    """What pair k lacks, in a modeller's words."""
+    d = found.get(k, {})
+    if not d:
+        return f"pair {k}: no hole ghost named Entry{k} or Exit{k}"
+    have, lack = ("entry", "exit") if "entry" in d else ("exit", "entry")
+    g = d[have]
+    return f"pair {k}: {g.ghost.name or g.ghost.identifier} has no {lack} hole ghost ({lack.capitalize()}{k}) beside it"
+
+
+def hole_pairs(world) -> list[HolePair]:
+    """Entry k / Exit k hole ghosts of the scene, by their number."""
+    found = hole_ghosts(world)
     out = []
     for k in sorted(found):
         d = found[k]
@@ -149,7 +166,9 @@ class SutureTask(GraspChoice, Motions):
         missing = [k for k in pairs if k not in all_pairs]
         if missing:
             have = ", ".join(str(k) for k in sorted(all_pairs)) or "none"
-            raise SutureError(f"the scene has no entry/exit hole pair {missing} (pairs: {have})")
+            found = hole_ghosts(world)
+            lacks = "; ".join(_missing_pair(k, found) for k in missing)
+            raise SutureError(f"{lacks} (the scene's whole pairs: {have})")
         self.pairs = [all_pairs[k] for k in pairs]
         self.psms = {n: PSM(world, n) for n in psm_names}
         self.phase = "start"
