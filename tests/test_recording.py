@@ -1,6 +1,6 @@
-"""Camera L's pictures over an episode (runner/recording.py, runner/mujoco/recorder.py): drawn in
-a process of its own they are the pictures drawn between the steps, pixel for pixel; a recorder
-that cannot start says why and the frames are drawn here instead."""
+"""Camera L's pictures over an episode (runner/recording.py, runner/mujoco/recorder.py), in either
+engine: drawn in a process of its own they are the pictures drawn between the steps, pixel for
+pixel; a recorder that cannot start says why and the frames are drawn here instead."""
 
 from __future__ import annotations
 
@@ -11,18 +11,20 @@ from conftest import ROOT
 BUNDLED = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
 
 
-@pytest.fixture(scope="module")
-def world():
+@pytest.fixture(scope="module", params=["pybullet", "mujoco"])
+def world(request):
+    """The bundled scene in each engine, drawn by MuJoCo's renderer (the PyBullet world's mirror,
+    the MuJoCo engine's own cameras)."""
     from adfkit.adf import load_scene
     from adfkit.runner import Options, open_world
 
-    w = open_world(load_scene(BUNDLED), Options(renderer="mujoco"))
+    w = open_world(load_scene(BUNDLED), Options(renderer="mujoco"), engine=request.param)
     try:
         w.cameras[0].render(w, rgb_only=True)
     except Exception as exc:  # noqa: BLE001
         w.close()
         pytest.skip(f"MuJoCo's renderer cannot draw here: {exc}")
-    if w.renderer != "mujoco":
+    if request.param == "pybullet" and w.renderer != "mujoco":
         w.close()
         pytest.skip(f"MuJoCo's renderer is not available here ({w.renderer_note})")
     yield w

@@ -17,11 +17,14 @@ def _mujoco_mirror(world):
 
 def camera_recording(world, cam, video_path=None, fps: float = 5.0, gif_width: int = 320, process: bool = True):
     """The pictures of ``cam`` over an episode (runner/recording.py's interface): drawn in a
-    process of its own beside the physics where a PyBullet world draws with the MuJoCo mirror
-    (its rigid bodies are all the mirror needs to know each frame), else between the steps here."""
+    process of its own beside the physics where MuJoCo's renderer draws them (the MuJoCo engine,
+    or a PyBullet world with the MuJoCo mirror: its rigid bodies' poses are all the mirror needs
+    to know each frame, and the pictures are the same pixel for pixel), else between the steps
+    here."""
     from .recording import CameraRecording
 
-    if process and world.engine == "pybullet" and world.renderer == "mujoco" and not _deforms(world):
+    mirrored = world.engine == "mujoco" or world.renderer == "mujoco"
+    if process and mirrored and not _deforms(world):
         from .mujoco.recorder import MirrorRecording
 
         return MirrorRecording(world, cam, video_path, fps, gif_width)
