@@ -1,9 +1,10 @@
 """A world's camera frames (a PyBullet world's, or the MuJoCo engine's) drawn by the MuJoCo
-mirror (mirror.py) in a process of its own, beside the physics: at each frame the episode's process sends only the drawn bodies' poses
-(a few kilobytes); the other process puts the mirror's bodies there, renders, writes the MP4 and
-keeps the preview's frames, which it hands back at the end. The pictures are the ones the mirror
-draws in the episode's process, pixel for pixel; the episode's process no longer waits for them
-(in the bundled suture ~20 ms a frame, 450 frames). A recorder that cannot start (no OpenGL
+mirror (mirror.py) in a process of its own, beside the physics: at each frame the episode's
+process sends only the drawn bodies' poses (a few kilobytes); the other process puts the
+mirror's bodies there, renders, writes the MP4 and keeps the preview's frames, which it hands
+back at the end. The pictures are the ones the mirror draws in the episode's process, pixel
+for pixel; the episode's process no longer waits for them (in the bundled suture ~20 ms a
+frame, 450 frames). A recorder that cannot start (no OpenGL
 there) says why and the frames are drawn in the episode's process from then on."""
 
 from __future__ import annotations

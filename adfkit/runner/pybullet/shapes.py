@@ -33,8 +33,9 @@ from ...model.semantics import (
 from ...validator.paths_check import obj_material_problems
 from ..plan import rgba
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
+from .egl import quiet_stdout
 from .margins import file_margin, give_margin
-from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, mesh_refusal, pybullet_mesh, quiet_stdout, untextured
+from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, mesh_refusal, pybullet_mesh, untextured
 
 
 @dataclass
