@@ -737,7 +737,8 @@ def test_both_engines_answer_the_same_public_api(tmp_path):
 
 
 def test_missing_and_flat_meshes_are_warned_not_fatal(tmp_path):
-    """A collision mesh file that is not there drops its shape (runner-mesh); a flat mesh,
+    """A collision mesh file that is not there: the body is skipped, as AMBF and the PyBullet
+    runner do (runner-missing-mesh; the engine made it without a shape before); a flat mesh,
     which MuJoCo cannot hull, collides as its bounding box (runner-flat-mesh): a box dropped
     on a 1 x 1 m flat square comes to rest on it."""
     (tmp_path / "flat.obj").write_text("v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nf 1 2 3\nf 1 3 4\n")
@@ -768,7 +769,8 @@ BODY box:
     world = MujocoWorld(_model(tmp_path, text), Options(gravity=(0, 0, -G), ground=False))
     try:
         rules = sorted({d.rule for d in world.diagnostics})
-        assert rules == ["runner-flat-mesh", "runner-mesh"]
+        assert rules == ["runner-flat-mesh", "runner-missing-mesh"]
+        assert world.skipped == ["BODY ghostly"] and "BODY ghostly" not in world.registry.items
         world.run(1.0)
         z = world.body("box").com_position()[2]
         assert z == pytest.approx(0.01 + 5e-4, abs=1e-3)  # on the floor's 1 mm box, not through it

@@ -178,3 +178,26 @@ def test_a_mesh_whose_texture_is_missing_is_one_located_warning_not_pybullets_no
     assert len(found) == 2  # each body's visual mesh, at its `mesh` key
     assert all(ln.startswith(f"{f}:") and ":9: warning[runner-missing-texture]" in ln for ln in found)
     assert "texture /home/someone/drape.png (in drape.mtl)" in found[0]
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_body_whose_collision_mesh_is_missing_is_skipped_in_both_engines(tmp_path, capsys, engine):
+    """AMBF does not create a body whose collision mesh file is missing (the corpus's sophie.yaml:
+    its Body.STL is missing in the source repository itself). The MuJoCo engine made it anyway,
+    without a collision shape, and the robot's legs fell with it; both engines skip it now, and
+    the joints that name it, each with a located warning."""
+    f = tmp_path / "m.yaml"
+    f.write_text(
+        "bodies: [BODY a, BODY b]\njoints: [JOINT a-b]\n"
+        + _body("a", z=0.5, shape="  mesh: gone.stl\n")
+        + _body("b", z=0.3)
+        + "JOINT a-b:\n  name: a-b\n  parent: BODY a\n  child: BODY b\n  type: revolute\n"
+        "  parent pivot: {x: 0, y: 0, z: -0.1}\n  child pivot: {x: 0, y: 0, z: 0.1}\n"
+        "  parent axis: {x: 1, y: 0, z: 0}\n  child axis: {x: 1, y: 0, z: 0}\n"
+    )
+    rc = main(["run", str(f), "--seconds", "0.05", "--no-frames", "--engine", engine, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    report = _strict((tmp_path / "out" / "report.json").read_text())
+    assert rc == 0 and report["skipped_bodies"] == ["BODY a"] and report["bodies"] == 1
+    assert f"{f}:8:9: warning[runner-missing-mesh]: BODY a: collision mesh" in err and "gone.stl not found" in err
+    assert f"{f}:17:3: warning[runner-joint-body]: JOINT a-b: parent or child body not found; skipped" in err

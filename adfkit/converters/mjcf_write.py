@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 from pathlib import Path
 
 from ..adf.paths import collision_mesh_path, visual_mesh_path
@@ -29,7 +30,7 @@ from ..model.semantics import (
     inertial_offset,
     joint_frames,
 )
-from ..model.tree import Link, build_tree, motion
+from ..model.tree import Link, build_tree, joint_ends, motion
 from . import inertia as inertia_math
 from .engine_fit import MeshFiles, flat_box, joint_range, split_objects, usable_scales
 from .losses import Loss
@@ -314,14 +315,20 @@ def to_mjcf(
     tree_kinds=None,
     names_out: dict | None = None,
     volumes: bool = True,
+    leave_out: frozenset[str] = frozenset(),
 ) -> tuple[str, list[Loss]]:
     """MJCF text and losses. ``tree_kinds``: joint kinds that join the tree (default revolute,
     prismatic, fixed); a link joined by another kind is written welded to its parent, for the
     caller to add its joints (the MuJoCo runner's six-dof springs). ``names_out`` receives
     {body identifier: (MJCF body name, tree Link)}; the key "" holds the KinematicTree.
     ``volumes``: write each volume as its iso-surface mesh (volume_mesh.py); False leaves them
-    out, for a caller that places them itself (the MuJoCo runner)."""
+    out, for a caller that places them itself (the MuJoCo runner). ``leave_out``: identifiers of
+    bodies not written, with the joints that name them (bodies AMBF does not create: the MuJoCo
+    runner's ``plan.uncreated_bodies``)."""
     losses: list[Loss] = []
+    if leave_out:
+        kept = [j for j in model.joints if not joint_ends(model, j) & leave_out]
+        model = replace(model, bodies=[b for b in model.bodies if b.identifier not in leave_out], joints=kept)
     model = usable_scales(model, losses)
     tree = build_tree(model) if tree_kinds is None else build_tree(model, tree_kinds)
     has_volume = volumes and any(v.defined for v in model.volumes)

@@ -111,6 +111,11 @@ def find_body(model: ModelFile, ref: str | None) -> Body | None:
     return hits[0] if len(hits) == 1 else None
 
 
+def joint_ends(model: ModelFile, joint) -> set[str | None]:
+    """The identifiers of the bodies a joint's `parent` and `child` name (None for one not found)."""
+    return {getattr(find_body(model, ref), "identifier", None) for ref in (joint.parent, joint.child)}
+
+
 def _scale(b: Body) -> float:
     return b.scale if b.scale is not None else 1.0
 

@@ -63,6 +63,60 @@ def not_played(world, models, engine: str) -> None:
                 world.not_played.append({"object": o.identifier, "what": kind, "why": why})
 
 
+def uncreated_bodies(world, model) -> frozenset[str]:
+    """The bodies of ``model`` AMBF does not create, each with a located warning and listed in
+    ``world.skipped`` (the joints that name them warned about too): a body whose collision comes
+    from a mesh file (no primitive collision shape) that is missing, refused by the input policy
+    (adfkit.inputs) or has no triangles. The PyBullet runner finds the same
+    ones as it builds their shapes (pybullet/shapes.py); an engine that writes the whole model
+    at once (the MuJoCo engine) leaves these out first."""
+    from .. import inputs
+    from ..adf.paths import collision_mesh_path
+    from ..diagnostics import AdfError, warning
+    from ..geometry.meshcheck import mesh_problem
+    from ..model.semantics import collision_primitives
+    from ..model.tree import joint_ends
+
+    out = set()
+    for b in model.bodies:
+        path = collision_mesh_path(model, b) if collision_primitives(b) is None else None
+        if path is None:
+            continue
+        where = b.where("collision mesh" if b.collision_mesh is not None else "mesh") or b.source
+        try:
+            inputs.check_file(path, "mesh", tree=getattr(model, "tree", None), what="mesh file")
+        except AdfError as exc:
+            d = exc.diagnostics[0]
+            why = f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
+            world.diagnostics.append(
+                warning(
+                    "runner-missing-mesh",
+                    f"{b.identifier}: collision mesh {why}; the body is skipped as AMBF does",
+                    where,
+                    "fix `collision mesh`/`mesh` or the resolution paths",
+                )
+            )
+            out.add(b.identifier)
+            continue
+        if (problem := mesh_problem(path)) is not None:
+            world.diagnostics.append(
+                warning(
+                    "runner-bad-mesh",
+                    f"{b.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; "
+                    "the body is skipped as AMBF does",
+                    where,
+                    "re-export the mesh as a triangle mesh (STL or OBJ)",
+                )
+            )
+            out.add(b.identifier)
+    ns = model.namespace or ""
+    world.skipped += [merge_namespace(ns, b.namespace) + b.identifier for b in model.bodies if b.identifier in out]
+    for j in model.joints:
+        if joint_ends(model, j) & out:
+            world._warn("runner-joint-body", f"{j.identifier}: parent or child body not found; skipped", j)
+    return frozenset(out)
+
+
 def resolve_parent(world, ref: str | None, ns: str, obj, body_type=None):
     """The body ``ref`` names for ``obj`` (a ghost, sensor, actuator), found as written or in the
     model's namespace; None with a located ``runner-parent`` warning when no unique body matches."""

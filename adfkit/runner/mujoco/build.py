@@ -26,6 +26,7 @@ from ...converters.mjcf_write import to_mjcf
 from ...converters.urdf import _material
 from ...model.semantics import JointKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
+from .. import plan as scene_rules
 from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
@@ -165,9 +166,12 @@ def build_plan(world) -> Plan:
     for i, m in enumerate(scene.all_models()):
         ns = m.namespace or ""
         mine = {}
-        if m.bodies:
+        uncreated = scene_rules.uncreated_bodies(world, m)  # skipped, warned about, with the joints naming them
+        if len(uncreated) < len(m.bodies):
             names: dict = {}
-            text, ls = to_mjcf(m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names, volumes=False)
+            text, ls = to_mjcf(
+                m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names, volumes=False, leave_out=uncreated
+            )
             losses += ls
             for loss in ls:  # the MJCF writer already made a flat collision mesh a thin box (engine_fit)
                 if loss.feature == "collision mesh" and "flat" in loss.reason:

@@ -202,7 +202,7 @@ def collision_parts(
             warning(
                 "runner-missing-mesh",
                 f"{obj.identifier}: collision mesh {refused}; the body is skipped as AMBF does",
-                obj.where("collision mesh") or obj.source,
+                obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
                 "fix `collision mesh`/`mesh` or the resolution paths",
             )
         )
