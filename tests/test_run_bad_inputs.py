@@ -201,3 +201,28 @@ def test_a_body_whose_collision_mesh_is_missing_is_skipped_in_both_engines(tmp_p
     assert rc == 0 and report["skipped_bodies"] == ["BODY a"] and report["bodies"] == 1
     assert f"{f}:8:9: warning[runner-missing-mesh]: BODY a: collision mesh" in err and "gone.stl not found" in err
     assert f"{f}:17:3: warning[runner-joint-body]: JOINT a-b: parent or child body not found; skipped" in err
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_the_floor_under_a_model_played_alone_meets_bodies_of_every_collision_group(tmp_path, engine):
+    """The floor stands in for a world's, which has no collision groups: it meets every body.
+    It met only the bodies of one group before (Bullet's static default: the second group;
+    MuJoCo's default bit: the first), and sophie.yaml's legs fell through it in MuJoCo."""
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+
+    text = "bodies: [BODY a, BODY b, BODY c]\n" + "".join(
+        _body(n, x=x, z=z) + f"  collision groups: {g}\n"
+        for n, x, z, g in (("a", 0.0, 0.0, "[0]"), ("b", 0.5, 0.2, "[3]"), ("c", 1.0, 0.3, "[3, 7]"))
+    )
+    f = tmp_path / "m.yaml"
+    f.write_text(text)
+    world = open_world(load_scene(f), Options(), engine=engine)
+    try:
+        world.run(1.5)
+        floor = world.ground_z
+        for n in "abc":
+            z = world.body(f"BODY {n}").com_position()[2]
+            assert z == pytest.approx(floor + 0.05, abs=2e-3), (n, z, floor)  # the 5 cm spheres rest on it
+    finally:
+        world.close()

@@ -33,6 +33,10 @@ SPRING_KINDS = (
     JointKind.TORSION_SPRING,
 )
 
+#: every collision-group bit: what a body without collision groups (and the runner's floor,
+#: which stands in for a world's) collides as, in both engines
+ALL_GROUPS = (1 << 31) - 1
+
 #: sections of a model each engine does not play (each is warned about and listed in the report)
 NOT_PLAYED = {
     "pybullet": (("vehicle", "vehicles"),),

@@ -11,6 +11,7 @@ import numpy as np
 
 from ...model.semantics import JointKind, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
+from ..plan import ALL_GROUPS
 from ..rotations import pose_to_matrix
 from .build import build_plan
 from .contacts import set_contacts
@@ -57,8 +58,15 @@ class Assembly:
         self.ground_z = None
         if ground and plan.bodies:
             self.ground_z = self._lowest_point() - 1e-3
+            # the floor stands in for a world's, which has no collision groups: every bit, so
+            # that it meets every body whatever its groups (the default bit met group 0's only)
             spec.worldbody.add_geom(
-                type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1], pos=[0, 0, self.ground_z], name="adfkit:ground"
+                type=mujoco.mjtGeom.mjGEOM_PLANE,
+                size=[0, 0, 1],
+                pos=[0, 0, self.ground_z],
+                name="adfkit:ground",
+                contype=ALL_GROUPS,
+                conaffinity=ALL_GROUPS,
             )
             self.model = compile_spec(self, spec)
             self.data = mujoco.MjData(self.model)

@@ -353,7 +353,7 @@ def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
     excluded body pairs."""
     groups = sorted({g for bp in bodies for g in (bp.body.collision_groups or []) if 0 <= g <= 999})
     bit = {g: 1 << (i % 31) for i, g in enumerate(groups)}
-    allbits = (1 << 31) - 1
+    allbits = scene_rules.ALL_GROUPS
     for bp in bodies:
         if bp.mjname == "world":
             continue

@@ -13,7 +13,16 @@ import pybullet as pb
 from ...model.semantics import JointKind, joint_frames, joint_kind, pose_or_identity
 from ..cameras import build_cameras
 from ..names import Registry, merge_namespace
-from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
+from ..plan import (
+    ALL_GROUPS,
+    SPRING_KINDS,
+    is_hole,
+    key_of,
+    not_played,
+    played_actuators,
+    played_sensors,
+    resolve_parent,
+)
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from . import articulation, egl
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
@@ -178,6 +187,9 @@ class Assembly:
             self.ground_uid = pb.createMultiBody(0.0, shape, vis, [0.0, 0.0, self.ground_z], physicsClientId=self.cid)
         else:  # soft bodies stop centimetres above a static plane: a thick slab instead
             self.ground_uid = self.soft.ground_slab(self.ground_z)
+        # the floor stands in for a world's, which has no collision groups: it meets every body,
+        # whatever its groups (Bullet's static default met only the bodies of the second group)
+        pb.setCollisionFilterGroupMask(self.ground_uid, -1, ALL_GROUPS, ALL_GROUPS, physicsClientId=self.cid)
         self._floor_z = self.ground_z
 
     def _shapes_for(self, sb: SimBody, frame_in_body) -> tuple[int, int]:
@@ -221,7 +233,7 @@ class Assembly:
         bit = {g: 1 << (i % 30) for i, g in enumerate(groups)}
         if len(groups) > 30:
             self._warn("runner-groups", "more than 30 collision groups: groups share mask bits", None)
-        allbits = (1 << 31) - 1
+        allbits = ALL_GROUPS
         for sb in self.bodies:
             gs = [g for g in (sb.body.collision_groups or []) if 0 <= g <= 999]
             if gs:
