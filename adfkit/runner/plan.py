@@ -67,51 +67,63 @@ def not_played(world, models, engine: str) -> None:
                 world.not_played.append({"object": o.identifier, "what": kind, "why": why})
 
 
-def uncreated_bodies(world, model) -> frozenset[str]:
-    """The bodies of ``model`` AMBF does not create, each with a located warning and listed in
-    ``world.skipped`` (the joints that name them warned about too): a body whose collision comes
-    from a mesh file (no primitive collision shape) that is missing, refused by the input policy
-    (adfkit.inputs) or has no triangles. The PyBullet runner finds the same
-    ones as it builds their shapes (pybullet/shapes.py); an engine that writes the whole model
-    at once (the MuJoCo engine) leaves these out first."""
+def mesh_refusal(model, path) -> str | None:
+    """Why the input policy (adfkit.inputs) keeps an engine from reading this mesh, or None:
+    missing, not a regular file, over the size cap, outside the model's tree."""
+    from .. import inputs
+    from ..diagnostics import AdfError
+
+    try:
+        inputs.check_file(path, "mesh", tree=getattr(model, "tree", None), what="mesh file")
+    except AdfError as exc:
+        d = exc.diagnostics[0]
+        return f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
+    return None
+
+
+def uncreated(model, obj):
+    """The located warning (a Diagnostic) when AMBF does not create ``obj`` (a body or ghost),
+    else None: its collision comes from a mesh file (no primitive collision shape) that is
+    missing, refused by the input policy or has no triangles."""
     from .. import inputs
     from ..adf.paths import collision_mesh_path
-    from ..diagnostics import AdfError, warning
+    from ..diagnostics import warning
     from ..geometry.meshcheck import mesh_problem
     from ..model.semantics import collision_primitives
+
+    path = collision_mesh_path(model, obj) if collision_primitives(obj) is None else None
+    if path is None:
+        return None
+    where = obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source
+    if (refused := mesh_refusal(model, path)) is not None:
+        return warning(
+            "runner-missing-mesh",
+            f"{obj.identifier}: collision mesh {refused}; the body is skipped as AMBF does",
+            where,
+            "fix `collision mesh`/`mesh` or the resolution paths",
+        )
+    if (problem := mesh_problem(path)) is not None:
+        # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some
+        return warning(
+            "runner-bad-mesh",
+            f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; the body is skipped as AMBF does",
+            where,
+            "re-export the mesh as a triangle mesh (STL or OBJ)",
+        )
+    return None
+
+
+def uncreated_bodies(world, model) -> frozenset[str]:
+    """The bodies of ``model`` AMBF does not create (``uncreated``), each warned about and listed
+    in ``world.skipped``, the joints that name them warned about too: an engine that writes the
+    whole model at once (the MuJoCo engine) leaves these out first; the PyBullet runner asks
+    ``uncreated`` as it builds each body's shapes (pybullet/shapes.py)."""
     from ..model.tree import joint_ends
 
     out = set()
     for b in model.bodies:
-        path = collision_mesh_path(model, b) if collision_primitives(b) is None else None
-        if path is None:
-            continue
-        where = b.where("collision mesh" if b.collision_mesh is not None else "mesh") or b.source
-        try:
-            inputs.check_file(path, "mesh", tree=getattr(model, "tree", None), what="mesh file")
-        except AdfError as exc:
-            d = exc.diagnostics[0]
-            why = f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
-            world.diagnostics.append(
-                warning(
-                    "runner-missing-mesh",
-                    f"{b.identifier}: collision mesh {why}; the body is skipped as AMBF does",
-                    where,
-                    "fix `collision mesh`/`mesh` or the resolution paths",
-                )
-            )
-            out.add(b.identifier)
-            continue
-        if (problem := mesh_problem(path)) is not None:
-            world.diagnostics.append(
-                warning(
-                    "runner-bad-mesh",
-                    f"{b.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; "
-                    "the body is skipped as AMBF does",
-                    where,
-                    "re-export the mesh as a triangle mesh (STL or OBJ)",
-                )
-            )
+        if (why := uncreated(model, b)) is not None:
+            world.diagnostics.append(why)
             out.add(b.identifier)
     ns = model.namespace or ""
     world.skipped += [merge_namespace(ns, b.namespace) + b.identifier for b in model.bodies if b.identifier in out]

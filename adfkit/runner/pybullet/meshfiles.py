@@ -14,20 +14,10 @@ from ... import inputs
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import AdfError
 from ...validator.paths_check import obj_material_problems
+from ..plan import mesh_refusal
 from .egl import quiet_stdout
 
 MESH_SUFFIXES = {".obj", ".stl"}  # what PyBullet's GEOM_MESH reads from a file
-
-
-def mesh_refusal(model, path: Path) -> str | None:
-    """Why the input policy (adfkit.inputs) keeps PyBullet from reading this mesh, or None:
-    missing, not a regular file, over the size cap, outside the model's tree."""
-    try:
-        inputs.check_file(path, "mesh", tree=getattr(model, "tree", None), what="mesh file")
-    except AdfError as exc:
-        d = exc.diagnostics[0]
-        return f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
-    return None
 
 
 _STL_DIR: str | None = None

@@ -31,11 +31,11 @@ from ...model.semantics import (
     shortest_arc,
 )
 from ...validator.paths_check import obj_material_problems
-from ..plan import rgba
+from ..plan import mesh_refusal, rgba, uncreated
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from .egl import quiet_stdout
 from .margins import file_margin, give_margin
-from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, mesh_refusal, pybullet_mesh, untextured
+from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, pybullet_mesh, untextured
 
 
 @dataclass
@@ -184,20 +184,11 @@ def collision_parts(
     path = collision_mesh_path(model, obj)
     if path is None:
         return parts  # no collision geometry: an empty shape (AMBF prints an error)
-    if mesh_refusal(model, path) is None and (problem := mesh_problem(path)) is not None:
-        # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some, reads garbage from others
-        diags.append(
-            warning(
-                "runner-bad-mesh",
-                f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: "
-                f"{problem}; the body is skipped as AMBF does",
-                obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
-                "re-export the mesh as a triangle mesh (STL or OBJ)",
-            )
-        )
+    if (why := uncreated(model, obj)) is not None:  # missing, refused or without triangles (plan.py)
+        diags.append(why)
         return None
     path, refused = pybullet_mesh(model, path)
-    if refused is not None:
+    if refused is not None:  # an STL neither PyBullet nor trimesh can read
         diags.append(
             warning(
                 "runner-missing-mesh",
