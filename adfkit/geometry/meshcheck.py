@@ -14,6 +14,7 @@ import os
 import re
 import struct
 from functools import lru_cache
+from pathlib import Path
 
 from .. import inputs
 from ..diagnostics import AdfError
@@ -86,3 +87,39 @@ def _obj_problem(data: bytes) -> str | None:
     if _OBJ_FACE.search(data) is None:
         return "the OBJ file has no faces ('f' lines)"
     return None
+
+
+TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")  # MTL statements naming a file
+
+
+@lru_cache(maxsize=1024)
+def obj_material_problems(obj_path: str) -> tuple[str, ...]:
+    """Missing MTL libraries and textures of an OBJ file (names as written)."""
+    missing: list[str] = []
+    base = Path(obj_path).parent
+    try:
+        inputs.check_file(obj_path, "mesh")
+        with open(obj_path, encoding="utf-8", errors="replace") as fh:
+            libs = [line.split(None, 1)[1].strip() for line in fh if line.startswith("mtllib") and " " in line]
+    except (OSError, ValueError, AdfError):
+        return ()
+    for lib in libs:
+        mtl = base / lib
+        if not inputs.is_regular(str(mtl)):
+            missing.append(f"material library {inputs.shown(lib, 80)}")
+            continue
+        try:
+            data = inputs.read_bytes(mtl, "text", tree=inputs.Tree(Path(os.path.realpath(base))))
+            lines = data.decode("utf-8", errors="replace").splitlines()
+        except AdfError:
+            missing.append(f"material library {inputs.shown(lib, 80)} (outside the mesh's folder or not readable)")
+            continue
+        for line in lines:
+            parts = line.strip().split()
+            if len(parts) >= 2 and parts[0].lower().startswith(TEXTURE_KEYS):
+                tex = parts[-1]
+                if not inputs.is_regular(str(mtl.parent / tex)) and not inputs.is_regular(
+                    str(mtl.parent / tex.replace("\\", "/"))
+                ):
+                    missing.append(f"texture {inputs.shown(tex, 80)} (in {inputs.shown(lib, 80)})")
+    return tuple(dict.fromkeys(missing))

@@ -4,34 +4,27 @@ shaders, skyboxes, sensor meshes, and the files launch, world and input-devices 
 from __future__ import annotations
 
 import os
-import stat
 from functools import lru_cache
 from pathlib import Path
 
 from .. import inputs
 from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
-from ..geometry.meshcheck import mesh_problem
+from ..geometry.meshcheck import mesh_problem, obj_material_problems
 from ..model import InputDevices, Launch, ModelFile, World
 from ..model.objects import Body, Ghost, SoftBody
 from . import softbody_rules, volume_rules
 from .rules import RULES
 
 AMBF_MESH_SUFFIXES = (".obj", ".stl", ".3ds")  # what CHAI3D's cMultiMesh::loadFromFile reads for AMBF
-TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")
 
 
 def _d(rule: str, message: str, loc: SourceLocation | None, hint: str | None = None) -> Diagnostic:
     return Diagnostic(RULES[rule].severity, rule, message, loc, hint)
 
 
-@lru_cache(maxsize=4096)
-def _exists(path: str) -> bool:
-    """A regular file is there (never raises: odd paths are simply not there)."""
-    try:
-        return stat.S_ISREG(os.stat(path).st_mode)
-    except (OSError, ValueError):
-        return False
+# a regular file is there (never raises: odd paths are simply not there); asked once per path
+_exists = lru_cache(maxsize=4096)(inputs.is_regular)
 
 
 def _present(path) -> bool:
@@ -61,37 +54,6 @@ def _policy(path, doc, kind: str, loc, owner: str) -> Diagnostic | None:
         return None
     rule, message, hint = found
     return _d(rule, f"{owner}: {message}", loc, hint)
-
-
-@lru_cache(maxsize=1024)
-def obj_material_problems(obj_path: str) -> tuple[str, ...]:
-    """Missing MTL libraries and textures of an OBJ file (names as written)."""
-    missing: list[str] = []
-    base = Path(obj_path).parent
-    try:
-        inputs.check_file(obj_path, "mesh")
-        with open(obj_path, encoding="utf-8", errors="replace") as fh:
-            libs = [line.split(None, 1)[1].strip() for line in fh if line.startswith("mtllib") and " " in line]
-    except (OSError, ValueError, AdfError):
-        return ()
-    for lib in libs:
-        mtl = base / lib
-        if not _exists(str(mtl)):
-            missing.append(f"material library {inputs.shown(lib, 80)}")
-            continue
-        try:
-            data = inputs.read_bytes(mtl, "text", tree=inputs.Tree(Path(os.path.realpath(base))))
-            lines = data.decode("utf-8", errors="replace").splitlines()
-        except AdfError:
-            missing.append(f"material library {inputs.shown(lib, 80)} (outside the mesh's folder or not readable)")
-            continue
-        for line in lines:
-            parts = line.strip().split()
-            if len(parts) >= 2 and parts[0].lower().startswith(TEXTURE_KEYS):
-                tex = parts[-1]
-                if not _exists(str(mtl.parent / tex)) and not _exists(str(mtl.parent / tex.replace("\\", "/"))):
-                    missing.append(f"texture {inputs.shown(tex, 80)} (in {inputs.shown(lib, 80)})")
-    return tuple(dict.fromkeys(missing))
 
 
 def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:

@@ -13,7 +13,7 @@ import numpy as np
 from ... import inputs
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import AdfError
-from ...validator.paths_check import obj_material_problems
+from ...geometry.meshcheck import obj_material_problems
 from ..plan import mesh_refusal
 from .egl import quiet_stdout
 

@@ -19,7 +19,7 @@ import pybullet as pb
 from ... import inputs
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import Diagnostic, warning
-from ...geometry.meshcheck import mesh_problem
+from ...geometry.meshcheck import mesh_problem, obj_material_problems
 from ...model.pose import Pose, Quat, Vec3
 from ...model.semantics import (
     CollisionMeshType,
@@ -30,7 +30,6 @@ from ...model.semantics import (
     shape_kind,
     shortest_arc,
 )
-from ...validator.paths_check import obj_material_problems
 from ..plan import mesh_refusal, rgba, uncreated
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from .egl import quiet_stdout
