@@ -163,3 +163,28 @@ def test_the_back_ends_have_the_same_layout_and_small_files():
         if (n := len(f.read_text(encoding="utf-8").splitlines())) > 400
     )
     assert long == []
+
+
+@pytest.mark.parametrize(
+    "module, name",
+    [("adfkit.runner.pybullet.world", "PyBulletWorld"), ("adfkit.runner.mujoco.world", "MujocoWorld")],
+)
+def test_a_back_end_method_is_not_shadowed_by_the_core(module, name):
+    """Each back end is its halves (Assembly, Interaction, ...) over the engine-neutral World:
+    what a half defines must be what the world calls, not World's default. With World first
+    among the bases, both engines' batched contacts_among (one query an arm, or one contact
+    table a step) were never called: the default asked body by body."""
+    import importlib
+
+    from adfkit.runner.world import World
+
+    pytest.importorskip(module.split(".")[2])
+    cls = getattr(importlib.import_module(module), name)
+    for half in cls.__mro__[1:]:
+        if half in (World, object):
+            continue
+        for attr, value in vars(half).items():
+            if callable(value) and not attr.startswith("__"):
+                assert getattr(cls, attr) is value, (
+                    f"{name}.{attr} is {getattr(cls, attr).__qualname__}, not {half.__name__}'s"
+                )

@@ -22,7 +22,7 @@ from .interact import Interaction
 from .objects import MjBody
 
 
-class MujocoWorld(World, Assembly, Interaction):
+class MujocoWorld(Assembly, Interaction, World):
     engine = "mujoco"
     body_type = MjBody
 

@@ -30,7 +30,7 @@ from .softbodies import in_scene as soft_in_scene
 from .state import WorldState
 
 
-class PyBulletWorld(World, Assembly, Interaction, WorldState):
+class PyBulletWorld(Assembly, Interaction, WorldState, World):
     engine = "pybullet"
     body_type = SimBody
 
