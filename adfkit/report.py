@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Iterable, Iterator
-from typing import IO, TypeVar
+from collections.abc import Iterable
+from typing import IO
 
 from .diagnostics import Diagnostic
-
-T = TypeVar("T")
 
 
 def print_diagnostics(diags: Iterable[Diagnostic], stream: IO[str] | None = None) -> None:
@@ -72,11 +70,3 @@ class Progress:
 
     def __exit__(self, *exc) -> None:
         self.close()
-
-
-def track(items: Iterable[T], label: str = "", total: int | None = None) -> Iterator[T]:
-    items = list(items) if total is None else items
-    with Progress(total if total is not None else len(items), label) as bar:  # type: ignore[arg-type]
-        for it in items:
-            yield it
-            bar.update()

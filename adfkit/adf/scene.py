@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import cast
 
 from ..diagnostics import AdfError, Diagnostic, SourceLocation, error
-from ..model import InputDevices, Launch, ModelFile, Scene, World
+from ..model import Launch, ModelFile, Scene, World
 from .paths import relative_to_file
 from .reader import read_file
 
@@ -93,15 +93,3 @@ def _attach_world(scene: Scene, world: World, diags: list[Diagnostic]) -> None:
         env, found = read_file(env_path, "model", tree=world.tree, referrer=world.where("environment"))
         diags.extend(found)
         scene.environment = cast(ModelFile, env)
-
-
-def load_input_devices(launch: Launch) -> InputDevices | None:
-    if not launch.input_devices_config:
-        return None
-    doc, _ = read_file(
-        relative_to_file(launch.path, launch.input_devices_config),
-        "input_devices",
-        tree=launch.tree,
-        referrer=launch.where("input devices config"),
-    )
-    return doc  # type: ignore[return-value]

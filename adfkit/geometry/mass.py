@@ -59,10 +59,6 @@ class MassProperties:
         com = (self.mass * self.com + other.mass * other.com) / mass
         return MassProperties(mass, self.volume + other.volume, com, self.about(com) + other.about(com))
 
-    def with_mass(self, mass: float) -> MassProperties:
-        k = mass / self.mass
-        return MassProperties(mass, self.volume, self.com, self.inertia * k)
-
 
 def _scale_for(volume: float, density: float | None, mass: float | None) -> float:
     """The density to use, from a density or a total mass (exactly one of them)."""

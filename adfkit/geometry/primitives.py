@@ -245,24 +245,6 @@ def fit_primitives(mesh: trimesh.Trimesh, kinds=("box", "sphere", "cylinder", "c
     return sorted(fits, key=lambda f: f.error)
 
 
-def capsule_chain(points, radius: float) -> list[ShapeEntry]:
-    """Capsules of ``radius`` along a polyline (one per segment), e.g. a needle's arc."""
-    pts = np.asarray(points, dtype=float)
-    out = []
-    for a, b in zip(pts[:-1], pts[1:]):
-        d = b - a
-        length = float(np.linalg.norm(d))
-        name, rot = _axis_frame(d / length)
-        out.append(
-            ShapeEntry(
-                shape="capsule",
-                geometry=Geometry(radius=radius, height=length + 2 * radius, axis=name),
-                offset=_pose(rot, (a + b) / 2),
-            )
-        )
-    return out
-
-
 def fit_capsule_chain(mesh: trimesh.Trimesh, count: int = 4) -> list[ShapeEntry]:
     """``count`` capsules enclosing a curved, tube-like mesh (a suture needle).
 

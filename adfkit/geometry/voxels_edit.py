@@ -64,10 +64,6 @@ class EditableVolume:
         """Continuous (x, y, z) voxel index of point ``p`` (volume frame): voxel i's centre is i."""
         return (np.asarray(p, dtype=float) + self.dimensions / 2) / self.step - 0.5
 
-    def centre_of(self, ijk: np.ndarray) -> np.ndarray:
-        """Centre (volume frame, metres) of voxels given as (..., 3) integer (x, y, z) indices."""
-        return (np.asarray(ijk, dtype=float) + 0.5) * self.step - self.dimensions / 2
-
     def _block(self, p: np.ndarray, radius: float):
         """Index ranges (per axis x, y, z) of the voxels whose centre can lie within ``radius``
         of ``p``, clipped to the volume; None when the sphere misses it."""

@@ -8,7 +8,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from .. import inputs
-from ..adf.paths import collision_mesh_path, relative_to_file, uses_collision_mesh, visual_mesh_path
+from ..adf.paths import collision_mesh_path, relative_to_file, shader_paths, uses_collision_mesh, visual_mesh_path
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..geometry.meshcheck import mesh_problem, obj_material_problems
 from ..model import InputDevices, Launch, ModelFile, World
@@ -57,21 +57,16 @@ def _policy(path, doc, kind: str, loc, owner: str) -> Diagnostic | None:
 
 
 def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:
-    out: list[Diagnostic] = []
-    if shaders is None or shaders.path is None:
-        return out
-    base = relative_to_file(doc_path, shaders.path)
-    for name in (shaders.vertex, shaders.fragment):
-        if name and not _exists(str(base / name)):
-            out.append(
-                _d(
-                    "missing-shader",
-                    f"shader {base / name} of {owner} not found",
-                    loc,
-                    "shader paths are relative to the file that declares them",
-                )
-            )
-    return out
+    return [
+        _d(
+            "missing-shader",
+            f"shader {path} of {owner} not found",
+            loc,
+            "shader paths are relative to the file that declares them",
+        )
+        for path in shader_paths(doc_path, shaders)
+        if not _exists(str(path))
+    ]
 
 
 def model_paths(m: ModelFile) -> list[Diagnostic]:

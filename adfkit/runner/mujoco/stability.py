@@ -21,10 +21,6 @@ def install_mujoco_handler() -> None:
     _MJ_HANDLER_SET = True
 
 
-def mujoco_pending() -> bool:
-    return bool(_MJ_MESSAGES)
-
-
 def pending_messages() -> list[str]:
     """The list MuJoCo's warnings land in (empty while there are none): a world's step loop
     tests it directly, without a call per step."""

@@ -91,10 +91,6 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         for i, p, v in zip(idxs, positions, vel):
             pb.resetJointState(art.uid, i, float(p), float(v), physicsClientId=self.cid)
 
-    def by_uid(self):
-        """{(PyBullet uid, link): SimBody}"""
-        return self._lookup
-
     def control(self) -> None:
         """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors.
         PyBullet's calls take their arguments by position here (this runs every control step)."""
