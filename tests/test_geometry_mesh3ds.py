@@ -137,3 +137,61 @@ def test_the_validator_says_where_a_3ds_mesh_is_broken(tmp_path):
     assert (d.location.line, d.location.column) == (5, 9)
     (tmp_path / "tet.3ds").write_bytes(good)
     assert [d for d in validate_file(model).diagnostics if d.rule == "mesh-unreadable"] == []
+
+
+# --- the validator's node count (geometry.softnodes): softmesh's count without numpy ------------
+
+
+def _count_both(path, data: bytes):
+    from adfkit.geometry.softnodes import node_count_3ds
+
+    path.write_bytes(data)
+    return node_count_3ds(path, data), unique_nodes(*read_3ds(path)).node_count
+
+
+def test_the_validators_node_count_is_the_soft_bodys(tmp_path):
+    """Two objects: the second repeats the first's vertices, one of them 1e-12 m off (the same
+    float32: one node) and one 1e-6 m off (a node of its own)."""
+    b_v = np.array([TET_V[0], TET_V[1], TET_V[2] + 1e-12, TET_V[3] + [0.0, 0.0, 1e-6]])
+    assert _count_both(tmp_path / "two.3ds", encode_3ds([("a", TET_V, TET_F), ("b", b_v, TET_F)])) == (5, 5)
+
+
+def test_the_node_count_rounds_as_numpy_does(tmp_path):
+    """Near 1 mm a float32 step is 1.2e-10 m: the next float32 after 0.001 rounds to the same
+    nanometre (its vertex and that one are one node), the one 9 steps on to the next (two)."""
+    x = np.float32(0.001)
+    step = np.nextafter(x, np.float32(1)) - x
+    for k, nodes in ((1, 3), (9, 4)):
+        v = np.array([[x, 0, 0], [0.1, 0, 0], [0, 0.1, 0], [x + k * step, 0, 0]], dtype=np.float32)
+        f = np.array([[0, 1, 2], [3, 1, 2]])
+        assert _count_both(tmp_path / f"near{k}.3ds", encode_3ds([("a", v.astype(float), f)])) == (nodes, nodes)
+
+
+def test_the_node_count_refuses_what_the_soft_mesh_refuses(tmp_path):
+    """A face naming a vertex past the file's: mesh-unreadable from both readers."""
+    from adfkit.diagnostics import AdfError
+    from adfkit.geometry.softmesh import load_soft_mesh
+    from adfkit.geometry.softnodes import node_count
+
+    data = bytearray(encode_3ds([("a", TET_V, TET_F)]))
+    at = data.index(struct.pack("<H", 0x4120)) + 8  # the first face's first index
+    data[at : at + 2] = struct.pack("<H", 9)
+    p = tmp_path / "bad.3ds"
+    p.write_bytes(bytes(data))
+    rules = []
+    for read in (lambda: node_count(p), lambda: load_soft_mesh(p)):
+        with pytest.raises(AdfError) as e:
+            read()
+        rules.append(e.value.diagnostics[0].rule)
+    assert rules == ["mesh-unreadable", "mesh-unreadable"]
+
+
+def test_the_node_count_of_every_corpus_3ds(tmp_path):
+    from conftest import CORPUS, require_corpus
+
+    require_corpus()
+    found = [p for p in CORPUS.rglob("*") if p.suffix.lower() == ".3ds"]
+    assert found
+    for p in found:
+        ours, softmesh = _count_both(tmp_path / p.name, p.read_bytes())
+        assert ours == softmesh, p

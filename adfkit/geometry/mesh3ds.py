@@ -28,17 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from ..adf.writer import atomic_write_bytes
+from .format3ds import EDITOR, FACES, MAIN, MESH_VERSION, OBJECT, TRIMESH, VERSION, VERTICES
 
-MAIN, VERSION, EDITOR, MESH_VERSION, OBJECT, TRIMESH, VERTICES, FACES = (
-    0x4D4D,
-    0x0002,
-    0x3D3D,
-    0x3D3E,
-    0x4000,
-    0x4100,
-    0x4110,
-    0x4120,
-)
 LIMIT = 0xFFFF  # u16 counts: vertices and triangles per object
 NAME_CHARS = 10  # the format's object-name length (longer names break older readers)
 FACE_FLAGS = 0x0007  # edges AB, BC and CA visible, as 3D Studio writes them

@@ -45,15 +45,15 @@ def _problem(path: str, size: int, _mtime: int) -> str | None:
     if suffix == ".stl":
         return _stl_problem(data)
     if suffix == ".3ds":
-        return _3ds_problem(path)
+        return _3ds_problem(path, data)
     return _obj_problem(data)
 
 
-def _3ds_problem(path: str) -> str | None:
-    from .softmesh import read_3ds  # numpy only: the chunk walk
+def _3ds_problem(path: str, data: bytes) -> str | None:
+    from .format3ds import walk_3ds
 
     try:
-        read_3ds(path)
+        walk_3ds(path, data)
     except AdfError as exc:
         return exc.diagnostics[0].message
     return None

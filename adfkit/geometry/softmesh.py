@@ -11,18 +11,14 @@ docs/soft-bodies.md). numpy only: the validator calls this too.
 from __future__ import annotations
 
 import os
-import struct
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..diagnostics import AdfError, SourceLocation, error
-
-# 3DS chunk ids (Autodesk 3D Studio binary format)
-_MAIN, _EDITOR, _OBJECT, _TRIMESH, _VERTICES, _FACES = 0x4D4D, 0x3D3D, 0x4000, 0x4100, 0x4110, 0x4120
-_CONTAINERS = (_MAIN, _EDITOR, _TRIMESH)
-MERGE_DECIMALS = 9  # vertices equal to 1e-9 m are one node
+from .format3ds import OBJECT, VERTICES, unreadable, walk_3ds
+from .softnodes import MERGE_DECIMALS
 
 
 @dataclass
@@ -35,10 +31,6 @@ class SoftMesh:
         return len(self.nodes)
 
 
-def _bad(path, message: str, hint: str) -> AdfError:
-    return AdfError(error("mesh-unreadable", message, SourceLocation(str(path)), hint))
-
-
 def read_3ds(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and triangles of every triangle object in a .3DS file, concatenated.
 
@@ -48,42 +40,13 @@ def read_3ds(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     verts: list[np.ndarray] = []
     faces: list[np.ndarray] = []
     base = 0
-
-    def walk(off: int, end: int) -> None:
-        nonlocal base
-        while off + 6 <= end:
-            cid, length = struct.unpack_from("<HI", data, off)
-            if length < 6 or off + length > end:
-                raise _bad(path, f"corrupt 3DS chunk 0x{cid:04x} at byte {off}", "re-export the mesh")
-            body = off + 6
-            if cid in _CONTAINERS:
-                walk(body, off + length)
-            elif cid == _OBJECT:
-                name_end = data.index(b"\0", body, off + length)
-                base = sum(len(v) for v in verts)
-                walk(name_end + 1, off + length)
-            elif cid == _VERTICES:
-                (n,) = struct.unpack_from("<H", data, body)
-                verts.append(np.frombuffer(data, "<f4", n * 3, body + 2).reshape(n, 3).astype(np.float64))
-            elif cid == _FACES:
-                (n,) = struct.unpack_from("<H", data, body)
-                f = np.frombuffer(data, "<u2", n * 4, body + 2).reshape(n, 4)[:, :3].astype(np.int64)
-                faces.append(f + base)
-            off += length
-
-    try:
-        walk(0, len(data))
-    except (struct.error, ValueError) as exc:
-        raise _bad(path, f"cannot read 3DS file: {exc}", "re-export the mesh as OBJ or STL") from None
-    if not verts or not faces:
-        raise AdfError(
-            error(
-                "mesh-empty",
-                "the 3DS file holds no triangle object",
-                SourceLocation(str(path)),
-                "export the object as a triangle mesh",
-            )
-        )
+    for cid, n, at in walk_3ds(path, data):
+        if cid == OBJECT:  # an object's faces index its own vertices
+            base = sum(len(v) for v in verts)
+        elif cid == VERTICES:
+            verts.append(np.frombuffer(data, "<f4", n * 3, at).reshape(n, 3).astype(np.float64))
+        else:
+            faces.append(np.frombuffer(data, "<u2", n * 4, at).reshape(n, 4)[:, :3].astype(np.int64) + base)
     return np.concatenate(verts), np.concatenate(faces)
 
 
@@ -95,7 +58,7 @@ def _raw_triangles(path: Path) -> tuple[np.ndarray, np.ndarray]:
     try:
         loaded = trimesh.load(str(path), force="mesh", process=False, skip_materials=True)
     except Exception as exc:  # trimesh raises many types for bad input
-        raise _bad(path, f"cannot read mesh: {type(exc).__name__}: {exc}", "is this a valid mesh file?") from None
+        raise unreadable(path, f"cannot read mesh: {type(exc).__name__}: {exc}", "is this a valid mesh file?") from None
     return np.asarray(loaded.vertices, dtype=np.float64), np.asarray(loaded.faces, dtype=np.int64)
 
 
@@ -149,7 +112,7 @@ def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0, tree=None) -> So
             )
         )
     if f.min() < 0 or f.max() >= len(v):
-        raise _bad(p, "a triangle refers to a vertex the file does not hold", "re-export the mesh")
+        raise unreadable(p, "a triangle refers to a vertex the file does not hold", "re-export the mesh")
     mesh = unique_nodes(v, f)
     mesh.nodes = mesh.nodes * float(scale)
     return mesh

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from ..adf.paths import collision_mesh_path
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
+from ..geometry.softnodes import node_count
 from ..model import ModelFile
 from .rules import RULES
 
@@ -173,10 +174,13 @@ def mesh_rules(m: ModelFile) -> list[Diagnostic]:
         path = collision_mesh_path(m, sb)
         if path is None:
             continue  # missing-mesh says so
-        from ..geometry.softmesh import load_soft_mesh  # noqa: PLC0415 - only when fixed nodes need counting
-
+        tree = getattr(m, "tree", None)
         try:  # through the input policy: a mesh outside the tree, a device or a bad name is not read
-            n = load_soft_mesh(path, sb.scale or 1.0, tree=getattr(m, "tree", None)).node_count
+            n = node_count(path, tree)
+            if n is None:  # numpy and trimesh, only when a format other than 3DS needs them
+                from ..geometry.softmesh import load_soft_mesh  # noqa: PLC0415
+
+                n = load_soft_mesh(path, sb.scale or 1.0, tree=tree).node_count
         except AdfError:
             continue  # the path rules report why it cannot be read
         bad = [i for i in cfg.fixed_nodes if not 0 <= i < n]
