@@ -30,10 +30,11 @@ def unreadable(path, message: str, hint: str) -> AdfError:
 
 
 def walk_3ds(path: str | os.PathLike, data: bytes) -> list[tuple[int, int, int]]:
-    """The triangle objects' blocks of a .3DS file's bytes, as (chunk id, count, offset of the
-    first item) for each vertex list (VERTICES) and face list (FACES), in file order: the
-    chunk walk alone, with the standard library (the validator checks a 3DS mesh with it
-    without importing numpy). A corrupt chunk or no triangle object is an AdfError."""
+    """The triangle objects' blocks of a .3DS file's bytes, in file order: (OBJECT, 0, 0) where
+    an object starts (its faces index its own vertices), then (chunk id, count, offset of the
+    first item) for each vertex list (VERTICES) and face list (FACES). The chunk walk alone,
+    with the standard library (the validator checks a 3DS mesh with it without importing
+    numpy). A corrupt or short chunk, or no triangle object, is an AdfError."""
     blocks: list[tuple[int, int, int]] = []
 
     def walk(off: int, end: int) -> None:
