@@ -18,6 +18,25 @@ def test_info_of_a_scene_folder_reads_its_launch_file(capsys):
     assert summary["kind"] == "launch" and summary["file"] == str(PAD / "launch.yaml")
 
 
+def test_info_of_several_files_summarises_each_and_reports_the_unreadable_one(tmp_path, capsys):
+    """`adfkit info *.yaml`: one summary per file in order (JSON: a list); a missing file is a
+    located error among them, the others still summarised, and the exit status says it."""
+    files = [PAD / "pad.yaml", tmp_path / "absent.yaml", PAD / "world.yaml"]
+    assert main(["info", "--json", *map(str, files)]) == 2
+    out, err = capsys.readouterr()
+    summaries = json.loads(out)
+    assert [(s["kind"], s["file"]) for s in summaries] == [("model", str(files[0])), ("world", str(files[2]))]
+    assert f"{files[1]}: error[file-not-found]" in err
+    assert main(["info", str(files[0]), str(files[2])]) == 0
+    text = capsys.readouterr().out
+    assert (
+        text.index(f"== {files[0]}")
+        < text.index("kind: model")
+        < text.index(f"== {files[2]}")
+        < text.index("kind: world")
+    )
+
+
 def test_run_of_a_scene_folder_plays_its_launch_file(tmp_path, capsys):
     pytest.importorskip("pybullet")
     assert main(["run", str(PAD), "--seconds", "0.05", "--no-frames", "--out", str(tmp_path)]) == 0

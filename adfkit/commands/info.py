@@ -1,4 +1,4 @@
-"""`adfkit info PATH`: a summary of a launch, world, input-devices or model file."""
+"""`adfkit info PATH [PATH ...]`: a summary of each launch, world, input-devices or model file."""
 
 from __future__ import annotations
 
@@ -6,13 +6,14 @@ import json
 import sys
 
 from .. import jsonout
+from ..summary import format_summary, summarize
 
 NAME = "info"
 HELP = "summarise a launch, world, input-devices or model file"
 
 
 def add_arguments(p) -> None:
-    p.add_argument("path", help="ADF file")
+    p.add_argument("path", nargs="+", help="ADF file(s); a folder stands for its launch.yaml")
     p.add_argument(
         "--kind",
         choices=["launch", "world", "input_devices", "model", "colors"],
@@ -23,25 +24,54 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
+    """Each file's summary in turn (JSON: the summary, or a list of them for several files);
+    a file that cannot be read is reported where it stands and the others still summarised.
+    Exit 2 when any file had an error."""
+    from ..diagnostics import AdfError
+    from ..report import print_diagnostics
+
+    several = len(args.path) > 1
+    summaries, status = [], 0
+    for n, path in enumerate(args.path):
+        try:
+            summary, code = _one(path, args)
+        except AdfError as exc:
+            print_diagnostics(exc.diagnostics, sys.stderr)
+            summary, code = None, 2
+        status = max(status, code)
+        if summary is None:
+            continue
+        summaries.append(summary)
+        if not args.json:
+            if several:
+                print(("\n" if n else "") + f"== {path}")
+            print(format_summary(summary))
+    if args.json and summaries:
+        jsonout.dump(summaries if several else summaries[0], sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    return status
+
+
+def _one(path, args) -> tuple[dict | None, int]:
+    """(the summary of one file or None, its exit status), its diagnostics printed."""
     from .. import inputs
     from ..adf import load_scene, parse_indices, read_file
     from ..diagnostics import Severity
     from ..report import print_diagnostics
-    from ..summary import format_summary, summarize
 
-    args.path = inputs.scene_file(args.path)  # a folder: its launch.yaml
+    path = inputs.scene_file(path)  # a folder: its launch.yaml
     if args.indices:
         diags: list = []
-        doc = load_scene(args.path, parse_indices(args.indices), diags)
+        doc = load_scene(path, parse_indices(args.indices), diags)
     else:
-        doc, diags = read_file(args.path, args.kind)
+        doc, diags = read_file(path, args.kind)
     summary = summarize(doc)
     try:  # a sum of huge masses can overflow: never print `total mass: inf` (or NaN) with exit 0
         json.dumps(summary, allow_nan=False)
     except ValueError:
         from ..diagnostics import SourceLocation, error
 
-        where = getattr(doc, "source", None) or SourceLocation(str(args.path), 1, 1)
+        where = getattr(doc, "source", None) or SourceLocation(str(path), 1, 1)
         diags = [
             *diags,
             error(
@@ -52,11 +82,6 @@ def run(args) -> int:
             ),
         ]
         print_diagnostics(diags, sys.stderr)
-        return 2
+        return None, 2
     print_diagnostics(diags, sys.stderr)
-    if args.json:
-        jsonout.dump(summary, sys.stdout, indent=2)
-        sys.stdout.write("\n")
-    else:
-        print(format_summary(summary))
-    return 2 if any(d.severity >= Severity.ERROR for d in diags) else 0
+    return summary, 2 if any(d.severity >= Severity.ERROR for d in diags) else 0
