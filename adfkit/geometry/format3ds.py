@@ -29,6 +29,11 @@ def unreadable(path, message: str, hint: str) -> AdfError:
     return AdfError(error("mesh-unreadable", message, SourceLocation(str(path)), hint))
 
 
+def empty(path, message: str = "the mesh has no triangles") -> AdfError:
+    """A mesh file without a triangle: the located `mesh-empty` error."""
+    return AdfError(error("mesh-empty", message, SourceLocation(str(path)), "export the object as a triangle mesh"))
+
+
 def walk_3ds(path: str | os.PathLike, data: bytes) -> list[tuple[int, int, int]]:
     """The triangle objects' blocks of a .3DS file's bytes, in file order: (OBJECT, 0, 0) where
     an object starts (its faces index its own vertices), then (chunk id, count, offset of the
@@ -64,12 +69,5 @@ def walk_3ds(path: str | os.PathLike, data: bytes) -> list[tuple[int, int, int]]
         raise unreadable(path, f"cannot read 3DS file: {exc}", "re-export the mesh as OBJ or STL") from None
     kinds = {cid for cid, _, _ in blocks}
     if VERTICES not in kinds or FACES not in kinds:
-        raise AdfError(
-            error(
-                "mesh-empty",
-                "the 3DS file holds no triangle object",
-                SourceLocation(str(path)),
-                "export the object as a triangle mesh",
-            )
-        )
+        raise empty(path, "the 3DS file holds no triangle object")
     return blocks

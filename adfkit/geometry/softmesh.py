@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..diagnostics import AdfError, SourceLocation, error
-from .format3ds import OBJECT, VERTICES, unreadable, walk_3ds
+from ..diagnostics import AdfError, error
+from .format3ds import OBJECT, VERTICES, empty, unreadable, walk_3ds
 from .softnodes import MERGE_DECIMALS
 
 
@@ -103,14 +103,7 @@ def load_soft_mesh(path: str | os.PathLike, scale: float = 1.0, tree=None) -> So
     p = inputs.check_mesh(path, tree=tree)
     v, f = _raw_triangles(p)
     if len(v) == 0 or len(f) == 0:
-        raise AdfError(
-            error(
-                "mesh-empty",
-                "the mesh has no triangles",
-                SourceLocation(str(p)),
-                "export the object as a triangle mesh",
-            )
-        )
+        raise empty(p)
     if f.min() < 0 or f.max() >= len(v):
         raise unreadable(p, "a triangle refers to a vertex the file does not hold", "re-export the mesh")
     mesh = unique_nodes(v, f)

@@ -7,26 +7,31 @@ from __future__ import annotations
 
 import math
 import struct
+import sys
 from array import array
 from pathlib import Path
 
-from ..diagnostics import AdfError, SourceLocation, error
-from .format3ds import FACES, OBJECT, VERTICES, unreadable, walk_3ds
+from .format3ds import FACES, OBJECT, VERTICES, empty, unreadable, walk_3ds
 
 MERGE_DECIMALS = 9  # vertices equal to 1e-9 m are one node
 
 
-def node_count(path: Path, tree=None) -> int | None:
-    """The node count of the soft body made of mesh file ``path`` (through the input policy,
-    as softmesh.load_soft_mesh reads it), or None where only that can tell (a format other
-    than .3DS, a coordinate that is not finite). AdfError as load_soft_mesh raises it."""
-    if path.suffix.lower() != ".3ds":
-        return None
-    from .. import inputs  # noqa: PLC0415
+def node_count(path: Path, tree=None) -> int:
+    """The node count of the soft body made of mesh file ``path``, read through the input policy
+    as softmesh.load_soft_mesh reads it: a .3DS file here, any other (or a 3DS coordinate that
+    is not finite) by load_soft_mesh, numpy and trimesh imported only then. AdfError as
+    load_soft_mesh raises it."""
+    n = None
+    if path.suffix.lower() == ".3ds":
+        from .. import inputs  # noqa: PLC0415
 
-    p = inputs.check_mesh(path, tree=tree)
-    data = inputs.read_bytes(p, "mesh", tree=tree, what="mesh file")
-    return node_count_3ds(p, data)
+        p = inputs.check_mesh(path, tree=tree)
+        n = node_count_3ds(p, inputs.read_bytes(p, "mesh", tree=tree, what="mesh file"))
+    if n is None:
+        from .softmesh import load_soft_mesh  # noqa: PLC0415
+
+        n = load_soft_mesh(path, tree=tree).node_count
+    return n
 
 
 def node_count_3ds(path, data: bytes) -> int | None:
@@ -50,19 +55,12 @@ def node_count_3ds(path, data: bytes) -> int | None:
             total += n
         elif cid == FACES and n:
             idx = array("H", data[at : at + 8 * n])
-            if array("H", b"\1\0")[0] != 1:  # a big-endian machine: the file's u16 are little-endian
+            if sys.byteorder == "big":  # the file's u16 are little-endian
                 idx.byteswap()
             top = max(top, base + max(max(idx[0::4]), max(idx[1::4]), max(idx[2::4])))
             faces += n
     if not total or not faces:
-        raise AdfError(
-            error(
-                "mesh-empty",
-                "the mesh has no triangles",
-                SourceLocation(str(path)),
-                "export the object as a triangle mesh",
-            )
-        )
+        raise empty(path)
     if top >= total:
         raise unreadable(path, "a triangle refers to a vertex the file does not hold", "re-export the mesh")
     return len(seen)

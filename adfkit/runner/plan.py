@@ -94,23 +94,35 @@ def uncreated(model, obj):
     path = collision_mesh_path(model, obj) if collision_primitives(obj) is None else None
     if path is None:
         return None
-    where = obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source
     if (refused := mesh_refusal(model, path)) is not None:
-        return warning(
-            "runner-missing-mesh",
-            f"{obj.identifier}: collision mesh {refused}; the body is skipped as AMBF does",
-            where,
-            "fix `collision mesh`/`mesh` or the resolution paths",
-        )
+        return mesh_skipped(obj, refused)
     if (problem := mesh_problem(path)) is not None:
         # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some
         return warning(
             "runner-bad-mesh",
             f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; the body is skipped as AMBF does",
-            where,
+            _mesh_key(obj),
             "re-export the mesh as a triangle mesh (STL or OBJ)",
         )
     return None
+
+
+def mesh_skipped(obj, refused: str):
+    """The located ``runner-missing-mesh`` warning for a body skipped because its collision mesh
+    cannot be read (``refused``: why, as mesh_refusal or an engine's own reader says it)."""
+    from ..diagnostics import warning
+
+    return warning(
+        "runner-missing-mesh",
+        f"{obj.identifier}: collision mesh {refused}; the body is skipped as AMBF does",
+        _mesh_key(obj),
+        "fix `collision mesh`/`mesh` or the resolution paths",
+    )
+
+
+def _mesh_key(obj):
+    """Where a body's collision mesh is named: `collision mesh`, else `mesh`."""
+    return obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source
 
 
 def uncreated_bodies(world, model) -> frozenset[str]:

@@ -153,16 +153,18 @@ def obj_colour(path: Path, tree=None) -> list[float] | None:
     return rgba if all(np.isfinite(rgba)) else None
 
 
-def untextured(files) -> bool:
-    """Whether an OBJ among ``files`` names a material file or texture that is not there (PyBullet
-    prints seven lines on standard output for each, one per folder it tried)."""
-    return any(str(f).lower().endswith(".obj") and obj_material_problems(str(f)) for f in files)
+def reads_quietly(files) -> contextlib.AbstractContextManager:
+    """Around a PyBullet call that reads mesh ``files``: when an OBJ among them names a material
+    file or texture that is not there, PyBullet's seven lines on standard output for each (one
+    per folder it tried) are not printed; adfkit says it once (``runner-missing-texture``,
+    validate's ``missing-texture``)."""
+    untextured = any(str(f).lower().endswith(".obj") and obj_material_problems(str(f)) for f in files)
+    return quiet_stdout(discard=True) if untextured else contextlib.nullcontext()
 
 
 def pybullet_reads_quietly(objs) -> contextlib.AbstractContextManager:
     """Around the PyBullet call that reads the meshes of ``objs`` ((model, body or ghost) pairs):
-    createMultiBody, where PyBullet loads the mesh files its shapes name. When one of them names
-    a material or texture that is not there, PyBullet's seven lines for each are not printed
-    (adfkit says it once: ``runner-missing-texture``, validate's ``missing-texture``)."""
-    files = [p for m, o in objs for p in (visual_mesh_path(m, o), collision_mesh_path(m, o)) if p is not None]
-    return quiet_stdout(discard=True) if untextured(files) else contextlib.nullcontext()
+    createMultiBody, where PyBullet loads the mesh files its shapes name (reads_quietly)."""
+    return reads_quietly(
+        [p for m, o in objs for p in (visual_mesh_path(m, o), collision_mesh_path(m, o)) if p is not None]
+    )

@@ -6,7 +6,6 @@ frame. Primitive collision dimensions are not scaled; meshes are (§12.3).
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
 import tempfile
@@ -30,11 +29,10 @@ from ...model.semantics import (
     shape_kind,
     shortest_arc,
 )
-from ..plan import mesh_refusal, rgba, uncreated
+from ..plan import mesh_refusal, mesh_skipped, rgba, uncreated
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
-from .egl import quiet_stdout
 from .margins import file_margin, give_margin
-from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, pybullet_mesh, untextured
+from .meshfiles import MESH_SUFFIXES, hull_pieces, is_convex, pybullet_mesh, reads_quietly
 
 
 @dataclass
@@ -188,14 +186,7 @@ def collision_parts(
         return None
     path, refused = pybullet_mesh(model, path)
     if refused is not None:  # an STL neither PyBullet nor trimesh can read
-        diags.append(
-            warning(
-                "runner-missing-mesh",
-                f"{obj.identifier}: collision mesh {refused}; the body is skipped as AMBF does",
-                obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source,
-                "fix `collision mesh`/`mesh` or the resolution paths",
-            )
-        )
+        diags.append(mesh_skipped(obj, refused))
         return None
     if path.suffix.lower() not in MESH_SUFFIXES:
         diags.append(
@@ -235,9 +226,8 @@ def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnost
     """Create the PyBullet collision shape, its children given the file's margin; -1 for an
     empty one, or (with a warning located at ``obj``) for one PyBullet refuses. A collision
     mesh does not need its textures: PyBullet's words about missing ones are not printed."""
-    files = [kw["fileName"] for kw in parts.kwargs if "fileName" in kw]
     try:
-        with quiet_stdout(discard=True) if untextured(files) else contextlib.nullcontext():
+        with reads_quietly([kw["fileName"] for kw in parts.kwargs if "fileName" in kw]):
             col = _create_collision(parts, cid)
             give_margin(col, parts.margin, cid)  # (a probe body: PyBullet reads the files there)
         return col
