@@ -16,22 +16,17 @@ from .format3ds import FACES, OBJECT, VERTICES, empty, unreadable, walk_3ds
 MERGE_DECIMALS = 9  # vertices equal to 1e-9 m are one node
 
 
-def node_count(path: Path, tree=None) -> int:
-    """The node count of the soft body made of mesh file ``path``, read through the input policy
-    as softmesh.load_soft_mesh reads it: a .3DS file here, any other (or a 3DS coordinate that
-    is not finite) by load_soft_mesh, numpy and trimesh imported only then. AdfError as
-    load_soft_mesh raises it."""
-    n = None
-    if path.suffix.lower() == ".3ds":
-        from .. import inputs  # noqa: PLC0415
+def node_count(path: Path, tree=None) -> int | None:
+    """The node count of the soft body made of mesh file ``path`` (through the input policy,
+    as softmesh.load_soft_mesh reads it), or None where only that can tell (a format other
+    than .3DS, a coordinate that is not finite; softmesh imports this module, so the caller
+    asks it). AdfError as load_soft_mesh raises it."""
+    if path.suffix.lower() != ".3ds":
+        return None
+    from .. import inputs  # noqa: PLC0415
 
-        p = inputs.check_mesh(path, tree=tree)
-        n = node_count_3ds(p, inputs.read_bytes(p, "mesh", tree=tree, what="mesh file"))
-    if n is None:
-        from .softmesh import load_soft_mesh  # noqa: PLC0415
-
-        n = load_soft_mesh(path, tree=tree).node_count
-    return n
+    p = inputs.check_mesh(path, tree=tree)
+    return node_count_3ds(p, inputs.read_bytes(p, "mesh", tree=tree, what="mesh file"))
 
 
 def node_count_3ds(path, data: bytes) -> int | None:

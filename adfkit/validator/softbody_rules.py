@@ -174,8 +174,13 @@ def mesh_rules(m: ModelFile) -> list[Diagnostic]:
         path = collision_mesh_path(m, sb)
         if path is None:
             continue  # missing-mesh says so
+        tree = getattr(m, "tree", None)
         try:  # through the input policy: a mesh outside the tree, a device or a bad name is not read
-            n = node_count(path, getattr(m, "tree", None))
+            n = node_count(path, tree)
+            if n is None:  # numpy and trimesh, only when a format other than 3DS needs them
+                from ..geometry.softmesh import load_soft_mesh  # noqa: PLC0415
+
+                n = load_soft_mesh(path, sb.scale or 1.0, tree=tree).node_count
         except AdfError:
             continue  # the path rules report why it cannot be read
         bad = [i for i in cfg.fixed_nodes if not 0 <= i < n]
