@@ -195,3 +195,29 @@ def test_the_node_count_of_every_corpus_3ds(tmp_path):
     for p in found:
         ours, softmesh = _count_both(tmp_path / p.name, p.read_bytes())
         assert ours == softmesh, p
+
+
+def test_a_3ds_file_nested_deeper_than_pythons_recursion_is_a_located_finding(tmp_path):
+    """50,000 nested editor chunks (300 kB) around no triangle object: `mesh-empty` from the
+    chunk walk, and `adfkit validate` of a soft body naming it answers with findings (a
+    recursive walk met RecursionError there: a traceback)."""
+    from adfkit.diagnostics import AdfError
+    from adfkit.geometry.format3ds import walk_3ds
+    from adfkit.validator.engine import validate_file
+
+    data = struct.pack("<HI", 0x3D3D, 6)
+    for _ in range(50_000):
+        data = struct.pack("<HI", 0x3D3D, 6 + len(data)) + data
+    data = struct.pack("<HI", 0x4D4D, 6 + len(data)) + data
+    mesh = tmp_path / "deep.3ds"
+    mesh.write_bytes(data)
+    with pytest.raises(AdfError) as e:
+        walk_3ds(mesh, data)
+    assert e.value.diagnostics[0].rule == "mesh-empty"
+    model = tmp_path / "soft.yaml"
+    model.write_text(
+        "bodies: []\nsoft bodies: [SOFTBODY cloth]\nSOFTBODY cloth:\n  name: cloth\n  mass: 0.1\n"
+        "  mesh: deep.3ds\n  collision mesh: deep.3ds\n  config: {fixed nodes: [0, 1]}\n"
+    )
+    found = validate_file(model).diagnostics
+    assert any("deep.3ds" in d.message and "no triangle object" in d.message for d in found)

@@ -41,30 +41,34 @@ def walk_3ds(path: str | os.PathLike, data: bytes) -> list[tuple[int, int, int]]
     with the standard library (the validator checks a 3DS mesh with it without importing
     numpy). A corrupt or short chunk, or no triangle object, is an AdfError."""
     blocks: list[tuple[int, int, int]] = []
-
-    def walk(off: int, end: int) -> None:
-        while off + 6 <= end:
-            cid, length = struct.unpack_from("<HI", data, off)
-            if length < 6 or off + length > end:
-                raise unreadable(path, f"corrupt 3DS chunk 0x{cid:04x} at byte {off}", "re-export the mesh")
-            body = off + 6
-            if cid in CONTAINERS:
-                walk(body, off + length)
-            elif cid == OBJECT:
-                name_end = data.index(b"\0", body, off + length)
-                blocks.append((OBJECT, 0, 0))
-                walk(name_end + 1, off + length)
-            elif cid in (VERTICES, FACES):
-                (n,) = struct.unpack_from("<H", data, body)
-                if body + 2 + n * (12 if cid == VERTICES else 8) > off + length:
-                    raise unreadable(
-                        path, f"3DS chunk 0x{cid:04x} at byte {off} is shorter than its {n} items", "re-export the mesh"
-                    )
-                blocks.append((cid, n, body + 2))
-            off += length
-
+    # depth first in file order, with a stack of the ranges still to read (not recursion: a
+    # file of nested chunks, 6 bytes a level, would reach Python's recursion limit at 6 kB)
+    stack = [(0, len(data))]
     try:
-        walk(0, len(data))
+        while stack:
+            off, end = stack.pop()
+            while off + 6 <= end:
+                cid, length = struct.unpack_from("<HI", data, off)
+                if length < 6 or off + length > end:
+                    raise unreadable(path, f"corrupt 3DS chunk 0x{cid:04x} at byte {off}", "re-export the mesh")
+                body, nxt = off + 6, off + length
+                if cid in CONTAINERS or cid == OBJECT:
+                    if cid == OBJECT:
+                        body = data.index(b"\0", body, nxt) + 1  # past the object's name
+                        blocks.append((OBJECT, 0, 0))
+                    stack.append((nxt, end))  # the rest of this range, once the chunk's own are read
+                    off, end = body, nxt
+                    continue
+                if cid in (VERTICES, FACES):
+                    (n,) = struct.unpack_from("<H", data, body)
+                    if body + 2 + n * (12 if cid == VERTICES else 8) > nxt:
+                        raise unreadable(
+                            path,
+                            f"3DS chunk 0x{cid:04x} at byte {off} is shorter than its {n} items",
+                            "re-export the mesh",
+                        )
+                    blocks.append((cid, n, body + 2))
+                off = nxt
     except (struct.error, ValueError) as exc:
         raise unreadable(path, f"cannot read 3DS file: {exc}", "re-export the mesh as OBJ or STL") from None
     kinds = {cid for cid, _, _ in blocks}
