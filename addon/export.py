@@ -72,8 +72,17 @@ def _mesh_paths(doc: ModelFile) -> tuple[str, str]:
 
 
 def _ordered(objs, order: list[str]):
-    rank = {ident: i for i, ident in enumerate(order)}
-    return sorted(objs, key=lambda o: (rank.get(o.identifier, len(rank)), o.identifier))
+    """The objects in the order the imported file listed them, an identifier listed twice
+    (the phantom's BODY BlackGround) again twice, where it stood; new ones after, by identifier."""
+    groups: dict[str, list] = {}
+    for o in objs:
+        groups.setdefault(o.identifier, []).append(o)
+    out, done = [], set()
+    for ident in order:
+        if ident in groups:
+            out += groups[ident][:1] if ident in done else groups[ident]
+            done.add(ident)
+    return out + sorted((o for o in objs if o.identifier not in done), key=lambda o: o.identifier)
 
 
 def gather_model(scene, objects=None, mesh_format: str | None = None) -> gather.Gathered:

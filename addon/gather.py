@@ -120,7 +120,7 @@ def gather_body(obj, out: Gathered, paths: tuple[str, str]) -> Body:
 
 
 def _pose_and_scale(obj, b) -> None:
-    if not (unchanged(obj) and b.location is not None):
+    if not unchanged(obj):  # unchanged: the location as the file wrote it (or left it out)
         b.location = world_pose(obj)
     s = uniform_scale(obj)
     old = b.scale if b.scale is not None else 1.0
@@ -136,7 +136,7 @@ def gather_ghost(obj, out: Gathered, paths: tuple[str, str]) -> Ghost:
     fields.merge(g, fields.GHOST, read_group(obj.adf.ghost, fields.GHOST))
     parent = adf_parent(obj)
     g.parent = _parent_ref(g.parent, parent)
-    if not (unchanged(obj) and g.location is not None):
+    if not unchanged(obj):
         g.location = relative_pose(obj, parent)
     _gather_geometry(obj, g, out, paths)
     if not (g.collision_shape or g.compound_collision_shape or g.collision_mesh or g.mesh):
@@ -416,7 +416,7 @@ def gather_camera(obj, out: Gathered) -> Camera:
     fields.merge(c, fields.CAMERA, read_group(obj.adf.camera, fields.CAMERA))
     parent = adf_parent(obj)
     c.parent = _parent_ref(c.parent, parent)
-    if not (unchanged(obj) and c.location is not None):
+    if not unchanged(obj):
         dist = 1.0
         if c.location is not None and c.look_at is not None:
             dist = max((Vec3(*c.look_at) - Vec3(*c.location)).norm(), 1e-6)
@@ -443,7 +443,7 @@ def gather_light(obj, out: Gathered) -> Light:
     fields.merge(li, fields.LIGHT, read_group(obj.adf.light, fields.LIGHT))
     parent = adf_parent(obj)
     li.parent = _parent_ref(li.parent, parent)
-    if not (unchanged(obj) and li.location is not None):
+    if not unchanged(obj):
         li.location = _vec_in_parent(obj, Vector((0, 0, 0)), True)
         li.direction = _vec_in_parent(obj, Vector((0, 0, -1)), False)
     if obj.type == "LIGHT" and obj.data.type == "SPOT":

@@ -87,7 +87,6 @@ NORMALISATIONS = {
     "typed-scalar": "a quoted number or boolean ('0.5', 'True', y/n) is written as a number or boolean",
     "int-as-float": "an integer in a real-valued field is written as a float (0 → 0.0)",
     "text-scalar": "a number in a text field (name: 1) is written as text ('1')",
-    "rpy-canonical": "roll/pitch/yaw is re-derived from the quaternion: the same rotation, canonical angles",
     "pose-halves": "a pose that omits position or orientation is written with both (zero / identity)",
     "null-list": "an empty (null) object list is written as []",
     "duplicate-key": "a duplicated key keeps its first value (AMBF's choice; PyYAML keeps the last)",
@@ -103,10 +102,9 @@ def _rot_equal(a: dict, b: dict) -> bool:
 def _content_equal(orig, new, used: set, path="") -> list[str]:
     if isinstance(orig, dict) and isinstance(new, dict):
         if set(orig) == {"r", "p", "y"} == set(new) and not all(orig[k] == new[k] for k in orig):
-            if _rot_equal(orig, new):
-                used.add("rpy-canonical")
-                return []
-            return [f"{path}: rotation {orig} != {new}"]
+            # angles are written as they were read, even the same rotation in other angles is a change
+            same = "the same rotation" if _rot_equal(orig, new) else "another rotation"
+            return [f"{path}: angles {orig} written as {new} ({same})"]
         out = []
         for k in orig.keys() | new.keys():
             if k not in new:

@@ -95,6 +95,30 @@ def test_pose_half_and_text_scalar_normalisations(tmp_path):
     }
 
 
+def test_angles_read_from_a_file_are_written_back_as_written(tmp_path):
+    """A triple outside quat_to_rpy's ranges (pitch 2.41, as AMBF's add-on wrote the challenge's
+    PSM) is the same rotation as a canonical one; written back, it is the triple of the file. A
+    rotation changed since is written from the quaternion."""
+    f = tmp_path / "m.yaml"
+    f.write_text(
+        "bodies: [BODY a]\nBODY a:\n  mass: 1\n  location:\n    position: {x: 0, y: 0, z: 0}\n"
+        "    orientation: {r: 0.8426372409, p: 2.4132249355, y: 1.0389281511}\n"
+    )
+    doc, _ = read_file(f)
+    q = doc.bodies[0].location.orientation
+    canonical = quat_to_rpy(q)
+    assert canonical[1] == pytest.approx(math.pi - 2.4132249355, abs=1e-9)  # the same rotation, another triple
+    assert yaml.safe_load(dumps(doc))["BODY a"]["location"]["orientation"] == {
+        "r": 0.8426372409,
+        "p": 2.4132249355,
+        "y": 1.0389281511,
+    }
+    turned = Pose(Vec3(), q * rpy_to_quat(0.0, 0.0, 0.1))
+    doc.bodies[0].location = turned
+    written = yaml.safe_load(dumps(doc))["BODY a"]["location"]["orientation"]
+    assert written["p"] == pytest.approx(quat_to_rpy(turned.orientation)[1], abs=1e-10) and written["p"] < math.pi / 2
+
+
 def test_unknown_keys_survive_a_round_trip(tmp_path):
     f = tmp_path / "m.yaml"
     f.write_text(

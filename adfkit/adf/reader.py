@@ -14,9 +14,10 @@ import yaml
 
 from .. import inputs
 from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation, error, warning
-from ..model import FILE_KINDS, AdfFile, Colors, Pose, Quat, Vec3, rpy_to_quat
+from ..model import FILE_KINDS, AdfFile, Colors, Pose, Quat, Vec3
 from ..model.common import RGBA
 from ..model.files import ObjectList
+from ..model.pose import rpy_to_quat_kept
 from ..model.spec import FloatOr, ListOf, Node, Obj, adf_fields
 from .kinds import detect_kind
 from .yamlnodes import STR_TAG, compose, location, mapping_items, plain, read_text, scalar_value
@@ -149,7 +150,8 @@ class Reader:
         return Vec3(*self.fields3(node, ("x", "y", "z"), "vector"))
 
     def as_rpy(self, node) -> Quat:
-        return rpy_to_quat(*self.fields3(node, ("r", "p", "y"), "orientation"))
+        # the angles as written are kept: a writer gives them back unchanged (pose.written_rpy)
+        return rpy_to_quat_kept(*self.fields3(node, ("r", "p", "y"), "orientation"))
 
     def as_pose(self, node) -> Pose:
         if not isinstance(node, yaml.MappingNode):

@@ -16,6 +16,7 @@ import yaml
 
 from ..model import Colors, Pose, Quat, Vec3, quat_to_rpy
 from ..model.files import AdfFile, ObjectList
+from ..model.pose import written_rpy
 from ..model.spec import FloatOr, ListOf, Node, adf_fields
 
 
@@ -60,6 +61,9 @@ def _angle(a: float) -> float:
 
 
 def _rpy(q: Quat) -> _Flow:
+    kept = written_rpy(q)
+    if kept is not None:  # read from a file and unchanged: the angles as they were written
+        return _Flow(r=float(kept[0]), p=float(kept[1]), y=float(kept[2]))
     r, p, y = quat_to_rpy(q)
     return _Flow(r=_angle(r), p=_angle(p), y=_angle(y))
 

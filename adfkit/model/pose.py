@@ -150,6 +150,31 @@ def rpy_to_quat(roll: float, pitch: float, yaw: float) -> Quat:
     )
 
 
+class WrittenQuat(Quat):
+    """A rotation read from roll/pitch/yaw that remembers the three angles as written. Files
+    often hold triples outside the ranges :func:`quat_to_rpy` returns (a pitch above pi/2 with
+    roll and yaw turned by pi): a writer gives the same numbers back (:func:`written_rpy`) as
+    long as the quaternion is exactly the one they make. Any arithmetic gives a plain Quat."""
+
+    written: tuple[float, float, float]
+
+
+def rpy_to_quat_kept(roll: float, pitch: float, yaw: float) -> Quat:
+    """:func:`rpy_to_quat`, remembering the angles (a :class:`WrittenQuat`)."""
+    q = rpy_to_quat(roll, pitch, yaw)
+    if q is NAN_QUAT:
+        return q
+    kept = WrittenQuat(*q)
+    kept.written = (roll, pitch, yaw)
+    return kept
+
+
+def written_rpy(q: Quat) -> tuple[float, float, float] | None:
+    """The roll/pitch/yaw ``q`` was read from, while ``q`` is still exactly their rotation."""
+    kept = getattr(q, "written", None)
+    return kept if kept is not None and rpy_to_quat(*kept) == tuple(q) else None
+
+
 def quat_to_rpy(q: Quat) -> tuple[float, float, float]:
     """Unit quaternion to ADF/URDF roll-pitch-yaw, each in (-pi, pi], pitch in [-pi/2, pi/2].
 
