@@ -285,21 +285,34 @@ def rebase_authored(model: ModelFile, objs, out_dir: Path) -> list[tuple[Path, P
 
 
 def _run_jobs(jobs, out_dir: Path, result: ExportResult) -> None:
+    """Write the meshes, each file only if its bytes change, and record every mesh file's
+    content hash (sha-256 of its bytes) in HASH_FILE."""
     hashes_path = out_dir / HASH_FILE
     try:
         known = json.loads(hashes_path.read_text()) if hashes_path.is_file() else {}
     except (OSError, ValueError):
         known = {}
+    if not isinstance(known, dict):
+        known = {}
+    now: dict[str, str] = {}
     for job in jobs:
-        rel = job.directory + job.filename
-        dst = out_dir / rel
-        if known.get(rel) == job.digest and dst.is_file():
-            result.skipped.append(dst)
-            continue
+        dst = out_dir / job.directory / job.filename
         if job.source is not None and job.parts is None:
-            result.written += meshes.copy_mesh_file(job.source, dst.parent, job.filename)
+            files = meshes.source_files(job.source, job.filename)
         else:
-            result.written += meshes.write_mesh(job.parts, dst.parent, job.filename, split=not job.whole)
-        known[rel] = job.digest
+            files = meshes.mesh_files(job.parts, job.filename, split=not job.whole)
+        done = meshes.write_files(dst.parent, files)
+        for path, (digest, written) in done.items():
+            now[path.relative_to(out_dir).as_posix()] = digest
+            if written:
+                result.written.append(path)
+        if not done[dst][1]:
+            result.skipped.append(dst)
+    # entries of files this export did not touch stay while they still describe the file
+    for rel, digest in known.items():
+        f = out_dir / rel
+        if rel not in now and isinstance(digest, str) and f.is_file():
+            if meshes.content_hash(f.read_bytes()) == digest:
+                now[rel] = digest
     if jobs:
-        atomic_write_text(hashes_path, json.dumps(known, indent=1, sort_keys=True))
+        atomic_write_text(hashes_path, json.dumps(now, indent=1, sort_keys=True))

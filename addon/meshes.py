@@ -1,5 +1,5 @@
 """Blender meshes to files: OBJ + MTL (base-colour texture, normal map), or STL, PLY, 3DS
-(adfkit.geometry.meshwrite), and content hashes.
+(adfkit.geometry.meshwrite), and content hashes (sha-256 of the bytes written).
 
 ``mesh_arrays`` is the only Blender-level function; the OBJ/MTL text writers are plain
 Python over NumPy arrays, so exports of unchanged meshes can be skipped by hash.
@@ -8,13 +8,12 @@ Python over NumPy arrays, so exports of unchanged meshes can be skipped by hash.
 from __future__ import annotations
 
 import hashlib
-import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from adfkit.adf.writer import atomic_write_text
+from adfkit.adf.writer import atomic_write_bytes
 
 
 @dataclass
@@ -196,28 +195,28 @@ def mtl_text(materials: list[MaterialInfo], texture_names: dict[str, str]) -> st
     return "".join(out)
 
 
-def write_obj(parts: list[MeshArrays], directory: Path, filename: str) -> list[Path]:
-    """Write OBJ (+ MTL and copied textures when materials exist). Returns the files written."""
-    directory.mkdir(parents=True, exist_ok=True)
+def obj_files(parts: list[MeshArrays], filename: str) -> dict[str, bytes | Path]:
+    """What an OBJ export writes, by file name: the OBJ, its MTL when the parts have materials,
+    and the images the MTL names (as the paths to copy them from)."""
     mats = {m.name: m for p in parts for m in p.materials}
-    written = []
+    files: dict[str, bytes | Path] = {}
     mtl = None
     if mats:
         mtl = Path(filename).stem + ".mtl"
-        tex = {}
+        tex: dict[str, str] = {}
         for m in mats.values():
             for src in (m.texture, m.normal_map):
                 if src and src not in tex:
                     tex[src] = Path(src).name
-                    dst = directory / tex[src]
-                    if not dst.exists() or dst.stat().st_size != Path(src).stat().st_size:
-                        shutil.copyfile(src, dst)
-                    written.append(dst)
-        atomic_write_text(directory / mtl, mtl_text(list(mats.values()), tex))
-        written.append(directory / mtl)
-    atomic_write_text(directory / filename, obj_text(parts, mtl))
-    written.append(directory / filename)
-    return written
+                    files[tex[src]] = Path(src)
+        files[mtl] = mtl_text(list(mats.values()), tex).encode()
+    files[filename] = obj_text(parts, mtl).encode()
+    return files
+
+
+def write_obj(parts: list[MeshArrays], directory: Path, filename: str) -> list[Path]:
+    """Write OBJ (+ MTL and copied textures when materials exist). Returns the files written."""
+    return list(write_files(directory, obj_files(parts, filename)))
 
 
 MESH_SUFFIXES = (".OBJ", ".STL", ".PLY", ".3DS", ".DAE", ".OFF", ".GLB", ".GLTF", ".FBX")
@@ -237,38 +236,52 @@ def with_format(name: str, fmt: str) -> str:
     return name.rsplit("/", 1)[-1] + suffix
 
 
-def write_mesh(parts: list[MeshArrays], directory: Path, filename: str, split: bool = True) -> list[Path]:
-    """Write the parts in the format the file name's suffix names: OBJ (+ MTL), else STL, PLY
-    or 3DS through adfkit.geometry.meshwrite (triangles only, no materials)."""
+def mesh_files(parts: list[MeshArrays], filename: str, split: bool = True) -> dict[str, bytes | Path]:
+    """The files of the parts in the format the file name's suffix names: OBJ (+ MTL, images),
+    else STL, PLY or 3DS through adfkit.geometry.meshwrite (triangles only, no materials)."""
     if Path(filename).suffix.lower() == ".obj":
-        return write_obj(parts, directory, filename)
-    from adfkit.geometry.meshwrite import write_parts
+        return obj_files(parts, filename)
+    from adfkit.geometry.meshwrite import encode_parts, format_of
 
-    return [write_parts(directory / filename, [(p.name, p.co, p.tris) for p in parts], split=split)]
+    return {filename: encode_parts(format_of(filename) or "", [(p.name, p.co, p.tris) for p in parts], split=split)}
 
 
-def copy_mesh_file(src: Path, directory: Path, filename: str) -> list[Path]:
-    """Copy an unchanged mesh file (and, for OBJ, its MTL and the images the MTL names)."""
-    directory.mkdir(parents=True, exist_ok=True)
-    dst = directory / filename
-    shutil.copyfile(src, dst)
-    out = [dst]
-    if src.suffix.lower() == ".obj":
-        for line in src.read_text(encoding="utf-8", errors="replace").splitlines():
-            if line.startswith("mtllib "):
-                mtl = src.parent / line[7:].strip()
-                if mtl.is_file():
-                    shutil.copyfile(mtl, directory / mtl.name)
-                    out.append(directory / mtl.name)
-                    for ml in mtl.read_text(encoding="utf-8", errors="replace").splitlines():
-                        parts = ml.strip().split()
-                        if (
-                            parts
-                            and parts[0].lower() in ("map_kd", "map_bump", "bump", "norm", "map_ks")
-                            and len(parts) > 1
-                        ):
-                            img = src.parent / parts[-1]
-                            if img.is_file():
-                                shutil.copyfile(img, directory / img.name)
-                                out.append(directory / img.name)
+def source_files(src: Path, filename: str) -> dict[str, bytes | Path]:
+    """An unchanged mesh file to copy as ``filename`` (and, for OBJ, its MTL and the images the
+    MTL names), by file name."""
+    files: dict[str, bytes | Path] = {filename: src}
+    if src.suffix.lower() != ".obj":
+        return files
+    for line in src.read_text(encoding="utf-8", errors="replace").splitlines():
+        if not line.startswith("mtllib "):
+            continue
+        mtl = src.parent / line[7:].strip()
+        if not mtl.is_file():
+            continue
+        files[mtl.name] = mtl
+        for ml in mtl.read_text(encoding="utf-8", errors="replace").splitlines():
+            parts = ml.strip().split()
+            if parts and parts[0].lower() in ("map_kd", "map_bump", "bump", "norm", "map_ks") and len(parts) > 1:
+                img = src.parent / parts[-1]
+                if img.is_file():
+                    files[img.name] = img
+    return files
+
+
+def content_hash(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def write_files(directory: Path, files: dict[str, bytes | Path]) -> dict[Path, tuple[str, bool]]:
+    """Write each file into ``directory`` (atomically; a Path is copied) unless the file there
+    already holds those bytes. Returns {path: (sha-256 of its bytes, written?)}."""
+    out = {}
+    for name, content in files.items():
+        data = content if isinstance(content, bytes) else content.read_bytes()
+        dst = directory / name
+        digest = content_hash(data)
+        same = dst.is_file() and content_hash(dst.read_bytes()) == digest
+        if not same:
+            atomic_write_bytes(dst, data)
+        out[dst] = (digest, not same)
     return out

@@ -46,7 +46,8 @@ def model_summary(model: ModelFile) -> dict[str, Any]:
         "volumes": len(model.volumes),
         "meshes": len(meshes),
         "missing meshes": missing,
-        "total mass": round(sum(effective_mass(b) for b in model.bodies), 9),
+        # soft bodies weigh too (AMBF reads their mass with the same 1 kg default)
+        "total mass": round(sum(effective_mass(b) for b in [*model.bodies, *model.soft_bodies]), 9),
     }
 
 

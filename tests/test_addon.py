@@ -219,6 +219,12 @@ def test_round_trip_is_byte_identical(addon, scene, tmp_path):
     assert a.keys() == b.keys()
     assert a["model.yaml"].decode() == b["model.yaml"].decode()
     assert [k for k in a if a[k] != b[k]] == []
+    # the mesh record holds content hashes: the same for the same bytes, whoever made them
+    import hashlib
+    import json
+
+    ha, hb = (json.loads((tmp_path / d / ".adfkit-meshes.json").read_text()) for d in "ab")
+    assert ha == hb == {k: hashlib.sha256(v).hexdigest() for k, v in a.items() if k.startswith("meshes/")}
 
 
 def test_unchanged_meshes_are_not_rewritten(addon, scene, tmp_path):

@@ -3,6 +3,7 @@ status 2 from `adfkit info`, and no traceback."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -188,6 +189,18 @@ def test_cli_process_exits_2_without_traceback(tmp_path):
     assert "Traceback" not in proc.stderr
     assert f"{f}:2:1: error[yaml-syntax]" in proc.stderr
     assert "hint:" in proc.stderr
+
+
+def test_info_total_mass_counts_soft_bodies(tmp_path, capsys):
+    """A tissue pad weighs: 0.5 kg of bodies, 0.2 kg of soft body and 1 kg for a soft body
+    without a mass (AMBF's default, as for a body)."""
+    f = tmp_path / "pad.yaml"
+    f.write_text(
+        "bodies: [BODY tray]\nsoft bodies: [SOFT pad, SOFT sheet]\nBODY tray:\n  mass: 0.5\n"
+        "SOFT pad:\n  mass: 0.2\n  mesh: pad.obj\nSOFT sheet:\n  mesh: sheet.obj\n"
+    )
+    assert main(["info", "--json", str(f)]) == 0
+    assert json.loads(capsys.readouterr().out)["total mass"] == pytest.approx(1.7)
 
 
 def test_info_never_prints_a_non_finite_total(tmp_path, capsys):

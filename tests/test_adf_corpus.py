@@ -68,10 +68,9 @@ def test_corpus_file_loads_and_counts_match_raw_yaml(path):
         # Joint types counted by the model equal the raw `type` strings of listed joints.
         raw_types = sorted(raw[j]["type"] for j in raw.get("joints") or [] if isinstance(raw.get(j), dict))
         assert sorted(j.type for j in doc.joints if j.defined) == raw_types
-        # Mass: missing mass means 1 kg (AMBF), quoted masses are numbers.
-        raw_mass = sum(
-            float(raw[b].get("mass", 1.0)) if isinstance(raw.get(b), dict) else 1.0 for b in raw.get("bodies") or []
-        )
+        # Mass of bodies and soft bodies: missing mass means 1 kg (AMBF), quoted masses are numbers.
+        listed = [*(raw.get("bodies") or []), *(raw.get("soft bodies") or [])]
+        raw_mass = sum(float(raw[b].get("mass", 1.0)) if isinstance(raw.get(b), dict) else 1.0 for b in listed)
         assert math.isclose(s["total mass"], raw_mass, rel_tol=1e-9, abs_tol=1e-9)
     elif isinstance(doc, World):
         assert len(doc.lights) == _list_len(raw, "lights")

@@ -21,7 +21,7 @@ MULTI_OBJECT = ("OBJ", "3DS")
 #: Formats that keep the vertex list as written (STL stores three corners per triangle).
 VERTEX_ORDER_KEPT = ("OBJ", "PLY", "3DS")
 
-__all__ = ["MULTI_OBJECT", "SUFFIXES", "VERTEX_ORDER_KEPT", "TooLarge", "format_of", "write_parts"]
+__all__ = ["MULTI_OBJECT", "SUFFIXES", "VERTEX_ORDER_KEPT", "TooLarge", "encode_parts", "format_of", "write_parts"]
 
 
 def format_of(path: str | os.PathLike) -> str | None:
@@ -31,14 +31,19 @@ def format_of(path: str | os.PathLike) -> str | None:
 
 
 def write_parts(path: str | os.PathLike, parts: list[tuple[str, np.ndarray, np.ndarray]], split: bool = True) -> Path:
-    """Write the parts to ``path`` in the format its suffix names (STL, PLY or 3DS). STL and
-    PLY hold one mesh: the parts are concatenated. 3DS keeps one object per part and splits a
-    part over its 65535-vertex limit (or raises :class:`TooLarge` without ``split``)."""
-    fmt = format_of(path)
+    """Write the parts to ``path`` in the format its suffix names (STL, PLY or 3DS): the bytes
+    of :func:`encode_parts`."""
+    return atomic_write_bytes(path, encode_parts(format_of(path) or Path(path).suffix, parts, split=split))
+
+
+def encode_parts(fmt: str, parts: list[tuple[str, np.ndarray, np.ndarray]], split: bool = True) -> bytes:
+    """The file of the parts in ``fmt`` ('STL', 'PLY' or '3DS'). STL and PLY hold one mesh:
+    the parts are concatenated. 3DS keeps one object per part and splits a part over its
+    65535-vertex limit (or raises :class:`TooLarge` without ``split``)."""
     if fmt == "3DS":
-        return atomic_write_bytes(path, encode_3ds(parts, split=split))
+        return encode_3ds(parts, split=split)
     if fmt not in ("STL", "PLY"):
-        raise ValueError(f"{Path(path).name}: write_parts writes STL, PLY or 3DS, not {Path(path).suffix}")
+        raise ValueError(f"encode_parts writes STL, PLY or 3DS, not {fmt}")
     import trimesh  # noqa: PLC0415 - only when a mesh is written
 
     verts, tris, base = [], [], 0
@@ -53,4 +58,4 @@ def write_parts(path: str | os.PathLike, parts: list[tuple[str, np.ndarray, np.n
         process=False,  # keep the vertex order: a soft body's node numbering depends on it
     )
     data = mesh.export(file_type=fmt.lower())
-    return atomic_write_bytes(path, data if isinstance(data, bytes) else data.encode())
+    return data if isinstance(data, bytes) else data.encode()
