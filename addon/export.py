@@ -13,6 +13,7 @@ from pathlib import Path
 from adfkit.adf import dumps, read_file
 from adfkit.adf.writer import atomic_write_text
 from adfkit.diagnostics import Diagnostic, Severity, error
+from adfkit.geometry.volume_slices import find_slice_files
 from adfkit.model import ModelFile
 
 from . import fields, gather, gather_soft, meshes, namespaces, volumes
@@ -262,7 +263,9 @@ def rebase_paths(model: ModelFile, source_dir: Path, out_dir: Path) -> list[tupl
                 sh.path = rebase(sh.path, shader_files(sh))
         im = getattr(obj, "images", None)
         if im is not None and im.count and im.prefix is not None and im.format:
-            names = [f"{im.prefix}{i}.{str(im.format).lstrip('.')}" for i in range(min(int(im.count), 4096))]
+            base = source_dir / im.path if im.path else source_dir
+            found = find_slice_files(base, str(im.prefix), str(im.format), min(int(im.count), 4096)).files
+            names = [os.path.relpath(f, base) for f in found]  # the slices AMBF reads: count is the most
             im.path = rebase(im.path, [*names, "labels.yaml"])  # the tissues `adfkit drill` reads, when there
     if getattr(model, "shaders", None) is not None:
         model.shaders.path = rebase(model.shaders.path, shader_files(model.shaders))

@@ -69,7 +69,8 @@ def test_export_back_leaves_the_volume_as_written(addon, drilling):
 def test_a_volume_whose_slices_are_gone_is_not_shown_and_not_exported(addon, drilling):
     shutil.rmtree(drilling / "slices")
     made, diags = addon.build.import_model(drilling / "drill.yaml")
-    assert [d.rule for d in diags if d.severity == Severity.WARNING] == ["file-not-found"]
+    assert [d.rule for d in diags if d.severity == Severity.WARNING] == ["volume-slice-missing"]
+    assert "does not exist" in diags[-1].message
     assert "the volume is kept but not shown" in diags[-1].message and "drill.yaml:" in str(diags[-1].location)
     assert not [o for o in bpy.context.scene.objects if addon.volumes.VOLUME_KEY in o]
     # the export validates what it would write, and a volume without slices is an error there
@@ -146,9 +147,12 @@ def test_check_reads_the_slices_where_they_are(addon, tmp_path):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     assert _author(tmp_path, tmp_path / "ct") == {"FINISHED"}
     assert addon.authoring.problems(bpy.context.scene) == []
-    (tmp_path / "ct" / "bone_7.png").unlink()
+    (tmp_path / "ct" / "bone_7.png").unlink()  # AMBF stacks the others: a warning
     (found,) = addon.authoring.problems(bpy.context.scene)
-    assert found.startswith("ERROR: volume 'VOLUME Bone': no such slice 7") and "bone_7.png" in found
+    assert found.startswith("WARNING: volume 'VOLUME Bone': slice 7 of 0..47 is missing")
+    (tmp_path / "ct" / "bone_8.png").write_text("no picture")
+    found = addon.authoring.problems(bpy.context.scene)
+    assert found[0].startswith("ERROR: volume 'VOLUME Bone': slice 7 (bone_8.png) is not an image")
     bpy.ops.wm.read_factory_settings(use_empty=True)
     addon.build.import_model(SAMPLE / "drill.yaml")
     assert addon.authoring.problems(bpy.context.scene) == []

@@ -95,7 +95,7 @@ def test_a_volume_without_bodies_converts_and_unreadable_slices_are_a_loss(drill
     assert main(["convert", str(only), str(tmp_path / "a.xml")]) == 0
     assert (tmp_path / "a_Bone.stl").is_file()
     assert "VOLUME Bone: voxel data: URDF has no voxel volume" in capsys.readouterr().out
-    (scene / "slices" / "bone_20.png").unlink()
+    (scene / "slices" / "bone_20.png").write_text("not an image")
     assert main(["convert", str(scene / "drill.yaml"), str(tmp_path / "b.xml")]) == 0
     out = capsys.readouterr()
     assert "VOLUME Bone: volume: not written:" in out.out and "bone_20.png" in out.out and "Traceback" not in out.err

@@ -27,6 +27,24 @@ def test_the_drilling_slices_are_one_stack():
     assert s.names()[-1] == "bone_47.png"
 
 
+@pytest.mark.parametrize(
+    "names, prefix, count",
+    [
+        ([f"plane00{i}.png" for i in range(12)], "plane00", 12),  # the drilling projects' naming
+        ([f"s_{i:03d}.png" for i in range(48)], "s_0", 48),  # padded within count's two digits
+        ([f"s_{i:03d}.png" for i in range(3)], "s_00", 3),
+    ],
+)
+def test_leading_zeros_are_read_as_ambf_reads_them(tmp_path, names, prefix, count):
+    from adfkit.geometry.volume_slices import find_slice_files
+
+    folder = _stack(tmp_path / "s", names)
+    s = find_slices(folder)
+    assert (s.prefix, s.count, s.files) == (prefix, count, names)
+    assert [p.name for p in find_slice_files(folder, s.prefix, "png", s.count).files] == names  # AMBF's rule agrees
+    assert find_slices(folder, prefix).files == names
+
+
 def test_a_prefix_picks_one_stack_of_several(tmp_path):
     folder = _stack(tmp_path / "s", ["a_0.png", "a_1.png", "b_0.png", "notes.txt.png"])
     (folder / "readme.txt").write_text("not a slice")
@@ -48,7 +66,8 @@ def test_a_prefix_picks_one_stack_of_several(tmp_path):
             "volume-slice-size",
             "ct_0.png is 8x8, ct_2.png is 4x4",
         ),
-        (["ct_000.png", "ct_001.png"], None, None, "volume-slice-names", "numbered with leading zeros (ct_000.png"),
+        (["ct_0.png", "ct_01.png", "ct_2.png"], None, None, "volume-slice-names", "mixes widths of numbering"),
+        (["ct_000.png", "ct_001.png", "ct_003.png"], None, None, "volume-slice-gap", "gaps: ct_002.png missing"),
         (
             ["a_0.png", "a_1.png", "b_0.png"],
             None,

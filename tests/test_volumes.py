@@ -133,7 +133,8 @@ def _images_line(scene_dir) -> int:
 @pytest.mark.parametrize(
     "case, rule",
     [
-        ("missing slice", "volume-slice-missing"),
+        ("no slice of the prefix", "volume-slice-missing"),
+        ("a format AMBF cannot read", "volume-format"),
         ("mixed sizes", "volume-slice-size"),
         ("count 10^9", "volume-images"),
         ("outside the tree", "volume-slice-missing"),
@@ -145,8 +146,10 @@ def test_hostile_volume_inputs_are_located_errors(drilling, tmp_path, case, rule
 
     scene = _copy(drilling, tmp_path)
     drill = scene / "drill.yaml"
-    if case == "missing slice":
-        (scene / "slices" / "bone_17.png").unlink()
+    if case == "no slice of the prefix":
+        drill.write_text(drill.read_text().replace("prefix: bone_", "prefix: bone"))
+    elif case == "a format AMBF cannot read":
+        drill.write_text(drill.read_text().replace("format: png", "format: tif"))
     elif case == "mixed sizes":
         Image.fromarray(np.zeros((10, 12), np.uint8)).save(scene / "slices" / "bone_5.png")
     elif case == "count 10^9":

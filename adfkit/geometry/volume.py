@@ -1,27 +1,31 @@
 """ADF volumes (§11.4): a voxel volume given as a stack of image slices, read into one array,
 and its iso-surface as a triangle mesh.
 
-The slices are ``images: {path, prefix, format, count}``: the files ``path/prefix<i>.format``
-for i = 0 .. count-1, relative to the ADF file, read through the project's one input policy
-(regular files inside the scene's tree, under the size cap) by Pillow. Voxel values are read
-as Pillow gives them (8 or 16 bit, colour slices as their luminance) and normalised to 0..1 by
-the format's maximum, so ``iso-surface value`` (default 0.5) is a fraction of full scale, as
-AMBF's volume shader compares it. The volume fills a box of ``dimensions`` (times ``scale``)
-centred on its ``location``: slice i lies at z = -d_z/2 + (i + 1/2)·d_z/count.
+The slices are the files AMBF stacks for ``images: {path, prefix, format, count}``
+(:mod:`adfkit.geometry.volume_slices`: ``count`` is the most it searches for; the slices found
+are stacked in index order), relative to the ADF file, each read through the project's one
+input policy (regular files inside the scene's tree, under the size cap) by Pillow. A voxel's
+value is what AMBF draws and collides by: the grey level of a grey slice, the alpha of a slice
+with alpha, 1 for a colour slice without alpha; normalised to 0..1 by the format's maximum, so
+``iso-surface value`` (default 0.5) is a fraction of full scale, as AMBF's volume shader
+compares it. The volume fills a box of ``dimensions`` (times ``scale``) centred on its
+``location``: of n slices found, slice i lies at z = -d_z/2 + (i + 1/2)·d_z/n; a slice's
+bottom row at -y.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .. import inputs
 from ..adf.paths import relative_to_file
-from ..diagnostics import AdfError, SourceLocation, error
+from ..diagnostics import AdfError, Diagnostic, SourceLocation, error, info, warning
+from .volume_slices import AMBF_FORMATS, READ_FORMATS, SliceFiles, find_slice_files, slice_values
 
-#: More slices than this, or more voxels than MAX_VOXELS, is refused before a file is opened.
+#: A count above this, or more voxels than MAX_VOXELS, is refused before a file is opened.
 MAX_SLICES = 4096
 MAX_VOXELS = 512**3
 DEFAULT_ISO = 0.5
@@ -29,10 +33,12 @@ DEFAULT_ISO = 0.5
 
 @dataclass
 class VolumeData:
-    voxels: np.ndarray  # (count, height, width) float32 in 0..1: slice, row, column
+    voxels: np.ndarray  # (slices, rows, columns) float32 in 0..1; row 0 is the slices' bottom row
     dimensions: np.ndarray  # (3,) metres along x (columns), y (rows), z (slices), scale applied
     files: list[Path]
     full_scale: float = 1.0  # the slice value that reads as 1.0 (255 for 8-bit slices)
+    findings: list[Diagnostic] = field(default_factory=list)  # what is odd but AMBF loads (notes, warnings)
+    count: int = 0  # `images: count` as written
 
 
 def _where(vol, key: str | None = None) -> SourceLocation:
@@ -44,9 +50,14 @@ def _fail(vol, rule: str, message: str, hint: str, key: str = "images") -> AdfEr
     return AdfError(error(rule, f"volume '{vol.identifier}': {message}", _where(vol, key), hint))
 
 
-def slice_paths(model, vol) -> list[Path]:
-    """The slice files a volume names, in order; a missing or impossible `images` entry is a
-    located error (AMBF skips such a volume with an error message)."""
+def _listed(items: list, most: int = 6) -> str:
+    shown = ", ".join(str(x) for x in items[:most])
+    return shown + (f" and {len(items) - most} more" if len(items) > most else "")
+
+
+def slice_files(model, vol) -> SliceFiles:
+    """The slice files AMBF stacks for ``vol``, in order; an impossible ``images`` entry, a
+    format AMBF cannot read or no slice at all is a located error (AMBF skips such a volume)."""
     im = vol.images
     missing = [k for k in ("path", "prefix", "format", "count") if im is None or getattr(im, k) is None]
     if missing:
@@ -62,43 +73,122 @@ def slice_paths(model, vol) -> list[Path]:
             "volume-images",
             f"`images: count` is {im.count}; a volume has 1 to {MAX_SLICES} slices",
             "count the slice files",
-            "images",
         )
-    fmt = str(im.format).lstrip(".")
+    fmt = str(im.format)
+    if fmt.lower() not in AMBF_FORMATS:
+        raise _fail(
+            vol,
+            "volume-format",
+            f"`images: format` is {fmt!r}: AMBF reads slices in {', '.join(AMBF_FORMATS)} only"
+            + (" (without the dot)" if fmt.lstrip(".").lower() in AMBF_FORMATS else "")
+            + "; it skips the volume",
+            "write the slices as PNG and give format: png",
+        )
+    if fmt.lower() not in READ_FORMATS:
+        raise _fail(vol, "volume-format", "raw slices have no header to read", "write the slices as PNG")
     base = relative_to_file(model.path, str(im.path))
-    return [base / f"{im.prefix}{i}.{fmt}" for i in range(im.count)]
+    inputs.check_path_text(base, _where(vol, "images"))
+    found = find_slice_files(base, str(im.prefix), fmt, im.count)
+    if not found.files:
+        where = inputs.shown(found.folder)
+        if not found.folder.is_dir():
+            message = f"the slice folder {where} does not exist"
+        else:
+            message = f"no slice {found.stem}<0..{im.count}>.{fmt} in {where}"
+            if found.others:
+                message += f" (it holds {_listed(found.others, 3)})"
+        raise _fail(
+            vol,
+            "volume-slice-missing",
+            message + "; AMBF skips the volume",
+            "check images: path (relative to this file), prefix and format; slices are numbered from 0",
+        )
+    return found
+
+
+def _findings(vol, found: SliceFiles, count: int, opaque: list[int]) -> list[Diagnostic]:
+    where = _where(vol, "images")
+    name = f"volume '{vol.identifier}'"
+    out = []
+    n = len(found.files)
+    if found.gaps:
+        out.append(
+            warning(
+                "volume-slice-gap",
+                f"{name}: slice {_listed(found.gaps)} of 0..{max(found.indices)} is missing; AMBF stacks the "
+                f"{n} it finds, so the slices after a gap move down and the volume is stretched",
+                where,
+                "restore the missing slices, or renumber the stack from 0 without gaps",
+            )
+        )
+    if found.twice:
+        out.append(
+            warning(
+                "volume-slice-names",
+                f"{name}: slice {_listed(found.twice)} is there under two names (with and without leading "
+                "zeros); AMBF stacks both",
+                where,
+                "keep one file per index",
+            )
+        )
+    if opaque:
+        out.append(
+            warning(
+                "volume-slice-opaque",
+                f"{name}: slice {_listed(opaque)} is a colour image without alpha; AMBF draws and collides a "
+                "colour volume by its alpha, so every voxel of it is solid",
+                where,
+                "write grey slices, or RGBA slices whose alpha is 0 outside the tissue",
+            )
+        )
+    if n < count and not found.gaps:  # a gap's warning says it already
+        out.append(
+            info(
+                "volume-slice-count",
+                f"{name}: `images: count` is {count} and {n} slices are found; AMBF reads count as the most "
+                f"to search for and stacks the {n} it finds",
+                where,
+                f"count: {n} says what the folder holds",
+            )
+        )
+    elif found.indices and found.indices[-1] == count:
+        out.append(
+            info(
+                "volume-slice-count",
+                f"{name}: AMBF also stacks slice {count}: it searches indices 0 to count inclusive",
+                where,
+                f"give count: {count + 1}, or remove the slice numbered {count}",
+            )
+        )
+    return out
 
 
 def load_volume(model, vol) -> VolumeData:
-    """Every slice of ``vol`` as one array, each read through the input policy; the first slice
-    that is missing, outside the tree, not an image or of another size is a located error."""
+    """Every slice of ``vol`` as one array, each read through the input policy; a slice outside
+    the tree, not an image or of another size is a located error. What AMBF loads but a modeller
+    should hear about (a gap, opaque colour slices, count above the slices found) is in
+    ``findings``."""
     from PIL import Image, UnidentifiedImageError
 
-    files = slice_paths(model, vol)
+    found = slice_files(model, vol)
+    files = found.files
     tree = getattr(model, "tree", None)
     where = _where(vol, "images")
-    slices, size, peak = [], None, 1.0
+    voxels = None
+    size, peak, opaque = None, 1.0, []
     for i, f in enumerate(files):
         inputs.check_file(f, "image", tree=tree, referrer=where, what=f"slice {i}")
         try:
             with Image.open(f) as img:
                 img.load()
-                mode = img.mode
-                arr = np.asarray(img.convert("L") if mode in ("RGB", "RGBA", "P", "LA", "CMYK") else img)
+                arr, peak_i, flat = slice_values(img)
         except (UnidentifiedImageError, OSError, ValueError) as exc:
             raise _fail(
                 vol,
                 "volume-slice-unreadable",
                 f"slice {i} ({inputs.shown(f.name)}) is not an image Pillow reads ({type(exc).__name__})",
-                "write the slices as PNG, TIFF or another Pillow format",
+                "write the slices as PNG",
             ) from None
-        if arr.ndim != 2:
-            raise _fail(
-                vol,
-                "volume-slice-unreadable",
-                f"slice {i} ({inputs.shown(f.name)}) is not a single-channel image",
-                "write grey slices",
-            )
         if size is None:
             size = arr.shape
             if len(files) * size[0] * size[1] > MAX_VOXELS:
@@ -108,6 +198,7 @@ def load_volume(model, vol) -> VolumeData:
                     f"{len(files)} slices of {size[1]}x{size[0]} are more than {MAX_VOXELS:,} voxels",
                     "downsample the slices",
                 )
+            voxels = np.empty((len(files), *size), dtype=np.float32)
         elif arr.shape != size:
             raise _fail(
                 vol,
@@ -115,11 +206,11 @@ def load_volume(model, vol) -> VolumeData:
                 f"slice {i} ({inputs.shown(f.name)}) is {arr.shape[1]}x{arr.shape[0]}, slice 0 is {size[1]}x{size[0]}",
                 "every slice of a volume has the same size",
             )
-        peak = (
-            65535.0 if arr.dtype == np.uint16 or mode.startswith("I;16") else 255.0 if arr.dtype == np.uint8 else peak
-        )
-        slices.append(arr)
-    voxels = np.stack(slices).astype(np.float32)
+        if flat:
+            opaque.append(i)
+        peak = max(peak, peak_i)
+        voxels[i] = arr
+    assert voxels is not None
     if peak == 1.0 and voxels.size and voxels.max() > 1.0:  # 32-bit integer or float slices: their own maximum
         peak = float(voxels.max())
     voxels /= peak
@@ -140,7 +231,8 @@ def load_volume(model, vol) -> VolumeData:
             "give a size in metres",
             "dimensions",
         )
-    return VolumeData(voxels, dims, files, peak)
+    count = int(vol.images.count)
+    return VolumeData(voxels, dims, files, peak, _findings(vol, found, count, opaque), count)
 
 
 def iso_surface(data: VolumeData, level: float | None = None) -> tuple[np.ndarray, np.ndarray]:

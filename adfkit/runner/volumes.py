@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..diagnostics import AdfError
+from ..diagnostics import AdfError, Severity
 from ..model import Body
 from ..model.semantics import pose_or_identity
 from .names import merge_namespace
@@ -85,6 +85,9 @@ def volume_surfaces(world, models) -> list[VolumeSurface]:
                     )
                 world.not_played.append({"object": vol.identifier, "what": "volume", "why": exc.diagnostics[0].message})
                 continue
+            for d in data.findings:
+                if d.severity >= Severity.WARNING:
+                    world._warn("runner-volume", d.message, vol, d.hint or "fix the slices")
             world.not_played.extend(not_played_parts(vol))
             if len(faces) == 0:
                 world._warn(
@@ -107,6 +110,7 @@ def volume_surfaces(world, models) -> list[VolumeSurface]:
                 "object": vol.identifier,
                 "key": key,
                 "voxels": list(data.voxels.shape[::-1]),
+                "slices_found": len(data.files),
                 "dimensions_m": data.dimensions.tolist(),
                 "triangles": int(len(faces)),
                 "iso_surface_value": level,

@@ -50,7 +50,7 @@ def write_slices(values: np.ndarray, full_scale: float, folder: Path, prefix: st
         files = []
         for i, s in enumerate(data):
             name = f"{prefix}{i}.png"
-            Image.fromarray(s).save(tmp / name)
+            Image.fromarray(np.ascontiguousarray(s[::-1])).save(tmp / name)  # row 0 is the bottom row
             files.append(folder / name)
         os.chmod(tmp, 0o755)
         old = None

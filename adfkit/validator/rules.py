@@ -287,18 +287,47 @@ _RULES = [
     Rule(
         "volume-slice-missing",
         E,
-        "A slice file of a volume (path + prefix + index + format) is missing, outside "
-        "the scene's tree or not a regular file",
-        "`count: 64` with slices 0..62 on disk",
+        "A volume's folder holds no slice AMBF reads (path + prefix + index 0..count + format; AMBF "
+        "skips the volume), or a slice is outside the scene's tree or not a regular file",
+        "`prefix: bone` for files named `bone_0.png` ...",
+    ),
+    Rule(
+        "volume-format",
+        E,
+        "A volume's `format` is not one AMBF reads slices in (bmp, gif, jpg, png, ppm, raw; AMBF skips the volume)",
+        "`format: tif`, or `format: .png` (AMBF adds the dot itself)",
+    ),
+    Rule(
+        "volume-slice-gap",
+        W,
+        "Slice indices are missing between 0 and the last slice: AMBF stacks the slices it finds, so "
+        "the ones after a gap move down",
+        "`bone_0.png` .. `bone_47.png` without `bone_17.png`",
+    ),
+    Rule(
+        "volume-slice-names",
+        W,
+        "A slice index is there under two names (with and without leading zeros); AMBF stacks both",
+        "`plane005.png` beside `plane0005.png`",
+    ),
+    Rule(
+        "volume-slice-opaque",
+        W,
+        "A colour slice without alpha: AMBF reads a colour volume's alpha, so every voxel is solid",
+        "RGB slices of a segmented scan",
+    ),
+    Rule(
+        "volume-slice-count",
+        I,
+        "`images: count` above the slices found (AMBF reads count as the most to search for), or a "
+        "slice numbered count (AMBF reads it too)",
+        "`count: 512` over a folder of 253 slices",
     ),
     Rule(
         "volume-slice-unreadable",
         E,
-        "A slice of a volume is not an image Pillow reads, or not a single-channel one",
+        "A slice of a volume is not an image Pillow reads",
         "`bone_3.png` that holds text",
-    ),
-    Rule(
-        "volume-slice-size", E, "The slices of a volume are not all the same size", "a 64x64 slice among 128x128 ones"
     ),
     Rule("volume-too-large", E, "A volume of more than 512^3 voxels", "`count: 2000` slices of 2048x2048"),
     Rule(

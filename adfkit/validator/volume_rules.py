@@ -1,6 +1,7 @@
 """Volumes (§11.4): every slice file read as the runner will read it (adfkit.geometry.volume:
 the input policy, Pillow, one size, a sane count), so a broken volume is a located error in CI
-rather than a volume AMBF silently skips."""
+rather than a volume AMBF silently skips; what AMBF loads but a modeller should hear about (a gap
+in the numbering, opaque colour slices, a count above the slices found) as a warning or a note."""
 
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ def check(m: ModelFile) -> list[Diagnostic]:
         except ImportError:
             return out
         try:
-            load_volume(m, vol)
+            out.extend(load_volume(m, vol).findings)
         except AdfError as exc:
             for d in exc.diagnostics:
                 rule = _SLICE_RULES.get(d.rule, d.rule)
