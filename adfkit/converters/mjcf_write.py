@@ -26,9 +26,11 @@ from ..model.semantics import (
     JointKind,
     ShapeKind,
     collision_primitives,
+    cone_vertices,
     effective_mass,
     inertial_offset,
     joint_frames,
+    plane_pose,
 )
 from ..model.tree import Link, build_tree, joint_ends, motion
 from . import inertia as inertia_math
@@ -86,6 +88,16 @@ class _Assets:
         """(a file MuJoCo reads or None, the mesh when it is flat): engine_fit.MeshFiles."""
         return self.files.fit(path, who, losses, check_flat=True)
 
+    def cone(self, radius: float, height: float) -> str:
+        """A mesh asset of the cone's vertices (model.semantics.cone_vertices), which MuJoCo hulls."""
+        key = (f"cone:{radius!r}:{height!r}", 1.0)
+        if key not in self.names:
+            name = _unique("cone", self.used)
+            pts = cone_vertices(radius, height)
+            ET.SubElement(self.el, "mesh", name=name, vertex=" ".join(_num(c) for p in pts for c in p))
+            self.names[key] = name
+        return self.names[key]
+
     def mesh(self, path: Path, scale: float, flat: bool = False) -> str:
         key = (str(path.resolve()), scale)
         if key not in self.names:
@@ -104,7 +116,9 @@ class _Assets:
         return self.names[key]
 
 
-def _geom_primitive(body_el: ET.Element, kind: ShapeKind, g, pose: Pose, name: str) -> bool:
+def _geom_primitive(body_el: ET.Element, kind: ShapeKind, g, pose: Pose, name: str, assets=None) -> bool:
+    """Write one primitive as a geom in group 3; False for a shape MJCF cannot hold here (a
+    cone without ``assets`` to hold its hull, a plane: see _write_geoms)."""
     if kind is ShapeKind.BOX:
         el = ET.SubElement(
             body_el, "geom", name=name, type="box", size=_vec(((g.x or 0) / 2, (g.y or 0) / 2, (g.z or 0) / 2))
@@ -119,6 +133,13 @@ def _geom_primitive(body_el: ET.Element, kind: ShapeKind, g, pose: Pose, name: s
         half = h / 2 if kind is ShapeKind.CYLINDER else max(h / 2 - r, 0.0)
         el = ET.SubElement(body_el, "geom", name=name, type=kind.value, size=_vec((r, half)))
         _place(el, pose * turn)
+    elif kind is ShapeKind.CONE and assets is not None:  # MuJoCo has no cone: its hull
+        turn = Pose(Vec3(), _AXIS_TO_Z.get((g.axis or "z").lower(), _AXIS_TO_Z["z"]))
+        el = ET.SubElement(body_el, "geom", name=name, type="mesh", mesh=assets.cone(g.radius or 0.0, g.height or 0.0))
+        _place(el, pose * turn)
+    elif kind is ShapeKind.PLANE:  # infinite; drawn as an infinite grid (size 0 0)
+        el = ET.SubElement(body_el, "geom", name=name, type="plane", size="0 0 1")
+        _place(el, pose * plane_pose(g))
     else:
         return False
     el.set("group", "3")
@@ -140,6 +161,11 @@ def _write_body(
     q0 = link.q0 if abs(link.q0) > INITIAL_VALUE_TOLERANCE else 0.0
     _place(el, link.origin if link.parent is None else link.origin * motion(link.kind, q0))
     mass = effective_mass(body)
+    if link.parent is None and mass > 0.0 and _has_plane(body):
+        losses.append(
+            Loss(who, "mass", "a body with a PLANE collision shape is static (MuJoCo collides a plane only then)")
+        )
+        mass = 0.0
     moving = not (link.parent is None and mass == 0.0)
     if link.parent is None and mass > 0.0:
         ET.SubElement(el, "freejoint", name=_unique(f"{names[id(link)]}_free", used["joint"]))
@@ -192,7 +218,7 @@ def _write_body(
         _place(inertial, Pose(Vec3(), com.orientation))
         inertial.set("mass", _num(mass))
         inertial.set("diaginertia", _vec((ix, iy, iz)))
-    _write_geoms(el, model, link, names[id(link)], assets, losses, used)
+    _write_geoms(el, model, link, names[id(link)], assets, losses, used, _static(link))
     for attr, key in _BODY_ONLY.items():
         if attr in ("friction", "damping"):
             continue
@@ -216,7 +242,23 @@ def _is_world(link: Link) -> bool:
     )
 
 
-def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets: _Assets, losses, used) -> None:
+def _has_plane(body) -> bool:
+    return any(p.kind is ShapeKind.PLANE for p in collision_primitives(body) or [])
+
+
+def _static(link: Link) -> bool:
+    """The link is welded to the world: a static root and fixed joints all the way down to it
+    (a root with a PLANE is written static, _write_body)."""
+    while link.parent is not None:
+        if link.kind is not JointKind.FIXED:
+            return False
+        link = link.parent
+    return effective_mass(link.body) == 0.0 or _has_plane(link.body)
+
+
+def _write_geoms(
+    el: ET.Element, model: ModelFile, link: Link, name: str, assets: _Assets, losses, used, static: bool = True
+) -> None:
     body = link.body
     who = body.identifier
     scale = body.scale if body.scale is not None else 1.0
@@ -284,8 +326,17 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
             )
     else:
         for n, p in enumerate(prims):
+            pose = p.pose
+            if p.kind is ShapeKind.PLANE:
+                if not static:
+                    losses.append(
+                        Loss(who, "collision plane", "MuJoCo collides a plane only on a static body: left out")
+                    )
+                    continue
+                if body.collision_shape:  # a lone PLANE is the Bullet body's own shape: no offset (§7.4)
+                    pose = inertial_offset(body)
             if not _geom_primitive(
-                el, p.kind, p.geometry, to_link * p.pose, _unique(f"{name}_collision{n}", used["geom"])
+                el, p.kind, p.geometry, to_link * pose, _unique(f"{name}_collision{n}", used["geom"]), assets
             ):
                 losses.append(Loss(who, f"collision {p.kind.value}", "MJCF has no such primitive"))
     for n, e in enumerate(body.compound_shape or []):
@@ -296,8 +347,14 @@ def _write_geoms(el: ET.Element, model: ModelFile, link: Link, name: str, assets
         if (
             k is None
             or e.geometry is None
+            or (k is ShapeKind.PLANE and not static)
             or not _geom_primitive(
-                g, k, e.geometry, to_link * pose_or_identity(e.offset), _unique(f"{name}_visual{n}", used["geom"])
+                g,
+                k,
+                e.geometry,
+                to_link * pose_or_identity(e.offset),
+                _unique(f"{name}_visual{n}", used["geom"]),
+                assets,
             )
         ):
             losses.append(Loss(who, f"visual {e.shape}", "MJCF has no such primitive"))

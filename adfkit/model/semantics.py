@@ -88,6 +88,27 @@ def axis_vector(axis: str | None) -> Vec3:
     return {"x": Vec3(1, 0, 0), "y": Vec3(0, 1, 0)}.get((axis or "z").lower(), Vec3(0, 0, 1))
 
 
+CONE_SIDES = 24  # a cone collides as this many-sided hull where an engine has no cone
+
+
+def cone_vertices(radius: float, height: float, sides: int = CONE_SIDES) -> list[tuple[float, float, float]]:
+    """A cone along +z centred on half its height (Bullet's btConeShapeZ), as the apex, the base
+    centre and ``sides`` points around the base: its hull is the cone an engine without one plays."""
+    out = [(0.0, 0.0, height / 2), (0.0, 0.0, -height / 2)]
+    for i in range(sides):
+        a = 2 * math.pi * i / sides
+        out.append((radius * math.cos(a), radius * math.sin(a), -height / 2))
+    return out
+
+
+def plane_pose(geometry) -> Pose:
+    """Where a PLANE shape's surface lies in its frame: the point `offset` along the unit
+    `normal` (Bullet's btStaticPlaneShape n·x = offset), its +z axis along the normal."""
+    n = normalized_or(geometry.normal, Vec3(0.0, 0.0, 1.0))
+    d = geometry.offset or 0.0
+    return Pose(Vec3(n[0] * d, n[1] * d, n[2] * d), shortest_arc(Vec3(0.0, 0.0, 1.0), n))
+
+
 class CollisionMeshType(str, Enum):
     CONVEX_HULL = "convex hull"
     CONVEX_MESH = "convex mesh"

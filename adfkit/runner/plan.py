@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..diagnostics import warning
 from ..model.semantics import (
     ACTUATOR_TYPES,
     DEFAULT_ACTUATOR_MAX_IMPULSE,
@@ -19,6 +20,9 @@ from ..model.semantics import (
     DEFAULT_SENSOR_RANGE,
     SENSOR_TYPES,
     JointKind,
+    ShapeKind,
+    collision_primitives,
+    effective_mass,
     pose_or_identity,
 )
 from .names import merge_namespace
@@ -36,6 +40,7 @@ SPRING_KINDS = (
 #: every collision-group bit: what a body without collision groups (and the runner's floor,
 #: which stands in for a world's) collides as, in both engines
 ALL_GROUPS = (1 << 31) - 1
+GROUP_BITS = 31
 
 #: sections of a model each engine does not play (each is warned about and listed in the report)
 NOT_PLAYED = {
@@ -65,6 +70,65 @@ def not_played(world, models, engine: str) -> None:
                     f"play it with --engine {other}" if other else "play this object in AMBF itself",
                 )
                 world.not_played.append({"object": o.identifier, "what": kind, "why": why})
+
+
+def collision_masks(world, bodies) -> dict[int, int]:
+    """{id(ADF body): its collision bits} for ``bodies`` (ADF bodies), AMBF's collision groups
+    (afFramework.cpp, buildCollisionGroups; checked in AMBF): two bodies that both have groups
+    collide only when they share one; a body with none (`collision groups` absent or `[]`)
+    collides with every body, so a floor written `collision groups: []` holds them all. A group
+    is one bit of ``GROUP_BITS``, a body without groups has them all, and the engines collide a
+    pair whose bits meet. Past ``GROUP_BITS`` groups two groups share a bit, so their bodies
+    collide where AMBF's would not: a located ``runner-groups`` warning at the first such body."""
+    bodies = list(bodies)
+    groups = sorted({g for b in bodies for g in _groups(b)})
+    bit = {g: 1 << (i % GROUP_BITS) for i, g in enumerate(groups)}
+    out = {}
+    for b in bodies:
+        mask = 0
+        for g in _groups(b):
+            mask |= bit[g]
+        out[id(b)] = mask or ALL_GROUPS
+    _floors_passed(world, bodies, out)
+    if len(groups) > GROUP_BITS:
+        first = next(b for b in bodies if groups[GROUP_BITS] in _groups(b))
+        world._warn(
+            "runner-groups",
+            f"{len(groups)} collision groups, more than the {GROUP_BITS} an engine's collision bits hold: "
+            f"group {groups[GROUP_BITS]} shares a bit with group {groups[0]}, so their bodies collide where AMBF's "
+            "do not",
+            first,
+            f"use at most {GROUP_BITS} distinct collision groups in one scene",
+        )
+    return out
+
+
+def _floors_passed(world, bodies, masks) -> None:
+    """A floor (a PLANE) with collision groups holds only the bodies that share one (or have
+    none); each one whose dynamic bodies fall through it, as in AMBF, is named at its groups."""
+    for floor in bodies:
+        if not _groups(floor) or not any(p.kind is ShapeKind.PLANE for p in collision_primitives(floor) or []):
+            continue
+        passed = [
+            b.identifier
+            for b in bodies
+            if b is not floor and effective_mass(b) > 0 and not masks[id(b)] & masks[id(floor)]
+        ]
+        if passed:
+            world.diagnostics.append(
+                warning(
+                    "runner-floor-groups",
+                    f"{floor.identifier}: its collision groups {_groups(floor)} share none with "
+                    f"{', '.join(passed[:5])}{' ...' if len(passed) > 5 else ''}: they fall through it, as in AMBF",
+                    floor.where("collision groups"),
+                    "give the floor `collision groups: []` to hold every body, or add their group to it",
+                )
+            )
+
+
+def _groups(body) -> list[int]:
+    """The body's collision groups AMBF keeps (0-999; it warns about and drops the others)."""
+    return [g for g in (body.collision_groups or []) if isinstance(g, int) and 0 <= g <= 999]
 
 
 def mesh_refusal(model, path) -> str | None:

@@ -23,13 +23,13 @@ import mujoco
 import numpy as np
 
 from ...converters.mjcf_write import to_mjcf
-from ...converters.urdf import _material
-from ...model.semantics import JointKind, collision_primitives, joint_frames, pose_or_identity
+from ...model.semantics import JointKind, ShapeKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
 from .. import plan as scene_rules
 from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
+from .collision import collision_filters, warn_losses
 from .drives import add_drive, drive_limit
 from .spec import _parse_spec, _resolve_meshes
 from .textures import apply_textures
@@ -53,6 +53,13 @@ class BodyPlan:
     mjname: str  # MJCF body name ("world" for ADF's world stand-in)
     link: object  # model.tree.Link
     spring: tuple | None = None  # (joint, kind) of a six-dof-family joint to its parent
+    prefix: str = ""  # the model's MJCF prefix (a "world" body's geoms are the worldbody's with it)
+
+    def geoms(self, spec) -> list:
+        """The MjsGeoms the MJCF writer made of this body."""
+        if self.mjname == "world":
+            return [g for g in spec.worldbody.geoms if g.name.startswith(self.prefix)]
+        return list(spec.body(self.mjname).geoms)
 
 
 #: kg·m² added to each hinge of a six-dof spring: a thread element's turn about its own axis has
@@ -61,7 +68,6 @@ class BodyPlan:
 #: 1e-9 is 2 % of the last element's bending inertia about its joint (Bullet's maximal
 #: coordinates give each element its own inertia and never meet the span)
 SPRING_HINGE_ARMATURE = 1e-9
-EXCLUDE_SPARE = 512  # run-time excluded pairs (MujocoWorld.set_collision); the suture turns off ~300
 
 
 @dataclass
@@ -112,7 +118,6 @@ def _ghost_geoms(body_el, gh, pose_in_link: np.ndarray, name: str, warn) -> list
             "runner-ghost", f"{gh.identifier}: only primitive ghost shapes are played by the MuJoCo engine; skipped", gh
         )
         return []
-    from ...model.semantics import ShapeKind
 
     out = []
     for n, p in enumerate(prims):
@@ -173,11 +178,7 @@ def build_plan(world) -> Plan:
                 m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names, volumes=False, leave_out=uncreated
             )
             losses += ls
-            for loss in ls:  # the MJCF writer already made a flat collision mesh a thin box (engine_fit)
-                if loss.feature == "collision mesh" and "flat" in loss.reason:
-                    world._warn("runner-flat-mesh", f"{loss.element}: {loss.reason}", m.body(loss.element))
-                elif loss.feature == "mesh" and "is not read by" in loss.reason:  # PLY, 3DS: converted or left out
-                    world._warn("runner-mesh-format", f"{loss.element}: {loss.reason}", m.body(loss.element))
+            warn_losses(world, m, ls)
             child = _parse_spec(text, m)
             _resolve_meshes(world, child, out_dir, m)
             prefix = f"m{i}/"
@@ -188,7 +189,7 @@ def build_plan(world) -> Plan:
                     continue
                 mjname, link = names[b.identifier]
                 key = registry.add(merge_namespace(ns, b.namespace) + b.identifier, None)
-                bp = BodyPlan(key, b, m, mjname if mjname == "world" else prefix + mjname, link)
+                bp = BodyPlan(key, b, m, mjname if mjname == "world" else prefix + mjname, link, prefix=prefix)
                 registry.items[key] = bp
                 if link.parent is not None and link.kind in SPRING_KINDS:
                     bp.spring = (link.joint, link.kind)
@@ -243,7 +244,7 @@ def build_plan(world) -> Plan:
                     j,
                 )
     _world_lights(world, spec)
-    _collision_filters(world, spec, bodies, joints, plans_by_model)
+    collision_filters(world, spec, bodies, joints, plans_by_model)
     apply_textures(world, spec, bodies)
     ghosts, actuators, sensors = [], [], []
     for m, _mine, _tree in plans_by_model:
@@ -345,51 +346,3 @@ def _world_lights(world, spec) -> None:
             exponent=light.spot_exponent if light.spot_exponent is not None else ADF_SPOT_EXPONENT,
             castshadow=False,
         )
-
-
-def _collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
-    """ADF collision groups as contype/conaffinity bits (bodies collide when they share a
-    group, as in the PyBullet runner); joints and models that ignore inter-collision as
-    excluded body pairs."""
-    groups = sorted({g for bp in bodies for g in (bp.body.collision_groups or []) if 0 <= g <= 999})
-    bit = {g: 1 << (i % 31) for i, g in enumerate(groups)}
-    allbits = scene_rules.ALL_GROUPS
-    for bp in bodies:
-        if bp.mjname == "world":
-            continue
-        gs = [g for g in (bp.body.collision_groups or []) if 0 <= g <= 999]
-        mask = 0
-        for g in gs:
-            mask |= bit[g]
-        fr = bp.body.friction
-        geoms = spec.body(bp.mjname).geoms
-        drawn = any(g.group == 1 for g in geoms)
-        rgba = _material(bp.body)
-        for g in geoms:
-            if not drawn and g.group == 3:
-                g.group = 0  # no visual shape written: the camera sees the collision shape
-                if rgba is not None:
-                    g.rgba = rgba
-
-            if g.contype == 0 and g.conaffinity == 0:
-                continue
-            g.contype = g.conaffinity = mask or allbits
-            if fr is not None and fr.static is not None:
-                g.friction = [fr.static, g.friction[1], fr.rolling if fr.rolling is not None else g.friction[2]]
-    pairs = set()
-    for j, _kind, parent, child, _jn in joints:
-        if j.ignore_inter_collision is not False:
-            pairs.add((parent.mjname, child.mjname))
-    for m, mine, _tree in plans_by_model:
-        if m.ignore_inter_collision:
-            bs = list(mine.values())
-            for i, a in enumerate(bs):
-                for b in bs[i + 1 :]:
-                    pairs.add((a.mjname, b.mjname))
-    for a, b in sorted(pairs):
-        if a != b and "world" not in (a, b):
-            spec.add_exclude(bodyname1=a, bodyname2=b)
-    # spare slots for MjWorld.set_collision: MuJoCo's excluded pairs are compiled in, so a task
-    # that turns a pair off at run time fills a world-world placeholder (a pair that never collides)
-    for _ in range(EXCLUDE_SPARE):
-        spec.add_exclude(bodyname1="world", bodyname2="world")

@@ -10,7 +10,7 @@ import numpy as np
 from ..plan import viscous_impulse_force
 from ..rotations import invert, matrix_to_quat, pose_matrix
 from .assemble import WAKE_FORCE, _xyzw
-from .build import EXCLUDE_SPARE
+from .collision import EXCLUDE_SPARE
 from .objects import MjActuator, MjBody, MjGhost, MjSensor
 
 

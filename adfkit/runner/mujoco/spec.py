@@ -15,6 +15,8 @@ def _resolve_meshes(world, child, out_dir: Path, model) -> None:
     """Absolute mesh paths; a mesh file that is not there drops its geoms, with a warning."""
     missing, missing_paths = {}, {}
     for mesh in list(child.meshes):
+        if not mesh.file:  # vertices written inline (a cone's hull)
+            continue
         path = (out_dir / mesh.file).resolve()
         if path.is_file():
             mesh.file = str(path)

@@ -16,6 +16,7 @@ from ..names import Registry, merge_namespace
 from ..plan import (
     ALL_GROUPS,
     SPRING_KINDS,
+    collision_masks,
     is_hole,
     key_of,
     not_played,
@@ -229,20 +230,10 @@ class Assembly:
         set_dynamics(sb)
 
     def _collision_filters(self, records) -> None:
-        groups = sorted({g for sb in self.bodies for g in (sb.body.collision_groups or []) if 0 <= g <= 999})
-        bit = {g: 1 << (i % 30) for i, g in enumerate(groups)}
-        if len(groups) > 30:
-            self._warn("runner-groups", "more than 30 collision groups: groups share mask bits", None)
-        allbits = ALL_GROUPS
+        masks = collision_masks(self, [sb.body for sb in self.bodies])
         for sb in self.bodies:
-            gs = [g for g in (sb.body.collision_groups or []) if 0 <= g <= 999]
-            if gs:
-                mask = 0
-                for g in gs:
-                    mask |= bit[g]
-                pb.setCollisionFilterGroupMask(sb.uid, sb.link, mask, mask, physicsClientId=self.cid)
-            else:
-                pb.setCollisionFilterGroupMask(sb.uid, sb.link, allbits, allbits, physicsClientId=self.cid)
+            mask = masks[id(sb.body)]
+            pb.setCollisionFilterGroupMask(sb.uid, sb.link, mask, mask, physicsClientId=self.cid)
         for j, _kind, parent, child in records:
             if j.ignore_inter_collision is not False:
                 self._no_collision(parent, child)
