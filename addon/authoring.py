@@ -7,17 +7,16 @@ input, so operators and scripts report the same thing.
 from __future__ import annotations
 
 import math
-import tempfile
-from pathlib import Path
 
 import bpy
 from mathutils import Matrix, Quaternion, Vector
 
 from adfkit.diagnostics import AdfError, SourceLocation, error
-from adfkit.model.pose import quat_to_rpy
+from adfkit.model.pose import Pose, Quat, Vec3, quat_to_rpy
 
-from . import gather, meshes
-from .elements import _link, add_collision_primitive, mass_from_density
+from . import exact, gather, meshes, precision
+from .elements import _link, add_collision_primitive, digits, exported_evaluated, mass_from_density
+from .precision import rounded, snapped, typed
 
 
 def _fail(rule: str, msg: str, obj=None, hint: str | None = None):
@@ -80,15 +79,17 @@ def fix_selected_nodes(obj, replace: bool = True) -> list[int]:
 
 
 def _trimesh_of(obj):
-    """The object's mesh as adfkit.geometry loads it (via a temporary OBJ)."""
-    load_mesh = geometry("meshio").load_mesh
+    """The mesh export writes for the object (its modifiers applied, with *Apply modifiers*),
+    as a trimesh in float64 with the coordinates as typed (precision.typed)."""
+    geometry("meshio")  # the geometry packages, or a readable error
+    import trimesh
+
     if obj.type != "MESH" or not len(obj.data.polygons):
         _fail("no-mesh", f"'{obj.name}' has no mesh faces", obj, "select a mesh object")
-    with tempfile.TemporaryDirectory() as tmp:
-        arr = meshes.mesh_arrays(obj)
-        arr.materials, arr.uv = [], None
-        meshes.write_obj([arr], Path(tmp), "m.obj")
-        return load_mesh(Path(tmp) / "m.obj")
+    arr = meshes.mesh_arrays(obj, evaluated=exported_evaluated())
+    if not len(arr.tris):
+        _fail("no-mesh", f"'{obj.name}' has no mesh faces", obj, "select a mesh object")
+    return trimesh.Trimesh(vertices=typed(arr.co), faces=arr.tris, process=True, validate=False)
 
 
 def generate_collision(obj, threshold: float = 0.05, max_hulls: int = 16, repair: bool = False) -> list:
@@ -135,7 +136,8 @@ def _pose_matrix(pose) -> Matrix:
 
 def fit_collision_primitive(obj, shape: str = "CAPSULE", replace: bool = True):
     """Fit an oriented primitive around the body's mesh (adfkit.geometry.primitives; a cone
-    takes the fitted cylinder's axis, base at the wider end) and add it as the body's collision."""
+    takes the fitted cylinder's axis, base at the wider end) and add it as the body's collision.
+    Its size and offset are kept exactly (:mod:`.exact`), rounded to the scene's Float digits."""
     prim = geometry("primitives")
     mesh = _trimesh_of(obj)
     kind = shape.upper()
@@ -147,17 +149,15 @@ def fit_collision_primitive(obj, shape: str = "CAPSULE", replace: bool = True):
     if replace:
         for c in [c for c in obj.children if c.adf.kind in ("COLLISION_SHAPE", "COLLISION_MESH")]:
             bpy.data.objects.remove(c, do_unlink=True)
-    g = entry.geometry
-    size = (g.x, g.y, g.z) if kind == "BOX" else (0.1, 0.1, 0.1)
+    g, n = entry.geometry, min(digits(), precision.FLOAT32_DIGITS)  # what float32 coordinates hold
+    size = tuple(rounded(v, n) for v in (g.x, g.y, g.z)) if kind == "BOX" else (0.1, 0.1, 0.1)
+    radius, height = rounded(g.radius or 0.05, n), rounded(g.height or 0.1, n)
+    pose = Pose(Vec3(*snapped(entry.offset.position, float(mesh.scale), n)), entry.offset.orientation)
     made = add_collision_primitive(
-        obj,
-        kind,
-        size=size,
-        radius=g.radius or 0.05,
-        height=g.height or 0.1,
-        axis=g.axis or "z",
-        offset=_pose_matrix(entry.offset),
+        obj, kind, size=size, radius=radius, height=height, axis=g.axis or "z", offset=_pose_matrix(pose)
     )
+    exact.keep(made, size=size, radius=radius, height=height)
+    exact.keep_offset(made, pose)
     bpy.context.view_layer.update()
     return made
 
@@ -187,7 +187,10 @@ def _cone_from_cylinder(entry, mesh):
 
 def estimate_inertia(obj, mass: float | None = None, density: float | None = None) -> None:
     """Mass, principal inertia and inertial offset from the body's closed mesh: the mass is
-    kept when given (typed by hand), else density × volume."""
+    kept when given (typed by hand), else density × volume. Computed in float64 and rounded
+    to the scene's Float digits (a symmetric body's centre of mass is 0, its axes its own),
+    kept exactly beside Blender's float32 properties (:mod:`.exact`)."""
+
     gmass = geometry("mass")
     mesh = _trimesh_of(obj)
     if not mesh.is_watertight:
@@ -199,15 +202,21 @@ def estimate_inertia(obj, mass: float | None = None, density: float | None = Non
         )
     if mass is None and density is None:
         density = obj.adf.density
+    n = min(digits(), precision.FLOAT32_DIGITS)  # what float32 coordinates hold
     props = gmass.mesh_mass_properties(mesh, density=density, mass=mass)
-    inertia, offset = gmass.to_adf(props)
+    moments_, axes = precision.principal(props.inertia, n)
+    com = snapped(props.com, float(mesh.scale), n)
     b = obj.adf.body
-    typed = b.mass_typed
-    b.use_mass, b.mass = True, float(props.mass)
-    b.mass_typed = typed and mass is not None
-    b.use_inertia, b.inertia = True, (inertia.ix, inertia.iy, inertia.iz)
-    b.use_inertial_offset = True
-    b.inertial_offset = (*offset.position, *quat_to_rpy(offset.orientation))
+    typed_by_hand = b.mass_typed
+    m = rounded(props.mass, n)
+    moments = tuple(rounded(v, n) for v in moments_)
+    pose = (*com, *quat_to_rpy(Quat.from_matrix(axes.tolist()).normalized()))
+    b.use_mass, b.mass = True, m
+    b.mass_typed = typed_by_hand and mass is not None
+    b.use_inertia, b.inertia = True, moments
+    b.use_inertial_offset, b.inertial_offset = True, pose
+    b.mass_note = ""
+    exact.keep(obj, mass=m, inertia=moments, inertial_offset=pose)
 
 
 def estimate_body(obj) -> None:

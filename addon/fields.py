@@ -442,7 +442,9 @@ def set_value(obj: Node, f: Field, value) -> None:
         cur.x, cur.y, cur.z = (tidy(c) for c in value)
         out = cur
     elif f.kind == "pose":
-        out = Pose(Vec3(*map(tidy, value[:3])), rpy_to_quat(*map(tidy, value[3:])))
+        # an exact (float64) angle goes to the writer as it is: pi stays pi (addon/exact.py)
+        angles = (tidy(a) if f32(a) == a else float(a) for a in value[3:])
+        out = Pose(Vec3(*map(tidy, value[:3])), rpy_to_quat(*angles))
     elif f.kind == "groups":
         out = parse_groups(value)
     elif f.kind == "vec3":

@@ -19,7 +19,7 @@ from adfkit.model.common import Geometry, ShapeEntry
 from adfkit.model.objects import Ray, SoftBody
 from adfkit.model.pose import Quat, Vec3
 
-from . import fields, joint_frames, meshes, meshformat
+from . import exact, fields, joint_frames, meshes, meshformat
 from .properties import read_group
 
 MESH_DIRS = ("meshes/high_res/", "meshes/low_res/")
@@ -99,7 +99,7 @@ def gather_body(obj, out: Gathered, paths: tuple[str, str]) -> Body:
     b.identifier = identifier(obj)
     if b.name is None:
         b.name = obj.name
-    values = read_group(obj.adf.body, fields.BODY)
+    values = exact.applied(obj, read_group(obj.adf.body, fields.BODY))
     if values.get("mass") is None:
         # refused when authored here; a file imported without mass is carried through as AMBF loads it
         out.diagnostics.append(
@@ -185,13 +185,19 @@ def _shape_entry(child, body_obj) -> ShapeEntry:
     s = child.adf.shape
     geo = Geometry()
     tidy = fields.tidy  # Blender keeps these in single precision: the shortest decimal, not 0.0099999997...
+    v = exact.applied(child, {"size": tuple(s.size), "radius": s.radius, "height": s.height})
     if s.shape == "BOX":
-        geo.x, geo.y, geo.z = (tidy(v) for v in s.size)
+        geo.x, geo.y, geo.z = (tidy(x) for x in v["size"])
     elif s.shape == "SPHERE":
-        geo.radius = tidy(s.radius)
+        geo.radius = tidy(v["radius"])
     else:
-        geo.radius, geo.height, geo.axis = tidy(s.radius), tidy(s.height), s.axis
-    return ShapeEntry(shape=s.shape.title(), geometry=geo, offset=relative_pose(child, body_obj))
+        geo.radius, geo.height, geo.axis = tidy(v["radius"]), tidy(v["height"]), s.axis
+    placed = exact.offset(child)  # where a fit put it, while it has not been moved
+    if placed is None:
+        offset = relative_pose(child, body_obj)
+    else:
+        offset = Pose(Vec3(*(fields.tidy(c * uniform_scale(body_obj)) for c in placed.position)), placed.orientation)
+    return ShapeEntry(shape=s.shape.title(), geometry=geo, offset=offset)
 
 
 def _entry_key(e: ShapeEntry):

@@ -8,7 +8,7 @@ import numpy as np
 from adfkit.diagnostics import error
 from adfkit.model.objects import SoftBody
 
-from . import fields, gather
+from . import exact, fields, gather
 from .properties import read_group
 
 
@@ -57,7 +57,7 @@ def gather_soft_body(obj, out: gather.Gathered, paths: tuple[str, str]) -> SoftB
     if sb.name is None:
         sb.name = obj.name
     try:
-        fields.merge(sb, fields.SOFT, read_group(obj.adf.soft, fields.SOFT))
+        fields.merge(sb, fields.SOFT, exact.applied(obj, read_group(obj.adf.soft, fields.SOFT)))
     except ValueError as exc:
         out.diagnostics.append(error("body-value", f"soft body '{obj.name}': {exc}", gather.where(obj)))
     gather._pose_and_scale(obj, sb)

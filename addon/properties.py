@@ -129,7 +129,10 @@ _LIMIT_PROPS = (
 _TYPED = {
     "mass_typed": BoolProperty(
         name="Mass typed by hand", default=False, description="off: mass follows density × mesh volume"
-    )
+    ),
+    "mass_note": StringProperty(
+        name="Mass note", options={"HIDDEN"}, description="why the mass could not be taken from density × volume"
+    ),
 }
 BodyProps = _make_group("AdfBodyProps", fields.BODY, dict(_TYPED), {"mass": (_mass_typed, None)})
 SoftProps = _make_group(
@@ -141,9 +144,6 @@ SoftProps = _make_group(
             name="Fixed nodes group",
             default="fixed nodes",
             description="vertex group whose vertices are the soft body's fixed nodes",
-        ),
-        "mass_note": StringProperty(
-            name="Mass note", options={"HIDDEN"}, description="why the mass could not be taken from density × volume"
         ),
     },
     {"mass": (_mass_typed, None)},

@@ -84,6 +84,8 @@ def draw_object(layout, obj) -> None:
     if adf.kind == "BODY":
         if not pg.use_mass:
             layout.label(text="No mass: AMBF warns and uses 1 kg with an estimated inertia", icon="ERROR")
+        elif pg.mass_note and not pg.mass_typed:
+            layout.label(text=pg.mass_note, icon="ERROR")
         elif not pg.mass_typed:
             layout.label(text="Mass from density × volume (type a mass to keep it)", icon="INFO")
         try:
