@@ -27,7 +27,7 @@ for name, pinned in pins:
 endef
 export LOCK_DRIFT
 
-.PHONY: run test test-all test-latest bench lock docs lint clean
+.PHONY: run test test-all test-latest bench lock docs lint clean ambf parity
 
 $(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -76,6 +76,24 @@ lint: $(STAMP)
 	$(VENV)/bin/ruff check --quiet .
 	$(VENV)/bin/ruff format --check --quiet .
 	$(VENV)/bin/mypy
+
+# AMBF 2.0 itself, built headless once from ../shared/ambf into the cache (outside the
+# checkout; a no-op when it is there), and adfkit's AMBF plugin built against it: what
+# `adfkit parity` plays scenes in. `make parity` runs the parity tests, the slow ones too.
+AMBF_KIT   ?= ../shared/ambf
+AMBF_CACHE ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/adfkit/ambf-build
+ambf: $(STAMP)
+	@if [ -x "$(AMBF_CACHE)/ambf/bin/lin-x86_64/ambf_simulator" ] && [ -f "$(AMBF_CACHE)/ambf/build/AMBFConfig.cmake" ]; then \
+		echo "AMBF is built: $(AMBF_CACHE)/ambf"; \
+	elif [ -f "$(AMBF_KIT)/build_ambf_headless.sh" ]; then \
+		bash "$(AMBF_KIT)/build_ambf_headless.sh" "$(AMBF_KIT)/ambf-2.0-src.tar.gz" "$(AMBF_CACHE)" 2; \
+	else \
+		echo "no AMBF kit at $(AMBF_KIT) (AMBF_KIT=DIR names one) and no build in $(AMBF_CACHE)"; exit 1; \
+	fi
+	@$(PY) -c "from adfkit.parity import ambf; print('adfkit AMBF plugin:', ambf.plugin_library(ambf.find_build('$(AMBF_CACHE)/ambf')))"
+
+parity: ambf
+	ADFKIT_AMBF="$(AMBF_CACHE)/ambf" $(PY) -m pytest -q -m '' tests/test_parity*.py
 
 bench: $(STAMP)
 	@for b in bench/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done

@@ -52,6 +52,7 @@ class World:
         self.articulations: list = []
         self.constraints: list = []
         self.joint_names: list[str] = []
+        self.joints_made: list[tuple] = []  # (ADF joint, parent body, child body) of each joint built
         self.skipped: list[str] = []
         self.steps = 0
         self.sim_time = 0.0

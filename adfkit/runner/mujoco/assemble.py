@@ -107,6 +107,7 @@ class Assembly:
             self.volumes.append(vs.report)
         self._by_plan = by_plan
         self.joint_names = [j.identifier for j, *_ in plan.joints] + [j.identifier for j, *_ in plan.loops]
+        self.joints_made = [(j, by_plan[id(p)], by_plan[id(c)]) for j, _k, p, c, *_ in plan.joints + plan.loops]
         self._build_articulations(plan, by_plan)
         self._drive_limits_and_springs()
         self._gravity_overrides()

@@ -82,6 +82,7 @@ class Assembly:
                     self._warn("runner-joint-body", f"{j.identifier}: parent or child body not found; skipped", j)
                     continue
                 records.append((j, kind, ends[0], ends[1]))
+        self.joints_made = [(j, parent, child) for j, _kind, parent, child in records]
         trees, leftover = articulation.components(records)
         in_tree = set()
         for root, recs in trees:
@@ -132,6 +133,7 @@ class Assembly:
                 made = make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5)
             except ConstraintRefused as exc:
                 self._warn("runner-constraint", f"{j.identifier}: {exc}; the joint is left out", j)
+                self.joints_made = [r for r in self.joints_made if r[0] is not j]
                 continue
             for c, pa, pbv, axis in made:
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))

@@ -91,6 +91,19 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         for i, p, v in zip(idxs, positions, vel):
             pb.resetJointState(art.uid, i, float(p), float(v), physicsClientId=self.cid)
 
+    def joint_motor(self, art, index: int, velocity: float, max_force: float) -> None:
+        """Joint ``index`` of ``art`` driven at ``velocity`` by a motor of at most ``max_force``
+        (runner/joint_commands.py: AMBF's velocity motor)."""
+        pb.setJointMotorControl2(
+            art.uid, index, pb.VELOCITY_CONTROL, targetVelocity=velocity, force=max_force, physicsClientId=self.cid
+        )
+
+    def joint_effort(self, art, index: int, effort: float) -> None:
+        """Joint ``index`` of ``art`` pushed by ``effort`` (N·m or N) for the next control step, its
+        motor off (runner/joint_commands.py: AMBF's commandEffort)."""
+        pb.setJointMotorControl2(art.uid, index, pb.VELOCITY_CONTROL, force=0.0, physicsClientId=self.cid)
+        pb.setJointMotorControl2(art.uid, index, pb.TORQUE_CONTROL, force=effort, physicsClientId=self.cid)
+
     def control(self) -> None:
         """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors.
         PyBullet's calls take their arguments by position here (this runs every control step)."""

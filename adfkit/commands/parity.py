@@ -1,0 +1,86 @@
+"""`adfkit parity SCENE --ambf DIR`: play a scene in AMBF itself (headless, through adfkit's
+AMBF plugin) and in adfkit, and compare, body by body, where each puts it over time, and what
+each created; exit 1 when they differ past the tolerances."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+NAME = "parity"
+HELP = "play a scene in AMBF and in adfkit and compare every body's pose over time"
+DESCRIPTION = (
+    "Play SCENE (a launch, world or model file) in AMBF's own simulator, headless, and in adfkit "
+    "for the same simulated time, driven by the same commands, and compare every body's position "
+    "and orientation over time and what each side created. Exit 1 when a body's gap passes the "
+    "tolerances or one side created something the other did not; 2 for bad input."
+)
+
+
+def add_arguments(p) -> None:
+    p.add_argument("path", help="launch, world or model ADF file (a folder: its launch.yaml)")
+    p.add_argument("-l", "--indices", help="launch file: the models to load, e.g. 6,7,8,9,10,11 or 6-11 (default: all)")
+    p.add_argument(
+        "--ambf",
+        metavar="DIR",
+        help="a built AMBF source tree (bin/lin-x86_64/ambf_simulator, build/); default $ADFKIT_AMBF, "
+        "else the one `make ambf` builds into ~/.cache/adfkit",
+    )
+    p.add_argument("--seconds", type=float, default=2.0, help="simulated time (default 2)")
+    p.add_argument("--every", type=float, default=0.02, help="a sample every so many seconds (default 0.02)")
+    p.add_argument("--engine", choices=("pybullet", "mujoco", "both"), default="pybullet", help="adfkit's engine")
+    p.add_argument(
+        "--commands",
+        metavar="FILE",
+        help="drive both sides: lines `TIME, KIND, TARGET[, VALUE]`, KIND position|velocity|effort "
+        "(a joint) or grasp|release (a constraint actuator; grasp names the body)",
+    )
+    p.add_argument(
+        "--control-substeps",
+        type=int,
+        help="adfkit's physics steps per control step (default 4, as adfkit run; 1 with a command file "
+        "that drives joints: AMBF applies joint commands at every 1 ms step)",
+    )
+    p.add_argument("--no-ground", action="store_true", help="a model file: no floor under it on either side")
+    p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")
+    p.add_argument("--tolerance-deg", type=float, default=1.0, help="largest orientation gap that agrees (1°)")
+    p.add_argument("--plot", metavar="PNG", help="draw each body's position gap over time")
+    p.add_argument("--json", action="store_true", help="print one JSON object (a list of them for --engine both)")
+
+
+def run(args) -> int:
+    from .. import inputs
+    from ..adf import parse_indices
+    from ..jsonout import dumps
+    from ..parity import ambf, session
+
+    path = inputs.scene_file(args.path)
+    inputs.check_file(path, what="ADF file")
+    build = ambf.find_build(args.ambf)
+    req = session.Request(
+        path=Path(path),
+        indices=parse_indices(args.indices),
+        build=build,
+        seconds=args.seconds,
+        every=args.every,
+        engines=("pybullet", "mujoco") if args.engine == "both" else (args.engine,),
+        commands=Path(args.commands) if args.commands else None,
+        control_substeps=args.control_substeps,  # None: session.Request decides
+        ground=not args.no_ground,
+        tolerance_m=args.tolerance_mm / 1e3,
+        tolerance_deg=args.tolerance_deg,
+    )
+    out = session.run(req, progress=None if not args.json else False)
+    from ..report import print_diagnostics
+
+    print_diagnostics(out.diagnostics, sys.stderr)
+    if args.plot:
+        from ..parity.plot import plot_gaps
+
+        plot_gaps(out.comparisons, Path(args.plot), str(path))
+    if args.json:
+        objs = [c.as_json() for c in out.comparisons]
+        print(dumps(objs[0] if len(objs) == 1 else objs, indent=1))
+    else:
+        session.print_text(out)
+    return 1 if any(c.failures() for c in out.comparisons) else 0

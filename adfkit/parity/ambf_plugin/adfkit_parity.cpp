@@ -1,0 +1,339 @@
+// adfkit's AMBF simulator plugin (`ambf_simulator --plugins libadfkit_parity.so`): it writes
+// what AMBF created from the scene (rigid and soft bodies, ghosts, joints, sensors, actuators),
+// then every rigid body's pose and every joint's position as the scene plays, and drives the
+// scene from a command file (joint position, velocity and effort commands, grasp and release
+// with AMBF's own constraint actuators). adfkit parity reads what it writes.
+//
+// Configuration (environment):
+//   ADFKIT_PARITY_OUT       file to write, JSON lines (required)
+//   ADFKIT_PARITY_SECONDS   simulated seconds to play; 0 writes what was created and exits (default 0)
+//   ADFKIT_PARITY_EVERY     a sample every so many simulated seconds (0: first and last only)
+//   ADFKIT_PARITY_COMMANDS  command file: one command a line, "TIME KIND TARGET [ARG]", KIND one of
+//                           position|velocity|effort (TARGET a joint's qualified name, ARG the value),
+//                           grasp (TARGET an actuator, ARG a rigid body), release (TARGET an actuator);
+//                           a joint command holds until the joint's next command
+//
+// Records: {"kind":"created",...} once, {"kind":"sample",...} per sample, {"kind":"end",...} last,
+// or {"kind":"error","message":...} (and exit status 3) for a command file it cannot follow.
+// The process ends (_exit) once the last sample is written: the simulator has no other way out
+// when it runs headless.
+#include <afFramework.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+using namespace ambf;
+using namespace chai3d;
+using namespace std;
+
+namespace {
+
+string json_text(const string& s) {
+    string out = "\"";
+    for (unsigned char c : s) {
+        if (c == '"' || c == '\\') { out += '\\'; out += (char)c; }
+        else if (c < 0x20) { char buf[8]; snprintf(buf, sizeof buf, "\\u%04x", c); out += buf; }
+        else out += (char)c;
+    }
+    return out + "\"";
+}
+
+string num(double v) {
+    if (!(v == v) || v > 1e300 || v < -1e300) return "null";  // strict JSON: no NaN or Inf
+    char buf[40];
+    snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
+const char* joint_type(afJointType t) {
+    switch (t) {
+    case afJointType::REVOLUTE: return "revolute";
+    case afJointType::PRISMATIC: return "prismatic";
+    case afJointType::LINEAR_SPRING: return "linear spring";
+    case afJointType::TORSION_SPRING: return "torsion spring";
+    case afJointType::P2P: return "p2p";
+    case afJointType::FIXED: return "fixed";
+    case afJointType::CONE_TWIST: return "cone twist";
+    case afJointType::SIX_DOF: return "six dof";
+    case afJointType::SIX_DOF_SPRING: return "six dof spring";
+    default: return "invalid";
+    }
+}
+
+const char* sensor_type(afSensorType t) {
+    switch (t) {
+    case afSensorType::RAYTRACER: return "proximity";
+    case afSensorType::RANGE: return "range";
+    case afSensorType::RESISTANCE: return "resistance";
+    default: return "invalid";
+    }
+}
+
+struct Command {
+    double t;
+    string kind, target, arg;
+    double value;
+    int line;
+};
+
+}  // namespace
+
+class AdfkitParity : public afSimulatorPlugin {
+public:
+    virtual int init(int argc, char** argv, const afWorldPtr a_afWorld) {
+        m_world = a_afWorld;
+        const char* out = getenv("ADFKIT_PARITY_OUT");
+        m_out = out ? fopen(out, "w") : nullptr;
+        if (!m_out) {
+            fprintf(stderr, "adfkit_parity: ADFKIT_PARITY_OUT is not a file it can write\n");
+            _exit(3);
+        }
+        m_seconds = env_double("ADFKIT_PARITY_SECONDS", 0.0);
+        m_every = env_double("ADFKIT_PARITY_EVERY", 0.0);
+        write_created();
+        const char* cmds = getenv("ADFKIT_PARITY_COMMANDS");
+        if (cmds && *cmds) read_commands(cmds);
+        sample(0);
+        m_nextSample = m_every > 0 ? m_every : m_seconds;
+        if (m_seconds <= 0) finish(0);
+        activate(0.0);
+        m_clock = chrono::steady_clock::now();
+        return 1;
+    }
+
+    virtual void physicsUpdate(double dt) {
+        m_steps++;
+        double t = m_world->getSimulationTime();
+        activate(t);
+        drive();
+        bool last = t + 1e-9 >= m_seconds;
+        if (last || t + 1e-9 >= m_nextSample) {
+            sample(m_steps);
+            while (m_nextSample <= t + 1e-9) m_nextSample += m_every > 0 ? m_every : m_seconds;
+        }
+        if (last) finish(m_steps);
+    }
+
+    virtual void reset() {}
+    virtual bool close() { return 0; }
+
+private:
+    static double env_double(const char* name, double fallback) {
+        const char* v = getenv(name);
+        return v && *v ? atof(v) : fallback;
+    }
+
+    void fail(const string& message) {
+        fprintf(m_out, "{\"kind\":\"error\",\"message\":%s}\n", json_text(message).c_str());
+        fflush(m_out);
+        _exit(3);
+    }
+
+    void finish(long steps) {
+        double wall = chrono::duration<double>(chrono::steady_clock::now() - m_clock).count();
+        fprintf(m_out, "{\"kind\":\"end\",\"steps\":%ld,\"t\":%s,\"wall_s\":%s}\n", steps,
+                num(m_world->getSimulationTime()).c_str(), num(steps ? wall : 0.0).c_str());
+        fflush(m_out);
+        fclose(m_out);
+        _exit(0);
+    }
+
+    static string body_name(afRigidBodyPtr rb) { return rb ? json_text(rb->getQualifiedName()) : "null"; }
+
+    void write_created() {
+        string s = "{\"kind\":\"created\",\"bodies\":[";
+        bool first = true;
+        for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
+            s += (first ? "" : ",") + string("{\"name\":") + json_text(rb->getName()) +
+                 ",\"qname\":" + json_text(rb->getQualifiedName()) + ",\"mass\":" + num(rb->getMass()) + "}";
+            first = false;
+        }
+        s += "],\"soft_bodies\":[";
+        first = true;
+        for (afSoftBodyPtr sb : m_world->getSoftBodies()) {
+            s += (first ? "" : ",") + string("{\"name\":") + json_text(sb->getName()) +
+                 ",\"qname\":" + json_text(sb->getQualifiedName()) + "}";
+            first = false;
+        }
+        s += "],\"ghosts\":[";
+        first = true;
+        for (afGhostObjectPtr g : m_world->getGhostObjects()) {
+            afRigidBodyPtr parent = dynamic_cast<afRigidBodyPtr>(g->getParentObject());
+            s += (first ? "" : ",") + string("{\"name\":") + json_text(g->getName()) +
+                 ",\"qname\":" + json_text(g->getQualifiedName()) + ",\"parent\":" + body_name(parent) + "}";
+            first = false;
+        }
+        s += "],\"joints\":[";
+        first = true;
+        for (afJointPtr j : m_world->getJoints()) {
+            afJointAttributes* a = dynamic_cast<afJointAttributes*>(j->getAttributes());
+            btTypedConstraint* c = j->getConstraint();
+            afRigidBodyPtr parent = c ? m_world->getRigidBody(&c->getRigidBodyA(), true) : nullptr;
+            afRigidBodyPtr child = c ? m_world->getRigidBody(&c->getRigidBodyB(), true) : nullptr;
+            s += (first ? "" : ",") + string("{\"name\":") + json_text(j->getName()) +
+                 ",\"qname\":" + json_text(j->getQualifiedName()) + ",\"type\":\"" + joint_type(j->m_jointType) +
+                 "\",\"parent\":" + body_name(parent) + ",\"child\":" + body_name(child);
+            if (a) {
+                s += ",\"motor\":" + string(a->m_enableMotor ? "true" : "false") +
+                     ",\"limits\":" + (a->m_enableLimits ? "[" + num(a->m_lowerLimit) + "," + num(a->m_upperLimit) + "]" : "null") +
+                     ",\"max_motor_impulse\":" + num(a->m_maxMotorImpulse) +
+                     ",\"controller\":{\"P\":" + num(a->m_controllerAttribs.m_P) + ",\"I\":" + num(a->m_controllerAttribs.m_I) +
+                     ",\"D\":" + num(a->m_controllerAttribs.m_D) + ",\"output\":\"" +
+                     (a->m_controllerAttribs.m_outputType == afControlType::FORCE ? "force" : "velocity") + "\"}";
+            }
+            s += "}";
+            first = false;
+        }
+        s += "],\"sensors\":[";
+        first = true;
+        for (afSensorPtr se : m_world->getSensors()) {
+            s += (first ? "" : ",") + string("{\"name\":") + json_text(se->getName()) +
+                 ",\"qname\":" + json_text(se->getQualifiedName()) + ",\"type\":\"" + sensor_type(se->m_sensorType) +
+                 "\",\"parent\":" + body_name(se->getParentBody()) + "}";
+            first = false;
+        }
+        s += "],\"actuators\":[";
+        first = true;
+        for (afActuatorPtr ac : actuators()) {
+            s += (first ? "" : ",") + string("{\"name\":") + json_text(ac->getName()) +
+                 ",\"qname\":" + json_text(ac->getQualifiedName()) + ",\"type\":\"" +
+                 (ac->m_actuatorType == afActuatorType::CONSTRAINT ? "constraint" : "invalid") +
+                 "\",\"parent\":" + body_name(ac->m_parentBody) + "}";
+            first = false;
+        }
+        s += "]}\n";
+        fputs(s.c_str(), m_out);
+        fflush(m_out);
+    }
+
+    // a sample lists the bodies and the joints in the order the created record lists them
+    // (two bodies may share a qualified name)
+    void sample(long step) {
+        string s = "{\"kind\":\"sample\",\"step\":" + to_string(step) + ",\"t\":" + num(m_world->getSimulationTime()) +
+                   ",\"bodies\":[";
+        bool first = true;
+        for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
+            // what AMBF publishes for a body: its ADF body frame (getLocalPos / getLocalRot)
+            cVector3d p = rb->getLocalPos();
+            cQuaternion q;
+            q.fromRotMat(rb->getLocalRot());
+            s += (first ? "[" : ",[") + num(p.x()) + "," + num(p.y()) + "," + num(p.z()) + "," + num(q.x) + "," +
+                 num(q.y) + "," + num(q.z) + "," + num(q.w) + "]";
+            first = false;
+        }
+        s += "],\"joints\":[";
+        first = true;
+        for (afJointPtr j : m_world->getJoints()) {
+            s += (first ? "" : ",") + (j->getConstraint() ? num(j->getPosition()) : string("null"));
+            first = false;
+        }
+        s += "]}\n";
+        fputs(s.c_str(), m_out);
+        fflush(m_out);
+    }
+
+    // AMBF 2.0 declares afObjectManager::getActuators but does not define it: its map is read
+    vector<afActuatorPtr> actuators() {
+        vector<afActuatorPtr> out;
+        for (auto& kv : *m_world->getActuatorMap()) out.push_back(static_cast<afActuatorPtr>(kv.second));
+        return out;
+    }
+
+    afJointPtr find_joint(const string& qname) {
+        for (afJointPtr j : m_world->getJoints())
+            if (j->getQualifiedName() == qname) return j;
+        return nullptr;
+    }
+
+    afConstraintActuator* find_actuator(const string& qname) {
+        for (afActuatorPtr a : actuators())
+            if (a->getQualifiedName() == qname && a->m_actuatorType == afActuatorType::CONSTRAINT)
+                return static_cast<afConstraintActuator*>(a);
+        return nullptr;
+    }
+
+    afRigidBodyPtr find_body(const string& qname) {
+        for (afRigidBodyPtr rb : m_world->getRigidBodies())
+            if (rb->getQualifiedName() == qname) return rb;
+        return nullptr;
+    }
+
+    void read_commands(const char* path) {
+        ifstream in(path);
+        if (!in) fail(string("cannot read the command file ") + path);
+        string line;
+        int n = 0;
+        while (getline(in, line)) {
+            n++;
+            if (line.empty() || line[0] == '#') continue;
+            istringstream ls(line);
+            Command c;
+            c.line = n;
+            c.value = 0.0;
+            if (!(ls >> c.t >> c.kind >> c.target)) fail("command line " + to_string(n) + ": expected TIME KIND TARGET");
+            string where = "command line " + to_string(n) + ": ";
+            if (c.kind == "position" || c.kind == "velocity" || c.kind == "effort") {
+                if (!(ls >> c.value)) fail(where + "a joint command needs a value");
+                if (!find_joint(c.target)) fail(where + "no joint " + c.target);
+            } else if (c.kind == "grasp") {
+                if (!(ls >> c.arg)) fail(where + "grasp needs a body");
+                if (!find_actuator(c.target)) fail(where + "no constraint actuator " + c.target);
+                if (!find_body(c.arg)) fail(where + "no rigid body " + c.arg);
+            } else if (c.kind == "release") {
+                if (!find_actuator(c.target)) fail(where + "no constraint actuator " + c.target);
+            } else {
+                fail(where + "unknown kind " + c.kind);
+            }
+            m_commands.push_back(c);
+        }
+        stable_sort(m_commands.begin(), m_commands.end(),
+                    [](const Command& a, const Command& b) { return a.t < b.t; });
+    }
+
+    // commands due by simulated time t take effect (a joint's command replaces its last)
+    void activate(double t) {
+        while (m_nextCommand < m_commands.size() && m_commands[m_nextCommand].t <= t + 1e-9) {
+            const Command& c = m_commands[m_nextCommand++];
+            if (c.kind == "grasp") {
+                find_actuator(c.target)->actuate(find_body(c.arg));
+            } else if (c.kind == "release") {
+                find_actuator(c.target)->deactuate();
+            } else {
+                m_drives[c.target] = c;
+                m_driveJoints[c.target] = find_joint(c.target);
+            }
+        }
+    }
+
+    // every joint command again each physics step, as AMBF's own ROS plugin applies the last
+    // command it received (position: the joint's controller; effort: a torque for the next step)
+    void drive() {
+        for (auto& kv : m_drives) {
+            afJointPtr j = m_driveJoints[kv.first];
+            double v = kv.second.value;
+            if (kv.second.kind == "position") j->commandPosition(v);
+            else if (kv.second.kind == "velocity") j->commandVelocity(v);
+            else j->commandEffort(v);
+        }
+    }
+
+    afWorldPtr m_world = nullptr;
+    FILE* m_out = nullptr;
+    double m_seconds = 0.0, m_every = 0.0, m_nextSample = 0.0;
+    long m_steps = 0;
+    vector<Command> m_commands;
+    size_t m_nextCommand = 0;
+    map<string, Command> m_drives;
+    map<string, afJointPtr> m_driveJoints;
+    chrono::steady_clock::time_point m_clock;
+};
+
+AF_REGISTER_SIMULATOR_PLUGIN(AdfkitParity)

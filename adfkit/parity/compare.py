@@ -1,0 +1,167 @@
+"""Two traces side by side: the bodies matched by name (two of one name by where they start),
+each one's position and orientation gap at every common sample, the joints' values likewise,
+and what one side created and the other did not; the verdict against the tolerances."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .traces import KINDS, Trace
+
+
+@dataclass
+class Gap:
+    """One matched body's (or joint's) gap over the common samples."""
+
+    name: str
+    position: np.ndarray  # (S,) m (a joint: its value's gap, rad or m)
+    angle: np.ndarray  # (S,) degrees (a joint: zeros)
+
+    @property
+    def max_position(self) -> float:
+        return float(np.nanmax(self.position)) if self.position.size else 0.0
+
+    @property
+    def max_angle(self) -> float:
+        return float(np.nanmax(self.angle)) if self.angle.size else 0.0
+
+
+@dataclass
+class Comparison:
+    ambf: Trace
+    adfkit: Trace
+    times: np.ndarray
+    bodies: list[Gap]
+    joints: list[Gap]
+    only_in_ambf: list[dict]
+    only_in_adfkit: list[dict]
+    tolerance_m: float
+    tolerance_deg: float
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def worst(self) -> tuple[Gap | None, Gap | None]:
+        """The bodies with the largest position and angle gaps."""
+        if not self.bodies:
+            return None, None
+        return max(self.bodies, key=lambda g: g.max_position), max(self.bodies, key=lambda g: g.max_angle)
+
+    def failures(self) -> list[str]:
+        """Why the sides disagree past the tolerances (empty: they agree)."""
+        out = [
+            f"{g.name}: {g.max_position * 1e3:.3f} mm, {g.max_angle:.3f}°"
+            for g in self.bodies
+            if g.max_position > self.tolerance_m or g.max_angle > self.tolerance_deg
+        ]
+        out += [f"only in AMBF: {d['kind']} {d['name']}" for d in self.only_in_ambf]
+        out += [f"only in adfkit: {d['kind']} {d['name']}" for d in self.only_in_adfkit]
+        return out
+
+    def as_json(self) -> dict:
+        pos, ang = self.worst
+        return {
+            "engine": self.adfkit.side,
+            "seconds": float(self.times[-1]) if self.times.size else 0.0,
+            "samples": int(self.times.size),
+            "tolerance_m": self.tolerance_m,
+            "tolerance_deg": self.tolerance_deg,
+            "agree": not self.failures(),
+            "bodies": [
+                {
+                    "name": g.name,
+                    "max_position_gap_m": g.max_position,
+                    "max_angle_gap_deg": g.max_angle,
+                    "final_position_gap_m": float(g.position[-1]) if g.position.size else 0.0,
+                    "final_angle_gap_deg": float(g.angle[-1]) if g.angle.size else 0.0,
+                    "at_s": float(self.times[int(np.nanargmax(g.position))]) if g.position.size else 0.0,
+                }
+                for g in self.bodies
+            ],
+            "largest_position_gap": {"name": pos.name, "m": pos.max_position} if pos else None,
+            "largest_angle_gap": {"name": ang.name, "deg": ang.max_angle} if ang else None,
+            "joints": [{"name": g.name, "max_value_gap": g.max_position} for g in self.joints],
+            "only_in_ambf": self.only_in_ambf,
+            "only_in_adfkit": self.only_in_adfkit,
+            "wall_s": {"ambf": self.ambf.wall_s, self.adfkit.side: self.adfkit.wall_s},
+            "notes": self.notes,
+        }
+
+
+def angle_deg(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
+    """The rotation between unit quaternions (…, 4), degrees."""
+    dot = np.abs(np.sum(qa * qb, axis=-1))
+    return np.degrees(2 * np.arccos(np.clip(dot, 0.0, 1.0)))
+
+
+def match(names_a: list[str], names_b: list[str], start_a: np.ndarray, start_b: np.ndarray) -> list[tuple[int, int]]:
+    """Pairs (i, j) of the same name; several of one name on both sides are paired by nearest
+    starting position (AMBF keeps two bodies of one name apart by where they are)."""
+    pairs = []
+    by_b: dict[str, list[int]] = {}
+    for j, n in enumerate(names_b):
+        by_b.setdefault(n, []).append(j)
+    by_a: dict[str, list[int]] = {}
+    for i, n in enumerate(names_a):
+        by_a.setdefault(n, []).append(i)
+    for n, ia in by_a.items():
+        jb = list(by_b.get(n, []))
+        for i in sorted(ia, key=lambda i: min((np.linalg.norm(start_a[i] - start_b[j]) for j in jb), default=0.0)):
+            if not jb:
+                break
+            j = min(jb, key=lambda j: np.linalg.norm(start_a[i] - start_b[j]))
+            jb.remove(j)
+            pairs.append((i, j))
+    return pairs
+
+
+def _only(a: dict[str, list[str]], b: dict[str, list[str]]) -> list[dict]:
+    out = []
+    for kind in KINDS:
+        rest = list(b.get(kind, []))
+        for n in a.get(kind, []):
+            if n in rest:
+                rest.remove(n)
+            else:
+                out.append({"kind": kind, "name": n})
+    return out
+
+
+def compare(ambf: Trace, adfkit: Trace, tolerance_m: float = 1e-3, tolerance_deg: float = 1.0) -> Comparison:
+    """The two traces side by side at their common sample times."""
+    ta, tb = np.round(ambf.times, 6), np.round(adfkit.times, 6)
+    common = np.intersect1d(ta, tb)
+    ia = np.searchsorted(ta, common)
+    ib = np.searchsorted(tb, common)
+    bodies = []
+    if ambf.poses.size and adfkit.poses.size:
+        for i, j in match(ambf.body_names, adfkit.body_names, ambf.poses[0, :, :3], adfkit.poses[0, :, :3]):
+            pa, pb = ambf.poses[ia, i], adfkit.poses[ib, j]
+            bodies.append(
+                Gap(ambf.body_names[i], np.linalg.norm(pa[:, :3] - pb[:, :3], axis=1), angle_deg(pa[:, 3:], pb[:, 3:]))
+            )
+    joints = []
+    for i, j in match(
+        ambf.joint_names,
+        adfkit.joint_names,
+        np.zeros((len(ambf.joint_names), 3)),
+        np.zeros((len(adfkit.joint_names), 3)),
+    ):
+        va, vb = ambf.joints[ia, i], adfkit.joints[ib, j]
+        if np.all(np.isnan(va)) or np.all(np.isnan(vb)):
+            continue
+        joints.append(Gap(ambf.joint_names[i], np.abs(va - vb), np.zeros(len(common))))
+    bodies.sort(key=lambda g: -g.max_position)
+    joints.sort(key=lambda g: -g.max_position)
+    return Comparison(
+        ambf,
+        adfkit,
+        common,
+        bodies,
+        joints,
+        _only(ambf.made, adfkit.made),
+        _only(adfkit.made, ambf.made),
+        tolerance_m,
+        tolerance_deg,
+    )

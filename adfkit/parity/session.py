@@ -1,0 +1,173 @@
+"""A parity run from end to end: the scene loaded by adfkit and built in each engine asked
+for, the same scene staged for AMBF (a launch file as it is; a world or a model file inside a
+launch file written for it, a model with the floor adfkit gives a model played alone), both
+played for the same time with the same commands and samples, and compared."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from ..diagnostics import AdfError, Diagnostic, Severity, error
+from . import ambf as ambf_run
+from . import commandfile
+from .compare import Comparison, compare
+from .traces import AdfkitPlayer, from_ambf
+
+
+@dataclass
+class Request:
+    path: Path
+    indices: list[int] | None
+    build: ambf_run.AmbfBuild
+    seconds: float = 2.0
+    every: float = 0.02
+    engines: tuple[str, ...] = ("pybullet",)
+    commands: Path | None = None
+    control_substeps: int | None = None  # None: 4 (adfkit run's), 1 with joint commands (AMBF's rate)
+    ground: bool = True
+    tolerance_m: float = 1e-3
+    tolerance_deg: float = 1.0
+
+
+@dataclass
+class Outcome:
+    comparisons: list[Comparison]
+    request: Request
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    ambf_process_s: float = 0.0
+    log: str = ""
+
+
+def check(req: Request) -> None:
+    """The request's numbers, as a located error when one makes no sense."""
+    bad_sub = req.control_substeps is not None and req.control_substeps < 1
+    if req.seconds <= 0 or req.every < 0 or bad_sub or req.tolerance_m < 0 or req.tolerance_deg < 0:
+        raise AdfError(
+            error(
+                "bad-option",
+                "--seconds must be positive, --every, --tolerance-mm and --tolerance-deg not negative, "
+                "--control-substeps ≥ 1",
+                None,
+                "e.g. --seconds 2 --every 0.02",
+            )
+        )
+    per = 0.001 * (req.control_substeps or 1)
+    for name, v in (("--seconds", req.seconds), ("--every", req.every)):
+        if abs(v / per - round(v / per)) > 1e-6:
+            raise AdfError(
+                error(
+                    "bad-option",
+                    f"{name} {v:g} is not a whole number of adfkit's control steps ({per * 1e3:g} ms)",
+                    None,
+                    f"round it to a multiple of {per:g} s",
+                )
+            )
+
+
+def _stage(scene, req: Request, floor_z: float | None) -> ambf_run.Stage:
+    path = req.path.resolve()
+    if scene.launch is not None:
+        n = len(scene.launch.multibody_configs or [])
+        return ambf_run.Stage(path, list(req.indices) if req.indices is not None else list(range(n)))
+    if scene.world is not None:
+        return ambf_run.write_stage(path, [], None)
+    return ambf_run.write_stage(None, [path], floor_z)
+
+
+def run(req: Request, progress: bool | None = None) -> Outcome:
+    """Play the request's scene in AMBF and in each of its engines; their comparisons."""
+    from ..adf import load_scene
+    from ..report import Progress
+    from ..runner import Options, open_world
+    from ..validator.engine import SEVERITY_OVERRIDES
+
+    check(req)
+    commands_read = commandfile.read(req.commands) if req.commands is not None else []
+    if req.control_substeps is None:
+        drives = any(c.kind in commandfile.JOINT_KINDS for c, _ in commands_read)
+        req = replace(req, control_substeps=1 if drives else 4)
+        check(req)
+    diags: list[Diagnostic] = []
+    scene = load_scene(req.path, req.indices, diags)
+    diags = [replace(d, severity=SEVERITY_OVERRIDES.get(d.rule, d.severity)) for d in diags]
+    if any(d.severity >= Severity.ERROR for d in diags):
+        raise AdfError(diags)
+    opt = Options(control_substeps=req.control_substeps, ground=req.ground, visuals=False, renderer="tiny")
+    worlds = [open_world(scene, opt, engine=e) for e in req.engines]
+    try:
+        players = [AdfkitPlayer(w) for w in worlds]
+        for w in worlds:
+            diags.extend(w.diagnostics)
+        commands = commandfile.resolved(commands_read, players[0].made)
+        if commands:
+            if any(c.kind in commandfile.JOINT_KINDS for c in commands) and "mujoco" in req.engines:
+                raise AdfError(
+                    error(
+                        "parity-engine",
+                        "joint commands are played by the PyBullet runner only",
+                        None,
+                        "use --engine pybullet with a command file that drives joints",
+                    )
+                )
+        floor_z = worlds[0].ground_z if req.ground else None
+        stage = _stage(scene, req, floor_z)
+        rec = ambf_run.run(req.build, stage, req.seconds, req.every, commands)
+        ambf_trace = from_ambf(rec, stage.staged_bodies)
+        out = Outcome([], req, diags, rec.process_s, rec.log)
+        for p in players:
+            steps = int(round(req.seconds / p.per))
+            bar = Progress(steps, f"parity {p.world.engine}", enabled=progress)
+            trace = p.play(req.seconds, req.every, commands, bar)
+            bar.close()
+            out.comparisons.append(compare(ambf_trace, trace, req.tolerance_m, req.tolerance_deg))
+        return out
+    finally:
+        for w in worlds:
+            w.close()
+
+
+def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
+    """The comparisons for people: the largest gaps, the bodies past the tolerances, what one
+    side made and the other did not, each side's stepping time."""
+    req = out.request
+    for c in out.comparisons:
+        eng = c.adfkit.side
+        print(
+            f"{req.path}: {c.times[-1] if c.times.size else 0:g} s, {c.times.size} samples, AMBF against adfkit {eng} "
+            f"(control step {req.control_substeps} ms)",
+            file=stream,
+        )
+        pos, ang = c.worst
+        if pos is not None:
+            print(
+                f"  {len(c.bodies)} bodies matched; largest gaps {pos.max_position * 1e3:.3f} mm ({pos.name}), "
+                f"{ang.max_angle:.3f}° ({ang.name})",
+                file=stream,
+            )
+            print(f"  {'body':<48} {'max mm':>9} {'max °':>8} {'end mm':>9} {'end °':>8}", file=stream)
+            for g in c.bodies[:rows]:
+                print(
+                    f"  {g.name[-48:]:<48} {g.max_position * 1e3:9.3f} {g.max_angle:8.3f} "
+                    f"{g.position[-1] * 1e3:9.3f} {g.angle[-1]:8.3f}",
+                    file=stream,
+                )
+            if len(c.bodies) > rows:
+                print(f"  … {len(c.bodies) - rows} more (--json lists every body)", file=stream)
+        for label, items in (("only in AMBF", c.only_in_ambf), ("only in adfkit", c.only_in_adfkit)):
+            for d in items:
+                print(f"  {label}: {d['kind']} {d['name']}", file=stream)
+        print(
+            f"  stepping: AMBF {c.ambf.wall_s:.2f} s, adfkit {eng} {c.adfkit.wall_s:.2f} s "
+            f"(AMBF's whole process {out.ambf_process_s:.2f} s)",
+            file=stream,
+        )
+        fails = c.failures()
+        if fails:
+            print(
+                f"  differ: {len(fails)} past {c.tolerance_m * 1e3:g} mm / {c.tolerance_deg:g}° or made on one side only",
+                file=stream,
+            )
+        else:
+            print(f"  agree: every body within {c.tolerance_m * 1e3:g} mm and {c.tolerance_deg:g}°", file=stream)

@@ -1,0 +1,159 @@
+"""Joint commands as AMBF plays them (its afJoint and afJointController): a position command
+goes through the joint's controller every time it is given (the file's `controller` P, I, D, or
+AMBF's P 10, D 1 without one) and the controller's output drives the joint's velocity motor
+(`max motor impulse`) or, for `controller output type: FORCE` (the default with a `controller`),
+is an effort; a velocity command sets the motor's target velocity; an effort turns the motor off
+and pushes the joint for the next step. AMBF applies the last command a joint was given at every
+physics step (its ROS plugin does); ``JointCommands.apply`` does that once per control step.
+The engine supplies ``joint_motor(art, index, velocity, max_force)`` and ``joint_effort(art,
+index, effort)`` for a revolute or prismatic joint of one of its articulations."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, joint_kind
+
+#: AMBF's joint controller without a `controller` block: a velocity command P·e + D·de/dt
+DEFAULT_PID = (10.0, 0.0, 1.0)
+#: AMBF's step for a prismatic motor's force (impulse / 0.001, whatever the physics rate)
+AMBF_SLIDER_DT = 0.001
+#: the shortest time between two controller updates AMBF divides by (afJointController.m_min_dt)
+MIN_DT = 1e-5
+KINDS = ("position", "velocity", "effort")
+
+
+def motor_enabled(joint) -> bool:
+    """AMBF's `enable motor`: on by default; when the key is there, AMBF reads `enable
+    feedback`'s value instead (its loader's slip)."""
+    if joint.enable_motor is None:
+        return True
+    return bool(joint.enable_feedback)
+
+
+def controller_of(joint) -> tuple[tuple[float, float, float], str]:
+    """((P, I, D), "force" | "velocity") AMBF builds the joint's controller with."""
+    c = joint.controller
+    if c is not None:
+        pid = (c.P if c.P is not None else 10.0, c.I if c.I is not None else 0.0, c.D if c.D is not None else 1.0)
+        out = "force"
+    else:
+        pid, out = DEFAULT_PID, "velocity"
+    t = joint.controller_output_type
+    if t is not None:
+        out = "velocity" if t in ("VELOCITY", "velocity", "POSITION", "position") else "force"
+    return pid, out
+
+
+def limits_of(joint) -> tuple[float, float] | None:
+    """The joint's limits when AMBF enables them (both `low` and `high` given)."""
+    lim = joint.joint_limits
+    if lim is None or lim.low is None or lim.high is None:
+        return None
+    return float(lim.low), float(lim.high)
+
+
+def shortest_angle(current: float, target: float) -> float:
+    """AMBF's afJoint::getShortestAngle: the way from ``current`` to ``target`` for a joint
+    without limits, in (-π, π]."""
+    if current < 0.0:
+        current += 2 * math.pi
+    return math.fmod(target - current + 3 * math.pi, 2 * math.pi) - math.pi
+
+
+@dataclass
+class Controller:
+    """afJointController's PID: the error's trapezoid integral and its backward difference."""
+
+    P: float
+    I: float
+    D: float
+    t_prev: float = 0.0
+    e_prev: float = 0.0
+    integral: float = 0.0
+
+    def output(self, current: float, target: float, t: float) -> float:
+        e = target - current
+        dt = t - self.t_prev
+        if dt <= MIN_DT:
+            dt = MIN_DT
+        de = (e - self.e_prev) / dt
+        self.integral += (e + self.e_prev) / 2 * dt
+        self.t_prev, self.e_prev = t, e
+        return self.P * e + self.I * self.integral + self.D * de
+
+
+@dataclass
+class DrivenJoint:
+    """A revolute or prismatic joint of an articulation, with what AMBF drives it with."""
+
+    joint: object
+    kind: JointKind
+    art: object
+    index: int
+    controller: Controller
+    output: str
+    limits: tuple[float, float] | None
+    max_force: float
+    motor: bool
+    command: tuple[str, float] | None = None
+
+
+class JointCommands:
+    """The commands given to a world's joints, applied as AMBF applies them."""
+
+    def __init__(self, world) -> None:
+        self.world = world
+        self.joints: dict[int, DrivenJoint] = {}
+
+    def drivable(self, joint, child) -> DrivenJoint | None:
+        """The joint (an ADF joint, its engine child body) as a driven joint, or None when the
+        engine did not make it a revolute/prismatic joint of an articulation."""
+        kind = joint_kind(joint.type)
+        art = getattr(child, "articulation", None)
+        if kind not in (JointKind.REVOLUTE, JointKind.PRISMATIC) or art is None:
+            return None
+        idx = next((i for i, r in enumerate(art.records) if r[0] is joint), None)
+        if idx is None:
+            return None
+        (p, i, d), out = controller_of(joint)
+        imp = joint.max_motor_impulse if joint.max_motor_impulse is not None else DEFAULT_JOINT_MAX_MOTOR_IMPULSE
+        dt = AMBF_SLIDER_DT if kind is JointKind.PRISMATIC else self.world.dt
+        return DrivenJoint(
+            joint, kind, art, idx, Controller(p, i, d), out, limits_of(joint), imp / dt, motor_enabled(joint)
+        )
+
+    def command(self, joint, child, kind: str, value: float) -> None:
+        """From now on ``joint`` follows ``kind`` ("position", "velocity", "effort") ``value``."""
+        if kind not in KINDS:
+            raise ValueError(f"joint command {kind!r} is not one of {', '.join(KINDS)}")
+        dj = self.joints.get(id(joint))
+        if dj is None:
+            dj = self.drivable(joint, child)
+            if dj is None:
+                raise ValueError(f"{joint.identifier}: not a revolute or prismatic joint of an articulation")
+            self.joints[id(joint)] = dj
+        dj.command = (kind, float(value))
+
+    def apply(self, t: float) -> None:
+        """Every joint's last command, at simulated time ``t`` (call it between control steps)."""
+        w = self.world
+        for dj in self.joints.values():
+            kind, value = dj.command
+            if kind == "velocity":
+                w.joint_motor(dj.art, dj.index, value, dj.max_force)
+            elif kind == "effort":
+                w.joint_effort(dj.art, dj.index, value)
+            elif dj.motor:  # AMBF ignores a position command (with a warning) without a motor
+                current = float(w.joint_state(dj.art, [dj.index])[0][0])
+                target = value
+                if dj.limits is not None:
+                    target = min(max(target, dj.limits[0]), dj.limits[1])
+                elif dj.kind is JointKind.REVOLUTE:
+                    target, current = shortest_angle(current, target), 0.0
+                out = dj.controller.output(current, target, t)
+                if dj.output == "force":
+                    w.joint_effort(dj.art, dj.index, out)
+                else:
+                    w.joint_motor(dj.art, dj.index, out, dj.max_force)

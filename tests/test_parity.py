@@ -1,0 +1,202 @@
+"""`adfkit parity`: AMBF itself (built headless, through adfkit's own AMBF plugin) against
+adfkit on the same scene. The tests that play AMBF skip, with the reason, where no AMBF build is
+present (`make ambf` builds one; `make parity` runs these); the others always run."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pybullet")
+
+from adfkit.cli import main  # noqa: E402
+from adfkit.diagnostics import AdfError  # noqa: E402
+from adfkit.parity import ambf, commandfile, compare  # noqa: E402
+from adfkit.runner.joint_commands import Controller, motor_enabled, shortest_angle  # noqa: E402
+
+BUILD, WHY = ambf.available()
+needs_ambf = pytest.mark.skipif(BUILD is None, reason=WHY)
+
+
+@pytest.fixture(scope="module")
+def scenes(tmp_path_factory):
+    from adfkit.scenes.parity import write_parity
+
+    return write_parity(tmp_path_factory.mktemp("parity")).parent
+
+
+# ---- without AMBF ----------------------------------------------------------------------------
+
+
+def test_the_parity_scenes_are_valid_and_play(scenes, capsys):
+    assert main(["validate", str(scenes / "launch.yaml")]) == 0
+    assert "0 error(s), 0 warning(s)" in capsys.readouterr().out
+    assert main(["run", str(scenes / "launch.yaml"), "--seconds", "0.2", "--no-frames"]) == 0
+    assert "5 bodies, 1 joints" in capsys.readouterr().out  # floor, slab, box, post and arm
+
+
+def test_parity_without_an_ambf_build_is_a_located_error(scenes, tmp_path, capsys):
+    rc = main(["parity", str(scenes / "launch.yaml"), "-l", "0", "--ambf", str(tmp_path / "nowhere")])
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert "error[ambf-missing]" in err and "make ambf" in err and "Traceback" not in err
+
+
+def test_joint_controller_is_ambfs_pid():
+    # afJointController::computeOutput: backward difference over the time since the last call,
+    # trapezoid integral; the first call differences against 0 at t = 0
+    c = Controller(P=10.0, I=2.0, D=1.0)
+    assert c.output(0.0, 0.5, 0.001) == pytest.approx(10 * 0.5 + 2 * 0.25 * 0.001 + 0.5 / 0.001)
+    out = c.output(0.1, 0.5, 0.002)  # e = 0.4
+    assert out == pytest.approx(10 * 0.4 + 2 * (0.25e-3 + 0.45e-3) + (0.4 - 0.5) / 0.001)
+    # AMBF divides by no less than 1e-5 s (a second call at the same time)
+    assert c.output(0.1, 0.5, 0.002) == pytest.approx(10 * 0.4 + 2 * (0.7e-3 + 0.4 * 1e-5) + 0.0)
+    # the shortest way round for a joint without limits, and `enable motor`'s slip in AMBF's loader
+    assert shortest_angle(3.0, -3.0) == pytest.approx(2 * math.pi - 6.0)
+    assert shortest_angle(-0.5, 0.5) == pytest.approx(1.0)
+
+    class J:
+        enable_motor, enable_feedback = None, None
+
+    assert motor_enabled(J())
+    J.enable_motor, J.enable_feedback = True, False
+    assert not motor_enabled(J())  # AMBF reads `enable feedback` for `enable motor`
+
+
+def test_command_file_errors_are_located(tmp_path):
+    good = tmp_path / "ok.txt"
+    good.write_text("# a comment\n0.0, position, psm1/base link-yaw link, 0.3\n\n1.5, grasp, psm1/Actuator0, Needle\n")
+    cmds = commandfile.read(good)
+    assert [(c.t, c.kind, c.target, c.value, c.body) for c, _ in cmds] == [
+        (0.0, "position", "psm1/base link-yaw link", 0.3, ""),
+        (1.5, "grasp", "psm1/Actuator0", 0.0, "Needle"),
+    ]
+    assert [w.line for _, w in cmds] == [2, 4]
+    for text, rule, line in (
+        ("0.1, push, a, 1\n", "command-kind", 1),
+        ("\n0.1, position, a\n", "command-syntax", 2),
+        ("x, position, a, 1\n", "command-syntax", 1),
+        ("0.1, velocity, a, nan\n", "command-syntax", 1),
+        ("0.1, release, act, extra\n", "command-syntax", 1),
+    ):
+        bad = tmp_path / "bad.txt"
+        bad.write_text(text)
+        with pytest.raises(AdfError) as info:
+            commandfile.read(bad)
+        (d,) = info.value.diagnostics
+        assert (d.rule, d.location.line) == (rule, line), text
+
+
+def test_command_targets_are_resolved_by_ambfs_names():
+    names = ["/ambf/env/psm1/baselink-yawlink", "/ambf/env/psm2/baselink-yawlink", "/ambf/env/arm/base-arm"]
+    assert commandfile.resolve("base-arm", names, "joint", None) == names[2]
+    assert commandfile.resolve("psm2/base link-yaw link", names, "joint", None) == names[1]
+    with pytest.raises(AdfError, match="several"):
+        commandfile.resolve("base link-yaw link", names, "joint", None)
+    with pytest.raises(AdfError, match="no joint"):
+        commandfile.resolve("elbow", names, "joint", None)
+
+
+def test_bodies_of_one_name_are_paired_by_where_they_start():
+    a = np.array([[0.0, 0, 0], [1.0, 0, 0], [5.0, 0, 0]])
+    b = np.array([[1.1, 0, 0], [0.1, 0, 0]])
+    pairs = compare.match(["twin", "twin", "solo"], ["twin", "twin"], a, b)
+    assert sorted(pairs) == [(0, 1), (1, 0)]
+
+
+def test_plugin_record_errors_are_reported():
+    with pytest.raises(AdfError, match="no joint /x"):
+        ambf._record([{"kind": "error", "message": "command line 1: no joint /x"}], 3, 0.1, "", 1.0)
+    with pytest.raises(AdfError) as info:
+        ambf._record([{"kind": "created"}], 139, 0.1, "a\nSegmentation fault\n", 1.0)
+    assert "exit status 139" in str(info.value) and "Segmentation fault" in str(info.value)
+
+
+# ---- with AMBF -------------------------------------------------------------------------------
+
+
+@needs_ambf
+def test_a_dropped_box_lands_where_ambf_lands_it(scenes):
+    from adfkit.parity import session
+    from adfkit.parity.traces import AdfkitPlayer
+    from adfkit.runner import Options, open_world
+
+    req = session.Request(scenes / "launch.yaml", [0], BUILD, seconds=0.5, every=0.02)
+    out = session.run(req, progress=False)
+    (c,) = out.comparisons
+    gaps = {g.name: g for g in c.bodies}
+    assert sorted(gaps) == ["/ambf/env/Floor", "/ambf/env/drop/box", "/ambf/env/drop/slab"]
+    box = gaps["/ambf/env/drop/box"]
+    # measured: 0.98 mm as it lands (the impact a step apart), 0.12 mm at rest, 0.007°
+    assert box.max_position < 1.0e-3 and box.position[-1] < 0.2e-3 and box.max_angle < 0.05
+    assert c.only_in_ambf == c.only_in_adfkit == [] and not c.failures()
+    assert c.times.size == 26 and c.times[-1] == pytest.approx(0.5)
+    # negative control: the box dropped from 1 cm higher on adfkit's side only
+    from adfkit.adf import load_scene
+    from adfkit.model import Pose, Vec3
+
+    scene = load_scene(scenes / "launch.yaml", [0])
+    box_body = scene.models[0].bodies[1]
+    box_body.location = Pose(Vec3(0.0, 0.0, 0.26), box_body.location.orientation)
+    w = open_world(scene, Options(visuals=False))
+    try:
+        higher = AdfkitPlayer(w).play(0.5, 0.02)
+    finally:
+        w.close()
+    bad = compare.compare(c.ambf, higher)
+    worst = max(bad.bodies, key=lambda g: g.max_position)
+    assert worst.name == "/ambf/env/drop/box" and worst.max_position > 5e-3
+    assert any("/ambf/env/drop/box" in f for f in bad.failures())
+
+
+@needs_ambf
+@pytest.mark.parametrize(
+    "commands, tip_mm",
+    [("arm_velocity.txt", 0.5), ("arm_effort.txt", 0.3), ("arm_position.txt", 1.5)],
+)
+def test_joint_commands_drive_both_sides_alike(scenes, commands, tip_mm, capsys):
+    rc = main(
+        ["parity", str(scenes / "launch.yaml"), "-l", "1", "--seconds", "1", "--commands", str(scenes / commands)]
+        + ["--tolerance-mm", str(tip_mm), "--json"]
+    )
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0, out
+    arm = next(b for b in out["bodies"] if b["name"] == "/ambf/env/arm/arm")
+    assert 0 < arm["max_position_gap_m"] < tip_mm * 1e-3
+    (joint,) = out["joints"]
+    assert joint["name"] == "/ambf/env/arm/base-arm" and joint["max_value_gap"] < 4e-3  # rad
+    assert out["only_in_ambf"] == out["only_in_adfkit"] == []
+
+
+@needs_ambf
+def test_an_undriven_arm_differs_from_ambfs_driven_one(scenes):
+    # negative control: AMBF's arm under a velocity command against adfkit's left alone
+    from adfkit.adf import load_scene
+    from adfkit.parity import session
+    from adfkit.parity.traces import AdfkitPlayer
+    from adfkit.runner import Options, open_world
+
+    req = session.Request(scenes / "launch.yaml", [1], BUILD, seconds=0.4, every=0.02)
+    req.commands = scenes / "arm_velocity.txt"
+    (c,) = session.run(req, progress=False).comparisons
+    assert not c.failures()
+    w = open_world(load_scene(scenes / "launch.yaml", [1]), Options(visuals=False, control_substeps=1))
+    try:
+        still = AdfkitPlayer(w).play(0.4, 0.02)
+    finally:
+        w.close()
+    bad = compare.compare(c.ambf, still)
+    arm = next(g for g in bad.bodies if g.name.endswith("/arm"))
+    assert arm.max_position > 0.05 and bad.failures()  # 0.25 rad at 35 cm: ~9 cm apart
+
+
+@needs_ambf
+def test_a_bad_command_target_is_a_located_error(scenes, tmp_path, capsys):
+    bad = tmp_path / "cmd.txt"
+    bad.write_text("0.0, velocity, base-arm, 1.0\n0.1, velocity, elbow, 1.0\n")
+    rc = main(["parity", str(scenes / "launch.yaml"), "-l", "1", "--commands", str(bad)])
+    err = capsys.readouterr().err
+    assert rc == 2 and f"{bad}:2:1: error[command-target]" in err and "base-arm" in err
