@@ -256,9 +256,17 @@ def estimate_all(scene) -> tuple[list, list[str]]:
     return done, skipped
 
 
-def add_joint(parent, child, joint_type: str = "revolute", frame: Matrix | None = None, name: str | None = None):
+def add_joint(
+    parent,
+    child,
+    joint_type: str = "revolute",
+    frame: Matrix | None = None,
+    name: str | None = None,
+    spring_defaults: bool = True,
+):
     """An Empty with a rigid body constraint between two bodies; the Empty is the joint frame
-    (Z: axis of hinge/spring joints, X: axis of prismatic joints)."""
+    (Z: axis of hinge/spring joints, X: axis of prismatic joints). A spring joint gets limits,
+    stiffness and damping that hold its child (tuning.spring_defaults)."""
     from adfkit.model.semantics import joint_kind
 
     from .build import RBC_TYPE, ensure_rigidbody_world
@@ -276,6 +284,10 @@ def add_joint(parent, child, joint_type: str = "revolute", frame: Matrix | None 
     e.rigid_body_constraint.object1, e.rigid_body_constraint.object2 = parent, child
     e.adf.kind = "JOINT"
     e.adf.joint.use_type, e.adf.joint.type = True, joint_type
+    if spring_defaults:
+        from .tuning import spring_defaults as defaults
+
+        defaults(scene, e)
     return e
 
 
@@ -325,7 +337,7 @@ def create_rope(
     bpy.context.view_layer.update()
     for i in range(count - 1):
         frame = Matrix.Translation(Vector(origin) + Vector(((i + 1) * seg, 0, 0))) @ rot
-        j = add_joint(bodies[i], bodies[i + 1], "six dof spring", frame, f"{name}_{i:03d}-{i + 1:03d}")
+        j = add_joint(bodies[i], bodies[i + 1], "six dof spring", frame, f"{name}_{i:03d}-{i + 1:03d}", False)
         p = j.adf.joint
         for attr, val in (
             ("linear_low", (0.0,) * 3),

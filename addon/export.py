@@ -126,6 +126,18 @@ def gather_model(scene, objects=None, mesh_format: str | None = None) -> gather.
     doc.volumes = [*doc.volumes, *volumes.gather_authored(objs)]  # those authored here, where they stand
     for key, items in other.items():
         setattr(doc, key, _ordered(items, order.get(key, [])))
+    if not doc.all_objects() and not any(d.severity >= Severity.ERROR for d in out.diagnostics):
+        out.diagnostics.append(
+            error(
+                "export-empty",
+                "nothing to export: "
+                + ("no selected object is" if objects is not None else "no object is")
+                + " an ADF object",
+                None,
+                "give objects an ADF kind in their ADF panel (body, joint, ...)"
+                + (", or export without 'Selected only'" if objects is not None else ""),
+            )
+        )
     seen: dict[str, str] = {}
     for job in out.jobs:
         rel = job.directory + job.filename

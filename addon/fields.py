@@ -80,6 +80,8 @@ def _pid(prefix: str, path: tuple[str, ...], label: str) -> list[Field]:
     ]
 
 
+VISIBLE = "drawn in AMBF; applied only together with a colour (color rgba or color components)"
+
 BODY = [
     Field("mass", ("mass",), "float", 1.0, "Mass", "kg; 0 makes the body static", min=0.0),
     Field("inertia", ("inertia",), "inertia", (0.001, 0.001, 0.001), "Inertia", "principal moments ix, iy, iz (kg·m²)"),
@@ -107,6 +109,7 @@ BODY = [
         "controller_output_type", ("controller_output_type",), "enum", "FORCE", "Controller output", items=OUTPUT_TYPES
     ),
     Field("passive", ("passive",), "bool", False, "Passive", "no ROS communication"),
+    Field("visible", ("visible",), "bool", True, "Visible", VISIBLE),
     Field("gravity", ("gravity",), "vec3", (0.0, 0.0, -9.8), "Gravity override", "m/s², this body only"),
     Field("publish_children_names", ("publish_children_names",), "bool", False, "Publish children names"),
     Field("publish_joint_names", ("publish_joint_names",), "bool", False, "Publish joint names"),
@@ -311,6 +314,7 @@ SOFT_DEFAULTS = {
 
 SOFT = [
     Field("mass", ("mass",), "float", 1.0, "Mass", "kg, spread over the nodes", min=0.0),
+    Field("visible", ("visible",), "bool", True, "Visible", VISIBLE),
     Field("collision_margin", ("collision_margin",), "float", 0.001, "Collision margin", "m", min=0.0),
     Field("collision_groups", ("collision_groups",), "groups", "", "Collision groups", "comma-separated ints 0-999"),
     Field("gravity", ("gravity",), "vec3", (0.0, 0.0, -9.8), "Gravity override", "m/s², this body only"),

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from adfkit.diagnostics import Diagnostic, SourceLocation, error, warning
+from adfkit.diagnostics import Diagnostic, SourceLocation, error, info, warning
 from adfkit.model import Actuator, Body, Camera, Ghost, Joint, Light, ModelFile, Pose, Sensor
 from adfkit.model.common import Geometry, ShapeEntry
 from adfkit.model.objects import Ray, SoftBody
@@ -327,6 +327,8 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
         return None
     j.parent = _parent_ref(j.parent, p)
     j.child = _parent_ref(j.child, c)
+    if not obj.adf.snapshot:  # authored here: say what AMBF would do with what it lacks
+        out.diagnostics += joint_findings(obj, j, c)
     keep = unchanged(obj) and unchanged(p) and unchanged(c) and j.parent_pivot is not None
     if not keep:
         d = joint_frames.derive(
@@ -339,6 +341,47 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
         if j.child_offset is not None and j.offset is None:
             j.child_offset = None
     return j
+
+
+def joint_findings(obj, j: Joint, child) -> list[Diagnostic]:
+    """A driven joint without a controller (AMBF then drives it by velocity, with no gains of
+    this model), and a six-dof spring without the limits, stiffness or damping that hold its
+    child (AMBF's defaults: ±1.2 on every axis, stiffness 1, which let a child fall)."""
+    from adfkit.model.semantics import JointKind, joint_kind
+
+    kind = joint_kind(j.type)
+    out = []
+    if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC) and not j.passive and j.controller is None:
+        out.append(
+            info(
+                "joint-controller",
+                f"joint '{obj.name}' has no controller gains; AMBF drives it by velocity",
+                where(obj),
+                "Estimate joint controller gains sets P, I and D from what the joint moves",
+            )
+        )
+    if kind is JointKind.SIX_DOF_SPRING:
+        lim = j.joint_limits
+        lacks = [
+            what
+            for what, given in (
+                ("limits", lim is not None and lim.linear is not None and lim.angular is not None),
+                ("stiffness", j.stiffness is not None),
+                ("damping", j.damping is not None),
+            )
+            if not given
+        ]
+        if lacks:
+            out.append(
+                warning(
+                    "spring-joint-defaults",
+                    f"six-dof spring '{obj.name}' has no {' or '.join(lacks)}: AMBF's defaults "
+                    f"(±1.2 m and rad, stiffness 1, damping 0.7) do not hold '{child.name}'",
+                    where(obj),
+                    "tick the joint's limits, stiffness and damping (a new spring joint gets values that hold its child)",
+                )
+            )
+    return out
 
 
 # --- sensors, actuators, cameras, lights ---------------------------------------------------

@@ -178,18 +178,24 @@ class ADF_OT_fix_nodes(bpy.types.Operator):
 class ADF_OT_estimate_gains(bpy.types.Operator):
     bl_idname = "adf.estimate_gains"
     bl_label = "Estimate joint controller gains"
-    bl_description = "P and D of each selected joint (all joints if none is selected) from what it moves"
+    bl_description = "P, I and D of every joint (or the selected ones) from what it moves"
     frequency: FloatProperty(name="Frequency (Hz)", default=2.0, min=0.01)
     damping_ratio: FloatProperty(name="Damping ratio", default=1.0, min=0.0)
+    selected_only: BoolProperty(
+        name="Selected joints only", default=False, description="the selected joints (off: every joint of the scene)"
+    )
 
     def execute(self, context):
         from .tuning import estimate_gains
 
-        joints = [o for o in context.selected_objects if o.adf.kind == "JOINT"] or [
-            o for o in context.scene.objects if o.adf.kind == "JOINT"
-        ]
+        pool = context.selected_objects if self.selected_only else context.scene.objects
+        joints = [o for o in pool if o.adf.kind == "JOINT"]
         done = estimate_gains(context.scene, joints, self.frequency, self.damping_ratio)
-        self.report({"INFO"}, f"gains of {len(done)} joints")
+        left = sorted(o.name for o in joints if o.name not in done)
+        context.scene.adf.findings = "\n".join(
+            f"INFO: no gains for joint {n}: its constraint has no child body" for n in left
+        )
+        self.report({"INFO"}, f"gains of {len(done)} joints" + (f"; none for {', '.join(left)}" if left else ""))
         return {"FINISHED"}
 
 

@@ -38,28 +38,42 @@ def subtree(scene, child) -> list:
     return seen
 
 
-def load_about_joint(scene, joint) -> float:
-    """What the joint moves: for a prismatic joint the subtree's mass (kg); otherwise its
-    inertia about the joint axis (kg·m²): each body's mass times its squared distance from
-    the axis plus its largest principal moment (an upper bound of its own term)."""
-    from adfkit.model.semantics import JointKind, joint_kind
+def _own_inertia(b, m: float) -> float:
+    """A body's largest principal moment: as given, else that of its bounding box (an upper
+    bound; a body just marked has no inertia yet)."""
+    if b.adf.body.use_inertia:
+        return max(b.adf.body.inertia)
+    return m * sum(d * d for d in b.dimensions) / 12.0
 
-    rbc = joint.rigid_body_constraint
-    p = joint.adf.joint
-    kind = joint_kind(p.type) if p.use_type else JointKind.REVOLUTE
-    bodies = subtree(scene, rbc.object2)
+
+def load_about(scene, joint, axis_local=(0.0, 0.0, 1.0), linear: bool = False) -> float:
+    """What the joint moves: along an axis (``linear``) the subtree's mass (kg); about the
+    joint frame's axis ``axis_local`` its inertia (kg·m²): each body's mass times its squared
+    distance from the axis plus its largest principal moment (an upper bound of its own term)."""
+    from mathutils import Vector
+
+    bodies = subtree(scene, joint.rigid_body_constraint.object2)
     masses = [(b, b.adf.body.mass if b.adf.body.use_mass else 1.0) for b in bodies]
-    if kind in (JointKind.PRISMATIC, JointKind.LINEAR_SPRING):
+    if linear:
         return sum(m for _, m in masses)
     origin = joint.matrix_world.translation
-    axis = (joint.matrix_world.to_3x3() @ __import__("mathutils").Vector((0, 0, 1))).normalized()
+    axis = (joint.matrix_world.to_3x3() @ Vector(axis_local)).normalized()
     total = 0.0
     for b, m in masses:
         r = b.matrix_world.translation - origin
         d2 = (r - axis * r.dot(axis)).length_squared
-        own = max(b.adf.body.inertia) if b.adf.body.use_inertia else 0.0
-        total += m * d2 + own
+        total += m * d2 + _own_inertia(b, m)
     return total
+
+
+def load_about_joint(scene, joint) -> float:
+    """What the joint moves: for a prismatic joint (or linear spring) the subtree's mass (kg);
+    otherwise its inertia about the joint axis (kg·m²), :func:`load_about`."""
+    from adfkit.model.semantics import JointKind, joint_kind
+
+    p = joint.adf.joint
+    kind = joint_kind(p.type) if p.use_type else JointKind.REVOLUTE
+    return load_about(scene, joint, linear=kind in (JointKind.PRISMATIC, JointKind.LINEAR_SPRING))
 
 
 def estimate_gains(scene, joints, frequency_hz: float = 2.0, damping_ratio: float = 1.0) -> dict:
@@ -76,6 +90,53 @@ def estimate_gains(scene, joints, frequency_hz: float = 2.0, damping_ratio: floa
         p.use_controller_d, p.controller_d = True, dgain
         done[j.name] = (pgain, dgain)
     return done
+
+
+#: A new spring joint's natural frequency and damping ratio: stiff enough that its child sags by
+#: g/ω² = 2.5 mm (or 2.5 mm·m/d rad at a distance d) under gravity, critically damped.
+SPRING_HZ, SPRING_DAMPING_RATIO = 10.0, 1.0
+#: A new spring's range: a linear spring ±1 cm, a torsion spring and a six-dof spring's
+#: rotations ±0.5 rad; a six-dof spring's translations held (the joints of AMBF's threads).
+SPRING_TRAVEL, SPRING_TURN = 0.01, 0.5
+
+
+def spring_defaults(scene, joint) -> None:
+    """Limits, stiffness, damping and equilibrium for a new spring joint, from what it moves
+    (stiffness = load·ω², damping = 2ζ·load·ω at :data:`SPRING_HZ`): AMBF keeps a spring without
+    limits locked, and a six-dof spring's defaults (±1.2, stiffness 1) let its child fall."""
+    from adfkit.model.semantics import JointKind, joint_kind
+
+    p = joint.adf.joint
+    kind = joint_kind(p.type)
+
+    def gains(load: float) -> tuple[float, float]:
+        return pd_gains(max(load, 1e-9), SPRING_HZ, SPRING_DAMPING_RATIO)
+
+    def put(**values) -> None:
+        for k, v in values.items():
+            setattr(p, "use_" + k, True)
+            setattr(p, k, v)
+
+    if kind in (JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING):
+        linear = kind is JointKind.LINEAR_SPRING
+        k, c = gains(load_about(scene, joint, linear=linear))
+        r = SPRING_TRAVEL if linear else SPRING_TURN
+        put(limit_low=-r, limit_high=r, stiffness=k, damping=c, equilibrium=0.0)
+    elif kind is JointKind.SIX_DOF_SPRING:
+        lin = gains(load_about(scene, joint, linear=True))
+        ang = [gains(load_about(scene, joint, a)) for a in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))]
+        put(
+            linear_low=(0.0,) * 3,
+            linear_high=(0.0,) * 3,
+            angular_low=(-SPRING_TURN,) * 3,
+            angular_high=(SPRING_TURN,) * 3,
+            stiffness_linear=(lin[0],) * 3,
+            damping_linear=(lin[1],) * 3,
+            stiffness_angular=tuple(k for k, _ in ang),
+            damping_angular=tuple(c for _, c in ang),
+            equilibrium_linear=(0.0,) * 3,
+            equilibrium_angular=(0.0,) * 3,
+        )
 
 
 def show_joints(scene, show: bool, passive_only: bool = False) -> int:

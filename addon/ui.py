@@ -100,6 +100,7 @@ def draw_object(layout, obj) -> None:
         col.operator_menu_enum("adf.add_collision_primitive", "shape")
         col.operator("adf.add_grasp")
     if adf.kind == "JOINT":
+        layout.operator("adf.estimate_gains", text="Estimate gains of the selected joints").selected_only = True
         rbc = obj.rigid_body_constraint
         if rbc is None or rbc.object1 is None or rbc.object2 is None:
             external = [e for e in str(obj.get("adf_external_ends", "")).split(",") if e]
@@ -136,6 +137,10 @@ class ADF_PT_object(bpy.types.Panel):
         draw_object(self.layout, context.object)
 
 
+#: The model-level keys the sidebar shows, each with its "write it" switch.
+MODEL_KEYS = ("namespace", "gravity", "ignore_inter_collision")
+
+
 class ADF_PT_sidebar(bpy.types.Panel):
     bl_label = "ADF"
     bl_space_type = "VIEW_3D"
@@ -149,14 +154,12 @@ class ADF_PT_sidebar(bpy.types.Panel):
         col.operator("adf.import_model")
         col.operator("adf.export_model")
         col.operator("adf.check")
-        row = lay.row(align=True)
-        row.prop(sc, "use_namespace", text="")
-        row.prop(sc, "namespace")
-        row = lay.row(align=True)
-        row.prop(sc, "use_gravity", text="")
-        sub = row.row()
-        sub.enabled = sc.use_gravity
-        sub.prop(sc, "gravity")
+        for key in MODEL_KEYS:
+            row = lay.row(align=True)
+            row.prop(sc, "use_" + key, text="")
+            sub = row.row()
+            sub.enabled = getattr(sc, "use_" + key)
+            sub.prop(sc, key)
         box = lay.box()
         box.label(text="Export")
         box.prop(sc, "precision")

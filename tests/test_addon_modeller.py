@@ -95,3 +95,129 @@ def test_the_documented_cube_exports_its_numbers_without_float32_error(addon, sc
     doc, _ = read_file(_export(addon, scene, tmp_path / "moved").path)
     (entry,) = doc.body("BODY Cone").compound_collision_shape
     assert entry.offset.rpy()[0] == pytest.approx(math.pi + 0.5 - 2 * math.pi, abs=1e-6)
+
+
+# --- export refuses an empty scene, visible, the model's keys in the sidebar ----------------
+
+
+def test_an_empty_export_is_refused_and_writes_nothing(addon, scene, tmp_path):
+    res = addon.export.export_scene(scene, tmp_path / "out")
+    assert not res.ok and [d.rule for d in res.diagnostics] == ["export-empty"]
+    assert not (tmp_path / "out").exists()
+    plain = cube("Plain")  # an object without an ADF kind is not a model either
+    assert bpy.ops.adf.check() == {"FINISHED"} and "nothing to export" in scene.adf.findings
+    body = cube("Body", location=(0.2, 0, 0))
+    addon.authoring.mark(body, "BODY")
+    for o in scene.objects:
+        o.select_set(o is plain)
+    with pytest.raises(RuntimeError, match="no selected object is an ADF object"):
+        bpy.ops.adf.export_model(directory=str(tmp_path / "sel"), use_selection=True)
+    assert not (tmp_path / "sel").exists()
+    assert _export(addon, scene, tmp_path / "all").ok  # with its body, the scene exports
+
+
+def test_visible_round_trips_and_the_sidebar_shows_every_model_key(addon, scene, tmp_path):
+    """`visible: false` (the challenge's phantom has 52 visible keys) is a body and soft-body
+    key: written when ticked, read back on import, written again as it came in. Every
+    model-level key with a "write it" switch is in the sidebar (ignore inter-collision was not)."""
+    hidden = cube("Hidden")
+    addon.authoring.mark(hidden, "BODY")
+    hidden.adf.body.use_visible, hidden.adf.body.visible = True, False
+    first = _export(addon, scene, tmp_path / "a")
+    assert "  visible: false\n" in first.path.read_text()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon.build.import_model(first.path)
+    b = bpy.data.objects["Hidden"].adf.body
+    assert b.use_visible and not b.visible
+    again = _export(addon, bpy.context.scene, tmp_path / "b")
+    assert again.path.read_text() == first.path.read_text()
+    assert "visible" in {f.prop for f in addon.fields.SOFT}
+    ui = __import__("importlib").import_module(addon.__name__ + ".ui")
+    scene_props = bpy.context.scene.adf.bl_rna.properties.keys()
+    switched = {k for k in scene_props if "use_" + k in scene_props}
+    assert switched == set(ui.MODEL_KEYS) and "ignore_inter_collision" in switched
+
+
+# --- joints: gains for every joint, springs that hold ---------------------------------------
+
+
+def _select(active, *others):
+    for o in bpy.context.scene.objects:
+        o.select_set(o is active or o in others)
+    bpy.context.view_layer.objects.active = active
+
+
+def _base_and_arms(addon, n=2):
+    base = cube("Base", 0.1)
+    addon.authoring.mark(base, "BODY")
+    base.adf.body.mass = 0.0
+    arms = []
+    for i in range(n):
+        arm = cube(f"Arm{i}", 0.04, (0.2 * (i + 1), 0.0, 0.0))
+        addon.authoring.mark(arm, "BODY")
+        arms.append(arm)
+    return base, arms
+
+
+def test_gains_for_every_new_joint_and_check_names_a_joint_without_any(addon, scene):
+    """Joints added one after the other through the operator (each new joint stays selected):
+    Estimate joint controller gains sets every joint's controller. Before, Check says which
+    hinge has none; a passive one is not driven, so it is not named."""
+    base, arms = _base_and_arms(addon, 3)
+    for arm in arms:
+        _select(arm, base)
+        assert bpy.ops.adf.add_joint(joint_type="revolute") == {"FINISHED"}
+    joints = sorted((o for o in scene.objects if o.adf.kind == "JOINT"), key=lambda o: o.name)
+    passive = joints[2].adf.joint
+    passive.use_passive = passive.passive = True
+    found = addon.export.check_scene(scene)
+    named = sorted(d.message.split("'")[1] for d in found if d.rule == "joint-controller")
+    assert named == [j.name for j in joints[:2]]
+    assert all(d.severity == Severity.INFO for d in found if d.rule == "joint-controller")
+    assert [o.name for o in bpy.context.selected_objects] == [joints[-1].name]  # the last one is selected
+    assert bpy.ops.adf.estimate_gains() == {"FINISHED"}
+    assert all(j.adf.joint.use_controller_p and j.adf.joint.controller_p > 0 for j in joints)
+    assert [d for d in addon.export.check_scene(scene) if d.rule == "joint-controller"] == []
+    # the joint panel's button: the selected joints only
+    for j in joints:
+        j.adf.joint.controller_p = 1.0
+    _select(joints[0])
+    assert bpy.ops.adf.estimate_gains(selected_only=True) == {"FINISHED"}
+    assert [j.adf.joint.controller_p != 1.0 for j in joints] == [True, False, False]
+
+
+@pytest.mark.parametrize("jtype", ["six dof spring", "linear spring", "torsion spring"])
+def test_a_new_spring_joint_holds_its_child_and_check_says_when_it_cannot(addon, scene, tmp_path, jtype):
+    """A spring added between a static base and a 64 g cube (through the operator) gets limits,
+    stiffness and damping: played for 2 s the cube stays within 5 mm of where it was placed (a
+    spring of 10 Hz sags g/ω² ≈ 2.5 mm). Without them a six-dof spring has AMBF's defaults
+    (±1.2, stiffness 1): Check says so, and the cube sinks by centimetres."""
+    pytest.importorskip("pybullet")
+    from adfkit.adf import load_scene
+    from adfkit.runner import open_world
+
+    base, (arm,) = _base_and_arms(addon, 1)
+    _select(arm, base)
+    assert bpy.ops.adf.add_joint(joint_type=jtype) == {"FINISHED"}
+    joint = next(o for o in scene.objects if o.adf.kind == "JOINT")
+    assert [d.rule for d in addon.export.check_scene(scene) if d.severity >= Severity.WARNING] == []
+
+    def drop(out: Path) -> float:
+        res = _export(addon, scene, out)
+        world = open_world(load_scene(res.path))
+        try:
+            start = world.body("Arm0").com_position()
+            world.run(2.0)
+            return float(math.dist(start, world.body("Arm0").com_position()))
+        finally:
+            world.close()
+
+    assert drop(tmp_path / "held") < 0.005
+    if jtype != "six dof spring":
+        return
+    p = joint.adf.joint
+    for k in ("linear_low", "linear_high", "angular_low", "angular_high", "stiffness_linear", "stiffness_angular"):
+        setattr(p, "use_" + k, False)
+    (d,) = [d for d in addon.export.check_scene(scene) if d.rule == "spring-joint-defaults"]
+    assert "no limits or stiffness" in d.message and "'Arm0'" in d.message
+    assert drop(tmp_path / "defaults") > 0.02
