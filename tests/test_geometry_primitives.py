@@ -88,3 +88,33 @@ def test_an_open_box_fits_its_own_box_exactly():
     entry = FITTERS["box"](_meshes()["open box"])
     assert sorted((entry.geometry.x, entry.geometry.y, entry.geometry.z)) == pytest.approx([0.01, 0.02, 0.03])
     assert fit_error(_meshes()["open box"], entry)[0] == pytest.approx(0.0, abs=1e-9)
+
+
+def _capsule_volume(r: float, height: float) -> float:
+    return np.pi * r * r * (height - 2 * r) + 4.0 / 3.0 * np.pi * r**3
+
+
+def test_a_capsule_around_a_square_pad_is_the_one_of_least_volume():
+    """A 0.2 × 0.2 × 0.004 pad: the thinnest enclosing capsule (radius 0.1) is 0.4 long, since
+    its caps must reach the corners; the fit is the capsule of least volume over every radius
+    (0.105, 0.346 long), and it encloses the pad."""
+    from adfkit.geometry.primitives import capsule_around
+
+    pad = trimesh.creation.box([0.2, 0.2, 0.004])
+    entry = FITTERS["capsule"](pad)
+    g = entry.geometry
+    assert _inside(entry, np.asarray(pad.vertices))
+    v = np.asarray(pad.vertices)
+    r_thin, h_thin, _ = capsule_around(v, np.zeros(3), np.array([1.0, 0.0, 0.0]))
+    assert (r_thin, h_thin) == pytest.approx((np.hypot(0.1, 0.002), 0.4), abs=1e-3)
+    assert g.height == pytest.approx(0.346, abs=0.002) and g.radius == pytest.approx(0.105, abs=0.001)
+    # no radius on a side's axis (or the diagonal's) encloses the pad in less
+    best = np.inf
+    for axis in (np.array([1.0, 0.0, 0.0]), np.array([1.0, 1.0, 0.0]) / np.sqrt(2)):
+        t, radial = v @ axis, np.linalg.norm(v - np.outer(v @ axis, axis), axis=1)
+        for r in np.linspace(radial.max(), 0.2, 4001):
+            reach = np.sqrt(np.maximum(r * r - radial**2, 0.0))
+            core = max(float((t - reach).max() - (t + reach).min()), 0.0)
+            best = min(best, np.pi * r * r * core + 4.0 / 3.0 * np.pi * r**3)
+    assert _capsule_volume(g.radius, g.height) <= best * (1 + 1e-4)
+    assert _capsule_volume(g.radius, g.height) < 0.95 * _capsule_volume(r_thin, h_thin)
