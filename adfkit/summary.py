@@ -43,12 +43,24 @@ def model_summary(model: ModelFile) -> dict[str, Any]:
         "cameras": len(model.cameras),
         "lights": len(model.lights),
         "vehicles": len(model.vehicles),
-        "volumes": len(model.volumes),
+        "volumes": _volumes(model),
         "meshes": len(meshes),
         "missing meshes": missing,
         # soft bodies weigh too (AMBF reads their mass with the same 1 kg default)
         "total mass": round(sum(effective_mass(b) for b in [*model.bodies, *model.soft_bodies]), 9),
     }
+
+
+def _volumes(model: ModelFile) -> list[dict[str, Any]]:
+    """Each volume's name, voxels, slices found, count and size (geometry.volume.volume_facts)."""
+    defined = [v for v in model.volumes if v.defined]
+    if not defined:
+        return []
+    try:
+        from .geometry.volume import volume_facts  # numpy and Pillow: only for a file with volumes
+    except ImportError:
+        return [{"name": v.name or v.identifier} for v in defined]
+    return [volume_facts(model, v) for v in defined]
 
 
 def world_summary(world: World, environment: ModelFile | None = None) -> dict[str, Any]:

@@ -159,3 +159,15 @@ def test_two_files_of_one_index_are_both_read_and_a_warning(tmp_path):
     write_slices(tmp_path, rgba[1:2], prefix="p0", indices=[1])  # p01.png beside p1.png
     found = find_slice_files(tmp_path, "p", "png", 12)
     assert [p.name for p in found.files] == ["p0.png", "p1.png", "p01.png", "p2.png"] and found.twice == [1]
+
+
+def test_info_names_each_volume_with_its_voxels_slices_and_size(tmp_path, capsys):
+    adf = project(tmp_path, slices=20, side=24, count=512)
+    (adf / "broken.yaml").write_text((adf / "volume_a.yaml").read_text().replace("prefix: plane00", "prefix: slice_"))
+    assert main(["info", str(adf / "volume_a.yaml"), str(adf / "broken.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "- name: mastoidectomy_volume, voxels: 24x24x20, slices found: 20, count: 512, "
+        "size m: 0.0492027x0.0492027x0.048485, voxel mm: 2.05x2.05x2.424"
+    ) in out
+    assert "- name: mastoidectomy_volume, problem: volume 'VOLUME mastoidectomy_volume': no slice slice_<0..512>" in out

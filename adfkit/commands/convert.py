@@ -58,7 +58,11 @@ def run(args) -> int:
         )
         sys.stdout.write("\n")
     else:
-        print(f"{src} ({fin}) -> {dst} ({fout}): {len(model.bodies)} bodies, {len(model.joints)} joints")
+        vols = sum(1 for v in model.volumes if v.defined)
+        print(
+            f"{src} ({fin}) -> {dst} ({fout}): {len(model.bodies)} bodies, {len(model.joints)} joints"
+            + (f", {vols} volume(s) as their iso-surfaces" if vols else "")
+        )
         if losses:
             print(f"{len(losses)} item(s) not carried over:")
             for stage, l in losses:

@@ -163,6 +163,38 @@ def _findings(vol, found: SliceFiles, count: int, opaque: list[int]) -> list[Dia
     return out
 
 
+def volume_facts(model, vol) -> dict:
+    """What `adfkit info` says of a volume without reading every slice: its name, the voxels
+    (the first slice's size, the slices found), ``count`` as written and its size in metres;
+    ``problem`` instead of the voxels when AMBF would skip it."""
+    from PIL import Image, UnidentifiedImageError
+
+    d = vol.dimensions
+    size = [
+        (getattr(d, k, None) if d is not None and getattr(d, k, None) is not None else 1.0)
+        * (vol.scale if vol.scale is not None else 1.0)
+        for k in "xyz"
+    ]
+    out: dict = {"name": vol.name or vol.identifier.removeprefix("VOLUME ")}
+    try:
+        found = slice_files(model, vol)
+        with Image.open(found.files[0]) as img:
+            w, h = img.size
+        n = len(found.files)
+        out["voxels"] = f"{w}x{h}x{n}"
+        out["slices found"] = n
+        out["count"] = int(vol.images.count)
+        out["size m"] = "x".join(f"{v:.6g}" for v in size)
+        out["voxel mm"] = "x".join(f"{1000 * v / k:.4g}" for v, k in zip(size, (w, h, n)))
+    except AdfError as exc:
+        out["problem"] = exc.diagnostics[0].message
+    except (UnidentifiedImageError, OSError, ValueError) as exc:
+        out["problem"] = f"the first slice is not an image Pillow reads ({type(exc).__name__})"
+    if vol.parent:
+        out["parent"] = vol.parent
+    return out
+
+
 def load_volume(model, vol) -> VolumeData:
     """Every slice of ``vol`` as one array, each read through the input policy; a slice outside
     the tree, not an image or of another size is a located error. What AMBF loads but a modeller
