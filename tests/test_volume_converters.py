@@ -54,9 +54,17 @@ def test_mjcf_gets_the_iso_surface_as_a_static_mesh_and_names_the_voxel_data(dri
     b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "Bone")
     g = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "Bone")
     assert np.allclose(d.xpos[b], [0, 0, 0.02]) and m.body_weldid[b] == 0  # static, at the volume's location
-    assert m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH and m.geom_contype[g] != 0 and m.geom_group[g] == 0
+    assert m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH and m.geom_contype[g] == 0 and m.geom_group[g] == 1  # drawn
     assert np.allclose(m.geom_rgba[g], [0.93, 0.89, 0.78, 1.0])
     assert m.mesh_vertnum[m.geom_dataid[g]] > 1000
+    parts = [i for i in range(m.ngeom) if m.geom_bodyid[i] == b and i != g]  # what collides
+    assert 50 < len(parts) < 216 and all(m.geom_group[i] == 3 and m.geom_contype[i] != 0 for i in parts)
+    # the parts cover the bone: its top face at 0.032 (a ray down beside the drill stops there)
+    hit = np.zeros(1, dtype=np.int32)
+    dist = mujoco.mj_ray(
+        m, d, np.array([0.01, 0.01, 0.1]), np.array([0, 0, -1.0]), np.array([0, 0, 0, 1, 0, 0], np.uint8), 1, -1, hit
+    )
+    assert hit[0] in parts and 0.1 - dist == pytest.approx(0.032, abs=2 * H)
 
 
 def test_urdf_gets_the_iso_surface_as_a_fixed_link_and_names_the_voxel_data(drilling, tmp_path):

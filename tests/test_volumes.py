@@ -92,9 +92,12 @@ def test_the_mujoco_engine_plays_the_volume_in_its_images_and_segmentation(drill
         {
             "object": "VOLUME Bone",
             "what": "concave collision",
-            "why": "MuJoCo collides a mesh as its convex hull: the volume's cavities are solid to contacts",
+            "why": "MuJoCo collides a mesh as its convex hull: the volume collides by "
+            f"{vol['convex_parts']} convex parts of at most 8³ voxels, so a cavity smaller than a part is solid "
+            "to contacts",
         }
     ]
+    assert 50 < vol["convex_parts"] < 216  # 6³ blocks of 8³ voxels; those the surface crosses
     assert "runner-volume" not in capsys.readouterr().err
     world = open_world(scene, Options(), engine="mujoco")
     try:
@@ -104,7 +107,8 @@ def test_the_mujoco_engine_plays_the_volume_in_its_images_and_segmentation(drill
         assert len(sb.surface[1]) == len(faces)  # what the viewer draws of it
         assert np.allclose(sb.world_matrix()[:3, 3], [0, 0, 0.02])  # at the volume's location
         m = world.model
-        (g,) = np.nonzero(m.geom_bodyid == sb.id)[0]
+        g, *parts = np.nonzero(m.geom_bodyid == sb.id)[0]  # the drawn surface, then the convex parts
+        assert len(parts) == vol["convex_parts"] and set(m.geom_group[parts]) == {3} and m.geom_contype[g] == 0
         r = world.data.geom_xmat[g].reshape(3, 3)  # MuJoCo turns a mesh to its principal axes
         top = (r @ m.geom_aabb[g, :3] + world.data.geom_xpos[g])[2] + np.abs(r[2]) @ m.geom_aabb[g, 3:]
         assert top == pytest.approx(0.02 + 0.3 * 0.04, abs=0.04 / 48)  # the bone's top face

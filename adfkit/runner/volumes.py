@@ -31,10 +31,22 @@ class VolumeSurface:
     model: object  # its ModelFile
     body: Body  # a static stand-in body (mass 0, the volume's location) for the world's tables
     pose: np.ndarray  # 4x4 volume frame in the world
+    dimensions: np.ndarray  # (3,) metres: the voxel box
     vertices: np.ndarray  # (n, 3) float32, metres in the volume's frame
     faces: np.ndarray  # (m, 3) uint32
     rgba: tuple  # colour
     report: dict  # the report.json entry
+    solid: np.ndarray | None = None  # (slices, rows, columns) bool: voxels at or above the level
+
+    def convex_parts(self) -> list[np.ndarray]:
+        """Point sets whose convex hulls cover the surface and the solid behind it, one per block
+        the surface crosses (geometry.surface_parts): what MuJoCo collides by."""
+        from ..geometry.surface_parts import convex_parts
+
+        assert self.solid is not None
+        parts = convex_parts(self.vertices, self.faces, self.solid, self.dimensions)
+        self.solid = None  # read once
+        return parts
 
     @property
     def surface(self) -> tuple:
@@ -122,10 +134,12 @@ def volume_surfaces(world, models) -> list[VolumeSurface]:
                     m,
                     body,
                     pose_to_matrix(pose_or_identity(vol.location)),
+                    data.dimensions,
                     np.asarray(verts, dtype=np.float32),
                     np.asarray(faces, dtype=np.uint32),
                     tuple(rgba(vol) or BONE),
                     report,
+                    data.voxels >= level,
                 )
             )
     return out

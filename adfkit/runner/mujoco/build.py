@@ -288,10 +288,13 @@ def build_plan(world) -> Plan:
 
 
 def _volumes(world, spec, models) -> list[tuple]:
-    """Each playable volume as a static body holding its iso-surface as one mesh geom, drawn
-    and colliding with every body (as a body without collision groups does). MuJoCo collides a
-    mesh as its convex hull, so what is concave in the volume (a canal, a drilled hole) is solid
-    to contacts: listed in ``not_played``."""
+    """Each playable volume as a static body: its iso-surface as one mesh geom that is drawn
+    and does not collide, and convex parts, one per block of voxels the surface crosses
+    (geometry.surface_parts), that collide with every body (as a body without collision groups
+    does) and are not drawn. MuJoCo collides a mesh as its convex hull: the parts keep the
+    contact on the surface up to concavities smaller than a block (``not_played`` says so)."""
+    from ...geometry.surface_parts import PART_BLOCK
+
     out = []
     for i, vs in enumerate(volume_surfaces(world, models)):
         name = f"adfkit:volume{i}"
@@ -304,14 +307,26 @@ def _volumes(world, spec, models) -> list[tuple]:
             name=name,
             rgba=list(vs.rgba),
             group=0,
-            contype=(1 << 31) - 1,
-            conaffinity=(1 << 31) - 1,
+            contype=0,
+            conaffinity=0,
         )
+        parts = vs.convex_parts()
+        for k, points in enumerate(parts):
+            spec.add_mesh(name=f"{name}:part{k}", uservert=points.astype(float).ravel())
+            body.add_geom(
+                type=mujoco.mjtGeom.mjGEOM_MESH,
+                meshname=f"{name}:part{k}",
+                group=3,
+                contype=(1 << 31) - 1,
+                conaffinity=(1 << 31) - 1,
+            )
+        vs.report["convex_parts"] = len(parts)
         world.not_played.append(
             {
                 "object": vs.volume.identifier,
                 "what": "concave collision",
-                "why": "MuJoCo collides a mesh as its convex hull: the volume's cavities are solid to contacts",
+                "why": f"MuJoCo collides a mesh as its convex hull: the volume collides by {len(parts)} convex parts "
+                f"of at most {PART_BLOCK}³ voxels, so a cavity smaller than a part is solid to contacts",
             }
         )
         out.append((vs, name))

@@ -154,7 +154,7 @@ class Assembly:
             else:  # --no-ground: nothing to fall through
                 self._floor_z = -math.inf
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
-        self._lookup = {(sb.uid, sb.link): sb for sb in self.bodies}
+        self._lookup = {(sb.uid, link): sb for sb in self.bodies for link in sb.links}
         self._dynamic_lookup = {k: sb for k, sb in self._lookup.items() if not sb.static}
         self._pairs_epoch = 0  # counts changes of collision pairs and grasps (interact.py's distance answers)
         self._parting: list = []  # (uid, link, body): a released grasp, collisions back once apart

@@ -39,6 +39,12 @@ class SimBody(EngineBody):
     articulation: object = None
     body_world_matrix: np.ndarray = None  # the file's `location`
     extra_force: list = field(default_factory=list)
+    piece_links: tuple = ()  # more links of the multibody that are this body (a volume's surface pieces)
+
+    @property
+    def links(self) -> tuple:
+        """Every link of the multibody that is this body."""
+        return (self.link, *self.piece_links)
 
     def state(self, velocity: bool = True):
         """(position, quaternion, linear velocity, angular velocity) of the COM frame; the

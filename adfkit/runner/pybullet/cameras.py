@@ -99,7 +99,7 @@ def label_table(world) -> np.ndarray:
     cached = getattr(world, "_seg_label_table", None)
     if cached is not None and cached[0] == (len(bodies), len(soft)):
         return cached[1]
-    ids = [(sb.uid, sb.link, i) for i, sb in enumerate(bodies) if sb.uid is not None and sb.uid >= 0]
+    ids = [(sb.uid, link, i) for i, sb in enumerate(bodies) if sb.uid is not None and sb.uid >= 0 for link in sb.links]
     ids += [(s.uid, -1, len(bodies) + k) for k, s in enumerate(soft) if s.uid is not None and s.uid >= 0]
     if ids:
         uids, links, index = (np.array(c) for c in zip(*ids))

@@ -248,7 +248,8 @@ class Interaction:
         """As World.contacts_among, one getContactPoints a multibody (all its links at once)."""
         wanted: dict[int, dict[int, SimBody]] = {}
         for sb in bodies:
-            wanted.setdefault(sb.uid, {})[sb.link] = sb
+            for link in sb.links:
+                wanted.setdefault(sb.uid, {})[link] = sb
         out = []
         lookup = self._lookup
         for uid, links in wanted.items():
@@ -266,7 +267,12 @@ class Interaction:
     def contacts(self, sb: SimBody) -> list:
         """[(other SimBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
         out = []
-        for c in pb.getContactPoints(bodyA=sb.uid, linkIndexA=sb.link, physicsClientId=self.cid) or ():
+        query = {"bodyA": sb.uid, "physicsClientId": self.cid}
+        if not sb.piece_links:
+            query["linkIndexA"] = sb.link
+        for c in pb.getContactPoints(**query) or ():
+            if c[3] not in sb.links:
+                continue
             other = self._lookup.get((c[2], c[4]))
             if other is not None and other is not sb:
                 out.append((other, float(c[9]), c[5]))
