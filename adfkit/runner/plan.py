@@ -231,6 +231,24 @@ def is_hole(ghost, opt) -> bool:
     return any(w in name for w in opt.hole_ghost_words)
 
 
+def joint_ends(registry, local, ns: str, joint) -> list:
+    """A joint's [parent, child] bodies (None where not found) by AMBF's lookup (adf-format.md
+    §12.2): the joint's own model (``local``), exact then substring, then that model with the
+    joint's namespace prepended, then the world (``registry``) with it, then the world."""
+    jns = merge_namespace(ns, joint.namespace)
+    ends = []
+    for ref in (joint.parent, joint.child):
+        key, hit = local.find(ref)
+        if key is None:
+            key, hit = local.find(jns + (ref or ""))
+        if key is None:
+            key, hit = registry.find(jns + (ref or ""))
+        if key is None:
+            key, hit = registry.find(ref)
+        ends.append(hit if key is not None else None)
+    return ends
+
+
 def key_of(ns: str, obj) -> str:
     return merge_namespace(ns, obj.namespace) + obj.identifier
 

@@ -163,6 +163,18 @@ class PSM:
         self.servo_jp(q)
         return q
 
+    def reach(self, pose, jump: bool = False) -> np.ndarray:
+        """A Cartesian target (4x4 in the DH base frame) through the IK: the joint motors take it
+        (``jump``: the joints are put there at once, at rest, as a reset). Returns the joint
+        values; an unreachable pose or a limit violation is a ValueError and changes nothing.
+        The viewer's target and the ROS teleoperation both aim the arm with this."""
+        q = self.kin.ik(np.asarray(pose, dtype=float))
+        if jump:
+            self.reset_jp(q)
+        else:
+            self.servo_jp(q)
+        return q
+
     def move_cp(self, pose, seconds: float) -> None:
         """Go to ``pose`` along a straight line (orientation interpolated about one axis) in
         ``seconds``, a set-point each control step, stepping the world."""

@@ -189,7 +189,7 @@ def psm_panel(v) -> None:
             pose[:3, 3] = np.asarray(target.value, dtype=float)
             try:
                 with v.lock:
-                    psm.reset_jp(psm.kin.ik(pose))
+                    psm.reach(pose, jump=True)
                 note.content = "reached"
             except ValueError as exc:
                 note.content = f"out of reach: {exc}"

@@ -20,13 +20,15 @@ class Interaction:
         t = s.parent.world_matrix() @ s.location
         a = s.starts @ t[:3, :3].T + t[:3, 3]
         b = s.ends @ t[:3, :3].T + t[:3, 3]
-        s.sensed = []
+        s.sensed, s.rays = [], []
         for p, q in zip(a, b):
             x = mujoco.mj_ray(m, d, p, q - p, self._ray_groups, 1, s.parent.id, self._ray_hit)
+            sb = None
             if 0.0 <= x <= 1.0 and self._ray_hit[0] >= 0:
                 sb = self._body_of_id.get(int(m.geom_bodyid[self._ray_hit[0]]))
                 if sb is not None and sb not in s.sensed:
                     s.sensed.append(sb)
+            s.rays.append((sb, float(x) if sb is not None else 1.0))
 
     def place_ghosts(self) -> None:
         """Ghost geoms ride on their parent bodies: nothing to move."""

@@ -84,13 +84,24 @@ class MjArticulation:
         self._eq, self._q0 = self.eqs[driven], m.qpos0[self.qadr[driven]]
         self._driven = np.flatnonzero(driven)
         self.targets = [float(world.data.qpos[a]) if a >= 0 else 0.0 for a in self.qadr]
+        self.efforts = False  # a drive is off for an effort command (MujocoWorld.drive_joints)
 
     def joint_values(self) -> list[float]:
         return [float(self.world.data.qpos[a]) if a >= 0 else 0.0 for a in self.qadr]
 
-    def drive(self) -> None:
+    def retarget(self) -> None:
+        """The drives' targets from ``targets`` (a drive switched off stays off)."""
         t = np.asarray(self.targets, dtype=float)[self._driven]
         self.world.model.eq_data[self._eq, 0] = t - self._q0
+
+    def drive(self) -> None:
+        """Every drive holds its target (one switched off for an effort command is on again)."""
+        self.retarget()
+        if self.efforts:
+            d = self.world.data
+            d.eq_active[self._eq] = 1
+            d.qfrc_applied[self.vadr[self._driven]] = 0.0
+            self.efforts = False
 
 
 @dataclass(eq=False)
@@ -128,3 +139,4 @@ class MjSensor:
     starts: np.ndarray
     ends: np.ndarray
     sensed: list = field(default_factory=list)
+    rays: list = field(default_factory=list)  # per ray: (body hit or None, fraction of the range)

@@ -58,6 +58,41 @@ class MujocoWorld(Assembly, Interaction, World):
         mujoco.mj_comPos(self.model, d)
         self._awake = None  # bodies moved by hand: control() looks at the hole ghosts again
 
+    def joint_motor(self, art, index: int, velocity: float, max_force: float) -> None:
+        """Joint ``index`` of ``art`` driven at ``velocity`` (runner/joint_commands.py: AMBF's
+        velocity motor): its drive's target moves by velocity·dt each control step, a velocity
+        servo on the same stiff drive (its force limit is watched as the drive's, DriveLimits)."""
+        d = self.data
+        eq, a = art.eqs[index], art.vadr[index]
+        if eq >= 0:
+            d.eq_active[eq] = 1
+        if a >= 0:
+            d.qfrc_applied[a] = 0.0
+        art.targets[index] = float(d.qpos[art.qadr[index]]) + float(velocity) * self.dt * self.opt.control_substeps
+        art.retarget()
+
+    def joint_effort(self, art, index: int, effort: float) -> None:
+        """Joint ``index`` of ``art`` pushed by ``effort`` (N·m or N), its drive off, until the next
+        command (runner/joint_commands.py: AMBF's commandEffort); ``art.drive()`` turns it on again."""
+        d = self.data
+        eq, a = art.eqs[index], art.vadr[index]
+        art.efforts = True
+        if eq >= 0:
+            d.eq_active[eq] = 0
+        if a >= 0:
+            d.qfrc_applied[a] = float(effort)
+
+    def set_body_velocity(self, sb, linear, angular) -> bool:
+        """Set a free body's COM velocity (world frame); False for a body that is not free."""
+        m, d = self.model, self.data
+        j = m.body_jntadr[sb.id]
+        if j < 0 or m.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE:
+            return False
+        a = m.jnt_dofadr[j]
+        d.qvel[a : a + 3] = linear
+        d.qvel[a + 3 : a + 6] = d.xmat[sb.id].reshape(3, 3).T @ np.asarray(angular, float)  # body frame
+        return True
+
     def control(self) -> None:
         """Per-control-step forces and senses: proximity sensors' rays, the bodies' velocity damping
         (damping.py), hole ghosts' viscous friction.

@@ -18,6 +18,7 @@ from ..plan import (
     SPRING_KINDS,
     collision_masks,
     is_hole,
+    joint_ends,
     key_of,
     not_played,
     played_actuators,
@@ -67,17 +68,7 @@ class Assembly:
                 if kind is None:
                     self._warn("runner-joint-type", f"{j.identifier}: unknown joint type {j.type!r}; skipped", j)
                     continue
-                jns = merge_namespace(ns, j.namespace)
-                ends = []
-                for ref in (j.parent, j.child):
-                    key, hit = local.find(ref)
-                    if key is None:
-                        key, hit = local.find(jns + (ref or ""))
-                    if key is None:
-                        key, hit = self.registry.find(jns + (ref or ""))
-                    if key is None:
-                        key, hit = self.registry.find(ref)
-                    ends.append(hit if key is not None else None)
+                ends = joint_ends(self.registry, local, ns, j)
                 if None in ends:
                     self._warn("runner-joint-body", f"{j.identifier}: parent or child body not found; skipped", j)
                     continue

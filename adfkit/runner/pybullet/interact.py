@@ -58,6 +58,7 @@ class SimSensor:
     starts: np.ndarray
     ends: np.ndarray
     sensed: list = field(default_factory=list)
+    rays: list = field(default_factory=list)  # per ray: (body hit or None, fraction of the range)
 
 
 class Interaction:
@@ -163,11 +164,14 @@ class Interaction:
         b = (t[:3, :3] @ s.ends.T).T + t[:3, 3]
         hits = pb.rayTestBatch(a.tolist(), b.tolist(), physicsClientId=self.cid)
         lookup = self._lookup
-        s.sensed = []
+        s.sensed, s.rays = [], []
         for h in hits:
             sb = lookup.get((h[0], h[1]))
-            if sb is not None and sb is not s.parent and sb not in s.sensed:
+            if sb is s.parent:
+                sb = None
+            if sb is not None and sb not in s.sensed:
                 s.sensed.append(sb)
+            s.rays.append((sb, float(h[2]) if sb is not None else 1.0))
 
     def actuate(self, actuator: SimActuator, target: SimBody) -> None:
         """Fix ``target`` to the actuator's parent at their current relative pose.

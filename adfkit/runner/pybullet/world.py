@@ -104,6 +104,13 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         pb.setJointMotorControl2(art.uid, index, pb.VELOCITY_CONTROL, force=0.0, physicsClientId=self.cid)
         pb.setJointMotorControl2(art.uid, index, pb.TORQUE_CONTROL, force=effort, physicsClientId=self.cid)
 
+    def set_body_velocity(self, sb, linear, angular) -> bool:
+        """Set a free body's (or a multibody base's) COM velocity, world frame; False for a link."""
+        if sb.link >= 0:
+            return False
+        pb.resetBaseVelocity(sb.uid, list(linear), list(angular), physicsClientId=self.cid)
+        return True
+
     def control(self) -> None:
         """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors.
         PyBullet's calls take their arguments by position here (this runs every control step)."""
