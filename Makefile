@@ -27,7 +27,7 @@ for name, pinned in pins:
 endef
 export LOCK_DRIFT
 
-.PHONY: run test test-all test-latest bench lock docs lint clean ambf parity
+.PHONY: run test test-all test-latest bench lock docs lint clean ambf parity ros
 
 $(UV):
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -94,6 +94,17 @@ ambf: $(STAMP)
 
 parity: ambf
 	ADFKIT_AMBF="$(AMBF_CACHE)/ambf" $(PY) -m pytest -q -m '' tests/test_parity*.py
+
+# ROS 1 from Debian's packages for `adfkit ros` and its tests (adfkit/ros/env.py names them): installed
+# where this runs as root with apt, else the command to run is printed. Without them the ROS
+# tests skip and nothing else changes.
+ros: $(STAMP)
+	@debs="$$($(PY) -c 'from adfkit.ros.env import DEBIAN_PACKAGES; print(*DEBIAN_PACKAGES)')"; \
+	if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$debs; \
+	else \
+		echo "ROS 1 for adfkit ros: run as root: apt-get install $$debs"; exit 1; \
+	fi
 
 bench: $(STAMP)
 	@for b in bench/*.py; do echo "== $$b"; $(PY) $$b || exit 1; done

@@ -188,3 +188,22 @@ def test_a_back_end_method_is_not_shadowed_by_the_core(module, name):
                 assert getattr(cls, attr) is value, (
                     f"{name}.{attr} is {getattr(cls, attr).__qualname__}, not {half.__name__}'s"
                 )
+
+
+def test_only_the_ros_front_end_imports_rospy():
+    """ROS stays at the edge: rospy (and the messages generated for it) are imported under
+    adfkit/ros only, and only the `adfkit ros` command imports that package."""
+    import re
+
+    pattern = re.compile(
+        r"^\s*(import|from)\s+(rospy|rosgraph|genpy|ambf_msgs|std_msgs|sensor_msgs|geometry_msgs)\b", re.M
+    )
+    outside = sorted(
+        str(f.relative_to(ROOT))
+        for f in (ROOT / "adfkit").rglob("*.py")
+        if "ros" not in f.relative_to(ROOT / "adfkit").parts[:1] and pattern.search(f.read_text(encoding="utf-8"))
+    )
+    assert outside == []
+    edges = _edges(_modules("adfkit"))
+    users = sorted({m for m, ts in edges.items() if not _in(m, "adfkit.ros") for t in ts if _in(t, "adfkit.ros")})
+    assert users == ["adfkit.commands.ros"]
