@@ -41,6 +41,11 @@ def add_arguments(p) -> None:
     p.add_argument("--record", action="store_true", help="write the dataset (RGB, depth, segmentation, poses)")
     p.add_argument("--every", type=int, default=10, help="with --record: a frame every N control steps")
     p.add_argument(
+        "--format",
+        choices=("dataset", "rosbag"),
+        help="with --record: a dataset folder (default) or a ROS 1 bag, OUT/episode.bag (images, depth, joints, TF)",
+    )
+    p.add_argument(
         "--episodes",
         type=int,
         default=1,
@@ -78,6 +83,9 @@ def run(args) -> int:
     pairs = _pairs(args.pairs)
     if args.every < 1:
         raise AdfError(error("bad-option", "--every must be ≥ 1", None, "e.g. --every 10"))
+    if args.format and not args.record:
+        raise AdfError(error("bad-option", "--format says how --record writes", None, "add --record"))
+    record = (args.format or "dataset") if args.record else False
     if args.scene:
         from .. import inputs
 
@@ -125,7 +133,7 @@ def run(args) -> int:
             args.workers or 2,
             args.address,
             out,
-            args.record,
+            record,
             args.every,
             engine=args.engine,
         )
@@ -146,7 +154,7 @@ def run(args) -> int:
         pairs,
         args.seed,
         out,
-        args.record,
+        record,
         args.gui,
         progress=True,
         every=args.every,

@@ -39,6 +39,7 @@ def _poses(task) -> dict:
     for name, psm in task.psms.items():
         out[name] = {
             "T_world_ee": (psm.base_in_world() @ psm.measured_cp()).tolist(),
+            "T_world_base": psm.base_in_world().tolist(),
             "jp": [float(v) for v in psm.measured_jp()],
             "jaw": psm.measured_jaw(),
         }
@@ -77,18 +78,23 @@ def play_task(
     world,
     task,
     out: Path | None = None,
-    record: bool = False,
+    record: bool | str = False,
     every: int = 10,
     gif: bool = True,
     progress: bool = True,
     render_process: bool = True,
 ) -> tuple[dict, SutureObserver, list]:
     """Drive ``task`` on ``world`` to its end (or failure); returns (metrics, observer, GIF frames).
+    ``record``: True or "dataset" for the dataset folder, "rosbag" for a ROS 1 bag.
     ``render_process``: camera L's frames drawn in a process of their own where the world
     allows it (runner.engines.camera_recording), else between the steps."""
     obs = SutureObserver(task)
     writer = None
-    if record and out is not None:
+    if record == "rosbag" and out is not None:
+        from ..dataset.rosbag import RosbagWriter
+
+        writer = RosbagWriter(world, Path(out) / "episode.bag")
+    elif record and out is not None:
         from ..dataset.writer import DatasetWriter
 
         writer = DatasetWriter(world, Path(out) / "dataset")
@@ -154,7 +160,9 @@ def play_task(
         }
     if rec is not None and rec.note:
         metrics["pictures_note"] = rec.note
-    if writer is not None:
+    if writer is not None and record == "rosbag":
+        metrics["rosbag"] = {"file": "episode.bag", "frames": writer.frames, "every_control_steps": every}
+    elif writer is not None:
         metrics["dataset"] = {"dir": "dataset", "frames": writer.frames, "every_control_steps": every}
     return metrics, obs, (rec.gif if rec is not None else [])
 
