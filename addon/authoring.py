@@ -162,6 +162,29 @@ def fit_collision_primitive(obj, shape: str = "CAPSULE", replace: bool = True):
     return made
 
 
+def fit_all(scene, shape: str = "AUTO") -> tuple[list, list[str]]:
+    """*Fit collision primitives* for every body with a mesh (AMBF's add-on: "estimate collision
+    shapes"): each body's one primitive is fitted again in its own shape (``AUTO``; a box where
+    it has none), or every body gets ``shape``. A body whose collision is a compound of
+    primitives or a set of collision meshes (convex hulls) is left as the modeller made it.
+    Returns (the primitives made, ["name: why not"])."""
+    done, skipped = [], []
+    for o in sorted((o for o in scene.objects if o.adf.kind == "BODY" and o.type == "MESH"), key=lambda o: o.name):
+        prims = [c for c in o.children if c.adf.kind == "COLLISION_SHAPE"]
+        if any(c.adf.kind == "COLLISION_MESH" for c in o.children):
+            skipped.append(f"{o.name}: its collision is a set of collision meshes")
+            continue
+        if len(prims) > 1:
+            skipped.append(f"{o.name}: its collision is a compound of {len(prims)} primitives")
+            continue
+        kind = shape if shape != "AUTO" else (prims[0].adf.shape.shape if prims else "BOX")
+        try:
+            done.append(fit_collision_primitive(o, kind))
+        except AdfError as exc:
+            skipped.append(f"{o.name}: {exc.diagnostics[0].message}")
+    return done, skipped
+
+
 def _cone_from_cylinder(entry, mesh):
     """A cone on the cylinder's axis and extent, its base at the end where the mesh is wider
     (Bullet's cone: apex at +height/2 along its axis)."""

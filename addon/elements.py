@@ -7,7 +7,7 @@ from __future__ import annotations
 import bpy
 from mathutils import Matrix
 
-from . import exact
+from . import exact, lowres
 from .precision import FLOAT32_DIGITS, rounded, typed
 
 
@@ -38,7 +38,8 @@ def mesh_volume(obj, evaluated: bool = False) -> tuple[float, bool]:
     bm = bmesh.new()
     try:
         if evaluated and len(obj.modifiers):
-            bm.from_object(obj, bpy.context.evaluated_depsgraph_get())
+            with lowres.shown([obj], False):  # the visual mesh: low-res modifiers make the collision
+                bm.from_object(obj, bpy.context.evaluated_depsgraph_get())
         else:
             bm.from_mesh(obj.data)
         closed = len(bm.faces) > 0 and all(e.is_manifold for e in bm.edges)

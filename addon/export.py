@@ -12,7 +12,7 @@ from pathlib import Path
 
 from adfkit.adf import dumps, read_file
 from adfkit.adf.writer import atomic_write_text
-from adfkit.diagnostics import Diagnostic, Severity, error
+from adfkit.diagnostics import Diagnostic, Severity, error, warning
 from adfkit.geometry.volume_slices import find_slice_files
 from adfkit.model import ModelFile
 
@@ -61,7 +61,22 @@ def _model_level(scene) -> tuple[ModelFile, dict]:
     return doc, snap.get("order", {})
 
 
-def _mesh_paths(doc: ModelFile) -> tuple[str, str]:
+def _mesh_paths(doc: ModelFile, folder: str = "", out_dir: Path | None = None) -> tuple[str, str]:
+    """The high- and low-res folders the model names, relative to its file: ``folder``'s
+    high_res/ and low_res/ when the scene names a meshes folder (relative to the model file's
+    folder, or absolute, or Blender's // for the .blend's folder), else the imported file's
+    folders while they stay inside the output folder, else meshes/high_res/ and meshes/low_res/."""
+    if folder:
+        if folder.startswith("//"):
+            import bpy
+
+            folder = bpy.path.abspath(folder)
+        base = Path(folder)
+        if base.is_absolute() and out_dir is not None:
+            base = Path(os.path.relpath(base, out_dir.resolve()))
+        rel = "" if base.as_posix() in (".", "") else base.as_posix().rstrip("/") + "/"
+        doc.high_resolution_path, doc.low_resolution_path = rel + "high_res/", rel + "low_res/"
+        return doc.high_resolution_path, doc.low_resolution_path
     out = []
     for attr, default in (("high_resolution_path", gather.MESH_DIRS[0]), ("low_resolution_path", gather.MESH_DIRS[1])):
         p = getattr(doc, attr)
@@ -86,9 +101,9 @@ def _ordered(objs, order: list[str]):
     return out + sorted((o for o in objs if o.identifier not in done), key=lambda o: o.identifier)
 
 
-def gather_model(scene, objects=None, mesh_format: str | None = None) -> gather.Gathered:
+def gather_model(scene, objects=None, mesh_format: str | None = None, out_dir: Path | None = None) -> gather.Gathered:
     doc, order = _model_level(scene)
-    hi, lo = _mesh_paths(doc)
+    hi, lo = _mesh_paths(doc, scene.adf.meshes_path, out_dir)
     sp = scene.adf
     fmt = (mesh_format or sp.mesh_format).upper()
     out = gather.Gathered(
@@ -209,15 +224,17 @@ def export_scene(
     written; meshes imported and left unchanged are copied in their own format."""
     out_dir = Path(out_dir)
     target = out_dir / f"{name}.yaml"
-    g = gather_model(scene, objects, mesh_format)
+    g = gather_model(scene, objects, mesh_format, out_dir)
     result = ExportResult(None, list(g.diagnostics))
+    sp = scene.adf  # the meshes the switches skip are named, not written: AMBF reads the ones there
+    jobs = [j for j in g.jobs if (sp.save_low_res if j.low else sp.save_high_res)]
     if any(d.severity >= Severity.ERROR for d in result.diagnostics):
         return result
     source = json.loads(scene.adf.snapshot).get("source_dir") if scene.adf.snapshot else None
     copies = rebase_paths(g.model, Path(source), out_dir) if source else []
     copies += rebase_authored(g.model, objects if objects is not None else scene.objects, out_dir)
     text = dumps(g.model)
-    pending = {out_dir / j.directory / j.filename for j in g.jobs}
+    pending = {out_dir / j.directory / j.filename for j in jobs}
     # the folder exists while the text is validated (paths through it, such as ../x, resolve);
     # a folder made for a refused export is taken away again
     made = next((p for p in reversed([out_dir, *out_dir.parents]) if not p.exists()), None)
@@ -236,7 +253,7 @@ def export_scene(
             shutil.rmtree(made, ignore_errors=True)
         return result
     result.written.extend(copied)
-    _run_jobs(g.jobs, out_dir, result)
+    _run_jobs(jobs, out_dir, result, textures=sp.save_textures)
     atomic_write_text(target, text)
     result.path = target
     result.written.append(target)
@@ -299,9 +316,9 @@ def rebase_authored(model: ModelFile, objs, out_dir: Path) -> list[tuple[Path, P
     return copies
 
 
-def _run_jobs(jobs, out_dir: Path, result: ExportResult) -> None:
-    """Write the meshes, each file only if its bytes change, and record every mesh file's
-    content hash (sha-256 of its bytes) in HASH_FILE."""
+def _run_jobs(jobs, out_dir: Path, result: ExportResult, textures: bool = True) -> None:
+    """Write the meshes (with their textures unless ``textures`` is off), each file only if its
+    bytes change, and record every mesh file's content hash (sha-256 of its bytes) in HASH_FILE."""
     hashes_path = out_dir / HASH_FILE
     try:
         known = json.loads(hashes_path.read_text()) if hashes_path.is_file() else {}
@@ -316,9 +333,11 @@ def _run_jobs(jobs, out_dir: Path, result: ExportResult) -> None:
             files = meshes.source_files(job.source, job.filename)
         else:
             files = meshes.mesh_files(job.parts, job.filename, split=not job.whole)
+        if not textures:
+            files = _without_textures(files, dst, result)
         done = meshes.write_files(dst.parent, files)
         for path, (digest, written) in done.items():
-            now[path.relative_to(out_dir).as_posix()] = digest
+            now[os.path.relpath(path, out_dir).replace(os.sep, "/")] = digest
             if written:
                 result.written.append(path)
         if not done[dst][1]:
@@ -331,3 +350,22 @@ def _run_jobs(jobs, out_dir: Path, result: ExportResult) -> None:
                 now[rel] = digest
     if jobs:
         atomic_write_text(hashes_path, json.dumps(now, indent=1, sort_keys=True))
+
+
+def _without_textures(files: dict, dst: Path, result: ExportResult) -> dict:
+    """The files of a mesh but its images ('Textures' off): an image the MTL names that is not
+    in the folder already is a warning, since AMBF will not find it."""
+    keep = {}
+    for name, content in files.items():
+        if name == dst.name or Path(name).suffix.lower() in (".mtl", *meshes.MESH_SUFFIXES_LOWER):
+            keep[name] = content
+        elif not (dst.parent / name).is_file():
+            result.diagnostics.append(
+                warning(
+                    "texture-not-saved",
+                    f"texture {name} of {dst.name} is not written ('Textures' is off) and is not in {dst.parent}",
+                    None,
+                    "tick 'Textures' in the Export options, or put the image there",
+                )
+            )
+    return keep

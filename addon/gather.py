@@ -19,7 +19,7 @@ from adfkit.model.common import Geometry, ShapeEntry
 from adfkit.model.objects import Ray, SoftBody
 from adfkit.model.pose import Quat, Vec3
 
-from . import exact, fields, joint_frames, meshes, meshformat
+from . import exact, fields, joint_frames, lowres, meshes, meshformat
 from .properties import read_group
 
 MESH_DIRS = ("meshes/high_res/", "meshes/low_res/")
@@ -33,6 +33,7 @@ class MeshJob:
     parts: list | None = None  # MeshArrays to write, or None to copy ``source``
     source: Path | None = None
     whole: bool = False  # a soft body's mesh: never split into several 3DS objects (its node numbering)
+    low: bool = False  # a low-resolution (collision) mesh, not a visual one
 
 
 @dataclass
@@ -244,10 +245,10 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
         )
         src = Path(obj.adf.collision_source) if obj.adf.collision_source else None
         if digest == obj.adf.collision_hash and src is not None and src.is_file():
-            out.jobs.append(MeshJob(lo, name, digest, source=src))
+            out.jobs.append(MeshJob(lo, name, digest, source=src, low=True))
         else:
             name = meshes.with_format(name, fmt)
-            out.jobs.append(MeshJob(lo, name, digest, parts=arrays))
+            out.jobs.append(MeshJob(lo, name, digest, parts=arrays, low=True))
             if b.collision_mesh_type is None:
                 b.collision_mesh_type = "CONVEX_HULL" if len(arrays) > 1 else None
         if name != b.mesh or b.collision_mesh is not None:
@@ -256,15 +257,20 @@ def _gather_collision(obj, b, out: Gathered, lo: str, visual: MeshJob | None, fi
     if visual is not None and not (b.collision_shape or b.compound_collision_shape):
         # no collision of its own: AMBF looks the visual file name up in the low-res folder
         name = b.collision_mesh or visual.filename
-        ratio = out.options.low_res_ratio
-        if ratio < 1.0 and obj.type == "MESH" and b.collision_mesh is None and not isinstance(b, SoftBody):
-            low = meshes.decimated_arrays(obj, ratio)
+        low = None
+        if obj.type == "MESH" and b.collision_mesh is None and not isinstance(b, SoftBody):
+            if lowres.modifiers(obj):  # the modeller's low-res modifiers make it
+                low = meshes.mesh_arrays(obj, evaluated=True, low_res=True)
+                low.uv, low.materials, low.material_index = None, [], None
+            elif out.options.low_res_ratio < 1.0:
+                low = meshes.decimated_arrays(obj, out.options.low_res_ratio)
+        if low is not None:
             if name != meshes.with_format(name, out.options.mesh_format):
                 name = meshes.with_format(name, out.options.mesh_format)
                 b.collision_mesh = name
-            out.jobs.append(MeshJob(lo, name, meshes.digest([low]), parts=[low]))
+            out.jobs.append(MeshJob(lo, name, meshes.digest([low]), parts=[low], low=True))
             return
-        out.jobs.append(MeshJob(lo, name, visual.digest, parts=visual.parts, source=visual.source))
+        out.jobs.append(MeshJob(lo, name, visual.digest, parts=visual.parts, source=visual.source, low=True))
 
 
 # --- joints --------------------------------------------------------------------------------
@@ -329,10 +335,11 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
     j.child = _parent_ref(j.child, c)
     if not obj.adf.snapshot:  # authored here: say what AMBF would do with what it lacks
         out.diagnostics += joint_findings(obj, j, c)
-    keep = unchanged(obj) and unchanged(p) and unchanged(c) and j.parent_pivot is not None
+    axis = obj.adf.joint.axis
+    keep = unchanged(obj) and unchanged(p) and unchanged(c) and j.parent_pivot is not None and axis == "DEFAULT"
     if not keep:
         d = joint_frames.derive(
-            j.type, world_pose(p), world_pose(c), world_pose(obj), uniform_scale(p), uniform_scale(c)
+            j.type, world_pose(p), world_pose(c), joint_frame(obj, j.type), uniform_scale(p), uniform_scale(c)
         )
         for k, v in d.items():
             if k in ("offset", "joint_offset") and v == 0.0 and getattr(j, k) is None:
@@ -341,6 +348,20 @@ def gather_joint(obj, out: Gathered) -> Joint | None:
         if j.child_offset is not None and j.offset is None:
             j.child_offset = None
     return j
+
+
+def joint_frame(obj, joint_type: str | None) -> Pose:
+    """The joint frame of a joint's Empty, turned so that the axis chosen in its panel (X, Y
+    or Z of the Empty) is the reference axis of its type (adf-format §8.1: z, x for prismatic)."""
+    from adfkit.model.semantics import JointKind, joint_kind, reference_axis, shortest_arc
+
+    frame = world_pose(obj)
+    axis = obj.adf.joint.axis
+    if axis == "DEFAULT":
+        return frame
+    chosen = Vec3(*(1.0 if a == axis else 0.0 for a in "XYZ"))
+    turn = shortest_arc(reference_axis(joint_kind(joint_type) or JointKind.REVOLUTE), chosen)
+    return Pose(frame.position, (frame.orientation * turn).normalized())
 
 
 def joint_findings(obj, j: Joint, child) -> list[Diagnostic]:

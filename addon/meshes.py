@@ -37,18 +37,22 @@ class MaterialInfo:
     normal_map: str | None = None
 
 
-def mesh_arrays(obj, name: str | None = None, evaluated: bool = False) -> MeshArrays:
+def mesh_arrays(obj, name: str | None = None, evaluated: bool = False, low_res: bool = False) -> MeshArrays:
     """Arrays of an object's mesh in its frame: its own data, or with ``evaluated`` the mesh
-    its modifiers make (Blender's depsgraph), as the viewport shows it."""
+    its modifiers make (Blender's depsgraph): the visual one, or with ``low_res`` the one its
+    low-res modifiers make too (addon/lowres.py), whether the viewport shows them or not."""
     if evaluated and len(obj.modifiers):
         import bpy
 
-        eo = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-        me = eo.to_mesh()
-        try:
-            return _arrays(obj, me, name)
-        finally:
-            eo.to_mesh_clear()
+        from .lowres import shown
+
+        with shown([obj], low_res):
+            eo = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+            me = eo.to_mesh()
+            try:
+                return _arrays(obj, me, name)
+            finally:
+                eo.to_mesh_clear()
     return _arrays(obj, obj.data, name)
 
 
@@ -220,6 +224,7 @@ def write_obj(parts: list[MeshArrays], directory: Path, filename: str) -> list[P
 
 
 MESH_SUFFIXES = (".OBJ", ".STL", ".PLY", ".3DS", ".DAE", ".OFF", ".GLB", ".GLTF", ".FBX")
+MESH_SUFFIXES_LOWER = tuple(s.lower() for s in MESH_SUFFIXES)
 
 
 def with_format(name: str, fmt: str) -> str:

@@ -212,27 +212,39 @@ class ADF_OT_show_joints(bpy.types.Operator):
         return {"FINISHED"}
 
 
+_SELECTED_ONLY = {
+    "name": "Selected only",
+    "default": False,
+    "description": "the selected objects (off: the whole scene)",
+}
+
+
 class ADF_OT_show_collision(bpy.types.Operator):
     bl_idname = "adf.show_collision"
     bl_label = "Show/hide collision shapes"
+    bl_description = "Show or hide the collision shapes and meshes of every body (or of the selected ones)"
     show: BoolProperty(name="Show", default=False)
+    selected_only: BoolProperty(**_SELECTED_ONLY)
 
     def execute(self, context):
         from .tuning import show_collision
 
-        self.report({"INFO"}, f"{show_collision(context.scene, self.show)} collision objects")
+        objs = list(context.selected_objects) if self.selected_only else None
+        self.report({"INFO"}, f"{show_collision(context.scene, self.show, objs)} collision objects")
         return {"FINISHED"}
 
 
 class ADF_OT_rename_joints(bpy.types.Operator):
     bl_idname = "adf.rename_joints"
     bl_label = "Name joints after their bodies"
-    bl_description = "Rename every joint 'parent-child' from its constraint's bodies"
+    bl_description = "Rename every joint (or the selected ones) 'parent-child' from its constraint's bodies"
+    selected_only: BoolProperty(**_SELECTED_ONLY)
 
     def execute(self, context):
         from .tuning import rename_joints
 
-        self.report({"INFO"}, f"{len(rename_joints(context.scene))} joints named")
+        objs = list(context.selected_objects) if self.selected_only else None
+        self.report({"INFO"}, f"{len(rename_joints(context.scene, objs))} joints named")
         return {"FINISHED"}
 
 

@@ -149,7 +149,25 @@ SoftProps = _make_group(
     {"mass": (_mass_typed, None)},
 )
 GhostProps = _make_group("AdfGhostProps", fields.GHOST)
-JointProps = _make_group("AdfJointProps", fields.JOINT, None, {k: _joint_limits for k in _LIMIT_PROPS})
+JOINT_AXES = (
+    ("DEFAULT", "Type's own", "the Empty's Z for hinges and springs, X for prismatic joints (AMBF's reference axis)"),
+    ("X", "X", "the Empty's X axis"),
+    ("Y", "Y", "the Empty's Y axis"),
+    ("Z", "Z", "the Empty's Z axis"),
+)
+JointProps = _make_group(
+    "AdfJointProps",
+    fields.JOINT,
+    {
+        "axis": EnumProperty(
+            name="Axis",
+            items=JOINT_AXES,
+            default="DEFAULT",
+            description="which axis of the joint's Empty the joint turns about or slides along",
+        )
+    },
+    {k: _joint_limits for k in _LIMIT_PROPS},
+)
 SensorProps = _make_group("AdfSensorProps", fields.SENSOR, {"rays": CollectionProperty(type=AdfRay)})
 ActuatorProps = _make_group("AdfActuatorProps", fields.ACTUATOR)
 CameraProps = _make_group("AdfCameraProps", fields.CAMERA)
@@ -234,6 +252,26 @@ class AdfSceneProps(bpy.types.PropertyGroup):
         items=MESH_FORMATS,
         default="OBJ",
         description="file format of the meshes export writes (meshes imported and left unchanged are copied as they are)",
+    )
+    meshes_path: StringProperty(
+        name="Meshes folder",
+        subtype="DIR_PATH",
+        default="",
+        description="folder of the high_res/ and low_res/ mesh folders: relative to the model file's folder, "
+        "or absolute (empty: meshes/ beside the model file)",
+    )
+    save_high_res: BoolProperty(
+        name="High res",
+        default=True,
+        description="write the visual (high-res) meshes; off: the model still names them, the files there are kept",
+    )
+    save_low_res: BoolProperty(
+        name="Low res",
+        default=True,
+        description="write the collision (low-res) meshes; off: the model still names them, the files there are kept",
+    )
+    save_textures: BoolProperty(
+        name="Textures", default=True, description="copy the images the meshes' materials use beside them"
     )
     low_res_ratio: FloatProperty(
         name="Low-res ratio",

@@ -68,12 +68,14 @@ def load_about(scene, joint, axis_local=(0.0, 0.0, 1.0), linear: bool = False) -
 
 def load_about_joint(scene, joint) -> float:
     """What the joint moves: for a prismatic joint (or linear spring) the subtree's mass (kg);
-    otherwise its inertia about the joint axis (kg·m²), :func:`load_about`."""
+    otherwise its inertia about the joint axis (the axis chosen in its panel, else Z) in kg·m²,
+    :func:`load_about`."""
     from adfkit.model.semantics import JointKind, joint_kind
 
     p = joint.adf.joint
     kind = joint_kind(p.type) if p.use_type else JointKind.REVOLUTE
-    return load_about(scene, joint, linear=kind in (JointKind.PRISMATIC, JointKind.LINEAR_SPRING))
+    axis = tuple(1.0 if a == p.axis else 0.0 for a in "XYZ") if p.axis != "DEFAULT" else (0.0, 0.0, 1.0)
+    return load_about(scene, joint, axis, linear=kind in (JointKind.PRISMATIC, JointKind.LINEAR_SPRING))
 
 
 def estimate_gains(scene, joints, frequency_hz: float = 2.0, damping_ratio: float = 1.0) -> dict:
@@ -155,21 +157,28 @@ def _passive(joint_obj) -> bool:
     return bool(getattr(j, "use_passive", False) and getattr(j, "passive", False))
 
 
-def show_collision(scene, show: bool) -> int:
-    """Hide or show every collision shape and collision mesh of every body and ghost."""
-    n = 0
-    for o in scene.objects:
-        if o.adf.kind in ("COLLISION_SHAPE", "COLLISION_MESH"):
-            o.hide_set(not show)
-            n += 1
-    return n
+COLLISION = ("COLLISION_SHAPE", "COLLISION_MESH")
 
 
-def rename_joints(scene) -> list[str]:
-    """Name every joint after its bodies, 'parent-child' (AMBF's add-on convention), keeping
-    names unique; returns the new names."""
+def show_collision(scene, show: bool, objects=None) -> int:
+    """Hide or show the collision shapes and collision meshes of every body and ghost, or of
+    ``objects`` only (bodies: their collision children; collision objects: themselves)."""
+    if objects is None:
+        targets = [o for o in scene.objects if o.adf.kind in COLLISION]
+    else:
+        targets = [o for o in objects if o.adf.kind in COLLISION]
+        targets += [c for o in objects for c in o.children if c.adf.kind in COLLISION and c not in targets]
+    for o in targets:
+        o.hide_set(not show)
+    return len(targets)
+
+
+def rename_joints(scene, objects=None) -> list[str]:
+    """Name every joint (or the joints among ``objects``) after its bodies, 'parent-child'
+    (AMBF's add-on convention), keeping names unique; returns the new names."""
     done = []
-    for o in sorted((o for o in scene.objects if o.adf.kind == "JOINT"), key=lambda o: o.name):
+    pool = scene.objects if objects is None else objects
+    for o in sorted((o for o in pool if o.adf.kind == "JOINT"), key=lambda o: o.name):
         rbc = o.rigid_body_constraint
         if rbc is None or rbc.object1 is None or rbc.object2 is None:
             continue

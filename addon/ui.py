@@ -98,9 +98,16 @@ def draw_object(layout, obj) -> None:
         col.operator("adf.generate_collision")
         col.operator_menu_enum("adf.fit_collision_primitive", "shape")
         col.operator_menu_enum("adf.add_collision_primitive", "shape")
+        row = col.row(align=True)
+        row.operator("adf.show_collision", text="Show its collision").selected_only = True
+        op = row.operator("adf.show_collision", text="Hide its collision")
+        op.show, op.selected_only = False, True
         col.operator("adf.add_grasp")
     if adf.kind == "JOINT":
-        layout.operator("adf.estimate_gains", text="Estimate gains of the selected joints").selected_only = True
+        layout.prop(pg, "axis")
+        col = layout.column(align=True)
+        col.operator("adf.estimate_gains", text="Estimate gains of the selected joints").selected_only = True
+        col.operator("adf.rename_joints", text="Name the selected joints after their bodies").selected_only = True
         rbc = obj.rigid_body_constraint
         if rbc is None or rbc.object1 is None or rbc.object2 is None:
             external = [e for e in str(obj.get("adf_external_ends", "")).split(",") if e]
@@ -166,8 +173,17 @@ class ADF_PT_sidebar(bpy.types.Panel):
         box.prop(sc, "apply_modifiers")
         box.prop(sc, "low_res_ratio")
         box.prop(sc, "mesh_format")
+        box.prop(sc, "meshes_path")
+        row = box.row(align=True)
+        for key in ("save_high_res", "save_low_res", "save_textures"):
+            row.prop(sc, key, toggle=True)
+        row = box.row(align=True)
+        row.operator("adf.add_low_res_modifiers", text="Low-res modifiers")
+        row.operator("adf.toggle_low_res_modifiers", text="Show/hide")
+        row.operator("adf.remove_low_res_modifiers", text="Remove")
         col = lay.column(align=True)
         col.operator("adf.estimate_all")
+        col.operator_menu_enum("adf.fit_all_collision", "shape")
         col.operator("adf.estimate_gains")
         row = col.row(align=True)
         row.operator("adf.show_joints", text="Show joints").show = True

@@ -221,3 +221,177 @@ def test_a_new_spring_joint_holds_its_child_and_check_says_when_it_cannot(addon,
     (d,) = [d for d in addon.export.check_scene(scene) if d.rule == "spring-joint-defaults"]
     assert "no limits or stiffness" in d.message and "'Arm0'" in d.message
     assert drop(tmp_path / "defaults") > 0.02
+
+
+# --- what AMBF's own add-on offered ---------------------------------------------------------
+
+
+def _textured_ball(tmp: Path, name="Ball"):
+    """A UV sphere (482 vertices) with a base-colour image texture."""
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.03)
+    o = bpy.context.active_object
+    o.name = o.data.name = name
+    img = bpy.data.images.new(f"{name}_skin", 4, 4)
+    img.filepath_raw = str(tmp / f"{name}_skin.png")
+    img.file_format = "PNG"
+    img.save()
+    mat = bpy.data.materials.new(f"{name}Mat")
+    mat.use_nodes = True
+    bsdf = next(n for n in mat.node_tree.nodes if n.type == "BSDF_PRINCIPLED")
+    tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    mat.node_tree.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+    o.data.materials.append(mat)
+    return o
+
+
+def test_meshes_folder_apart_from_the_model_file(addon, scene, tmp_path):
+    """A meshes folder of the scene's own: relative to the model file's folder, or absolute
+    (written relative); the model names it, the meshes are there, the validator is content."""
+    from adfkit.adf import visual_mesh_path
+    from adfkit.validator import validate_file
+
+    ball = cube("Link")
+    addon.authoring.mark(ball, "BODY")
+    for folder, want in (("../assets/meshes", "../assets/meshes/"), (str(tmp_path / "shared"), "../shared/")):
+        scene.adf.meshes_path = folder
+        res = _export(addon, scene, tmp_path / "model")
+        doc, _ = read_file(res.path)
+        assert (doc.high_resolution_path, doc.low_resolution_path) == (want + "high_res/", want + "low_res/")
+        assert visual_mesh_path(doc, doc.bodies[0]).is_file()
+        assert (tmp_path / "model" / want / "low_res" / "Link.OBJ").is_file()
+        assert [d for d in validate_file(res.path).diagnostics if d.severity >= Severity.WARNING] == []
+    assert not (tmp_path / "model" / "meshes").exists()  # nothing in the default folder
+
+
+def test_switches_skip_high_res_low_res_and_textures(addon, scene, tmp_path):
+    """High res / Low res / Textures off: the model still names the files, the ones already
+    there are kept as they are, nothing else is written; a texture that is not there is said."""
+    ball = _textured_ball(tmp_path)
+    addon.authoring.mark(ball, "BODY")
+    out = tmp_path / "out"
+    _export(addon, scene, out)
+    hi, lo = out / "meshes/high_res/Ball.OBJ", out / "meshes/low_res/Ball.OBJ"
+    before = {p: p.read_bytes() for p in (hi, lo)}
+    ball.data.vertices[0].co.x += 0.01  # an edit both files would take
+    scene.adf.save_high_res = False
+    res = _export(addon, scene, out)
+    assert hi.read_bytes() == before[hi] and lo.read_bytes() != before[lo]
+    assert "meshes/high_res/Ball.OBJ" not in {p.relative_to(out).as_posix() for p in res.written}
+    scene.adf.save_high_res, scene.adf.save_low_res = True, False
+    lo_now = lo.read_bytes()
+    _export(addon, scene, out)
+    assert hi.read_bytes() != before[hi] and lo.read_bytes() == lo_now
+    # textures off: a fresh folder gets the meshes and the MTL, not the image, and says so
+    scene.adf.save_low_res, scene.adf.save_textures = True, False
+    res = _export(addon, scene, tmp_path / "fresh")
+    assert (tmp_path / "fresh/meshes/high_res/Ball.mtl").is_file()
+    assert not (tmp_path / "fresh/meshes/high_res/Ball_skin.png").exists()
+    said = [d for d in res.diagnostics if "Ball_skin.png" in d.message]  # beside both copies of the mesh
+    assert {d.rule for d in said} == {"texture-not-saved"} and any("high_res" in d.message for d in said)
+    res = _export(addon, scene, out)  # where the image already is: nothing to say
+    assert (out / "meshes/high_res/Ball_skin.png").is_file()
+    assert [d for d in res.diagnostics if d.rule == "texture-not-saved"] == []
+
+
+def test_the_constraint_axis_chosen_per_joint(addon, scene, tmp_path):
+    """A hinge whose Empty's X is the axis (AMBF's add-on: Axis X): exported, the joint turns
+    about that direction; with the type's own axis about the Empty's Z."""
+    from mathutils import Matrix
+
+    from adfkit.model.semantics import joint_frames
+
+    base, (arm,) = _base_and_arms(addon, 1)
+    frame = Matrix.Translation((0.1, 0.0, 0.0)) @ Matrix.Rotation(math.radians(30), 4, "Z")
+    joint = addon.authoring.add_joint(base, arm, "revolute", frame, "J")
+    x_axis = (math.cos(math.radians(30)), math.sin(math.radians(30)), 0.0)
+    for axis, want in (("X", x_axis), ("DEFAULT", (0.0, 0.0, 1.0)), ("Y", (-x_axis[1], x_axis[0], 0.0))):
+        joint.adf.joint.axis = axis
+        doc, _ = read_file(_export(addon, scene, tmp_path / axis).path)
+        (j,) = doc.joints
+        assert tuple(j.parent_axis) == pytest.approx(want, abs=1e-6)  # the base sits at the origin
+        fa, fb = joint_frames(j)
+        wa, wb = doc.body("BODY Base").location * fa, doc.body("BODY Arm0").location * fb
+        assert (wa.position - wb.position).norm() < 1e-7 and wa.orientation.angle_to(wb.orientation) < 1e-6
+
+
+def test_show_collision_and_rename_per_object(addon, scene):
+    a, b = cube("A"), cube("B", location=(0.2, 0, 0))
+    for o in (a, b):
+        addon.authoring.mark(o, "BODY")
+        addon.authoring.add_collision_primitive(o, "BOX")
+    c = cube("C", location=(0.4, 0, 0))
+    addon.authoring.mark(c, "BODY")
+    _select(a)
+    assert bpy.ops.adf.show_collision(show=False, selected_only=True) == {"FINISHED"}
+    assert [o.name for o in scene.objects if o.adf.kind == "COLLISION_SHAPE" and o.hide_get()] == ["A.box"]
+    j1 = addon.authoring.add_joint(a, b, "fixed", name="first")
+    j2 = addon.authoring.add_joint(b, c, "fixed", name="second")
+    _select(j2)
+    assert bpy.ops.adf.rename_joints(selected_only=True) == {"FINISHED"}
+    assert (j1.name, j2.name) == ("first", "B-C")
+    assert bpy.ops.adf.rename_joints() == {"FINISHED"} and j1.name == "A-B"
+
+
+def test_fit_collision_primitives_for_all_bodies_in_one_click(addon, scene):
+    """Each body's own primitive is fitted again in its shape, a body without one gets a box;
+    a compound, a set of convex hulls and a flat mesh are left as they are, each with why."""
+    a = addon.authoring
+    ball = cube("Ball", 0.04)
+    a.mark(ball, "BODY")
+    a.add_collision_primitive(ball, "SPHERE", radius=0.5)  # far too big: refitted
+    plain = cube("Plain", 0.06, (0.2, 0, 0))
+    a.mark(plain, "BODY")
+    compound = cube("Compound", 0.04, (0.4, 0, 0))
+    a.mark(compound, "BODY")
+    for _ in range(2):
+        a.add_collision_primitive(compound, "BOX")
+    hulls = cube("Hulls", 0.04, (0.6, 0, 0))
+    a.mark(hulls, "BODY")
+    a.generate_collision(hulls, max_hulls=1)
+    flat = _pad(None)
+    flat.location = (0.8, 0, 0)
+    a.mark(flat, "BODY")
+    assert bpy.ops.adf.fit_all_collision() == {"FINISHED"}
+    shapes = {o.parent.name: o.adf.shape for o in scene.objects if o.adf.kind == "COLLISION_SHAPE"}
+    assert shapes["Ball"].shape == "SPHERE" and shapes["Ball"].radius == pytest.approx(0.02 * math.sqrt(3), rel=1e-6)
+    assert shapes["Plain"].shape == "BOX" and tuple(shapes["Plain"].size) == pytest.approx((0.06,) * 3, rel=1e-6)
+    said = scene.adf.findings
+    assert "Compound: its collision is a compound of 2 primitives" in said
+    assert "Hulls: its collision is a set of collision meshes" in said and "Pad: " in said and "flat" in said
+    assert bpy.ops.adf.fit_all_collision(shape="CAPSULE") == {"FINISHED"}
+    assert shapes_of(scene)["Ball"] == "CAPSULE" and shapes_of(scene)["Plain"] == "CAPSULE"
+
+
+def shapes_of(scene) -> dict:
+    return {o.parent.name: o.adf.shape.shape for o in scene.objects if o.adf.kind == "COLLISION_SHAPE"}
+
+
+def test_low_res_modifiers_make_the_collision_mesh_only(addon, scene, tmp_path):
+    """Low-res modifiers (a Decimate on each body mesh over the limit) make the low-res copy of
+    the visual mesh, shown or hidden in the viewport; the visual mesh and the geometry tools
+    leave them out; removing them removes only them (a Solidify stays)."""
+    ball = _textured_ball(tmp_path)
+    addon.authoring.mark(ball, "BODY")
+    mass = ball.adf.body.mass
+    small = cube("Small", 0.04, (0.2, 0, 0))  # 8 vertices: under the limit, left alone
+    addon.authoring.mark(small, "BODY")
+    small.modifiers.new("Solidify", "SOLIDIFY")
+    assert bpy.ops.adf.add_low_res_modifiers(max_vertices=100) == {"FINISHED"}
+    assert [m.name for m in ball.modifiers] == ["ADF low-res"] and [m.name for m in small.modifiers] == ["Solidify"]
+
+    def counts(out):
+        _export(addon, scene, out)
+        return [(out / f"meshes/{d}/Ball.OBJ").read_text().count("\nv ") for d in ("high_res", "low_res")]
+
+    hi, lo = counts(tmp_path / "on")
+    assert hi == len(ball.data.vertices) == 482 and 60 < lo <= 110
+    addon.authoring.mark(ball, "BODY")
+    assert ball.adf.body.mass == pytest.approx(mass, rel=1e-9)  # measured on the visual mesh
+    assert bpy.ops.adf.toggle_low_res_modifiers() == {"FINISHED"}
+    assert not ball.modifiers["ADF low-res"].show_viewport
+    assert counts(tmp_path / "hidden") == [hi, lo]
+    assert ball.modifiers["ADF low-res"].show_viewport is False  # export left the toggle as it was
+    assert bpy.ops.adf.remove_low_res_modifiers() == {"FINISHED"}
+    assert list(ball.modifiers) == [] and [m.name for m in small.modifiers] == ["Solidify"]
+    assert counts(tmp_path / "off") == [hi, hi]
