@@ -395,3 +395,56 @@ def test_low_res_modifiers_make_the_collision_mesh_only(addon, scene, tmp_path):
     assert bpy.ops.adf.remove_low_res_modifiers() == {"FINISHED"}
     assert list(ball.modifiers) == [] and [m.name for m in small.modifiers] == ["Solidify"]
     assert counts(tmp_path / "off") == [hi, hi]
+
+
+# --- scripting: docs/blender.md names every operator id and enum value ----------------------
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "blender.md"
+
+
+def test_the_docs_name_every_operator_and_its_enum_values(addon):
+    """The Scripting section's table names every registered bpy.ops.adf operator (and no
+    other), and in its row every value of each of its enum arguments; the object and scene
+    enums are named too."""
+    import re
+
+    text = DOCS.read_text()
+    registered = set(dir(bpy.ops.adf))
+    assert set(re.findall(r"bpy\.ops\.adf\.(\w+)", text)) == registered
+    rows = {m.group(1): m.group(0) for m in re.finditer(r"^\| `bpy\.ops\.adf\.(\w+)\(.*$", text, re.M)}
+    assert set(rows) == registered
+    for name in registered:
+        for p in getattr(bpy.ops.adf, name).get_rna_type().properties:
+            if p.type == "ENUM":
+                missing = [i.identifier for i in p.enum_items if f"`{i.identifier}`" not in rows[name]]
+                assert missing == [], (name, p.identifier, missing)
+    props = bpy.types.Object.bl_rna.properties["adf"].fixed_type.properties
+    for enum in (
+        props["kind"],
+        bpy.types.Scene.bl_rna.properties["adf"].fixed_type.properties["mesh_format"],
+        props["joint"].fixed_type.properties["axis"],
+        props["shape"].fixed_type.properties["shape"],
+    ):
+        assert [i.identifier for i in enum.enum_items if f"`{i.identifier}`" not in text] == []
+
+
+def test_the_docs_install_and_example_are_what_runs(addon, scene, tmp_path, monkeypatch):
+    """The headless install the docs show is the call tests/bundled_child.py makes; the docs'
+    example script runs as written: a 64 g link on a static base, its hinge with gains."""
+    import re
+
+    text = DOCS.read_text()
+    child = (Path(__file__).resolve().parent / "bundled_child.py").read_text()
+    call = re.search(r"package_install_files\((.*?)\)", text, re.S).group(1)
+    assert (
+        re.sub(r"filepath=[^,]*, ", "", " ".join(call.split())).strip() == 'repo="user_default", enable_on_install=True'
+    )
+    assert 'repo="user_default", enable_on_install=True' in child
+    example = text[text.index("A link on a static base") :]
+    code = example[example.index("```python\n") + 10 : example.index("```\n", example.index("```python"))]
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, str(DOCS), "exec"), {})
+    doc, _ = read_file(tmp_path / "out" / "link.yaml")
+    (joint,) = doc.joints
+    assert joint.type == "revolute" and joint.controller.P > 0
+    assert doc.body("BODY Cube").mass == 0.064 and doc.body("BODY Cube.001").mass == 0.0
