@@ -169,7 +169,7 @@ def read_lights(m, d, names: dict[int, str], world_pose: dict[int, Pose], losses
 
 
 def write_cameras_lights(
-    model, tree, elements: dict[int, ET.Element], world: ET.Element, used: dict, losses: list[Loss]
+    model, tree, elements: dict[int, ET.Element], world: ET.Element, used: dict, losses: list[Loss], lights: bool = True
 ) -> None:
     """Each ADF camera and light of ``model`` into the MJCF body of its parent (``elements``:
     link id → body element), or into ``world`` without a parent."""
@@ -179,7 +179,7 @@ def write_cameras_lights(
         placed = _parent_frame(model, tree, cam, elements, world, losses, "camera")
         if placed is not None:
             _write_camera(cam, *placed, used, losses)
-    for light in model.lights:
+    for light in model.lights if lights else []:
         placed = _parent_frame(model, tree, light, elements, world, losses, "light")
         if placed is not None:
             _write_light(light, *placed, used, losses)

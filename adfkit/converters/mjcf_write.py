@@ -373,6 +373,7 @@ def to_mjcf(
     names_out: dict | None = None,
     volumes: bool = True,
     leave_out: frozenset[str] = frozenset(),
+    lights: bool = True,
 ) -> tuple[str, list[Loss]]:
     """MJCF text and losses. ``tree_kinds``: joint kinds that join the tree (default revolute,
     prismatic, fixed); a link joined by another kind is written welded to its parent, for the
@@ -381,7 +382,8 @@ def to_mjcf(
     ``volumes``: write each volume as its iso-surface mesh (volume_mesh.py); False leaves them
     out, for a caller that places them itself (the MuJoCo runner). ``leave_out``: identifiers of
     bodies not written, with the joints that name them (bodies AMBF does not create: the MuJoCo
-    runner's ``plan.uncreated_bodies``)."""
+    runner's ``plan.uncreated_bodies``). ``lights``: False leaves the lights to the caller (the
+    MuJoCo runner places them under parents in other files and under cameras)."""
     losses: list[Loss] = []
     if leave_out:
         kept = [j for j in model.joints if not joint_ends(model, j) & leave_out]
@@ -464,7 +466,7 @@ def to_mjcf(
             losses.append(Loss(j.identifier, "joint", f"no MJCF form for a {kind.value} joint here"))
     if eq is not None:
         root.append(eq)
-    write_cameras_lights(model, tree, elements, world, used, losses)
+    write_cameras_lights(model, tree, elements, world, used, losses, lights)
     write_soft_bodies(model, world, used, losses)
     if volumes:
         write_mjcf_volumes(model, world, assets, name or model.name, used, losses)

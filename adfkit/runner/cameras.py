@@ -56,18 +56,18 @@ class Camera:
 
 
 def _camera(world, cam, ns: str) -> list[Camera]:
-    parent = None
-    if cam.parent:
-        key, hit = world.registry.find(cam.parent)
-        if key is None or hit is None:
-            world._warn("runner-camera", f"{cam.identifier}: parent {cam.parent!r} is not a body; camera skipped", cam)
-            return []
-        parent = hit
+    from .frames import resolve_frame
+
     loc = np.array(cam.location or (0, 0, 0), float)
     look = np.array(cam.look_at or (0, 0, 0), float)
     up = np.array(cam.up or (0, 0, 1), float)
     if np.allclose(loc, look) or np.linalg.norm(np.cross(look - loc, up)) < 1e-12:
         world._warn("runner-camera", f"{cam.identifier}: look at equals location or up is parallel to the view", cam)
+    # a parent body, or a parent camera (AMBF's stereoL under main_camera): the view in the
+    # frame of the body at the root of its parents (None: the world)
+    parent, t = resolve_frame(world, cam.parent, ns, cam)
+    r, p = t[:3, :3], t[:3, 3]
+    loc, look, up = r @ loc + p, r @ look + p, r @ up
     clip = cam.clipping_plane
     near = clip.near if clip is not None and clip.near is not None else DEFAULT_CAMERA_NEAR
     far = clip.far if clip is not None and clip.far is not None else DEFAULT_CAMERA_FAR

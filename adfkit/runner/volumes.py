@@ -1,12 +1,12 @@
 """ADF volumes as either engine plays them, decided once here: each volume's iso-surface
 (:mod:`adfkit.geometry.volume`, marching cubes) as a static body at the volume's location, in
-its colour, with a label of its own in the segmentation. The back ends only turn a
-:class:`VolumeSurface` into their engine's mesh body.
+its colour, with a label of its own in the segmentation. A volume with a ``parent`` (a body,
+or a camera: runner.frames, as AMBF follows it) is placed in the frame of the body at the root
+of its parents. The back ends only turn a :class:`VolumeSurface` into their engine's mesh body.
 
 What of a volume is not played is listed in ``world.not_played``, never dropped: its
-``shaders`` (the runner draws the iso-surface, not AMBF's ray-marched volume), a ``parent``
-(the volume stays where its location puts it), a volume whose slices cannot be read or whose
-iso-surface is empty (the reason, located)."""
+``shaders`` (the runner draws the iso-surface, not AMBF's ray-marched volume), a volume whose
+slices cannot be read or whose iso-surface is empty (the reason, located)."""
 
 from __future__ import annotations
 
@@ -30,7 +30,8 @@ class VolumeSurface:
     volume: object  # the ADF Volume
     model: object  # its ModelFile
     body: Body  # a static stand-in body (mass 0, the volume's location) for the world's tables
-    pose: np.ndarray  # 4x4 volume frame in the world
+    parent: object  # the engine's body at the root of the volume's parents, or None (the world)
+    location: np.ndarray  # 4x4 volume frame in the parent's ADF body frame (or the world)
     dimensions: np.ndarray  # (3,) metres: the voxel box
     vertices: np.ndarray  # (n, 3) float32, metres in the volume's frame
     faces: np.ndarray  # (m, 3) uint32
@@ -64,21 +65,15 @@ def not_played_parts(vol) -> list[dict]:
                 "why": "the runner draws the iso-surface as a mesh, not AMBF's ray-marched volume",
             }
         )
-    if vol.parent:
-        out.append(
-            {
-                "object": vol.identifier,
-                "what": "parent",
-                "why": f"not followed: the volume stays where its location puts it (parent {vol.parent!r})",
-            }
-        )
     return out
 
 
-def volume_surfaces(world, models) -> list[VolumeSurface]:
-    """Every defined volume of ``models`` that can be played, as its iso-surface; the others are
-    warned about (``runner-volume``) and listed in ``world.not_played``."""
+def volume_surfaces(world, models, body_type=None) -> list[VolumeSurface]:
+    """Every defined volume of ``models`` that can be played, as its iso-surface, its parent
+    resolved among the engine's bodies of ``body_type``; the others are warned about
+    (``runner-volume``) and listed in ``world.not_played``."""
     from ..geometry.volume import DEFAULT_ISO, iso_surface, load_volume
+    from .frames import resolve_frame
 
     out = []
     for m in models:
@@ -118,6 +113,7 @@ def volume_surfaces(world, models) -> list[VolumeSurface]:
                 source=vol.source,
             )
             key = merge_namespace(ns, vol.namespace) + vol.identifier
+            parent, frame = resolve_frame(world, vol.parent, ns, vol, body_type)
             report = {
                 "object": vol.identifier,
                 "key": key,
@@ -133,7 +129,8 @@ def volume_surfaces(world, models) -> list[VolumeSurface]:
                     vol,
                     m,
                     body,
-                    pose_to_matrix(pose_or_identity(vol.location)),
+                    parent,
+                    frame @ pose_to_matrix(pose_or_identity(vol.location)),
                     data.dimensions,
                     np.asarray(verts, dtype=np.float32),
                     np.asarray(faces, dtype=np.uint32),

@@ -175,7 +175,14 @@ def build_plan(world) -> Plan:
         if len(uncreated) < len(m.bodies):
             names: dict = {}
             text, ls = to_mjcf(
-                m, out_dir, f"m{i}", tree_kinds=TREE_KINDS, names_out=names, volumes=False, leave_out=uncreated
+                m,
+                out_dir,
+                f"m{i}",
+                tree_kinds=TREE_KINDS,
+                names_out=names,
+                volumes=False,
+                leave_out=uncreated,
+                lights=False,
             )
             losses += ls
             warn_losses(world, m, ls)
@@ -243,7 +250,7 @@ def build_plan(world) -> Plan:
                     f"{j.identifier}: a {kind.value} joint closing a loop is not played by the MuJoCo engine; skipped",
                     j,
                 )
-    _world_lights(world, spec)
+    _lights(world, spec)
     collision_filters(world, spec, bodies, joints, plans_by_model)
     apply_textures(world, spec, bodies)
     ghosts, actuators, sensors = [], [], []
@@ -296,11 +303,16 @@ def _volumes(world, spec, models) -> list[tuple]:
     from ...geometry.surface_parts import PART_BLOCK
 
     out = []
-    for i, vs in enumerate(volume_surfaces(world, models)):
+    for i, vs in enumerate(volume_surfaces(world, models, BodyPlan)):
         name = f"adfkit:volume{i}"
         spec.add_mesh(name=name, uservert=vs.vertices.astype(float).ravel(), userface=vs.faces.astype(int).ravel())
-        q = matrix_to_quat(vs.pose[:3, :3])
-        body = spec.worldbody.add_body(name=name, pos=vs.pose[:3, 3], quat=[q[3], q[0], q[1], q[2]])
+        el, frame = spec.worldbody, vs.location
+        if vs.parent is not None:  # a child of the parent's MJCF body, moving with it
+            frame = np.linalg.inv(pose_to_matrix(vs.parent.link.frame_in_body)) @ frame
+            if vs.parent.mjname != "world":
+                el = spec.body(vs.parent.mjname)
+        q = matrix_to_quat(frame[:3, :3])
+        body = el.add_body(name=name, pos=frame[:3, 3], quat=[q[3], q[0], q[1], q[2]])
         body.add_geom(
             type=mujoco.mjtGeom.mjGEOM_MESH,
             meshname=name,
@@ -309,6 +321,7 @@ def _volumes(world, spec, models) -> list[tuple]:
             group=0,
             contype=0,
             conaffinity=0,
+            density=0.0,  # adds no mass to a parent it hangs from
         )
         parts = vs.convex_parts()
         for k, points in enumerate(parts):
@@ -317,6 +330,7 @@ def _volumes(world, spec, models) -> list[tuple]:
                 type=mujoco.mjtGeom.mjGEOM_MESH,
                 meshname=f"{name}:part{k}",
                 group=3,
+                density=0.0,
                 contype=(1 << 31) - 1,
                 conaffinity=(1 << 31) - 1,
             )
@@ -333,23 +347,26 @@ def _volumes(world, spec, models) -> list[tuple]:
     return out
 
 
-def _world_lights(world, spec) -> None:
-    """The world file's spot lights (the writer handles model files' lights), without shadows:
-    a shadow map is a render pass per light per camera."""
+def _lights(world, spec) -> None:
+    """The world's and the model files' spot lights, each in the MJCF body at the root of its
+    parents (a body, through parent cameras: runner.frames), without shadows: a shadow map is
+    a render pass per light per camera."""
     import math
 
     from ...converters.mjcf_cameras import ADF_CUTOFF, ADF_SPOT_EXPONENT
+    from ..frames import resolve_frame
 
     w = world.scene.world
-    for light in w.lights if w is not None else []:
+    placed = [(w.namespace or "", light) for light in (w.lights if w is not None else [])]
+    placed += [(m.namespace or "", light) for m in world.scene.all_models() for light in m.lights]
+    for ns, light in placed:
         el, to_link = spec.worldbody, np.eye(4)
-        if light.parent:
-            parent = resolve_parent(world, light.parent, w.namespace or "", light, BodyPlan)
-            if parent is None:
-                continue
+        parent, t = resolve_frame(world, light.parent, ns, light, BodyPlan)
+        if parent is not None:
             to_link = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body))
             if parent.mjname != "world":
                 el = spec.body(parent.mjname)
+        to_link = to_link @ t
         d = np.array(light.direction if light.direction is not None else (1.0, 0.0, 0.0), float)
         if np.linalg.norm(d) == 0:
             d = np.array([1.0, 0.0, 0.0])

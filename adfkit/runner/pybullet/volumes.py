@@ -36,9 +36,23 @@ def _shapes(world, verts: np.ndarray, faces: np.ndarray, rgba) -> tuple[int, int
 
 def build_volumes(world, models) -> None:
     """Add each model's volumes to ``world`` (a SimWorld) as static iso-surface bodies."""
-    for vs in volume_surfaces(world, models):
+    from .bodies import SimBody
+
+    for vs in volume_surfaces(world, models, SimBody):
         sb = make_sim_body(vs.key, vs.body, vs.model)
-        pos, orn = matrix_to_pq(vs.pose)
+        pose = vs.location if vs.parent is None else vs.parent.world_matrix() @ vs.location
+        if vs.parent is not None and not vs.parent.static:
+            world._warn(
+                "runner-volume",
+                f"{vs.volume.identifier}: placed where its parent {vs.parent.name!r} starts; PyBullet collides "
+                "with a triangle mesh only on a static body, so it does not follow the parent when it moves",
+                vs.volume,
+                "give the parent no mass, or play the scene with --engine mujoco",
+            )
+            world.not_played.append(
+                {"object": vs.volume.identifier, "what": "moving parent", "why": "PyBullet: a static triangle mesh"}
+            )
+        pos, orn = matrix_to_pq(pose)
         pieces = split_surface(vs.vertices, vs.faces, PYBULLET_MAX_VERTICES, PYBULLET_MAX_FACES)
         shapes = [_shapes(world, v, f, vs.rgba) for v, f in pieces]
         k = len(shapes) - 1
@@ -65,10 +79,11 @@ def build_volumes(world, models) -> None:
         for link in (-1, *sb.piece_links):
             pb.setCollisionFilterGroupMask(sb.uid, link, ALL_GROUPS, ALL_GROUPS, physicsClientId=world.cid)
         sb.ref_in_body = np.eye(4)
-        sb.body_world_matrix = vs.pose
+        sb.body_world_matrix = pose
         sb._parts = None  # no ADF collision parts: the iso-surface mesh is its collision
         vs.solid = None  # (what MuJoCo makes its convex parts of)
         sb.surface = vs.surface  # what a viewer draws of it (its own frame)
+        sb.key = world.registry.add(vs.key, sb)  # world.body("VOLUME ...") finds it, as in MuJoCo
         world.bodies.append(sb)
         vs.report["pieces"] = len(pieces)
         world.volumes.append(vs.report)

@@ -1,0 +1,94 @@
+"""Parents as AMBF follows them, for the objects the runner places relative to one (cameras,
+lights, volumes): an object's pose is its parent's times its own ``location``
+(``afBaseObject::updateGlobalPose``), and a parent may be a body or a camera, which may have a
+parent of its own (the drilling projects' ``stereoL``, ``stereoR`` and ``light1`` hang from
+``main_camera``). AMBF finds a parent by its qualified name, else by a unique part of one
+(``resolveObjectsMissingParents``); one it cannot find leaves the object where its own
+location puts it, in the world.
+
+A camera's own frame is the one ``afCamera::setView`` makes from location, look at and up:
+x from the point looked at towards the eye, z along up made orthogonal, y = z × x.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .names import merge_namespace
+
+MAX_DEPTH = 16  # parents deeper than this (or in a loop) are not followed
+
+
+def camera_frame(cam) -> np.ndarray:
+    """4×4 of an ADF camera in its parent's frame, as AMBF's setView makes it."""
+    eye = np.array(cam.location or (0.0, 0.0, 0.0), float)
+    look = np.array(cam.look_at or (0.0, 0.0, 0.0), float)
+    up = np.array(cam.up or (0.0, 0.0, 1.0), float)
+    t = np.eye(4)
+    t[:3, 3] = eye
+    x = eye - look
+    if np.linalg.norm(x) < 1e-12 or np.linalg.norm(np.cross(up, x)) < 1e-12:
+        return t  # AMBF leaves such a view unset (warned about where the camera is built)
+    x /= np.linalg.norm(x)
+    y = np.cross(up, x)
+    y /= np.linalg.norm(y)
+    t[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
+    return t
+
+
+def scene_cameras(scene) -> list[tuple[str, str, object]]:
+    """(qualified key, namespace, camera) of every camera of the world and the model files."""
+    out = []
+    w = scene.world
+    for ns, cams in [(w.namespace or "", w.cameras)] if w is not None else []:
+        out += [(merge_namespace(ns, c.namespace) + c.identifier, ns, c) for c in cams]
+    for m in scene.all_models():
+        ns = m.namespace or ""
+        out += [(merge_namespace(ns, c.namespace) + c.identifier, ns, c) for c in m.cameras]
+    return out
+
+
+def _camera(scene, ref: str, ns: str):
+    cams = scene_cameras(scene)
+    for want in (ref, ns + ref):
+        exact = [c for c in cams if c[0] == want]
+        if exact:
+            return exact[0]
+    named = [c for c in cams if ref in (c[2].identifier, c[2].name)]
+    if len(named) == 1:
+        return named[0]
+    part = [c for c in cams if ref in c[0]]
+    return part[0] if len(part) == 1 else None
+
+
+def resolve_frame(world, ref: str | None, ns: str, obj, body_type=None):
+    """(root body or None, 4×4 of the parent's frame in the root body's ADF frame, or in the
+    world when the root is None) for ``obj``'s parent ``ref``, through parent cameras. A parent
+    that is not found is a ``runner-parent`` warning, and the object stays in the world frame
+    (``None, identity``), as AMBF leaves it."""
+    t = np.eye(4)
+    seen: list[str] = []
+    while ref:
+        key, hit = world.registry.find(ref)
+        if key is None:
+            key, hit = world.registry.find(ns + ref)
+        if key is not None and hit is not None and (body_type is None or isinstance(hit, body_type)):
+            return hit, t
+        cam = _camera(world.scene, ref, ns)
+        if cam is None or cam[0] in seen or len(seen) >= MAX_DEPTH:
+            why = "a loop of parents" if cam is not None else "not found"
+            world._warn(
+                "runner-parent",
+                f"{obj.identifier}: parent {ref!r} {why}; placed where its own location puts it in the world",
+                obj,
+                "name a body or a camera of the scene",
+            )
+            return None, t
+        key, ns, c = cam
+        seen.append(key)
+        t = camera_frame(c) @ t
+        ref = c.parent
+    return None, t
+
+
+__all__ = ["camera_frame", "resolve_frame", "scene_cameras"]
