@@ -32,8 +32,8 @@ def main() -> int:
 
     from adfkit.geometry.voxels_edit import BlockSurface, EditableVolume
     from adfkit.scenes.drilling import DrillingParams, bone_voxels
-    from adfkit.tasks.drill_inputs import label_array
-    from adfkit.tasks.drilling import DrillTask
+    from adfkit.tasks.drilling.inputs import label_array
+    from adfkit.tasks.drilling.task import DrillTask
 
     p = DrillingParams(voxels=args.voxels)
     t0 = time.perf_counter()

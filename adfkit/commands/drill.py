@@ -98,10 +98,10 @@ def run(args) -> int:
     from ..diagnostics import Severity, warning
     from ..geometry.voxels_edit import BlockSurface
     from ..report import Progress, print_diagnostics
-    from ..tasks import drill_output as outp
-    from ..tasks.drill_inputs import read_path_file
-    from ..tasks.drill_setup import default_path, editable, prepare
-    from ..tasks.drilling import DrillParams, DrillTask
+    from ..tasks.drilling import output as outp
+    from ..tasks.drilling.inputs import read_path_file
+    from ..tasks.drilling.prepare import default_path, editable, prepare
+    from ..tasks.drilling.task import DrillParams, DrillTask
 
     _check_options(args)
     launch = _scene(args)

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..adf import atomic_write_bytes, atomic_write_text, write_file
-from ..model import ModelFile
-from ..model.objects import VolumeImages
+from ...adf import atomic_write_bytes, atomic_write_text, write_file
+from ...model import ModelFile
+from ...model.objects import VolumeImages
 
 PALETTE = [
     (236, 226, 198),  # first tissue (bone)

@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import inputs
-from ..adf.volume_labels import parse_labels
-from ..diagnostics import AdfError, SourceLocation, error
+from ... import inputs
+from ...adf.volume_labels import parse_labels
+from ...diagnostics import AdfError, SourceLocation, error
 
 MAX_WAYPOINTS = 100_000
 MAX_COORD = 10.0  # m: a drill path further than this from the origin is a unit mistake

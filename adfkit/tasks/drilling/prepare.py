@@ -8,10 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..adf.paths import relative_to_file
-from ..diagnostics import AdfError, error
-from ..geometry.voxels_edit import EditableVolume
-from .drill_inputs import default_labels, label_array, read_labels
+from ...adf.paths import relative_to_file
+from ...diagnostics import AdfError, error
+from ...geometry.voxels_edit import EditableVolume
+from .inputs import default_labels, label_array, read_labels
 
 
 @dataclass
@@ -30,8 +30,8 @@ class DrillScene:
 
 
 def _pose(p) -> np.ndarray:
-    from ..model.semantics import pose_or_identity
-    from ..runner.rotations import pose_to_matrix
+    from ...model.semantics import pose_or_identity
+    from ...runner.rotations import pose_to_matrix
 
     return pose_to_matrix(pose_or_identity(p))
 
@@ -82,7 +82,7 @@ def find_burr(scene, name: str | None):
 
 
 def prepare(scene, volume_name: str | None = None, burr_name: str | None = None, protect=()) -> DrillScene:
-    from ..geometry.volume import DEFAULT_ISO, load_volume
+    from ...geometry.volume import DEFAULT_ISO, load_volume
 
     model, vol = find_volume(scene, volume_name)
     body, radius = find_burr(scene, burr_name)
@@ -123,7 +123,7 @@ def prepare(scene, volume_name: str | None = None, burr_name: str | None = None,
 
 
 def editable(ds: DrillScene) -> EditableVolume:
-    from ..geometry.volume import DEFAULT_ISO
+    from ...geometry.volume import DEFAULT_ISO
 
     iso = ds.volume.iso_surface_value if ds.volume.iso_surface_value is not None else DEFAULT_ISO
     vals = ds.data.voxels

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.voxels_edit import BlockSurface, EditableVolume
+from ...geometry.voxels_edit import BlockSurface, EditableVolume
 
 
 @dataclass
