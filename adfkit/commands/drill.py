@@ -20,10 +20,20 @@ BUNDLED = ROOT / "sample_scenes" / "drilling" / "launch.yaml"
 
 def add_arguments(p) -> None:
     p.add_argument("scene", nargs="?", help="launch file or folder (default: the bundled sample_scenes/drilling)")
+    p.add_argument("-l", "--indices", help="launch file: multibody configs to load, as AMBF's -l (e.g. 0,1 or 0-2)")
     p.add_argument("--path", help="tool path file: one waypoint `x y z` (metres, world frame) per line")
     p.add_argument("--out", default="drill-output", help="output folder (default drill-output)")
-    p.add_argument("--volume", help="which volume (default: the scene's only one)")
-    p.add_argument("--burr", help="the burr's body (default: the sphere body named *burr*)")
+    p.add_argument(
+        "--volume",
+        help="which volume: its index (0: the first loaded), its model file (FILE or FILE:NAME) or its name "
+        "(default: the scene's only one)",
+    )
+    p.add_argument(
+        "--burr", help="the burr's body: a sphere, or a drill mesh whose tip is the burr (default: the body named *burr*)"
+    )
+    p.add_argument(
+        "--burr-radius", type=float, help="m: drill with a sphere of this radius (at a mesh drill's tip: its end)"
+    )
     p.add_argument(
         "--protect", action="append", default=[], metavar="TISSUE", help="a tissue the burr must not touch (repeat)"
     )
@@ -54,6 +64,9 @@ def _check_options(args) -> None:
         raise _bad(f"--removal-rate {args.removal_rate} is out of range", "0 (no removal) to 10000 per second")
     if not 1 <= args.frames <= 500:
         raise _bad(f"--frames {args.frames} is out of range", "1 to 500")
+    r = args.burr_radius
+    if r is not None and (not math.isfinite(r) or not 1e-5 <= r <= 0.1):
+        raise _bad(f"--burr-radius {r} is out of range", "a radius in metres, 0.00001 to 0.1 (e.g. 0.003 for 6 mm)")
 
 
 def _scene(args):
@@ -94,7 +107,7 @@ def run(args) -> int:
 
     import numpy as np
 
-    from ..adf import load_scene
+    from ..adf import load_scene, parse_indices
     from ..diagnostics import Severity, warning
     from ..geometry.voxels_edit import BlockSurface
     from ..report import Progress, print_diagnostics
@@ -107,11 +120,11 @@ def run(args) -> int:
     launch = _scene(args)
     waypoints = read_path_file(args.path) if args.path else None
     diags: list = []
-    scene = load_scene(launch, None, diags)
+    scene = load_scene(launch, parse_indices(args.indices), diags)
     if any(d.severity >= Severity.ERROR for d in diags):
         print_diagnostics(diags, sys.stderr)
         return 2
-    ds = prepare(scene, args.volume, args.burr, args.protect)
+    ds = prepare(scene, args.volume, args.burr, args.protect, args.burr_radius)
     out = Path(args.out)
     _check_out(out, ds.data.files)
     vol = editable(ds)
@@ -149,7 +162,12 @@ def run(args) -> int:
     metrics = {
         "scene": str(launch),
         "volume": ds.volume.identifier,
-        "burr": {"body": ds.burr_name, "radius_m": ds.burr_radius, "start_m": ds.burr_start.tolist()},
+        "burr": {
+            "body": ds.burr_name,
+            "sphere": ds.burr_how,
+            "radius_m": ds.burr_radius,
+            "start_m": ds.burr_start.tolist(),
+        },
         "path_m": task.points.tolist(),
         "labels": {n: list(r) if np.isfinite(r[1]) else [r[0], None] for n, r in zip(names[1:], ds.label_ranges)},
         "labels_file": ds.labels_file,
@@ -179,7 +197,7 @@ def run(args) -> int:
     }
     prefix = ds.volume.images.prefix
     try:
-        outp.write_slices(vol.values, ds.data.full_scale, out / "slices", prefix)
+        outp.write_slices(ds.data.files, vol.removed_mask, out / "slices", prefix)
         outp.write_volume_model(ds.volume, ds.model, vol.values.shape[0], prefix, out / "volume.yaml")
         outp.write_surface(verts, faces, out / "surface.stl")
         outp.write_metrics(metrics, out / "metrics.json")
@@ -209,6 +227,7 @@ def run(args) -> int:
     print_diagnostics(warns, sys.stderr)
     counts = ", ".join(f"{n} {c}" for n, c in removed.items())
     print(
+        f"burr: {ds.burr_name}, {ds.burr_how}, radius {ds.burr_radius * 1000:.3g} mm\n"
         f"drilled {ds.volume.identifier} for {st.t:.2f} s: {metrics['voxels_removed_total']} voxels removed "
         f"({counts}); peak force {metrics['force']['max_n']:.2f} N; wrote {out}/"
     )

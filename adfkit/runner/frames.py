@@ -48,16 +48,18 @@ def scene_cameras(scene) -> list[tuple[str, str, object]]:
     return out
 
 
-def _camera(scene, ref: str, ns: str):
-    cams = scene_cameras(scene)
+def match(keyed: list[tuple], ref: str, ns: str):
+    """The entry of ``keyed`` ((qualified key, ..., object) tuples) that ``ref`` names as AMBF
+    finds a parent: the qualified key as written or in the namespace ``ns``, else the object's
+    identifier or name, else a unique part of a key; None when none or several match."""
     for want in (ref, ns + ref):
-        exact = [c for c in cams if c[0] == want]
+        exact = [c for c in keyed if c[0] == want]
         if exact:
             return exact[0]
-    named = [c for c in cams if ref in (c[2].identifier, c[2].name)]
+    named = [c for c in keyed if ref in (c[-1].identifier, c[-1].name)]
     if len(named) == 1:
         return named[0]
-    part = [c for c in cams if ref in c[0]]
+    part = [c for c in keyed if ref in c[0]]
     return part[0] if len(part) == 1 else None
 
 
@@ -74,7 +76,7 @@ def resolve_frame(world, ref: str | None, ns: str, obj, body_type=None):
             key, hit = world.registry.find(ns + ref)
         if key is not None and hit is not None and (body_type is None or isinstance(hit, body_type)):
             return hit, t
-        cam = _camera(world.scene, ref, ns)
+        cam = match(scene_cameras(world.scene), ref, ns)
         if cam is None or cam[0] in seen or len(seen) >= MAX_DEPTH:
             why = "a loop of parents" if cam is not None else "not found"
             world._warn(
@@ -91,4 +93,4 @@ def resolve_frame(world, ref: str | None, ns: str, obj, body_type=None):
     return None, t
 
 
-__all__ = ["camera_frame", "resolve_frame", "scene_cameras"]
+__all__ = ["camera_frame", "match", "resolve_frame", "scene_cameras"]

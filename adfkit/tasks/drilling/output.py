@@ -1,7 +1,8 @@
 """What `adfkit drill` writes, every file atomically (beside its target, then renamed):
 
-- ``slices/<prefix><i>.png``: the drilled volume (8-bit slices for 8-bit input, 16-bit
-  otherwise), written as a whole folder that replaces any earlier one only once complete;
+- ``slices/<prefix><i>.png``: the drilled volume: the input slices with every removed voxel
+  set to 0 (grey, 16-bit and RGBA slices keep their kind and colours), written as a whole
+  folder that replaces any earlier one only once complete;
 - ``volume.yaml``: an ADF model file holding the volume, pointing at those slices, so the
   result validates and plays like the input;
 - ``surface.stl``: the iso-surface at the end (the blocks re-meshed as they were drilled);
@@ -36,21 +37,27 @@ REMOVED = (70, 35, 35)
 BURR = (255, 200, 40)
 
 
-def write_slices(values: np.ndarray, full_scale: float, folder: Path, prefix: str) -> list[Path]:
-    """Write (count, rows, cols) values 0..1 as PNG slices into ``folder``, all or nothing."""
+def write_slices(sources: list[Path], removed: np.ndarray, folder: Path, prefix: str) -> list[Path]:
+    """The input slices ``sources`` with the voxels ``removed`` ((slices, rows, columns) bool,
+    row 0 the picture's bottom row, as geometry.volume reads them) set to 0 in every channel, as
+    AMBF's drilling empties a voxel, as PNG slices ``<prefix><i>.png`` (i from 0) into
+    ``folder``, all or nothing: grey, 16-bit and RGBA slices keep their kind and colours."""
     from PIL import Image
 
     folder = Path(folder)
     folder.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
     try:
-        eight = full_scale == 255.0
-        peak = 255.0 if eight else 65535.0
-        data = np.clip(np.rint(values * peak), 0, peak).astype(np.uint8 if eight else np.uint16)
         files = []
-        for i, s in enumerate(data):
+        for i, src in enumerate(sources):
+            with Image.open(src) as img:
+                img.load()
+                if img.mode == "P" or (img.mode not in ("1", "L", "LA", "RGB", "RGBA", "I;16") and img.mode[0] != "I"):
+                    img = img.convert("RGBA")
+                arr = np.array(img)
+            arr[removed[i][::-1]] = 0
             name = f"{prefix}{i}.png"
-            Image.fromarray(np.ascontiguousarray(s[::-1])).save(tmp / name)  # row 0 is the bottom row
+            Image.fromarray(arr).save(tmp / name)  # the mode follows the array: L, LA, RGB, RGBA, I;16
             files.append(folder / name)
         os.chmod(tmp, 0o755)
         old = None

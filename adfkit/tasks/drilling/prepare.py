@@ -1,13 +1,15 @@
-"""From a loaded scene to a drilling task: the volume, the burr (a sphere body of the scene),
-the tissue labels and the tool path."""
+"""From a loaded scene to a drilling task: the volume (chosen by index, file or name), the burr
+(burr.py: a sphere body, or a drill mesh's tip), the tissue labels and the tool path."""
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
+from ... import inputs
 from ...adf.paths import relative_to_file
 from ...diagnostics import AdfError, error
 from ...geometry.voxels_edit import EditableVolume
@@ -27,6 +29,32 @@ class DrillScene:
     label_ranges: list[tuple[float, float]]
     protected: set[str]
     labels_file: str | None
+    burr_how: str = "its sphere shape"  # what the burr's sphere is (burr.Burr.how)
+
+
+def _volume_pose(scene, model, vol) -> np.ndarray:
+    """The volume's frame in the world, its parents followed as AMBF does (a body's location, a
+    camera's setView frame: runner.frames), from where the scene puts them."""
+    from ...runner.frames import camera_frame, match, scene_cameras
+    from ...runner.names import merge_namespace
+
+    bodies = [(merge_namespace(m.namespace or "", b.namespace) + b.identifier, b) for m in scene.models for b in m.bodies]
+    cameras = scene_cameras(scene)
+    t = _pose(vol.location)
+    ref, ns = vol.parent, model.namespace or ""
+    for _ in range(16):
+        if not ref:
+            break
+        body = match(bodies, ref, ns)
+        if body is not None:
+            return _pose(body[-1].location) @ t
+        cam = match(cameras, ref, ns)
+        if cam is None:
+            break  # not found: where its own location puts it, as AMBF leaves it
+        key, ns, c = cam
+        t = camera_frame(c) @ t
+        ref = c.parent
+    return t
 
 
 def _pose(p) -> np.ndarray:
@@ -36,56 +64,65 @@ def _pose(p) -> np.ndarray:
     return pose_to_matrix(pose_or_identity(p))
 
 
-def find_volume(scene, name: str | None):
+def volume_choices(scene) -> list[tuple[int, object, object]]:
+    """(index, model, volume) of every defined volume of the scene, in the order they load."""
     found = [(m, v) for m in scene.models for v in m.volumes if v.defined]
-    if name:
-        found = [(m, v) for m, v in found if name in (v.identifier, v.name, v.identifier.removeprefix("VOLUME "))]
-    if len(found) != 1:
-        names = [v.identifier for m in scene.models for v in m.volumes]
-        raise AdfError(
-            error(
-                "drill-volume",
-                f"the scene has {len(found)} volume(s) matching {name!r}: {names}"
-                if name
-                else f"drilling needs one volume; the scene has {len(found)}: {names}",
-                None,
-                "name one with --volume NAME" if found else "drill a scene with a `volumes` section",
-            )
-        )
-    return found[0]
+    return [(i, m, v) for i, (m, v) in enumerate(found)]
 
 
-def find_burr(scene, name: str | None):
-    """The sphere body the burr is: the one named ``name``, else the sphere body whose name
-    holds 'burr', else the only sphere body."""
-    spheres = []
-    for m in scene.models:
-        for b in m.bodies:
-            shape = (b.collision_shape or b.shape or "").lower()
-            geo = b.collision_geometry if b.collision_shape else b.geometry
-            if shape == "sphere" and geo is not None and geo.radius:
-                spheres.append((b, float(geo.radius) * (b.scale if b.scale is not None else 1.0)))
-    if name:
-        pick = [s for s in spheres if name in (s[0].identifier, s[0].name, s[0].identifier.removeprefix("BODY "))]
+def _listed(choices) -> str:
+    return "; ".join(
+        f"{i}: {v.name or v.identifier} ({inputs.shown(m.path) if m.path else 'no file'})" for i, m, v in choices
+    )
+
+
+def _same_file(model, text: str) -> bool:
+    if model.path is None:
+        return False
+    try:
+        return Path(text).resolve() == Path(model.path).resolve()
+    except (OSError, ValueError):
+        return False
+
+
+def _names(v) -> set:
+    return {v.identifier, v.name, v.identifier.removeprefix("VOLUME ")}
+
+
+def find_volume(scene, choice: str | None):
+    """(model, volume) that ``choice`` names: an index (0 is the first volume loaded), the model
+    file holding it (``FILE``, or ``FILE:NAME`` when the file has several), or its name; none
+    given, the scene's only volume. Anything else is a ``drill-volume`` error listing them."""
+    choices = volume_choices(scene)
+    hint = "choose one with --volume INDEX, --volume NAME or --volume FILE (the model file holding it)"
+    if not choices:
+        raise AdfError(error("drill-volume", "the scene has no volume", None, "drill a scene with a `volumes` section"))
+    if not choice:
+        if len(choices) == 1:
+            return choices[0][1:]
+        raise AdfError(error("drill-volume", f"the scene has {len(choices)} volumes: {_listed(choices)}", None, hint))
+    if choice.isdigit():
+        pick = [c for c in choices if c[0] == int(choice)]
     else:
-        pick = [s for s in spheres if "burr" in (s[0].name or s[0].identifier).lower()] or spheres
+        file, _, name = choice.rpartition(":")
+        if file and any(_same_file(m, file) for _, m, _ in choices):
+            pick = [c for c in choices if _same_file(c[1], file) and name in _names(c[2])]
+        else:
+            pick = [c for c in choices if _same_file(c[1], choice)] or [c for c in choices if choice in _names(c[2])]
     if len(pick) != 1:
-        raise AdfError(
-            error(
-                "drill-burr",
-                f"no single burr: {len(pick)} sphere bodies match ({[s[0].identifier for s in spheres]})",
-                None,
-                "name the burr's body with --burr NAME (a body with a sphere shape)",
-            )
-        )
-    return pick[0]
+        what = f"matches {len(pick)} volumes: {_listed(pick)}" if pick else f"matches none of {_listed(choices)}"
+        raise AdfError(error("drill-volume", f"--volume {choice!r} {what}", None, hint))
+    return pick[0][1:]
 
 
-def prepare(scene, volume_name: str | None = None, burr_name: str | None = None, protect=()) -> DrillScene:
+def prepare(
+    scene, volume_name: str | None = None, burr_name: str | None = None, protect=(), burr_radius: float | None = None
+) -> DrillScene:
     from ...geometry.volume import DEFAULT_ISO, load_volume
+    from .burr import find_burr
 
     model, vol = find_volume(scene, volume_name)
-    body, radius = find_burr(scene, burr_name)
+    burr = find_burr(scene, burr_name, burr_radius)
     data = load_volume(model, vol)
     iso = vol.iso_surface_value if vol.iso_surface_value is not None else DEFAULT_ISO
     labels_path = relative_to_file(model.path, str(vol.images.path)) / "labels.yaml"
@@ -105,20 +142,20 @@ def prepare(scene, volume_name: str | None = None, burr_name: str | None = None,
                 "name a tissue of the volume's labels.yaml, or add it there",
             )
         )
-    pos = body.location.position if body.location else None
-    start = np.array([pos.x, pos.y, pos.z] if pos else [0.0, 0.0, 0.0])
+    start = (_pose(burr.body.location) @ np.append(burr.centre_in_body, 1.0))[:3]
     return DrillScene(
         model,
         vol,
         data,
-        _pose(vol.location),
-        body.identifier,
+        _volume_pose(scene, model, vol),
+        burr.body.identifier,
         start,
-        radius,
+        burr.radius,
         ["unlabelled", *names],
         ranges,
         set(protected) | set(protect),
         labels_file,
+        burr.how,
     )
 
 
@@ -150,4 +187,4 @@ def default_path(ds: DrillScene, vol: EditableVolume, depth: float) -> np.ndarra
     return centre[None, :]
 
 
-__all__ = ["DrillScene", "default_path", "editable", "find_burr", "find_volume", "prepare"]
+__all__ = ["DrillScene", "default_path", "editable", "find_volume", "prepare", "volume_choices"]
