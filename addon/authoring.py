@@ -137,7 +137,7 @@ def _pose_matrix(pose) -> Matrix:
 def fit_collision_primitive(obj, shape: str = "CAPSULE", replace: bool = True):
     """Fit an oriented primitive around the body's mesh (adfkit.geometry.primitives; a cone
     takes the fitted cylinder's axis, base at the wider end) and add it as the body's collision.
-    Its size and offset are kept exactly (:mod:`.exact`), rounded to the scene's Float digits."""
+    Its size and offset, rounded as :func:`estimate_inertia` rounds, are kept exactly (:mod:`.exact`)."""
     prim = geometry("primitives")
     mesh = _trimesh_of(obj)
     kind = shape.upper()
@@ -210,10 +210,10 @@ def _cone_from_cylinder(entry, mesh):
 
 def estimate_inertia(obj, mass: float | None = None, density: float | None = None) -> None:
     """Mass, principal inertia and inertial offset from the body's closed mesh: the mass is
-    kept when given (typed by hand), else density × volume. Computed in float64 and rounded
-    to the scene's Float digits (a symmetric body's centre of mass is 0, its axes its own),
-    kept exactly beside Blender's float32 properties (:mod:`.exact`)."""
-
+    kept when given (typed by hand), else density × volume. Computed in float64 and rounded to
+    the 7 digits float32 coordinates hold, at most the scene's Float digits (a symmetric body's
+    centre of mass is 0, its axes its own); kept exactly beside Blender's float32 properties
+    (:mod:`.exact`)."""
     gmass = geometry("mass")
     mesh = _trimesh_of(obj)
     if not mesh.is_watertight:

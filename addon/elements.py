@@ -23,7 +23,7 @@ def exported_evaluated() -> bool:
 
 
 def digits() -> int:
-    """The scene's *Float digits*: what computed values are rounded to."""
+    """The scene's *Float digits*: the most significant digits a computed value is written with."""
     return int(bpy.context.scene.adf.precision)
 
 
