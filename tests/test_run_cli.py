@@ -54,8 +54,10 @@ def test_run_selects_launch_indices(tmp_path, capsys):
     )
     assert rc == 0
     rep = json.loads((out / "report.json").read_text())
-    # psm1 alone, with the world's floor (its environment model)
-    assert rep["bodies"] == 11 and rep["joints"] == 8 and rep["multibodies"] == 1
+    # psm1 alone: the world's floor (its environment model) has no Plane.OBJ, so AMBF and the
+    # runner leave it out
+    assert rep["bodies"] == 10 and rep["joints"] == 8 and rep["multibodies"] == 1
+    assert rep["skipped_bodies"] == ["/ambf/env/BODY Plane"]
     assert rep["steps"] == 48  # 0.05 s in whole control steps of 4 ms
     # the world's stereo pair hangs from the phantom's CameraFrame, which index 10 would load:
     # as AMBF leaves an object whose parent it cannot find, they stay where their location puts them

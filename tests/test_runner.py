@@ -30,7 +30,10 @@ def suturing():
 def test_suturing_scene_is_complete(suturing):
     scene, world = suturing
     models = scene.all_models()
-    assert len(world.bodies) == sum(len(m.bodies) for m in models) == 75
+    # the floor's Plane.OBJ is not in the corpus (nor in its repository): AMBF leaves the body out
+    # whatever its PLANE collision shape, and so does the runner; 74 bodies, as AMBF makes
+    assert sum(len(m.bodies) for m in models) == 75 and len(world.bodies) == 74
+    assert world.skipped == ["/ambf/env/BODY Plane"]
     assert len(world.joint_names) == sum(len(m.joints) for m in models) == 64
     assert len(world.ghosts) == sum(len(m.ghost_objects) for m in models) == 12
     assert len(world.actuators) == sum(len(m.actuators) for m in models) == 2

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import re
+import shutil
 
 import numpy as np
 import pytest
@@ -149,6 +150,8 @@ def test_a_model_that_is_not_a_psm_is_refused(tmp_path):
     )
     assert bent != text
     (tmp_path / "psm1.yaml").write_text(bent)
+    for res in ("high_res", "low_res"):  # a body whose visual mesh is not there is not made (AMBF)
+        shutil.copytree(CORPUS / PSM1.rsplit("/", 1)[0] / res, tmp_path / res)
     world = open_world(load_scene(tmp_path / "psm1.yaml"), Options(visuals=False, ground=False))
     try:
         with pytest.raises(PSMModelError, match=r"residual"):

@@ -11,12 +11,12 @@ import pytest
 import yaml
 from conftest import corpus_files, corpus_id
 
+from adfkit.adf.yamlcompat import repair
 from adfkit.adf_schema import KINDS, load_schema, schema_file
 from adfkit.model import FILE_KINDS
 from adfkit.model.spec import Node, adf_fields
 from adfkit.validator.engine import validate_file
 from adfkit.validator.schemagen import build_schema, schema_text
-from adfkit.validator.yamlcompat import repair
 
 
 @pytest.mark.parametrize("kind", KINDS)

@@ -7,10 +7,16 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import cast
 
-from ..diagnostics import AdfError, Diagnostic, SourceLocation, error
+from ..diagnostics import AdfError, Diagnostic, SourceLocation, error, warning
 from ..model import Launch, ModelFile, Scene, World
 from .paths import relative_to_file
-from .reader import read_file
+from .yamlcompat import read_as_ambf
+
+
+def read_file(path, kind: str | None = None, *, tree=None, referrer=None):
+    """A file read as AMBF reads it (yaml-cpp's layouts too, adf.yamlcompat): (doc, diagnostics)."""
+    doc, diags, _text, _moved = read_as_ambf(path, kind, tree=tree, referrer=referrer)
+    return doc, diags
 
 
 def parse_indices(text: str | None) -> list[int] | None:
@@ -78,9 +84,22 @@ def load_scene(
                     "pick indices from the multibody configs list",
                 )
             )
-        model, found = read_file(
-            relative_to_file(doc.path, configs[i]), "model", tree=doc.tree, referrer=doc.where("multibody configs")
-        )
+        path = relative_to_file(doc.path, configs[i])
+        try:
+            model, found = read_file(path, "model", tree=doc.tree, referrer=doc.where("multibody configs"))
+        except AdfError as exc:
+            if exc.diagnostics[0].rule != "file-not-found":
+                raise
+            # AMBF says it failed to load the file and loads the others (measured)
+            diags.append(
+                warning(
+                    "missing-model-file",
+                    f"{exc.diagnostics[0].message}; the launch file's other models are loaded, as AMBF does",
+                    doc.where("multibody configs"),
+                    "paths in a launch file are relative to the launch file's directory",
+                )
+            )
+            continue
         diags.extend(found)
         scene.models.append(cast(ModelFile, model))
     return scene

@@ -90,9 +90,19 @@ class Comparison:
 
 
 def angle_deg(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
-    """The rotation between unit quaternions (…, 4), degrees."""
-    dot = np.abs(np.sum(qa * qb, axis=-1))
-    return np.degrees(2 * np.arccos(np.clip(dot, 0.0, 1.0)))
+    """The rotation between quaternions x y z w (…, 4), degrees: 2·atan2(|v|, |w|) of the
+    relative quaternion, well conditioned near 0 (an arccos of the dot product turns AMBF's
+    quaternions, unit to 4e-10, into 0.003° for the same rotation)."""
+    qa = qa / np.linalg.norm(qa, axis=-1, keepdims=True)
+    qb = qb / np.linalg.norm(qb, axis=-1, keepdims=True)
+    xa, ya, za, wa = np.moveaxis(qa, -1, 0)
+    xb, yb, zb, wb = np.moveaxis(qb, -1, 0)
+    # conj(qa) * qb
+    w = wa * wb + xa * xb + ya * yb + za * zb
+    x = wa * xb - xa * wb - ya * zb + za * yb
+    y = wa * yb + xa * zb - ya * wb - za * xb
+    z = wa * zb - xa * yb + ya * xb - za * wb
+    return np.degrees(2 * np.arctan2(np.sqrt(x * x + y * y + z * z), np.abs(w)))
 
 
 def match(names_a: list[str], names_b: list[str], start_a: np.ndarray, start_b: np.ndarray) -> list[tuple[int, int]]:

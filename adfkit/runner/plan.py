@@ -147,14 +147,17 @@ def mesh_refusal(model, path) -> str | None:
 
 def uncreated(model, obj):
     """The located warning (a Diagnostic) when AMBF does not create ``obj`` (a body or ghost),
-    else None: its collision comes from a mesh file (no primitive collision shape) that is
-    missing, refused by the input policy or has no triangles."""
+    else None: its visual `mesh` (without a visual primitive) cannot be loaded, or its collision
+    comes from a mesh file (no primitive collision shape) that is missing, refused by the input
+    policy or has no triangles."""
     from .. import inputs
     from ..adf.paths import collision_mesh_path
     from ..diagnostics import warning
     from ..geometry.meshcheck import mesh_problem
     from ..model.semantics import collision_primitives
 
+    if (why := _visual_refused(model, obj)) is not None:
+        return why
     path = collision_mesh_path(model, obj) if collision_primitives(obj) is None else None
     if path is None:
         return None
@@ -169,6 +172,36 @@ def uncreated(model, obj):
             "re-export the mesh as a triangle mesh (STL or OBJ)",
         )
     return None
+
+
+def _visual_refused(model, obj):
+    """AMBF makes an object's visual first and leaves the object out when its visual `mesh` (no
+    `shape` or `compound shape`) does not load, whatever its collision shape is. Measured in
+    AMBF 2.0: a missing file, an STL without triangles or that is no STL is left out; an OBJ
+    without faces, even an empty one, loads (chai3d's OBJ reader takes it)."""
+    from .. import inputs
+    from ..adf.paths import visual_mesh_path
+    from ..diagnostics import warning
+    from ..geometry.meshcheck import mesh_problem
+
+    if getattr(obj, "shape", None) or getattr(obj, "compound_shape", None):
+        return None
+    path = visual_mesh_path(model, obj)
+    if path is None:
+        return None
+    where = obj.where("mesh") or obj.source
+    if (refused := mesh_refusal(model, path)) is not None:
+        why = refused
+    elif path.suffix.lower() != ".obj" and (problem := mesh_problem(path)) is not None:
+        why = f"{inputs.shown(path.name)}: {problem}"
+    else:
+        return None
+    return warning(
+        "runner-missing-mesh",
+        f"{obj.identifier}: visual mesh {why}; the body is skipped as AMBF does (it makes the visual first)",
+        where,
+        "fix `mesh` or the high resolution path",
+    )
 
 
 def mesh_skipped(obj, refused: str):
@@ -209,12 +242,14 @@ def uncreated_bodies(world, model) -> frozenset[str]:
     return frozenset(out)
 
 
-def resolve_parent(world, ref: str | None, ns: str, obj, body_type=None):
+def resolve_parent(world, ref: str | None, ns: str, obj, body_type=None, known=None):
     """The body ``ref`` names for ``obj`` (a ghost, sensor, actuator), found as written or in the
-    model's namespace; None with a located ``runner-parent`` warning when no unique body matches."""
-    key, hit = world.registry.find(ref)
+    model's namespace among ``known`` (a Registry; default: every body of the world); None with a
+    located ``runner-parent`` warning when no unique body matches."""
+    reg = known if known is not None else world.registry
+    key, hit = reg.find(ref)
     if key is None and ref:
-        key, hit = world.registry.find(ns + ref)
+        key, hit = reg.find(ns + ref)
     if key is None or (body_type is not None and not isinstance(hit, body_type)):
         world._warn(
             "runner-parent",
@@ -272,8 +307,9 @@ class Grasper:
     max_impulse: float
 
 
-def played_sensors(world, m, body_type=None) -> list[SensorRays]:
-    """The model's proximity sensors with rays, parents resolved; the others warned about."""
+def played_sensors(world, m, body_type=None, known=None) -> list[SensorRays]:
+    """The model's proximity sensors with rays, parents resolved among ``known``, the bodies of
+    the models loaded so far (``loaded_so_far``); the others warned about."""
     ns = m.namespace or ""
     out = []
     for s in m.sensors:
@@ -284,7 +320,7 @@ def played_sensors(world, m, body_type=None) -> list[SensorRays]:
                 s,
             )
             continue
-        parent = resolve_parent(world, s.parent, ns, s, body_type)
+        parent = resolve_parent(world, s.parent, ns, s, body_type, known)
         if parent is None:
             continue
         rng = s.range if s.range is not None else DEFAULT_SENSOR_RANGE
@@ -295,20 +331,34 @@ def played_sensors(world, m, body_type=None) -> list[SensorRays]:
     return out
 
 
-def played_actuators(world, m, body_type=None) -> list[Grasper]:
-    """The model's constraint actuators, parents resolved; other types warned about."""
+def played_actuators(world, m, body_type=None, known=None) -> list[Grasper]:
+    """The model's constraint actuators, parents resolved among ``known`` (as sensors); other
+    types warned about."""
     ns = m.namespace or ""
     out = []
     for a in m.actuators:
         if ACTUATOR_TYPES.get(a.type) != "constraint":
             world._warn("runner-actuator", f"{a.identifier}: actuator type {a.type!r} not supported; skipped", a)
             continue
-        parent = resolve_parent(world, a.parent, ns, a, body_type)
+        parent = resolve_parent(world, a.parent, ns, a, body_type, known)
         if parent is None:
             continue
         imp = a.max_impulse if a.max_impulse is not None else DEFAULT_ACTUATOR_MAX_IMPULSE
         out.append(Grasper(key_of(ns, a), a, parent, pose_to_matrix(pose_or_identity(a.location)), imp))
     return out
+
+
+def loaded_so_far(known, bodies) -> object:
+    """``known`` (a Registry, created when None) with ``bodies`` (engine bodies with a ``key``)
+    added: AMBF makes a model's sensors and actuators only on a parent already loaded, its own or
+    an earlier model's (measured: a later model's body is not found; a ghost's parent is, the
+    runner finds it among every body)."""
+    from .names import Registry
+
+    known = known if known is not None else Registry()
+    for b in bodies:
+        known.items[b.key] = b
+    return known
 
 
 def viscous_impulse_force(mass: float, v_rel: np.ndarray, k: float, cdt: float) -> np.ndarray:

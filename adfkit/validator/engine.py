@@ -15,12 +15,11 @@ from pathlib import Path
 from .. import inputs
 from ..adf.reader import read_file
 from ..adf.volume_labels import is_labels_file, parse_labels
+from ..adf.yamlcompat import read_as_ambf
 from ..adf.yamlnodes import read_text
 from ..diagnostics import AdfError, Diagnostic, Severity, SourceLocation
 from ..model import FILE_KINDS, Launch, ModelFile, World
 from . import paths_check, schema_check, semantic
-from .rules import RULES
-from .yamlcompat import repair
 
 KIND_OF = {cls: name for name, cls in FILE_KINDS.items()}
 YAML_SUFFIXES = (".yaml", ".yml")
@@ -40,34 +39,8 @@ class FileResult:
 
 
 def _read_with_compat(path: Path, kind: str | None, text: str, roots: list, tree=None, referrer=None):
-    """read_file, retrying layouts yaml-cpp accepts and PyYAML does not (see yamlcompat)."""
-    try:
-        doc, diags = read_file(path, kind, text=text, root_out=roots, tree=tree, referrer=referrer)
-        return doc, diags, text, []
-    except AdfError as exc:
-        if not exc.diagnostics or exc.diagnostics[0].rule != "yaml-syntax":
-            raise
-        fixed, moved = repair(text)
-        if not moved:
-            raise
-        try:
-            roots.clear()
-            doc, diags = read_file(path, kind, text=fixed, root_out=roots, tree=tree, referrer=referrer)
-        except AdfError as again:
-            if again.diagnostics and again.diagnostics[0].rule == "yaml-syntax":
-                raise exc from None
-            raise
-        first = exc.diagnostics[0]
-        note = Diagnostic(
-            RULES["pyyaml-unparseable"].severity,
-            "pyyaml-unparseable",
-            f"PyYAML cannot parse this file ({first.message.removeprefix('not valid YAML: ')}), "
-            f"but AMBF's yaml-cpp does: a flow collection starts at its key's indentation "
-            f"(line {moved[0]}). Validated after re-indenting it",
-            SourceLocation(str(path), moved[0], 1),
-            "indent the '{' or '[' block under its key so every YAML tool reads the file",
-        )
-        return doc, [note, *diags], fixed, moved
+    """read_file, retrying layouts yaml-cpp accepts and PyYAML does not (adf.yamlcompat)."""
+    return read_as_ambf(path, kind, text=text, root_out=roots, tree=tree, referrer=referrer)
 
 
 def _adjust(d: Diagnostic) -> Diagnostic:

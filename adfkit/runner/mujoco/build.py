@@ -26,7 +26,16 @@ from ...converters.mjcf_write import to_mjcf
 from ...model.semantics import JointKind, ShapeKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
 from .. import plan as scene_rules
-from ..plan import SPRING_KINDS, is_hole, key_of, not_played, played_actuators, played_sensors, resolve_parent
+from ..plan import (
+    SPRING_KINDS,
+    is_hole,
+    key_of,
+    loaded_so_far,
+    not_played,
+    played_actuators,
+    played_sensors,
+    resolve_parent,
+)
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
 from .collision import collision_filters, warn_losses
@@ -254,7 +263,9 @@ def build_plan(world) -> Plan:
     collision_filters(world, spec, bodies, joints, plans_by_model)
     apply_textures(world, spec, bodies)
     ghosts, actuators, sensors = [], [], []
-    for m, _mine, _tree in plans_by_model:
+    known = None
+    for m, mine, _tree in plans_by_model:
+        known = loaded_so_far(known, mine.values())
         ns = m.namespace or ""
         for gh in m.ghost_objects:
             parent = resolve_parent(world, gh.parent, ns, gh, BodyPlan) if gh.parent else None
@@ -273,8 +284,8 @@ def build_plan(world) -> Plan:
             )
             if gp.geoms:
                 ghosts.append(gp)
-        sensors += played_sensors(world, m, BodyPlan)
-        for g in played_actuators(world, m, BodyPlan):
+        sensors += played_sensors(world, m, BodyPlan, known)
+        for g in played_actuators(world, m, BodyPlan, known):
             parent, key = g.parent, g.key
             weld = f"grasp:{key}"
             spec.add_equality(

@@ -20,6 +20,7 @@ from ..plan import (
     is_hole,
     joint_ends,
     key_of,
+    loaded_so_far,
     not_played,
     played_actuators,
     played_sensors,
@@ -132,10 +133,12 @@ class Assembly:
                 self.fixed_frames.append((j.identifier, parent, child, fa[:3, :3], fb[:3, :3]))
         self.springs = SpringSet(springs, self.cid)
         build_volumes(self, models)
+        known = None
         for m in models:
+            known = loaded_so_far(known, self._model_bodies.get(id(m), []))
             self._build_ghosts(m)
-            self._build_actuators(m)
-            self._build_sensors(m)
+            self._build_actuators(m, known)
+            self._build_sensors(m, known)
         self.cameras = build_cameras(self)
         self._floor_z = self._floor()
         self.ground_z = None
@@ -267,12 +270,12 @@ class Assembly:
                 SimGhost(key, gh, uid, parent, rel, friction, pq_in_parent=matrix_to_pq(rel), moves=moves)
             )
 
-    def _build_actuators(self, m) -> None:
-        for g in played_actuators(self, m):
+    def _build_actuators(self, m, known) -> None:
+        for g in played_actuators(self, m, known=known):
             self.actuators.append(SimActuator(g.key, g.actuator, g.parent, g.location, g.max_impulse / self.dt))
 
-    def _build_sensors(self, m) -> None:
-        for r in played_sensors(self, m):
+    def _build_sensors(self, m, known) -> None:
+        for r in played_sensors(self, m, known=known):
             self.sensors.append(SimSensor(r.key, r.sensor, r.parent, r.location, r.starts, r.ends))
 
     def _floor(self) -> float:

@@ -150,6 +150,9 @@ def collision_parts(
     (Bullet's sparse SDF gives every point a distance 0 to a non-convex shape, so the nodes
     near one are pushed away): a static concave mesh is played as convex hulls, one per OBJ
     object, with a warning unless the mesh is convex anyway."""
+    if (why := uncreated(model, obj)) is not None:  # a mesh missing, refused or without triangles (plan.py)
+        diags.append(why)
+        return None
     parts = ShapeParts(margin=file_margin(obj))
     body_to_com = invert(frame_in_body)
     prims = collision_primitives(obj)
@@ -181,9 +184,6 @@ def collision_parts(
     path = collision_mesh_path(model, obj)
     if path is None:
         return parts  # no collision geometry: an empty shape (AMBF prints an error)
-    if (why := uncreated(model, obj)) is not None:  # missing, refused or without triangles (plan.py)
-        diags.append(why)
-        return None
     path, refused = pybullet_mesh(model, path)
     if refused is not None:  # an STL neither PyBullet nor trimesh can read
         diags.append(mesh_skipped(obj, refused))
