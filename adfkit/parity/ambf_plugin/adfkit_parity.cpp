@@ -8,6 +8,11 @@
 //   ADFKIT_PARITY_OUT       file to write, JSON lines (required)
 //   ADFKIT_PARITY_SECONDS   simulated seconds to play; 0 writes what was created and exits (default 0)
 //   ADFKIT_PARITY_EVERY     a sample every so many simulated seconds (0: first and last only)
+//   ADFKIT_PARITY_GHOSTS    "follow" (default): every object's global pose is brought up to date after
+//                           each physics step, so that ghost objects follow their parents as they do
+//                           with AMBF's window open (its graphics loop updates them, ~120 times a
+//                           second; headless nothing does and every ghost stays where it was made);
+//                           "headless": left as AMBF leaves them without a window
 //   ADFKIT_PARITY_COMMANDS  command file: one command a line, "TIME KIND TARGET [ARG]", KIND one of
 //                           position|velocity|effort (TARGET a joint's qualified name, ARG the value),
 //                           grasp (TARGET an actuator, ARG a rigid body), release (TARGET an actuator);
@@ -98,6 +103,9 @@ public:
         }
         m_seconds = env_double("ADFKIT_PARITY_SECONDS", 0.0);
         m_every = env_double("ADFKIT_PARITY_EVERY", 0.0);
+        const char* ghosts = getenv("ADFKIT_PARITY_GHOSTS");
+        m_followGhosts = !(ghosts && string(ghosts) == "headless");
+        update_global_poses();
         write_created();
         const char* cmds = getenv("ADFKIT_PARITY_COMMANDS");
         if (cmds && *cmds) read_commands(cmds);
@@ -111,6 +119,7 @@ public:
 
     virtual void physicsUpdate(double dt) {
         m_steps++;
+        update_global_poses();
         double t = m_world->getSimulationTime();
         activate(t);
         drive();
@@ -126,6 +135,13 @@ public:
     virtual bool close() { return 0; }
 
 private:
+    // what AMBF's graphics loop does (afWorld::updateSceneObjects) for the poses physics reads:
+    // a ghost object places itself at its global pose at each step
+    void update_global_poses() {
+        if (!m_followGhosts) return;
+        for (afModelPtr m : m_world->getModels()) m->updateGlobalPose();
+    }
+
     static double env_double(const char* name, double fallback) {
         const char* v = getenv(name);
         return v && *v ? atof(v) : fallback;
@@ -229,6 +245,15 @@ private:
                  num(q.y) + "," + num(q.z) + "," + num(q.w) + "]";
             first = false;
         }
+        s += "],\"ghosts\":[";
+        first = true;
+        for (afGhostObjectPtr g : m_world->getGhostObjects()) {
+            // where Bullet has the ghost (what it senses with), not AMBF's scene-graph pose
+            btTransform t = g->m_bulletGhostObject->getWorldTransform();
+            s += (first ? "[" : ",[") + num(t.getOrigin().x()) + "," + num(t.getOrigin().y()) + "," +
+                 num(t.getOrigin().z()) + "]";
+            first = false;
+        }
         s += "],\"joints\":[";
         first = true;
         for (afJointPtr j : m_world->getJoints()) {
@@ -329,6 +354,7 @@ private:
     FILE* m_out = nullptr;
     double m_seconds = 0.0, m_every = 0.0, m_nextSample = 0.0;
     long m_steps = 0;
+    bool m_followGhosts = true;
     vector<Command> m_commands;
     size_t m_nextCommand = 0;
     map<string, Command> m_drives;
