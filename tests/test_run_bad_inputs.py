@@ -185,7 +185,8 @@ def test_a_body_whose_collision_mesh_is_missing_is_skipped_in_both_engines(tmp_p
     """AMBF does not create a body whose collision mesh file is missing (the corpus's sophie.yaml:
     its Body.STL is missing in the source repository itself). The MuJoCo engine made it anyway,
     without a collision shape, and the robot's legs fell with it; both engines skip it now, and
-    the joints that name it, each with a located warning."""
+    the joints that name it, each with a located warning. The file is its visual mesh too, which
+    AMBF loads first: the warning names that."""
     f = tmp_path / "m.yaml"
     f.write_text(
         "bodies: [BODY a, BODY b]\njoints: [JOINT a-b]\n"
@@ -199,7 +200,7 @@ def test_a_body_whose_collision_mesh_is_missing_is_skipped_in_both_engines(tmp_p
     err = capsys.readouterr().err
     report = _strict((tmp_path / "out" / "report.json").read_text())
     assert rc == 0 and report["skipped_bodies"] == ["BODY a"] and report["bodies"] == 1
-    assert f"{f}:8:9: warning[runner-missing-mesh]: BODY a: collision mesh" in err and "gone.stl not found" in err
+    assert f"{f}:8:9: warning[runner-missing-mesh]: BODY a: visual mesh" in err and "gone.stl not found" in err
     assert f"{f}:17:3: warning[runner-joint-body]: JOINT a-b: parent or child body not found; skipped" in err
 
 

@@ -191,16 +191,16 @@ def _visual_refused(model, obj):
         return None
     where = obj.where("mesh") or obj.source
     if (refused := mesh_refusal(model, path)) is not None:
-        why = refused
+        rule, why = "runner-missing-mesh", refused
     elif path.suffix.lower() != ".obj" and (problem := mesh_problem(path)) is not None:
-        why = f"{inputs.shown(path.name)}: {problem}"
+        rule, why = "runner-bad-mesh", f"{inputs.shown(path.name)}: {problem}"
     else:
         return None
     return warning(
-        "runner-missing-mesh",
+        rule,
         f"{obj.identifier}: visual mesh {why}; the body is skipped as AMBF does (it makes the visual first)",
         where,
-        "fix `mesh` or the high resolution path",
+        "fix `mesh` or the high resolution path" if rule == "runner-missing-mesh" else "re-export the mesh",
     )
 
 
