@@ -29,7 +29,8 @@ def add_arguments(p) -> None:
         "(default: the scene's only one)",
     )
     p.add_argument(
-        "--burr", help="the burr's body: a sphere, or a drill mesh whose tip is the burr (default: the body named *burr*)"
+        "--burr",
+        help="the burr's body: a sphere, or a drill mesh whose tip is the burr (default: the body named *burr*)",
     )
     p.add_argument(
         "--burr-radius", type=float, help="m: drill with a sphere of this radius (at a mesh drill's tip: its end)"

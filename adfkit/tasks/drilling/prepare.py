@@ -38,7 +38,9 @@ def _volume_pose(scene, model, vol) -> np.ndarray:
     from ...runner.frames import camera_frame, match, scene_cameras
     from ...runner.names import merge_namespace
 
-    bodies = [(merge_namespace(m.namespace or "", b.namespace) + b.identifier, b) for m in scene.models for b in m.bodies]
+    bodies = [
+        (merge_namespace(m.namespace or "", b.namespace) + b.identifier, b) for m in scene.models for b in m.bodies
+    ]
     cameras = scene_cameras(scene)
     t = _pose(vol.location)
     ref, ns = vol.parent, model.namespace or ""
