@@ -361,6 +361,55 @@ def op_garbage_mesh(rng, files, seed):
     return files, {}
 
 
+TRIANGLE_OBJ = b"v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nv 0 0 0.05\n"
+#: what a static body's mesh may hold that no engine can make a shape of: (suffix, bytes)
+BROKEN_MESHES = {
+    "obj-face-past-vertices": (".obj", TRIANGLE_OBJ + b"f 1 2 3\nf 1 2 9\n"),
+    "obj-face-zero": (".obj", TRIANGLE_OBJ + b"f 0 1 2\n"),
+    "obj-face-relative-past": (".obj", TRIANGLE_OBJ + b"f -1 -2 -7\n"),
+    "obj-face-word": (".obj", TRIANGLE_OBJ + b"f 1/1/1 2//2 x\n"),
+    "obj-texture-index-past": (".obj", TRIANGLE_OBJ + b"vt 0 0\nf 1/1 2/9 3/1\n"),
+    "obj-no-faces": (".obj", TRIANGLE_OBJ),
+    "obj-no-vertices": (".obj", b"f 1 2 3\n"),
+    "obj-empty": (".obj", b""),
+    "obj-binary": (".obj", bytes(range(256)) * 3),
+    "stl-empty": (".stl", b""),
+    "stl-huge-count": (".stl", b"\0" * 80 + (2**31 - 1).to_bytes(4, "little") + b"\0" * 50),
+    "stl-binary-lie": (".stl", b"\0" * 80 + (3).to_bytes(4, "little") + b"\x01" * 20),
+    "stl-ascii-junk": (".stl", b"solid\nfacet normal a b c\nouter loop\nvertex 1 2\nendloop\nendfacet\nendsolid\n"),
+    "3ds-empty": (".3ds", b""),
+    "3ds-junk": (".3ds", b"\x4d\x4d" + (1000).to_bytes(4, "little") + bytes(range(200))),
+}
+
+
+def static_broken_mesh(files: dict[str, bytes], model: str, kind: str) -> dict[str, bytes]:
+    """``files`` with one body of ``model`` that has a mesh made static (mass 0) and its mesh
+    (and collision mesh) a broken file of ``kind`` (BROKEN_MESHES): every engine reads a static
+    body's mesh as it is, without the mass properties that read a dynamic one first."""
+    suffix, data = BROKEN_MESHES[kind]
+    name = f"broken{suffix}"
+    text = files[model].decode("utf-8", "surrogateescape")
+    blocks = list(re.finditer(r"^(BODY [^\n:]+):\n((?:[ \t]+[^\n]*\n?)*)", text, re.M))
+    meshed = [b for b in blocks if re.search(r"^[ \t]+(collision )?mesh:", b.group(2), re.M)]
+    if not meshed:
+        return files
+    b = meshed[0]
+    body = re.sub(r"^([ \t]+(?:collision )?mesh:)[^\n]*", rf"\1 {name}", b.group(2), flags=re.M)
+    if re.search(r"^[ \t]+mass:", body, re.M):
+        body = re.sub(r"^([ \t]+mass:)[^\n]*", r"\1 0.0", body, count=1, flags=re.M)
+    else:
+        body = "  mass: 0.0\n" + body
+    text = text[: b.start(2)] + body + text[b.end(2) :]
+    return {**files, model: text.encode("utf-8", "surrogateescape"), name: data}
+
+
+def op_static_broken_mesh(rng, files, seed):
+    models = [f for f in _yaml_files(files, seed) if re.search(rb"^[ \t]+(collision )?mesh:", files[f], re.M)]
+    if not models:
+        return op_garbage_mesh(rng, files, seed)
+    return static_broken_mesh(files, rng.choice(models), rng.choice(sorted(BROKEN_MESHES))), {}
+
+
 XML_ATTRS = [
     'velocity="abc"',
     'effort="nan"',
@@ -440,5 +489,6 @@ YAML_OPS = {
     "keys": op_keys,
     "duplicate": op_duplicate,
     "garbage_mesh": op_garbage_mesh,
+    "static_broken_mesh": op_static_broken_mesh,
 }
 XML_OPS = {"xml": op_xml, "xml2": op_xml, "odd_bytes": op_odd_bytes, "garbage_mesh": op_garbage_mesh}

@@ -33,10 +33,12 @@ PASSWD_MARK = "root:x:0:0"
 LOCATED = re.compile(r"^(?P<file>[^\n]+?)(?::(?P<line>\d+):(?P<col>\d+))?: error\[(?P<rule>[a-z0-9-]+)\]: ", re.M)
 
 from fuzz_mutations import (  # noqa: F401 - re-exported: the suite's one entry point is fuzzkit
+    BROKEN_MESHES,
     HOSTILE_PATHS,
     XML_OPS,
     YAML_OPS,
     _plants,
+    static_broken_mesh,
 )
 from fuzz_seeds import (  # noqa: F401
     SMALL_DEVICES,
@@ -101,6 +103,12 @@ def commands_for(seed: Seed, with_run: bool, with_blender: bool) -> list[tuple[s
     if with_run and seed.small:
         extra = ["-l", "0,1"] if seed.kind == "launch" else []
         cmds += [("run", ["run", main, *extra, "--seconds", "0.004", "--no-frames", "--out", "{dir}/run"])]
+        cmds += [
+            (
+                "run-mujoco",
+                ["run", main, *extra, "--engine", "mujoco", "--seconds", "0.004", "--no-frames", "--out", "{dir}/run"],
+            )
+        ]
     if with_blender and seed.kind == "model" and seed.small:
         cmds += [("blend-import", ["blend-import", main, "{dir}/out.blend"])]
     return cmds

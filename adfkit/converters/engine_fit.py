@@ -22,6 +22,7 @@ from pathlib import Path
 from .. import inputs
 from ..adf.writer import atomic_write_bytes
 from ..diagnostics import AdfError
+from ..geometry.meshcheck import is_ascii_stl, mesh_problem
 from .losses import Loss
 
 #: Mesh file suffixes each engine reads itself.
@@ -106,7 +107,17 @@ class MeshFiles:
                 losses.append(Loss(who, "mesh", f"{exc.diagnostics[0].message}: left out"))
                 self._done[key] = (None, False, None)
                 return None, None
-            readable = path.suffix.lower() in ENGINE_SUFFIXES[self.engine]
+            try:  # only a file the input policy lets in is opened here
+                inputs.check_file(path, "mesh", tree=self.tree, what="mesh file")
+                let_in = True
+            except AdfError:
+                let_in = False
+            if let_in and (problem := mesh_problem(path)) is not None:  # no triangles, a face naming no vertex
+                losses.append(Loss(who, "mesh", f"{inputs.shown(path.name)}: {problem}: left out"))
+                self._done[key] = (None, False, None)
+                return None, None
+            ascii_stl = let_in and self.engine == "mjcf" and path.suffix.lower() == ".stl" and is_ascii_stl(path)
+            readable = path.suffix.lower() in ENGINE_SUFFIXES[self.engine] and not ascii_stl
             mesh = None
             if not readable or check_flat:
                 if path.is_file():
@@ -134,12 +145,16 @@ class MeshFiles:
                         out = self.folder / f"{path.stem}_{n}.stl"
                     self.folder.mkdir(parents=True, exist_ok=True)
                     atomic_write_bytes(out, mesh.export(file_type="stl"))
+                    what = (
+                        "MuJoCo reads binary STL only: converted"
+                        if ascii_stl
+                        else f"{path.suffix} is not read by the engine: converted"
+                    )
                     losses.append(
                         Loss(
                             who,
                             "mesh",
-                            f"{path.name}: {path.suffix} is not read by the engine: converted "
-                            f"to {out.parent.name}/{out.name} (normals, UVs and materials dropped)",
+                            f"{path.name}: {what} to {out.parent.name}/{out.name} (normals, UVs and materials dropped)",
                         )
                     )
             flat = mesh if (mesh is not None and _is_flat(mesh)) else None
@@ -163,7 +178,10 @@ def split_objects(path: Path, folder: Path) -> list[Path]:
     holds one or is no OBJ."""
     if path.suffix.lower() != ".obj" or not path.is_file():
         return [path]
-    objs = obj_objects(path.read_text(encoding="utf-8", errors="replace"))
+    try:
+        objs = obj_objects(path.read_text(encoding="utf-8", errors="replace"))
+    except ValueError:  # a face that names no vertex: MeshFiles.fit left such a mesh out already
+        return [path]
     if len(objs) < 2:
         return [path]
     folder.mkdir(parents=True, exist_ok=True)

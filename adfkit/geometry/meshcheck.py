@@ -59,6 +59,17 @@ def _3ds_problem(path: str, data: bytes) -> str | None:
     return None
 
 
+def is_ascii_stl(path: str | os.PathLike) -> bool:
+    """An ASCII STL (``solid`` ... ``facet`` text), which MuJoCo's STL decoder refuses."""
+    try:
+        data = inputs.read_bytes(path, "mesh", what="mesh file")
+    except AdfError:
+        return False
+    if len(data) >= 84 and len(data) == 84 + 50 * struct.unpack_from("<I", data, 80)[0]:
+        return False  # a binary STL whose header happens to start with "solid"
+    return data[:512].lstrip().lower().startswith(b"solid")
+
+
 def _stl_problem(data: bytes) -> str | None:
     if len(data) >= 84:
         (n,) = struct.unpack_from("<I", data, 80)
@@ -81,12 +92,35 @@ def _stl_problem(data: bytes) -> str | None:
     )
 
 
+_OBJ_FACE_LINE = re.compile(rb"^[ \t]*f[ \t]+([^\r\n]*)", re.M)
+
+
 def _obj_problem(data: bytes) -> str | None:
     if _OBJ_VERTEX.search(data) is None:
         return "the OBJ file has no vertices ('v' lines)"
     if _OBJ_FACE.search(data) is None:
         return "the OBJ file has no faces ('f' lines)"
+    return _obj_face_problem(data)
+
+
+def _obj_face_problem(data: bytes) -> str | None:
+    """The first face corner that names no vertex of the file (0, an index past the vertices,
+    a relative index before the first, or no number): every reader indexes the vertices with it
+    (adfkit's own hull split raised IndexError on a static body's mesh)."""
+    total = len(_OBJ_VERTEX.findall(data))
+    for tok in b" ".join(_OBJ_FACE_LINE.findall(data)).split():
+        try:
+            i = int(tok.split(b"/", 1)[0])
+        except ValueError:
+            return f"a face corner is not a vertex number ({_shown(tok)})"
+        if i == 0 or not -total <= i <= total:
+            return f"a face names vertex {i}; the file has {total} vertices"
     return None
+
+
+def _shown(raw: bytes) -> str:
+    text = raw.decode("utf-8", errors="replace")
+    return text if len(text) <= 40 else text[:40] + "..."
 
 
 TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")  # MTL statements naming a file

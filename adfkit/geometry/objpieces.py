@@ -11,7 +11,9 @@ from __future__ import annotations
 def obj_pieces(text: str) -> list[tuple[list, list]]:
     """The sub-meshes of a Wavefront OBJ text: the faces of each object (``o``/``g``) of each
     material (``usemtl``), in the order they first appear, each as (vertices as strings, faces
-    with indices into its own vertices). One entry when the file has one object and material."""
+    with indices into its own vertices). One entry when the file has one object and material.
+    ValueError for a face corner that names no vertex of the file (geometry.meshcheck says so
+    first, where it is asked)."""
     verts: list[list[str]] = []
     groups: dict[tuple[str, str], list[list[int]]] = {}
     obj, mtl = "", ""
@@ -32,6 +34,9 @@ def obj_pieces(text: str) -> list[tuple[list, list]]:
     out = []
     for fs in groups.values():
         used = sorted({i for f in fs for i in f})
+        if used and not (0 <= used[0] and used[-1] < len(verts)):
+            bad = used[-1] + 1 if used[-1] >= len(verts) else used[0] - len(verts)
+            raise ValueError(f"a face names vertex {bad}; the file has {len(verts)} vertices")
         remap = {old: new for new, old in enumerate(used)}
         out.append(([verts[i] for i in used], [[remap[i] for i in f] for f in fs]))
     return out

@@ -42,7 +42,10 @@ def _obj_groups(path: Path) -> list[np.ndarray]:
     from ..geometry.objpieces import obj_pieces
 
     with open(path, encoding="utf-8", errors="replace") as f:
-        pieces = obj_pieces(f.read())
+        try:
+            pieces = obj_pieces(f.read())
+        except ValueError:  # a face that names no vertex: the engines do not make the body
+            return []
     return [np.array(v, dtype=float) for v, _ in pieces if len(v) >= 4]
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ...diagnostics import AdfError, SourceLocation, error
+from ...diagnostics import AdfError, SourceLocation, error, warning
 
 
 def _resolve_meshes(world, child, out_dir: Path, model) -> None:
@@ -39,43 +39,130 @@ def _resolve_meshes(world, child, out_dir: Path, model) -> None:
 
 def compile_spec(world, spec):
     """spec.compile(), replacing a collision mesh MuJoCo cannot hull (flat: coplanar vertices)
-    by a box around its vertices (at least 1 mm thick), with a warning."""
+    by a box around its vertices (at least 1 mm thick), and leaving out a mesh MuJoCo cannot
+    read, each with a located warning; anything else MuJoCo refuses is a located error."""
     import re
 
     for _ in range(100):
         try:
-            return spec.compile()
+            return _compile_noting_warnings(world, spec)
         except ValueError as e:
-            hit = re.search(r"mesh '([^']+)' has coplanar vertices", str(e))
-            if hit is None:
-                raise
-            mesh = spec.mesh(hit.group(1))
-            lo, hi = _obj_bounds(Path(mesh.file), np.array(mesh.scale, float))
-            for g in list(spec.geoms):
-                if g.meshname != mesh.name:
-                    continue
-                body = g.parent
-                box = body.add_geom(
-                    type=mujoco.mjtGeom.mjGEOM_BOX,
-                    size=np.maximum((hi - lo) / 2, 5e-4),
-                    contype=g.contype,
-                    conaffinity=g.conaffinity,
-                    group=g.group,
-                    friction=g.friction,
-                    rgba=g.rgba,
-                    name=(g.name or "") + "#box",
-                )
-                r = _quat_matrix(np.array(g.quat, float))
-                box.pos = np.array(g.pos, float) + r @ ((lo + hi) / 2)
-                box.quat = g.quat
-                spec.delete(g)
-            world._warn(
-                "runner-flat-mesh",
-                f"{Path(mesh.file).name}: a flat mesh has no convex hull for MuJoCo; it collides as its bounding box",
-                None,
-            )
-            spec.delete(mesh)
-    return spec.compile()
+            text = str(e)
+            hit = re.search(r"mesh '([^']+)' has coplanar vertices", text)
+            if hit is not None:
+                _flat_to_box(world, spec, spec.mesh(hit.group(1)))
+                continue
+            mesh = _named_mesh(spec, text)
+            if mesh is None:
+                raise AdfError(
+                    error(
+                        "mujoco-refused",
+                        f"MuJoCo cannot build the scene: {_first_line(text)}",
+                        _where(world, spec, text),
+                        "play it with --engine pybullet",
+                    )
+                ) from None
+            _drop_mesh(world, spec, mesh, text)
+    return _compile_noting_warnings(world, spec)
+
+
+def _compile_noting_warnings(world, spec):
+    """spec.compile(), its warnings (a mesh's texture coordinates discarded, ...) kept for the
+    report's ``engine_warnings`` instead of printed as Python warnings with a line of code."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model = spec.compile()
+    notes = getattr(world, "engine_warnings", None)
+    for w in caught:
+        if notes is not None:
+            notes.append(f"compile: {w.message}")
+    return model
+
+
+def _first_line(text: str) -> str:
+    return text.removeprefix("Error: ").splitlines()[0] if text else "no reason given"
+
+
+def _named_mesh(spec, text: str):
+    """The mesh asset MuJoCo's error names (its element, or its file), or None."""
+    import re
+
+    hit = re.search(r"Element name '([^']*)'", text)
+    if hit is not None and (mesh := spec.mesh(hit.group(1))) is not None:
+        return mesh
+    hit = re.search(r"file '([^']+)'", text)
+    if hit is not None:
+        return next((m for m in spec.meshes if m.file and Path(m.file) == Path(hit.group(1))), None)
+    return None
+
+
+def _adf_bodies(world, spec, geoms) -> list:
+    """The ADF bodies (the plan's) whose MJCF bodies hold ``geoms``."""
+    plan = getattr(world, "_plan", None)
+    names = {g.parent.name for g in geoms}
+    return [bp.body for bp in (plan.bodies if plan is not None else []) if bp.mjname in names]
+
+
+def _where(world, spec, text: str):
+    """Where the element MuJoCo's error names comes from: its ADF body, else the scene's first model."""
+    import re
+
+    hit = re.search(r"Element name '([^']*)'", text)
+    el = spec.body(hit.group(1)) if hit is not None and hit.group(1) else None
+    bodies = _adf_bodies(world, spec, [g for g in spec.geoms if el is not None and g.parent.name == el.name])
+    if bodies:
+        return bodies[0].source
+    models = list(world.scene.all_models())
+    return models[0].source if models else None
+
+
+def _drop_mesh(world, spec, mesh, text: str) -> None:
+    """A mesh MuJoCo cannot read (an STL its decoder refuses, ...): its geoms are left out, each
+    body's warned about at its mesh key and listed in ``not_played``."""
+    geoms = [g for g in spec.geoms if g.meshname == mesh.name]
+    why = f"MuJoCo cannot read {Path(mesh.file).name if mesh.file else mesh.name}: {_first_line(text)}"
+    bodies = _adf_bodies(world, spec, geoms)
+    for b in bodies:
+        key = "collision mesh" if getattr(b, "collision_mesh", None) is not None else "mesh"
+        world.diagnostics.append(
+            warning("runner-mesh-refused", f"{b.identifier}: {why}; its shapes from it are left out", b.where(key))
+        )
+        world.not_played.append({"object": b.identifier, "what": "mesh", "why": why})
+    if not bodies:
+        world._warn("runner-mesh-refused", f"{why}; its shapes are left out", None)
+    for g in geoms:
+        spec.delete(g)
+    spec.delete(mesh)
+
+
+def _flat_to_box(world, spec, mesh) -> None:
+    lo, hi = _obj_bounds(Path(mesh.file), np.array(mesh.scale, float))
+    for g in list(spec.geoms):
+        if g.meshname != mesh.name:
+            continue
+        body = g.parent
+        box = body.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=np.maximum((hi - lo) / 2, 5e-4),
+            contype=g.contype,
+            conaffinity=g.conaffinity,
+            group=g.group,
+            friction=g.friction,
+            rgba=g.rgba,
+            name=(g.name or "") + "#box",
+        )
+        r = _quat_matrix(np.array(g.quat, float))
+        box.pos = np.array(g.pos, float) + r @ ((lo + hi) / 2)
+        box.quat = g.quat
+        spec.delete(g)
+    world._warn(
+        "runner-flat-mesh",
+        f"{Path(mesh.file).name}: a flat mesh has no convex hull for MuJoCo; it collides as its bounding box",
+        None,
+    )
+    spec.delete(mesh)
 
 
 def _obj_bounds(path: Path, scale: np.ndarray):
