@@ -374,6 +374,7 @@ def to_mjcf(
     volumes: bool = True,
     leave_out: frozenset[str] = frozenset(),
     lights: bool = True,
+    flexes_out: dict | None = None,
 ) -> tuple[str, list[Loss]]:
     """MJCF text and losses. ``tree_kinds``: joint kinds that join the tree (default revolute,
     prismatic, fixed); a link joined by another kind is written welded to its parent, for the
@@ -383,7 +384,8 @@ def to_mjcf(
     out, for a caller that places them itself (the MuJoCo runner). ``leave_out``: identifiers of
     bodies not written, with the joints that name them (bodies AMBF does not create: the MuJoCo
     runner's ``plan.uncreated_bodies``). ``lights``: False leaves the lights to the caller (the
-    MuJoCo runner places them under parents in other files and under cameras)."""
+    MuJoCo runner places them under parents in other files and under cameras). ``flexes_out``
+    receives {soft body identifier: the name of its flexcomp}."""
     losses: list[Loss] = []
     if leave_out:
         kept = [j for j in model.joints if not joint_ends(model, j) & leave_out]
@@ -467,7 +469,7 @@ def to_mjcf(
     if eq is not None:
         root.append(eq)
     write_cameras_lights(model, tree, elements, world, used, losses, lights)
-    write_soft_bodies(model, world, used, losses)
+    write_soft_bodies(model, world, used, losses, flexes_out)
     if volumes:
         write_mjcf_volumes(model, world, assets, name or model.name, used, losses)
     for j in tree.unresolved:

@@ -45,7 +45,7 @@ GROUP_BITS = 31
 #: sections of a model each engine does not play (each is warned about and listed in the report)
 NOT_PLAYED = {
     "pybullet": (("vehicle", "vehicles"),),
-    "mujoco": (("soft body", "soft_bodies"), ("vehicle", "vehicles")),
+    "mujoco": (("vehicle", "vehicles"),),
 }
 
 

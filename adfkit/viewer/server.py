@@ -223,7 +223,7 @@ class Viewer:
                 continue
             colour = rgba(s.soft) or (0.85, 0.55, 0.5, 1.0)
             h = self.server.scene.add_mesh_simple(
-                f"/soft/s{n}", s.nodes(self.world.cid).astype(np.float32), tris, color=tuple(colour[:3]), side="double"
+                f"/soft/s{n}", s.nodes().astype(np.float32), tris, color=tuple(colour[:3]), side="double"
             )
             self.soft_nodes.append((s, h))
 
@@ -279,7 +279,7 @@ class Viewer:
                 if np.all(np.isfinite(m)):
                     frame.position, frame.wxyz = tuple(m[:3, 3]), _wxyz(m)
             for s, h in self.soft_nodes:
-                h.vertices = s.nodes(w.cid).astype(np.float32)
+                h.vertices = s.nodes().astype(np.float32)
             for g, frame in self.ghost_nodes:
                 if frame.visible:
                     m = w.ghost_pose(g)

@@ -34,7 +34,11 @@ class Assembly:
         spec = plan.spec
         spec.option.timestep = self.dt
         spec.option.gravity = self.gravity
-        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        # implicit-fast for rigid scenes; MuJoCo 4 integrates a flex's elasticity implicitly only
+        # in its discrete integrator (implicit/implicitfast refuse a flex: "no longer integrated")
+        spec.option.integrator = (
+            mujoco.mjtIntegrator.mjINT_DISCRETE if spec.flexes else mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        )
         # Newton stops at a 1e-6 relative improvement (MuJoCo's 1e-8 costs 1.8x the time here);
         # dense or sparse algebra: jacobian_for, once the model is compiled
         spec.option.tolerance = SOLVER_TOLERANCE
@@ -51,12 +55,13 @@ class Assembly:
 
         cams = prepare_cameras(self, plan)
         ground = self.opt.ground and self.scene.world is None and self.scene.environment is None
+        self._plan = plan  # (compile_spec finds the ADF body of what MuJoCo refuses in it)
         self.model = compile_spec(self, spec)
         self.model.opt.jacobian = jacobian_for(self.model)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self.ground_z = None
-        if ground and plan.bodies:
+        if ground and (plan.bodies or (self.soft is not None and self.soft.items)):
             self.ground_z = self._lowest_point() - 1e-3
             # the floor stands in for a world's, which has no collision groups: every bit, so
             # that it meets every body whatever its groups (the default bit met group 0's only)
@@ -72,6 +77,8 @@ class Assembly:
             self.data = mujoco.MjData(self.model)
             mujoco.mj_forward(self.model, self.data)
         self._plan = plan
+        if self.soft is not None:
+            self.soft.bind(spec)
         m, d = self.model, self.data
         set_contacts(m, self.dt)  # rigid, frictions combined as Bullet does (contacts.py)
         self.bodies: list[MjBody] = []
@@ -177,6 +184,8 @@ class Assembly:
     def _lowest_point(self) -> float:
         m = self.model
         z = [self._geom_bottom(g) for g in range(m.ngeom) if m.geom_group[g] != 4 and m.geom_rbound[g] > 0]
+        if m.nflexvert:  # soft bodies' nodes, less their radius
+            z.append(float(np.min(self.data.flexvert_xpos[:, 2] - np.repeat(m.flex_radius, m.flex_vertnum))))
         return min(z) if z else 0.0
 
     def _geom_bottom(self, g: int) -> float:

@@ -181,8 +181,10 @@ def build_plan(world) -> Plan:
         ns = m.namespace or ""
         mine = {}
         uncreated = scene_rules.uncreated_bodies(world, m)  # skipped, warned about, with the joints naming them
-        if len(uncreated) < len(m.bodies):
+        soft = world.soft is not None and any(sb.defined for sb in m.soft_bodies)
+        if len(uncreated) < len(m.bodies) or soft:
             names: dict = {}
+            flexes: dict = {}
             text, ls = to_mjcf(
                 m,
                 out_dir,
@@ -192,9 +194,12 @@ def build_plan(world) -> Plan:
                 volumes=False,
                 leave_out=uncreated,
                 lights=False,
+                flexes_out=flexes,
             )
             losses += ls
             warn_losses(world, m, ls)
+            if soft:
+                world.soft.plan(m, f"m{i}/", flexes, ls)
             child = _parse_spec(text, m)
             _resolve_meshes(world, child, out_dir, m)
             prefix = f"m{i}/"
@@ -259,6 +264,8 @@ def build_plan(world) -> Plan:
                     f"{j.identifier}: a {kind.value} joint closing a loop is not played by the MuJoCo engine; skipped",
                     j,
                 )
+    if world.soft is not None:
+        world.soft.attach(spec, scene.all_models(), {bp.key: bp for bp in bodies})
     _lights(world, spec)
     collision_filters(world, spec, bodies, joints, plans_by_model)
     apply_textures(world, spec, bodies)

@@ -117,10 +117,13 @@ class _Renderer:
             np.minimum(seg, scn.ngeom, out=seg)
         lut = np.full(max(scn.ngeom + 1, 256), -1, dtype=np.int32)
         labels = self.world._geom_label
+        soft = {s.fid: len(self.world.bodies) + k for k, s in enumerate(getattr(self.world.soft, "items", None) or [])}
         for n in range(scn.ngeom):
             g = scn.geoms[n]
             if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
                 lut[g.segid + 1] = labels[g.objid]
+            elif g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_FLEX:  # soft body k: after the bodies
+                lut[g.segid + 1] = soft.get(g.objid, -1)
         lut[scn.ngeom + 1 :] = lut[scn.ngeom]  # an id past the last geom reads as the last (as clamped before)
         segmentation = np.take(lut, seg)
         depth[seg == 0] = np.inf

@@ -15,11 +15,14 @@ import numpy as np
 
 from ..options import Options
 from ..rotations import invert, matrix_to_quat
+from ..soft import in_scene as soft_in_scene
+from ..soft import soft_health
 from ..world import World
 from . import stability as mj_stability
 from .assemble import Assembly
 from .interact import Interaction
 from .objects import MjBody
+from .soft import MjSoftBodies
 
 
 class MujocoWorld(Assembly, Interaction, World):
@@ -32,6 +35,7 @@ class MujocoWorld(Assembly, Interaction, World):
         if gui:
             raise ValueError("the MuJoCo engine plays headless only (use --engine pybullet for --gui)")
         self._setup(scene, options, False)
+        self.soft = MjSoftBodies(self) if soft_in_scene(scene) else None  # the flexes of its soft bodies
         self.engine_warnings: list[str] = []  # MuJoCo's other warnings, with their time
         mj_stability.install_mujoco_handler()
         self.sleep = sleep and hasattr(mujoco.mjtEnableBit, "mjENBL_SLEEP")  # MuJoCo 4's island sleeping
@@ -263,8 +267,8 @@ class MujocoWorld(Assembly, Interaction, World):
             "trees": int(self.model.ntree),
             "spring_joints": self.springs_count,
             "renderer": "mujoco",
-            "soft_bodies": [],  # not played by this engine (a runner-soft-body warning names each)
             "engine_warnings": self.engine_warnings,
+            **soft_health(self.soft, self._floor_z, rep),
         }
 
     def _renderer(self):

@@ -35,17 +35,14 @@ import pybullet as pb
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import AdfError
 from ...geometry.softmesh import DEFAULT_SOFT_MASS, link_stiffness, placed_soft_mesh, write_obj
-from ...model.semantics import pose_or_identity
 from ..names import merge_namespace
 from ..plan import rgba
-from ..rotations import pose_to_matrix
+from ..soft import DEFAULT_MARGIN, held_nodes, soft_end, soft_report
 from .meshfiles import obj_colour
 
-DEFAULT_MARGIN = 0.001  # adf-format.md §7.4
 CL_SELF = 0x40  # btSoftBody::fCollision::CL_SELF
 ELASTIC_CAP = 0.4  # largest stable spring stiffness, in m_node/dt² (see parameters())
 BENDING_CAP = 0.15
-EXPLODED_STRETCH = 3.0  # a soft body wider than this many times its rest size has exploded
 # ADF config keys the mapping above uses; every other key a file sets is reported as not played
 MAPPED = {"kLST", "piterations", "bending constraint", "kDP", "kDF", "fixed nodes", "flags"}
 
@@ -64,39 +61,18 @@ class SimSoftBody:
     attached: dict = field(default_factory=dict)  # rigid body key -> node indices
     unmapped: list = field(default_factory=list)
 
-    def nodes(self, cid: int) -> np.ndarray:
+    cid: int = 0  # the PyBullet client
+
+    def nodes(self, cid: int | None = None) -> np.ndarray:
         """Node positions in the world, (n, 3)."""
+        cid = self.cid if cid is None else cid
         _, pos = pb.getMeshData(self.uid, -1, flags=pb.MESH_DATA_SIMULATION_MESH, physicsClientId=cid)
         return np.asarray(pos, dtype=float)
-
-
-def in_scene(scene) -> bool:
-    """True when some model defines a soft body: the world must then be a deformable one."""
-    return any(sb.defined for m in scene.all_models() for sb in m.soft_bodies)
 
 
 def enable_deformable_world(cid: int) -> None:
     """Must run before anything is created in the client (it resets the simulation)."""
     pb.resetSimulation(pb.RESET_USE_DEFORMABLE_WORLD, physicsClientId=cid)
-
-
-def _refers(ref: str | None, ns: str, sb) -> bool:
-    if not ref:
-        return False
-    # exact only: AMBF's substring lookup (§12) searches rigid bodies, and a rigid body whose
-    # name is part of a soft body's key must stay the rigid body
-    return ref in (sb.identifier, merge_namespace(ns, sb.namespace) + sb.identifier)
-
-
-def soft_end(m, j) -> tuple[object | None, str | None]:
-    """(soft body, 'parent' | 'child') when joint ``j`` of model ``m`` names one of its soft bodies."""
-    ns = m.namespace or ""
-    for sb in m.soft_bodies:
-        if _refers(j.child, ns, sb):
-            return sb, "child"
-        if _refers(j.parent, ns, sb):
-            return sb, "parent"
-    return None, None
 
 
 class SoftBodies:
@@ -165,7 +141,9 @@ class SoftBodies:
             pb.changeVisualShape(uid, -1, rgbaColor=colour, physicsClientId=w.cid)
         span = mesh.nodes.max(axis=0) - mesh.nodes.min(axis=0)
         key = w.registry.add(merge_namespace(m.namespace or "", sb.namespace) + sb.identifier, None)
-        made = SimSoftBody(key, sb, m, uid, mesh.node_count, len(mesh.triangles), float(np.linalg.norm(span)), params)
+        made = SimSoftBody(
+            key, sb, m, uid, mesh.node_count, len(mesh.triangles), float(np.linalg.norm(span)), params, cid=w.cid
+        )
         cfg = sb.config
         for i in (cfg.fixed_nodes or []) if cfg is not None else []:
             if 0 <= i < mesh.node_count:
@@ -244,16 +222,7 @@ class SoftBodies:
         if made is None or key is None or rigid is None or rigid.uid is None:
             w._warn("runner-soft-joint", f"{j.identifier}: soft body or rigid body not found; not attached", j)
             return
-        pivot = j.child_pivot if end == "child" else j.parent_pivot
-        local = np.array([*pivot]) * (soft.scale or 1.0) if pivot is not None else np.zeros(3)
-        pose = pose_to_matrix(pose_or_identity(soft.location))
-        at = pose[:3, :3] @ local + pose[:3, 3]
-        nodes = made.nodes(w.cid)
-        d = np.linalg.norm(nodes - at, axis=1)
-        radius = max(made.params["collisionMargin"], 1e-3)
-        chosen = np.flatnonzero(d <= radius)
-        if len(chosen) == 0:
-            chosen = np.array([int(np.argmin(d))])
+        chosen = held_nodes(soft, j, end, made.nodes())
         for i in chosen:
             pb.createSoftBodyAnchor(made.uid, int(i), rigid.uid, rigid.link, physicsClientId=w.cid)
         made.attached.setdefault(key, []).extend(int(i) for i in chosen)
@@ -269,40 +238,15 @@ class SoftBodies:
 
     # ---- queries -------------------------------------------------------------------------
     def lowest_z(self) -> float | None:
-        zs = [float(s.nodes(self.world.cid)[:, 2].min()) for s in self.items]
+        zs = [float(s.nodes()[:, 2].min()) for s in self.items]
         return min(zs) if zs else None
 
     def report(self, floor_z: float) -> tuple[list[dict], list[str], list[str], list[str]]:
         """(per-soft-body entries, nan keys, exploded keys, fell-through-floor keys)."""
-        rows, nan, exploded, fell = [], [], [], []
-        for s in self.items:
-            p = s.nodes(self.world.cid)
-            finite = bool(np.all(np.isfinite(p)))
-            size = float(np.linalg.norm(p.max(axis=0) - p.min(axis=0))) if finite else None
-            rows.append(
-                {
-                    "name": s.key,
-                    "nodes": s.node_count,
-                    "triangles": s.triangles,
-                    "fixed_nodes": len(s.fixed),
-                    "attached_nodes": {k: len(v) for k, v in s.attached.items()},
-                    "lowest_z": float(p[:, 2].min()) if finite else None,
-                    "size_m": size,
-                    "rest_size_m": s.rest_size,
-                    "spring_stiffness": s.params["springElasticStiffness"],
-                    "not_played": s.unmapped,
-                }
-            )
-            if not finite:
-                nan.append(s.key)
-            elif size > EXPLODED_STRETCH * max(s.rest_size, 1e-6):
-                exploded.append(s.key)
-            elif p[:, 2].min() < floor_z - 0.1:
-                fell.append(s.key)
-        return rows, nan, exploded, fell
+        return soft_report(self.items, floor_z, lambda s: {"spring_stiffness": s.params["springElasticStiffness"]})
 
     def close(self) -> None:
         shutil.rmtree(self._tmp, ignore_errors=True)
 
 
-__all__ = ["SimSoftBody", "SoftBodies", "in_scene", "enable_deformable_world", "soft_end"]
+__all__ = ["SimSoftBody", "SoftBodies", "enable_deformable_world"]

@@ -17,6 +17,8 @@ import pybullet as pb
 
 from ..options import Options
 from ..rotations import matrix_to_pq, pose_matrix, quat_to_matrix
+from ..soft import in_scene as soft_in_scene
+from ..soft import soft_health
 from ..stability import CHECK_EVERY_S
 from ..world import World
 from . import egl
@@ -26,7 +28,6 @@ from .bodies import SimBody
 from .cameras import choose_renderer, render
 from .interact import Interaction
 from .softbodies import SoftBodies, enable_deformable_world
-from .softbodies import in_scene as soft_in_scene
 from .state import WorldState
 
 
@@ -206,13 +207,9 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         return parts is not None and not parts.types and parts.plane is None
 
     def _engine_report(self, rep: dict) -> dict:
-        soft = self.soft.report(self._floor_z) if self.soft is not None else ([], [], [], [])
         return {
             "engine": "pybullet",
-            "soft_bodies": soft[0],
-            "nan": rep["nan"] + soft[1],
-            "exploded": rep["exploded"] + soft[2],
-            "fell_through_floor": rep["fell_through_floor"] + soft[3],
+            **soft_health(self.soft, self._floor_z, rep),
             "spring_joints": len(self.springs.joints),
             "renderer": self.renderer,
             **({"renderer_note": self.renderer_note} if self.renderer_note else {}),
