@@ -6,7 +6,13 @@ median and 99th percentile of: the control step alone (contact force, wear, remo
 counts; `DrillTask.step`), the local re-mesh of the blocks it changed (done per rendered
 frame, here measured after every step too), and, for comparison, one full marching-cubes
 re-mesh of the volume. Wall time on a loaded machine has outliers from other processes; the
-thread's CPU time is printed beside it.   Usage: python bench/drilling.py [--voxels 256]
+thread's CPU time is printed beside it.
+
+With ``--memory N``: the whole `adfkit drill` of the skull scene (adfkit.scenes.skull, RGBA
+slices as the drilling projects ship them) at N voxels a side, in a child process: its peak
+resident memory and wall time.
+
+Usage: python bench/drilling.py [--voxels 256] [--memory 512]
 """
 
 from __future__ import annotations
@@ -24,7 +30,10 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--voxels", type=int, default=256)
     ap.add_argument("--steps", type=int, default=1000)
+    ap.add_argument("--memory", type=int, help="voxels a side of the skull scene drilled whole (e.g. 512)")
     args = ap.parse_args()
+    if args.memory:
+        return _memory(args.memory)
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")  # one core
     sys.path.insert(0, str(ROOT))
@@ -37,12 +46,12 @@ def main() -> int:
 
     p = DrillingParams(voxels=args.voxels)
     t0 = time.perf_counter()
-    values = bone_voxels(p).astype(np.float32) / 255.0
-    labels = label_array(values, [(150 / 255, 1.0), (60 / 255, 120 / 255)])
-    vol = EditableVolume(values, np.full(3, p.size), 0.5, labels, ["unlabelled", "bone", "canal"])
+    values = bone_voxels(p)  # 8-bit values, as `adfkit drill` holds 8-bit slices
+    labels = label_array(values, [(150, 255), (60, 120)], 255.0)
+    vol = EditableVolume(values, np.full(3, p.size), 127.5, labels, ["unlabelled", "bone", "canal"])
     t_setup = time.perf_counter() - t0
     t0 = time.perf_counter()
-    surface = BlockSurface(vol.values, vol.dimensions, 0.5)
+    surface = BlockSurface(vol.values, vol.dimensions, vol.iso)
     t_full = time.perf_counter() - t0
     pose = np.eye(4)
     pose[2, 3] = p.size / 2
@@ -68,7 +77,7 @@ def main() -> int:
         remesh.append(t2 - t1)
     step_ms, cpu_ms, remesh_ms = np.array(step) * 1e3, np.array(cpu) * 1e3, np.array(remesh) * 1e3
     removed = int(task.state.removed.sum())
-    print(f"volume {args.voxels}^3 ({values.nbytes / 2**20:.0f} MiB float32), set-up {t_setup:.2f} s")
+    print(f"volume {args.voxels}^3 ({values.nbytes / 2**20:.0f} MiB, uint8), set-up {t_setup:.2f} s")
     print(f"full marching-cubes build of the surface ({len(surface.meshes)} blocks): {t_full * 1e3:.0f} ms")
     print(f"{len(step)} control steps, burr radius {p.burr_radius / (p.size / args.voxels):.1f} voxels:")
     print(
@@ -85,6 +94,45 @@ def main() -> int:
     )
     print(f"  voxels removed {removed}, burr now at z = {task.burr[2] * 1e3:.2f} mm")
     return 0
+
+
+def _memory(voxels: int) -> int:
+    import resource
+    import subprocess
+    import tempfile
+
+    sys.path.insert(0, str(ROOT))
+    from adfkit.scenes.skull import SkullParams, write_skull
+
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        launch = write_skull(tmp, SkullParams(voxels=voxels))
+        t_write = time.perf_counter() - t0
+        path = Path(tmp) / "path.txt"
+        path.write_text("0.005 0.002 0.030\n0.004 0.002 0.016\n0.0 0.0 0.016\n")  # into the mastoid, then along
+        t0 = time.perf_counter()
+        r = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "adfkit",
+                "drill",
+                str(launch),
+                "--path",
+                str(path),
+                "--out",
+                str(Path(tmp) / "out"),
+            ],
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        wall = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 2**20
+    print(f"skull scene {voxels}^2 x {SkullParams(voxels=voxels).slices} slices (RGBA), written in {t_write:.1f} s")
+    print(r.stdout.strip() or r.stderr.strip()[-400:])
+    print(f"adfkit drill: {wall:.1f} s wall, peak resident memory {peak:.2f} GiB (goal < 2 GiB)")
+    return r.returncode
 
 
 if __name__ == "__main__":

@@ -149,3 +149,17 @@ def test_rgba_slices_are_drilled_and_keep_their_colours(drilling_project):
     m = json.loads((root / "out" / "metrics.json").read_text())
     assert removed == m["voxels_removed_total"] > 0 and kept > 1000
     assert main(["validate", str(root / "out" / "volume.yaml")]) == 0
+
+
+def test_the_skull_scene_is_laid_out_as_the_projects_and_drills(tmp_path, capsys):
+    from adfkit.scenes.skull import SkullParams, write_skull
+    from adfkit.validator.engine import validate_paths
+
+    launch = write_skull(tmp_path, SkullParams(voxels=32))
+    results, problems = validate_paths([launch])
+    found = [(str(d.severity), d.rule) for r in results for d in r.diagnostics] + [(p.rule,) for p in problems]
+    assert found == [("info", "volume-slice-count")]  # 30 slices under count 512; cameras under main_camera
+    assert main(["drill", str(launch), "--out", str(tmp_path / "out"), "--frames", "2"]) == 0
+    assert "burr: BODY 2mm, a sphere fitted to the tip of 2mm.OBJ" in capsys.readouterr().out
+    m = json.loads((tmp_path / "out" / "metrics.json").read_text())
+    assert m["burr"]["radius_m"] == pytest.approx(0.001, rel=0.01) and m["voxels_removed_total"] > 0

@@ -179,3 +179,16 @@ def test_cameras_and_a_light_hang_from_a_camera(tmp_path, engine):
     finally:
         world.close()
     assert not [d for d in world.diagnostics if d.rule in ("runner-parent", "runner-camera")]
+
+
+def test_validate_knows_a_camera_is_a_parent(tmp_path):
+    from adfkit.validator.engine import validate_paths
+
+    _stereo_scene(tmp_path)
+    rules = [d.rule for r in validate_paths([tmp_path / "launch.yaml"])[0] for d in r.diagnostics]
+    assert "dangling-reference" not in rules
+    (tmp_path / "stereo.yaml").write_text(STEREO.replace("parent: main_camera", "parent: side_camera", 1))
+    found = [d for r in validate_paths([tmp_path / "launch.yaml"])[0] for d in r.diagnostics]
+    assert [d.message for d in found if d.rule == "dangling-reference"] == [
+        "'parent' of 'stereoL' is 'side_camera', which names no body in this file or the models loaded before it"
+    ]

@@ -152,14 +152,13 @@ def run(args) -> int:
     st = task.state
     names = vol.label_names
     removed = {names[i]: int(st.removed[i]) for i in range(1, len(names))}
-    trace = np.array(st.trace) if st.trace else np.zeros((0, 8))
+    trace = np.array(st.trace) if st.trace else np.zeros((0, 9))
     fmag = np.linalg.norm(trace[:, 4:7], axis=1) if len(trace) else np.zeros(0)
     keep = np.unique(np.linspace(0, len(trace) - 1, min(len(trace), 500)).astype(int)) if len(trace) else []
     protected_hits = {}
     for lid, (t_first, where) in sorted(st.first_touch.items()):
         n = int(np.count_nonzero(vol.protected_hit & (vol.labels == lid)))
         protected_hits[names[lid]] = {"voxels_touched": n, "first_time_s": round(t_first, 6), "first_burr_m": where}
-    verts, faces = surface.mesh()
     metrics = {
         "scene": str(launch),
         "volume": ds.volume.identifier,
@@ -170,7 +169,10 @@ def run(args) -> int:
             "start_m": ds.burr_start.tolist(),
         },
         "path_m": task.points.tolist(),
-        "labels": {n: list(r) if np.isfinite(r[1]) else [r[0], None] for n, r in zip(names[1:], ds.label_ranges)},
+        "labels": {  # 0..1 of full scale
+            n: [r[0] / ds.data.unit, r[1] / ds.data.unit if np.isfinite(r[1]) else None]
+            for n, r in zip(names[1:], ds.label_ranges)
+        },
         "labels_file": ds.labels_file,
         "protected": sorted(ds.protected),
         "voxel_size_m": vol.step.tolist(),
@@ -185,6 +187,8 @@ def run(args) -> int:
         "force": {
             "max_n": float(fmag.max()) if len(fmag) else 0.0,
             "mean_in_contact_n": float(fmag[fmag > 0].mean()) if np.any(fmag > 0) else 0.0,
+            "pull_max_n": float(trace[:, 8].max()) if len(trace) else 0.0,
+            "steps_above_pull_cap": int((fmag > params.max_force).sum()),
             "profile": {
                 "t_s": [round(float(trace[k, 0]), 6) for k in keep],
                 "force_n": [round(float(fmag[k]), 6) for k in keep],
@@ -193,14 +197,14 @@ def run(args) -> int:
             },
         },
         "params": {k: getattr(params, k) for k in params.__dataclass_fields__},
-        "surface": {"triangles": int(len(faces)), "blocks_remeshed": surface.remeshed},
+        "surface": {"triangles": surface.triangles, "blocks_remeshed": surface.remeshed},
         "wall_s": {"drilling_per_step": step_s / max(1, st.steps), "remesh_total": remesh_s},
     }
     prefix = ds.volume.images.prefix
     try:
         outp.write_slices(ds.data.files, vol.removed_mask, out / "slices", prefix)
         outp.write_volume_model(ds.volume, ds.model, vol.values.shape[0], prefix, out / "volume.yaml")
-        outp.write_surface(verts, faces, out / "surface.stl")
+        surface.write_stl(out / "surface.stl")
         outp.write_metrics(metrics, out / "metrics.json")
         outp.write_gif(frames, out / "drilling.gif")
     except OSError as exc:

@@ -33,12 +33,17 @@ DEFAULT_ISO = 0.5
 
 @dataclass
 class VolumeData:
-    voxels: np.ndarray  # (slices, rows, columns) float32 in 0..1; row 0 is the slices' bottom row
+    voxels: np.ndarray  # (slices, rows, columns) float32 in 0..1 (raw: the slices' own values); row 0 the bottom row
     dimensions: np.ndarray  # (3,) metres along x (columns), y (rows), z (slices), scale applied
     files: list[Path]
     full_scale: float = 1.0  # the slice value that reads as 1.0 (255 for 8-bit slices)
     findings: list[Diagnostic] = field(default_factory=list)  # what is odd but AMBF loads (notes, warnings)
     count: int = 0  # `images: count` as written
+
+    @property
+    def unit(self) -> float:
+        """Full scale in the array's units: ``full_scale`` for raw integer values, else 1."""
+        return self.full_scale if self.voxels.dtype.kind in "ui" else 1.0
 
 
 def _where(vol, key: str | None = None) -> SourceLocation:
@@ -195,11 +200,13 @@ def volume_facts(model, vol) -> dict:
     return out
 
 
-def load_volume(model, vol) -> VolumeData:
+def load_volume(model, vol, raw: bool = False) -> VolumeData:
     """Every slice of ``vol`` as one array, each read through the input policy; a slice outside
     the tree, not an image or of another size is a located error. What AMBF loads but a modeller
     should hear about (a gap, opaque colour slices, count above the slices found) is in
-    ``findings``."""
+    ``findings``. ``raw``: the values as the slices hold them (uint8 for 8-bit slices, uint16 for
+    16-bit ones, a quarter or half the memory of float32: the drill's 512³ volume), to be read
+    against ``full_scale``."""
     from PIL import Image, UnidentifiedImageError
 
     found = slice_files(model, vol)
@@ -230,7 +237,9 @@ def load_volume(model, vol) -> VolumeData:
                     f"{len(files)} slices of {size[1]}x{size[0]} are more than {MAX_VOXELS:,} voxels",
                     "downsample the slices",
                 )
-            voxels = np.empty((len(files), *size), dtype=np.float32)
+            kind = arr.dtype if raw and arr.dtype in (np.uint8, np.uint16) else np.float32
+            voxels = np.empty((len(files), *size), dtype=kind)
+            peak = peak_i  # the first slice's kind is the volume's (AMBF's rule for a set of images)
         elif arr.shape != size:
             raise _fail(
                 vol,
@@ -240,12 +249,12 @@ def load_volume(model, vol) -> VolumeData:
             )
         if flat:
             opaque.append(i)
-        peak = max(peak, peak_i)
-        voxels[i] = arr
+        voxels[i] = arr if peak_i == peak else np.clip(arr * (peak / peak_i), 0, peak)  # 8 among 16 bit
     assert voxels is not None
     if peak == 1.0 and voxels.size and voxels.max() > 1.0:  # 32-bit integer or float slices: their own maximum
         peak = float(voxels.max())
-    voxels /= peak
+    if voxels.dtype == np.float32:
+        voxels /= peak
     d = vol.dimensions
     dims = np.array(
         [

@@ -22,6 +22,7 @@ BUILDERS = {
     "suturing-pad": _lazy("suturing_pad", "write_suturing_pad"),
     "soft-phantom": _lazy("soft_phantom", "write_soft_phantom"),
     "drilling": _lazy("drilling", "write_drilling"),
+    "skull": _lazy("skull", "write_skull"),
     "parity": _lazy("parity", "write_parity"),
 }
 
@@ -32,6 +33,7 @@ _EXPORTS = {
     "write_suturing": "suturing",
     "write_soft_phantom": "soft_phantom",
     "write_drilling": "drilling",
+    "write_skull": "skull",
     "write_parity": "parity",
 }
 

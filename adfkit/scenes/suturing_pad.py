@@ -248,9 +248,10 @@ def build_suturing_pad(p: SuturingPadParams | None = None) -> ModelFile:
     return m
 
 
-def build_floor() -> ModelFile:
+def build_floor(top: float = 0.0) -> ModelFile:
+    """A static 2 m square floor whose top face is at z = ``top``."""
     m = ModelFile(namespace="/ambf/env/")
-    m.bodies.append(_static_box("BODY Floor", "Floor", (2.0, 2.0, 0.02), Pose(Vec3(0, 0, -0.01)), FLOOR))
+    m.bodies.append(_static_box("BODY Floor", "Floor", (2.0, 2.0, 0.02), Pose(Vec3(0, 0, top - 0.01)), FLOOR))
     return m
 
 

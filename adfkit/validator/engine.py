@@ -190,6 +190,9 @@ def validate_files(files, kind: str | None = None, follow: bool = True) -> list[
             for p in targets.get(slot, []):
                 if os.path.lexists(p):
                     res = run(p, k, tree=launch.tree, referrer=launch.where(slot))
+                    if k == "world" and isinstance(res.doc, World) and res.doc.cameras:
+                        # the world's cameras: parents the models' cameras and lights may name
+                        context.append(ModelFile(namespace=res.doc.namespace, cameras=list(res.doc.cameras)))
                     if k == "world" and isinstance(res.doc, World) and res.doc.environment:
                         env_path = paths_check.relative_to_file(res.doc.path, res.doc.environment)
                         env = results.get(Path(os.path.realpath(env_path)))

@@ -51,3 +51,13 @@ def body_registry(models) -> Registry:
         for b in m.bodies:
             reg.add(object_key(m.namespace, b), b)
     return reg
+
+
+def camera_registry(models) -> Registry:
+    """The cameras of ``models``: AMBF finds a parent among every object, and cameras are
+    parents of cameras and lights (the drilling projects' stereoL under main_camera)."""
+    reg = Registry()
+    for m in models:
+        for c in m.cameras:
+            reg.add(object_key(m.namespace, c), c)
+    return reg

@@ -22,7 +22,7 @@ from ..model.spec import Node
 from ..model.spec import adf_fields as _adf_fields
 from ..model.spec import adf_keys as _adf_keys
 from . import softbody_rules
-from .references import Registry, body_registry, merge_namespace
+from .references import Registry, body_registry, camera_registry, merge_namespace
 from .rules import RULES
 
 
@@ -272,8 +272,9 @@ class Checker:
         for s in [*m.sensors, *m.actuators]:
             self.sensor(s)
             self.reference(m, s, "parent", own, earlier, immediate=True)
+        cameras = camera_registry([*self.context, m])
         for obj in [*m.ghost_objects, *m.cameras, *m.lights, *m.volumes]:
-            self.reference(m, obj, "parent", own, earlier, immediate=False)
+            self.reference(m, obj, "parent", own, earlier, immediate=False, cameras=cameras)
         for v in m.vehicles:
             self.reference(m, v, "chassis", Registry(), earlier, immediate=True, world_only=True)
             for w in v.wheels or []:
@@ -586,6 +587,7 @@ class Checker:
         immediate: bool,
         world_only: bool = False,
         owner=None,
+        cameras: Registry | None = None,
     ):
         text = getattr(obj, key)
         label = (owner or obj).identifier
@@ -597,6 +599,10 @@ class Checker:
             status, hits = registry.lookup(text, prefixed)
             if status == "found":
                 return registry.keys[hits[0]]
+            if status == "missing" and registry is earlier and cameras is not None:
+                status, found = cameras.lookup(text, prefixed)
+                if status == "found":
+                    return cameras.keys[found[0]]
             if status == "ambiguous":
                 self.emit(
                     "ambiguous-reference",

@@ -145,7 +145,7 @@ def _from_body(model, body, radius: float | None) -> Burr:
 def find_burr(scene, name: str | None, radius: float | None = None) -> Burr:
     """The burr: the body ``name`` names (a sphere shape, or a drill mesh); without a name, the
     sphere body whose name holds 'burr', else the only sphere body, else the only body whose
-    name holds 'drill' or 'burr'."""
+    name holds 'drill' or 'burr', else the only body drawn with a mesh."""
     bodies = _candidates(scene)
     if name:
         hit = [(m, b) for m, b in bodies if name in _names(b)]
@@ -164,6 +164,8 @@ def find_burr(scene, name: str | None, radius: float | None = None) -> Burr:
     pick = [s for s in spheres if "burr" in (s[1].name or s[1].identifier).lower()] or spheres
     if not pick:
         pick = [(m, b) for m, b in bodies if any(w in (b.name or b.identifier).lower() for w in ("drill", "burr"))]
+    if not pick:
+        pick = [(m, b) for m, b in bodies if mesh_path(m, b) is not None]
     if len(pick) != 1:
         listed = ", ".join(b.identifier for _, b in pick or bodies) or "none"
         raise AdfError(

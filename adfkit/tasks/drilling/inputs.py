@@ -96,13 +96,17 @@ def read_labels(path: Path, full_scale: float, tree) -> tuple[list[str], list[tu
     return names, [(max(lo, 0.0) / full_scale, hi / full_scale) for lo, hi in ranges], set(protected)
 
 
-def label_array(values: np.ndarray, ranges: list[tuple[float, float]]) -> np.ndarray:
-    """uint8 label id per voxel: 1 + the first range holding its value, 0 for none (or empty)."""
+def label_array(values: np.ndarray, ranges: list[tuple[float, float]], unit: float = 1.0) -> np.ndarray:
+    """uint8 label id per voxel: 1 + the first range holding its value, 0 for none (or empty);
+    ``ranges`` in the values' units (``unit``: full scale in them), a few slices at a time."""
     out = np.zeros(values.shape, dtype=np.uint8)
-    eps = 0.5 / 65535.0  # a value written as an integer and normalised may sit this far off
-    for i in range(len(ranges) - 1, -1, -1):
-        lo, hi = ranges[i]
-        out[(values >= lo - eps) & (values <= hi + eps) & (values > 0)] = i + 1
+    eps = 0.5 / 65535.0 * unit  # a value written as an integer and normalised may sit this far off
+    for z in range(0, len(values), 16):
+        v, o = values[z : z + 16], out[z : z + 16]
+        tissue = v > 0
+        for i in range(len(ranges) - 1, -1, -1):
+            lo, hi = ranges[i]
+            o[(v >= lo - eps) & (v <= hi + eps) & tissue] = i + 1
     return out
 
 

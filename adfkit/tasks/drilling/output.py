@@ -79,13 +79,6 @@ def write_volume_model(volume, model, count: int, prefix: str, path: Path) -> Pa
     return write_file(ModelFile(namespace=model.namespace, volumes=[vol]), path)
 
 
-def write_surface(verts: np.ndarray, faces: np.ndarray, path: Path) -> None:
-    import trimesh
-
-    mesh = trimesh.Trimesh(np.asarray(verts, dtype=float), np.asarray(faces), process=False)
-    atomic_write_bytes(path, mesh.export(file_type="stl"))
-
-
 def write_metrics(metrics: dict, path: Path) -> None:
     atomic_write_text(path, json.dumps(metrics, indent=2, allow_nan=False) + "\n")
 
@@ -146,4 +139,4 @@ def write_gif(frames: list, path: Path, fps: float = 10.0) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
-__all__ = ["render_frame", "write_gif", "write_metrics", "write_slices", "write_surface", "write_volume_model"]
+__all__ = ["render_frame", "write_gif", "write_metrics", "write_slices", "write_volume_model"]

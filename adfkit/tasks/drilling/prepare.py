@@ -125,12 +125,12 @@ def prepare(
 
     model, vol = find_volume(scene, volume_name)
     burr = find_burr(scene, burr_name, burr_radius)
-    data = load_volume(model, vol)
-    iso = vol.iso_surface_value if vol.iso_surface_value is not None else DEFAULT_ISO
+    data = load_volume(model, vol, raw=True)  # the slices' own values: uint8 for 8-bit slices
+    iso = (vol.iso_surface_value if vol.iso_surface_value is not None else DEFAULT_ISO) * data.unit
     labels_path = relative_to_file(model.path, str(vol.images.path)) / "labels.yaml"
     labels_file = None
     if os.path.lexists(labels_path):
-        names, ranges, protected = read_labels(labels_path, data.full_scale, getattr(model, "tree", None))
+        names, ranges, protected = read_labels(labels_path, data.full_scale / data.unit, getattr(model, "tree", None))
         labels_file = str(labels_path)
     else:
         names, ranges, protected = default_labels(iso)
@@ -164,9 +164,11 @@ def prepare(
 def editable(ds: DrillScene) -> EditableVolume:
     from ...geometry.volume import DEFAULT_ISO
 
-    iso = ds.volume.iso_surface_value if ds.volume.iso_surface_value is not None else DEFAULT_ISO
+    iso = (ds.volume.iso_surface_value if ds.volume.iso_surface_value is not None else DEFAULT_ISO) * ds.data.unit
     vals = ds.data.voxels
-    return EditableVolume(vals, ds.data.dimensions, iso, label_array(vals, ds.label_ranges), ds.label_names)
+    return EditableVolume(
+        vals, ds.data.dimensions, iso, label_array(vals, ds.label_ranges, ds.data.unit), ds.label_names
+    )
 
 
 def default_path(ds: DrillScene, vol: EditableVolume, depth: float) -> np.ndarray:

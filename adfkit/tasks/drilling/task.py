@@ -40,8 +40,9 @@ class DrillState:
     steps: int = 0
     removed: np.ndarray | None = None  # per label id
     first_touch: dict[int, tuple[float, list[float]]] = field(default_factory=dict)  # protected label -> (t, where)
-    trace: list[tuple[float, float, float, float, float, float, float, float]] = field(default_factory=list)
-    # per step: t, burr x, y, z (world), contact force x, y, z (world, N), deepest penetration (m)
+    trace: list[tuple[float, float, float, float, float, float, float, float, float]] = field(default_factory=list)
+    # per step: t, burr x, y, z (world), contact force x, y, z (world, N), deepest penetration (m),
+    # the coupling's pull (N, at most max_force)
 
 
 class DrillTask:
@@ -116,7 +117,7 @@ class DrillTask:
         if n > p.max_force:
             pull *= p.max_force / n
         self.burr = self.burr + p.dt * (pull + f_contact) / p.damping
-        st.trace.append((st.t, *self.burr.tolist(), *f_contact.tolist(), contact.depth))
+        st.trace.append((st.t, *self.burr.tolist(), *f_contact.tolist(), contact.depth, float(np.linalg.norm(pull))))
 
     def run(self, on_step: Callable[[DrillTask], None] | None = None) -> DrillState:
         for _ in range(self.total_steps):
