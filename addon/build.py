@@ -300,7 +300,7 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     _scene_snapshot(scene, doc)
     from .volumes import import_volumes
 
-    import_volumes(doc, scene, diags)  # pictures of the volumes (kind NONE: export keeps them as written)
+    import_volumes(doc, scene, diags, bodies)  # pictures of the volumes (kind NONE: export keeps them as written)
     diags.extend(mesh_import.UNREADABLE)
     mesh_import.UNREADABLE.clear()
     return made, diags

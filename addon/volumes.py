@@ -34,9 +34,14 @@ def _matrix(p: Pose):
     return m
 
 
-def import_volumes(doc, scene, diags: list[Diagnostic]) -> list:
-    """One mesh object per readable volume of ``doc``; returns them."""
+def import_volumes(doc, scene, diags: list[Diagnostic], bodies: dict | None = None) -> list:
+    """One mesh object per readable volume of ``doc``; returns them. A volume whose `parent`
+    names a body of ``bodies`` (identifier -> object) is placed in that body's frame and
+    parented to it, as AMBF places it (the skull-base project's volume under
+    ``BODY volume_Anatomical_Origin``)."""
     from adfkit.geometry.volume import DEFAULT_ISO, iso_surface, load_volume
+
+    from .build import _find
 
     made = []
     for vol in doc.volumes:
@@ -50,7 +55,10 @@ def import_volumes(doc, scene, diags: list[Diagnostic]) -> list:
                 diags.append(warning(d.rule, f"{d.message}; the volume is kept but not shown", d.location, d.hint))
             continue
         obj = _surface_object(scene, vol, verts, faces)
-        obj.matrix_world = _matrix(vol.location or Pose())
+        parent = _find(bodies or {}, vol.parent)
+        local = _matrix(vol.location or Pose())
+        obj.parent = parent
+        obj.matrix_world = parent.matrix_world.normalized() @ local if parent is not None else local
         obj.hide_select = True  # a picture of the slices: editing it would change nothing
         made.append(obj)
     return made
