@@ -43,6 +43,9 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
+    from . import scratch
+
+    scratch.sweep()  # what a killed command left in $TMPDIR
     try:
         return int(args._run(args) or 0)
     except AdfError as exc:
@@ -53,6 +56,8 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         return 0
+    finally:
+        scratch.cleanup()  # the command's temporary files
 
 
 if __name__ == "__main__":  # pragma: no cover

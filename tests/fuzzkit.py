@@ -24,6 +24,7 @@ import random
 import re
 import signal
 import sys
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -204,6 +205,7 @@ class Outcome:
     opened: list[str]
     scene: Path
     outside: Path
+    left: list[str] = field(default_factory=list)  # temporary files the command left behind
 
 
 def materialise(case: Case, scene: Path, outside: Path) -> None:
@@ -251,6 +253,10 @@ def run_case(case: Case, workdir: Path, timeout: float = 20.0) -> Outcome:
     )
     materialise(case, scene, outside)
     argv = [_fill(a, scene, outside) for a in case.argv]
+    tmpdir = workdir / "tmp"  # the command's $TMPDIR: empty when it returns
+    tmpdir.mkdir(parents=True, exist_ok=True)
+    old_tmp = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir = os.environ["TMPDIR"] = str(tmpdir)
     out, err = io.StringIO(), io.StringIO()
     rc, error = None, None
     old_env = os.environ.get("ADFKIT_INPUT_ROOT")
@@ -282,7 +288,28 @@ def run_case(case: Case, workdir: Path, timeout: float = 20.0) -> Outcome:
             os.environ.pop("ADFKIT_INPUT_ROOT", None)
         else:
             os.environ["ADFKIT_INPUT_ROOT"] = old_env
-    return Outcome(case, rc, out.getvalue(), err.getvalue(), error, opened, scene, outside)
+        tempfile.tempdir = old_tmp[0]
+        if old_tmp[1] is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = old_tmp[1]
+    return Outcome(case, rc, out.getvalue(), err.getvalue(), error, opened, scene, outside, left_behind(tmpdir, scene))
+
+
+#: what a writer puts beside its target until it renames it (adfkit.scratch, video.py, ...)
+BESIDE = re.compile(r"^\..+\.\d+\..*\.tmp(\.npz)?$|^\..+\.\d+\.[^/]*$|\.part\.|\.tmp\.png$")
+
+
+def left_behind(tmpdir: Path, scene: Path) -> list[str]:
+    """Every file or folder in the command's $TMPDIR, and every temporary file beside a target
+    in the scene's folder."""
+    left = [str(p) for p in sorted(tmpdir.iterdir())] if tmpdir.is_dir() else []
+    bpy = sys.modules.get("bpy")  # Blender's session folder lives as long as bpy (gone at exit)
+    live = os.path.realpath(bpy.app.tempdir) if bpy is not None and getattr(bpy, "app", None) else None
+    left = [p for p in left if os.path.realpath(p) != live]
+    for root, dirs, files in os.walk(scene):
+        left += [os.path.join(root, n) for n in dirs + files if BESIDE.search(n)]
+    return left
 
 
 def _strict_json(text: str) -> object:
@@ -318,6 +345,8 @@ def problems(o: Outcome) -> list[str]:
     text = o.out + o.err
     if o.error:
         return [f"escaped: {o.error}"]
+    if o.left:
+        bad.append(f"left temporary files behind: {o.left[:3]}")
     if o.rc not in (0, 1, 2):
         bad.append(f"exit status {o.rc}")
     if "Traceback (most recent call last)" in text:

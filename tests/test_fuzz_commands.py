@@ -221,6 +221,11 @@ def test_the_checks_catch_what_they_claim(tmp_path):
         "opened a device or FIFO: /dev/zero",
     ]
     assert fuzzkit.problems(mk(None, error="timeout after 1 s")) == ["escaped: timeout after 1 s"]
+    left = mk(0)
+    left.left = [str(tmp_path / "tmp" / "adfkit-run-1-x")]
+    assert fuzzkit.problems(left)[0].startswith("left temporary files behind")
+    (scene / ".out.xml.4242.abcd.tmp").write_text("x")  # a writer's temporary file beside its target
+    assert fuzzkit.left_behind(tmp_path / "none", scene) == [str(scene / ".out.xml.4242.abcd.tmp")]
 
 
 # --- slow: >= 100,000 cases --------------------------------------------------------------------

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +17,7 @@ from ..model import Colors, Pose, Quat, Vec3, quat_to_rpy
 from ..model.files import AdfFile, ObjectList
 from ..model.pose import written_rpy
 from ..model.spec import FloatOr, ListOf, Node, adf_fields
+from ..scratch import temp_beside
 
 
 class _Flow(dict):
@@ -179,7 +179,7 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     Returns the path written."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = temp_beside(path)  # .<name>.<pid>.*.tmp: a later write removes it if this one is killed
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)

@@ -25,7 +25,6 @@ def add_arguments(p) -> None:
 
 def run(args) -> int:
     import sys
-    import tempfile
 
     from ..adf import load_scene, parse_indices
     from ..diagnostics import Severity
@@ -39,9 +38,10 @@ def run(args) -> int:
     else:
         launch, indices = BUNDLED, None
         if not launch.exists():  # installed without the repository's sample_scenes/: author it now
+            from .. import scratch
             from ..scenes import write_suturing
 
-            launch = write_suturing(Path(tempfile.mkdtemp(prefix="adfkit-demo-")))
+            launch = write_suturing(scratch.mkdtemp("adfkit-demo-"))
     diags: list = []
     scene = load_scene(launch, parse_indices(indices) if indices else None, diags)
     print_diagnostics(diags, sys.stderr)

@@ -16,7 +16,6 @@ import dataclasses
 import hashlib
 import json
 import os
-import tempfile
 import time
 from dataclasses import dataclass
 from importlib import metadata
@@ -26,6 +25,7 @@ import manifold3d
 import numpy as np
 import trimesh
 
+from ..scratch import temp_beside
 from .repair import from_manifold
 
 #: Number of times CoACD itself ran in this process (the cache skips it).
@@ -97,7 +97,7 @@ def _read_cache(path: Path) -> list[trimesh.Trimesh] | None:
 
 def _write_cache(path: Path, hulls: list[trimesh.Trimesh]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
+    fd, tmp = temp_beside(path, ".tmp.npz")
     os.close(fd)
     try:
         np.savez(

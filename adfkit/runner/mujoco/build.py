@@ -15,13 +15,13 @@ runner adds (docs/mujoco.md):
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
+from ... import scratch
 from ...converters.mjcf_write import to_mjcf
 from ...model.semantics import JointKind, ShapeKind, collision_primitives, joint_frames, pose_or_identity
 from ...model.tree import ONE_DOF
@@ -168,7 +168,7 @@ def build_plan(world) -> Plan:
     from ..names import Registry, merge_namespace
 
     scene, opt = world.scene, world.opt
-    tmp = tempfile.TemporaryDirectory(prefix="adfkit-mj-")
+    tmp = scratch.temporary_directory("adfkit-mj-")
     out_dir = Path(tmp.name)
     spec = mujoco.MjSpec()
     spec.compiler.degree = False

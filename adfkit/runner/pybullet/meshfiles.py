@@ -4,13 +4,13 @@ are refused with a reason (too large, unreadable, a binary STL whose size lies).
 from __future__ import annotations
 
 import contextlib
+import itertools
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from ... import inputs
+from ... import inputs, scratch
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import AdfError
 from ...geometry.meshcheck import obj_material_problems
@@ -20,7 +20,7 @@ from .egl import quiet_stdout
 MESH_SUFFIXES = {".obj", ".stl"}  # what PyBullet's GEOM_MESH reads from a file
 
 
-_STL_DIR: str | None = None
+_MADE = itertools.count()  # numbers the files made in the scratch folder
 _STL_CACHE: dict[tuple[str, int, int], tuple[str | None, str | None]] = {}
 
 
@@ -38,7 +38,7 @@ def pybullet_mesh(model, path: Path) -> tuple[Path | None, str | None]:
         return path, None
     st = path.stat()
     key = (str(path), st.st_size, st.st_mtime_ns)
-    if key not in _STL_CACHE:
+    if key not in _STL_CACHE or not _still_there(_STL_CACHE[key][0]):
         _STL_CACHE[key] = _checked_stl(path, st.st_size)
     done, why = _STL_CACHE[key]
     return (Path(done) if done else None), why
@@ -59,15 +59,17 @@ def _checked_stl(path: Path, size: int) -> tuple[str | None, str | None]:
         mesh = load_mesh(path)
     except AdfError as exc:
         return None, f"{inputs.shown(path)} is not a readable mesh ({exc.diagnostics[0].message})"
-    global _STL_DIR
-    if _STL_DIR is None:
-        _STL_DIR = tempfile.mkdtemp(prefix="adfkit-stl-")
-    out = os.path.join(_STL_DIR, f"mesh_{len(_STL_CACHE)}.stl")
+    out = os.path.join(scratch.scratch_dir(), f"mesh_{next(_MADE)}.stl")
     mesh.export(out, file_type="stl")
     return out, None
 
 
 _HULL_CACHE: dict[tuple[str, int, int], Path] = {}
+
+
+def _still_there(made) -> bool:
+    """A cached file is still there (the scratch folder it was made in goes when a command ends)."""
+    return made is None or os.path.exists(made)
 
 
 def hull_pieces(path: Path, tree=None) -> Path:
@@ -81,7 +83,7 @@ def hull_pieces(path: Path, tree=None) -> Path:
         return path
     st = path.stat()
     key = (str(path), st.st_size, st.st_mtime_ns)
-    if key not in _HULL_CACHE:
+    if key not in _HULL_CACHE or not _still_there(_HULL_CACHE[key]):
         _HULL_CACHE[key] = _split_hulls(path, tree)
     return _HULL_CACHE[key]
 
@@ -97,10 +99,7 @@ def _split_hulls(path: Path, tree) -> Path:
     objects = {ln.strip() for ln in text.splitlines() if ln.startswith(("o ", "g "))}
     if len(pieces) <= max(len(objects), 1):
         return path  # one material per object: PyBullet's hulls are AMBF's
-    global _STL_DIR
-    if _STL_DIR is None:
-        _STL_DIR = tempfile.mkdtemp(prefix="adfkit-stl-")
-    out = Path(_STL_DIR) / f"hulls_{len(_HULL_CACHE)}.obj"
+    out = scratch.scratch_dir() / f"hulls_{next(_MADE)}.obj"
     out.write_text(pieces_obj_text(pieces), encoding="utf-8")
     return out
 

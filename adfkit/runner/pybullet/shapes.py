@@ -10,12 +10,11 @@ import math
 import os
 import tempfile
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pybullet as pb
 
-from ... import inputs
+from ... import inputs, scratch
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import Diagnostic, warning
 from ...geometry.meshcheck import mesh_problem, obj_material_problems
@@ -26,6 +25,7 @@ from ...model.semantics import (
     ShapeKind,
     collision_mesh_type,
     collision_primitives,
+    cone_vertices,
     shape_kind,
     shortest_arc,
 )
@@ -50,28 +50,24 @@ class ShapeParts:
 
 
 _CONE_CACHE: dict[tuple[float, float], str] = {}
-_CONE_DIR = None
 
 
 def cone_obj(radius: float, height: float) -> str:
-    """A cone along +z centred on half its height (Bullet's btConeShapeZ), as an OBJ file."""
-    global _CONE_DIR
+    """A cone along +z centred on half its height (Bullet's btConeShapeZ, model.semantics'
+    cone_vertices, as the MJCF writer's), as an OBJ file in the scratch folder."""
     key = (round(radius, 9), round(height, 9))
-    if key in _CONE_CACHE:
+    if key in _CONE_CACHE and os.path.exists(_CONE_CACHE[key]):
         return _CONE_CACHE[key]
-    if _CONE_DIR is None:
-        _CONE_DIR = tempfile.mkdtemp(prefix="adfkit-cones-")
-    n = 24
-    lines = [f"v 0 0 {height / 2:.9g}", f"v 0 0 {-height / 2:.9g}"]
-    for i in range(n):
-        a = 2 * math.pi * i / n
-        lines.append(f"v {radius * math.cos(a):.9g} {radius * math.sin(a):.9g} {-height / 2:.9g}")
+    pts = cone_vertices(radius, height)
+    n = len(pts) - 2
+    lines = [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in pts]
     for i in range(n):
         j = (i + 1) % n
         lines.append(f"f 1 {i + 3} {j + 3}")
         lines.append(f"f 2 {j + 3} {i + 3}")
-    path = os.path.join(_CONE_DIR, f"cone_{len(_CONE_CACHE)}.obj")
-    Path(path).write_text("\n".join(lines) + "\n")
+    fd, path = tempfile.mkstemp(prefix="cone_", suffix=".obj", dir=scratch.scratch_dir())
+    with os.fdopen(fd, "w") as f:
+        f.write("\n".join(lines) + "\n")
     _CONE_CACHE[key] = path
     return path
 

@@ -25,13 +25,12 @@ randomize constraints, ...) has no PyBullet counterpart and is reported once per
 from __future__ import annotations
 
 import shutil
-import tempfile
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pybullet as pb
 
+from ... import scratch
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import AdfError
 from ...geometry.softmesh import DEFAULT_SOFT_MASS, link_stiffness, placed_soft_mesh, write_obj
@@ -82,7 +81,7 @@ class SoftBodies:
         self.world = world
         self.items: list[SimSoftBody] = []
         self.joints: list[tuple] = []  # (model, joint) naming a soft body, claimed from the rigid build
-        self._tmp = Path(tempfile.mkdtemp(prefix="adfkit-soft-"))
+        self._tmp = scratch.mkdtemp("adfkit-soft-")
 
     def claim(self, m, j) -> bool:
         """Keep a joint that joins a soft body (built as anchors later); False for rigid joints."""

@@ -16,13 +16,13 @@ restores followed by the same steps agree bit for bit.
 from __future__ import annotations
 
 import os
-import tempfile
 import weakref
 from dataclasses import dataclass
 
 import numpy as np
 import pybullet as pb
 
+from ... import scratch
 from ..rotations import matrix_to_pq
 
 
@@ -58,7 +58,7 @@ class WorldState:
             n = len(art.records)
             states = pb.getJointStates(art.uid, list(range(n)), physicsClientId=cid) if n else []
             joints.append([(s[0], s[1]) for s in states])
-        with tempfile.TemporaryDirectory(prefix="adfkit-state-") as tmp:
+        with scratch.temporary_directory("adfkit-state-") as tmp:
             path = os.path.join(tmp, "state.bullet")
             pb.saveBullet(path, physicsClientId=cid)
             with open(path, "rb") as f:
@@ -105,7 +105,7 @@ class WorldState:
     def _restore_file(self, snap: Snapshot) -> None:
         if len(snap.bases) != sum(1 for sb in self.bodies if sb.link < 0 and sb.uid is not None and sb.uid >= 0):
             raise ValueError("the snapshot was taken in a world with other bodies")
-        with tempfile.TemporaryDirectory(prefix="adfkit-state-") as tmp:
+        with scratch.temporary_directory("adfkit-state-") as tmp:
             path = os.path.join(tmp, "state.bullet")
             with open(path, "wb") as f:
                 f.write(snap.bullet)

@@ -17,15 +17,15 @@ LAUNCH = "launch.yaml"
 
 def _write_bytes(path: Path, data: bytes) -> None:
     import os
-    import tempfile
 
     from ...adf.writer import atomic_write_text
+    from ...scratch import temp_beside
 
     if isinstance(data, str):
         atomic_write_text(path, data)
         return
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    fd, tmp = temp_beside(path)
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)

@@ -15,7 +15,6 @@ import io
 import json
 import os
 import shutil
-import tempfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -24,6 +23,7 @@ import numpy as np
 from ...adf import atomic_write_bytes, atomic_write_text, write_file
 from ...model import ModelFile
 from ...model.objects import VolumeImages
+from ...scratch import temp_dir_beside
 
 PALETTE = [
     (236, 226, 198),  # first tissue (bone)
@@ -46,7 +46,7 @@ def write_slices(sources: list[Path], removed: np.ndarray, folder: Path, prefix:
 
     folder = Path(folder)
     folder.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
+    tmp = temp_dir_beside(folder)  # .<name>.<pid>.*: a later write removes it if this one is killed
     try:
         files = []
         for i, src in enumerate(sources):
@@ -62,7 +62,7 @@ def write_slices(sources: list[Path], removed: np.ndarray, folder: Path, prefix:
         os.chmod(tmp, 0o755)
         old = None
         if folder.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{folder.name}.old.", dir=folder.parent))
+            old = temp_dir_beside(folder)
             os.replace(folder, old / "slices")
         os.replace(tmp, folder)
         if old is not None:
