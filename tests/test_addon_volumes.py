@@ -203,28 +203,12 @@ def test_a_project_shaped_volume_imports_under_its_parent_and_exports_as_written
     """The skull-base projects' shape: RGBA slices under `count: 512`, the volume hanging from a
     body at the anatomy's origin (turned 90° about z)."""
     import numpy as np
-    from volume_shapes import skull_rgba, volume_yaml, write_slices
+    from volume_shapes import skull_base
 
     from adfkit.geometry.volume import iso_surface, load_volume
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    write_slices(tmp_path / "slices", skull_rgba(12, 16))
-    body = (
-        "BODY volume_Anatomical_Origin:\n  name: volume_Anatomical_Origin\n  mass: 0.0\n"
-        "  shape: Sphere\n  geometry: {radius: 0.001}\n"
-        "  location: {position: {x: 0.1, y: 0.2, z: 0.3}, orientation: {r: 0.0, p: 0.0, y: 1.5707963267948966}}\n"
-    )
-    text = volume_yaml(
-        "skull",
-        "slices/",
-        dims=(0.04, 0.04, 0.03),
-        parent="BODY volume_Anatomical_Origin",
-        position=(0.01, 0.0, 0.0),
-        rpy=(0.0, 0.0, 0.0),
-        bodies=body,
-        body_list="[BODY volume_Anatomical_Origin]",
-    ).replace("  shaders:\n    path: ./shaders/volume/\n    vertex: shader.vs\n    fragment: shader.fs\n", "")
-    (tmp_path / "skull.yaml").write_text(text)
+    skull_base(tmp_path)
     made, diags = addon.build.import_model(tmp_path / "skull.yaml")
     assert [d for d in diags if d.severity >= Severity.WARNING] == []
     (obj,) = [o for o in bpy.context.scene.objects if o.get(addon.volumes.VOLUME_KEY) == "VOLUME skull"]

@@ -13,7 +13,7 @@ import pytest
 pytest.importorskip("skimage", reason="scikit-image (geometry extra) is not installed")
 trimesh = pytest.importorskip("trimesh")
 
-from volume_shapes import BONE, project  # noqa: E402
+from volume_shapes import BONE, project, write_launch  # noqa: E402
 
 from adfkit.cli import main  # noqa: E402
 
@@ -62,13 +62,8 @@ def drilling_project(tmp_path):
     (adf / "meshes" / "high_res").mkdir(parents=True)
     _drill_mesh(adf / "meshes" / "high_res" / "4mm.OBJ")
     (adf / "drills.yaml").write_text(DRILLS)
-    (tmp_path / "launch.yaml").write_text(
-        "world config: ADF/world.yaml\ncolor config: ADF/colors.yaml\ninput devices config: ADF/input_devices.yaml\n"
-        "multibody configs:\n  - ADF/drills.yaml\n  - ADF/volume_a.yaml\n  - ADF/volume_b.yaml\n"
-    )
     (adf / "world.yaml").write_text("enclosure size: {length: 10.0, width: 10.0, height: 3.0}\nnamespace: /ambf/env/\n")
-    (adf / "colors.yaml").write_text("colors: {}\n")
-    (adf / "input_devices.yaml").write_text("input devices: []\n")
+    write_launch(tmp_path, "ADF", "world.yaml", ["drills.yaml", "volume_a.yaml", "volume_b.yaml"])
     return tmp_path
 
 

@@ -11,15 +11,13 @@ import pytest
 
 pytest.importorskip("skimage", reason="scikit-image (geometry extra) is not installed")
 
-from volume_shapes import skull_rgba, volume_yaml, write_slices  # noqa: E402
+from volume_shapes import ORIGIN, skull_base, write_launch  # noqa: E402
 
 from adfkit.adf import load_scene  # noqa: E402
 from adfkit.runner import open_world  # noqa: E402
 from adfkit.runner.frames import camera_frame  # noqa: E402
 from adfkit.runner.options import Options  # noqa: E402
 from adfkit.runner.rotations import pose_to_matrix  # noqa: E402
-
-ORIGIN = (0.1, 0.2, 0.3)  # the parent body, turned 90° about z
 
 
 def _rz(a):
@@ -28,27 +26,7 @@ def _rz(a):
 
 
 def _skull_base(tmp_path, mass: float = 0.0):
-    """A model file as the skull-base project has its volume: under a body at the anatomy's origin."""
-    write_slices(tmp_path / "slices", skull_rgba(12, 16))
-    body = (
-        "BODY volume_Anatomical_Origin:\n  name: volume_Anatomical_Origin\n"
-        f"  mass: {mass}\n  shape: Sphere\n  geometry: {{radius: 0.001}}\n"
-        f"  location:\n    position: {{x: {ORIGIN[0]}, y: {ORIGIN[1]}, z: {ORIGIN[2]}}}\n"
-        "    orientation: {r: 0.0, p: 0.0, y: 1.5707963267948966}\n"
-    )
-    text = volume_yaml(
-        "skull",
-        "slices/",
-        count=512,
-        dims=(0.04, 0.04, 0.03),
-        parent="BODY volume_Anatomical_Origin",
-        position=(0.01, 0.0, 0.0),
-        rpy=(0.0, 0.0, 0.0),
-        bodies=body,
-        body_list="[BODY volume_Anatomical_Origin]",
-    ).replace("  shaders:\n    path: ./shaders/volume/\n    vertex: shader.vs\n    fragment: shader.fs\n", "")
-    (tmp_path / "skull.yaml").write_text(text)
-    return load_scene(tmp_path / "skull.yaml")
+    return load_scene(skull_base(tmp_path, mass))
 
 
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
@@ -145,13 +123,7 @@ stereoR:
 def _stereo_scene(tmp_path):
     (tmp_path / "world.yaml").write_text(WORLD)
     (tmp_path / "stereo.yaml").write_text(STEREO)
-    (tmp_path / "launch.yaml").write_text(
-        "world config: world.yaml\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
-        "multibody configs:\n  - stereo.yaml\n"
-    )
-    (tmp_path / "colors.yaml").write_text("colors: {}\n")
-    (tmp_path / "input_devices.yaml").write_text("input devices: []\n")
-    return load_scene(tmp_path / "launch.yaml")
+    return load_scene(write_launch(tmp_path, "", "world.yaml", ["stereo.yaml"]))
 
 
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])

@@ -85,6 +85,48 @@ VOLUME {name}:
 """
 
 
+ORIGIN = (0.1, 0.2, 0.3)  # the skull-base volume's parent body, turned 90° about z
+
+
+def skull_base(folder: Path, mass: float = 0.0) -> Path:
+    """A model file as the skull-base project has its volume: RGBA slices under count 512,
+    hanging from a body at the anatomy's origin (10 mm along its x); returns the file."""
+    write_slices(folder / "slices", skull_rgba(12, 16))
+    body = (
+        "BODY volume_Anatomical_Origin:\n  name: volume_Anatomical_Origin\n"
+        f"  mass: {mass}\n  shape: Sphere\n  geometry: {{radius: 0.001}}\n"
+        f"  location:\n    position: {{x: {ORIGIN[0]}, y: {ORIGIN[1]}, z: {ORIGIN[2]}}}\n"
+        "    orientation: {r: 0.0, p: 0.0, y: 1.5707963267948966}\n"
+    )
+    text = volume_yaml(
+        "skull",
+        "slices/",
+        dims=(0.04, 0.04, 0.03),
+        parent="BODY volume_Anatomical_Origin",
+        position=(0.01, 0.0, 0.0),
+        rpy=(0.0, 0.0, 0.0),
+        bodies=body,
+        body_list="[BODY volume_Anatomical_Origin]",
+    ).replace("  shaders:\n    path: ./shaders/volume/\n    vertex: shader.vs\n    fragment: shader.fs\n", "")
+    (folder / "skull.yaml").write_text(text)
+    return folder / "skull.yaml"
+
+
+def write_launch(root: Path, adf: str, world: str, models: list[str]) -> Path:
+    """``root/launch.yaml`` naming ``adf/world`` and the model files, with the colour and
+    input-device files AMBF requires (written empty into ``root/adf``)."""
+    d = root / adf if adf else root
+    pre = f"{adf}/" if adf else ""
+    (d / "colors.yaml").write_text("colors: {}\n")
+    (d / "input_devices.yaml").write_text("input devices: []\n")
+    listed = "".join(f"  - {pre}{m}\n" for m in models)
+    (root / "launch.yaml").write_text(
+        f"world config: {pre}{world}\ncolor config: {pre}colors.yaml\ninput devices config: {pre}input_devices.yaml\n"
+        f"multibody configs:\n{listed}"
+    )
+    return root / "launch.yaml"
+
+
 def write_shaders(adf_dir: Path) -> None:
     """The volume shader files the model files name (the runner does not use them)."""
     d = adf_dir / "shaders" / "volume"
@@ -113,4 +155,15 @@ def project(
     return adf
 
 
-__all__ = ["BONE", "SINUS", "project", "skull_rgba", "volume_yaml", "write_shaders", "write_slices"]
+__all__ = [
+    "BONE",
+    "ORIGIN",
+    "SINUS",
+    "project",
+    "skull_base",
+    "skull_rgba",
+    "volume_yaml",
+    "write_launch",
+    "write_shaders",
+    "write_slices",
+]
