@@ -164,3 +164,22 @@ def test_validate_knows_a_camera_is_a_parent(tmp_path):
     assert [d.message for d in found if d.rule == "dangling-reference"] == [
         "'parent' of 'stereoL' is 'side_camera', which names no body in this file or the models loaded before it"
     ]
+
+
+def test_a_camera_under_a_camera_of_the_same_file_converts_to_mjcf_where_ambf_puts_it(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    from adfkit.cli import main
+
+    main_cam = WORLD[WORLD.index("main_camera:\n") :]
+    (tmp_path / "stereo.yaml").write_text(
+        STEREO.replace("cameras: [stereoR, stereoL]", "cameras: [stereoR, stereoL, main_camera]") + main_cam
+    )
+    assert main(["convert", str(tmp_path / "stereo.yaml"), str(tmp_path / "s.xml")]) == 0
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "s.xml"))
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    frame = camera_frame(load_scene(tmp_path / "stereo.yaml").models[0].cameras[2])
+    eye_r = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_CAMERA, "stereoR")
+    assert np.allclose(d.cam_xpos[eye_r], frame[:3, 3] + 0.025 * frame[:3, 1], atol=1e-9)
+    # MJCF cameras look along their -z: stereoR looks along the main camera's -x, as AMBF has it
+    assert np.allclose(-d.cam_xmat[eye_r].reshape(3, 3)[:, 2], -frame[:3, 0], atol=1e-9)

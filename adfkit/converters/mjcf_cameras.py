@@ -15,6 +15,7 @@ import xml.etree.ElementTree as ET
 
 from ..model.objects import Attenuation, Camera, ClippingPlane, Light, Resolution
 from ..model.pose import Pose, Quat, Vec3
+from ..model.semantics import camera_pose
 from ..model.spec import adf_fields
 from ..model.tree import find_body
 from .losses import Loss
@@ -185,14 +186,25 @@ def write_cameras_lights(
             _write_light(light, *placed, used, losses)
 
 
-def _parent_frame(model, tree, obj, elements, world, losses, label):
-    """(MJCF element, ADF body frame → that element's frame) for an object's `parent`."""
+def _parent_frame(model, tree, obj, elements, world, losses, label, depth: int = 0):
+    """(MJCF element, parent frame → that element's frame) for an object's `parent`: a body,
+    or a camera of this file (AMBF follows a camera as a parent: the drilling projects' stereo
+    pair under main_camera), through that camera's own parent."""
     if not obj.parent:
         return world, Pose()
     body = find_body(model, obj.parent)
+    cam = next((c for c in model.cameras if obj.parent in (c.identifier, c.name) and c is not obj), None)
+    if body is None and cam is not None and depth < 16:
+        placed = _parent_frame(model, tree, cam, elements, world, losses, label, depth + 1)
+        frame = camera_pose(cam)
+        if placed is None or frame is None:
+            return None
+        return placed[0], placed[1] * frame
     link = tree.links.get(body.identifier) if body is not None else None
     if link is None or id(link) not in elements:
-        losses.append(Loss(obj.identifier, label, f"parent {obj.parent!r} is not a body of this file: not written"))
+        losses.append(
+            Loss(obj.identifier, label, f"parent {obj.parent!r} is not a body or camera of this file: not written")
+        )
         return None
     el = elements[id(link)]
     return el, (Pose() if el is world else link.frame_in_body.inverse())

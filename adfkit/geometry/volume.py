@@ -183,7 +183,10 @@ def volume_facts(model, vol) -> dict:
     out: dict = {"name": vol.name or vol.identifier.removeprefix("VOLUME ")}
     try:
         found = slice_files(model, vol)
-        with Image.open(found.files[0]) as img:
+        first = inputs.check_file(
+            found.files[0], "image", tree=getattr(model, "tree", None), referrer=_where(vol, "images")
+        )
+        with Image.open(first) as img:
             w, h = img.size
         n = len(found.files)
         out["voxels"] = f"{w}x{h}x{n}"

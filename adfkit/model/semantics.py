@@ -285,3 +285,17 @@ def joint_frames(joint, parent_scale: float = 1.0, child_scale: float = 1.0) -> 
 
 
 __all__ = [n for n in dir() if not n.startswith("_")] + ["ShapeEntry"]
+
+
+def camera_pose(cam) -> Pose | None:
+    """An ADF camera's frame in its parent's, as AMBF's ``afCamera::setView`` makes it (x from
+    the point looked at towards the eye, z along `up`, y = z × x); a camera may be the parent of
+    cameras and lights. None for a view AMBF leaves unset (look at = location, or up along it)."""
+    loc, at, up = cam.location or Vec3(), cam.look_at or Vec3(), cam.up or Vec3(0.0, 0.0, 1.0)
+    x = loc - at
+    if x.norm() < 1e-12 or up.cross(x).norm() < 1e-12 * max(x.norm(), 1.0):
+        return None
+    x = x.normalized()
+    y = up.cross(x).normalized()
+    z = x.cross(y)
+    return Pose(loc, Quat.from_matrix(((x.x, y.x, z.x), (x.y, y.y, z.y), (x.z, y.z, z.z))))

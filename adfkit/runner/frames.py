@@ -14,26 +14,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.semantics import camera_pose
 from .names import merge_namespace
+from .rotations import pose_to_matrix
 
 MAX_DEPTH = 16  # parents deeper than this (or in a loop) are not followed
 
 
 def camera_frame(cam) -> np.ndarray:
-    """4×4 of an ADF camera in its parent's frame, as AMBF's setView makes it."""
-    eye = np.array(cam.location or (0.0, 0.0, 0.0), float)
-    look = np.array(cam.look_at or (0.0, 0.0, 0.0), float)
-    up = np.array(cam.up or (0.0, 0.0, 1.0), float)
-    t = np.eye(4)
-    t[:3, 3] = eye
-    x = eye - look
-    if np.linalg.norm(x) < 1e-12 or np.linalg.norm(np.cross(up, x)) < 1e-12:
-        return t  # AMBF leaves such a view unset (warned about where the camera is built)
-    x /= np.linalg.norm(x)
-    y = np.cross(up, x)
-    y /= np.linalg.norm(y)
-    t[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
-    return t
+    """4×4 of an ADF camera in its parent's frame, as AMBF's setView makes it
+    (model.semantics.camera_pose; an unset view: the camera's location, unturned)."""
+    pose = camera_pose(cam)
+    if pose is None:
+        t = np.eye(4)
+        t[:3, 3] = np.array(cam.location or (0.0, 0.0, 0.0), float)
+        return t
+    return pose_to_matrix(pose)
 
 
 def scene_cameras(scene) -> list[tuple[str, str, object]]:
