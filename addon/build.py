@@ -300,7 +300,8 @@ def import_model(path: str | Path, scene=None) -> tuple[list, list[Diagnostic]]:
     _scene_snapshot(scene, doc)
     from .volumes import import_volumes
 
-    import_volumes(doc, scene, diags, bodies)  # pictures of the volumes (kind NONE: export keeps them as written)
+    # pictures of the volumes (kind NONE: export keeps them as written), in their parent body's frame
+    import_volumes(doc, scene, diags, lambda ref: _find(bodies, ref))
     diags.extend(mesh_import.UNREADABLE)
     mesh_import.UNREADABLE.clear()
     return made, diags

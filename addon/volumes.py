@@ -34,14 +34,12 @@ def _matrix(p: Pose):
     return m
 
 
-def import_volumes(doc, scene, diags: list[Diagnostic], bodies: dict | None = None) -> list:
+def import_volumes(doc, scene, diags: list[Diagnostic], body_named=None) -> list:
     """One mesh object per readable volume of ``doc``; returns them. A volume whose `parent`
-    names a body of ``bodies`` (identifier -> object) is placed in that body's frame and
-    parented to it, as AMBF places it (the skull-base project's volume under
+    names a body (``body_named``: reference -> the body's object, or None) is placed in that
+    body's frame and parented to it, as AMBF places it (the skull-base project's volume under
     ``BODY volume_Anatomical_Origin``)."""
     from adfkit.geometry.volume import DEFAULT_ISO, iso_surface, load_volume
-
-    from .build import _find
 
     made = []
     for vol in doc.volumes:
@@ -55,7 +53,7 @@ def import_volumes(doc, scene, diags: list[Diagnostic], bodies: dict | None = No
                 diags.append(warning(d.rule, f"{d.message}; the volume is kept but not shown", d.location, d.hint))
             continue
         obj = _surface_object(scene, vol, verts, faces)
-        parent = _find(bodies or {}, vol.parent)
+        parent = body_named(vol.parent) if body_named is not None and vol.parent else None
         local = _matrix(vol.location or Pose())
         obj.parent = parent
         obj.matrix_world = parent.matrix_world.normalized() @ local if parent is not None else local

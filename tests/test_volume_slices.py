@@ -171,3 +171,21 @@ def test_info_names_each_volume_with_its_voxels_slices_and_size(tmp_path, capsys
         "size m: 0.0492027x0.0492027x0.048485, voxel mm: 2.05x2.05x2.424"
     ) in out
     assert "- name: mastoidectomy_volume, problem: volume 'VOLUME mastoidectomy_volume': no slice slice_<0..512>" in out
+
+
+def test_a_project_shaped_volume_converts_to_files_both_engines_load(tmp_path, capsys):
+    mujoco = pytest.importorskip("mujoco")
+    pb = pytest.importorskip("pybullet")
+    adf = project(tmp_path, slices=20, side=24, count=512)
+    for out in ("v.xml", "v.urdf"):
+        assert main(["convert", str(adf / "volume_a.yaml"), str(tmp_path / out)]) == 0
+    assert "0 bodies, 0 joints, 1 volume(s) as their iso-surfaces" in capsys.readouterr().out
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "v.xml"))
+    assert (m.geom_group == 1).sum() == 1 and (m.geom_group == 3).sum() > 5  # drawn surface, convex parts
+    cid = pb.connect(pb.DIRECT)
+    try:
+        uid = pb.loadURDF(str(tmp_path / "v.urdf"), useFixedBase=True, physicsClientId=cid)
+        lo, hi = np.array(pb.getAABB(uid, 0, physicsClientId=cid))
+        assert np.all(hi - lo > 0.02)  # the skull's surface, about its 49 mm box
+    finally:
+        pb.disconnect(cid)
