@@ -177,7 +177,10 @@ def test_a_mesh_whose_texture_is_missing_is_one_located_warning_not_pybullets_no
     found = [ln for ln in err.splitlines() if "runner-missing-texture" in ln]
     assert len(found) == 2  # each body's visual mesh, at its `mesh` key
     assert all(ln.startswith(f"{f}:") and ":9: warning[runner-missing-texture]" in ln for ln in found)
-    assert "texture /home/someone/drape.png (in drape.mtl)" in found[0]
+    assert (
+        "texture /home/someone/drape.png (in drape.mtl; an absolute path, from the machine the file was made on)"
+        in found[0]
+    )
 
 
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])

@@ -284,14 +284,175 @@ def test_the_mujoco_engine_serves_its_cameras(scene, tmp_path):
             box = w.body("box").world_matrix()[:3, 3]
             expected = box + [np.cos(0.6), np.sin(0.6), 0.5]
             assert cam.view(w)[0] == pytest.approx(expected, abs=2e-3)
-        else:  # the page opened where the left eye is
-            eye0, _, _ = w.cameras[0].view(w)
-            assert v.server.initial_camera.position == pytest.approx(eye0, abs=1e-3)
+        else:  # the page opened on the scene from the side the left eye looks from
+            eye0, target0, _ = (np.array(x) for x in w.cameras[0].view(w))
+            init = v.server.initial_camera
+            back = np.array(init.position) - np.array(init.look_at)
+            assert back / np.linalg.norm(back) == pytest.approx(
+                (eye0 - target0) / np.linalg.norm(eye0 - target0), abs=1e-3
+            )
         v.draw_camera()
         img = np.asarray(v.camera_image.image)
         assert img.shape == (w.cameras[0].height, w.cameras[0].width, 3) and img.std() > 5
         assert v.camera_image.label.startswith(names[0] + " · RGB")
         small = dataclasses.replace(w.cameras[0], width=32, height=24).render(w)
         assert small["rgb"].shape == (24, 32, 3) and small["segmentation"].shape == (24, 32)
+    finally:
+        v.close()
+
+
+# --- the first view -------------------------------------------------------------------------------
+
+
+def _in_view(cam, points) -> np.ndarray:
+    """Which ``points`` the page's first camera shows (its vertical field of view, as wide)."""
+    eye, target, up = (np.array(x, float) for x in (cam.position, cam.look_at, cam.up))
+    fwd = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(fwd, up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    rel = np.asarray(points, float) - eye
+    depth = rel @ fwd
+    t = np.tan(cam.fov / 2)
+    return (depth > 0) & (np.abs(rel @ right) <= t * depth) & (np.abs(rel @ up) <= t * depth)
+
+
+def _spread_scene(folder):
+    """Five boxes 3 m apart, a 40 m static floor under them, and a camera a few cm from one box
+    (as the challenge's endoscope looks at its phantom)."""
+    text = "bodies: [BODY floor, BODY b0, BODY b1, BODY b2, BODY b3, BODY b4]\ncameras: [CAMERA close]\n"
+    text += (
+        "BODY floor:\n  name: floor\n  mass: 0.0\n"
+        "  location: {position: {x: 0, y: 0, z: -0.05}, orientation: {r: 0, p: 0, y: 0}}\n"
+        "  collision shape: BOX\n  collision geometry: {x: 40, y: 40, z: 0.1}\n"
+        "  shape: BOX\n  geometry: {x: 40, y: 40, z: 0.1}\n"
+    )
+    for i, (x, y) in enumerate([(0, 0), (3, 0), (-3, 0), (0, 3), (0, -3)]):
+        text += (
+            f"BODY b{i}:\n  name: b{i}\n  mass: 1.0\n  inertia: {{ix: 0.01, iy: 0.01, iz: 0.01}}\n"
+            f"  location: {{position: {{x: {x}, y: {y}, z: 0.1}}, orientation: {{r: 0, p: 0, y: 0}}}}\n"
+            "  collision shape: BOX\n  collision geometry: {x: 0.2, y: 0.2, z: 0.2}\n"
+            "  shape: BOX\n  geometry: {x: 0.2, y: 0.2, z: 0.2}\n"
+        )
+    text += (
+        "CAMERA close:\n  name: close\n  location: {x: 0.0, y: -0.3, z: 0.35}\n"
+        "  look at: {x: 0.0, y: 0.0, z: 0.1}\n  up: {x: 0.0, y: 0.0, z: 1.0}\n"
+    )
+    path = folder / "spread.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_the_first_view_frames_every_body_whatever_the_cameras(tmp_path):
+    """The page opens on all five boxes, from the side the scene's close-up camera looks from;
+    the 40 m floor is drawn but not framed (it would shrink the boxes to dots). The camera's own
+    view, what the page opened on before, shows one box."""
+    from adfkit.viewer.server import Viewer
+
+    v = Viewer(_spread_scene(tmp_path), None, "pybullet", "127.0.0.1", _free_port())
+    v.load()
+    v.start()
+    try:
+        w = v.world
+        corners = np.array(
+            [
+                sb.world_matrix()[:3, 3] + np.array([sx, sy, sz]) * 0.1
+                for sb in w.bodies
+                if sb.name != "floor"
+                for sx in (-1, 1)
+                for sy in (-1, 1)
+                for sz in (-1, 1)
+            ]
+        )
+        init = v.server.initial_camera
+        assert _in_view(init, corners).all()
+        back = np.array(init.position) - np.array(init.look_at)
+        eye, target, _ = (np.array(x) for x in w.cameras[0].view(w))
+        assert back / np.linalg.norm(back) == pytest.approx((eye - target) / np.linalg.norm(eye - target), abs=1e-6)
+        assert np.linalg.norm(back) < 20  # framed on the boxes (~6 m across), not on the 40 m floor
+
+        class Close:  # the scene camera's own view: the negative control
+            position, look_at, up, fov = eye, target, (0, 0, 1), init.fov
+
+        assert _in_view(Close, corners).sum() < len(corners) / 2
+    finally:
+        v.close()
+
+
+def test_textures_are_drawn_tinted_by_the_adf_colour_and_a_missing_one_is_said_once(tmp_path):
+    """A textured OBJ is drawn with its texture even where the body has an ADF colour (AMBF's
+    material modulates the texture): the colour tints it. A texture its MTL names by an absolute
+    path from another machine is one finding for the two bodies that use the mesh."""
+    from PIL import Image
+
+    from adfkit.adf import load
+    from adfkit.viewer.geometry import visual_parts
+    from adfkit.viewer.server import Viewer
+
+    Image.new("RGB", (8, 8), (200, 100, 50)).save(tmp_path / "tex.png")
+    obj = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nvt 0 0\nvt 1 0\nvt 0 1\n"
+    obj += "f 1/1 3/3 2/2\nf 1/1 2/2 4/3\nf 1/1 4/3 3/2\nf 2/1 3/2 4/3\n"
+    (tmp_path / "t.obj").write_text("mtllib t.mtl\nusemtl m\n" + obj)
+    (tmp_path / "t.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd tex.png\n")
+    (tmp_path / "far.obj").write_text("mtllib far.mtl\nusemtl m\n" + obj)
+    (tmp_path / "far.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd /home/someone/drape.png\n")
+    body = (
+        "BODY {n}:\n  name: {n}\n  mass: 0.0\n  mesh: {mesh}\n{colour}"
+        "  location: {{position: {{x: {x}, y: 0, z: 0}}, orientation: {{r: 0, p: 0, y: 0}}}}\n"
+    )
+    text = "bodies: [BODY plain, BODY tinted, BODY far1, BODY far2]\n"
+    text += body.format(n="plain", mesh="t.obj", colour="", x=0)
+    text += body.format(n="tinted", mesh="t.obj", colour="  color rgba: {r: 0.5, g: 1.0, b: 1.0, a: 1.0}\n", x=0.3)
+    text += body.format(n="far1", mesh="far.obj", colour="", x=0.6)
+    text += body.format(n="far2", mesh="far.obj", colour="", x=0.9)
+    (tmp_path / "m.yaml").write_text(text)
+    m = load(tmp_path / "m.yaml")
+    (plain,) = visual_parts(m, m.body("BODY plain"))
+    (tinted,) = visual_parts(m, m.body("BODY tinted"))
+    assert plain.textured is not None and tinted.textured is not None
+    assert list(tinted.textured.visual.material.diffuse[:3]) == [127, 255, 255]
+    assert tinted.textured.visual.material.image.getpixel((0, 0)) == (200, 100, 50)
+    (far,) = visual_parts(m, m.body("BODY far1"))
+    assert far.textured is None  # its texture is not here: the flat colour
+    v = Viewer(tmp_path / "m.yaml", None, "pybullet", "127.0.0.1", _free_port())
+    v.load()
+    v.start()
+    try:
+        said = [d for d in v.findings if d.rule == "view-missing-texture"]
+        assert len(said) == 1, said
+        assert (
+            "/home/someone/drape.png (in far.mtl; an absolute path, from the machine the file was made on)"
+            in said[0].message
+        )
+        assert said[0].location.file.endswith("m.yaml")
+    finally:
+        v.close()
+
+
+def test_the_challenge_scene_opens_on_its_arms_and_textured_drape(browser, tmp_path):
+    """The challenge's scene (corpus src/launch.yaml -l 6-11) opened as a grey close-up of the
+    phantom (its endoscope's view, the drape drawn in its flat ADF grey: 1,200 colours, standard
+    deviation 9); now on both arms and the phantom over the textured drape (measured 8,600
+    colours, standard deviation 62)."""
+    from conftest import CORPUS, require_corpus
+
+    from adfkit.viewer.server import Viewer
+
+    require_corpus()
+    v = Viewer(CORPUS / "src" / "launch.yaml", [6, 7, 8, 9, 10, 11], "pybullet", "127.0.0.1", _free_port())
+    v.load()
+    address = v.start()
+    try:
+        w = v.world
+        arms = np.array([sb.world_matrix()[:3, 3] for sb in w.bodies if not sb.static])
+        assert _in_view(v.server.initial_camera, arms).all()
+        page = _open(browser, address)
+        page.wait_for_timeout(6000)
+        pic = _canvas(page)
+        assert len(np.unique(pic.reshape(-1, 3), axis=0)) > 4000 and pic.std() > 30, (
+            len(np.unique(pic.reshape(-1, 3), axis=0)),
+            pic.std(),
+        )
+        page.close()
     finally:
         v.close()

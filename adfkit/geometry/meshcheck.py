@@ -126,6 +126,11 @@ def _shown(raw: bytes) -> str:
 TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")  # MTL statements naming a file
 
 
+def _absolute(name: str) -> bool:
+    """A POSIX or Windows absolute path (``C:\\...``, ``\\\\server\\...``)."""
+    return name.startswith(("/", "\\")) or (len(name) > 2 and name[1] == ":" and name[2] in "/\\")
+
+
 @lru_cache(maxsize=1024)
 def obj_material_problems(obj_path: str) -> tuple[str, ...]:
     """Missing MTL libraries and textures of an OBJ file (names as written)."""
@@ -155,5 +160,6 @@ def obj_material_problems(obj_path: str) -> tuple[str, ...]:
                 if not inputs.is_regular(str(mtl.parent / tex)) and not inputs.is_regular(
                     str(mtl.parent / tex.replace("\\", "/"))
                 ):
-                    missing.append(f"texture {inputs.shown(tex, 80)} (in {inputs.shown(lib, 80)})")
+                    far = "; an absolute path, from the machine the file was made on" if _absolute(tex) else ""
+                    missing.append(f"texture {inputs.shown(tex, 80)} (in {inputs.shown(lib, 80)}{far})")
     return tuple(dict.fromkeys(missing))

@@ -74,8 +74,9 @@ def _mesh_file(model, path, scale: float) -> trimesh.Trimesh | None:
         return None
 
 
-def _textured(model, path, scale: float) -> trimesh.Trimesh | None:
-    """An OBJ visual mesh with its material's texture (the MTL and the image beside it), scaled;
+def _textured(model, path, scale: float, tint=None) -> trimesh.Trimesh | None:
+    """An OBJ visual mesh with its material's texture (the MTL and the image beside it), scaled,
+    the texture multiplied by ``tint`` (an ADF colour: AMBF's material modulates its texture);
     None when it has none. The OBJ goes through the input policy; trimesh reads its MTL and
     image from the OBJ's own folder."""
     from .. import inputs
@@ -95,6 +96,8 @@ def _textured(model, path, scale: float) -> trimesh.Trimesh | None:
     if getattr(visual, "kind", None) != "texture" or getattr(getattr(visual, "material", None), "image", None) is None:
         return None
     mesh.apply_scale(scale)
+    if tint is not None:
+        visual.material.diffuse = np.clip(np.asarray(tint, float) * 255, 0, 255).astype(np.uint8)
     return mesh
 
 
@@ -129,9 +132,21 @@ def visual_parts(model, obj) -> list[Part]:
     path = visual_mesh_path(model, obj)
     mesh = _mesh_file(model, path, scale) if path is not None else None
     part = _part(mesh, colour or (_mesh_colour(mesh) if mesh is not None else DEFAULT_COLOUR))
-    if part is not None and colour is None:
-        part.textured = _textured(model, path, scale)
+    if part is not None:  # its file's texture, tinted by the ADF colour (AMBF's material modulates it)
+        part.textured = _textured(model, path, scale, colour)
     return [part] if part is not None else []
+
+
+def missing_textures(model, obj) -> tuple[str, ...]:
+    """The textures an object's OBJ visual mesh names that are not there (drawn without them)."""
+    from ..geometry.meshcheck import obj_material_problems
+
+    if obj.shape or getattr(obj, "compound_shape", None):
+        return ()
+    path = visual_mesh_path(model, obj)
+    if path is None or path.suffix.lower() != ".obj":
+        return ()
+    return tuple(w for w in obj_material_problems(str(path)) if w.startswith("texture "))
 
 
 def collision_parts(model, obj, colour=(0.1, 0.9, 0.3, 0.35)) -> list[Part]:

@@ -75,6 +75,8 @@ class Viewer:
         self.episode = None
         self.server = None
         self.rtf = 0.0
+        self.boxes: list = []  # (low, high, static) world box of each body drawn: the first view frames them
+        self._textures_said: set[str] = set()
         self.camera_image = None  # the Cameras panel's image and its Draw (panels.camera_panel)
         self.draw_camera = None
 
@@ -120,12 +122,13 @@ class Viewer:
         check_port(self.host, self.port)
         self.server = viser.ViserServer(host=self.host, port=self.port, verbose=False)
         self.server.scene.set_up_direction("+z")
-        self._initial_view()
         from . import panels
 
-        panels.findings_panel(self)
         if self.world is not None:
             self._draw()
+            self._initial_view()
+        panels.findings_panel(self)
+        if self.world is not None:
             panels.simulation_panel(self)
             panels.show_panel(self)
             panels.joints_panel(self)
@@ -139,22 +142,16 @@ class Viewer:
         return f"http://{shown}:{self.port}"
 
     def _initial_view(self) -> None:
-        """Open the page looking as the scene's first camera looks (else at the bodies from above
-        and aside)."""
-        cam = self.server.initial_camera
-        w = self.world
-        if w is not None and w.cameras:
-            eye, target, up = w.cameras[0].view(w)
+        """Open the page on every body of the scene (framing.py), looking from the side its first
+        camera looks from (else from above and aside)."""
+        from .framing import overview
+
+        cam, w = self.server.initial_camera, self.world
+        look = w.cameras[0].view(w) if w.cameras else None
+        view = overview(self.boxes, cam.fov, look)
+        if view is not None:
+            eye, target, up = view
             cam.position, cam.look_at, cam.up = tuple(eye), tuple(target), tuple(up)
-            return
-        if w is not None and w.bodies:
-            pts = np.array([sb.world_matrix()[:3, 3] for sb in w.bodies])
-            pts = pts[np.all(np.isfinite(pts), axis=1)]
-            if len(pts):
-                centre = pts.mean(axis=0)
-                reach = max(float(np.linalg.norm(pts - centre, axis=1).max()), 0.05)
-                cam.look_at = tuple(centre)
-                cam.position = tuple(centre + np.array([1.5, -1.5, 1.2]) * reach)
 
     def _draw(self) -> None:
         scene, w = self.server.scene, self.world
@@ -164,6 +161,8 @@ class Viewer:
             frame = scene.add_frame(f"/bodies/b{i}", show_axes=False)
             surface = getattr(sb, "surface", None)  # a volume's iso-surface (runner/volumes.py)
             parts = [geometry.Part(*surface)] if surface is not None else geometry.visual_parts(sb.model, sb.body)
+            self._note_missing_textures(sb)
+            self._box(sb, parts)
             for k, part in enumerate(parts):
                 if part.textured is not None:
                     h = scene.add_mesh_trimesh(f"/bodies/b{i}/visual{k}", part.textured)
@@ -207,6 +206,36 @@ class Viewer:
         self._draw_joint_frames()
         self._draw_cameras()
         self.update_poses()
+
+    def _box(self, sb, parts) -> None:
+        """The world box of a body's drawn parts, for the first view's framing."""
+        if not parts:
+            return
+        m = sb.world_matrix()
+        v = np.concatenate([np.asarray(p.vertices, float) for p in parts]) @ m[:3, :3].T + m[:3, 3]
+        self.boxes.append((v.min(axis=0), v.max(axis=0), sb.static))
+
+    def _note_missing_textures(self, sb) -> None:
+        """A texture a visual mesh names that is not there (the challenge's drape names one by an
+        absolute path from its author's machine) is said once, in the findings and on stderr,
+        however many bodies share it."""
+        import sys
+
+        from ..diagnostics import warning
+
+        for what in geometry.missing_textures(sb.model, sb.body):
+            if what in self._textures_said:
+                continue
+            self._textures_said.add(what)
+            d = warning(
+                "view-missing-texture",
+                f"{sb.body.identifier}: {what} of its visual mesh not found; drawn without it (said once for "
+                "every body whose mesh names it)",
+                sb.body.where("mesh") or sb.body.source,
+                "textures come from the mesh's own material (MTL) file: give it a path relative to that file",
+            )
+            self.findings.append(d)
+            print(d.format(), file=sys.stderr)
 
     def _draw_soft_bodies(self) -> None:
         """Soft bodies as their simulation meshes, the nodes sent again with every frame."""
