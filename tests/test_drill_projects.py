@@ -158,3 +158,35 @@ def test_the_skull_scene_is_laid_out_as_the_projects_and_drills(tmp_path, capsys
     assert "burr: BODY 2mm, a sphere fitted to the tip of 2mm.OBJ" in capsys.readouterr().out
     m = json.loads((tmp_path / "out" / "metrics.json").read_text())
     assert m["burr"]["radius_m"] == pytest.approx(0.001, rel=0.01) and m["voxels_removed_total"] > 0
+
+
+def test_tissues_by_colour_and_a_protected_nerve(tmp_path, capsys):
+    """The skull scene's labels.yaml names its colours' tissues, as the projects' segmented
+    volumes are coloured: a path down through the facial nerve is reported; one that stops
+    above it is not."""
+    from adfkit.scenes.skull import SkullParams, write_skull
+
+    launch = write_skull(tmp_path, SkullParams(voxels=64))
+    for depth, rc in ((-0.004, 1), (0.006, 0)):
+        (tmp_path / "p.txt").write_text(f"-0.005 0.0018 0.03\n-0.005 0.0018 {depth}\n")
+        out = tmp_path / f"out{rc}"
+        args = ["drill", str(launch), "--path", str(tmp_path / "p.txt"), "--removal-rate", "1000", "--out", str(out)]
+        assert main([*args, "--frames", "2"]) == rc
+        m = json.loads((out / "metrics.json").read_text())
+        assert m["labels"] == {"bone": "#fff9db", "sigmoid sinus": "#6eb8d1", "facial nerve": "#f4d631"}
+        assert m["voxels_removed"]["bone"] > 0 and m["protected"] == ["facial nerve", "sigmoid sinus"]
+        err = capsys.readouterr().err
+        assert ("warning[drill-protected]: the burr touched protected tissue 'facial nerve'" in err) == (rc == 1)
+        assert (m["voxels_removed"]["facial nerve"] > 0) == (rc == 1)
+
+
+def test_tissues_by_colour_need_colour_slices(tmp_path, capsys):
+    from adfkit.scenes.drilling import write_drilling
+
+    launch = write_drilling(tmp_path)
+    (tmp_path / "slices" / "labels.yaml").write_text('bone: "#fff9db"\n')
+    assert main(["drill", str(launch), "--out", str(tmp_path / "out")]) == 2
+    assert "names tissues by colour, and the volume's slices are grey" in capsys.readouterr().err
+    (tmp_path / "slices" / "labels.yaml").write_text('bone: "#fff9dx"\n')  # not a colour
+    assert main(["validate", str(tmp_path / "slices" / "labels.yaml")]) == 1
+    assert 'or a colour "#rrggbb"' in capsys.readouterr().out

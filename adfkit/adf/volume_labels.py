@@ -1,10 +1,15 @@
 """A volume's labels file (``labels.yaml`` in its slice folder; ``adfkit drill`` reads it): the
-tissue each range of slice values stands for, in the slices' own units, and which tissues a
-burr must not touch::
+tissue each range of slice values stands for, in the slices' own units, or each colour of a
+colour-segmented volume (RGBA slices, as the drilling projects ship theirs), and which tissues
+a burr must not touch::
 
     bone: [150, 255]
     canal: [60, 120]
     protected: [canal]
+
+    bone: "#fff9db"
+    facial nerve: "#f4d631"
+    protected: [facial nerve]
 
 Not an ADF file (AMBF never reads it); its syntax is checked here, in the core, so that
 ``adfkit validate`` of a scene folder checks it too and ``adfkit drill`` reads it the same way.
@@ -24,9 +29,20 @@ def is_labels_file(path) -> bool:
     return str(path).replace("\\", "/").rsplit("/", 1)[-1].lower() == FILE_NAME
 
 
-def parse_labels(text: str, shown: str) -> tuple[list[str], list[tuple[float, float]], list[str]]:
-    """(tissue names, their (low, high) ranges in the slices' units, protected names) of a
-    labels file's text; ``shown``: the file name the errors carry."""
+def _colour(v) -> tuple[int, int, int] | None:
+    """(r, g, b) of a ``"#rrggbb"`` scalar, else None."""
+    text = str(getattr(v, "value", ""))
+    if len(text) == 7 and text.startswith("#"):
+        try:
+            return int(text[1:3], 16), int(text[3:5], 16), int(text[5:7], 16)
+        except ValueError:
+            return None
+    return None
+
+
+def parse_labels(text: str, shown: str) -> tuple[list[str], list[tuple], list[str]]:
+    """(tissue names, each one's (low, high) range in the slices' units or (r, g, b) colour,
+    protected names) of a labels file's text; ``shown``: the file name the errors carry."""
     import yaml
 
     from .yamlnodes import compose
@@ -49,13 +65,20 @@ def parse_labels(text: str, shown: str) -> tuple[list[str], list[tuple[float, fl
             )
         )
     names: list[str] = []
-    ranges: list[tuple[float, float]] = []
+    ranges: list[tuple] = []
     protected_nodes: list = []
     for k, v in root.value:
         if k.value == "protected":
             if not isinstance(v, yaml.SequenceNode) or not all(isinstance(x, yaml.ScalarNode) for x in v.value):
                 raise bad(v, "`protected` is a list of tissue names", "e.g. protected: [canal]")
             protected_nodes = v.value
+            continue
+        colour = _colour(v) if isinstance(v, yaml.ScalarNode) else None
+        if colour is not None:
+            if len(names) >= MAX_TISSUES:
+                raise bad(k, f"more than {MAX_TISSUES} tissues", "merge tissues")
+            names.append(str(k.value))
+            ranges.append(colour)
             continue
         ok = isinstance(v, yaml.SequenceNode) and len(v.value) == 2
         try:
@@ -65,8 +88,9 @@ def parse_labels(text: str, shown: str) -> tuple[list[str], list[tuple[float, fl
         if not ok or not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi or hi < 0:
             raise bad(
                 v,
-                f"tissue '{str(k.value)[:40]}' needs a range [low, high] of slice values, low <= high",
-                "e.g. bone: [150, 255] (the slices' own units)",
+                f"tissue '{str(k.value)[:40]}' needs a range [low, high] of slice values, low <= high, "
+                'or a colour "#rrggbb"',
+                'e.g. bone: [150, 255] (the slices\' own units), or bone: "#fff9db" for colour slices',
             )
         if len(names) >= MAX_TISSUES:
             raise bad(k, f"more than {MAX_TISSUES} tissues", "merge tissues")

@@ -113,7 +113,7 @@ def run(args) -> int:
     from ..geometry.voxels_edit import BlockSurface
     from ..report import Progress, print_diagnostics
     from ..tasks.drilling import output as outp
-    from ..tasks.drilling.inputs import read_path_file
+    from ..tasks.drilling.inputs import label_colour, read_path_file
     from ..tasks.drilling.prepare import default_path, editable, prepare
     from ..tasks.drilling.task import DrillParams, DrillTask
 
@@ -137,6 +137,7 @@ def run(args) -> int:
     every = max(1, task.total_steps // args.frames)
     frames, remesh_s, step_s = [], 0.0, 0.0
     prot_ids = task.protected_ids
+    tissue_colours = [None, *(label_colour(r) for r in ds.label_ranges)]
     with Progress(task.total_steps, "drill") as bar:
         for i in range(task.total_steps):
             t0 = time.perf_counter()
@@ -147,7 +148,7 @@ def run(args) -> int:
                 surface.update()
                 remesh_s += time.perf_counter() - t0
                 local = task.rot.T @ (task.burr - task.origin)
-                frames.append(outp.render_frame(vol, local, ds.burr_radius, prot_ids))
+                frames.append(outp.render_frame(vol, local, ds.burr_radius, prot_ids, colours=tissue_colours))
             bar.update(1)
     st = task.state
     names = vol.label_names
@@ -169,8 +170,8 @@ def run(args) -> int:
             "start_m": ds.burr_start.tolist(),
         },
         "path_m": task.points.tolist(),
-        "labels": {  # 0..1 of full scale
-            n: [r[0] / ds.data.unit, r[1] / ds.data.unit if np.isfinite(r[1]) else None]
+        "labels": {  # 0..1 of full scale, or a colour
+            n: label_colour(r) or [r[0] / ds.data.unit, r[1] / ds.data.unit if np.isfinite(r[1]) else None]
             for n, r in zip(names[1:], ds.label_ranges)
         },
         "labels_file": ds.labels_file,

@@ -8,6 +8,7 @@ a temporal-bone-shaped volume of adfkit's own making:
     ADF/stereo_cameras.yaml              stereoL, stereoR hanging from main_camera
     ADF/meshes/high_res/2mm.OBJ
     resources/volumes/skull/plane00<i>.png   RGBA slices, fewer than count (AMBF reads count as a maximum)
+    resources/volumes/skull/labels.yaml      the colours' tissues for `adfkit drill`, sinus and nerve protected
 
 The volume is segmented as the projects' are, by colour, with alpha 255 in tissue and 0 in
 air: a rounded block of bone whose cortex covers mastoid air cells, a sigmoid sinus, the facial
@@ -123,13 +124,27 @@ def skull_slice(p: SkullParams, k: int, cells: np.ndarray | None = None) -> np.n
     return out
 
 
+LABELS_YAML = """\
+# The tissue each colour of the slices stands for, read by `adfkit drill`; the burr must not
+# touch a protected tissue.
+bone: "#{:02x}{:02x}{:02x}"
+sigmoid sinus: "#{:02x}{:02x}{:02x}"
+facial nerve: "#{:02x}{:02x}{:02x}"
+protected: [sigmoid sinus, facial nerve]
+""".format(*BONE, *SINUS, *NERVE)
+
+
 def write_skull_slices(folder: Path, p: SkullParams) -> None:
+    """The slices, and labels.yaml naming their colours' tissues."""
     from PIL import Image
+
+    from ..adf import atomic_write_text
 
     folder.mkdir(parents=True, exist_ok=True)
     cells = _cells(p)
     for k in range(p.slices):
         Image.fromarray(skull_slice(p, k, cells), "RGBA").save(folder / f"plane00{k}.png")
+    atomic_write_text(folder / "labels.yaml", LABELS_YAML)
 
 
 def write_drill_mesh(path: Path) -> None:

@@ -88,26 +88,48 @@ def default_labels(iso: float) -> tuple[list[str], list[tuple[float, float]], se
     return ["bone", "soft tissue"], [(iso, math.inf), (1e-12, iso)], set()
 
 
-def read_labels(path: Path, full_scale: float, tree) -> tuple[list[str], list[tuple[float, float]], set[str]]:
-    """Names, value ranges (0..1 of full scale, inclusive) and protected names of a labels file
-    (its syntax: adf.volume_labels, which ``adfkit validate`` checks too)."""
+def read_labels(path: Path, full_scale: float, tree) -> tuple[list[str], list[tuple], set[str]]:
+    """Names, value ranges (0..1 of full scale, inclusive) or (r, g, b) colours, and protected
+    names of a labels file (its syntax: adf.volume_labels, which ``adfkit validate`` checks too)."""
     text = inputs.read_text(path, "text", tree=tree, what="labels file")
     names, ranges, protected = parse_labels(text, inputs.shown(path))
-    return names, [(max(lo, 0.0) / full_scale, hi / full_scale) for lo, hi in ranges], set(protected)
+    scaled = [r if len(r) == 3 else (max(r[0], 0.0) / full_scale, r[1] / full_scale) for r in ranges]
+    return names, scaled, set(protected)
 
 
-def label_array(values: np.ndarray, ranges: list[tuple[float, float]], unit: float = 1.0) -> np.ndarray:
-    """uint8 label id per voxel: 1 + the first range holding its value, 0 for none (or empty);
-    ``ranges`` in the values' units (``unit``: full scale in them), a few slices at a time."""
+def label_array(values: np.ndarray, ranges: list[tuple], unit: float = 1.0, files=None) -> np.ndarray:
+    """uint8 label id per voxel: 1 + the first tissue holding it, 0 for none (or empty).
+    ``ranges``: (low, high) in the values' units (``unit``: full scale in them), or (r, g, b) of
+    a colour tissue, matched against the colour slices ``files`` (read again, a slice at a
+    time, rows flipped as geometry.volume reads them)."""
+    from PIL import Image
+
     out = np.zeros(values.shape, dtype=np.uint8)
     eps = 0.5 / 65535.0 * unit  # a value written as an integer and normalised may sit this far off
-    for z in range(0, len(values), 16):
-        v, o = values[z : z + 16], out[z : z + 16]
+    by_colour = any(len(r) == 3 for r in ranges)
+    step = 1 if by_colour else 16
+    for z in range(0, len(values), step):
+        v, o = values[z : z + step], out[z : z + step]
         tissue = v > 0
+        rgb = None
+        if by_colour and files is not None:
+            with Image.open(files[z]) as img:
+                rgb = np.asarray(img.convert("RGBA"))[::-1, :, :3][None]
         for i in range(len(ranges) - 1, -1, -1):
-            lo, hi = ranges[i]
-            o[(v >= lo - eps) & (v <= hi + eps) & tissue] = i + 1
+            r = ranges[i]
+            if len(r) == 3:
+                if rgb is None:
+                    continue
+                hit = tissue & np.all(rgb == np.array(r, dtype=np.uint8), axis=-1)
+            else:
+                hit = (v >= r[0] - eps) & (v <= r[1] + eps) & tissue
+            o[hit] = i + 1
     return out
 
 
-__all__ = ["MAX_WAYPOINTS", "default_labels", "label_array", "read_labels", "read_path_file"]
+def label_colour(r: tuple) -> str | None:
+    """``"#rrggbb"`` of a colour tissue, None for a value range."""
+    return "#{:02x}{:02x}{:02x}".format(*r) if len(r) == 3 else None
+
+
+__all__ = ["MAX_WAYPOINTS", "default_labels", "label_array", "label_colour", "read_labels", "read_path_file"]

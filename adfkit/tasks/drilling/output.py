@@ -83,22 +83,25 @@ def write_metrics(metrics: dict, path: Path) -> None:
     atomic_write_text(path, json.dumps(metrics, indent=2, allow_nan=False) + "\n")
 
 
-def _colours(n_labels: int, protected_ids) -> np.ndarray:
+def _colours(n_labels: int, protected_ids, own=None) -> np.ndarray:
+    """Label id -> picture colour: a colour tissue's own colour (``own[i]``, "#rrggbb"), else
+    the palette's; protected ones red."""
     lut = np.zeros((n_labels, 3), dtype=np.uint8)
     for i in range(1, n_labels):
-        lut[i] = PALETTE[(i - 1) % len(PALETTE)]
+        mine = own[i] if own is not None and i < len(own) else None
+        lut[i] = tuple(int(mine[k : k + 2], 16) for k in (1, 3, 5)) if mine else PALETTE[(i - 1) % len(PALETTE)]
     for i in protected_ids:
         lut[i] = PROTECTED
     return lut
 
 
-def render_frame(vol, burr_local: np.ndarray, radius: float, protected_ids, size: int = 240):
+def render_frame(vol, burr_local: np.ndarray, radius: float, protected_ids, size: int = 240, colours=None):
     """A picture of the volume now: left, the top view (looking down z) shaded by height;
     right, the section through the burr's row (x across, z up), tissues by colour, removed
     voxels dark, the burr as a ring."""
     from PIL import Image, ImageDraw
 
-    lut = _colours(len(vol.label_names), protected_ids)
+    lut = _colours(len(vol.label_names), protected_ids, colours)
     tissue = vol.values > 0
     nz = tissue.shape[0]
     has = tissue.any(axis=0)

@@ -26,10 +26,17 @@ class DrillScene:
     burr_start: np.ndarray  # (3,) world
     burr_radius: float
     label_names: list[str]  # index = label id; 0 is "unlabelled"
-    label_ranges: list[tuple[float, float]]
+    label_ranges: list[tuple]  # (low, high) in the values' units, or (r, g, b) of a colour tissue
     protected: set[str]
     labels_file: str | None
     burr_how: str = "its sphere shape"  # what the burr's sphere is (burr.Burr.how)
+
+
+def _colour_slices(path) -> bool:
+    from PIL import Image
+
+    with Image.open(path) as img:
+        return img.mode not in ("1", "L", "I", "F") and not img.mode.startswith("I;16")
 
 
 def _volume_pose(scene, model, vol) -> np.ndarray:
@@ -131,6 +138,15 @@ def prepare(
     labels_file = None
     if os.path.lexists(labels_path):
         names, ranges, protected = read_labels(labels_path, data.full_scale / data.unit, getattr(model, "tree", None))
+        if any(len(r) == 3 for r in ranges) and not _colour_slices(data.files[0]):
+            raise AdfError(
+                error(
+                    "drill-labels",
+                    f"{inputs.shown(labels_path)} names tissues by colour, and the volume's slices are grey",
+                    None,
+                    "give grey slices' tissues as ranges of values, e.g. bone: [150, 255]",
+                )
+            )
         labels_file = str(labels_path)
     else:
         names, ranges, protected = default_labels(iso)
@@ -166,9 +182,8 @@ def editable(ds: DrillScene) -> EditableVolume:
 
     iso = (ds.volume.iso_surface_value if ds.volume.iso_surface_value is not None else DEFAULT_ISO) * ds.data.unit
     vals = ds.data.voxels
-    return EditableVolume(
-        vals, ds.data.dimensions, iso, label_array(vals, ds.label_ranges, ds.data.unit), ds.label_names
-    )
+    labels = label_array(vals, ds.label_ranges, ds.data.unit, ds.data.files)
+    return EditableVolume(vals, ds.data.dimensions, iso, labels, ds.label_names)
 
 
 def default_path(ds: DrillScene, vol: EditableVolume, depth: float) -> np.ndarray:
