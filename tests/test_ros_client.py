@@ -130,8 +130,8 @@ def test_the_client_steps_the_world(ros):
         c = Client("t_step"); c.connect(); time.sleep(0.3)
         w = c.get_world_handle()
         w.enable_throttling(True); w.set_num_step_skips(5)
-        w.update(); time.sleep(0.3)
-        s0 = w._state.sim_step; time.sleep(0.2); held = w._state.sim_step - s0
+        w.update(); time.sleep(0.15)  # under AMBF's 0.5 s world watchdog, which would end throttling
+        s0 = w._state.sim_step; time.sleep(0.15); held = w._state.sim_step - s0
         steps = []
         for _ in range(10):
             before = w._state.sim_step

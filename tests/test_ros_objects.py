@@ -11,18 +11,10 @@ pytest.importorskip("pybullet")
 from adfkit.adf import load_scene
 from adfkit.ros.objects import ros_objects, topic_of
 from adfkit.runner import Options, open_world
+from adfkit.runner.psm import ARM_JOINTS, JAW_JOINTS
 
 SAMPLE = ROOT / "sample_scenes" / "suturing"
-ARM = [
-    "baselink-yawlink",
-    "yawlink-pitchbacklink",
-    "pitchendlink-maininsertionlink",
-    "maininsertionlink-toolrolllink",
-    "toolrolllink-toolpitchlink",
-    "toolpitchlink-toolyawlink",
-    "toolyawlink-toolgripper1link",
-    "toolyawlink-toolgripper2link",
-]
+ARM = [j.replace(" ", "") for j in ARM_JOINTS + JAW_JOINTS]  # AMBF's names: spaces removed
 
 
 def _served(launch, indices=None):
@@ -71,18 +63,7 @@ def test_joint_order_follows_ambf_creation_order(tmp_path):
     """AMBF numbers a body's joints as addChildBodyJointPair meets them, in the file's `joints:`
     order: the corpus PSM's definitions in alphabetical order give this order (worked through
     by hand from afFramework.cpp), not the arm's; a passive joint is left out."""
-    alphabetical = sorted(
-        [
-            "base link-yaw link",
-            "yaw link-pitch back link",
-            "pitch end link-main insertion link",
-            "main insertion link-tool roll link",
-            "tool roll link-tool pitch link",
-            "tool pitch link-tool yaw link",
-            "tool yaw link-tool gripper1 link",
-            "tool yaw link-tool gripper2 link",
-        ]
-    )
+    alphabetical = sorted(ARM_JOINTS + JAW_JOINTS)
     launch = _psm_copy(tmp_path, alphabetical)
     base = next(o for o in _served(launch).values() if o.name == "baselinksimple")
     assert [j.name for j in base.joints] == [
@@ -98,17 +79,7 @@ def test_joint_order_follows_ambf_creation_order(tmp_path):
 
 
 def test_a_passive_joint_is_not_served(tmp_path):
-    order = list(ARM)
-    names = [
-        "base link-yaw link",
-        "yaw link-pitch back link",
-        "pitch end link-main insertion link",
-        "main insertion link-tool roll link",
-        "tool roll link-tool pitch link",
-        "tool pitch link-tool yaw link",
-        "tool yaw link-tool gripper1 link",
-        "tool yaw link-tool gripper2 link",
-    ]
+    order, names = list(ARM), list(ARM_JOINTS + JAW_JOINTS)
     (tmp_path / "a").mkdir()
     launch = _psm_copy(tmp_path / "a", names, passive="tool yaw link-tool gripper1 link")
     base = next(o for o in _served(launch).values() if o.name == "baselinksimple")

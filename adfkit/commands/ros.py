@@ -32,6 +32,12 @@ def add_arguments(p) -> None:
         help="drive a PSM from an input device: geomagic=psm1 (/Geomagic/pose, /Geomagic/button), "
         "joy=psm2 (/joy, sensor_msgs/Joy); a topic prefix may follow: geomagic:/MyDevice=psm1",
     )
+    p.add_argument(
+        "--solver-iterations",
+        type=int,
+        default=10,
+        help="the physics solver's iterations a step (default 10, AMBF's; the scripted suture plays with 50)",
+    )
     p.add_argument("--seconds", type=float, help="stop after this many seconds of wall time")
 
 
@@ -43,6 +49,10 @@ def run(args) -> int:
 
     scene = inputs.scene_file(args.scene)
     inputs.check_file(scene, what="ADF file")
+    if args.solver_iterations < 1:
+        raise AdfError(
+            error("bad-option", "--solver-iterations must be at least 1", None, "e.g. --solver-iterations 10")
+        )
     if not 1.0 <= args.rate <= 100000.0:
         raise AdfError(error("bad-option", f"--rate {args.rate:g} is not a physics rate", None, "e.g. --rate 1000"))
     from ..ros.teleop import parse
@@ -58,6 +68,7 @@ def run(args) -> int:
         crtk=not args.no_crtk,
         teleop=args.teleop,
         images=not args.no_images,
+        solver_iterations=args.solver_iterations,
         log=lambda text: print(text, file=sys.stderr, flush=True),
     )
     try:

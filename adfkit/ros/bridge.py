@@ -70,6 +70,11 @@ class Handler:
         self.cmd = None
         self.heard = -math.inf  # monotonic time of the last command message
         self.next_pub = 0.0
+        self.rebind(obj)
+
+    def rebind(self, obj: RosObject) -> None:
+        """Take ``obj``'s engine object (a world rebuilt from the same scene gives new ones)."""
+        self.obj = obj
 
     def _on_cmd(self, msg) -> None:
         self.cmd = msg
@@ -105,10 +110,7 @@ class Handler:
 class BodyHandler(Handler):
     state_type, cmd_type = "RigidBodyState", "RigidBodyCmd"
 
-    def __init__(self, bridge, obj) -> None:
-        super().__init__(bridge, obj)
-        self.rebind(obj)
-        self.velocity_warned = False
+    velocity_warned = False
 
     def rebind(self, obj: RosObject) -> None:
         self.obj, self.sb = obj, obj.target
@@ -244,10 +246,6 @@ def _angle(a: np.ndarray, b: np.ndarray) -> float:
 class SensorHandler(Handler):
     state_type, cmd_type = "SensorState", "SensorCmd"  # AMBF reads no sensor command
 
-    def __init__(self, bridge, obj) -> None:
-        super().__init__(bridge, obj)
-        self.rebind(obj)
-
     def rebind(self, obj: RosObject) -> None:
         self.obj, self.s = obj, obj.target
         st = self.state
@@ -273,10 +271,6 @@ class SensorHandler(Handler):
 
 class ActuatorHandler(Handler):
     state_type, cmd_type = "ActuatorState", "ActuatorCmd"
-
-    def __init__(self, bridge, obj) -> None:
-        super().__init__(bridge, obj)
-        self.rebind(obj)
 
     def rebind(self, obj: RosObject) -> None:
         self.obj, self.a = obj, obj.target
@@ -316,10 +310,6 @@ class ActuatorHandler(Handler):
 class CameraHandler(Handler):
     state_type, cmd_type = "CameraState", "CameraCmd"
 
-    def __init__(self, bridge, obj) -> None:
-        super().__init__(bridge, obj)
-        self.rebind(obj)
-
     def rebind(self, obj: RosObject) -> None:
         self.obj, self.cams = obj, obj.target
         self.state.parent_name.data = self.cams[0].camera.parent or ""
@@ -343,9 +333,8 @@ class CameraHandler(Handler):
 class LightHandler(Handler):
     state_type, cmd_type = "LightState", "LightCmd"
 
-    def __init__(self, bridge, obj) -> None:
-        super().__init__(bridge, obj)
-        light = obj.target
+    def rebind(self, obj: RosObject) -> None:
+        self.obj, light = obj, obj.target
         self.state.parent_name.data = light.parent or ""
         t = np.eye(4)  # the light's `direction` is its +x axis (adf-format.md §10)
         t[:3, 3] = light.location or (0.0, 0.0, 0.0)
@@ -357,9 +346,6 @@ class LightHandler(Handler):
             y /= np.linalg.norm(y)
             t[:3, :3] = np.column_stack([x, y, np.cross(x, y)])
         _set_pose(self.state.pose, t)
-
-    def rebind(self, obj: RosObject) -> None:
-        self.obj = obj
 
 
 HANDLERS = {

@@ -44,10 +44,12 @@ class RosServer:
         teleop: list[str] | None = None,
         images: bool = True,
         log=print,
+        solver_iterations: int = 10,
     ) -> None:
         self.scene_path, self.indices, self.engine, self.rate = Path(scene_path), indices, engine, float(rate)
         self.master = master or os.environ.get("ROS_MASTER_URI") or "http://localhost:11311"
         self.crtk_on, self.teleop_specs, self.images_on, self.log = crtk, list(teleop or []), images, log
+        self.solver_iterations = solver_iterations
         self.stop = threading.Event()
         self.world = self.bridge = self.crtk = None
         self.teleops: list = []
@@ -100,7 +102,12 @@ class RosServer:
         scene = load_scene(self.scene_path, self.indices, [])
         # AMBF's dt is 1 ms (1/rate above 1 kHz); a loop slower than 1 kHz takes several 1 ms steps
         substeps = max(1, round(1000.0 / self.rate))
-        opt = Options(physics_hz=max(self.rate, 1000.0), control_substeps=substeps, renderer="auto")
+        opt = Options(
+            physics_hz=max(self.rate, 1000.0),
+            control_substeps=substeps,
+            renderer="auto",
+            solver_iterations=self.solver_iterations,
+        )
         return open_world(scene, opt, engine=self.engine)
 
     def summary(self) -> str:
