@@ -20,7 +20,7 @@ def ros(tmp_path_factory):
     rs.require_client()
     master = rs.Master()
     paths = rs.ambf_client(tmp_path_factory.mktemp("ambf"))
-    server = rs.Server(master, rs.SAMPLE, "--teleop", "joy:/test_joy=psm2")
+    server = rs.Server(master, rs.SAMPLE, "--teleop", "joy:/test_joy=psm2", "--teleop", "geomagic:/test_geo/=psm1")
     yield master, paths, server
     err = server.close()
     master.close()
@@ -105,7 +105,15 @@ def test_reset_puts_the_scene_back(ros):
         before = needle.get_pos(); before = [before.x, before.y, before.z]
         step0 = c.get_world_handle()._state.sim_step
         c.get_world_handle().reset()
-        time.sleep(0.5)
+        from adfkit.scenes.suturing import layout
+        start = layout.needle_start()[:3, 3]
+        t = time.time()  # the next loop step restores the scene; its state then comes at 50 Hz
+        while time.time() - t < 5:
+            p = needle.get_pos()
+            if sum((a - b) ** 2 for a, b in zip((p.x, p.y, p.z), start)) ** 0.5 < 1e-3:
+                break
+            time.sleep(0.05)
+        time.sleep(0.2)
         after = needle.get_pos(); after = [after.x, after.y, after.z]
         print(json.dumps({"before": before, "after": after, "steps": c.get_world_handle()._state.sim_step - step0}))
         """,
@@ -222,6 +230,48 @@ def test_a_joystick_moves_psm2_and_its_button_closes_the_jaw(ros):
     assert 0.002 < d[2] < 0.03 and abs(d[0]) < 1e-3 + 0.1 * d[2] and abs(d[1]) < 1e-3 + 0.1 * d[2]
     assert sum(out["closed"]) < 0.05  # the button held: the jaw closed (nothing between the jaws)
     assert sum(out["opened"]) > 0.4  # let go: open again
+
+
+def test_a_geomagic_clutch_moves_psm1_by_the_scaled_stylus_motion(ros):
+    """Grey button held (the clutch): the stylus's 50 mm along x is 10 mm of the tool (the
+    challenge's 0.0002 scale); let go, the stylus moves freely."""
+    master, paths, server = ros
+    out = rs.run_client(
+        master,
+        [],
+        """
+        import json, time, rospy
+        from adfkit.ros import msggen
+        from pathlib import Path
+        import adfkit.ros as pkg
+        msggen.ensure(Path(pkg.__file__).parent / "geomagic_control", "geomagic_control")
+        from geomagic_control.msg import DeviceButtonEvent
+        from geometry_msgs.msg import PoseStamped
+        rospy.init_node("t_geo")
+        got = {}
+        rospy.Subscriber("/CRTK/psm1/measured_cp", PoseStamped, lambda m: got.__setitem__("cp", m))
+        pose = rospy.Publisher("/test_geo/pose", PoseStamped, queue_size=1)
+        button = rospy.Publisher("/test_geo/button", DeviceButtonEvent, queue_size=1)
+        time.sleep(1.0)
+        def send(x, grey, seconds):
+            t = time.time()
+            while time.time() - t < seconds:
+                m = PoseStamped(); m.pose.position.x = x; m.pose.orientation.w = 1.0
+                pose.publish(m); button.publish(DeviceButtonEvent(grey_button=grey, white_button=0)); time.sleep(0.02)
+        send(0.0, 1, 0.5)
+        p0 = got["cp"].pose.position; p0 = [p0.x, p0.y, p0.z]
+        for k in range(1, 21):
+            send(2.5 * k, 1, 0.05)  # 50 mm in 1 s
+        send(50.0, 1, 1.5)
+        p1 = got["cp"].pose.position; p1 = [p1.x, p1.y, p1.z]
+        send(100.0, 0, 1.0)  # the clutch let go: no motion
+        p2 = got["cp"].pose.position; p2 = [p2.x, p2.y, p2.z]
+        print(json.dumps({"p0": p0, "p1": p1, "p2": p2}))
+        """,
+    )
+    d = np.array(out["p1"]) - np.array(out["p0"])
+    assert abs(d[0] - 0.01) < 2e-3 and abs(d[1]) < 1e-3 and abs(d[2]) < 1e-3
+    assert np.linalg.norm(np.array(out["p2"]) - np.array(out["p1"])) < 1e-3
 
 
 def test_no_master_is_a_located_error_not_a_traceback():

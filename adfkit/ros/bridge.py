@@ -99,7 +99,7 @@ class Handler:
         self.fill()
         st = self.state
         st.header.stamp = stamp
-        st.sim_step, st.sim_time, st.wall_time = self.bridge.world.steps, self.bridge.world.sim_time, self.bridge.wall
+        st.sim_step, st.sim_time, st.wall_time = self.bridge.steps, self.bridge.world.sim_time, self.bridge.wall
         self.pub.publish(st)
 
     def close(self) -> None:
@@ -431,7 +431,7 @@ class WorldHandler:
             return
         st, w = self.state, self.bridge.world
         st.header.stamp = stamp
-        st.sim_step, st.sim_time, st.wall_time = w.steps, w.sim_time, self.bridge.wall
+        st.sim_step, st.sim_time, st.wall_time = self.bridge.steps, w.sim_time, self.bridge.wall
         st.dynamic_loop_freq = int(round(rate_hz))
         st.graphics_loop_freq = int(round(self.bridge.graphics_hz))
         st.n_devices = 0
@@ -449,6 +449,7 @@ class Bridge:
     def __init__(self, world, rospy, msgs, log=print) -> None:
         self.world, self.rospy, self.msgs, self.log = world, rospy, msgs, log
         self.t0 = time.monotonic()
+        self.steps = 0  # loop steps: AMBF's sim_step counts physics updates, however many 1 ms steps each is
         self.graphics_hz = 0.0
         self.notes: set[str] = set()
         self.joints = JointCommands(world)

@@ -164,6 +164,7 @@ class RosServer:
             self.world.step(1)
             wh.stepped()
             self.steps_run += 1
+            self.bridge.steps += 1
             window_n += 1
             if now - window_t >= 1.0:
                 measured, window_t, window_n = window_n / (now - window_t), now, 0
