@@ -137,25 +137,26 @@ def test_the_client_steps_the_world(ros):
         from ambf_client import Client
         c = Client("t_step"); c.connect(); time.sleep(0.3)
         w = c.get_world_handle()
+        w.set_active()  # the client's thread re-sends the world command: AMBF's 0.5 s watchdog stays fed
         w.enable_throttling(True); w.set_num_step_skips(5)
-        w.update(); time.sleep(0.15)  # under AMBF's 0.5 s world watchdog, which would end throttling
-        s0 = w._state.sim_step; time.sleep(0.15); held = w._state.sim_step - s0
-        steps = []
+        w.update(); time.sleep(0.3)
+        s0 = w._state.sim_step; time.sleep(0.3); held = w._state.sim_step - s0
+        start = target = w._state.sim_step
         for _ in range(10):
-            before = w._state.sim_step
             w.update()
+            target += 5
             t = time.time()
-            while w._state.sim_step < before + 5 and time.time() - t < 2:
+            while w._state.sim_step < target and time.time() - t < 5:
                 time.sleep(0.0005)
-            time.sleep(0.01)
-            steps.append(w._state.sim_step - before)
+        time.sleep(0.3)
+        steps = w._state.sim_step - start
         w.enable_throttling(False); w.update(); time.sleep(0.2)
         s1 = w._state.sim_step; time.sleep(0.2)
         print(json.dumps({"held": held, "steps": steps, "free": w._state.sim_step - s1}))
         """,
     )
     assert out["held"] == 0  # throttled, nothing moves without the clock
-    assert out["steps"] == [5] * 10
+    assert out["steps"] == 50  # ten toggles of the step clock, five steps each
     assert out["free"] >= 10  # released: it runs on by itself
 
 
