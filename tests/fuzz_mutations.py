@@ -403,6 +403,14 @@ def static_broken_mesh(files: dict[str, bytes], model: str, kind: str) -> dict[s
     return {**files, model: text.encode("utf-8", "surrogateescape"), name: data}
 
 
+def op_truncate(rng, files, seed):
+    """A file cut short at a random byte (a copy or a download interrupted), in a multi-byte
+    character, a quoted string or a flow collection as it falls."""
+    f = _pick_file(rng, files, seed)
+    files[f] = files[f][: rng.randrange(len(files[f]) + 1)]
+    return files, {}
+
+
 def op_static_broken_mesh(rng, files, seed):
     models = [f for f in _yaml_files(files, seed) if re.search(rb"^[ \t]+(collision )?mesh:", files[f], re.M)]
     if not models:
@@ -490,5 +498,6 @@ YAML_OPS = {
     "duplicate": op_duplicate,
     "garbage_mesh": op_garbage_mesh,
     "static_broken_mesh": op_static_broken_mesh,
+    "truncate": op_truncate,
 }
 XML_OPS = {"xml": op_xml, "xml2": op_xml, "odd_bytes": op_odd_bytes, "garbage_mesh": op_garbage_mesh}

@@ -107,11 +107,17 @@ class MeshFiles:
                 losses.append(Loss(who, "mesh", f"{exc.diagnostics[0].message}: left out"))
                 self._done[key] = (None, False, None)
                 return None, None
-            try:  # only a file the input policy lets in is opened here
+            try:  # only a file the input policy lets in is read here
                 inputs.check_file(path, "mesh", tree=self.tree, what="mesh file")
                 let_in = True
-            except AdfError:
-                let_in = False
+            except AdfError as exc:
+                d = exc.diagnostics[0]
+                if d.rule != "outside-tree":  # missing, not a file: left out, so the output loads
+                    why = f"{inputs.shown(path)} not found" if d.rule == "file-not-found" else d.message
+                    losses.append(Loss(who, "mesh", f"{why}: left out"))
+                    self._done[key] = (None, False, None)
+                    return None, None
+                let_in = False  # outside the model's tree: named as it is, never opened
             if let_in and (problem := mesh_problem(path)) is not None:  # no triangles, a face naming no vertex
                 losses.append(Loss(who, "mesh", f"{inputs.shown(path.name)}: {problem}: left out"))
                 self._done[key] = (None, False, None)

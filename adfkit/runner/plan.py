@@ -103,6 +103,43 @@ def collision_masks(world, bodies) -> dict[int, int]:
     return out
 
 
+#: deeper than this at the start, two bodies' shapes overlap (not a body resting on another)
+HULL_OVERLAP = 0.002  # m
+
+
+def concave_mesh(body) -> bool:
+    """The body collides with a mesh AMBF keeps concave (a triangle mesh: `collision mesh type`
+    CONCAVE_MESH, its default), which an engine may take the convex hull of."""
+    from ..model.semantics import CollisionMeshType, collision_mesh_type
+
+    return collision_primitives(body) is None and collision_mesh_type(body.collision_mesh_type)[0] is (
+        CollisionMeshType.CONCAVE_MESH
+    )
+
+
+def hull_overlaps(world, pairs: dict, engine: str) -> None:
+    """Each pair of bodies whose collision shapes overlap at the start by more than HULL_OVERLAP
+    where one collides as the convex hull of a concave mesh (``pairs``: {(hull body, other body):
+    depth, m}, engine bodies): the hollow it was made for is solid to the engine (puzzle1's torus
+    starts 19 cm inside its peg's hull in MuJoCo and is flung off), said at the hull body's mesh and
+    listed in ``not_played``."""
+    for (hull, other), depth in sorted(pairs.items(), key=lambda kv: -kv[1]):
+        b = hull.body
+        why = (
+            f"the {engine} engine collides its mesh as a convex hull, which starts {depth * 1e3:.0f} mm inside "
+            f"{other.key}'s collision shape: what is hollow in it is solid here, and the two are pushed apart"
+        )
+        world.diagnostics.append(
+            warning(
+                "runner-hull-overlap",
+                f"{b.identifier}: {why}",
+                _mesh_key(b),
+                "decompose the mesh into convex parts (adfkit decompose, or the add-on's Generate convex collision)",
+            )
+        )
+        world.not_played.append({"object": b.identifier, "what": "concave collision", "why": why})
+
+
 def _floors_passed(world, bodies, masks) -> None:
     """A floor (a PLANE) with collision groups holds only the bodies that share one (or have
     none); each one whose dynamic bodies fall through it, as in AMBF, is named at its groups."""
@@ -164,10 +201,17 @@ def uncreated(model, obj):
     if (refused := mesh_refusal(model, path)) is not None:
         return mesh_skipped(obj, refused)
     if (problem := mesh_problem(path)) is not None:
-        # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some
+        # no triangles at all (the validator's mesh-unreadable): PyBullet crashes on some. An
+        # OBJ face naming no vertex: AMBF 2.0 makes the body of what it reads (measured: it
+        # collides with nothing and falls freely); the engines here could not read it at all
+        as_ambf = (
+            "as AMBF does"
+            if path.suffix.lower() != ".obj" or "no faces" in problem or "no vertices" in problem
+            else ("(AMBF 2.0 makes it of what it reads of the mesh, which collides with nothing)")
+        )
         return warning(
             "runner-bad-mesh",
-            f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; the body is skipped as AMBF does",
+            f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; the body is skipped {as_ambf}",
             _mesh_key(obj),
             "re-export the mesh as a triangle mesh (STL or OBJ)",
         )

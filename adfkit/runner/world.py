@@ -140,9 +140,11 @@ class World:
         return False
 
     def health(self) -> dict:
-        """Dynamic bodies that fell through the floor, move faster than 10 m/s, are NaN, or have
-        no collision shape."""
+        """Dynamic bodies that fell through the floor (are 10 cm below the lowest static body
+        and 10 cm below where they started: an arm hanging from a static base above the others
+        starts below them), move faster than 10 m/s, are NaN, or have no collision shape."""
         fell, fast, nan, shapeless = [], [], [], []
+        start = getattr(self, "initial_positions", {})
         for sb in self.bodies:
             if sb.static:
                 continue
@@ -153,7 +155,8 @@ class World:
             if self._shapeless(sb):
                 shapeless.append(sb.key)
                 continue
-            if math.isfinite(self._floor_z) and p[2] < self._floor_z - 0.1:
+            below_start = sb.key not in start or p[2] < start[sb.key][2] - 0.1
+            if math.isfinite(self._floor_z) and p[2] < self._floor_z - 0.1 and below_start:
                 fell.append(sb.key)
             if np.linalg.norm(v) > 10.0:
                 fast.append(sb.key)

@@ -195,7 +195,10 @@ def validate_files(files, kind: str | None = None, follow: bool = True) -> list[
                         context.append(ModelFile(namespace=res.doc.namespace, cameras=list(res.doc.cameras)))
                     if k == "world" and isinstance(res.doc, World) and res.doc.environment:
                         env_path = paths_check.relative_to_file(res.doc.path, res.doc.environment)
-                        env = results.get(Path(os.path.realpath(env_path)))
+                        try:  # a name no file can have (a NUL byte): the world's own check says so
+                            env = results.get(Path(os.path.realpath(env_path)))
+                        except (ValueError, OSError):
+                            env = None
                         if env is not None and isinstance(env.doc, ModelFile):
                             context.append(env.doc)
         for p in targets.get("multibody configs", []):

@@ -11,7 +11,7 @@ import numpy as np
 
 from ...model.semantics import JointKind, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
-from ..plan import ALL_GROUPS
+from ..plan import ALL_GROUPS, HULL_OVERLAP, concave_mesh, hull_overlaps
 from ..rotations import pose_to_matrix
 from .build import build_plan
 from .contacts import set_contacts
@@ -179,7 +179,27 @@ class Assembly:
         self.cameras = cams.finish(self)
         self.damping = BodyDamping(self)
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
+        self._hull_overlaps()
         plan.tmp.cleanup()
+
+    def _hull_overlaps(self) -> None:
+        """Bodies whose shapes overlap at the start where one is a mesh's hull (plan.hull_overlaps)."""
+        m, d = self.model, self.data
+        by_id = {sb.id: sb for sb in self.bodies}
+        pairs: dict = {}
+        for c in d.contact[: d.ncon]:
+            if c.dist > -HULL_OVERLAP:
+                continue
+            g = (c.geom1, c.geom2)
+            a, b = (by_id.get(int(m.geom_bodyid[x])) for x in g)
+            if a is None or b is None:
+                continue
+            mesh = [m.geom_type[x] == mujoco.mjtGeom.mjGEOM_MESH and concave_mesh(s.body) for x, s in zip(g, (a, b))]
+            if not any(mesh):
+                continue
+            hull, other = (a, b) if mesh[0] and (not mesh[1] or b.static) else (b, a)
+            pairs[(hull, other)] = max(pairs.get((hull, other), 0.0), -float(c.dist))
+        hull_overlaps(self, pairs, "MuJoCo")
 
     def _lowest_point(self) -> float:
         m = self.model
@@ -250,11 +270,12 @@ class Assembly:
                     clamped.append(m.joint(j).name)
                     m.jnt_stiffness[j] = cap
         if clamped:
+            joint = next((j for j, *_r, names in self._plan.joints if clamped[0] in names), None)
             self._warn(
                 "runner-spring-clamp",
                 f"{len(clamped)} spring axes stiffer than an explicit {dt * 1e3:g} ms "
                 f"step keeps stable were softened to 0.25·M/dt² (e.g. {clamped[0]})",
-                None,
+                joint,
             )
 
     def _gravity_overrides(self) -> None:

@@ -139,6 +139,7 @@ def _drop_mesh(world, spec, mesh, text: str) -> None:
 
 def _flat_to_box(world, spec, mesh) -> None:
     lo, hi = _obj_bounds(Path(mesh.file), np.array(mesh.scale, float))
+    bodies = _adf_bodies(world, spec, [g for g in spec.geoms if g.meshname == mesh.name])
     for g in list(spec.geoms):
         if g.meshname != mesh.name:
             continue
@@ -160,7 +161,7 @@ def _flat_to_box(world, spec, mesh) -> None:
     world._warn(
         "runner-flat-mesh",
         f"{Path(mesh.file).name}: a flat mesh has no convex hull for MuJoCo; it collides as its bounding box",
-        None,
+        bodies[0] if bodies else None,
     )
     spec.delete(mesh)
 

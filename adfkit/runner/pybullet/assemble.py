@@ -15,8 +15,11 @@ from ..cameras import build_cameras
 from ..names import Registry, merge_namespace
 from ..plan import (
     ALL_GROUPS,
+    HULL_OVERLAP,
     SPRING_KINDS,
     collision_masks,
+    concave_mesh,
+    hull_overlaps,
     is_hole,
     joint_ends,
     key_of,
@@ -149,6 +152,7 @@ class Assembly:
                 self._floor_z = -math.inf
         self.initial_positions = {sb.key: np.array(sb.com_position()) for sb in self.bodies}
         self._lookup = {(sb.uid, link): sb for sb in self.bodies for link in sb.links}
+        self._hull_overlaps()
         self._dynamic_lookup = {k: sb for k, sb in self._lookup.items() if not sb.static}
         self._pairs_epoch = 0  # counts changes of collision pairs and grasps (interact.py's distance answers)
         self._parting: list = []  # (uid, link, body): a released grasp, collisions back once apart
@@ -168,6 +172,23 @@ class Assembly:
                 (uid, [sb.link for sb in sbs], sbs, [(sb.mass * (sb.gravity - self.gravity)).tolist() for sb in sbs])
             )
         return out
+
+    def _hull_overlaps(self) -> None:
+        """Bodies whose shapes overlap at the start where one is a concave mesh PyBullet takes the
+        hull of (a dynamic one; plan.hull_overlaps)."""
+        pb.performCollisionDetection(physicsClientId=self.cid)
+        pairs: dict = {}
+        for c in pb.getContactPoints(physicsClientId=self.cid):
+            if c[8] > -HULL_OVERLAP:
+                continue
+            a, b = self._lookup.get((c[1], c[3])), self._lookup.get((c[2], c[4]))
+            if a is None or b is None:
+                continue
+            hull = [_hulled(s) for s in (a, b)]
+            if any(hull):
+                pair = (a, b) if hull[0] and (not hull[1] or b.static) else (b, a)
+                pairs[pair] = max(pairs.get(pair, 0.0), -float(c[8]))
+        hull_overlaps(self, pairs, "PyBullet")
 
     def _add_ground(self) -> None:
         """A model played without a world gets what AMBF's worlds give it: a floor, here a
@@ -287,3 +308,11 @@ class Assembly:
                 else:
                     zs.append(pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2])
         return min(zs) if zs else -math.inf
+
+
+def _hulled(sb) -> bool:
+    """PyBullet collides the body's concave mesh as convex hulls (a dynamic body; a static one is
+    its exact triangles unless beside soft bodies: shapes.py)."""
+    parts = sb._parts
+    exact = parts is not None and any(kw.get("flags") == pb.GEOM_FORCE_CONCAVE_TRIMESH for kw in parts.kwargs)
+    return parts is not None and bool(parts.types) and not exact and concave_mesh(sb.body)

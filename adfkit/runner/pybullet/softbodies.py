@@ -104,14 +104,13 @@ class SoftBodies:
         for m, j in self.joints:
             self._attach(m, j, by_obj)
         shutil.rmtree(self._tmp, ignore_errors=True)  # loadSoftBody has read the OBJ files
-        planes = [
-            b.key for b in self.world.bodies if getattr(b, "_parts", None) is not None and b._parts.plane is not None
-        ]
+        planes = [b for b in self.world.bodies if getattr(b, "_parts", None) is not None and b._parts.plane is not None]
         if self.items and planes:
             self.world._warn(
                 "runner-soft-plane",
-                f"{', '.join(planes)}: PyBullet's soft bodies stop centimetres above a PLANE (36-100 mm measured)",
-                None,
+                f"{', '.join(b.key for b in planes)}: PyBullet's soft bodies stop centimetres above a PLANE "
+                "(36-100 mm measured)",
+                planes[0].body,
                 "give the floor a thick BOX collision shape instead",
             )
 
