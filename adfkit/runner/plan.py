@@ -20,9 +20,7 @@ from ..model.semantics import (
     DEFAULT_SENSOR_RANGE,
     SENSOR_TYPES,
     JointKind,
-    ShapeKind,
     collision_primitives,
-    effective_mass,
     pose_or_identity,
 )
 from .names import merge_namespace
@@ -40,7 +38,6 @@ SPRING_KINDS = (
 #: every collision-group bit: what a body without collision groups (and the runner's floor,
 #: which stands in for a world's) collides as, in both engines
 ALL_GROUPS = (1 << 31) - 1
-GROUP_BITS = 31
 
 #: sections of a model each engine does not play (each is warned about and listed in the report)
 NOT_PLAYED = {
@@ -72,102 +69,6 @@ def not_played(world, models, engine: str) -> None:
                 world.not_played.append({"object": o.identifier, "what": kind, "why": why})
 
 
-def collision_masks(world, bodies) -> dict[int, int]:
-    """{id(ADF body): its collision bits} for ``bodies`` (ADF bodies), AMBF's collision groups
-    (afFramework.cpp, buildCollisionGroups; checked in AMBF): two bodies that both have groups
-    collide only when they share one; a body with none (`collision groups` absent or `[]`)
-    collides with every body, so a floor written `collision groups: []` holds them all. A group
-    is one bit of ``GROUP_BITS``, a body without groups has them all, and the engines collide a
-    pair whose bits meet. Past ``GROUP_BITS`` groups two groups share a bit, so their bodies
-    collide where AMBF's would not: a located ``runner-groups`` warning at the first such body."""
-    bodies = list(bodies)
-    groups = sorted({g for b in bodies for g in _groups(b)})
-    bit = {g: 1 << (i % GROUP_BITS) for i, g in enumerate(groups)}
-    out = {}
-    for b in bodies:
-        mask = 0
-        for g in _groups(b):
-            mask |= bit[g]
-        out[id(b)] = mask or ALL_GROUPS
-    _floors_passed(world, bodies, out)
-    if len(groups) > GROUP_BITS:
-        first = next(b for b in bodies if groups[GROUP_BITS] in _groups(b))
-        world._warn(
-            "runner-groups",
-            f"{len(groups)} collision groups, more than the {GROUP_BITS} an engine's collision bits hold: "
-            f"group {groups[GROUP_BITS]} shares a bit with group {groups[0]}, so their bodies collide where AMBF's "
-            "do not",
-            first,
-            f"use at most {GROUP_BITS} distinct collision groups in one scene",
-        )
-    return out
-
-
-#: deeper than this at the start, two bodies' shapes overlap (not a body resting on another)
-HULL_OVERLAP = 0.002  # m
-
-
-def concave_mesh(body) -> bool:
-    """The body collides with a mesh AMBF keeps concave (a triangle mesh: `collision mesh type`
-    CONCAVE_MESH, its default), which an engine may take the convex hull of."""
-    from ..model.semantics import CollisionMeshType, collision_mesh_type
-
-    return collision_primitives(body) is None and collision_mesh_type(body.collision_mesh_type)[0] is (
-        CollisionMeshType.CONCAVE_MESH
-    )
-
-
-def hull_overlaps(world, pairs: dict, engine: str) -> None:
-    """Each pair of bodies whose collision shapes overlap at the start by more than HULL_OVERLAP
-    where one collides as the convex hull of a concave mesh (``pairs``: {(hull body, other body):
-    depth, m}, engine bodies): the hollow it was made for is solid to the engine (puzzle1's torus
-    starts 19 cm inside its peg's hull in MuJoCo and is flung off), said at the hull body's mesh and
-    listed in ``not_played``."""
-    for (hull, other), depth in sorted(pairs.items(), key=lambda kv: -kv[1]):
-        b = hull.body
-        why = (
-            f"the {engine} engine collides its mesh as a convex hull, which starts {depth * 1e3:.0f} mm inside "
-            f"{other.key}'s collision shape: what is hollow in it is solid here, and the two are pushed apart"
-        )
-        world.diagnostics.append(
-            warning(
-                "runner-hull-overlap",
-                f"{b.identifier}: {why}",
-                _mesh_key(b),
-                "decompose the mesh into convex parts (adfkit decompose, or the add-on's Generate convex collision)",
-            )
-        )
-        world.not_played.append({"object": b.identifier, "what": "concave collision", "why": why})
-
-
-def _floors_passed(world, bodies, masks) -> None:
-    """A floor (a PLANE) with collision groups holds only the bodies that share one (or have
-    none); each one whose dynamic bodies fall through it, as in AMBF, is named at its groups."""
-    for floor in bodies:
-        if not _groups(floor) or not any(p.kind is ShapeKind.PLANE for p in collision_primitives(floor) or []):
-            continue
-        passed = [
-            b.identifier
-            for b in bodies
-            if b is not floor and effective_mass(b) > 0 and not masks[id(b)] & masks[id(floor)]
-        ]
-        if passed:
-            world.diagnostics.append(
-                warning(
-                    "runner-floor-groups",
-                    f"{floor.identifier}: its collision groups {_groups(floor)} share none with "
-                    f"{', '.join(passed[:5])}{' ...' if len(passed) > 5 else ''}: they fall through it, as in AMBF",
-                    floor.where("collision groups"),
-                    "give the floor `collision groups: []` to hold every body, or add their group to it",
-                )
-            )
-
-
-def _groups(body) -> list[int]:
-    """The body's collision groups AMBF keeps (0-999; it warns about and drops the others)."""
-    return [g for g in (body.collision_groups or []) if isinstance(g, int) and 0 <= g <= 999]
-
-
 def mesh_refusal(model, path) -> str | None:
     """Why the input policy (adfkit.inputs) keeps an engine from reading this mesh, or None:
     missing, not a regular file, over the size cap, outside the model's tree."""
@@ -189,9 +90,7 @@ def uncreated(model, obj):
     policy or has no triangles."""
     from .. import inputs
     from ..adf.paths import collision_mesh_path
-    from ..diagnostics import warning
     from ..geometry.meshcheck import mesh_problem
-    from ..model.semantics import collision_primitives
 
     if (why := _visual_refused(model, obj)) is not None:
         return why
@@ -225,7 +124,6 @@ def _visual_refused(model, obj):
     without faces, even an empty one, loads (chai3d's OBJ reader takes it)."""
     from .. import inputs
     from ..adf.paths import visual_mesh_path
-    from ..diagnostics import warning
     from ..geometry.meshcheck import mesh_problem
 
     if getattr(obj, "shape", None) or getattr(obj, "compound_shape", None):
@@ -251,7 +149,6 @@ def _visual_refused(model, obj):
 def mesh_skipped(obj, refused: str):
     """The located ``runner-missing-mesh`` warning for a body skipped because its collision mesh
     cannot be read (``refused``: why, as mesh_refusal or an engine's own reader says it)."""
-    from ..diagnostics import warning
 
     return warning(
         "runner-missing-mesh",

@@ -11,7 +11,8 @@ import numpy as np
 
 from ...model.semantics import JointKind, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
-from ..plan import ALL_GROUPS, HULL_OVERLAP, concave_mesh, hull_overlaps
+from ..collisions import HULL_OVERLAP, concave_mesh, hull_overlaps
+from ..plan import ALL_GROUPS
 from ..rotations import pose_to_matrix
 from .build import build_plan
 from .contacts import set_contacts
@@ -183,7 +184,7 @@ class Assembly:
         plan.tmp.cleanup()
 
     def _hull_overlaps(self) -> None:
-        """Bodies whose shapes overlap at the start where one is a mesh's hull (plan.hull_overlaps)."""
+        """Bodies whose shapes overlap at the start where one is a mesh's hull (collisions.hull_overlaps)."""
         m, d = self.model, self.data
         by_id = {sb.id: sb for sb in self.bodies}
         pairs: dict = {}

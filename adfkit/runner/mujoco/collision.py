@@ -1,5 +1,5 @@
 """What the MuJoCo engine collides, from the MJCF writer's model: ADF collision groups as
-contype/conaffinity bits (plan.collision_masks: AMBF's rule), excluded pairs for joints and
+contype/conaffinity bits (collisions.collision_masks: AMBF's rule), excluded pairs for joints and
 models that ignore inter-collision, each body's friction, and a located warning for every
 collision shape the writer could not give MuJoCo."""
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 from ...converters.urdf import _material
 from ...diagnostics import warning
 from ...model.semantics import ShapeKind
-from .. import plan as scene_rules
+from ..collisions import collision_masks
 
 EXCLUDE_SPARE = 512  # run-time excluded pairs (MujocoWorld.set_collision); the suture turns off ~300
 _SHAPE_FEATURES = {f"collision {k.value}" for k in ShapeKind}
@@ -53,7 +53,7 @@ def collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
     """ADF collision groups as contype/conaffinity bits (bodies collide when they share a
     group, as in the PyBullet runner); joints and models that ignore inter-collision as
     excluded body pairs."""
-    masks = scene_rules.collision_masks(world, [bp.body for bp in bodies])
+    masks = collision_masks(world, [bp.body for bp in bodies])
     for bp in bodies:
         mask = masks[id(bp.body)]
         fr = bp.body.friction

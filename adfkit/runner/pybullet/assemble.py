@@ -12,14 +12,11 @@ import pybullet as pb
 
 from ...model.semantics import JointKind, joint_frames, joint_kind, pose_or_identity
 from ..cameras import build_cameras
+from ..collisions import HULL_OVERLAP, collision_masks, concave_mesh, hull_overlaps
 from ..names import Registry, merge_namespace
 from ..plan import (
     ALL_GROUPS,
-    HULL_OVERLAP,
     SPRING_KINDS,
-    collision_masks,
-    concave_mesh,
-    hull_overlaps,
     is_hole,
     joint_ends,
     key_of,
@@ -175,7 +172,7 @@ class Assembly:
 
     def _hull_overlaps(self) -> None:
         """Bodies whose shapes overlap at the start where one is a concave mesh PyBullet takes the
-        hull of (a dynamic one; plan.hull_overlaps)."""
+        hull of (a dynamic one; collisions.hull_overlaps)."""
         pb.performCollisionDetection(physicsClientId=self.cid)
         pairs: dict = {}
         for c in pb.getContactPoints(physicsClientId=self.cid):
