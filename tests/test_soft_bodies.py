@@ -435,6 +435,38 @@ def test_soft_rigid_attachment_and_parameter_mapping(tmp_path):
     assert rep["soft_bodies"][0]["attached_nodes"] == {"BODY weight": 1}
 
 
+def test_soft_rigid_attachment_in_the_mujoco_engine(tmp_path):
+    """The same sheet and weight in MuJoCo: the joint holds node 24 to the weight (a connect
+    equality), node 0 stays pinned, and the sheet carries the weight as in PyBullet."""
+    from adfkit.adf import load_scene
+    from adfkit.scenes.soft_phantom import grid_obj
+
+    text = grid_obj(0.1, 4).splitlines()
+    shifted = [
+        f"v {float(l.split()[1]) + 0.05:.6f} {float(l.split()[2]) + 0.05:.6f} 0.0" if l.startswith("v ") else l
+        for l in text
+    ]
+    (tmp_path / "sheet.obj").write_text("\n".join(shifted) + "\n")
+    (tmp_path / "sheet.yaml").write_text(SHEET.format())
+    world = open_world(load_scene(tmp_path / "sheet.yaml"), Options(visuals=False, ground=False), engine="mujoco")
+    try:
+        world.run(0.6)
+        (soft,) = world.soft.items
+        nodes = soft.nodes()
+        weight = np.array(world.body("weight").com_position())
+        rules = {d.rule: d.message for d in world.diagnostics}
+        rep = world.report()
+    finally:
+        world.close()
+    assert soft.attached == {"BODY weight": [24]}
+    np.testing.assert_allclose(nodes[0], [0.0, 0.0, 1.0], atol=1e-6)
+    # the weight hangs on its node (measured 0.8 mm; MuJoCo's default equality softness: 13 mm)
+    assert np.linalg.norm(nodes[24] - weight) < 0.002
+    assert 0.8 < weight[2] < 0.99  # held up by the sheet, not falling freely (PyBullet: 0.868, MuJoCo 0.856)
+    assert "config.kAST" in rules["runner-soft-body-approx"]
+    assert rep["soft_bodies"][0]["attached_nodes"] == {"BODY weight": 1} and rep["nan"] == []
+
+
 def test_plane_beside_a_soft_body_is_warned_and_the_default_floor_is_a_slab(tmp_path):
     (tmp_path / "sq.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nf 1 2 3\nf 1 3 4\n")
     soft = "SOFT s:\n  name: s\n  mesh: sq.obj\n  mass: 0.01\n"

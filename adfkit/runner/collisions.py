@@ -5,8 +5,14 @@ the convex hull of where that hull starts inside another body."""
 from __future__ import annotations
 
 from ..diagnostics import warning
-from ..model.semantics import ShapeKind, collision_primitives, effective_mass
-from .plan import ALL_GROUPS, _mesh_key
+from ..model.semantics import (
+    CollisionMeshType,
+    ShapeKind,
+    collision_mesh_type,
+    collision_primitives,
+    effective_mass,
+)
+from .plan import ALL_GROUPS, mesh_key
 
 GROUP_BITS = 31
 
@@ -49,8 +55,6 @@ HULL_OVERLAP = 0.002  # m
 def concave_mesh(body) -> bool:
     """The body collides with a mesh AMBF keeps concave (a triangle mesh: `collision mesh type`
     CONCAVE_MESH, its default), which an engine may take the convex hull of."""
-    from ..model.semantics import CollisionMeshType, collision_mesh_type
-
     return collision_primitives(body) is None and collision_mesh_type(body.collision_mesh_type)[0] is (
         CollisionMeshType.CONCAVE_MESH
     )
@@ -72,7 +76,7 @@ def hull_overlaps(world, pairs: dict, engine: str) -> None:
             warning(
                 "runner-hull-overlap",
                 f"{b.identifier}: {why}",
-                _mesh_key(b),
+                mesh_key(b),
                 "decompose the mesh into convex parts (adfkit decompose, or the add-on's Generate convex collision)",
             )
         )

@@ -111,7 +111,7 @@ def uncreated(model, obj):
         return warning(
             "runner-bad-mesh",
             f"{obj.identifier}: collision mesh {inputs.shown(path.name)}: {problem}; the body is skipped {as_ambf}",
-            _mesh_key(obj),
+            mesh_key(obj),
             "re-export the mesh as a triangle mesh (STL or OBJ)",
         )
     return None
@@ -153,12 +153,12 @@ def mesh_skipped(obj, refused: str):
     return warning(
         "runner-missing-mesh",
         f"{obj.identifier}: collision mesh {refused}; the body is skipped as AMBF does",
-        _mesh_key(obj),
+        mesh_key(obj),
         "fix `collision mesh`/`mesh` or the resolution paths",
     )
 
 
-def _mesh_key(obj):
+def mesh_key(obj):
     """Where a body's collision mesh is named: `collision mesh`, else `mesh`."""
     return obj.where("collision mesh" if obj.collision_mesh is not None else "mesh") or obj.source
 

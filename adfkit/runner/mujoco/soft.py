@@ -16,6 +16,8 @@ from ...geometry.softmesh import placed_soft_mesh
 from ..names import merge_namespace
 from ..soft import held_nodes, soft_end, soft_report
 
+HOLD_STEPS = 2  # a held node's connect equality: time constant in physics steps (as the grasp weld's)
+
 
 @dataclass(eq=False)
 class MjSoftBody:
@@ -103,7 +105,8 @@ class MjSoftBodies:
                         name1=f"{made.flex}_{i}",
                         name2=plan.mjname,
                         objtype=mujoco.mjtObj.mjOBJ_BODY,
-                        data=np.zeros(11),
+                        data=np.zeros(12),
+                        solref=[HOLD_STEPS * w.dt, 1.0],  # stiff: MuJoCo's default 0.02 s let the node drift 13 mm
                     )
                 made.attached.setdefault(key, []).extend(chosen)
 

@@ -3,6 +3,8 @@ MJCF writer referenced resolved to files MuJoCo reads."""
 
 from __future__ import annotations
 
+import re
+import warnings
 from pathlib import Path
 
 import mujoco
@@ -41,8 +43,6 @@ def compile_spec(world, spec):
     """spec.compile(), replacing a collision mesh MuJoCo cannot hull (flat: coplanar vertices)
     by a box around its vertices (at least 1 mm thick), and leaving out a mesh MuJoCo cannot
     read, each with a located warning; anything else MuJoCo refuses is a located error."""
-    import re
-
     for _ in range(100):
         try:
             return _compile_noting_warnings(world, spec)
@@ -69,8 +69,6 @@ def compile_spec(world, spec):
 def _compile_noting_warnings(world, spec):
     """spec.compile(), its warnings (a mesh's texture coordinates discarded, ...) kept for the
     report's ``engine_warnings`` instead of printed as Python warnings with a line of code."""
-    import warnings
-
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         model = spec.compile()
@@ -87,8 +85,6 @@ def _first_line(text: str) -> str:
 
 def _named_mesh(spec, text: str):
     """The mesh asset MuJoCo's error names (its element, or its file), or None."""
-    import re
-
     hit = re.search(r"Element name '([^']*)'", text)
     if hit is not None and (mesh := spec.mesh(hit.group(1))) is not None:
         return mesh
@@ -107,8 +103,6 @@ def _adf_bodies(world, spec, geoms) -> list:
 
 def _where(world, spec, text: str):
     """Where the element MuJoCo's error names comes from: its ADF body, else the scene's first model."""
-    import re
-
     hit = re.search(r"Element name '([^']*)'", text)
     el = spec.body(hit.group(1)) if hit is not None and hit.group(1) else None
     bodies = _adf_bodies(world, spec, [g for g in spec.geoms if el is not None and g.parent.name == el.name])
