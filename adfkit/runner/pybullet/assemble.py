@@ -131,7 +131,7 @@ class Assembly:
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
             if kind_c is JointKind.FIXED:  # its relative orientation is held too (joint_angle_error)
                 self.fixed_frames.append((j.identifier, parent, child, fa[:3, :3], fb[:3, :3]))
-        self.springs = SpringSet(springs, self.cid)
+        self.springs = SpringSet(springs, self.cid, self.gravity)
         build_volumes(self, models)
         known = None
         for m in models:
