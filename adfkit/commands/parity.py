@@ -18,7 +18,11 @@ DESCRIPTION = (
 
 
 def add_arguments(p) -> None:
-    p.add_argument("path", help="launch, world or model ADF file (a folder: its launch.yaml)")
+    p.add_argument(
+        "path",
+        nargs="?",
+        help="launch, world or model ADF file (a folder: its launch.yaml)",
+    )
     p.add_argument("-l", "--indices", help="launch file: the models to load, e.g. 6,7,8,9,10,11 or 6-11 (default: all)")
     p.add_argument(
         "--ambf",
@@ -41,6 +45,12 @@ def add_arguments(p) -> None:
         help="adfkit's physics steps per control step (default 4, as adfkit run; 1 with a command file "
         "that drives joints: AMBF applies joint commands at every 1 ms step)",
     )
+    p.add_argument(
+        "--ghosts",
+        choices=("ambf", "hole-friction"),
+        help="what adfkit's ghosts do (default hole-friction: the paper's F = -K·v in hole ghosts; "
+        "ambf: AMBF's own ghost objects, gravity off and 10 %% of the velocity taken per step; PyBullet)",
+    )
     p.add_argument("--no-ground", action="store_true", help="a model file: no floor under it on either side")
     p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")
     p.add_argument("--tolerance-deg", type=float, default=1.0, help="largest orientation gap that agrees (1°)")
@@ -51,9 +61,12 @@ def add_arguments(p) -> None:
 def run(args) -> int:
     from .. import inputs
     from ..adf import parse_indices
+    from ..diagnostics import AdfError, error
     from ..jsonout import dumps
     from ..parity import ambf, session
 
+    if not args.path:
+        raise AdfError(error("bad-option", "name the scene to compare", None, "adfkit parity SCENE [-l 6-11]"))
     path = inputs.scene_file(args.path)
     inputs.check_file(path, what="ADF file")
     build = ambf.find_build(args.ambf)
@@ -67,6 +80,7 @@ def run(args) -> int:
         commands=Path(args.commands) if args.commands else None,
         control_substeps=args.control_substeps,  # None: session.Request decides
         ground=not args.no_ground,
+        ghosts=args.ghosts,
         tolerance_m=args.tolerance_mm / 1e3,
         tolerance_deg=args.tolerance_deg,
     )

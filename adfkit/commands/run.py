@@ -43,6 +43,13 @@ def add_arguments(p) -> None:
     )
     p.add_argument("--gravity", help="override the world gravity, e.g. 0,0,-9.81")
     p.add_argument("--hole-friction", type=float, default=2.0, help="K of F = -K·v inside hole ghosts, N·s/m")
+    p.add_argument(
+        "--ghosts",
+        choices=("hole-friction", "ambf"),
+        default="hole-friction",
+        help="what ghosts do: hole-friction (default; the paper's F = -K·v inside hole ghosts) or ambf "
+        "(AMBF's ghost objects: gravity off and 10%% of the velocity taken per step; PyBullet only)",
+    )
     p.add_argument("--no-frames", action="store_true", help="do not render camera frames")
     p.add_argument(
         "--renderer",
@@ -122,6 +129,7 @@ def run(args) -> int:
         contact_threshold=args.contact_threshold,
         gravity=gravity,
         hole_friction=args.hole_friction,
+        ghosts=args.ghosts,
         ground=not args.no_ground,
         renderer="tiny" if args.no_frames else args.renderer,
     )

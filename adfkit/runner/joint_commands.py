@@ -54,6 +54,37 @@ def limits_of(joint) -> tuple[float, float] | None:
     return float(lim.low), float(lim.high)
 
 
+#: AMBF's joint `erp` default, which its hinge's motor slows with near a limit (motor_factor)
+AMBF_JOINT_ERP = 0.1
+#: N·m (N) a limit may push with when an effort presses a joint past it (a limit row is unbounded)
+LIMIT_FORCE = 1e4
+
+
+def motor_factor(q: float, limits: tuple[float, float] | None, velocity: float, dt: float) -> float:
+    """Bullet's btTypedConstraint::getMotorFactor for a motor of AMBF's joints: 1 away from the
+    limits, falling to 0 over the last step's worth of travel toward one (at erp·rate), 0 past
+    it. The motor stops at a limit however the joint engine keeps its limits (PyBullet forgets a
+    multibody link's changeDynamics limits while other joints of it are driven: measured, the
+    LND PSM's jaw 0.068 rad past its lower limit in 0.4 s)."""
+    if limits is None:
+        return 1.0
+    lo, hi = limits
+    if lo > hi:
+        return 1.0
+    if lo == hi:
+        return 0.0
+    delta = velocity * dt / AMBF_JOINT_ERP
+    if delta < 0.0:
+        if lo <= q < lo - delta:
+            return (lo - q) / delta
+        return 0.0 if q < lo else 1.0
+    if delta > 0.0:
+        if hi >= q > hi - delta:
+            return (hi - q) / delta
+        return 0.0 if q > hi else 1.0
+    return 0.0
+
+
 def shortest_angle(current: float, target: float) -> float:
     """AMBF's afJoint::getShortestAngle: the way from ``current`` to ``target`` for a joint
     without limits, in (-π, π]."""
@@ -136,15 +167,31 @@ class JointCommands:
             self.joints[id(joint)] = dj
         dj.command = (kind, float(value))
 
+    def _effort(self, dj: DrivenJoint, effort: float) -> None:
+        """An effort, held at the joint's limits as AMBF's hinge and slider hold them (hard rows):
+        past a limit and pushed on, the joint is driven back at erp·error per step instead
+        (PyBullet drops a multibody link's limits while others of it are driven; the LND PSM's
+        jaw, pushed on its stop, turned 141° past it)."""
+        w = self.world
+        if dj.limits is not None:
+            q = float(w.joint_state(dj.art, [dj.index])[0][0])
+            lo, hi = dj.limits
+            err = q - hi if q > hi else (q - lo if q < lo else 0.0)
+            if err * effort > 0.0:
+                w.joint_motor(dj.art, dj.index, -AMBF_JOINT_ERP * err / w.dt, LIMIT_FORCE)
+                return
+        w.joint_effort(dj.art, dj.index, effort)
+
     def apply(self, t: float) -> None:
         """Every joint's last command, at simulated time ``t`` (call it between control steps)."""
         w = self.world
         for dj in self.joints.values():
             kind, value = dj.command
             if kind == "velocity":
-                w.joint_motor(dj.art, dj.index, value, dj.max_force)
+                q = float(w.joint_state(dj.art, [dj.index])[0][0])
+                w.joint_motor(dj.art, dj.index, value * motor_factor(q, dj.limits, value, w.dt), dj.max_force)
             elif kind == "effort":
-                w.joint_effort(dj.art, dj.index, value)
+                self._effort(dj, value)
             elif dj.motor:  # AMBF ignores a position command (with a warning) without a motor
                 current = float(w.joint_state(dj.art, [dj.index])[0][0])
                 target = value
@@ -154,6 +201,7 @@ class JointCommands:
                     target, current = shortest_angle(current, target), 0.0
                 out = dj.controller.output(current, target, t)
                 if dj.output == "force":
-                    w.joint_effort(dj.art, dj.index, out)
+                    self._effort(dj, out)
                 else:
-                    w.joint_motor(dj.art, dj.index, out, dj.max_force)
+                    q = float(w.joint_state(dj.art, [dj.index])[0][0])
+                    w.joint_motor(dj.art, dj.index, out * motor_factor(q, dj.limits, out, w.dt), dj.max_force)

@@ -14,6 +14,10 @@ class Options:
     contact_threshold: float | None = None  # Bullet's contact breaking threshold; None: its default 0.02
     gravity: tuple | None = None  # override the world's
     visuals: bool = True
+    # what ghost objects do to the bodies inside them (ghost_rules.GHOST_RULES): "ambf", AMBF's afGhostObject
+    # (every ghost: gravity off and 0.9 of the velocity kept per step and contact point);
+    # "hole-friction", the paper's F = -K·v_rel inside hole ghosts only (K: hole_friction)
+    ghosts: str = "hole-friction"
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
     ground: bool = True  # a model played without a world gets a floor under it

@@ -7,7 +7,6 @@ decides into their engine; the geometry and joint rules live in ``model.semantic
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -300,12 +299,6 @@ def loaded_so_far(known, bodies) -> object:
     for b in bodies:
         known.items[b.key] = b
     return known
-
-
-def viscous_impulse_force(mass: float, v_rel: np.ndarray, k: float, cdt: float) -> np.ndarray:
-    """F = -K·v_rel held for a control step ``cdt`` as the exact exp(-K·t/m) decay of
-    dv/dt = -K·v/m (the paper's needle friction in the hole ghosts), never overshooting."""
-    return -mass * v_rel * (1.0 - math.exp(-k * cdt / mass)) / cdt
 
 
 def rgba(obj) -> list[float] | None:

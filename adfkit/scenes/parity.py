@@ -1,12 +1,15 @@
 """Small scenes that each exercise one part of the physics, to be played side by side in AMBF
 and adfkit (``adfkit parity``, docs/parity.md): a box dropped onto a slab, an arm on a revolute
-joint driven by position, velocity and effort commands (a command file for each). They need
-nothing but themselves: no corpus, no meshes. The launch file lists one model per scene on the
-same world (a floor); ``-l`` picks one."""
+joint driven by position, velocity and effort commands (a command file for each), three boxes
+settling in a stack, a cube falling into a ghost object, the suture thread falling from a held
+needle. They need nothing but themselves: no corpus, no meshes. The launch file lists one model
+per scene on the same world (a floor); ``-l`` picks one."""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+import numpy as np
 
 from ..adf import atomic_write_text
 from ..adf.writer import write_file
@@ -15,6 +18,7 @@ from ..model import (
     Body,
     Colors,
     Geometry,
+    Ghost,
     InputDevices,
     Joint,
     JointLimits,
@@ -32,7 +36,7 @@ GREY = RGBA(r=0.6, g=0.6, b=0.65, a=1.0)
 ORANGE = RGBA(r=0.9, g=0.5, b=0.1, a=1.0)
 
 #: the launch file's models, in order (-l INDEX)
-SCENES = ("drop", "arm")
+SCENES = ("drop", "arm", "stack", "ghost", "thread")
 
 #: command files beside the scenes: (file, scene, lines)
 COMMANDS = {
@@ -99,7 +103,69 @@ def build_arm() -> ModelFile:
     return m
 
 
-BUILD = {"drop": build_drop, "arm": build_arm}
+def build_stack() -> ModelFile:
+    """Three boxes, each turned a little and 2 mm above the one below, settling into a stack on
+    the floor: resting contacts, box on box."""
+    m = ModelFile(namespace="/ambf/env/stack/")
+    z = 0.0
+    for i, (size, yaw) in enumerate(((0.2, 0.0), (0.14, 0.3), (0.08, -0.2))):
+        z += 0.002 + size / 2
+        m.bodies.append(
+            _box(f"box{i + 1}", (size, size, size), (0.01 * i, 0.0, z), (0.0, 0.0, yaw), mass=1.0 - 0.3 * i)
+        )
+        z += size / 2
+    return m
+
+
+def build_ghost() -> ModelFile:
+    """A 4 cm cube dropped from 2 cm above a ghost slab hung on a static post (a ghost with a
+    parent, as the challenge's holes), and a twin dropped beside the slab: what a ghost does to a
+    body that enters it. AMBF (with its ghosts following their parents) stops the cube in it."""
+    m = ModelFile(namespace="/ambf/env/ghost/")
+    m.bodies.append(_box("post", (0.02, 0.02, 0.3), (0.0, 0.2, 0.15)))
+    m.bodies.append(_box("cube", (0.04, 0.04, 0.04), (0.0, 0.0, 0.27), mass=0.2, color=ORANGE))
+    m.bodies.append(_box("twin", (0.04, 0.04, 0.04), (0.2, 0.0, 0.27), mass=0.2, color=ORANGE))
+    g = Geometry(x=0.1, y=0.3, z=0.05)
+    m.ghost_objects.append(
+        Ghost(
+            identifier="BODY slab",
+            name="slab",
+            parent="BODY post",
+            location=Pose(Vec3(0.0, -0.2, 0.055), rpy_to_quat(0.0, 0.0, 0.0)),  # 0.18-0.23 m up
+            shape="BOX",
+            geometry=g,
+            collision_shape="BOX",
+            collision_geometry=g,
+            color_rgba=RGBA(r=0.2, g=0.8, b=0.3, a=0.3),
+        )
+    )
+    return m
+
+
+def build_thread() -> ModelFile:
+    """The suture thread of the sample scene (40 capsules on six-dof springs, the published
+    settings) held at one end by a static stand-in for the needle 0.2 m up, lying level at the
+    start: it falls and swings down until it hangs."""
+    from .suturing import layout as L
+    from .suturing.thread import thread_bodies_and_joints
+
+    needle_world = np.eye(4)
+    rest = L.SLAB[2] + L.THREAD_RADIUS + 0.00001  # the height the builder lays the thread at
+    needle_world[:3, 3] = (L.NEEDLE_RADIUS, 0.0, rest)  # its tail (angle pi) at x = 0, level
+    bodies, joints = thread_bodies_and_joints(needle_world)
+    lift = 0.2 - rest
+    m = ModelFile(namespace="/ambf/env/thread/")
+    needle = _box("Needle", (0.004, 0.004, 0.004), (L.NEEDLE_RADIUS, 0.0, 0.2))
+    m.bodies.append(needle)
+    for b in bodies:
+        p = b.location.position
+        b.location = Pose(Vec3(p.x, p.y, round(p.z + lift, 9)), b.location.orientation)
+        m.bodies.append(b)
+    m.joints.extend(joints)
+    return m
+
+
+BUILD = {"drop": build_drop, "arm": build_arm, "stack": build_stack, "ghost": build_ghost, "thread": build_thread}
 
 
 def write_parity(out_dir: str | Path) -> Path:
@@ -126,4 +192,13 @@ def write_parity(out_dir: str | Path) -> Path:
     return write_file(launch, out / "launch.yaml")
 
 
-__all__ = ["SCENES", "COMMANDS", "write_parity", "build_drop", "build_arm"]
+__all__ = [
+    "SCENES",
+    "COMMANDS",
+    "write_parity",
+    "build_drop",
+    "build_arm",
+    "build_stack",
+    "build_ghost",
+    "build_thread",
+]

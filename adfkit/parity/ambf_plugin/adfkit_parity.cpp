@@ -15,7 +15,10 @@
 //                           "headless": left as AMBF leaves them without a window
 //   ADFKIT_PARITY_COMMANDS  command file: one command a line, "TIME KIND TARGET [ARG]", KIND one of
 //                           position|velocity|effort (TARGET a joint's qualified name, ARG the value),
-//                           grasp (TARGET an actuator, ARG a rigid body), release (TARGET an actuator);
+//                           grasp (TARGET an actuator, ARG a rigid body), release (TARGET an actuator),
+//                           place (TARGET a rigid body, ARG its body frame "x y z qx qy qz qw": set
+//                           there at rest), force (TARGET a rigid body, ARG "fx fy fz px py pz": a
+//                           force at a world point, every step until its next force command);
 //                           a joint command holds until the joint's next command
 //
 // Records: {"kind":"created",...} once, {"kind":"sample",...} per sample, {"kind":"end",...} last,
@@ -86,6 +89,7 @@ struct Command {
     double t;
     string kind, target, arg;
     double value;
+    vector<double> numbers;  // a place's pose, a force's vector and point
     int line;
 };
 
@@ -314,6 +318,12 @@ private:
                 if (!find_body(c.arg)) fail(where + "no rigid body " + c.arg);
             } else if (c.kind == "release") {
                 if (!find_actuator(c.target)) fail(where + "no constraint actuator " + c.target);
+            } else if (c.kind == "place" || c.kind == "force") {
+                if (!find_body(c.target)) fail(where + "no rigid body " + c.target);
+                double v;
+                while (ls >> v) c.numbers.push_back(v);
+                size_t want = c.kind == "place" ? 7 : 6;
+                if (c.numbers.size() != want) fail(where + c.kind + " needs " + to_string(want) + " numbers");
             } else {
                 fail(where + "unknown kind " + c.kind);
             }
@@ -331,6 +341,11 @@ private:
                 find_actuator(c.target)->actuate(find_body(c.arg));
             } else if (c.kind == "release") {
                 find_actuator(c.target)->deactuate();
+            } else if (c.kind == "place") {
+                place(find_body(c.target), c.numbers);
+            } else if (c.kind == "force") {
+                m_forces[c.target] = c;
+                m_forceBodies[c.target] = find_body(c.target);
             } else {
                 m_drives[c.target] = c;
                 m_driveJoints[c.target] = find_joint(c.target);
@@ -338,9 +353,30 @@ private:
         }
     }
 
+    // a body set at a pose (its ADF body frame) at rest; its broadphase box moved with it (a
+    // static body's is not moved by the world's own step)
+    void place(afRigidBodyPtr rb, const vector<double>& n) {
+        btTransform body(btQuaternion(n[3], n[4], n[5], n[6]), btVector3(n[0], n[1], n[2]));
+        btTransform com = body * rb->getInertialOffsetTransform();
+        btRigidBody* b = rb->m_bulletRigidBody;
+        b->setCenterOfMassTransform(com);
+        if (b->getMotionState()) b->getMotionState()->setWorldTransform(com);
+        b->setInterpolationWorldTransform(com);
+        b->setLinearVelocity(btVector3(0, 0, 0));
+        b->setAngularVelocity(btVector3(0, 0, 0));
+        m_world->m_bulletWorld->updateSingleAabb(b);
+        rb->update(0.0);
+    }
+
     // every joint command again each physics step, as AMBF's own ROS plugin applies the last
     // command it received (position: the joint's controller; effort: a torque for the next step)
     void drive() {
+        for (auto& kv : m_forces) {
+            const vector<double>& n = kv.second.numbers;
+            btRigidBody* b = m_forceBodies[kv.first]->m_bulletRigidBody;
+            btVector3 at = btVector3(n[3], n[4], n[5]) - b->getCenterOfMassPosition();
+            b->applyForce(btVector3(n[0], n[1], n[2]), at);
+        }
         for (auto& kv : m_drives) {
             afJointPtr j = m_driveJoints[kv.first];
             double v = kv.second.value;
@@ -359,6 +395,8 @@ private:
     size_t m_nextCommand = 0;
     map<string, Command> m_drives;
     map<string, afJointPtr> m_driveJoints;
+    map<string, Command> m_forces;
+    map<string, afRigidBodyPtr> m_forceBodies;
     chrono::steady_clock::time_point m_clock;
 };
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from ..plan import viscous_impulse_force
+from ..ghost_rules import viscous_impulse_force
 from ..rotations import invert, matrix_to_quat, pose_matrix
 from .assemble import WAKE_FORCE, _xyzw
 from .collision import EXCLUDE_SPARE

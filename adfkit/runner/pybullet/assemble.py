@@ -155,6 +155,8 @@ class Assembly:
         self._parting: list = []  # (uid, link, body): a released grasp, collisions back once apart
         self._gravity_overrides = self._group_gravity_overrides()
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
+        # the ghosts that act on what is inside them each control step (Options.ghosts)
+        self._acting_ghosts = self.ghosts if self.opt.ghosts == "ambf" else self._friction_ghosts
 
     def _group_gravity_overrides(self):
         """Bodies whose gravity differs from the world's, grouped per multibody so each control

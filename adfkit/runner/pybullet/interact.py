@@ -1,6 +1,6 @@
-"""What the PyBullet world does between steps (the Interaction half of PyBulletWorld): hole
-ghosts sensing what is inside them and applying viscous friction, ray sensors, the grasp's
-constraint actuator, collision switches, contacts."""
+"""What the PyBullet world does between steps (the Interaction half of PyBulletWorld): ghosts
+sensing what is inside them and acting on it (AMBF's rule, or viscous friction in holes), ray
+sensors, the grasp's constraint actuator, collision switches, contacts."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..plan import viscous_impulse_force
+from ..ghost_rules import ghost_velocity, viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
 
@@ -33,9 +33,10 @@ class SimGhost:
     friction: bool = False
     overlapping: list = field(default_factory=list)
     pq_in_parent: tuple = ()  # pose_in_parent as PyBullet (position, quaternion)
+    points: list = field(default_factory=list)  # (body, penetrating contact points) at the last query
     moves: bool = False  # a dynamic parent: the ghost follows it every step
     placed_at: tuple | None = None  # the parent's (position, quaternion) the ghost was last placed at
-    distances: dict = field(default_factory=dict)  # (uid, link) -> (placement, body pose, inside): _overlap
+    distances: dict = field(default_factory=dict)  # (uid, link) -> (placement, body pose, inside, points): _overlap
 
 
 @dataclass(eq=False)
@@ -76,9 +77,10 @@ class Interaction:
         return self._frame(g.parent) @ g.pose_in_parent if g.parent is not None else np.array(g.pose_in_parent)
 
     def _update_ghosts(self, poses: dict | None = None) -> None:
-        """Hole ghosts (the ones with viscous friction) sense every control step; the others
-        only when asked (overlapping()): a moving ghost costs a pose reset and a distance query
-        per nearby body, and the PSMs' finger ghosts are only read when grasping.
+        """The ghosts that act sense every control step (AMBF's rule: every ghost; the paper's
+        friction: the hole ghosts); the others only when asked (overlapping()): a moving ghost
+        costs a pose reset and a distance query per nearby body, and without AMBF's rule the
+        PSMs' finger ghosts are only read when grasping.
 
         ``poses``: {(uid, link): (position, quaternion)} of the bodies read since the last step
         (control() passes the springs' and the gravity overrides'), used rather than read again.
@@ -89,7 +91,9 @@ class Interaction:
             self.place_ghosts()
         poses = dict(poses) if poses else {}  # hole ghosts share parents: read each once
         cid = self.cid
-        for g in self._friction_ghosts:
+        ambf = self.opt.ghosts == "ambf"
+        held: dict[int, SimBody] = {}
+        for g in self._acting_ghosts:
             if g.moves:
                 parent = g.parent
                 key = (parent.uid, parent.link)
@@ -100,9 +104,36 @@ class Interaction:
                     pos, orn = pb.multiplyTransforms(pq[0], pq[1], *g.pq_in_parent)
                     pb.resetBasePositionAndOrientation(g.uid, pos, orn, cid)
                     g.placed_at = pq
-            found = self._overlap(g, poses)
-            if found:
+            found = self._overlap(g, poses, with_parent=ambf)
+            if found and ambf:
+                self._ambf_ghost(g, held)
+            elif found:
                 self._viscous(g, found)
+        if ambf:
+            self._weightless(held.values())
+
+    def _ambf_ghost(self, g: SimGhost, held: dict) -> None:
+        """AMBF's ghost on the bodies in penetrating contact with it (ghost_rules.ghost_velocity), for
+        the physics steps of this control step: their velocities reset (a multibody link's cannot
+        be, only its weight is taken off) and their gravity off until the next control step."""
+        steps = self.opt.control_substeps
+        cid = self.cid
+        parent = g.parent
+        v_par = parent.state()[2] if parent is not None and not parent.static else (0.0, 0.0, 0.0)
+        for sb, points in g.points:
+            if points == 0:
+                continue
+            held[id(sb)] = sb
+            if sb.link < 0:
+                v, w = pb.getBaseVelocity(sb.uid, cid)
+                v2, w2 = ghost_velocity(v, w, v_par, points * steps)
+                pb.resetBaseVelocity(sb.uid, v2.tolist(), w2.tolist(), cid)
+
+    def _weightless(self, bodies) -> None:
+        """Each body's weight taken off for this control step (AMBF switches its gravity off)."""
+        for sb in bodies:
+            g = sb.gravity if sb.gravity is not None else self.gravity
+            sb.force((-sb.mass * np.asarray(g)).tolist(), list(sb.com_position()))
 
     def place_ghosts(self) -> None:
         """Move every ghost with a moving parent to it (before a picture is taken)."""
@@ -122,31 +153,36 @@ class Interaction:
         self._place(g)
         return self._overlap(g)
 
-    def _overlap(self, g: SimGhost, poses: dict | None = None) -> list[SimBody]:
-        """``overlapping`` with the ghost already where its parent is. With ``poses`` (see
+    def _overlap(self, g: SimGhost, poses: dict | None = None, with_parent: bool = False) -> list[SimBody]:
+        """``overlapping`` with the ghost already where its parent is (its parent left out unless
+        ``with_parent``: AMBF's ghosts sense the body they hang on). With ``poses`` (see
         _update_ghosts), each answer is kept with the ghost's and the body's poses and reused
-        while both stay exactly where they were (and no collision pair or grasp has changed)."""
+        while both stay exactly where they were (and no collision pair or grasp has changed).
+        ``g.points`` gets each body found with its penetrating contact points (distance < 0)."""
         cid = self.cid
         lo, hi = pb.getAABB(g.uid, -1, cid)
-        found = []
+        found, points = [], []
         dynamic, parent, closest = self._dynamic_lookup, g.parent, pb.getClosestPoints
         at = (self._pairs_epoch, g.placed_at)
         known = g.distances
         for key in pb.getOverlappingObjects(lo, hi, cid) or ():
             sb = dynamic.get(key)
-            if sb is None or sb is parent:
+            if sb is None or (sb is parent and not with_parent):
                 continue
             pose = poses.get(key) if poses else None
             was = known.get(key) if pose is not None else None
             if was is not None and was[0] == at and was[1] == pose:
-                inside = was[2]
+                inside, deep = was[2], was[3]
             else:
-                inside = bool(closest(g.uid, key[0], 0.0, -1, key[1], physicsClientId=cid))
+                hits = closest(g.uid, key[0], 0.0, -1, key[1], physicsClientId=cid)
+                inside, deep = bool(hits), sum(1 for h in hits if h[8] < 0.0)
                 if pose is not None:
-                    known[key] = (at, pose, inside)
+                    known[key] = (at, pose, inside, deep)
             if inside:
                 found.append(sb)
+                points.append((sb, deep))
         g.overlapping = found
+        g.points = points
         return found
 
     def _viscous(self, g: SimGhost, found) -> None:

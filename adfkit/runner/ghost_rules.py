@@ -1,0 +1,33 @@
+"""What ghost objects do to the bodies inside them, for every engine (Options.ghosts): AMBF's own
+rule, or the challenge paper's viscous friction inside hole ghosts."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: what ghosts do (Options.ghosts): AMBF's own rule, or the paper's viscous friction in holes
+GHOST_RULES = ("ambf", "hole-friction")
+#: AMBF's afGhostObject::update, after every physics step, for each penetrating contact point
+#: between a ghost and a rigid body (measured in AMBF 2.0): the body's gravity is switched off for
+#: the next step, its velocity across the ghost parent's keeps this share (along the parent's
+#: velocity it takes the parent's), its angular velocity too; leaving, it gets the world's gravity
+AMBF_GHOST_KEEP = 0.9
+
+
+def ghost_velocity(v, w, v_parent, points: int):
+    """(linear, angular) velocity of a body after ``points`` of AMBF's ghost updates (one per
+    penetrating contact point and physics step): keep^points of what is across the parent's
+    velocity, plus the parent's."""
+    keep = AMBF_GHOST_KEEP**points
+    v, w, va = np.asarray(v, float), np.asarray(w, float), np.asarray(v_parent, float)
+    mag = float(np.linalg.norm(va))
+    along = va * (float(v @ va) / (mag * mag)) if mag > 1e-5 else np.zeros(3)
+    return keep * (v - along) + va, keep * w
+
+
+def viscous_impulse_force(mass: float, v_rel: np.ndarray, k: float, cdt: float) -> np.ndarray:
+    """F = -K·v_rel held for a control step ``cdt`` as the exact exp(-K·t/m) decay of
+    dv/dt = -K·v/m (the paper's needle friction in the hole ghosts), never overshooting."""
+    return -mass * v_rel * (1.0 - math.exp(-k * cdt / mass)) / cdt

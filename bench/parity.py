@@ -1,0 +1,163 @@
+"""The parity table: each scene played in AMBF itself (headless, adfkit's AMBF plugin) and in
+adfkit, the largest gap of any body over the run and at its end, and each side's stepping time
+beside the other's. Prints a markdown table (docs/parity.md); with --plots DIR, draws each scene's
+gaps over time there. Asserts nothing; skips, with the reason, without an AMBF build.
+
+    .venv/bin/python bench/parity.py [--plots DIR] [--only NAME ...] [--json OUT]
+
+Scenes: the project's own (`adfkit build-scene parity`: a dropped box, an arm under position,
+velocity and effort commands, a stack of boxes, a cube into a ghost, the thread falling from a
+held needle) and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
+own floor (from the AMBF tree), and the KUKA and a PSM under joint programs (parity.programs).
+Timings are of a shared 2-core box: noisy; compare AMBF's and adfkit's of one row.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CORPUS = Path(os.environ.get("ADFKIT_CORPUS", ROOT.parent / "shared" / "corpus"))
+
+
+@dataclass
+class Scene:
+    name: str
+    path: Path
+    indices: list[int] | None
+    seconds: float
+    engines: tuple[str, ...] = ("pybullet",)
+    commands: Path | None = None
+    ghosts: str | None = None
+    note: str = ""
+    rows: list = field(default_factory=list)
+
+
+def own_scenes(folder: Path) -> list[Scene]:
+    from adfkit.scenes.parity import write_parity
+
+    launch = write_parity(folder)
+    both = ("pybullet", "mujoco")
+    out = [Scene("box dropped on a slab", launch, [0], 0.5, both)]
+    for kind in ("position", "velocity", "effort"):
+        out.append(Scene(f"arm, {kind} commands", launch, [1], 1.0, commands=folder / f"arm_{kind}.txt"))
+    out.append(Scene("three boxes settling in a stack", launch, [2], 1.0, both))
+    out.append(Scene("cube into a ghost (hole-friction, the default)", launch, [3], 0.6))
+    out.append(Scene("cube into a ghost (--ghosts ambf)", launch, [3], 0.6, ghosts="ambf"))
+    out.append(Scene("thread falling from a held needle", launch, [4], 2.0, both))
+    return out
+
+
+def corpus_scenes(build, folder: Path) -> list[Scene]:
+    from adfkit.parity import programs
+
+    if not CORPUS.is_dir():
+        return []
+    out = [
+        Scene(
+            "suturing set (src/launch.yaml -l 6-11)",
+            CORPUS / "src" / "launch.yaml",
+            [6, 7, 8, 9, 10, 11],
+            2.0,
+            ("pybullet", "mujoco"),
+        )
+    ]
+    floor_world = build.root / "ambf_models" / "descriptions" / "world" / "world.yaml"
+    puzzle = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/puzzles/puzzle1.yaml"
+    if floor_world.is_file():
+        (folder / "colors.yaml").write_text("{}\n")
+        (folder / "input_devices.yaml").write_text("input devices: []\n")
+        launch = folder / "puzzle_on_floor.yaml"
+        launch.write_text(
+            f"world config: {floor_world}\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
+            f"multibody configs: [{puzzle}]\n"
+        )
+        out.append(Scene("puzzle 1 on AMBF's checkered floor", launch, [0], 3.0, ("pybullet", "mujoco")))
+    robots = (
+        ("KUKA", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml"),
+        ("PSM (LND 400006)", CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml"),
+    )
+    for label, model in robots:
+        for kind in ("position", "velocity", "effort"):
+            cmd = programs.write_program(model, None, kind, 1.0, folder / f"{model.stem}_{kind}.txt")
+            out.append(Scene(f"{label}, {kind} program", model, None, 1.0, commands=cmd))
+    return out
+
+
+def main(argv: list[str]) -> int:
+    from adfkit.parity import ambf, session
+
+    build, why = ambf.available()
+    if build is None:
+        print(f"skipped: {why}")
+        return 0
+    plots = Path(argv[argv.index("--plots") + 1]) if "--plots" in argv else None
+    out_json = Path(argv[argv.index("--json") + 1]) if "--json" in argv else None
+    only = argv[argv.index("--only") + 1 :] if "--only" in argv else []
+    os.environ.setdefault("ADFKIT_INPUT_ROOT", "/")  # the puzzle's launch names AMBF's floor and the corpus
+    rows, results = [], []
+    with tempfile.TemporaryDirectory(prefix="adfkit-parity-bench-") as tmp:
+        folder = Path(tmp)
+        scenes = own_scenes(folder / "own") + corpus_scenes(build, folder)
+        for sc in scenes:
+            if only and not any(o.lower() in sc.name.lower() for o in only):
+                continue
+            req = session.Request(
+                sc.path, sc.indices, build, seconds=sc.seconds, every=0.02, engines=sc.engines,
+                commands=sc.commands, ghosts=sc.ghosts,
+            )  # fmt: skip
+            t0 = time.perf_counter()
+            out = session.run(req, progress=False)
+            wall = time.perf_counter() - t0
+            if plots is not None:
+                from adfkit.parity.plot import plot_gaps
+
+                plots.mkdir(parents=True, exist_ok=True)
+                slug = "".join(c if c.isalnum() else "-" for c in sc.name.lower()).strip("-")
+                while "--" in slug:
+                    slug = slug.replace("--", "-")
+                plot_gaps(out.comparisons, plots / f"parity-{slug}.png", sc.name, top=5)
+            for c in out.comparisons:
+                pos, ang = c.worst
+                end = max(c.bodies, key=lambda g: g.position[-1]) if c.bodies else None
+                row = {
+                    "scene": sc.name,
+                    "engine": c.adfkit.side,
+                    "seconds": sc.seconds,
+                    "control_ms": out.request.control_substeps,
+                    "max_mm": pos.max_position * 1e3 if pos else 0.0,
+                    "max_body": pos.name if pos else "",
+                    "max_deg": ang.max_angle if ang else 0.0,
+                    "end_mm": end.position[-1] * 1e3 if end else 0.0,
+                    "end_deg": max((g.angle[-1] for g in c.bodies), default=0.0),
+                    "ambf_s": c.ambf.wall_s,
+                    "adfkit_s": c.adfkit.wall_s,
+                    "agree": not c.failures(),
+                    "made_alike": not (c.only_in_ambf or c.only_in_adfkit),
+                }
+                results.append(row)
+                rows.append(
+                    f"| {sc.name} | {row['engine']} | {sc.seconds:g} s | **{row['max_mm']:.2f} mm** "
+                    f"(`{row['max_body'].rsplit('/', 1)[-1]}`), {row['max_deg']:.2f}° | {row['end_mm']:.2f} mm, "
+                    f"{row['end_deg']:.2f}° | {row['ambf_s']:.2f} s | {row['adfkit_s']:.2f} s | "
+                    f"{'agree' if row['agree'] else 'differ'} |"
+                )
+            print(f"  ({sc.name}: {wall:.0f} s in all)", file=sys.stderr)
+    print(
+        "| scene | adfkit | played | largest gap over the run | at the end | AMBF stepping | adfkit stepping | 1 mm / 1° |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    print("\n".join(rows))
+    if out_json is not None:
+        out_json.write_text(json.dumps(results, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
