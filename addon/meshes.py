@@ -163,6 +163,8 @@ def obj_text(parts: list[MeshArrays], mtl_name: str | None) -> str:
     out = ["# written by adfkit (Blender add-on)\n"]
     if mtl_name:
         out.append(f"mtllib {mtl_name}\n")
+    from adfkit.geometry.meshwrite import vertex_normals
+
     v_base = vt_base = 1
     for p in parts:
         out.append(f"o {p.name}\n")
@@ -170,6 +172,10 @@ def obj_text(parts: list[MeshArrays], mtl_name: str | None) -> str:
             out.append("".join(f"v {x:.9g} {y:.9g} {z:.9g}\n" for x, y, z in p.co.tolist()))
         if p.uv is not None:
             out.append("".join(f"vt {u:.9g} {v:.9g}\n" for u, v in p.uv.tolist()))
+        # a normal per vertex at its own index: AMBF's OBJ reader needs full triplets
+        # (adfkit.geometry.meshwrite.obj_faces)
+        polys = [p.loops[s : s + t].tolist() for s, t in zip(p.loop_start.tolist(), p.loop_total.tolist())]
+        out.append("".join("vn {:.6g} {:.6g} {:.6g}\n".format(*n) for n in vertex_normals(p.co, polys)))
         vidx = (p.loops + v_base).tolist()
         cur_mat = None
         for fi, (s, t) in enumerate(zip(p.loop_start.tolist(), p.loop_total.tolist())):
@@ -179,9 +185,9 @@ def obj_text(parts: list[MeshArrays], mtl_name: str | None) -> str:
                     out.append(f"usemtl {p.materials[mi].name}\n")
                     cur_mat = mi
             if p.uv is not None:
-                out.append("f " + " ".join(f"{vidx[k]}/{k + vt_base}" for k in range(s, s + t)) + "\n")
+                out.append("f " + " ".join(f"{vidx[k]}/{k + vt_base}/{vidx[k]}" for k in range(s, s + t)) + "\n")
             else:
-                out.append("f " + " ".join(str(vidx[k]) for k in range(s, s + t)) + "\n")
+                out.append("f " + " ".join(f"{vidx[k]}//{vidx[k]}" for k in range(s, s + t)) + "\n")
         v_base += len(p.co)
         vt_base += 0 if p.uv is None else len(p.uv)
     return "".join(out)

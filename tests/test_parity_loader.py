@@ -188,3 +188,61 @@ def test_corpus_files_as_ambf_loads_them(rel, ambf_does, rules):
 def test_every_corpus_file_loads_in_adfkit_as_in_ambf(path):
     r = loader.check_file(path, BUILD)
     assert r.agree, r.as_json()
+
+
+TRIANGLE_VT = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+
+
+def _one_mesh_model(folder, mesh_text):
+    (folder / "m.obj").write_text(mesh_text)
+    return _write(
+        folder,
+        "m.yaml",
+        """\
+        bodies: [BODY a]
+        BODY a:
+          name: a
+          mesh: m.obj
+          mass: 0.0
+          collision shape: BOX
+          collision geometry: {x: 0.1, y: 0.1, z: 0.1}
+        """,
+    )
+
+
+def test_obj_faces_that_crash_ambf_are_an_error_and_adfkit_writes_none(tmp_path):
+    from adfkit.geometry.meshwrite import obj_faces
+    from adfkit.scenes.suturing.meshes import obj_text
+    from adfkit.validator.engine import validate_file
+
+    bad = _one_mesh_model(tmp_path, TRIANGLE_VT + "f 1/1 2/2 3/3\n")
+    rules = [d.rule for d in validate_file(bad).diagnostics]
+    assert rules == ["obj-faces-crash-ambf"]
+    for good in ("f 1/1/1 2/2/1 3/3/1\n", "f 1 2 3\n", "f 1//1 2//1 3//1\n"):
+        ok = _one_mesh_model(tmp_path, TRIANGLE_VT + "vn 0 0 1\n" + good)
+        assert [d.rule for d in validate_file(ok).diagnostics] == [], good
+    # adfkit's writers: every corner a full triplet, the normal at the vertex's own index
+    _, faces = obj_faces([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [(0, 1, 2)], uvs=[[0, 0], [1, 0], [0, 1]])
+    assert faces == ["f 1/1/1 2/2/2 3/3/3"]
+    text = obj_text([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [(0, 1, 2)])
+    assert "f 1//1 2//2 3//3" in text and "vn 0 0 1" in text
+
+
+@needs_ambf
+def test_ambf_crashes_on_texture_faces_without_normals_and_loads_the_sample_scene(tmp_path):
+    from adfkit.diagnostics import AdfError
+
+    with pytest.raises(AdfError, match="ambf-failed|stopped"):  # measured: chai3d's OBJ reader
+        ambf.run(
+            BUILD, ambf.write_stage(None, [_one_mesh_model(tmp_path, TRIANGLE_VT + "f 1/1 2/2 3/3\n")], None), 0.0, 0.0
+        )
+    rec = ambf.run(
+        BUILD, ambf.write_stage(None, [_one_mesh_model(tmp_path, TRIANGLE_VT + "f 1 2 3\n")], None), 0.0, 0.0
+    )
+    assert [b["name"] for b in rec.created["bodies"]] == ["a"]
+    from conftest import ROOT
+
+    launch = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
+    rec = ambf.run(BUILD, ambf.Stage(launch, list(range(6))), 0.0, 0.0)
+    counts = {k: len(v) for k, v in rec.created.items() if isinstance(v, list)}
+    assert counts == {"bodies": 70, "soft_bodies": 0, "ghosts": 12, "joints": 56, "sensors": 2, "actuators": 2}

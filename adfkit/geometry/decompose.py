@@ -174,6 +174,8 @@ def hulls_obj_text(hulls: list[trimesh.Trimesh], mtl_name: str, prefix: str = "h
     """(OBJ text, MTL text): one object, group and material per hull."""
     obj = [f"# {len(hulls)} convex hulls written by adfkit", f"mtllib {mtl_name}"]
     mtl = [f"# materials for {len(hulls)} convex hulls"]
+    from .meshwrite import obj_faces
+
     base = 1
     for i, h in enumerate(hulls):
         name = f"{prefix}_{i:03d}"
@@ -181,7 +183,8 @@ def hulls_obj_text(hulls: list[trimesh.Trimesh], mtl_name: str, prefix: str = "h
         mtl += [f"newmtl {name}", f"Kd {r:.4f} {g:.4f} {b:.4f}", "Ka 0 0 0", "Ks 0 0 0", "d 1", ""]
         obj += [f"o {name}", f"g {name}", f"usemtl {name}"]
         obj += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in h.vertices]
-        obj += [f"f {a + base} {b_ + base} {c + base}" for a, b_, c in h.faces]
+        normals, faces = obj_faces(h.vertices, h.faces, v_base=base)  # full triplets: AMBF reads them
+        obj += normals + faces
         base += len(h.vertices)
     return "\n".join(obj) + "\n", "\n".join(mtl)
 

@@ -123,6 +123,31 @@ def _shown(raw: bytes) -> str:
     return text if len(text) <= 40 else text[:40] + "..."
 
 
+#: a face whose first corner is `v/vt`: texture coordinates without normals
+_OBJ_VT_FACE = re.compile(rb"^f[ \t]+-?\d+/-?\d+(?=[ \t\r\n])", re.M)
+
+
+def obj_faces_crash_ambf(obj_path: str) -> bool:
+    """The OBJ has faces written `f v/vt` (texture coordinates, no normals), which AMBF 2.0's OBJ
+    reader (chai3d cOBJModel::parseFaceString) reads as `v/vt/vn` with an index it never set:
+    ambf_simulator crashes loading it (measured, a one-triangle file). `f v`, `f v//vn` and
+    `f v/vt/vn` load."""
+    try:
+        st = os.stat(obj_path)
+    except (OSError, ValueError):
+        return False
+    return _vt_faces(os.fspath(obj_path), st.st_size, st.st_mtime_ns)
+
+
+@lru_cache(maxsize=1024)
+def _vt_faces(path: str, _size: int, _mtime: int) -> bool:
+    try:
+        data = inputs.read_bytes(path, "mesh", what="mesh file")
+    except AdfError:
+        return False
+    return _OBJ_VT_FACE.search(data) is not None
+
+
 TEXTURE_KEYS = ("map_", "bump", "norm", "disp", "decal", "refl")  # MTL statements naming a file
 
 

@@ -59,3 +59,48 @@ def encode_parts(fmt: str, parts: list[tuple[str, np.ndarray, np.ndarray]], spli
     )
     data = mesh.export(file_type=fmt.lower())
     return data if isinstance(data, bytes) else data.encode()
+
+
+def face_normal(points) -> tuple[float, float, float]:
+    """The unit normal of a polygon (Newell's method, any vertex count; +z when degenerate)."""
+    p = np.asarray(points, dtype=float)
+    q = np.roll(p, -1, axis=0)
+    n = np.array(
+        [
+            np.sum((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])),
+            np.sum((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])),
+            np.sum((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])),
+        ]
+    )
+    length = float(np.linalg.norm(n))
+    return (0.0, 0.0, 1.0) if length == 0.0 else tuple(float(x) for x in n / length)
+
+
+def vertex_normals(vertices, faces) -> np.ndarray:
+    """(n, 3) unit normals at the vertices: the sum of the normals of the faces around each,
+    weighted by their areas (+z for a vertex no face uses)."""
+    v = np.asarray(vertices, dtype=float)
+    out = np.zeros_like(v)
+    for f in faces:
+        p = v[list(f)]
+        n = np.cross(p[1] - p[0], p[-1] - p[0]) if len(p) == 3 else np.array(face_normal(p))
+        out[list(f)] += n
+    length = np.linalg.norm(out, axis=1, keepdims=True)
+    return np.where(length > 0, out / np.where(length > 0, length, 1.0), np.array([0.0, 0.0, 1.0]))
+
+
+def obj_faces(vertices, faces, uvs=None, v_base: int = 1, vt_base: int = 1) -> tuple[list[str], list[str]]:
+    """(``vn`` lines, ``f`` lines) of an OBJ mesh, every face with normals: `f v//vn`, or
+    `f v/vt/vn` with ``uvs`` (one per vertex, same index), a normal per vertex at the vertex's
+    own index (so that a reader keeping (vertex, normal) pairs, trimesh's, does not split the
+    mesh). AMBF 2.0's OBJ reader (chai3d cOBJModel::parseFaceString) reads any face with a '/'
+    as v/vt/vn, and decides from an unterminated copy of the face's first triplet, so that
+    `f v/vt` crashes it and a plain `f v` crashes it after a file with slashes was read
+    (measured: the sample scene's floor, phantom and needle, loaded in that order, killed
+    ambf_simulator). Full triplets read right always."""
+    normals = ["vn {:.6g} {:.6g} {:.6g}".format(*n) for n in vertex_normals(vertices, faces)]
+    if uvs is None:
+        lines = ["f " + " ".join(f"{i + v_base}//{i + v_base}" for i in f) for f in faces]
+    else:
+        lines = ["f " + " ".join(f"{i + v_base}/{i + vt_base}/{i + v_base}" for i in f) for f in faces]
+    return normals, lines

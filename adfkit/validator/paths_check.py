@@ -10,7 +10,7 @@ from pathlib import Path
 from .. import inputs
 from ..adf.paths import collision_mesh_path, relative_to_file, shader_paths, uses_collision_mesh, visual_mesh_path
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
-from ..geometry.meshcheck import mesh_problem, obj_material_problems
+from ..geometry.meshcheck import mesh_problem, obj_faces_crash_ambf, obj_material_problems
 from ..model import InputDevices, Launch, ModelFile, World
 from ..model.objects import Body, Ghost, SoftBody
 from . import softbody_rules, volume_rules
@@ -117,6 +117,16 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
                     )
                 )
             elif path.suffix.lower() == ".obj":
+                if obj_faces_crash_ambf(str(path)):
+                    out.append(
+                        _d(
+                            "obj-faces-crash-ambf",
+                            f"mesh {path.name} of '{obj.identifier}' has faces written `f v/vt` (texture "
+                            "coordinates without normals): AMBF 2.0's OBJ reader crashes on them",
+                            obj.where(key),
+                            "export the normals too (`f v/vt/vn`), or no texture coordinates",
+                        )
+                    )
                 for what in obj_material_problems(str(path)):
                     out.append(
                         _d(

@@ -181,6 +181,12 @@ _RULES = [
         "`mesh: part.PLY`",
     ),
     Rule(
+        "obj-faces-crash-ambf",
+        E,
+        "An OBJ mesh has faces `f v/vt` (texture coordinates, no normals): AMBF 2.0's OBJ reader crashes on them",
+        "`f 1/1 2/2 3/3`",
+    ),
+    Rule(
         "missing-texture",
         W,
         "A material library or texture named by an OBJ/MTL is not found",

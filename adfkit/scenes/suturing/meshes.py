@@ -11,19 +11,21 @@ import numpy as np
 def obj_text(
     vertices, faces, uvs=None, mtllib: str | None = None, material: str | None = None, comment: str = ""
 ) -> str:
-    """OBJ text of one mesh; faces index vertices (and, when given, the same-index uvs) from 0."""
+    """OBJ text of one mesh; faces index vertices (and, when given, the same-index uvs) from 0,
+    each with its normal (AMBF's OBJ reader needs full triplets: meshwrite.obj_faces)."""
+    from ...geometry.meshwrite import obj_faces
+
     out = [f"# {comment}" if comment else "# written by adfkit"]
     if mtllib:
         out.append(f"mtllib {mtllib}")
     out += [f"v {x:.7f} {y:.7f} {z:.7f}" for x, y, z in np.asarray(vertices, float)]
     if uvs is not None:
-        out += [f"vt {u:.5f} {v:.5f}" for u, v in np.asarray(uvs, float)]
+        out += [f"vt {u:.5f} {w:.5f}" for u, w in np.asarray(uvs, float)]
+    normals, face_lines = obj_faces(vertices, faces, uvs)
+    out += normals
     if material:
         out.append(f"usemtl {material}")
-    if uvs is not None:
-        out += ["f " + " ".join(f"{i + 1}/{i + 1}" for i in f) for f in faces]
-    else:
-        out += ["f " + " ".join(str(i + 1) for i in f) for f in faces]
+    out += face_lines
     return "\n".join(out) + "\n"
 
 
