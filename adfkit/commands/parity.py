@@ -21,7 +21,8 @@ def add_arguments(p) -> None:
     p.add_argument(
         "path",
         nargs="?",
-        help="launch, world or model ADF file (a folder: its launch.yaml)",
+        help="launch, world or model ADF file (a folder: its launch.yaml); with --suture a suturing scene "
+        "(default: the bundled sample_scenes/suturing)",
     )
     p.add_argument("-l", "--indices", help="launch file: the models to load, e.g. 6,7,8,9,10,11 or 6-11 (default: all)")
     p.add_argument(
@@ -55,6 +56,14 @@ def add_arguments(p) -> None:
     p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")
     p.add_argument("--tolerance-deg", type=float, default=1.0, help="largest orientation gap that agrees (1°)")
     p.add_argument("--plot", metavar="PNG", help="draw each body's position gap over time")
+    p.add_argument(
+        "--suture",
+        action="store_true",
+        help="play adfkit's scripted suture, replay its PSM set-points and grasps in AMBF and judge the "
+        "needle's path on both sides with the same verdicts (exit 1 when a pair's verdicts differ)",
+    )
+    p.add_argument("--pairs", default="1,2,3,4", help="--suture: the hole pairs, e.g. 4 or 1,2 (default 1,2,3,4)")
+    p.add_argument("--seed", type=int, default=0, help="--suture: the plan's seed (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object (a list of them for --engine both)")
 
 
@@ -65,6 +74,8 @@ def run(args) -> int:
     from ..jsonout import dumps
     from ..parity import ambf, session
 
+    if args.suture:
+        return _suture(args)
     if not args.path:
         raise AdfError(error("bad-option", "name the scene to compare", None, "adfkit parity SCENE [-l 6-11]"))
     path = inputs.scene_file(args.path)
@@ -98,3 +109,47 @@ def run(args) -> int:
     else:
         session.print_text(out)
     return 1 if any(c.failures() for c in out.comparisons) else 0
+
+
+def _suture(args) -> int:
+    from .. import inputs
+    from ..adf import parse_indices
+    from ..diagnostics import AdfError, error
+    from ..jsonout import dumps
+    from ..parity import ambf
+    from ..parity.suture import compare_suture
+
+    bundled = Path(__file__).resolve().parents[2] / "sample_scenes" / "suturing" / "launch.yaml"
+    path = inputs.scene_file(args.path) if args.path else bundled
+    inputs.check_file(path, what="ADF file")
+    build = ambf.find_build(args.ambf)
+    text = args.pairs.strip()
+    try:
+        pairs = (
+            list(range(1, int(text) + 1))
+            if text.isdigit() and len(text) == 1 and "," not in text
+            else parse_indices(text)
+        )
+    except AdfError:
+        raise
+    if not pairs or any(k < 1 for k in pairs):
+        raise AdfError(
+            error("bad-option", f"--pairs {args.pairs!r} names no hole pair", None, "e.g. --pairs 4 or --pairs 1,2")
+        )
+    out = compare_suture(Path(path), parse_indices(args.indices), pairs, build, args.seed, progress=not args.json)
+    if args.json:
+        print(dumps(out, indent=1))
+    else:
+        print(
+            f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF ({out['commands']} commands)"
+        )
+        for p in out["pairs"]:
+            gap = p["tip_path_gap_m"]
+            print(
+                f"  pair {p['pair']}: adfkit {p['adfkit']}, AMBF {p['ambf']}"
+                + (f" ({p['ambf_rule']}: {p['ambf_reason']})" if p["ambf_rule"] else "")
+                + (f", tip paths {gap * 1e3:.1f} mm apart at most" if gap == gap and gap is not None else "")
+            )
+        w = out["wall_s"]
+        print(f"  stepping: adfkit {w['adfkit']:.1f} s (the whole episode), AMBF {w['ambf']:.1f} s")
+    return 0 if out["same_verdicts"] else 1

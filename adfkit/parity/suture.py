@@ -1,0 +1,441 @@
+"""The suture replayed in AMBF (``adfkit parity --suture``): adfkit's scripted suture is played
+and recorded (every PSM joint set-point it gives, each grasp and release, the push that settles
+the needle, where the setup puts the arms), the recording is replayed in AMBF through adfkit's
+plugin (the set-points as AMBF's joint position commands, the grasps through AMBF's own
+constraint actuators), and the needle's path on each side is judged by the same verdict code
+(``tasks.verdicts.pair_verdict``).
+
+AMBF's side is judged from the poses the plugin records: the tip's crossings of each hole's
+plane (inside its opening, tip first), the thread through both holes when each pull ended, the
+needle slipping in a grasp. The plugin records no contact force, so the rules that read forces
+(a tool pressing on the tissue, a tip forced through) are judged on adfkit's side only."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..runner.rotations import invert, pose_matrix
+from . import ambf
+from .traces import ambf_name, joint_key
+
+#: a sample of AMBF's poses every so many simulated seconds (the tip's path, the crossings)
+EVERY = 0.02
+
+
+@dataclass
+class Recording:
+    """What adfkit's suture did, as commands AMBF's plugin follows, and what it judged."""
+
+    commands: list[ambf.Command]
+    seconds: float
+    phase_log: list[tuple[str, float]]
+    tip_path: np.ndarray  # (n, 4): t, x, y, z
+    verdicts: list[dict]
+    task: object  # the adfkit task (its pairs, needle geometry): what the verdict code reads
+    holes: list[dict]  # per hole: pair, kind, body (AMBF name), half, label, ghost, ghost_offset
+    needle: str  # the needle's AMBF name
+    thread: list[str]  # the thread elements' AMBF names, from the needle on
+    grasps: list[tuple[float, str, str | None]] = field(default_factory=list)  # (t, arm, body or None)
+    joint_start: dict[str, tuple[float, str]] = field(default_factory=dict)  # joint -> (adfkit's value at start, kind)
+    tools: dict[str, str] = field(default_factory=dict)  # arm -> the AMBF name of the body its actuator is on
+    wall_s: float = 0.0
+
+
+def joint_zeros(rec: Recording, build: ambf.AmbfBuild, stage: ambf.Stage) -> dict[str, float]:
+    """AMBF's value of each recorded revolute joint where the scene starts, less adfkit's: where
+    the two read a joint's zero differently (the bundled PSM, whose joints AMBF reads at minus
+    their `offset` at the file's pose, adfkit at 0), a set-point is moved by it. A prismatic
+    joint's position AMBF computes only once it has stepped, so is taken as read alike."""
+    run = ambf.run(build, stage, 0.0, 0.0)
+    names = [j["qname"] for j in run.created["joints"]]
+    values = dict(zip(names, run.samples[0]["joints"])) if run.samples else {}
+    out = {}
+    for name, (q, kind) in rec.joint_start.items():
+        v = values.get(name)
+        out[name] = float(v) - q if kind == "revolute" and v is not None else 0.0
+    return out
+
+
+class _Recorder:
+    """Wraps a world's step, actuate and release and the needle's force, and writes them down
+    as plugin commands: joint set-points when they change, grasps, releases, forces."""
+
+    def __init__(self, world, task) -> None:
+        self.world, self.task = world, task
+        self.commands: list[ambf.Command] = []
+        self.grasps: list[tuple[float, str, str | None]] = []
+        self.arms = {id(psm.art): name for name, psm in task.psms.items()}
+        self.joint_names = {}
+        self.start: dict[str, tuple[float, str]] = {}  # joint -> (adfkit's value at the start, its kind)
+        for j, _p, child in world.joints_made:
+            art = getattr(child, "articulation", None)
+            if art is None or id(art) not in self.arms:
+                continue
+            idx = next((i for i, r in enumerate(art.records) if r[0] is j), None)
+            if idx is not None:
+                name = ambf_name(joint_key(world, j), j)
+                self.joint_names[(id(art), idx)] = name
+                q = float(world.joint_state(art, [idx])[0][0])
+                self.start[name] = (q, art.kinds[idx].value)
+        self.last: dict[tuple, float] = {}
+        self.placed = False
+        self.forced = False
+        self._force_now = None
+        step, actuate, release = world.step, world.actuate, world.release
+        needle = task.needle
+        force = needle.force
+
+        def rec_step(n: int = 1) -> None:
+            for _ in range(n):
+                self._before_step()
+                step(1)
+
+        def rec_actuate(act, body) -> None:
+            actuate(act, body)
+            arm = self._arm_of(act)
+            self.commands.append(ambf.Command(world.sim_time, "grasp", _name(act), body=_name(body)))
+            self.grasps.append((world.sim_time, arm, _name(body)))
+
+        def rec_release(act) -> None:
+            held = getattr(act, "target", None) is not None or getattr(act, "constraint", None) is not None
+            release(act)
+            if held:
+                self.commands.append(ambf.Command(world.sim_time, "release", _name(act)))
+                self.grasps.append((world.sim_time, self._arm_of(act), None))
+
+        def rec_force(f, at) -> None:
+            force(f, at)
+            self._force_now = (tuple(map(float, f)), tuple(map(float, at)))
+
+        world.step, world.actuate, world.release = rec_step, rec_actuate, rec_release
+        needle.force = rec_force
+
+    def _arm_of(self, act) -> str:
+        art = getattr(act.parent, "articulation", None)
+        return self.arms.get(id(art), "") if art is not None else ""
+
+    def _before_step(self) -> None:
+        w, t = self.world, self.world.sim_time
+        if not self.placed:  # the arms where adfkit's setup put them (their bases slid, jaws open)
+            self.placed = True
+            for psm in self.task.psms.values():
+                for sb in w.bodies:
+                    if sb.articulation is psm.art:
+                        m = sb.world_matrix()
+                        from ..runner.rotations import matrix_to_pq
+
+                        p, q = matrix_to_pq(m)
+                        self.commands.append(ambf.Command(t, "place", _name(sb), numbers=(*p, *q)))
+        for psm in self.task.psms.values():
+            art = psm.art
+            for i, v in enumerate(art.targets):
+                key = (id(art), i)
+                name = self.joint_names.get(key)
+                if name is not None and self.last.get(key) != v:
+                    self.last[key] = v
+                    self.commands.append(ambf.Command(t, "position", name, float(v)))
+        needle = _name(self.task.needle)
+        if self._force_now is not None:
+            f, at = self._force_now
+            self.commands.append(ambf.Command(t, "force", needle, numbers=(*f, *at)))
+            self.forced, self._force_now = True, None
+        elif self.forced:
+            at = tuple(map(float, self.task.needle.com_position()))
+            self.commands.append(ambf.Command(t, "force", needle, numbers=(0.0, 0.0, 0.0, *at)))
+            self.forced = False
+
+
+def _name(obj) -> str:
+    """An adfkit world object's AMBF name (a body, an actuator)."""
+    inner = getattr(obj, "body", None) or getattr(obj, "actuator", None)
+    return ambf_name(obj.key, inner)
+
+
+def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False) -> Recording:
+    """Play adfkit's scripted suture (PyBullet) and record it for AMBF."""
+    import time
+
+    from ..adf import load_scene
+    from ..runner import Options, open_world
+    from ..tasks.episode import SOLVER_ITERATIONS, play_task
+    from ..tasks.suture import SutureError, SutureTask
+
+    scene = load_scene(Path(launch), indices)
+    world = open_world(scene, Options(renderer="tiny", visuals=False, solver_iterations=SOLVER_ITERATIONS))
+    try:
+        task = SutureTask(world, list(pairs), seed=seed)
+        rec = _Recorder(world, task)
+        t0 = time.perf_counter()
+        try:
+            metrics, obs, _ = play_task(world, task, None, gif=False, progress=progress)
+        except SutureError as exc:  # play_task records a planner's failure itself; this is setup's
+            raise RuntimeError(f"the suture could not start: {exc}") from None
+        wall = time.perf_counter() - t0
+        holes = [
+            {
+                "pair": h.pair,
+                "kind": h.kind,
+                "body": _name(h.body) if h.body is not None else None,
+                "half": None if h.half is None else np.asarray(h.half, float),
+                "label": h.label,
+                "name": h.name,
+                "ghost": h.ghost,
+                "ghost_offset": h.ghost_offset,
+            }
+            for h in obs.holes
+        ]
+        thread = [_name(sb) for sb in obs.thread]
+        tools = {}
+        for a in world.actuators:
+            arm = rec._arm_of(a)
+            if arm:
+                tools[arm] = _name(a.parent)
+        return Recording(
+            rec.commands,
+            world.sim_time,
+            list(task.phase_log),
+            np.array(obs.tip_path, float),
+            metrics["pairs"],
+            task,
+            holes,
+            _name(task.needle),
+            thread,
+            grasps=rec.grasps,
+            tools=tools,
+            joint_start=rec.start,
+            wall_s=wall,
+        )
+    finally:
+        world.close()
+
+
+class _Hole:
+    """One hole as the verdict code reads it, its frame from AMBF's poses."""
+
+    def __init__(self, d: dict) -> None:
+        self.pair, self.kind, self.name, self.label = d["pair"], d["kind"], d["name"], d["label"]
+        self.half, self.ghost, self.ghost_offset = d["half"], d["ghost"], d["ghost_offset"]
+        self.body = d["body"]
+        self.crossings: list[dict] = []
+        self.closest = math.inf
+
+
+class AmbfObservation:
+    """What ``tasks.verdicts.pair_verdict`` reads, from AMBF's recorded poses."""
+
+    def __init__(self, rec: Recording, trace) -> None:
+        self.task = rec.task
+        self.holes = [_Hole(d) for d in rec.holes]
+        self.thread_by_pair: dict[int, dict] = {}
+        self.slips: list[dict] = []
+        self.tool_events: list[dict] = []  # no contact forces recorded in AMBF
+        self.needle_contacts: dict = {}
+        self.tip_contacts: dict = {}
+        self.first_forced: dict = {}
+        geom = rec.task.geom
+        self.wire_radius = 0.0
+        names = trace.body_names
+        idx = {n: i for i, n in enumerate(names)}
+        self.times = trace.times
+        frames = _frames(trace.poses)
+        needle = frames[:, idx[rec.needle]]
+        tip = needle @ np.r_[geom.tip, 1.0]
+        self.tip_path = np.column_stack([trace.times, tip[:, :3]])
+        tangent_in_needle = geom.arc_in_needle[:3, :3] @ np.array([0.0, 1.0, 0.0])
+        phase_at = _phases(rec.phase_log)
+        for h in self.holes:
+            hf = frames[:, idx[h.body]] if h.body in idx else None
+            if hf is None or h.half is None:
+                continue
+            inv = np.linalg.inv(hf)
+            local = np.einsum("nij,nj->ni", inv, tip)[:, :3]
+            beyond = np.maximum(np.abs(local[:, :2]) - h.half, 0.0)
+            h.closest = float(np.min(np.hypot(np.linalg.norm(beyond, axis=1), local[:, 2])))
+            from ..tasks.holes import plane_crossing, tip_leading
+            from ..tasks.metrics import NEAR_HOLE
+
+            for k in range(1, len(local)):
+                hit = plane_crossing(local[k - 1], local[k], h.half)
+                if hit is None or hit[1] > NEAR_HOLE:
+                    continue
+                at, outside = hit
+                tangent = inv[k, :3, :3] @ (needle[k, :3, :3] @ tangent_in_needle)
+                h.crossings.append(
+                    {
+                        "t": float(trace.times[k]),
+                        "phase": phase_at(trace.times[k]),
+                        "inward": bool(local[k - 1][2] > 0),
+                        "at_mm": [float(v) * 1000 for v in at],
+                        "outside_opening_m": outside,
+                        # the holes' ghosts sit on their openings: a crossing inside an opening
+                        # goes through its ghost (the plugin records where ghosts are, not what
+                        # they hold)
+                        "ghost_overlap": outside <= 0.0,
+                        "tip_leading": tip_leading(tangent, local[k - 1], local[k]),
+                    }
+                )
+        self._thread(rec, frames, idx, needle, geom)
+        self._slips(rec, frames, idx, needle, phase_at)
+
+    def _thread(self, rec, frames, idx, needle, geom) -> None:
+        """Through each pair's holes when its pull ended, as the observer judges it."""
+        from ..tasks.holes import chain_crossing
+        from ..tasks.metrics import THREAD_TOLERANCE
+
+        ends = {}
+        for (name, _start), nxt in zip(rec.phase_log, rec.phase_log[1:] + [("end", rec.seconds)]):
+            if name.startswith("pull "):
+                ends[int(name.split()[1])] = nxt[1]
+        elements = [idx[n] for n in rec.thread if n in idx]
+        if len(elements) < 2:
+            return
+        for k, t_end in ends.items():
+            s = min(int(np.searchsorted(self.times, t_end)), len(self.times) - 1)
+            c = frames[s, elements, :3, 3]
+            tail = (needle[s] @ np.r_[geom.tail, 1.0])[:3]
+            if np.linalg.norm(c[-1] - tail) < np.linalg.norm(c[0] - tail):
+                c = c[::-1]
+            c = np.vstack([tail, c])
+            step = float(np.median(np.linalg.norm(np.diff(c[1:], axis=0), axis=1)))
+            out = {}
+            for h in self.holes:
+                if h.pair != k or h.half is None or h.body not in idx:
+                    continue
+                f = np.linalg.inv(frames[s, idx[h.body]])
+                local = c @ f[:3, :3].T + f[:3, 3]
+                out[h.kind] = chain_crossing(local, h.half, THREAD_TOLERANCE)
+            self.thread_by_pair[k] = {
+                "t": float(self.times[s]),
+                "through_entry": out.get("entry") is not None,
+                "through_exit": out.get("exit") is not None,
+                "length_m": min(len(elements), out["entry"] + 0.5) * step if out.get("entry") is not None else 0.0,
+            }
+
+    def _slips(self, rec, frames, idx, needle, phase_at) -> None:
+        """The needle moving in a grasp, while one arm alone holds it, once that grasp has
+        settled after the other arm let go (the observer's slip)."""
+        from ..tasks.verdicts import SLIP_LIMIT, SLIP_SETTLE_S
+
+        holding: dict[str, np.ndarray] = {}  # arm -> the needle in its tool at the grasp
+        events = sorted(rec.grasps)
+        e = 0
+        alone_since = None
+        for s, t in enumerate(self.times):
+            changed = False
+            while e < len(events) and events[e][0] <= t + 1e-9:
+                _, arm, body = events[e]
+                tool = rec.tools.get(arm)
+                if body is None:
+                    holding.pop(arm, None)
+                elif tool in idx:
+                    holding[arm] = invert(frames[s, idx[tool]]) @ needle[s]
+                e += 1
+                changed = True
+            if len(holding) != 1:
+                alone_since = None
+                continue
+            if changed or alone_since is None:
+                alone_since = t
+            if t - alone_since < SLIP_SETTLE_S:
+                continue
+            arm, rel = next(iter(holding.items()))
+            expected = frames[s, idx[rec.tools[arm]]] @ rel
+            slip = float(np.linalg.norm(expected[:3, 3] - needle[s, :3, 3]))
+            phase = phase_at(t)
+            if slip > SLIP_LIMIT and not any(x["phase"] == phase for x in self.slips):
+                self.slips.append({"phase": phase, "t": float(t), "arm": arm, "slip_m": slip})
+
+
+def _frames(poses: np.ndarray) -> np.ndarray:
+    """(S, B, 4, 4) world matrices from (S, B, 7) positions and quaternions."""
+    s, b = poses.shape[:2]
+    out = np.array([pose_matrix(p[:3], p[3:]) for p in poses.reshape(-1, 7)])
+    return out.reshape(s, b, 4, 4)
+
+
+def _phases(log: list[tuple[str, float]]):
+    """The phase adfkit's task was in at a time."""
+    starts = np.array([t for _, t in log]) if log else np.zeros(0)
+
+    def at(t: float) -> str:
+        i = int(np.searchsorted(starts, t + 1e-9, side="right")) - 1
+        return log[i][0] if i >= 0 else "start"
+
+    return at
+
+
+def tip_gaps(adfkit_tip: np.ndarray, ambf_tip: np.ndarray, log, pairs) -> dict[int, float]:
+    """The largest distance between the two tips over each pair's phases (m), adfkit's path
+    taken at AMBF's sample times."""
+    phase_at = _phases(log)
+    from ..tasks.verdicts import in_pair
+
+    out: dict[int, float] = {}
+    t = ambf_tip[:, 0]
+    mine = np.column_stack([np.interp(t, adfkit_tip[:, 0], adfkit_tip[:, i]) for i in (1, 2, 3)])
+    d = np.linalg.norm(mine - ambf_tip[:, 1:], axis=1)
+    for n, p in enumerate(pairs):
+        mask = np.array([in_pair(phase_at(x), p.index, n == 0) for x in t])
+        out[p.index] = float(d[mask].max()) if mask.any() else math.nan
+    return out
+
+
+def replay(rec: Recording, build: ambf.AmbfBuild, launch: Path, indices) -> tuple[list[dict], dict, object]:
+    """The recording played in AMBF: (its verdicts per pair, tip gaps per pair, the trace)."""
+    from ..tasks.verdicts import pair_verdict
+    from .traces import from_ambf
+
+    stage = ambf.Stage(Path(launch).resolve(), list(indices) if indices is not None else _all(launch))
+    zeros = joint_zeros(rec, build, stage)
+    commands = [
+        ambf.Command(c.t, c.kind, c.target, c.value + zeros.get(c.target, 0.0)) if c.kind == "position" else c
+        for c in rec.commands
+    ]
+    run = ambf.run(build, stage, rec.seconds, EVERY, commands, timeout=600 + 10 * rec.seconds)
+    trace = from_ambf(run)
+    obs = AmbfObservation(rec, trace)
+    verdicts = [pair_verdict(obs, p) for p in rec.task.pairs]
+    gaps = tip_gaps(rec.tip_path, obs.tip_path, rec.phase_log, rec.task.pairs)
+    return verdicts, gaps, trace
+
+
+def _all(launch: Path) -> list[int]:
+    from ..adf import read_file
+
+    doc, _ = read_file(launch)
+    return list(range(len(getattr(doc, "multibody_configs", None) or [])))
+
+
+def compare_suture(launch: Path, indices, pairs, build: ambf.AmbfBuild, seed: int = 0, progress: bool = False) -> dict:
+    """The suture in adfkit and replayed in AMBF, judged alike: the issue's JSON."""
+    rec = record(launch, indices, pairs, seed, progress)
+    verdicts, gaps, trace = replay(rec, build, launch, indices)
+    mine = {v["pair"]: v for v in rec.verdicts}
+    out = []
+    for v in verdicts:
+        a = mine.get(v["pair"], {})
+        out.append(
+            {
+                "pair": v["pair"],
+                "adfkit": a.get("verdict", "not-tried"),
+                "ambf": v["verdict"],
+                "adfkit_rule": a.get("rule"),
+                "ambf_rule": v["rule"],
+                "ambf_reason": v["reason"],
+                "tip_path_gap_m": gaps.get(v["pair"]),
+            }
+        )
+    return {
+        "scene": str(launch),
+        "seed": seed,
+        "seconds": rec.seconds,
+        "commands": len(rec.commands),
+        "pairs": out,
+        "same_verdicts": all(p["adfkit"] == p["ambf"] for p in out),
+        "wall_s": {"adfkit": rec.wall_s, "ambf": trace.wall_s},
+        "not_judged_on_ambf": ["tool-hit-tissue", "blocked-at-entry by force", "blocked-in-channel by force"],
+    }
