@@ -390,8 +390,9 @@ def test_textures_are_drawn_tinted_by_the_adf_colour_and_a_missing_one_is_said_o
     from adfkit.viewer.server import Viewer
 
     Image.new("RGB", (8, 8), (200, 100, 50)).save(tmp_path / "tex.png")
-    obj = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nvt 0 0\nvt 1 0\nvt 0 1\n"
-    obj += "f 1/1 3/3 2/2\nf 1/1 2/2 4/3\nf 1/1 4/3 3/2\nf 2/1 3/2 4/3\n"
+    obj = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n"
+    # v/vt/vn: `f v/vt` faces crash AMBF, an error (obj-faces-crash-ambf) the viewer stops at
+    obj += "f 1/1/1 3/3/1 2/2/1\nf 1/1/1 2/2/1 4/3/1\nf 1/1/1 4/3/1 3/2/1\nf 2/1/1 3/2/1 4/3/1\n"
     (tmp_path / "t.obj").write_text("mtllib t.mtl\nusemtl m\n" + obj)
     (tmp_path / "t.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd tex.png\n")
     (tmp_path / "far.obj").write_text("mtllib far.mtl\nusemtl m\n" + obj)

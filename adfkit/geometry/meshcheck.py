@@ -26,11 +26,18 @@ _OBJ_VERTEX = re.compile(rb"^[ \t]*v[ \t]", re.M)
 def mesh_problem(path: str | os.PathLike) -> str | None:
     """Why the STL/OBJ file at ``path`` holds no usable triangles, or None (also None for other
     formats and for files the input policy refuses: that is reported on its own)."""
+    key = _cache_key(path)
+    return None if key is None else _problem(*key)
+
+
+def _cache_key(path: str | os.PathLike) -> tuple[str, int, int] | None:
+    """The path with its size and mtime, so a cached read of a file that changed is read again;
+    None where it cannot be stat'ed."""
     try:
         st = os.stat(path)
     except (OSError, ValueError):
         return None
-    return _problem(os.fspath(path), st.st_size, st.st_mtime_ns)
+    return os.fspath(path), st.st_size, st.st_mtime_ns
 
 
 @lru_cache(maxsize=4096)
@@ -132,11 +139,8 @@ def obj_faces_crash_ambf(obj_path: str) -> bool:
     reader (chai3d cOBJModel::parseFaceString) reads as `v/vt/vn` with an index it never set:
     ambf_simulator crashes loading it (measured, a one-triangle file). `f v`, `f v//vn` and
     `f v/vt/vn` load."""
-    try:
-        st = os.stat(obj_path)
-    except (OSError, ValueError):
-        return False
-    return _vt_faces(os.fspath(obj_path), st.st_size, st.st_mtime_ns)
+    key = _cache_key(obj_path)
+    return key is not None and _vt_faces(*key)
 
 
 @lru_cache(maxsize=1024)
