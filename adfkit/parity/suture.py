@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..runner.rotations import invert, pose_matrix
+from ..runner.rotations import invert, matrix_to_pq, pose_matrix
 from . import ambf
 from .traces import ambf_name, joint_key
 
@@ -125,10 +125,7 @@ class _Recorder:
             for psm in self.task.psms.values():
                 for sb in w.bodies:
                     if sb.articulation is psm.art:
-                        m = sb.world_matrix()
-                        from ..runner.rotations import matrix_to_pq
-
-                        p, q = matrix_to_pq(m)
+                        p, q = matrix_to_pq(sb.world_matrix())
                         self.commands.append(ambf.Command(t, "place", _name(sb), numbers=(*p, *q)))
         for psm in self.task.psms.values():
             art = psm.art
@@ -228,6 +225,9 @@ class AmbfObservation:
     """What ``tasks.verdicts.pair_verdict`` reads, from AMBF's recorded poses."""
 
     def __init__(self, rec: Recording, trace) -> None:
+        from ..tasks.holes import plane_crossing, tip_leading
+        from ..tasks.metrics import NEAR_HOLE
+
         self.task = rec.task
         self.holes = [_Hole(d) for d in rec.holes]
         self.thread_by_pair: dict[int, dict] = {}
@@ -255,9 +255,6 @@ class AmbfObservation:
             local = np.einsum("nij,nj->ni", inv, tip)[:, :3]
             beyond = np.maximum(np.abs(local[:, :2]) - h.half, 0.0)
             h.closest = float(np.min(np.hypot(np.linalg.norm(beyond, axis=1), local[:, 2])))
-            from ..tasks.holes import plane_crossing, tip_leading
-            from ..tasks.metrics import NEAR_HOLE
-
             for k in range(1, len(local)):
                 hit = plane_crossing(local[k - 1], local[k], h.half)
                 if hit is None or hit[1] > NEAR_HOLE:
