@@ -47,6 +47,17 @@ def test_parity_without_an_ambf_build_is_a_located_error(scenes, tmp_path, capsy
     assert "error[ambf-missing]" in err and "make ambf" in err and "Traceback" not in err
 
 
+def test_parity_suture_reads_pairs_as_the_suture_does(tmp_path, capsys):
+    """--pairs is read before AMBF is looked for, the way `adfkit suture` reads it."""
+    nowhere = str(tmp_path / "nowhere")
+    for bad in ("0", "x", "1,1"):
+        assert main(["parity", "--suture", "--pairs", bad, "--ambf", nowhere]) == 2
+        err = capsys.readouterr().err
+        assert "error[bad-option]" in err and "ambf-missing" not in err and "Traceback" not in err
+    assert main(["parity", "--suture", "--pairs", "2,3", "--ambf", nowhere]) == 2  # good pairs, no AMBF
+    assert "error[ambf-missing]" in capsys.readouterr().err
+
+
 def test_joint_controller_is_ambfs_pid():
     # afJointController::computeOutput: backward difference over the time since the last call,
     # trapezoid integral; the first call differences against 0 at t = 0
@@ -339,6 +350,24 @@ def test_the_replayed_needle_is_judged_by_the_same_verdicts():
     assert v["rule"] == "entry-not-tip-first"
     v = pair_verdict(AmbfObservation(rec, _replay_trace([(0.0, 0.0, 0.004), (0.0, 0.0, 0.003)])), rec.task.pairs[0])
     assert v["rule"] == "entry-missed"  # it never went in (and AMBF records no force that blocked it)
+
+
+def test_a_replay_whose_ambf_world_blew_up_is_judged_on_what_came_before():
+    """AMBF's poses turn NaN when its world blows up (the bundled scene's thread did, 5.5 s into
+    the replay): the verdicts read the samples before, and say no NaN."""
+    from adfkit.parity.suture import AmbfObservation, finite_samples
+    from adfkit.tasks.verdicts import pair_verdict
+
+    down = [(0.0, 0.0, z) for z in (0.004, 0.002, 0.001, -0.002, -0.005, -0.008, -0.012, -0.014)]
+    rec = _replay_recording()
+    late = _replay_trace(down)
+    late.poses[7:, 0] = np.nan  # after the needle went through both holes
+    assert finite_samples(late) == 7
+    assert pair_verdict(AmbfObservation(rec, late), rec.task.pairs[0])["verdict"] == "passed"
+    early = _replay_trace(down)
+    early.poses[3:, 0] = np.nan  # before it reached Entry1's plane
+    v = pair_verdict(AmbfObservation(rec, early), rec.task.pairs[0])
+    assert v["rule"] == "entry-missed" and "nan" not in v["reason"] and "1.0 mm" in v["reason"], v["reason"]
 
 
 @needs_ambf

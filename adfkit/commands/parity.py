@@ -114,28 +114,16 @@ def run(args) -> int:
 def _suture(args) -> int:
     from .. import inputs
     from ..adf import parse_indices
-    from ..diagnostics import AdfError, error
     from ..jsonout import dumps
     from ..parity import ambf
     from ..parity.suture import compare_suture
+    from .suture import parse_pairs
 
     bundled = Path(__file__).resolve().parents[2] / "sample_scenes" / "suturing" / "launch.yaml"
     path = inputs.scene_file(args.path) if args.path else bundled
     inputs.check_file(path, what="ADF file")
+    pairs = parse_pairs(args.pairs.strip())
     build = ambf.find_build(args.ambf)
-    text = args.pairs.strip()
-    try:
-        pairs = (
-            list(range(1, int(text) + 1))
-            if text.isdigit() and len(text) == 1 and "," not in text
-            else parse_indices(text)
-        )
-    except AdfError:
-        raise
-    if not pairs or any(k < 1 for k in pairs):
-        raise AdfError(
-            error("bad-option", f"--pairs {args.pairs!r} names no hole pair", None, "e.g. --pairs 4 or --pairs 1,2")
-        )
     out = compare_suture(Path(path), parse_indices(args.indices), pairs, build, args.seed, progress=not args.json)
     if args.json:
         print(dumps(out, indent=1))
@@ -149,6 +137,10 @@ def _suture(args) -> int:
                 f"  pair {p['pair']}: adfkit {p['adfkit']}, AMBF {p['ambf']}"
                 + (f" ({p['ambf_rule']}: {p['ambf_reason']})" if p["ambf_rule"] else "")
                 + (f", tip paths {gap * 1e3:.1f} mm apart at most" if gap == gap and gap is not None else "")
+            )
+        if out["ambf_not_finite_from_s"] is not None:
+            print(
+                f"  AMBF's world blew up at {out['ambf_not_finite_from_s']:.2f} s (poses not finite): judged before it"
             )
         w = out["wall_s"]
         print(f"  stepping: adfkit {w['adfkit']:.1f} s (the whole episode), AMBF {w['ambf']:.1f} s")

@@ -55,7 +55,8 @@ def add_arguments(p) -> None:
     p.add_argument("--address", help="Ray cluster address (auto, ray://head:10001); default: a local Ray")
 
 
-def _pairs(text: str) -> list[int]:
+def parse_pairs(text: str) -> list[int]:
+    """``--pairs``: a count (pairs 1..N) or a list of pair numbers."""
     from ..diagnostics import AdfError, error
 
     try:
@@ -80,7 +81,7 @@ def _pairs(text: str) -> list[int]:
 def run(args) -> int:
     from ..diagnostics import AdfError, error
 
-    pairs = _pairs(args.pairs)
+    pairs = parse_pairs(args.pairs)
     if args.every < 1:
         raise AdfError(error("bad-option", "--every must be ≥ 1", None, "e.g. --every 10"))
     if args.format and not args.record:

@@ -240,16 +240,18 @@ class AmbfObservation:
         self.wire_radius = 0.0
         names = trace.body_names
         idx = {n: i for i, n in enumerate(names)}
-        self.times = trace.times
-        frames = _frames(trace.poses)
+        # judged up to where AMBF's world blew up, if it did (its poses not finite from there on)
+        n_ok = finite_samples(trace)
+        self.times = trace.times[:n_ok]
+        frames = _frames(trace.poses[:n_ok])
         needle = frames[:, idx[rec.needle]]
         tip = needle @ np.r_[geom.tip, 1.0]
-        self.tip_path = np.column_stack([trace.times, tip[:, :3]])
+        self.tip_path = np.column_stack([self.times, tip[:, :3]])
         tangent_in_needle = geom.arc_in_needle[:3, :3] @ np.array([0.0, 1.0, 0.0])
         phase_at = _phases(rec.phase_log)
         for h in self.holes:
             hf = frames[:, idx[h.body]] if h.body in idx else None
-            if hf is None or h.half is None:
+            if hf is None or h.half is None or not n_ok:
                 continue
             inv = np.linalg.inv(hf)
             local = np.einsum("nij,nj->ni", inv, tip)[:, :3]
@@ -263,8 +265,8 @@ class AmbfObservation:
                 tangent = inv[k, :3, :3] @ (needle[k, :3, :3] @ tangent_in_needle)
                 h.crossings.append(
                     {
-                        "t": float(trace.times[k]),
-                        "phase": phase_at(trace.times[k]),
+                        "t": float(self.times[k]),
+                        "phase": phase_at(self.times[k]),
                         "inward": bool(local[k - 1][2] > 0),
                         "at_mm": [float(v) * 1000 for v in at],
                         "outside_opening_m": outside,
@@ -288,7 +290,7 @@ class AmbfObservation:
             if name.startswith("pull "):
                 ends[int(name.split()[1])] = nxt[1]
         elements = [idx[n] for n in rec.thread if n in idx]
-        if len(elements) < 2:
+        if len(elements) < 2 or not len(self.times):
             return
         for k, t_end in ends.items():
             s = min(int(np.searchsorted(self.times, t_end)), len(self.times) - 1)
@@ -347,10 +349,17 @@ class AmbfObservation:
                 self.slips.append({"phase": phase, "t": float(t), "arm": arm, "slip_m": slip})
 
 
+def finite_samples(trace) -> int:
+    """How many of the trace's samples come before the first pose that is not finite (a world
+    that blew up: Bullet's NaN spreads to every body it touches)."""
+    ok = np.isfinite(trace.poses).all(axis=(1, 2))
+    return len(ok) if ok.all() else int(np.argmin(ok))
+
+
 def _frames(poses: np.ndarray) -> np.ndarray:
     """(S, B, 4, 4) world matrices from (S, B, 7) positions and quaternions."""
     s, b = poses.shape[:2]
-    out = np.array([pose_matrix(p[:3], p[3:]) for p in poses.reshape(-1, 7)])
+    out = np.array([pose_matrix(p[:3], p[3:]) for p in poses.reshape(-1, 7)]).reshape(-1, 4, 4)
     return out.reshape(s, b, 4, 4)
 
 
@@ -412,6 +421,7 @@ def compare_suture(launch: Path, indices, pairs, build: ambf.AmbfBuild, seed: in
     rec = record(launch, indices, pairs, seed, progress)
     verdicts, gaps, trace = replay(rec, build, launch, indices)
     mine = {v["pair"]: v for v in rec.verdicts}
+    n_ok = finite_samples(trace)
     out = []
     for v in verdicts:
         a = mine.get(v["pair"], {})
@@ -433,6 +443,8 @@ def compare_suture(launch: Path, indices, pairs, build: ambf.AmbfBuild, seed: in
         "commands": len(rec.commands),
         "pairs": out,
         "same_verdicts": all(p["adfkit"] == p["ambf"] for p in out),
+        # AMBF's world blew up there (its poses not finite); judged on what came before
+        "ambf_not_finite_from_s": float(trace.times[n_ok]) if n_ok < len(trace.times) else None,
         "wall_s": {"adfkit": rec.wall_s, "ambf": trace.wall_s},
         "not_judged_on_ambf": ["tool-hit-tissue", "blocked-at-entry by force", "blocked-in-channel by force"],
     }
