@@ -137,6 +137,7 @@ def suture_job(job: dict) -> dict:
         progress=False,
         every=job.get("every", 10),
         engine=job.get("engine", "pybullet"),
+        not_tissue=tuple(job.get("not_tissue", ())),
     )
     return {
         "dir": name,
@@ -167,6 +168,7 @@ def suture_episodes(
     every: int = 10,
     kill_once: str | None = None,
     engine: str = "pybullet",
+    not_tissue=(),
 ) -> int:
     """`adfkit suture --episodes N --workers W`: exit 0 when every episode ran and passed every
     pair, 1 otherwise (the index says which)."""
@@ -179,12 +181,13 @@ def suture_episodes(
         {
             "launch": str(Path(launch).resolve()),
             "indices": indices,
-            "pairs": list(pairs),
+            "pairs": list(pairs) if pairs is not None else None,
             "seed": s,
             "out": str(out),
             "record": record,
             "every": every,
             "engine": engine,
+            "not_tissue": list(not_tissue),
         }
         for s in range(seed, seed + episodes)
     ]
@@ -201,7 +204,7 @@ def suture_episodes(
             "command": "suture",
             "launch": jobs[0]["launch"],
             "indices": indices,
-            "pairs": list(pairs),
+            "pairs": list(pairs) if pairs is not None else None,
             "workers": workers,
             "address": address,
             "wall_s": wall,

@@ -55,8 +55,10 @@ def _report(m: dict, seed: int, engine: str) -> None:
     for p in m.get("pairs", []):
         print(f"  pair {p['pair']}: {p.get('verdict')}" + (f" [{p['rule']}] {p['reason']}" if p.get("rule") else ""))
     drift = m.get("grasp_drift_one_arm_by_phase_m") or {}
+    err = m.get("max_constraint_error_m")
     print(
-        f"  max constraint error {1000 * (m.get('max_constraint_error_m') or 0):.2f} mm; grasp drift while one "
+        (f"  max constraint error {1000 * err:.2f} mm" if err is not None else "  no loop-closing joint to measure")
+        + "; grasp drift while one "
         "arm holds, by phase (mm): "
         + ", ".join(f"{k} {1000 * v:.2f}" for k, v in drift.items())
         + f"; thread through tissue {1000 * (m.get('thread_length_through_tissue_m') or 0):.1f} mm"

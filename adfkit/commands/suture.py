@@ -28,7 +28,19 @@ def add_arguments(p) -> None:
         help="launch file (default: the bundled sample_scenes/suturing, else the corpus suturing set with -l 6-11)",
     )
     p.add_argument("-l", "--indices", help="launch indices, e.g. 6-11")
-    p.add_argument("--pairs", default="1", help="how many hole pairs, 1..4 (pairs 1..N), or a list such as 2,3")
+    p.add_argument(
+        "--pairs",
+        default="1",
+        help="how many hole pairs (pairs 1..N), a list such as 2,3, or all (every pair of the phantom)",
+    )
+    p.add_argument(
+        "--not-tissue",
+        action="append",
+        default=[],
+        metavar="BODY",
+        help="a body the verdicts do not judge as tissue (every body but the arms, the needle and the thread is); "
+        "repeat for more",
+    )
     p.add_argument("--out", default="suture-output", help="output folder (default suture-output)")
     p.add_argument("--seed", type=int, default=0, help="seed of the plan's small randomisation")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
@@ -81,7 +93,8 @@ def parse_pairs(text: str) -> list[int]:
 def run(args) -> int:
     from ..diagnostics import AdfError, error
 
-    pairs = parse_pairs(args.pairs)
+    # all: every whole pair the scene has (run_episode finds them)
+    pairs = None if args.pairs.strip().lower() == "all" else parse_pairs(args.pairs)
     if args.every < 1:
         raise AdfError(error("bad-option", "--every must be ≥ 1", None, "e.g. --every 10"))
     if args.format and not args.record:
@@ -137,6 +150,7 @@ def run(args) -> int:
             record,
             args.every,
             engine=args.engine,
+            not_tissue=args.not_tissue,
         )
     from ..tasks.episode import run_episode
 
@@ -160,6 +174,7 @@ def run(args) -> int:
         progress=True,
         every=args.every,
         engine=args.engine,
+        not_tissue=args.not_tissue,
     )
     if m.get("failure", "").startswith("setup:") if m.get("failure") else False:
         raise AdfError(
@@ -184,10 +199,11 @@ def run(args) -> int:
         print(f"stopped: {m['failure']}", file=sys.stderr)
     rtf = m.get("real_time_factor")
     angles = (m.get("joint_angle_error_by_phase_deg") or {}).values()
+    err = m.get("max_constraint_error_m")
     print(
         f"simulated {m.get('simulated_time_s', 0):.2f} s, {rtf:.2f}x real time, thread through tissue "
-        f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm, max constraint error "
-        f"{(m.get('max_constraint_error_m') or 0) * 1000:.2f} mm"
+        f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm, "
+        + (f"max constraint error {err * 1000:.2f} mm" if err is not None else "no loop-closing joint to measure")
         + (f" (fixed joints {max(angles):.1f}° off)" if angles else "")
         + (", EXPLODED" if m.get("exploded") else "")
     )

@@ -63,10 +63,10 @@ class _TipWatch:
     """What adfkit.tasks.metrics.SutureObserver reads of a task: the world, the hole pair, the
     needle and its tip (the challenge's check: the tip through entry k, then out of exit k)."""
 
-    def __init__(self, world, pair: int) -> None:
+    def __init__(self, world, pair: int, psms: dict) -> None:
         from ..tasks.suture import find_needle, hole_pairs
 
-        self.world = world
+        self.world, self.psms = world, psms  # the arms: robots, not tissue, to the observer
         self.needle, self.geom = find_needle(world)
         self.pairs = [p for p in hole_pairs(world) if p.index == pair]
         if not self.pairs:
@@ -86,7 +86,7 @@ class SutureOnePair(SuturingEnv):
     pair = 1
 
     def _task_setup(self) -> None:
-        self.watch = _TipWatch(self.world, self.pair)
+        self.watch = _TipWatch(self.world, self.pair, self.psms)
         p = self.watch.pairs[0]
         self.entry, self.exit = p.entry, p.exit
 

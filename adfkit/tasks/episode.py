@@ -168,17 +168,19 @@ def play_task(
 
 
 def tissue_outline(task):
-    """The tissue's collision-mesh vertices in the world (for the plot), or None."""
+    """The tissue bodies' mesh vertices in the world (for the plot), or None (the plot's view,
+    around the holes, leaves out a floor's far corners)."""
     from ..adf.paths import collision_mesh_path
     from .needle import obj_vertices
 
+    out = []
     for sb in task.tissue():
         path = collision_mesh_path(sb.model, sb.body)
         if path is not None and path.is_file() and path.suffix.lower() == ".obj":
             v = obj_vertices(path) * (sb.body.scale or 1.0)
             t = sb.world_matrix()
-            return v @ t[:3, :3].T + t[:3, 3]
-    return None
+            out.append(v @ t[:3, :3].T + t[:3, 3])
+    return np.concatenate(out) if out else None
 
 
 def plot_trajectory(obs: SutureObserver, task, path: Path, verdicts: list | None = None) -> None:
@@ -267,9 +269,12 @@ def run_episode(
     options=None,
     engine: str = "pybullet",
     render_process: bool = True,
+    not_tissue=(),
 ) -> dict:
-    """Play one scripted suture of hole ``pairs`` on the scene; returns the metrics (also written
-    with the pictures to ``out`` when given)."""
+    """Play one scripted suture of hole ``pairs`` (None: every whole pair of the scene) on the
+    scene; returns the metrics (also written with the pictures to ``out`` when given).
+    ``not_tissue``: bodies the verdicts do not judge as tissue
+    (tasks/roles.py)."""
     from ..adf import load_scene, parse_indices
     from ..runner import Options, open_world
 
@@ -282,9 +287,16 @@ def run_episode(
     world = open_world(scene, options, gui=gui, engine=engine)
     try:
         try:
-            task = SutureTask(world, list(pairs), seed=seed)
+            if pairs is None:
+                from .suture import hole_pairs
+
+                pairs = [p.index for p in hole_pairs(world)] or [1]
+            task = SutureTask(world, list(pairs), seed=seed, not_tissue=not_tissue)
         except (SutureError, KeyError, ValueError) as exc:
             return {"pairs": [], "all_passed": False, "failure": f"setup: {exc}", "seed": seed}
+        for k, found in task.check_sweep().items():
+            if progress:  # said at once; the run goes on, and its physics judges the pair
+                print(f"pair {k}, before the run: {found}", file=sys.stderr)
         metrics, obs, frames = play_task(
             world, task, Path(out) if out else None, record, every, gif and out is not None, progress, render_process
         )

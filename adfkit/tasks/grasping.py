@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..runner.psm import PSM
+from ..runner.psm_kinematics import PRISMATIC
 from ..runner.rotations import invert
 from .clearance import clearances
 
@@ -163,5 +164,47 @@ class GraspChoice:
             if worst > 0 and (best_key is None or key > best_key):
                 best, best_key = Grasp(m, margin, float(clear[i])), key
         if best is None:
-            raise SutureError(f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})")
+            raise SutureError(
+                f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})"
+                + self._shortfall(psm, [m for m, _ in cands], needle_poses)
+            )
         return best
+
+    def _shortfall(self, psm: PSM, ee_in_needle: list, needle_poses: list) -> str:
+        """How far the nearest of the grasps misses: "; the nearest needs <arm>'s <joint> n mm
+        (or degrees) past its limit with the needle's tip n mm from <hole>", or "" where the IK
+        finds no configuration at all."""
+        base_inv = invert(psm.base_in_world())
+        lo, hi = psm.kin.lower_limits[:6], psm.kin.upper_limits[:6]
+        best = None
+        for m in ee_in_needle[:: max(1, len(ee_in_needle) // 240)]:
+            worst = None
+            for pose in needle_poses:
+                try:
+                    q = psm.kin.ik(base_inv @ pose @ m, check_limits=False)
+                except ValueError:
+                    worst = None
+                    break
+                over = np.maximum(lo - q, 0.0) + np.maximum(q - hi, 0.0)
+                i = int(np.argmax(over / (hi - lo)))
+                if over[i] > 0 and (worst is None or over[i] / (hi[i] - lo[i]) > worst[0]):
+                    worst = (over[i] / (hi[i] - lo[i]), i, float(over[i]), pose)
+            if worst is not None and (best is None or worst[0] < best[0]):
+                best = worst
+        if best is None:
+            return ""
+        _, i, over, pose = best
+        name = psm.kin.joint_names[i]
+        amount = f"{over * 1000:.1f} mm" if psm.kin.links[i].joint_type == PRISMATIC else f"{math.degrees(over):.1f}°"
+        return f"; the nearest needs {psm.name}'s {name} {amount} past its limit{self._tip_near(pose)}"
+
+    def _tip_near(self, needle_pose: np.ndarray) -> str:
+        """ " with the needle's tip n mm from <hole>" for the hole of the task's pairs nearest the tip."""
+        from .holes import hole_frame, hole_label
+
+        tip = (needle_pose @ np.r_[self.geom.tip, 1.0])[:3]
+        holes = [(g, hole_frame(self.world, g)[:3, 3]) for p in getattr(self, "pairs", []) for g in (p.entry, p.exit)]
+        if not holes:
+            return ""
+        g, at = min(holes, key=lambda h: float(np.linalg.norm(h[1] - tip)))
+        return f" with the needle's tip {np.linalg.norm(at - tip) * 1000:.1f} mm from {hole_label(g)}"

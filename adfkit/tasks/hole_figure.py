@@ -55,7 +55,7 @@ def draw(launch: Path, pair: int, out: Path) -> None:
     from ..adf import load_scene
     from ..runner import Options, open_world
     from .holes import opening_half_extents
-    from .metrics import wire_radius
+    from .needle import wire_radius
     from .suture import SutureTask
 
     world = open_world(load_scene(launch), Options(renderer="tiny"))

@@ -16,17 +16,6 @@ import numpy as np
 DEFAULT_HALF_OPENING = 0.0024
 
 
-def tissue_bodies(world, model) -> list:
-    """What the needle and the tools press on: the static bodies of the needle's model, and the
-    bodies the hole ghosts sit on (the corpus set's holes are bodies of 0.2 kg on springs to
-    the phantom, not static, and what presses on them presses on the tissue)."""
-    out = [sb for sb in world.bodies if sb.model is model and sb.static]
-    for g in world.ghosts:
-        if g.friction and g.parent is not None and g.parent not in out:
-            out.append(g.parent)
-    return out
-
-
 def has_boundary(body) -> bool:
     """Whether a hole body is framed by capsule boundary bodies: the bundled scene's holes and the
     corpus set's (its Entry/Exit bodies have a mesh to draw and four capsules to collide, 2.5 mm
@@ -38,6 +27,12 @@ def boundary_body(ghost):
     """The capsule-framed hole body a hole ghost sits on, or None."""
     parent = getattr(ghost, "parent", None)
     return parent if parent is not None and has_boundary(parent.body) else None
+
+
+def hole_label(ghost) -> str:
+    """A hole's name for a modeller: its boundary body's (Entry1), else its ghost's."""
+    b = boundary_body(ghost)
+    return (b.body.name or b.body.identifier) if b is not None else (ghost.ghost.name or ghost.ghost.identifier)
 
 
 def hole_frame(world, ghost) -> np.ndarray:

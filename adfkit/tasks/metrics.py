@@ -21,11 +21,13 @@ from .holes import (
     opening_half_extents,
     plane_crossing,
     tip_leading,
-    tissue_bodies,
 )
-from .verdicts import SLIP_LIMIT, SLIP_SETTLE_S, TIP_FORCE_N, pair_verdict
+from .needle import wire_radius
+from .roles import task_roles
+from .verdicts import FORCED_N, SLIP_LIMIT, SLIP_SETTLE_S, THREAD_FORCED_N, TOOL_HIT_N, pair_verdict, phase_pair
 
 TOOL_TOUCH_N = 0.05  # N: a tool-tissue contact at least this strong is recorded as an event
+NEEDLE_EVENT_N = 1.0  # N: a needle's or thread's touch this strong at its peak is written in the metrics
 SUSTAIN_STEPS = 5  # control steps (20 ms at 250 Hz) over which a touch's force is held (sustained_force_n)
 NEAR_HOLE = 0.005  # m: a crossing of a hole's plane farther than this beside its opening is not an attempt at it
 TIP_CONTACT = 0.002  # m: a contact this near the tip is the tip's
@@ -34,23 +36,6 @@ THREAD_TOLERANCE = 0.001  # m beyond a hole's opening a thread element's centre 
 
 def _name(sb) -> str:
     return sb.body.name or sb.body.identifier
-
-
-def wire_radius(task) -> float:
-    """The needle wire's radius, m, measured from its collision mesh (the 90th percentile of
-    the vertices' distances from the fitted circle: the tip's taper does not count)."""
-    from ..adf.paths import collision_mesh_path
-    from .needle import obj_vertices
-
-    b = task.needle.body
-    path = collision_mesh_path(task.needle.model, b)
-    if path is None or not path.is_file():
-        return 0.0
-    v = obj_vertices(path) * (b.scale or 1.0)
-    a = invert(task.geom.arc_in_needle)
-    p = v @ a[:3, :3].T + a[:3, 3]
-    rho = np.hypot(np.hypot(p[:, 0], p[:, 1]) - task.geom.radius, p[:, 2])
-    return float(np.percentile(rho, 90))
 
 
 class _Hole:
@@ -99,33 +84,26 @@ class SutureObserver:
         # the same while one arm alone holds it, from SLIP_SETTLE_S after the other let go (as slip)
         self.one_arm_drift_by_phase: dict[str, float] = {}
         self.slips: list[dict] = []  # phases where the needle slipped past SLIP_LIMIT
-        self.thread = [
-            sb
-            for sb in self.world.bodies
-            if sb.model is task.needle.model and "thread" in (sb.body.name or sb.body.identifier).lower()
-        ]
+        self.roles = task_roles(task)
+        self.thread = self.roles.thread  # in the chain's order from the needle
         self.thread_by_pair: dict[int, dict] = {}
         self.holes = [_Hole(self.world, p.index, "entry", p.entry_name, p.entry) for p in task.pairs] + [
             _Hole(self.world, p.index, "exit", p.exit_name, p.exit) for p in task.pairs
         ]
-        self.tissue = tissue_bodies(self.world, task.needle.model)
-        self._tissue_ids = {id(sb) for sb in self.tissue}
+        self.tissue = self.roles.tissue
         # the tools' links, watched for touches when they collide with the tissue
         self._tool = (
-            {
-                id(sb): n
-                for n, psm in getattr(task, "psms", {}).items()
-                for sb in self.world.bodies
-                if sb.articulation is psm.art
-            }
+            {id(sb): n for n, links in self.roles.robots.items() for sb in links}
             if getattr(task, "tools_collide_with_tissue", False)
             else {}
         )
         self._tool_links = [sb for sb in self.world.bodies if id(sb) in self._tool]
+        self._whom = self._who()
         self.needle_contacts: dict[str, dict[str, float]] = {}  # phase -> {tissue body: max N}
         self.tip_contacts: dict[str, dict[str, float]] = {}  # the same, within TIP_CONTACT of the tip
-        self.first_forced: dict[str, dict] = {}  # insert phase -> where the tip was first forced (_forced)
+        self.thread_contacts: dict[str, dict[str, float]] = {}  # the same for the thread (all its elements)
         self.tool_events: list[dict] = []
+        self.needle_events: list[dict] = []  # the needle's (each part's) and the thread's touches
         self._open_touch: dict[tuple, dict] = {}
         self._recent: dict[tuple, list[float]] = {}  # the last SUSTAIN_STEPS forces of each touch (0: none)
         self._in_ghost: dict[str, bool] = {}
@@ -134,7 +112,12 @@ class SutureObserver:
         g = task.geom
         self.tangent_in_needle = g.arc_in_needle[:3, :3] @ np.array([0.0, 1.0, 0.0])
         self._tip_h = np.r_[g.tip, 1.0]
+        self._arc_inv = invert(g.arc_in_needle)
         self.wire_radius = wire_radius(task)
+        # whether the engine built any of the scene's joints as a loop-closing constraint, whose
+        # two ends can drift apart (PyBullet's thread); MuJoCo plays the thread and the arms as
+        # trees of joints, exact by construction: nothing to measure there, and nothing is reported
+        self.measures_constraints = bool(getattr(self.world, "constraints", None))
 
     def _holders(self) -> int:
         return sum(1 for a in self.world.actuators if getattr(a, "target", None) is not None)
@@ -172,72 +155,134 @@ class SutureObserver:
                 }
             )
 
-    def _forced(self, phase: str, t: float, body: str, force: float, tip) -> None:
-        """Where the tip first pressed on the tissue hard enough to be forced (TIP_FORCE_N) in
-        an insertion: how far from the pair's entry and exit openings, so that a verdict can
-        tell a hole that stops the needle from a channel closed farther in."""
-        k = int(phase.split()[1])
-        near = {h.kind: float(np.linalg.norm(np.asarray(tip) - h.frame()[:3, 3])) for h in self.holes if h.pair == k}
-        self.first_forced[phase] = {
-            "t": t,
-            "body": body,
-            "force_n": float(force),
-            "from_entry_m": near.get("entry", math.inf),
-            "from_exit_m": near.get("exit", math.inf),
-        }
+    def _who(self) -> dict[int, tuple]:
+        """What touches the tissue, by body: ("needle", None), ("thread", element index, 1 the
+        nearest the needle) or ("tool", arm) for the tools' links when they collide with it."""
+        out: dict[int, tuple] = {id(self.task.needle): ("needle", None)}
+        for i, sb in enumerate(self.thread):
+            out[id(sb)] = ("thread", i + 1)
+        for sb in self._tool_links:
+            out[id(sb)] = ("tool", self._tool[id(sb)])
+        return out
 
-    def _watch_contacts(self, t: float) -> None:
+    def needle_part(self, at, needle_inv: np.ndarray) -> tuple[str, float]:
+        """Which part of the needle a world point is on: "tip" or "tail" (within TIP_CONTACT of
+        that end along the wire) or "body", and how far from the tip along the wire, m."""
+        g = self.task.geom
+        p = (self._arc_inv @ needle_inv @ np.r_[np.asarray(at, float), 1.0])[:3]
+        s = -math.atan2(p[1], p[0]) * g.radius  # 0 at the tip, growing toward the tail
+        if s < TIP_CONTACT:
+            return "tip", max(s, 0.0)
+        if s > g.span * g.radius - TIP_CONTACT:
+            return "tail", s
+        return "body", s
+
+    def place(self, at, phase: str) -> dict:
+        """Where a contact point lies for a reason: its pair (from the phase), how far past the
+        pair's entry along the needle's planned arc (m, negative before it), how far before the
+        exit, and how far off the arc; the point itself."""
+        out: dict = {"point_m": [float(v) for v in at]}
+        k = phase_pair(phase, self.task)
+        frames = getattr(self.task, "frames", {})
+        if k is None:
+            return out
+        out["pair"] = k
+        if k in frames:
+            b, psi_x = frames[k][0], frames[k][1]
+            q = invert(b) @ np.r_[np.asarray(at, float), 1.0]
+            r = self.task.geom.radius
+            psi = math.atan2(q[1], q[0])
+            out["past_entry_m"] = r * psi
+            out["before_exit_m"] = r * (psi_x - psi)
+            out["off_arc_m"] = float(math.hypot(math.hypot(q[0], q[1]) - r, q[2]))
+        return out
+
+    def _watch_contacts(self, t: float, needle_pose: np.ndarray) -> None:
+        """Every contact of the needle, the thread and (when they collide with it) the tools
+        with every tissue body after this step: the per-phase largest forces, and the touches
+        as events with the force they held (see _touch)."""
         phase = self.task.phase
-        w = self.world
-        tip = self.tip_path[-1][1:] if self.tip_path else None
-        per_body: dict[str, float] = {}
-        for other, f, at in w.contacts(self.task.needle):
-            if id(other) in self._tissue_ids:
-                n = _name(other)
-                per_body[n] = per_body.get(n, 0.0) + f
-                if tip is not None and f > 0 and math.dist(at, tip) < TIP_CONTACT:
-                    d = self.tip_contacts.setdefault(phase, {})
-                    d[n] = max(d.get(n, 0.0), f)
-                    if f >= TIP_FORCE_N and phase.startswith("insert ") and phase not in self.first_forced:
-                        self._forced(phase, t, n, f, tip)
-        for n, f in per_body.items():
+        needle_inv = None
+        per_touch: dict[tuple, list] = {}  # key -> [summed force, strongest contact's force, its point, element]
+        needle_per_body: dict[str, float] = {}
+        for tb, other, f, at in self.world.contacts_among(self.tissue):
+            who = self._whom.get(id(other))
+            if who is None:
+                continue
+            kind, what = who
+            n = _name(tb)
+            if kind == "tool":
+                key: tuple = ("tool", what, _name(other), n)
+            elif kind == "needle":
+                if needle_inv is None:
+                    needle_inv = invert(needle_pose)
+                part, _ = self.needle_part(at, needle_inv)
+                key = ("needle", part, n)
+                needle_per_body[n] = needle_per_body.get(n, 0.0) + f
+            else:
+                key = ("thread", None, n)
+            acc = per_touch.setdefault(key, [0.0, -1.0, None, None])
+            acc[0] += f
+            if f > acc[1]:
+                acc[1], acc[2], acc[3] = f, at, what
+        for n, f in needle_per_body.items():
             d = self.needle_contacts.setdefault(phase, {})
             d[n] = max(d.get(n, 0.0), f)
-        if not self._tool:
-            return
+        for (kind, part, n), (f, _, _, _) in ((k, v) for k, v in per_touch.items() if k[0] != "tool"):
+            if kind == "needle" and part == "tip":
+                d = self.tip_contacts.setdefault(phase, {})
+                d[n] = max(d.get(n, 0.0), f)
+            elif kind == "thread":
+                d = self.thread_contacts.setdefault(phase, {})
+                d[n] = max(d.get(n, 0.0), f)
         touching = set()
-        per_touch: dict[tuple, float] = {}
-        # asked of the tools (a query an arm), not of the tissue, which the thread lies on
-        for link, other, f, _ in w.contacts_among(self._tool_links):
-            if id(other) in self._tissue_ids:
-                key = (self._tool[id(link)], _name(link), _name(other))
-                per_touch[key] = per_touch.get(key, 0.0) + f
-        for key, f in per_touch.items():
+        for key, (f, _, at, what) in per_touch.items():
             if f < TOOL_TOUCH_N:
                 continue
             touching.add(key)
-            ev = self._open_touch.get(key)
-            if ev is None:
-                ev = self._open_touch[key] = {
-                    "t_start": t,
-                    "t_end": t,
-                    "phase": phase,
-                    "arm": key[0],
-                    "link": key[1],
-                    "tissue": key[2],
-                    "max_force_n": f,
-                    "sustained_force_n": 0.0,
-                }
-                self.tool_events.append(ev)
-            ev["t_end"] = t
-            ev["max_force_n"] = max(ev["max_force_n"], f)
-            ev["sustained_force_n"] = max(ev["sustained_force_n"], self._held(key, f))
+            self._touch(key, t, phase, f, at, what, needle_pose)
         for key in list(self._open_touch):
             if key not in touching:
                 del self._open_touch[key]
         for key in list(self._recent):
             if key not in touching:
                 self._held(key, 0.0)
+
+    def _touch(self, key: tuple, t: float, phase: str, f: float, at, what, needle_pose: np.ndarray) -> None:
+        """One control step of a touch: its event opened or carried on, its largest and held
+        force, and, the first time the force held reaches its limit (TOOL_HIT_N for a tool,
+        FORCED_N for the needle, THREAD_FORCED_N for the thread), when, in which phase, where
+        and how hard."""
+        ev = self._open_touch.get(key)
+        if ev is None:
+            ev = self._open_touch[key] = {"t_start": t, "t_end": t, "phase": phase}
+            if key[0] == "tool":
+                ev.update(arm=key[1], link=key[2], tissue=key[3])
+                self.tool_events.append(ev)
+            else:
+                ev.update(part=key[1] or "thread", tissue=key[2])
+                self.needle_events.append(ev)
+            ev.update(max_force_n=f, sustained_force_n=0.0)
+        ev["t_end"] = t
+        if f >= ev["max_force_n"] or "at_peak" not in ev:
+            ev["max_force_n"] = max(ev["max_force_n"], f)
+            if key[0] != "tool":
+                ev["at_peak"] = self._where(key, phase, at, what, needle_pose)
+        held = self._held(key, f)
+        ev["sustained_force_n"] = max(ev["sustained_force_n"], held)
+        limit = {"tool": TOOL_HIT_N, "thread": THREAD_FORCED_N}.get(key[0], FORCED_N)
+        if limit is not None and held >= limit and "over_limit" not in ev:
+            ev["over_limit"] = {"t": t, "phase": phase, "force_n": held}
+            if key[0] != "tool":
+                ev["over_limit"].update(self._where(key, phase, at, what, needle_pose))
+
+    def _where(self, key: tuple, phase: str, at, what, needle_pose: np.ndarray) -> dict:
+        out = self.place(at, phase)
+        if key[0] == "needle":
+            out["from_tip_m"] = self.needle_part(at, invert(needle_pose))[1]
+        elif what is not None:
+            out["element"] = what
+        return out
 
     def _held(self, key: tuple, f: float) -> float:
         """The force a touch held over the last SUSTAIN_STEPS control steps: their mean, a step
@@ -263,9 +308,9 @@ class SutureObserver:
             self._thread_at_end_of_pull(int(self._last_phase.split()[1]))
         self._last_phase = phase
         self._watch_holes(t, tip, needle_pose)
-        self._watch_contacts(t)
+        self._watch_contacts(t, needle_pose)
         self.n += 1
-        if self.n % self.error_every == 0:
+        if self.n % self.error_every == 0 and self.measures_constraints:
             e = self.world.constraint_error()
             self.max_constraint_error = max(self.max_constraint_error, e)
             kind = phase.split()[0]
@@ -385,11 +430,13 @@ class SutureObserver:
             "tool_tissue_events": self.tool_events,
             "needle_tissue_contact_n": self.needle_contacts,
             "tip_tissue_contact_n": self.tip_contacts,
-            "tip_first_forced": self.first_forced,
-            "constraint_error_by_phase_m": self.error_by_phase,
+            "thread_tissue_contact_n": self.thread_contacts,
+            # the needle's and the thread's touches of 1 N or more (lighter ones: lying on the tissue)
+            "needle_tissue_events": [e for e in self.needle_events if e["max_force_n"] >= NEEDLE_EVENT_N],
             "joint_angle_error_by_phase_deg": {k: float(np.degrees(a)) for k, a in self.angle_by_phase.items()},
             "needle_wire_radius_m": self.wire_radius,
-            "max_constraint_error_m": max(self.max_constraint_error, rep["max_constraint_error_m"]),
+            # what the check of the needle's swept arc before the run found, per pair (sweep.py)
+            "swept_arc_check": {str(k): v for k, v in getattr(self.task, "sweep", {}).items()},
             "simulated_time_s": self.world.sim_time,
             "physics_wall_time_s": self.world.wall_time,
             "episode_wall_time_s": wall_s,
@@ -400,9 +447,26 @@ class SutureObserver:
             + rep["nan"]
             + [e["body"] for e in rep.get("instabilities", []) if e["body"]],
             "instabilities": rep.get("instabilities", []),  # runner/stability.py: time, body, kind, message
+            **self._constraint_errors(rep),
             "control_steps": self.n,
             "clipped_setpoints": self.task.clipped,
             "plan": self._plan(),
+        }
+
+    def _constraint_errors(self, rep: dict) -> dict:
+        """The joints' constraint error where the engine has loop-closing constraints to measure;
+        else no figure, and a note that says why."""
+        if self.measures_constraints:
+            return {
+                "constraint_error_by_phase_m": self.error_by_phase,
+                "max_constraint_error_m": max(self.max_constraint_error, rep["max_constraint_error_m"]),
+            }
+        return {
+            "max_constraint_error_m": None,
+            "constraint_error_note": (
+                f"not measured: the {self.world.engine or 'engine'} world built none of the scene's joints as a "
+                "loop-closing constraint (its joints form trees, exact by construction)"
+            ),
         }
 
     def _plan(self) -> list[dict]:

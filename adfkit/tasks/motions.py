@@ -10,7 +10,6 @@ from ..runner.psm import PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
 from .grasping import BACK_OFF, JAW_APPROACH, ROLL, Grasp, SutureError
-from .holes import tissue_bodies
 
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
@@ -150,9 +149,8 @@ class Motions:
         yield from self.wait(0.15)
 
     def _touch(self, psm: PSM) -> tuple[list, set[int]]:
-        """What a guard watches: the arm's links and the tissue (holes.tissue_bodies) they may press on."""
-        links = [sb for sb in self.world.bodies if sb.articulation is psm.art]
-        return links, {id(sb) for sb in tissue_bodies(self.world, self.needle.model)}
+        """What a guard watches: the arm's links and the tissue (roles.py) they may press on."""
+        return self.roles.robots[psm.name], self.roles.tissue_ids()
 
     def _pressing(self, links: list, tissue: set[int]) -> bool:
         """One of ``links`` presses on the tissue with GUARD_N or more (after the last step)."""

@@ -92,3 +92,20 @@ def fit_needle(vertices: np.ndarray, tail_hint: np.ndarray | None = None) -> Nee
     t[:3, :3] = np.c_[x, y, z]
     t[:3, 3] = centre
     return NeedleGeometry(radius, span, t)
+
+
+def wire_radius(task) -> float:
+    """The needle wire's radius, m, measured from its collision mesh (the 90th percentile of
+    the vertices' distances from the fitted circle: the tip's taper does not count)."""
+    from ..adf.paths import collision_mesh_path
+    from ..runner.rotations import invert
+
+    b = task.needle.body
+    path = collision_mesh_path(task.needle.model, b)
+    if path is None or not path.is_file():
+        return 0.0
+    v = obj_vertices(path) * (b.scale or 1.0)
+    a = invert(task.geom.arc_in_needle)
+    p = v @ a[:3, :3].T + a[:3, 3]
+    rho = np.hypot(np.hypot(p[:, 0], p[:, 1]) - task.geom.radius, p[:, 2])
+    return float(np.percentile(rho, 90))

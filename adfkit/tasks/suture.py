@@ -28,6 +28,7 @@ import numpy as np
 from ..adf.paths import collision_mesh_path
 from ..runner.psm import JAW_OPEN, PSM
 from ..runner.rotations import invert
+from . import sweep
 from .clearance import Tissue, ToolShape
 from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError are the task's too
     JAW_APPROACH,
@@ -39,7 +40,8 @@ from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError 
 )
 from .holes import hole_frame
 from .motions import Motions, interpolate, smooth
-from .needle import fit_needle, obj_vertices
+from .needle import fit_needle, obj_vertices, wire_radius
+from .roles import body_roles
 
 LIFT = 0.015  # m the needle is lifted when carried between the phantom and a hole
 APPROACH = math.radians(15)  # the tip starts this far before the entry on its arc
@@ -154,6 +156,7 @@ class SutureTask(GraspChoice, Motions):
         psm_names=("psm1", "psm2"),
         speed: float = 1.0,
         tools_collide_with_tissue: bool = True,
+        not_tissue=(),
     ) -> None:
         self.world = world
         self.tools_collide_with_tissue = tools_collide_with_tissue
@@ -171,6 +174,9 @@ class SutureTask(GraspChoice, Motions):
             raise SutureError(f"{lacks} (the scene's whole pairs: {have})")
         self.pairs = [all_pairs[k] for k in pairs]
         self.psms = {n: PSM(world, n) for n in psm_names}
+        # the needle, the thread, the arms' links and the tissue (everything else), for the plan
+        # and the verdicts alike
+        self.roles = body_roles(world, self.needle, self.psms, not_tissue)
         self.phase = "start"
         self.clipped = 0  # set-points clipped to the joint limits
         self.phase_log: list[tuple[str, float]] = []  # (phase, simulated start time)
@@ -242,6 +248,13 @@ class SutureTask(GraspChoice, Motions):
         beyond = (g_tip + CLEAR + free - g_tail - CLEAR) / 2
         return b, psi_x, beyond, g_tip, g_tail
 
+    def check_sweep(self) -> dict[int, str]:
+        """The needle's swept arc at each pair against the tissue's collision shapes, and the
+        surface at the holes (sweep.py), in words per pair: what the physics will meet, said
+        before it; kept as ``self.sweep`` for the verdicts' reasons."""
+        self.sweep = sweep.check(self, wire_radius(self))
+        return self.sweep
+
     def needle_at(self, b: np.ndarray, psi: float) -> np.ndarray:
         """Needle body pose with its tip at angle psi in arc frame B."""
         return b @ _rot_z(psi) @ invert(self.geom.arc_in_needle)
@@ -299,15 +312,16 @@ class SutureTask(GraspChoice, Motions):
         the puller's (along the pull and the lift)."""
         n0 = self.needle_pose()
         self.driver, self.puller = self._sides()
-        static = [sb for sb in self.world.bodies if sb.model is self.needle.model and sb.static]
         centres = [
             (hole_frame(self.world, p.entry)[:3, 3] + hole_frame(self.world, p.exit)[:3, 3]) / 2 for p in self.pairs
         ]
-        self.tissue_shapes = Tissue(static, centres)
+        self.tissue_shapes = Tissue(self.roles.tissue, centres)
         self.tools = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
         if not hasattr(self, "tools_wide"):  # planned without steps(): the jaws as they are
             self.tools_wide = self.tools
         self.frames = {p.index: self.arc_frame(p) for p in self.pairs}
+        if not hasattr(self, "sweep"):
+            self.check_sweep()
         self.drive_grasps, self.pull_grasps, self.handbacks, self.tail_clears = [], [], [], []
         self.pulls: list[tuple[float, list, tuple]] = []  # per pair: the grasp's angle, the poses, where clear
         for k, p in enumerate(self.pairs):
@@ -411,13 +425,9 @@ class SutureTask(GraspChoice, Motions):
             "arms can hand the needle over"
         )
 
-    def tissue(self):
-        m = self.needle.model
-        return [
-            sb
-            for sb in self.world.bodies
-            if sb.model is m and sb.static and "phantom" in (sb.body.name or sb.body.identifier).lower()
-        ]
+    def tissue(self) -> list:
+        """Every tissue body (roles.py)."""
+        return self.roles.tissue
 
     def _arms_apart(self) -> None:
         """The two arms, brought closer on their setup joints, do not collide with each other's
@@ -425,13 +435,11 @@ class SutureTask(GraspChoice, Motions):
         thread with the phantom and the hole boundaries at every step. The tools collide with the
         tissue when ``tools_collide_with_tissue`` (a touch is then recorded by the observer as an
         event with its force); otherwise that is switched off and named in the metrics."""
-        arms = {n: [sb for sb in self.world.bodies if sb.articulation is psm.art] for n, psm in self.psms.items()}
+        arms = self.roles.robots
         if not self.tools_collide_with_tissue:
-            m = self.needle.model
-            static = [sb for sb in self.world.bodies if sb.model is m and sb.static]
             for links in arms.values():
                 for sb in links:
-                    for t in static:
+                    for t in self.roles.tissue:
                         self.world.set_collision(t, sb, False)
             self.switched_off.append("tool-tissue collisions (asked for: SutureTask(tools_collide_with_tissue=False))")
         names = list(arms)

@@ -1,12 +1,16 @@
 """The verdict on one hole pair and, when it fails, a reason a phantom modeller can act on.
 
-A pair passes when, from the physics: the tip went in through entry k and out through exit k
-inside each hole's real opening (the free square inside its boundary capsules), tip first,
-overlapping each hole's ghost as it crossed (so the ghost's friction acted there); the thread
-followed through both holes by the end of the pull; the needle did not slip more than
-SLIP_LIMIT in the grasp while one arm held it; no tool pressed on the tissue harder than
-TOOL_HIT_N; and the planner reached every pose of the pair. The first rule broken is the
-verdict's ``rule`` and ``reason`` (rules in the order below).
+A pair passes when, from the physics: neither the needle (tip, body or tail) nor the thread
+pressed on the tissue with FORCED_N held, in any phase of the pair, and no tool with
+TOOL_HIT_N (the earlier of the two is the verdict, before anything that followed it); the tip
+went in through entry k and out through exit k inside each hole's real opening (the free square
+inside its boundary capsules), tip first, overlapping each hole's ghost as it crossed (so the
+ghost's friction acted there); the thread followed through both holes by the end of the pull;
+the needle did not slip more than SLIP_LIMIT in the grasp while one arm held it; and the planner
+reached every pose of the pair. The first rule broken is the verdict's ``rule`` and ``reason``.
+
+The verdict reads only what the observer recorded (contacts of the needle, the thread and the
+tools with the tissue bodies, with forces and points, and the needle's poses), never an engine.
 """
 
 from __future__ import annotations
@@ -21,12 +25,31 @@ import math
 #: thousands
 TOOL_HIT_N: float | None = 50.0
 
+#: N: the needle (its tip, body or tail) or the thread pressing on a tissue body at least this
+#: hard, held over 20 ms as a tool's touch is (the mean of five control steps less the largest),
+#: fails the pair in whichever phase: the driver forced it through what should have let it pass.
+#: Good runs press with a few newtons (the needle lying on the tissue, picked up and carried
+#: over it; brushing a hole's boundary), forced ones with hundreds (docs/suture.md has both)
+FORCED_N = 40.0
+#: N: the same for the thread. Drawn through the holes by the puller, its tension presses it on
+#: their boundaries and the phantom's edges: up to 8 N held in PyBullet, up to 127 N in MuJoCo's
+#: rigid contacts on a good run (docs/suture.md has the figures); caught on the tissue, hundreds
+THREAD_FORCED_N = 300.0
+#: m along the needle's arc from a hole within which a block is the hole's (blocked-at-entry,
+#: blocked-at-exit); farther in, it is the channel's
+AT_HOLE = 0.002
+#: m off the planned arc beyond which a contact's place is given as a point, not along the arc
+ON_ARC = 0.004
 SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
 SLIP_SETTLE_S = 0.25  # s a grasp is given to settle after the other arm let go
-TIP_FORCE_N = 20.0  # N: the tip pressing this hard on the tissue between a pair's holes was forced through
 BLOCK_N = 1.0  # N: a carried needle pressing on the tissue this hard on its way to a hole is blocked there
 RULES = (
     "not-tried",
+    "blocked-at-entry",
+    "blocked-in-channel",
+    "blocked-at-exit",
+    "pressed-on-tissue",
+    "tool-hit-tissue",
     "reach",
     "blocked-at-entry",
     "entry-missed",
@@ -34,14 +57,12 @@ RULES = (
     "entry-not-tip-first",
     "entry-ghost-off-hole",
     "left-boundary",
-    "blocked-in-channel",
     "exit-missed",
     "exit-outside-opening",
     "exit-not-tip-first",
     "exit-ghost-off-hole",
     "thread-not-through",
     "slip",
-    "tool-hit-tissue",
 )
 
 
@@ -54,6 +75,18 @@ def in_pair(phase: str | None, k: int, first: bool) -> bool:
     if not phase:
         return False
     return phase.endswith(f" {k}") or (first and phase in ("pick up", "settle"))
+
+
+def phase_pair(phase: str | None, task) -> int | None:
+    """The pair a phase belongs to: its number ("insert 2"), the first pair's for the pick-up
+    and the settling, else None."""
+    if not phase:
+        return None
+    last = phase.split()[-1]
+    if last.isdigit():
+        return int(last)
+    pairs = getattr(task, "pairs", None)
+    return pairs[0].index if pairs and phase in ("pick up", "settle") else None
 
 
 def _label(hole) -> str:
@@ -126,6 +159,113 @@ def _back_out(crossings: list[dict], t_in: float, t_exit: float) -> list[dict]:
     return back
 
 
+def _who(ev: dict, where: dict) -> str:
+    """The part that pressed, in words: the needle's tip, body (n mm from its tip) or tail, or
+    the thread (element n, from the needle)."""
+    if ev["part"] == "thread":
+        return f"the thread (element {where['element']})" if where.get("element") else "the thread"
+    if ev["part"] == "body" and where.get("from_tip_m") is not None:
+        return f"the needle's body ({_mm(where['from_tip_m'])} from its tip)"
+    return f"the needle's {ev['part']}"
+
+
+def _static_note(obs, k: int) -> str:
+    """What the check of the needle's swept arc before the episode found at pair k, if anything."""
+    found = getattr(obs.task, "sweep", {}).get(k)
+    return f"; before the run: {found}" if found else ""
+
+
+def _pressing(ev: dict, on: str = "") -> str:
+    """ "<part> pressed on <body> with up to N held over 20 ms (peak N)" for a forced touch."""
+    w = ev["over_limit"]
+    held = max(ev.get("sustained_force_n", 0.0), w["force_n"])
+    return f"{_who(ev, w)} pressed on {on or ev['tissue']} with up to {held:.0f} N held over 20 ms (peak {ev['max_force_n']:.0f} N)"
+
+
+def _forced(obs, k: int, first: bool, entry, exit_) -> tuple[float, str, str] | None:
+    """The first touch of the needle or the thread in pair k's phases that held FORCED_N or more
+    on the tissue: (when, rule, reason), the rule by where it was along the needle's arc; the
+    reason names it, where and from when, then the pair's other touches over FORCED_N."""
+    evs = [
+        e
+        for e in getattr(obs, "needle_events", [])
+        if "over_limit" in e and in_pair(e["over_limit"]["phase"], k, first)
+    ]
+    if not evs:
+        return None
+    evs.sort(key=lambda e: e["over_limit"]["t"])
+    ev = evs[0]
+    w = ev["over_limit"]
+    body, phase = ev["tissue"], w["phase"]
+    past, before, off = w.get("past_entry_m"), w.get("before_exit_m"), w.get("off_arc_m")
+    on_arc = past is not None and off is not None and off <= ON_ARC
+    e_l, x_l = _label(entry), _label(exit_)
+    then = f" from t = {w['t']:.2f} s in {phase}"
+    more = {}
+    for e in evs[1:]:  # the other bodies and parts it was forced on, the strongest of each
+        key = (e["tissue"], e["part"])
+        if key != (body, ev["part"]) and (key not in more or e["sustained_force_n"] > more[key]["sustained_force_n"]):
+            more[key] = e
+    also = "".join(f"; {_pressing(e)}" for e in sorted(more.values(), key=lambda e: -e["sustained_force_n"])[:3])
+    if on_arc and phase.split()[0] in ("insert", "regrasp", "pull"):
+        if past <= AT_HOLE:
+            at = f"{_mm(past)} past it" if past >= 0 else f"{_mm(-past)} before it"
+            narrow = _narrower_than_wire(obs, entry)
+            return (
+                w["t"],
+                "blocked-at-entry",
+                (f"blocked at {e_l} ({at}): {_pressing(ev)}{then}{also}" + (f"; {narrow}" if narrow else "")),
+            )
+        if before <= AT_HOLE:
+            at = f"{_mm(before)} before it" if before >= 0 else f"{_mm(-before)} past it"
+            narrow = _narrower_than_wire(obs, exit_)
+            return (
+                w["t"],
+                "blocked-at-exit",
+                (f"blocked at {x_l} ({at}): {_pressing(ev)}{then}{also}" + (f"; {narrow}" if narrow else "")),
+            )
+        return (
+            w["t"],
+            "blocked-in-channel",
+            (
+                f"the channel between {e_l} and {x_l} is blocked {_mm(past)} past {e_l} by {body}: "
+                f"{_pressing(ev, 'it')}{then}{also}"
+            ),
+        )
+    if on_arc:
+        where = f", {_mm(past)} past {e_l}" if past >= 0 else f", {_mm(-past)} before {e_l}"
+        where += " on the needle's arc"
+    else:
+        where = " at ({}) mm".format(", ".join(f"{v * 1000:.1f}" for v in w["point_m"]))
+    return w["t"], "pressed-on-tissue", f"{_pressing(ev)}{then}{where}{also}"
+
+
+def _tool_hit(obs, k: int, first: bool) -> tuple[float, str, str] | None:
+    """The first touch of a tool in pair k's phases that held TOOL_HIT_N or more on the tissue."""
+    if TOOL_HIT_N is None:
+        return None
+    hits = []
+    for e in obs.tool_events:
+        over = e.get("over_limit")
+        pressed = e.get("sustained_force_n", e["max_force_n"])
+        if over is None and pressed >= TOOL_HIT_N:  # recorded without the moment (older records)
+            over = {"t": e["t_start"], "phase": e["phase"], "force_n": pressed}
+        if over is not None and in_pair(over["phase"], k, first):
+            hits.append((over["t"], e, over))
+    if not hits:
+        return None
+    t, e, over = min(hits, key=lambda h: h[0])
+    return (
+        t,
+        "tool-hit-tissue",
+        (
+            f"{e['arm']}'s {e['link']} hit {e['tissue']} with {e.get('sustained_force_n', over['force_n']):.1f} N "
+            f"held over 20 ms (peak {e['max_force_n']:.1f} N) during {over['phase']} (t = {over['t']:.2f} s): "
+            "the tool cannot reach the needle there without pressing on the tissue"
+        ),
+    )
+
+
 def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: bool, out: dict):
     k = pair.index
     entry, exit_ = _hole(obs, k, "entry"), _hole(obs, k, "exit")
@@ -134,6 +274,18 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     if log and not any(in_pair(name, k, first) for name in log):
         return "not-tried", f"not tried: the episode stopped before it ({failure or 'no failure recorded'})"
     ins = [c for c in entry.crossings if c["inward"]]
+    outs_all = [c for c in exit_.crossings if not c["inward"]]
+    # forcing and a tool pressing on the tissue are judged first, whatever came after them (a
+    # planner that then lost the needle, a thread that did not follow): the earlier of the two
+    physical = [f for f in (_forced(obs, k, first, entry, exit_), _tool_hit(obs, k, first)) if f is not None]
+    if physical:
+        _, rule, reason = min(physical, key=lambda f: f[0])
+        for key, crossings in (("entry_passed_s", ins), ("exit_passed_s", outs_all)):
+            through = [c for c in crossings if c["outside_opening_m"] <= 0.0]
+            out[key] = through[0]["t"] if through else None
+        if rule != "tool-hit-tissue":
+            reason += _static_note(obs, k)
+        return rule, reason + (f"; then the planner stopped: {failure}" if failed_here else "")
     if not ins:
         approach = f"carry {k}"
         if (
@@ -146,7 +298,8 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
             return rule, f"{reason}, before the insertion (the planner stopped: {failure})"
         if failed_here and not (failure_phase or "").startswith(("insert", "regrasp")):
             return "reach", failure
-        return _blocked_reason(obs, k, entry)
+        rule, reason = _blocked_reason(obs, k, entry)
+        return rule, reason + _static_note(obs, k)
     c_in = ins[0]
     if c_in["outside_opening_m"] > 0 and obs.needle_contacts.get(f"insert {k}"):
         # deflected by the tissue: the tip crossed the hole's plane beside the opening, not through it
@@ -159,7 +312,7 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
     fault = _crossing_fault(c_in, entry, "entry")
     if fault:
         return fault
-    outs = [c for c in exit_.crossings if not c["inward"] and c["t"] > c_in["t"]]
+    outs = [c for c in outs_all if c["t"] > c_in["t"]]
     back = _back_out(entry.crossings, c_in["t"], outs[0]["t"] if outs else math.inf)
     at_tip = {b: f for b, f in getattr(obs, "tip_contacts", {}).get(f"insert {k}", {}).items() if f >= 0.05}
     if back and at_tip:
@@ -168,42 +321,20 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         return "blocked-at-entry", (
             f"blocked past {_label(entry)}: the tip went in through its opening at t = {c_in['t']:.2f} s, "
             f"pressed on {hits} and came back out at t = {back[0]['t']:.2f} s before reaching {_label(exit_)}"
+            + _static_note(obs, k)
         )
     if back:
         return "left-boundary", (
             f"the needle left the boundary of {_label(entry)}: the tip came back out at "
             f"t = {back[0]['t']:.2f} s before reaching {_label(exit_)}"
         )
-    forced = {b: f for b, f in at_tip.items() if f >= TIP_FORCE_N}
-    if forced:
-        # through a free channel the tip brushes the holes' boundaries with a few newtons: this much
-        # means the driver forced it through what should have stopped it
-        hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forced.items(), key=lambda kv: -kv[1]))
-        narrow_in = _narrower_than_wire(obs, entry)
-        if narrow_in:
-            # the pointed tip fits an opening the wire behind it does not: the entry stops the needle
-            return "blocked-at-entry", (
-                f"blocked at {_label(entry)}: {narrow_in}; the tip went in at t = {c_in['t']:.2f} s and "
-                f"the needle was forced on, the tip pressing on {hits}"
-            )
-        first = getattr(obs, "first_forced", {}).get(f"insert {k}")
-        if first is not None and first["from_entry_m"] < first["from_exit_m"]:
-            # it met the tissue at the hole it went in by, and the driver forced it on from there
-            return "blocked-at-entry", (
-                f"blocked at {_label(entry)}: the tip pressed on {first['body']} ({first['force_n']:.1f} N) "
-                f"{_mm(first['from_entry_m'])} from its centre at t = {first['t']:.2f} s and the needle "
-                f"was forced on, the tip pressing on {hits}: the hole is closed there"
-            )
-        narrow = _narrower_than_wire(obs, exit_)
-        return "blocked-in-channel", (
-            f"the needle was forced from {_label(entry)} toward {_label(exit_)}: the tip pressed on {hits} "
-            f"(a free channel lets it through with under {TIP_FORCE_N:.0f} N); "
-            + (narrow or "the channel is closed there")
-        )
     if not outs:
         if failed_here:
             return "reach", failure
-        return "exit-missed", f"exit missed by {_mm(exit_.closest)}: the tip never came out through {_label(exit_)}"
+        return "exit-missed", (
+            f"exit missed by {_mm(exit_.closest)}: the tip never came out through {_label(exit_)}"
+            + _static_note(obs, k)
+        )
     out["exit_passed_s"] = outs[0]["t"]
     fault = _crossing_fault(outs[0], exit_, "exit")
     if fault:
@@ -227,14 +358,6 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
             return "slip", (
                 f"the needle slipped {_mm(s['slip_m'])} in {s['arm']}'s grasp during {s['phase']} "
                 f"(limit {_mm(obs_slip_limit())} while one arm holds)"
-            )
-    for e in obs.tool_events:
-        pressed = e.get("sustained_force_n", e["max_force_n"])
-        if TOOL_HIT_N is not None and in_pair(e["phase"], k, first) and pressed >= TOOL_HIT_N:
-            return "tool-hit-tissue", (
-                f"{e['arm']}'s {e['link']} hit {e['tissue']} with {pressed:.1f} N held over 20 ms "
-                f"(peak {e['max_force_n']:.1f} N) during {e['phase']} (t = {e['t_start']:.2f} s): "
-                "the tool cannot reach the needle there without pressing on the tissue"
             )
     if failed_here:
         return "reach", failure

@@ -1,0 +1,76 @@
+"""The suture's negative controls built from the bundled scene (tests/suture_phantoms.py), played
+in both engines (slow: pair 1, about 20 s simulated each): a phantom that blocks the needle
+fails at its pair with a reason naming the body and the place; the phantom in a model file of
+its own passes, its contacts with the needle recorded. Each of these passed, or failed as
+`reach`, before the whole needle and every tissue body were judged."""
+
+from __future__ import annotations
+
+import pytest
+from suture_phantoms import (
+    fill_holes,
+    narrow_channel,
+    phantom_in_own_file,
+    raise_floor,
+    raise_phantom,
+)
+
+ENGINES = ["pybullet", "mujoco"]
+
+
+def _pair_1(launch, engine: str) -> tuple[dict, dict]:
+    from adfkit.tasks.episode import run_episode
+
+    m = run_episode(launch, pairs=(1,), seed=0, progress=False, gif=False, engine=engine)
+    return m["pairs"][0], m
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("width", [0.001, 0.0009])
+def test_a_channel_narrower_than_the_wire_fails_at_it(tmp_path, engine, width):
+    p, m = _pair_1(narrow_channel(tmp_path, width), engine)
+    assert not p["passed"] and p["rule"] in ("blocked-at-entry", "blocked-in-channel"), p
+    assert "pressed on Phantom" in p["reason"] or "blocked" in p["reason"] and "by Phantom" in p["reason"]
+    assert f"the channel at pair 1 is {width * 1000:.1f} mm wide where the wire needs 1.23 mm" in p["reason"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_channel_floor_raised_into_the_arc_fails_where_it_blocks(tmp_path, engine):
+    p, _ = _pair_1(raise_floor(tmp_path, 0.020), engine)
+    assert not p["passed"] and p["rule"] == "blocked-in-channel", p
+    assert p["reason"].startswith("the channel between Entry1 and Exit1 is blocked ")
+    assert " mm past Entry1 by Phantom: the needle's" in p["reason"]
+    assert "Phantom lies in the needle's path between Entry1 and Exit1 (from 3.6 to 7.8 mm past Entry1)" in p["reason"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_phantom_raised_under_its_holes_fails_and_says_so(tmp_path, engine):
+    p, _ = _pair_1(raise_phantom(tmp_path), engine)
+    assert not p["passed"] and p["rule"] in ("blocked-at-entry", "blocked-in-channel", "blocked-at-exit"), p
+    assert "Phantom" in p["reason"] and "the tissue's surface is 4.0 mm above Entry1 and Exit1" in p["reason"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_phantom_in_its_own_file_passes_with_its_contacts_recorded(tmp_path, engine):
+    p, m = _pair_1(phantom_in_own_file(tmp_path), engine)
+    assert p["passed"], p
+    assert m["needle_tissue_contact_n"]["pick up"]["Phantom"] > 0.1
+    assert max(m["thread_tissue_contact_n"]["pull 1"].values()) > 0.1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_solid_phantom_in_its_own_file_fails_at_the_entry(tmp_path, engine):
+    p, _ = _pair_1(phantom_in_own_file(tmp_path, filled=True), engine)
+    assert not p["passed"] and p["rule"] == "blocked-at-entry", p
+    assert "Phantom" in p["reason"] and "before the run: Phantom lies in the needle's path" in p["reason"]
+
+
+@pytest.mark.slow
+def test_filled_holes_fail_at_their_entry_in_mujoco(tmp_path):
+    p, _ = _pair_1(fill_holes(tmp_path, (1,)), "mujoco")
+    assert not p["passed"] and p["rule"] == "blocked-at-entry", p
