@@ -143,10 +143,10 @@ def phantom_file(
     along the ridge, 14 mm from entry to exit; the whole phantom turned ``turn_deg`` about the
     vertical and moved to ``at``; the line of pairs slanted ``line_deg`` (each pair still across
     the ridge); slab and ridge ``thicker`` (the holes on its top). Returns the model file."""
-    from adfkit.model import Body, Friction, Ghost, ModelFile
+    from adfkit.model import ModelFile
     from adfkit.scenes.suturing.frames import pose, rot_y, rot_z, translation
     from adfkit.scenes.suturing.meshes import boxes_mesh, obj_text
-    from adfkit.scenes.suturing.phantom import GHOST, GHOST_SIZE, TEXTURE_SCALE, _hole_body
+    from adfkit.scenes.suturing.phantom import TEXTURE_SCALE, _hole_body, _phantom_body, hole_ghost
 
     ys = [((pairs + 1) / 2 - k) * spacing for k in range(1, pairs + 1)]
     slant = math.tan(math.radians(line_deg))
@@ -162,51 +162,14 @@ def phantom_file(
     edges.append(y_end)
     boxes += [((-half_x, a, slab), (half_x, b, top)) for a, b in zip(edges[0::2], edges[1::2])]
     place = translation(at[0], at[1], 0.0) @ rot_z(math.radians(turn_deg))
-    parts = [
-        ShapeEntry(
-            shape="Box",
-            geometry=Geometry(x=hi[0] - lo[0], y=hi[1] - lo[1], z=hi[2] - lo[2]),
-            offset=Pose(Vec3(*[(a + b) / 2 for a, b in zip(lo, hi)])),
-        )
-        for lo, hi in boxes
-    ]
     m = ModelFile(namespace="/ambf/env/phantom/", high_resolution_path="./meshes/", low_resolution_path="./meshes/")
-    m.bodies.append(
-        Body(
-            identifier="BODY Phantom",
-            name="Phantom",
-            mass=0.0,
-            location=pose(place),
-            mesh="Phantom.OBJ",
-            compound_collision_shape=parts,
-            collision_margin=0.0001,
-            use_material=True,
-            friction=Friction(static=0.8, rolling=0.01),
-            restitution=0.0,
-            passive=False,
-        )
-    )
+    m.bodies.append(_phantom_body(boxes, pose(place)))
     tilt = L.entry_angle()
     for kind, sign in (("Entry", -1.0), ("Exit", 1.0)):
         for k, (x, y) in enumerate(zip(xs, ys), start=1):
             hole = place @ translation(x + sign * L.HOLE_HALF_GAP, y, top) @ rot_y(sign * tilt)
             m.bodies.append(_hole_body(f"{kind}{k}", hole))
-            g = Geometry(x=GHOST_SIZE[0], y=GHOST_SIZE[1], z=GHOST_SIZE[2])
-            m.ghost_objects.append(
-                Ghost(
-                    identifier=f"GHOST ghost{kind}{k}",
-                    name=f"ghost{kind}{k}",
-                    parent=f"BODY {kind}{k}",
-                    location=Pose(),
-                    shape="Box",
-                    geometry=g,
-                    collision_shape="Box",
-                    collision_geometry=g,
-                    collision_margin=0.0001,
-                    color_rgba=GHOST,
-                    passive=False,
-                )
-            )
+            m.ghost_objects.append(hole_ghost(kind, k))
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "meshes").mkdir(exist_ok=True)
     v, uv, f = boxes_mesh(boxes, TEXTURE_SCALE)

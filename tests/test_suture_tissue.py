@@ -86,7 +86,7 @@ def test_the_swept_arc_check_finds_nothing_on_the_bundled_phantom(tmp_path):
 def test_the_swept_arc_check_says_where_the_phantom_blocks_the_needle(tmp_path):
     """Before any motion: a channel narrower than the wire (its width, the wire's), a floor
     raised into the arc (from where to where past the entry), the phantom raised under its
-    holes (how far its surface stands above them), a filled hole."""
+    holes (how far its surface stands above them), a filled hole, a hole narrower than the wire."""
     got = _swept(narrow_channel(tmp_path / "a", 0.001))
     assert got[1].startswith("the channel at pair 1 is 1.0 mm wide where the wire needs 1.23 mm (Phantom, from ")
     assert _swept(narrow_channel(tmp_path / "b", 0.0009))[1].startswith("the channel at pair 1 is 0.9 mm wide")
@@ -102,6 +102,10 @@ def test_the_swept_arc_check_says_where_the_phantom_blocks_the_needle(tmp_path):
     )
     got = _swept(fill_holes(tmp_path / "e", (2,)), (1, 2))
     assert set(got) == {2} and "Phantom lies in the needle's path between Entry2 and Exit2" in got[2]
+    from test_suture_verdicts import _narrow, _scene
+
+    got = _swept(_scene(tmp_path / "f", _narrow("Entry1")))
+    assert got == {1: "Entry1's opening (0.6 mm) is narrower than the needle's wire (1.23 mm)"}
 
 
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])

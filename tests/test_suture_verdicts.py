@@ -202,6 +202,15 @@ def test_the_needle_or_thread_forced_on_the_tissue_fails_where_it_was_forced():
     obs.needle_events = [_pressed(part="thread", phase="pull 1", **dict(arc, element=3))]
     v = pair_verdict(obs, pair)
     assert v["rule"] == "blocked-in-channel" and "the thread (element 3) pressed on it" in v["reason"]
+    # pushed aside at a narrow entry: pressed 8.6 mm beside the arc while the tip was at the hole
+    aside = dict(arc, off_arc_m=0.0086)
+    aside["tip"] = {"pair": 1, "past_entry_m": 0.0004, "before_exit_m": 0.0108, "off_arc_m": 0.0005}
+    obs.needle_events = [_pressed(**aside)]
+    v = pair_verdict(obs, pair)
+    assert v["rule"] == "blocked-at-entry" and v["reason"].startswith(
+        "blocked at ghostEntry1 (the tip 0.4 mm past it): the needle's body (8.6 mm from its tip) pressed on "
+        "Phantom with up to 300 N held over 20 ms (peak 500 N) 8.6 mm beside its arc from t = 6.00 s"
+    )
     # off the arc, while carried: pressed on the tissue, at a point
     obs.needle_events = [_pressed(phase="carry 1", **dict(arc, off_arc_m=0.02))]
     v = pair_verdict(obs, pair)

@@ -275,6 +275,8 @@ class SutureObserver:
             ev["over_limit"] = {"t": t, "phase": phase, "force_n": held}
             if key[0] != "tool":
                 ev["over_limit"].update(self._where(key, phase, at, what, needle_pose))
+                tip = (needle_pose @ self._tip_h)[:3]
+                ev["over_limit"]["tip"] = {k: v for k, v in self.place(tip, phase).items() if k != "point_m"}
 
     def _where(self, key: tuple, phase: str, at, what, needle_pose: np.ndarray) -> dict:
         out = self.place(at, phase)

@@ -25,7 +25,7 @@ import numpy as np
 
 from .clearance import Tissue
 from .grasping import SutureError
-from .holes import boundary_body, hole_frame, hole_label
+from .holes import boundary_body, hole_frame, hole_label, opening_half_extents
 
 SAMPLE = 0.0002  # m between the wire's points along its circle
 RING = 0.005  # m from a hole's centre to where the surface around it is read ...
@@ -74,6 +74,7 @@ class Block:
     depth_m: float  # how far the body reaches into the wire at most (its radius less the distance)
     width_m: float | None  # the channel's width across the needle's plane where narrowest, when the centre line is free
     wire_m: float  # the wire's thickness
+    opening_m: float | None = None  # the body's opening, when it is one of the pair's holes
 
     def text(self, entry: str, exit_: str) -> str:
         a, b = self.start_m * 1000, self.end_m * 1000
@@ -85,6 +86,11 @@ class Block:
             span = f"from {-a:.1f} to {-b:.1f} mm before {entry}"
         else:
             span = f"from {-a:.1f} mm before {entry} to {b:.1f} mm past it"
+        if self.opening_m is not None and self.opening_m < self.wire_m:
+            return (
+                f"{self.body}'s opening ({self.opening_m * 1000:.1f} mm) is narrower than the needle's wire "
+                f"({self.wire_m * 1000:.2f} mm)"
+            )
         if self.width_m is not None and self.width_m < self.wire_m:
             return (
                 f"the channel at pair {self.pair} is {self.width_m * 1000:.1f} mm wide where the wire needs "
@@ -178,6 +184,10 @@ def check(task, wire_r: float) -> dict[int, str]:
             blocks = arc_blocks(task, pair, wire_r, bodies)
         except SutureError:  # no arc to sweep: the plan says why it cannot drive this pair
             blocks = []
+        for blk in blocks:
+            hole = next((b for g in (pair.entry, pair.exit) if (b := boundary_body(g)) and b.name == blk.body), None)
+            if hole is not None:
+                blk.opening_m = 2 * float(min(opening_half_extents(hole.body)))
         notes += [blk.text(entry, exit_) for blk in blocks]
         if notes:
             out[pair.index] = "; ".join(dict.fromkeys(notes))

@@ -199,36 +199,39 @@ def _forced(obs, k: int, first: bool, entry, exit_) -> tuple[float, str, str] | 
     body, phase = ev["tissue"], w["phase"]
     past, before, off = w.get("past_entry_m"), w.get("before_exit_m"), w.get("off_arc_m")
     on_arc = past is not None and off is not None and off <= ON_ARC
+    pushed = ""
+    tip = w.get("tip") or {}
+    driven = phase.split()[0] in ("insert", "regrasp", "pull")
+    if driven and not on_arc and tip.get("off_arc_m") is not None and tip["off_arc_m"] <= ON_ARC:
+        # pressed beside its arc while the tip was on it: the needle was pushed aside, where its tip was
+        pushed = f" {_mm(off)} beside its arc" if off is not None else ""
+        past, before, on_arc = tip["past_entry_m"], tip["before_exit_m"], True
     e_l, x_l = _label(entry), _label(exit_)
-    then = f" from t = {w['t']:.2f} s in {phase}"
+    then = f"{pushed} from t = {w['t']:.2f} s in {phase}"
     more = {}
     for e in evs[1:]:  # the other bodies and parts it was forced on, the strongest of each
         key = (e["tissue"], e["part"])
         if key != (body, ev["part"]) and (key not in more or e["sustained_force_n"] > more[key]["sustained_force_n"]):
             more[key] = e
     also = "".join(f"; {_pressing(e)}" for e in sorted(more.values(), key=lambda e: -e["sustained_force_n"])[:3])
-    if on_arc and phase.split()[0] in ("insert", "regrasp", "pull"):
-        if past <= AT_HOLE:
-            at = f"{_mm(past)} past it" if past >= 0 else f"{_mm(-past)} before it"
-            narrow = _narrower_than_wire(obs, entry)
-            return (
-                w["t"],
-                "blocked-at-entry",
-                (f"blocked at {e_l} ({at}): {_pressing(ev)}{then}{also}" + (f"; {narrow}" if narrow else "")),
-            )
-        if before <= AT_HOLE:
-            at = f"{_mm(before)} before it" if before >= 0 else f"{_mm(-before)} past it"
-            narrow = _narrower_than_wire(obs, exit_)
-            return (
-                w["t"],
-                "blocked-at-exit",
-                (f"blocked at {x_l} ({at}): {_pressing(ev)}{then}{also}" + (f"; {narrow}" if narrow else "")),
-            )
+    if on_arc and driven:
+        for rule, hole, d, ahead in (
+            ("blocked-at-entry", entry, past, "past"),
+            ("blocked-at-exit", exit_, before, "before"),
+        ):
+            if d <= AT_HOLE:  # within AT_HOLE of the hole, or beyond it on the far side
+                behind = "before" if ahead == "past" else "past"
+                at = ("the tip " if pushed else "") + (f"{_mm(d)} {ahead} it" if d >= 0 else f"{_mm(-d)} {behind} it")
+                narrow = _narrower_than_wire(obs, hole)
+                reason = f"blocked at {_label(hole)} ({at}): {_pressing(ev)}{then}{also}"
+                return w["t"], rule, reason + (f"; {narrow}" if narrow else "")
         return (
             w["t"],
             "blocked-in-channel",
             (
-                f"the channel between {e_l} and {x_l} is blocked {_mm(past)} past {e_l} by {body}: "
+                f"the channel between {e_l} and {x_l} is blocked {_mm(past)} past {e_l} by {body}"
+                + (" (where the tip was)" if pushed else "")
+                + ": "
                 f"{_pressing(ev, 'it')}{then}{also}"
             ),
         )

@@ -79,9 +79,11 @@ def phantom_mtl_text() -> str:
     )
 
 
-def _phantom_body() -> Body:
+def _phantom_body(boxes=None, location: Pose | None = None) -> Body:
+    """BODY Phantom: a mesh, colliding as ``boxes`` (its frame's; the bundled phantom's by
+    default), at ``location`` (the world's origin by default)."""
     parts = []
-    for lo, hi in phantom_boxes():
+    for lo, hi in boxes if boxes is not None else phantom_boxes():
         c = [(a + b) / 2 for a, b in zip(lo, hi)]
         parts.append(
             ShapeEntry(
@@ -94,7 +96,7 @@ def _phantom_body() -> Body:
         identifier="BODY Phantom",
         name="Phantom",
         mass=0.0,
-        location=Pose(),
+        location=location or Pose(),
         mesh="Phantom.OBJ",
         compound_collision_shape=parts,
         collision_margin=0.0001,
@@ -169,26 +171,27 @@ def build_phantom() -> ModelFile:
     return m
 
 
+def hole_ghost(kind: str, k: int) -> Ghost:
+    """The ghost ghost<kind><k> on hole body <kind><k> (kind: Entry or Exit), at its centre."""
+    g = Geometry(x=GHOST_SIZE[0], y=GHOST_SIZE[1], z=GHOST_SIZE[2])
+    return Ghost(
+        identifier=f"GHOST ghost{kind}{k}",
+        name=f"ghost{kind}{k}",
+        parent=f"BODY {kind}{k}",
+        location=Pose(),
+        shape="Box",
+        geometry=g,
+        collision_shape="Box",
+        collision_geometry=g,
+        collision_margin=0.0001,
+        color_rgba=GHOST,
+        passive=False,
+    )
+
+
 def build_hole_ghosts() -> ModelFile:
     m = ModelFile(namespace="/ambf/env/phantom/", ignore_inter_collision=True)
-    g = Geometry(x=GHOST_SIZE[0], y=GHOST_SIZE[1], z=GHOST_SIZE[2])
-    for kind in ("Entry", "Exit"):
-        for k in range(1, 5):
-            m.ghost_objects.append(
-                Ghost(
-                    identifier=f"GHOST ghost{kind}{k}",
-                    name=f"ghost{kind}{k}",
-                    parent=f"BODY {kind}{k}",
-                    location=Pose(),
-                    shape="Box",
-                    geometry=g,
-                    collision_shape="Box",
-                    collision_geometry=g,
-                    collision_margin=0.0001,
-                    color_rgba=GHOST,
-                    passive=False,
-                )
-            )
+    m.ghost_objects = [hole_ghost(kind, k) for kind in ("Entry", "Exit") for k in range(1, 5)]
     return m
 
 
