@@ -130,3 +130,23 @@ def test_the_constraint_error_is_measured_where_there_is_one_and_absent_where_no
             assert m["constraint_error_note"].startswith("not measured: the mujoco world built none")
     finally:
         world.close()
+
+
+def test_a_hole_ghosts_box_is_read_from_its_shape_its_collision_or_its_compound():
+    """The bundled ghosts have a shape; the Blender add-on writes a ghost's box as its compound
+    collision shape: the planner aims inside the ghost by its box either way (it read no box from
+    the add-on's ghosts, and drove their pairs through the holes' centres, a wider bite)."""
+    from types import SimpleNamespace
+
+    from adfkit.model import Geometry, Ghost, ShapeEntry
+    from adfkit.tasks.holes import ghost_box
+
+    box = Geometry(x=0.005, y=0.004, z=0.0005)
+    for g in (
+        Ghost(shape="Box", geometry=box),
+        Ghost(collision_shape="Box", collision_geometry=box),
+        Ghost(compound_collision_shape=[ShapeEntry(shape="Box", geometry=box)], scale=2.0),
+    ):
+        got = ghost_box(SimpleNamespace(ghost=g))
+        assert got == pytest.approx([0.005 * (g.scale or 1.0), 0.004 * (g.scale or 1.0), 0.0005 * (g.scale or 1.0)])
+    assert ghost_box(SimpleNamespace(ghost=Ghost(shape="Sphere", geometry=Geometry(radius=0.003)))) is None

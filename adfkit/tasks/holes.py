@@ -29,6 +29,20 @@ def boundary_body(ghost):
     return parent if parent is not None and has_boundary(parent.body) else None
 
 
+def ghost_box(ghost) -> tuple[float, float, float] | None:
+    """A hole ghost's box (x, y, z sizes, m, scaled): its shape's geometry, else its collision
+    geometry, else a box of its compound collision shape (the Blender add-on writes a ghost's
+    box so); None for another shape."""
+    g = ghost.ghost
+    found = [(g.shape, g.geometry), (g.collision_shape, g.collision_geometry)]
+    found += [(e.shape, e.geometry) for e in g.compound_collision_shape or []]
+    for shape, geo in found:
+        if geo is not None and (shape or "box").lower() == "box" and None not in (geo.x, geo.y, geo.z):
+            s = g.scale or 1.0
+            return (geo.x * s, geo.y * s, geo.z * s)
+    return None
+
+
 def hole_label(ghost) -> str:
     """A hole's name for a modeller: its boundary body's (Entry1), else its ghost's."""
     b = boundary_body(ghost)

@@ -165,12 +165,17 @@ class SutureObserver:
             out[id(sb)] = ("tool", self._tool[id(sb)])
         return out
 
-    def needle_part(self, at, needle_inv: np.ndarray) -> tuple[str, float]:
+    def to_arc(self, needle_pose: np.ndarray) -> np.ndarray:
+        """The world-to-arc-frame transform of the needle where it is."""
+        return self._arc_inv @ invert(needle_pose)
+
+    def needle_part(self, at, to_arc: np.ndarray) -> tuple[str, float]:
         """Which part of the needle a world point is on: "tip" or "tail" (within TIP_CONTACT of
-        that end along the wire) or "body", and how far from the tip along the wire, m."""
+        that end along the wire) or "body", and how far from the tip along the wire, m.
+        ``to_arc``: the world-to-arc-frame transform (to_arc)."""
         g = self.task.geom
-        p = (self._arc_inv @ needle_inv @ np.r_[np.asarray(at, float), 1.0])[:3]
-        s = -math.atan2(p[1], p[0]) * g.radius  # 0 at the tip, growing toward the tail
+        x, y = to_arc[0, :3] @ at + to_arc[0, 3], to_arc[1, :3] @ at + to_arc[1, 3]
+        s = -math.atan2(y, x) * g.radius  # 0 at the tip, growing toward the tail
         if s < TIP_CONTACT:
             return "tip", max(s, 0.0)
         if s > g.span * g.radius - TIP_CONTACT:
@@ -189,7 +194,7 @@ class SutureObserver:
         out["pair"] = k
         if k in frames:
             b, psi_x = frames[k][0], frames[k][1]
-            q = invert(b) @ np.r_[np.asarray(at, float), 1.0]
+            q = invert(b) @ np.array([at[0], at[1], at[2], 1.0])
             r = self.task.geom.radius
             psi = math.atan2(q[1], q[0])
             out["past_entry_m"] = r * psi
@@ -202,7 +207,7 @@ class SutureObserver:
         with every tissue body after this step: the per-phase largest forces, and the touches
         as events with the force they held (see _touch)."""
         phase = self.task.phase
-        needle_inv = None
+        to_arc = None
         per_touch: dict[tuple, list] = {}  # key -> [summed force, strongest contact's force, its point, element]
         needle_per_body: dict[str, float] = {}
         for tb, other, f, at in self.world.contacts_among(self.tissue):
@@ -214,9 +219,9 @@ class SutureObserver:
             if kind == "tool":
                 key: tuple = ("tool", what, _name(other), n)
             elif kind == "needle":
-                if needle_inv is None:
-                    needle_inv = invert(needle_pose)
-                part, _ = self.needle_part(at, needle_inv)
+                if to_arc is None:
+                    to_arc = self.to_arc(needle_pose)
+                part, _ = self.needle_part(at, to_arc)
                 key = ("needle", part, n)
                 needle_per_body[n] = needle_per_body.get(n, 0.0) + f
             else:
@@ -281,7 +286,7 @@ class SutureObserver:
     def _where(self, key: tuple, phase: str, at, what, needle_pose: np.ndarray) -> dict:
         out = self.place(at, phase)
         if key[0] == "needle":
-            out["from_tip_m"] = self.needle_part(at, invert(needle_pose))[1]
+            out["from_tip_m"] = self.needle_part(at, self.to_arc(needle_pose))[1]
         elif what is not None:
             out["element"] = what
         return out

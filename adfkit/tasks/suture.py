@@ -38,7 +38,7 @@ from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError 
     GraspChoice,
     SutureError,
 )
-from .holes import hole_frame
+from .holes import ghost_box, hole_frame
 from .motions import Motions, interpolate, smooth
 from .needle import fit_needle, obj_vertices, wire_radius
 from .roles import body_roles
@@ -82,10 +82,8 @@ def _rot_z(a: float) -> np.ndarray:
 
 def _in_plane_room(ghost, direction) -> float:
     """How far from its centre a hole ghost reaches along ``direction`` (in its plane)."""
-    geo = getattr(ghost.ghost, "geometry", None)
-    if geo is None or geo.x is None or geo.y is None:
-        return 0.0
-    return min(geo.x, geo.y) / 2 * (ghost.ghost.scale or 1.0)
+    box = ghost_box(ghost)
+    return min(box[0], box[1]) / 2 if box is not None else 0.0
 
 
 def hole_ghosts(world) -> dict[int, dict]:
