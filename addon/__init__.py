@@ -8,18 +8,20 @@ from __future__ import annotations
 
 
 def register() -> None:
-    from . import operators, properties, tool_operators, ui
+    from . import holes, operators, properties, tool_operators, ui
 
     properties.register()
     operators.register()
     tool_operators.register()
+    holes.register()
     ui.register()
 
 
 def unregister() -> None:
-    from . import operators, properties, tool_operators, ui
+    from . import holes, operators, properties, tool_operators, ui
 
     ui.unregister()
+    holes.unregister()
     tool_operators.unregister()
     operators.unregister()
     properties.unregister()

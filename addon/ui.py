@@ -205,6 +205,7 @@ class ADF_PT_sidebar(bpy.types.Panel):
         box.prop(sc, "rope_mass")
         box.operator("adf.create_rope")
         lay.operator("adf.add_ghost")
+        lay.operator("adf.add_hole_pair")
         lay.operator("adf.add_volume")
         lay.operator_menu_enum("adf.add_joint", "joint_type")
         for line in sc.findings.splitlines()[:12]:

@@ -137,6 +137,7 @@ def suture_job(job: dict) -> dict:
         progress=False,
         every=job.get("every", 10),
         engine=job.get("engine", "pybullet"),
+        phantom=job.get("phantom"),
         not_tissue=tuple(job.get("not_tissue", ())),
     )
     return {
@@ -168,6 +169,7 @@ def suture_episodes(
     every: int = 10,
     kill_once: str | None = None,
     engine: str = "pybullet",
+    phantom=None,
     not_tissue=(),
 ) -> int:
     """`adfkit suture --episodes N --workers W`: exit 0 when every episode ran and passed every
@@ -187,6 +189,7 @@ def suture_episodes(
             "record": record,
             "every": every,
             "engine": engine,
+            "phantom": str(Path(phantom).resolve()) if phantom else None,
             "not_tissue": list(not_tissue),
         }
         for s in range(seed, seed + episodes)

@@ -34,6 +34,12 @@ def add_arguments(p) -> None:
         help="how many hole pairs (pairs 1..N), a list such as 2,3, or all (every pair of the phantom)",
     )
     p.add_argument(
+        "--phantom",
+        metavar="MODEL.yaml",
+        help="your phantom's model file (as the Blender add-on exports it, with Entry k / Exit k hole ghosts), "
+        "played in the bundled scene in place of its phantom, the arms, needle and cameras placed for its holes",
+    )
+    p.add_argument(
         "--not-tissue",
         action="append",
         default=[],
@@ -100,6 +106,15 @@ def run(args) -> int:
     if args.format and not args.record:
         raise AdfError(error("bad-option", "--format says how --record writes", None, "add --record"))
     record = (args.format or "dataset") if args.record else False
+    if args.phantom and args.scene:
+        raise AdfError(
+            error(
+                "bad-option",
+                "--phantom puts your phantom into the bundled scene; it does not go with a SCENE",
+                None,
+                "drop SCENE (adfkit suture --phantom MODEL.yaml), or play your whole scene (adfkit suture SCENE)",
+            )
+        )
     if args.scene:
         from .. import inputs
 
@@ -125,6 +140,24 @@ def run(args) -> int:
 
     diags: list = []
     load_scene(launch, parse_indices(indices) if indices else None, diags)
+    if args.phantom:
+        from .. import inputs
+        from ..scenes.suturing.own_phantom import load_phantom
+
+        phantom = Path(args.phantom)
+        inputs.check_path_text(phantom)
+        if not phantom.is_file():
+            raise AdfError(error("no-file", f"{phantom} does not exist", None, "give the phantom's model file"))
+        load_phantom(phantom, diags)
+        if launch != BUNDLED:
+            raise AdfError(
+                error(
+                    "no-scene",
+                    "--phantom needs the bundled scene (sample_scenes/suturing), which is not here",
+                    None,
+                    "run from a checkout of adfkit",
+                )
+            )
     if any(d.severity >= Severity.ERROR for d in diags):
         print_diagnostics(diags, sys.stderr)
         return 2
@@ -150,6 +183,7 @@ def run(args) -> int:
             record,
             args.every,
             engine=args.engine,
+            phantom=args.phantom,
             not_tissue=args.not_tissue,
         )
     from ..tasks.episode import run_episode
@@ -174,6 +208,7 @@ def run(args) -> int:
         progress=True,
         every=args.every,
         engine=args.engine,
+        phantom=args.phantom,
         not_tissue=args.not_tissue,
     )
     if m.get("failure", "").startswith("setup:") if m.get("failure") else False:
@@ -182,7 +217,9 @@ def run(args) -> int:
                 "suture-setup",
                 m["failure"].removeprefix("setup: "),
                 None,
-                "the scene needs a Needle, Entry k/Exit k hole ghosts and two PSMs",
+                "the phantom needs Entry k/Exit k hole ghosts (the add-on's hole helpers make them; docs/phantom.md)"
+                if args.phantom
+                else "the scene needs a Needle, Entry k/Exit k hole ghosts and two PSMs",
             )
         )
     for p in m["pairs"]:

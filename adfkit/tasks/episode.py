@@ -269,17 +269,28 @@ def run_episode(
     options=None,
     engine: str = "pybullet",
     render_process: bool = True,
+    phantom=None,
     not_tissue=(),
 ) -> dict:
     """Play one scripted suture of hole ``pairs`` (None: every whole pair of the scene) on the
     scene; returns the metrics (also written with the pictures to ``out`` when given).
-    ``not_tissue``: bodies the verdicts do not judge as tissue
+    ``phantom``: a phantom model file put into the scene in place of its phantom
+    (scenes/suturing/own_phantom.py); ``not_tissue``: bodies the verdicts do not judge as tissue
     (tasks/roles.py)."""
     from ..adf import load_scene, parse_indices
     from ..runner import Options, open_world
 
     diags: list = []
     scene = load_scene(Path(launch), parse_indices(indices) if isinstance(indices, str) else indices, diags)
+    placed = None
+    if phantom is not None:
+        from ..scenes.suturing.own_phantom import PhantomError, compose, load_phantom
+
+        try:
+            placed = compose(scene, load_phantom(Path(phantom), diags))
+        except PhantomError as exc:
+            return {"pairs": [], "all_passed": False, "failure": f"setup: {exc}", "seed": seed}
+        scene = placed.scene
     # many frames (the dataset, the GIF): the fastest renderer that works here (cameras.choose_renderer)
     options = options or Options(
         renderer="auto" if record or (gif and out is not None) else "tiny", solver_iterations=SOLVER_ITERATIONS
@@ -312,6 +323,13 @@ def run_episode(
                 "solver_iterations": options.solver_iterations if engine != "mujoco" else None,
             }
         )
+        if placed is not None:
+            metrics["phantom"] = {
+                "file": str(phantom),
+                "pairs": placed.pairs,
+                "placement": [[float(v) for v in row] for row in placed.placement],
+                "needle_bed_raised_m": placed.lift_m,
+            }
         if out is not None:
             metrics["files"] = write_outputs(Path(out), metrics, obs, task, frames)
             from ..adf import atomic_write_text

@@ -3,7 +3,7 @@ the phantom's boxes, the boundary capsules of Entry k and Exit k, their ghosts, 
 the planner drives the needle's tip along (with the wire's thickness). Side view in the
 needle's plane and top view.
 
-    python -m adfkit.tasks.hole_figure [LAUNCH] [--pair K] [--out docs/suture-hole.png]
+    python -m adfkit.tasks.hole_figure [LAUNCH] [--pair K] [--phantom MODEL.yaml] [--out docs/suture-hole.png]
 """
 
 from __future__ import annotations
@@ -16,15 +16,20 @@ from pathlib import Path
 import numpy as np
 
 
-def _boxes(body) -> list[tuple[np.ndarray, np.ndarray]]:
+def _box_corners(sb) -> list[np.ndarray]:
+    """The 8 corners (8, 3) of each box of a tissue body's collision, in the world."""
+    from ..model.semantics import ShapeKind, collision_primitives
+    from ..runner.rotations import pose_to_matrix
+
+    t = sb.world_matrix()
     out = []
-    for s in body.compound_collision_shape or []:
-        if (s.shape or "").lower() != "box" or s.geometry is None:
+    for p in collision_primitives(sb.body) or []:
+        if p.kind is not ShapeKind.BOX:
             continue
-        c = s.offset.position if s.offset is not None and s.offset.position is not None else None
-        c = np.array([c.x, c.y, c.z]) if c is not None else np.zeros(3)
-        h = np.array([s.geometry.x, s.geometry.y, s.geometry.z]) / 2
-        out.append((c - h, c + h))
+        g = p.geometry
+        h = np.array([g.x or 0.0, g.y or 0.0, g.z or 0.0]) / 2
+        c = np.array([[sx, sy, sz, 1.0] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * np.r_[h, 1.0]
+        out.append((c @ (t @ pose_to_matrix(p.pose)).T)[:, :3])
     return out
 
 
@@ -45,55 +50,85 @@ def _capsules(sb) -> list[tuple[np.ndarray, np.ndarray, float]]:
     return out
 
 
-def draw(launch: Path, pair: int, out: Path) -> None:
+def _hull(points: np.ndarray) -> np.ndarray:
+    from scipy.spatial import ConvexHull
+
+    return points[ConvexHull(points).vertices]
+
+
+def draw(launch: Path, pair: int, out: Path, phantom: Path | None = None) -> None:
+    """The figure of pair ``pair`` of the scene (with ``phantom`` in place of its phantom,
+    as `adfkit suture --phantom` plays it), in the pair's frame: x from entry to exit, z up."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Circle, Polygon, Rectangle
+    from matplotlib.patches import Circle, Polygon
 
     from ..adf import load_scene
     from ..runner import Options, open_world
-    from .holes import opening_half_extents
+    from ..runner.rotations import invert
+    from .holes import boundary_body, ghost_box, hole_frame, hole_label, opening_half_extents
     from .needle import wire_radius
     from .suture import SutureTask
 
-    world = open_world(load_scene(launch), Options(renderer="tiny"))
+    scene = load_scene(launch)
+    if phantom is not None:
+        from ..adf import read_file
+        from ..scenes.suturing.own_phantom import compose
+
+        scene = compose(scene, read_file(phantom, "model")[0]).scene
+    world = open_world(scene, Options(renderer="tiny", visuals=False))
     try:
         task = SutureTask(world, [pair], seed=0)
         p = task.pairs[0]
         b, psi_x, beyond, _, _ = task.arc_frame(p)
         wire = wire_radius(task)
+        e, x = hole_frame(world, p.entry)[:3, 3], hole_frame(world, p.exit)[:3, 3]
+        ax_x = x - e
+        ax_x[2] = 0.0
+        ax_x /= np.linalg.norm(ax_x)
+        f = np.eye(4)
+        f[:3, 0], f[:3, 1], f[:3, 2], f[:3, 3] = ax_x, np.cross([0.0, 0.0, 1.0], ax_x), [0.0, 0.0, 1.0], (e + x) / 2
+        inv = invert(f)
+
+        def local(pts):
+            return np.asarray(pts) @ inv[:3, :3].T + inv[:3, 3]
+
         psi = np.linspace(-task.approach, psi_x + beyond, 200)
         r = task.geom.radius
-        arc = np.array([(b @ np.r_[r * math.cos(a), r * math.sin(a), 0.0, 1.0])[:3] for a in psi])
-        y_k = world.ghost_pose(p.entry)[1, 3]
-        phantom = next(sb for sb in task.tissue() if "phantom" in (sb.body.name or "").lower())
-        boxes = _boxes(phantom.body)
-        holes = [(p.entry, "Entry"), (p.exit, "Exit")]
-        half = opening_half_extents(p.entry.parent.body)
+        arc = local([(b @ np.r_[r * math.cos(a), r * math.sin(a), 0.0, 1.0])[:3] for a in psi])
+        holes = {id(boundary_body(g) or g.parent) for g in (p.entry, p.exit)}
+        half = opening_half_extents(boundary_body(p.entry).body) if boundary_body(p.entry) else None
         fig, axes = plt.subplots(1, 2, figsize=(10, 4.4), dpi=80)
         side, top = axes
-        for lo, hi in boxes:
-            if lo[1] <= y_k <= hi[1]:
-                side.add_patch(Rectangle((lo[0], lo[2]), hi[0] - lo[0], hi[2] - lo[2], fc="#e8b4a8", ec="#a0544a"))
-            if hi[2] > 0.017:
-                top.add_patch(
-                    Rectangle((lo[0], lo[1]), hi[0] - lo[0], hi[1] - lo[1], fc="#e8b4a8", ec="#a0544a", alpha=0.8)
-                )
-        for g, _kind in holes:
-            for a, c, rad in _capsules(g.parent):
+        z_hole = float(local([e])[0, 2])
+        for sb in task.tissue():
+            if id(sb) in holes:
+                continue
+            for corners in _box_corners(sb):
+                c = local(corners)
+                if c[:, 1].min() <= 0.0 <= c[:, 1].max():
+                    side.add_patch(Polygon(_hull(c[:, [0, 2]]), fc="#e8b4a8", ec="#a0544a"))
+                if c[:, 2].max() > z_hole - 0.005:
+                    top.add_patch(Polygon(_hull(c[:, [0, 1]]), fc="#e8b4a8", ec="#a0544a", alpha=0.8))
+        for g in (p.entry, p.exit):
+            body = boundary_body(g)
+            for a, c, rad in _capsules(body) if body is not None else []:
+                a, c = local([a])[0], local([c])[0]
                 if abs(a[1] - c[1]) > 1e-6:  # across the needle's plane: a circle in the side view
                     side.add_patch(Circle((a[0], a[2]), rad, fc="#5a3030"))
                 else:
                     side.plot([a[0], c[0]], [a[2], c[2]], color="#5a3030", lw=1, ls="--")
                 top.plot([a[0], c[0]], [a[1], c[1]], color="#5a3030", lw=2.5, solid_capstyle="round")
             gp = world.ghost_pose(g)
-            geo = g.ghost.geometry
+            box = ghost_box(g)
+            if box is None:
+                continue
             corners = np.array(
-                [[sx * geo.x / 2, 0.0, sz * geo.z / 2, 1.0] for sx, sz in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+                [[sx * box[0] / 2, 0.0, sz * box[2] / 2, 1.0] for sx, sz in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
             )
-            w = corners @ gp.T
+            w = local((corners @ gp.T)[:, :3])
             side.add_patch(Polygon(w[:, [0, 2]], fc=(0.8, 0.04, 0.02, 0.45), ec="none"))
         side.plot(
             arc[:, 0],
@@ -105,23 +140,22 @@ def draw(launch: Path, pair: int, out: Path) -> None:
         )
         side.plot(arc[:, 0], arc[:, 2], color="white", lw=0.5)
         top.plot(arc[:, 0], arc[:, 1], color="#2060c0", lw=2)
-        side.set_xlim(-0.014, 0.014)
-        side.set_ylim(0.012, 0.034)
-        top.set_xlim(-0.014, 0.014)
-        top.set_ylim(y_k - 0.011, y_k + 0.011)
-        side.set_title(f"side view in the needle's plane (y = {y_k * 1000:.0f} mm)", fontsize=10)
-        top.set_title(
-            f"top view: pair {pair}, opening {2 * half[0] * 1000:.1f} x {2 * half[1] * 1000:.1f} mm", fontsize=10
-        )
-        for ax, lab in ((side, "z (m)"), (top, "y (m)")):
+        for ax in (side, top):
+            ax.set_xlim(-0.014, 0.014)
+        side.set_ylim(z_hole - 0.010, z_hole + 0.012)
+        top.set_ylim(-0.011, 0.011)
+        label = f"{hole_label(p.entry)} to {hole_label(p.exit)}"
+        side.set_title(f"side view in the needle's plane ({label})", fontsize=10)
+        opening = f", opening {2 * half[0] * 1000:.1f} x {2 * half[1] * 1000:.1f} mm" if half is not None else ""
+        top.set_title(f"top view: pair {pair}{opening}", fontsize=10)
+        for ax, lab in ((side, "up (m)"), (top, "across (m)")):
             ax.set_aspect("equal")
-            ax.set_xlabel("x (m)")
+            ax.set_xlabel("from entry to exit (m)")
             ax.set_ylabel(lab)
             ax.tick_params(labelsize=7)
         side.legend(loc="upper right", fontsize=8)
         fig.suptitle(
-            "collision shapes: phantom boxes (pink), boundary capsules (dark), ghosts (red), "
-            "the planned tip arc (blue)",
+            "collision shapes: tissue boxes (pink), boundary capsules (dark), ghosts (red), the planned tip arc (blue)",
             fontsize=9,
         )
         fig.tight_layout()
@@ -139,9 +173,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("launch", nargs="?", default=str(root / "sample_scenes" / "suturing" / "launch.yaml"))
     ap.add_argument("--pair", type=int, default=1)
+    ap.add_argument(
+        "--phantom", help="a phantom model file, in the scene in place of its phantom (adfkit suture --phantom)"
+    )
     ap.add_argument("--out", default="docs/suture-hole.png")
     a = ap.parse_args(argv)
-    draw(Path(a.launch), a.pair, Path(a.out))
+    draw(Path(a.launch), a.pair, Path(a.out), Path(a.phantom) if a.phantom else None)
     print(a.out)
     return 0
 

@@ -1,0 +1,285 @@
+"""A modeller's phantom in the bundled suturing scene (``adfkit suture --phantom MODEL.yaml``).
+
+The phantom file, as the Blender add-on exports it, holds the tissue bodies and, for each hole
+pair k, the hole ghosts Entry k and Exit k (any ghost whose name ends in "entry k" or "exit k",
+the add-on's ``ghostEntry1``), each on its hole body (the add-on's hole helpers frame the hole
+with four capsules; a hole without them is where its ghost is). It takes the place of the
+bundled phantom (its tissue bodies, hole bodies and hole ghosts); the needle, the thread, the
+stereo camera's frame and both PSMs stay, and are placed for the phantom's holes:
+
+- **The placement** is the rigid motion, about the vertical, that takes the bundled holes'
+  centre to the phantom's holes' centre (all its pairs) and the bundled pairs' direction from
+  entry to exit (world x) to the phantom's mean one. The PSMs' bases and the camera's frame go
+  with it, so that they stand to the phantom's holes as they stand to the bundled ones; the
+  needle and the thread too, moved along the line of holes to lie as far beyond its end as in
+  the bundled scene (24 mm past the pair at the end of the line).
+- **The needle's bed.** The needle lies, as in the bundled scene, across a slot (the jaws close
+  around the wire in it) of a static tray, ``SutureTray``, the thread on a strip of it; the
+  tray's top is where the bundled slab's is, 6 mm below the holes' centre, raised (with the
+  needle and the thread) where the phantom's tissue would fill the slot or stand above the wire
+  (a slab there: by the tray's depth, 4 mm). Laid flat on a slab instead, the planner found no
+  pick-up that kept the jaws off it and took a grasp that drove the wrist into the phantom at
+  the first insertion (2.9 kN); lifted without the strip, the falling thread drew the needle
+  1.3 mm aside as the scene settled, and the plan made there failed the same way. The tray is
+  tissue to the suture like any other body.
+
+Pure model work (numpy and the ADF model): the scene comes back as a Scene for the runner.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...model import Body, Friction, Geometry, ModelFile, Pose, Scene, ShapeEntry, Vec3
+from ...model.semantics import collision_primitives
+from ...runner.rotations import pose_to_matrix
+from . import layout as L
+from .frames import pose, rot_z, translation
+
+#: the bundled phantom's bodies the modeller's phantom replaces (the needle's file keeps the rest)
+BUNDLED_TISSUE = re.compile(r"^(Phantom|Entry\d+|Exit\d+)$")
+HOLE_NAME = re.compile(r"(entry|exit)\D*(\d+)\s*$", re.IGNORECASE)
+TRAY = "SutureTray"
+#: m: the tray's thickness, the depth of its slot: room for the jaws' fingers around the wire
+#: (the bundled slab's slot is 8 mm deep; a tray raised 8 mm onto a phantom's slab stood 2 mm
+#: above the holes, and the driver's wrist struck it at the first insertion)
+TRAY_DEPTH = 0.004
+TRAY_MARGIN = 0.003  # m the tray reaches beyond the needle and the thread lying on it
+NEEDLE_PARTS = re.compile(r"^(Needle|Thread(_\d+)?)$")
+
+
+class PhantomError(ValueError):
+    """The phantom file cannot go into the scene (no hole pairs, a needle of its own, ...)."""
+
+
+def _matrix(p: Pose | None) -> np.ndarray:
+    return pose_to_matrix(p) if p is not None else np.eye(4)
+
+
+def _has_capsules(body: Body) -> bool:
+    return any((s.shape or "").lower() == "capsule" for s in body.compound_collision_shape or [])
+
+
+@dataclass
+class Holes:
+    """The phantom's hole pairs: {k: {"entry": 4x4, "exit": 4x4}} in the world (the hole body's
+    frame where it is framed by capsules, else the ghost's), and the names."""
+
+    frames: dict[int, dict[str, np.ndarray]] = field(default_factory=dict)
+    names: dict[int, dict[str, str]] = field(default_factory=dict)
+
+    def pairs(self) -> list[int]:
+        return sorted(k for k, d in self.frames.items() if "entry" in d and "exit" in d)
+
+
+def phantom_holes(model: ModelFile) -> Holes:
+    """The hole ghosts of a phantom file, by pair, with where each hole is."""
+    bodies = {(b.identifier or "").split()[-1]: b for b in model.bodies}
+    out = Holes()
+    for g in model.ghost_objects:
+        m = HOLE_NAME.search(g.name or g.identifier or "")
+        if not m:
+            continue
+        k, kind = int(m.group(2)), m.group(1).lower()
+        parent = bodies.get((g.parent or "").split()[-1]) if g.parent else None
+        at = _matrix(parent.location) if parent is not None else np.eye(4)
+        if parent is not None and _has_capsules(parent):
+            frame, name = at, parent.name or parent.identifier
+        else:
+            frame, name = at @ _matrix(g.location), g.name or g.identifier
+        out.frames.setdefault(k, {})[kind] = frame
+        out.names.setdefault(k, {})[kind] = name
+    return out
+
+
+def _up() -> np.ndarray:
+    return np.array([0.0, 0.0, 1.0])
+
+
+def _centre_and_heading(frames: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, float]:
+    """The centre of the holes (entry, exit pairs) and the heading (rad about the vertical) of
+    their mean direction from entry to exit."""
+    pts = np.array([f[:3, 3] for pair in frames for f in pair])
+    d = sum(x[:3, 3] - e[:3, 3] for e, x in frames)
+    d = np.asarray(d, float) - np.dot(d, _up()) * _up()
+    if np.linalg.norm(d) < 1e-9:
+        raise PhantomError("the phantom's entry and exit holes lie on top of each other: no direction to suture in")
+    return pts.mean(axis=0), math.atan2(d[1], d[0])
+
+
+def bundled_holes() -> list[tuple[np.ndarray, np.ndarray]]:
+    return [L.hole_poses(k) for k in range(1, len(L.HOLE_YS) + 1)]
+
+
+def placement(holes: Holes) -> np.ndarray:
+    """The rigid motion (4x4, about the vertical) from the bundled holes to the phantom's."""
+    if not holes.pairs():
+        raise PhantomError("no hole pair: the phantom has no ghosts named Entry k and Exit k (ghostEntry1, ...)")
+    c_b, h_b = _centre_and_heading(bundled_holes())
+    c_u, h_u = _centre_and_heading([(holes.frames[k]["entry"], holes.frames[k]["exit"]) for k in holes.pairs()])
+    return translation(*c_u) @ rot_z(h_u - h_b) @ translation(*(-c_b))
+
+
+class _Placed:
+    """A body of a model file where the file puts it, as clearance.Tissue reads bodies."""
+
+    def __init__(self, body: Body, model: ModelFile) -> None:
+        self.body, self.model = body, model
+        self.name = body.name or body.identifier
+        self._t = _matrix(body.location)
+
+    def world_matrix(self) -> np.ndarray:
+        return self._t
+
+
+def tissue_top(model: ModelFile, points: np.ndarray, below: float = 0.03) -> np.ndarray:
+    """For each world point (N, 3), the height of the phantom's collision surface under it (the
+    first it meets looking down from ``below`` above the point); -inf where there is none within
+    2 * ``below``."""
+    from ...tasks.clearance import Tissue
+    from ...tasks.sweep import march
+
+    bodies = [_Placed(b, model) for b in model.bodies if collision_primitives(b) != [] and (b.mass or 0.0) == 0.0]
+    shapes = Tissue(bodies)
+    t = march(shapes, points + below * _up(), -_up(), far=2 * below)
+    return np.where(np.isfinite(t), points[:, 2] + below - t, -np.inf)
+
+
+def _wire(needle_start: np.ndarray) -> np.ndarray:
+    """Points along the needle's wire where it lies, in the bundled frame."""
+    return np.array([L.arc_point(needle_start, a) for a in np.linspace(L.NEEDLE_TIP_ANGLE, L.NEEDLE_TAIL_ANGLE, 12)])
+
+
+def _tray_boxes(wire: np.ndarray, thread: np.ndarray) -> tuple[list, list]:
+    """The tray's top as rectangles ((x0, y0), (x1, y1)), bundled frame: under the needle, with
+    the bundled slab's slot where the jaws close around the wire, and a strip under the thread;
+    and the slot's rectangle."""
+    lo, hi = wire[:, :2].min(axis=0) - TRAY_MARGIN, wire[:, :2].max(axis=0) + TRAY_MARGIN
+    lo[0] = min(lo[0], L.SLOT_X[0] - (L.SLOT_X[1] - L.SLOT_X[0]) / 2)  # the slot closed at both ends, as in the slab
+    gy = L.NEEDLE_GRASP_XY[1]
+    sx0, sx1 = L.SLOT_X
+    sy0, sy1 = gy - L.SLOT_HALF_Y, gy + L.SLOT_HALF_Y
+    out = [
+        ((lo[0], lo[1]), (hi[0], sy0)),
+        ((lo[0], sy1), (hi[0], hi[1])),
+        ((lo[0], sy0), (sx0, sy1)),
+        ((sx1, sy0), (hi[0], sy1)),
+    ]
+    if len(thread):
+        tlo, thi = thread[:, :2].min(axis=0) - TRAY_MARGIN, thread[:, :2].max(axis=0) + TRAY_MARGIN
+        out.append(((tlo[0], tlo[1]), (thi[0], min(thi[1], lo[1]))))
+    return [(a, b) for a, b in out if b[0] - a[0] > 1e-6 and b[1] - a[1] > 1e-6], [((sx0, sy0), (sx1, sy1))]
+
+
+def _tray(rects: list, top: float, t: np.ndarray) -> Body:
+    """The static tray (rectangles of the bundled frame, TRAY_DEPTH deep under ``top``), placed by t."""
+    parts = [
+        ShapeEntry(
+            shape="Box",
+            geometry=Geometry(x=x1 - x0, y=y1 - y0, z=TRAY_DEPTH),
+            offset=Pose(Vec3((x0 + x1) / 2, (y0 + y1) / 2, top - TRAY_DEPTH / 2)),
+        )
+        for (x0, y0), (x1, y1) in rects
+    ]
+    return Body(
+        identifier=f"BODY {TRAY}",
+        name=TRAY,
+        mass=0.0,
+        location=pose(t),
+        compound_collision_shape=parts,
+        collision_margin=0.0001,
+        friction=Friction(static=0.8, rolling=0.01),
+        restitution=0.0,
+        passive=False,
+    )
+
+
+@dataclass
+class Composed:
+    scene: Scene
+    placement: np.ndarray  # the bundled frame -> the phantom's
+    lift_m: float  # how far the needle's bed was raised onto the phantom's tissue
+    pairs: list[int]
+    names: dict[int, dict[str, str]]
+
+
+def _moved(body: Body, t: np.ndarray) -> None:
+    body.location = pose(t @ _matrix(body.location))
+
+
+def compose(bundled: Scene, phantom: ModelFile) -> Composed:
+    """The bundled scene with ``phantom`` in place of its phantom, the rest placed for its holes
+    (the module docstring)."""
+    holes = phantom_holes(phantom)
+    own = [b.name or b.identifier for b in phantom.bodies if NEEDLE_PARTS.match(b.name or "")]
+    if own:
+        raise PhantomError(
+            f"the phantom file has its own {own[0]}: --phantom puts a phantom beside the bundled needle "
+            "and thread; export the phantom's bodies alone, or play your whole scene (adfkit suture SCENE)"
+        )
+    if not holes.pairs():
+        lone = {k: d for k, d in holes.frames.items() if len(d) == 1}
+        raise PhantomError(
+            "no hole pair: the phantom has no ghosts named Entry k and Exit k (ghostEntry1, ghostExit1, ...)"
+            + (f"; pair {min(lone)} has only its {next(iter(lone[min(lone)]))} hole" if lone else "")
+        )
+    t = placement(holes)
+    scene = copy.deepcopy(bundled)
+    needle_file = None
+    models = []
+    for m in scene.models:
+        names = {b.name for b in m.bodies}
+        if "Needle" in names:
+            needle_file = m
+            m.bodies = [b for b in m.bodies if not BUNDLED_TISSUE.match(b.name or "")]
+        elif m.ghost_objects and all(HOLE_NAME.search(g.name or "") for g in m.ghost_objects) and not m.bodies:
+            continue  # the bundled hole ghosts go with the bundled holes
+        models.append(m)
+    if needle_file is None:
+        raise PhantomError("the bundled scene has no needle to put beside the phantom")
+    # the needle and the thread lie as far beyond the end of the line of holes as they do in the
+    # bundled scene (24 mm past pair 1, along the line): placed from the pairs' centre (60 mm),
+    # a short line left them far from its end pair, and the driver's grasp, chosen to reach both,
+    # came down onto the needle's bed (the planner found no grasp off it: -0.3 mm; 178 N held)
+    ends = [(np.linalg.inv(t) @ ((f["entry"] + f["exit"]) / 2)[:, 3])[1] for f in holes.frames.values() if len(f) == 2]
+    needle_t = t @ translation(0.0, max(ends) - max(L.HOLE_YS), 0.0)
+    for m in models:
+        for b in m.bodies:
+            _moved(b, needle_t if m is needle_file and NEEDLE_PARTS.match(b.name or "") else t)
+    # the needle's bed (the module docstring)
+    wire = _wire(L.needle_start())
+    needle_bodies = next(m for m in bundled.models if any(x.name == "Needle" for x in m.bodies)).bodies
+    thread = np.array([_matrix(b.location)[:3, 3] for b in needle_bodies if (b.name or "").startswith("Thread")])
+    rects, slot = _tray_boxes(wire, thread.reshape(-1, 3))
+    bed = L.SLAB[2]
+    (sx0, sy0), (sx1, sy1) = slot[0]
+    grid = [(x, y, bed - TRAY_DEPTH) for x in np.linspace(sx0, sx1, 9) for y in np.linspace(sy0, sy1, 5)]
+    under = np.array(grid + [(p[0], p[1], bed) for p in wire])
+    placed = np.c_[under, np.ones(len(under))] @ needle_t.T
+    top = tissue_top(phantom, placed[:, :3])
+    lift = max(0.0, float(np.max(top - placed[:, 2]))) if np.isfinite(top).any() else 0.0
+    if lift > 0:
+        up = translation(0.0, 0.0, lift)
+        for b in needle_file.bodies:
+            if NEEDLE_PARTS.match(b.name or ""):
+                _moved(b, up)
+    needle_file.bodies.append(_tray(rects, bed, translation(0.0, 0.0, lift) @ needle_t))
+    models.append(phantom)
+    scene.models = models
+    pairs = holes.pairs()
+    return Composed(scene, t, lift, pairs, holes.names)
+
+
+def load_phantom(path: Path, diagnostics: list) -> ModelFile:
+    """The phantom model file, read through the input policy (a file named on the command line)."""
+    from ...adf import read_file
+
+    doc, found = read_file(path, "model")
+    diagnostics.extend(found)
+    return doc

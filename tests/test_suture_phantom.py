@@ -1,0 +1,147 @@
+"""`adfkit suture --phantom MODEL.yaml` (adfkit/scenes/suturing/own_phantom.py): a phantom in a
+model file of its own put into the bundled scene in place of its phantom, the arms, the needle
+and the camera placed for its holes. Fast: the composed scene, its placement and the check
+before the run; what a file it cannot use says. Slow: a generated family of good phantoms
+(pairs 8-14 mm apart, 3 and 5 pairs, turned, slanted, thicker) passes every pair."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pytest
+from suture_phantoms import BUNDLED, phantom_file
+
+from adfkit.adf import load_scene, read_file, write_file
+from adfkit.scenes.suturing import layout as L
+from adfkit.scenes.suturing.own_phantom import TRAY_DEPTH, PhantomError, compose, phantom_holes
+
+
+def _compose(path):
+    return compose(load_scene(BUNDLED / "launch.yaml"), read_file(path, "model")[0])
+
+
+def test_the_arms_needle_and_camera_stand_to_the_phantoms_holes_as_to_the_bundled_ones(tmp_path):
+    """A phantom turned 30 degrees and moved 20 mm, 3 mm thicker: the placement is the same turn
+    and move; the PSMs' bases, the camera's frame and the needle go with it; the needle's tray
+    rests on the phantom's slab, its slot free; the bundled phantom, its holes and its ghosts are
+    gone, the needle's file keeps the needle, the thread and the camera frame."""
+    path = phantom_file(tmp_path, pairs=3, spacing=0.010, turn_deg=30.0, at=(0.02, -0.01), thicker=0.003)
+    c = _compose(path)
+    assert c.pairs == [1, 2, 3]
+    turn = c.placement[:3, :3]
+    assert math.degrees(math.atan2(turn[1, 0], turn[0, 0])) == pytest.approx(30.0, abs=1e-6)
+    # the holes' centre: (0, 0) of the phantom, 25 mm up; the bundled one: (0, 0, 22 mm)
+    assert (c.placement @ [0.0, 0.0, L.RIDGE_TOP, 1.0])[:3] == pytest.approx([0.02, -0.01, L.RIDGE_TOP + 0.003])
+    names = {b.name for m in c.scene.models for b in m.bodies}
+    assert {"Needle", "Thread_039", "CameraFrame", "SutureTray", "Phantom", "Entry3"} <= names
+    assert "Entry4" not in names and sum(b.name == "Phantom" for m in c.scene.models for b in m.bodies) == 1
+    ghosts = sorted(g.name for m in c.scene.models for g in m.ghost_objects if "ghostE" in g.name)
+    assert ghosts == sorted(f"ghost{k}{i}" for k in ("Entry", "Exit") for i in (1, 2, 3))
+    base = next(b for m in c.scene.models for b in m.bodies if m.namespace and "psm1" in m.namespace)
+    bundled = next(b for m in load_scene(BUNDLED / "launch.yaml").models for b in m.bodies if b.name == base.name)
+    from adfkit.runner.rotations import pose_to_matrix
+
+    assert pose_to_matrix(base.location) == pytest.approx(c.placement @ pose_to_matrix(bundled.location), abs=1e-9)
+    # the slab's top stands 6 mm below the holes, where the tray's top is: the tray is raised
+    # its depth to rest on the slab, its slot free; the needle with it
+    assert c.lift_m == pytest.approx(TRAY_DEPTH, abs=1e-4)
+
+
+def test_the_swept_arc_is_clear_on_a_good_phantom_and_says_what_blocks_a_bad_one(tmp_path):
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.needle import wire_radius
+    from adfkit.tasks.suture import SutureTask
+    from adfkit.tasks.sweep import check
+
+    for raised, expect in ((0.0, {}), (0.004, None)):
+        path = phantom_file(tmp_path / f"t{raised}", pairs=3, spacing=0.012, turn_deg=20.0, thicker=0.003)
+        if raised:  # the holes 4 mm above the ridge's top
+            doc, _ = read_file(path, "model")
+            for b in doc.bodies:
+                if b.name.startswith(("Entry", "Exit")):
+                    p = b.location.position
+                    b.location = type(b.location)(type(p)(p.x, p.y, p.z + 0.004), b.location.orientation)
+            write_file(doc, path)
+        c = _compose(path)
+        world = open_world(c.scene, Options(renderer="tiny", visuals=False))
+        try:
+            task = SutureTask(world, c.pairs, seed=0)
+            got = check(task, wire_radius(task))
+        finally:
+            world.close()
+        if expect is not None:
+            assert got == expect
+        else:
+            assert set(got) == {1, 2, 3} and got[2].startswith("the tissue's surface is 4.0 mm below Entry2 and Exit2")
+
+
+def test_holes_are_found_by_their_ghosts_names_and_bodies(tmp_path):
+    doc, _ = read_file(phantom_file(tmp_path, pairs=5, spacing=0.014), "model")
+    h = phantom_holes(doc)
+    assert h.pairs() == [1, 2, 3, 4, 5] and h.names[5] == {"entry": "Entry5", "exit": "Exit5"}
+    ys = [h.frames[k]["entry"][1, 3] for k in h.pairs()]
+    assert np.diff(ys) == pytest.approx([-0.014] * 4)
+
+
+def test_a_file_it_cannot_use_is_told_why(tmp_path, capsys):
+    from adfkit.cli import main
+
+    path = phantom_file(tmp_path / "a", pairs=2)
+    doc, _ = read_file(path, "model")
+    doc.ghost_objects = [g for g in doc.ghost_objects if g.name != "ghostExit1" and g.name != "ghostExit2"]
+    write_file(doc, path)
+    with pytest.raises(PhantomError, match=r"no hole pair: .* pair 1 has only its entry hole"):
+        _compose(path)
+    assert main(["suture", "--phantom", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert "no hole pair" in capsys.readouterr().err
+    whole = BUNDLED / "phantom" / "phantom.yaml"  # the bundled phantom file holds the needle too
+    with pytest.raises(PhantomError, match="the phantom file has its own Needle"):
+        _compose(whole)
+    assert main(["suture", str(BUNDLED / "launch.yaml"), "--phantom", str(path)]) == 2
+    assert main(["suture", "--phantom", str(tmp_path / "none.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert "--phantom puts your phantom into the bundled scene" in err and "none.yaml does not exist" in err
+
+
+# ---- the good family, played (slow) ----------------------------------------------------------
+FAMILY = {
+    "3 pairs 8 mm apart": dict(pairs=3, spacing=0.008),
+    "5 pairs 14 mm apart": dict(pairs=5, spacing=0.014),
+    "turned 30 degrees, moved": dict(pairs=4, spacing=0.011, turn_deg=30.0, at=(0.02, -0.01)),
+    "line slanted 30 degrees": dict(pairs=3, spacing=0.010, line_deg=30.0),
+    "3 mm thicker": dict(pairs=3, spacing=0.012, thicker=0.003),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(FAMILY))
+def test_a_good_phantom_passes_every_pair(tmp_path, name):
+    from adfkit.tasks.episode import run_episode
+
+    path = phantom_file(tmp_path, **FAMILY[name])
+    m = run_episode(BUNDLED / "launch.yaml", pairs=None, seed=0, progress=False, gif=False, phantom=path)
+    assert m["failure"] is None and m["all_passed"], [(p["pair"], p["rule"], p["reason"]) for p in m["pairs"]]
+    assert len(m["pairs"]) == FAMILY[name]["pairs"] and m["swept_arc_check"] == {}
+
+
+def test_a_pair_out_of_the_arms_reach_is_named_with_how_far(tmp_path):
+    """Two pairs 170 mm apart: the arms, placed for their centre, reach neither; the plan says
+    which hole, which joint and by how much, before anything moves."""
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.suture import SutureError, SutureTask
+
+    c = _compose(phantom_file(tmp_path, pairs=2, spacing=0.17))
+    world = open_world(c.scene, Options(renderer="tiny", visuals=False))
+    try:
+        task = SutureTask(world, c.pairs, seed=0)
+        with pytest.raises(SutureError) as exc:
+            task.plan()
+        msg = str(exc.value)
+        assert "no grasp of the needle reachable along the whole plan (pair 1, driving); the nearest needs " in msg
+        assert re.search(
+            r"'s outer_\w+ \d+\.\d(°| mm) past its limit with the needle's tip \d+\.\d mm from (Entry|Exit)1", msg
+        )
+    finally:
+        world.close()
