@@ -31,10 +31,11 @@ TOOL_HIT_N: float | None = 50.0
 #: Good runs press with a few newtons (the needle lying on the tissue, picked up and carried
 #: over it; brushing a hole's boundary), forced ones with hundreds (docs/suture.md has both)
 FORCED_N = 40.0
-#: N: the same for the thread. Drawn through the holes by the puller, its tension presses it on
-#: their boundaries and the phantom's edges: up to 8 N held in PyBullet, up to 127 N in MuJoCo's
-#: rigid contacts on a good run (docs/suture.md has the figures); caught on the tissue, hundreds
-THREAD_FORCED_N = 300.0
+#: N: the same for the thread. Drawn through the holes by the puller and dragged over them in
+#: the hand-back, its tension presses it on their boundaries and the phantom's edges: up to 12 N
+#: held in PyBullet, up to 322 N in MuJoCo's rigid contacts on good runs (docs/suture.md has the
+#: figures; 300 N failed a good MuJoCo seed); a thread caught on the tissue holds more
+THREAD_FORCED_N = 1000.0
 #: m along the needle's arc from a hole within which a block is the hole's (blocked-at-entry,
 #: blocked-at-exit); farther in, it is the channel's
 AT_HOLE = 0.002
