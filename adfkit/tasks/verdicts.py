@@ -52,7 +52,7 @@ RULES = (
     "pressed-on-tissue",
     "tool-hit-tissue",
     "reach",
-    "blocked-at-entry",
+    # blocked-at-entry again, without forcing: the tip stopped at the entry (_blocked_reason)
     "entry-missed",
     "entry-outside-opening",
     "entry-not-tip-first",
