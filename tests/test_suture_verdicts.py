@@ -211,6 +211,19 @@ def test_the_needle_or_thread_forced_on_the_tissue_fails_where_it_was_forced():
         "blocked at ghostEntry1 (the tip 0.4 mm past it): the needle's body (8.6 mm from its tip) pressed on "
         "Phantom with up to 300 N held over 20 ms (peak 500 N) 8.6 mm beside its arc from t = 6.00 s"
     )
+    # thrown beside the arc, tip and all, in the insertion before the tip went in through the
+    # entry's opening: the entry blocked it; the same after the tip went in is judged at its point
+    thrown = dict(arc, off_arc_m=0.009, past_entry_m=-0.0025)
+    thrown["tip"] = {"pair": 1, "past_entry_m": -0.0013, "before_exit_m": 0.0126, "off_arc_m": 0.0101}
+    obs.needle_events = [_pressed(**thrown)]
+    assert pair_verdict(obs, pair)["rule"] == "pressed-on-tissue"  # went in at 5.0 s, pressed at 6.0 s
+    not_in, _ = _record(None, None)
+    not_in.needle_events = [_pressed(**thrown)]
+    v = pair_verdict(not_in, pair)
+    assert v["rule"] == "blocked-at-entry" and v["reason"].startswith(
+        "blocked at ghostEntry1 (the tip 1.3 mm before it, 10.1 mm beside the needle's arc): the needle's body "
+        "(8.6 mm from its tip) pressed on Phantom with up to 300 N held over 20 ms (peak 500 N) from t = 6.00 s in insert 1"
+    )
     # off the arc, while carried: pressed on the tissue, at a point
     obs.needle_events = [_pressed(phase="carry 1", **dict(arc, off_arc_m=0.02))]
     v = pair_verdict(obs, pair)

@@ -170,10 +170,13 @@ def _who(ev: dict, where: dict) -> str:
     return f"the needle's {ev['part']}"
 
 
-def _static_note(obs, k: int) -> str:
-    """What the check of the needle's swept arc before the episode found at pair k, if anything."""
-    found = getattr(obs.task, "sweep", {}).get(k)
-    return f"; before the run: {found}" if found else ""
+def _static_note(obs, k: int, said: str = "") -> str:
+    """What the check of the needle's swept arc before the episode found at pair k, if anything,
+    less a hole's opening narrower than the wire that the reason ``said`` already."""
+    found = getattr(obs.task, "sweep", {}).get(k) or ""
+    narrow = "narrower than the needle's wire"
+    notes = [n for n in found.split("; ") if n and not (narrow in n and narrow in said and n.split("'s")[0] in said)]
+    return f"; before the run: {'; '.join(notes)}" if notes else ""
 
 
 def _pressing(ev: dict, on: str = "") -> str:
@@ -207,14 +210,28 @@ def _forced(obs, k: int, first: bool, entry, exit_) -> tuple[float, str, str] | 
         # pressed beside its arc while the tip was on it: the needle was pushed aside, where its tip was
         pushed = f" {_mm(off)} beside its arc" if off is not None else ""
         past, before, on_arc = tip["past_entry_m"], tip["before_exit_m"], True
-    e_l, x_l = _label(entry), _label(exit_)
-    then = f"{pushed} from t = {w['t']:.2f} s in {phase}"
     more = {}
     for e in evs[1:]:  # the other bodies and parts it was forced on, the strongest of each
         key = (e["tissue"], e["part"])
         if key != (body, ev["part"]) and (key not in more or e["sustained_force_n"] > more[key]["sustained_force_n"]):
             more[key] = e
     also = "".join(f"; {_pressing(e)}" for e in sorted(more.values(), key=lambda e: -e["sustained_force_n"])[:3])
+    e_l, x_l = _label(entry), _label(exit_)
+    in_through = [c["t"] for c in entry.crossings if c["inward"] and c["outside_opening_m"] <= 0.0]
+    if not on_arc and phase == f"insert {k}" and not (in_through and in_through[0] <= w["t"]):
+        # forced while driven into entry k before the tip went in through its opening, the needle
+        # thrown beside its arc by what stopped it: the entry blocked it, wherever it was pushed
+        at_tip = tip.get("past_entry_m")
+        pushed = (
+            f" (the tip {_mm(abs(at_tip))} {'before' if at_tip < 0 else 'past'} it, "
+            f"{_mm(tip['off_arc_m'])} beside the needle's arc)"
+            if at_tip is not None and tip.get("off_arc_m") is not None
+            else ""
+        )
+        narrow = _narrower_than_wire(obs, entry)
+        reason = f"blocked at {e_l}{pushed}: {_pressing(ev)} from t = {w['t']:.2f} s in {phase}{also}"
+        return w["t"], "blocked-at-entry", reason + (f"; {narrow}" if narrow else "")
+    then = f"{pushed} from t = {w['t']:.2f} s in {phase}"
     if on_arc and driven:
         for rule, hole, d, ahead in (
             ("blocked-at-entry", entry, past, "past"),
@@ -288,7 +305,7 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
             through = [c for c in crossings if c["outside_opening_m"] <= 0.0]
             out[key] = through[0]["t"] if through else None
         if rule != "tool-hit-tissue":
-            reason += _static_note(obs, k)
+            reason += _static_note(obs, k, reason)
         return rule, reason + (f"; then the planner stopped: {failure}" if failed_here else "")
     if not ins:
         approach = f"carry {k}"
@@ -303,7 +320,7 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         if failed_here and not (failure_phase or "").startswith(("insert", "regrasp")):
             return "reach", failure
         rule, reason = _blocked_reason(obs, k, entry)
-        return rule, reason + _static_note(obs, k)
+        return rule, reason + _static_note(obs, k, reason)
     c_in = ins[0]
     if c_in["outside_opening_m"] > 0 and obs.needle_contacts.get(f"insert {k}"):
         # deflected by the tissue: the tip crossed the hole's plane beside the opening, not through it
