@@ -202,6 +202,23 @@ def split_objects(path: Path, folder: Path) -> list[Path]:
     return out
 
 
+def concave_parts(model, body, cmesh: Path, folder: Path, losses: list[Loss]) -> list[Path] | None:
+    """The convex parts a moving body's concave collision mesh ``cmesh`` collides as in the
+    engines (``geometry.concave``: the runner's decision), one mesh file each in ``folder``, with
+    a ``concave collision mesh`` loss; None where its hull per sub-mesh stands in."""
+    from ..geometry.concave import body_parts
+    from ..geometry.decompose import write_hull_files
+
+    stand_in = body_parts(model, body)
+    if stand_in is None:
+        return None
+    folder.mkdir(parents=True, exist_ok=True)
+    losses.append(
+        Loss(body.identifier, "concave collision mesh", f"{stand_in.describe()} (AMBF collides the mesh itself)")
+    )
+    return write_hull_files(stand_in.hulls, folder, f"{cmesh.stem.replace(' ', '_')}_convex")
+
+
 def _is_flat(mesh) -> bool:
     """True when the mesh spans (almost) no volume: all its vertices on one plane."""
     import numpy as np

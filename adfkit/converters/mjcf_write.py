@@ -34,7 +34,7 @@ from ..model.semantics import (
 )
 from ..model.tree import Link, build_tree, joint_ends, motion
 from . import inertia as inertia_math
-from .engine_fit import MeshFiles, flat_box, joint_range, split_objects, usable_scales
+from .engine_fit import MeshFiles, concave_parts, flat_box, joint_range, split_objects, usable_scales
 from .losses import Loss
 from .mjcf_cameras import write_cameras_lights
 from .mjcf_soft import write_soft_bodies
@@ -304,8 +304,10 @@ def _write_geoms(
             )
         elif cmesh is not None:
             # an OBJ of several objects (a convex decomposition) collides as one hull per object,
-            # as in PyBullet, not as the hull of them all (a curved needle's would fill its arc)
-            parts = split_objects(cmesh, assets.files.folder)
+            # as in PyBullet, not as the hull of them all (a curved needle's would fill its arc);
+            # a moving concave mesh whose hull is a poor stand-in, as its convex parts (geometry.concave)
+            stand_in = concave_parts(model, body, cmesh, assets.files.folder, losses)
+            parts = stand_in or split_objects(cmesh, assets.files.folder)
             for n, part in enumerate(parts):
                 g = ET.SubElement(
                     el,
@@ -316,14 +318,15 @@ def _write_geoms(
                     group="3",
                 )
                 _place(g, to_link)
-            losses.append(
-                Loss(
-                    who,
-                    "collision mesh",
-                    "MuJoCo collides with the convex hull of a mesh"
-                    + (f" (here of each of its {len(parts)} objects)" if len(parts) > 1 else ""),
+            if not stand_in:
+                losses.append(
+                    Loss(
+                        who,
+                        "collision mesh",
+                        "MuJoCo collides with the convex hull of a mesh"
+                        + (f" (here of each of its {len(parts)} objects)" if len(parts) > 1 else ""),
+                    )
                 )
-            )
     else:
         for n, p in enumerate(prims):
             pose = p.pose

@@ -26,7 +26,7 @@ from ..model.semantics import (
 )
 from ..model.tree import Link, build_tree
 from . import inertia as inertia_math
-from .engine_fit import MeshFiles, joint_range, usable_scales
+from .engine_fit import MeshFiles, concave_parts, joint_range, usable_scales
 from .losses import Loss
 from .safexml import to_text
 from .urdf_volumes import write_urdf_volumes
@@ -152,10 +152,11 @@ def _write_link(
         cmesh = collision_mesh_path(model, body)
         if cmesh is not None:
             cmesh = files.fit(cmesh, who, losses)[0]
-        if cmesh is not None:
-            _mesh_element(el, "collision", to_link, cmesh, scale, out_dir)
-            if body.collision_mesh_type is not None:
-                losses.append(Loss(who, "collision mesh type", "URDF has none; PyBullet uses the convex hull"))
+        stand_in = concave_parts(model, body, cmesh, files.folder, losses) if cmesh is not None else None
+        for part in stand_in or ([cmesh] if cmesh is not None else []):
+            _mesh_element(el, "collision", to_link, part, scale, out_dir)
+        if cmesh is not None and not stand_in and body.collision_mesh_type is not None:
+            losses.append(Loss(who, "collision mesh type", "URDF has none; PyBullet uses the convex hull"))
     else:
         for prim in prims:
             parts = _primitive_geometry(prim.kind, prim.geometry, el)

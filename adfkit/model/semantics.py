@@ -237,6 +237,14 @@ def collision_primitives(body) -> list[Primitive] | None:
     return None
 
 
+def concave_mesh(body) -> bool:
+    """The body collides with a mesh AMBF keeps concave (a triangle mesh: `collision mesh type`
+    CONCAVE_MESH, its default), which an engine may take the convex hull of."""
+    return collision_primitives(body) is None and collision_mesh_type(body.collision_mesh_type)[0] is (
+        CollisionMeshType.CONCAVE_MESH
+    )
+
+
 def normalized_or(v: Vec3 | None, fallback: Vec3) -> Vec3:
     if v is None:
         return fallback

@@ -1,17 +1,12 @@
 """What collides with what, the same way in every engine: AMBF's collision groups as bit masks
-(and the floors they let bodies through), and the bodies whose concave mesh an engine takes
-the convex hull of where that hull starts inside another body."""
+(and the floors they let bodies through), the moving concave meshes played as convex parts
+(``geometry.concave``), and the bodies whose concave mesh an engine takes the convex hull of
+where that hull starts inside another body."""
 
 from __future__ import annotations
 
-from ..diagnostics import warning
-from ..model.semantics import (
-    CollisionMeshType,
-    ShapeKind,
-    collision_mesh_type,
-    collision_primitives,
-    effective_mass,
-)
+from ..diagnostics import info, warning
+from ..model.semantics import ShapeKind, collision_primitives, concave_mesh, effective_mass
 from .plan import ALL_GROUPS, mesh_key
 
 GROUP_BITS = 31
@@ -48,16 +43,41 @@ def collision_masks(world, bodies) -> dict[int, int]:
     return out
 
 
+def convex_stand_in(model, body, diagnostics: list):
+    """The convex parts a moving body's concave collision mesh is played as in every engine
+    (``geometry.concave.body_parts``), said as ``runner-convex-parts`` at the mesh; None where
+    its hull per sub-mesh stands in (or the body is static, primitive, not concave)."""
+    from ..geometry.concave import body_parts
+
+    parts = body_parts(model, body)
+    if parts is not None:
+        convex_parts_note(diagnostics, body, parts.describe())
+    return parts
+
+
+def convex_parts_note(diagnostics: list, body, what: str) -> None:
+    """The located ``runner-convex-parts`` note (``what``: ConvexParts.describe)."""
+    diagnostics.append(
+        info(
+            "runner-convex-parts",
+            f"{body.identifier}: its concave collision mesh {what}, standing in for the triangles AMBF collides",
+            mesh_key(body),
+            "to choose the parts, decompose the mesh yourself (adfkit decompose) and give `collision mesh type: "
+            "CONVEX_HULL`",
+        )
+    )
+
+
+def one_hull(sb) -> bool:
+    """The engine body ``sb`` collides its concave mesh as the hull of each sub-mesh: not a
+    moving mesh played as convex parts (``convex_stand_in``; its decision is remembered)."""
+    from ..geometry.concave import body_parts
+
+    return concave_mesh(sb.body) and body_parts(sb.model, sb.body) is None
+
+
 #: deeper than this at the start, two bodies' shapes overlap (not a body resting on another)
 HULL_OVERLAP = 0.002  # m
-
-
-def concave_mesh(body) -> bool:
-    """The body collides with a mesh AMBF keeps concave (a triangle mesh: `collision mesh type`
-    CONCAVE_MESH, its default), which an engine may take the convex hull of."""
-    return collision_primitives(body) is None and collision_mesh_type(body.collision_mesh_type)[0] is (
-        CollisionMeshType.CONCAVE_MESH
-    )
 
 
 def hull_overlaps(world, pairs: dict, engine: str) -> None:

@@ -11,7 +11,7 @@ import numpy as np
 
 from ...model.semantics import JointKind, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
-from ..collisions import HULL_OVERLAP, concave_mesh, hull_overlaps
+from ..collisions import HULL_OVERLAP, hull_overlaps, one_hull
 from ..plan import ALL_GROUPS
 from ..rotations import pose_to_matrix
 from .build import build_plan
@@ -203,7 +203,7 @@ class Assembly:
             a, b = (by_id.get(int(m.geom_bodyid[x])) for x in g)
             if a is None or b is None:
                 continue
-            mesh = [m.geom_type[x] == mujoco.mjtGeom.mjGEOM_MESH and concave_mesh(s.body) for x, s in zip(g, (a, b))]
+            mesh = [m.geom_type[x] == mujoco.mjtGeom.mjGEOM_MESH and one_hull(s) for x, s in zip(g, (a, b))]
             if not any(mesh):
                 continue
             hull, other = (a, b) if mesh[0] and (not mesh[1] or b.static) else (b, a)

@@ -8,7 +8,7 @@ from __future__ import annotations
 from ...converters.urdf import _material
 from ...diagnostics import warning
 from ...model.semantics import ShapeKind
-from ..collisions import collision_masks
+from ..collisions import collision_masks, convex_parts_note
 
 EXCLUDE_SPARE = 512  # run-time excluded pairs (MujocoWorld.set_collision); the suture turns off ~300
 _SHAPE_FEATURES = {f"collision {k.value}" for k in ShapeKind}
@@ -22,6 +22,8 @@ def warn_losses(world, m, losses) -> None:
             world._warn("runner-flat-mesh", f"{loss.element}: {loss.reason}", m.body(loss.element))
         elif loss.feature == "mesh" and "is not read by" in loss.reason:  # PLY, 3DS: converted or left out
             world._warn("runner-mesh-format", f"{loss.element}: {loss.reason}", m.body(loss.element))
+        elif loss.feature == "concave collision mesh":  # the same parts as the PyBullet runner's, said alike
+            convex_parts_note(world.diagnostics, m.body(loss.element), loss.reason.split(" (AMBF")[0])
         elif loss.feature in _SHAPE_FEATURES:
             _shape_left_out(world, m, loss)
         elif loss.feature == "mass" and "PLANE" in loss.reason:  # as the PyBullet runner's runner-plane

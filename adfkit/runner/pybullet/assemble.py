@@ -12,7 +12,7 @@ import pybullet as pb
 
 from ...model.semantics import JointKind, joint_frames, joint_kind, pose_or_identity
 from ..cameras import build_cameras
-from ..collisions import HULL_OVERLAP, collision_masks, concave_mesh, hull_overlaps
+from ..collisions import HULL_OVERLAP, collision_masks, hull_overlaps, one_hull
 from ..names import Registry, merge_namespace
 from ..plan import (
     ALL_GROUPS,
@@ -310,8 +310,8 @@ class Assembly:
 
 
 def _hulled(sb) -> bool:
-    """PyBullet collides the body's concave mesh as convex hulls (a dynamic body; a static one is
-    its exact triangles unless beside soft bodies: shapes.py)."""
+    """PyBullet collides the body's concave mesh as convex hulls (a dynamic body not played as
+    convex parts; a static one is its exact triangles unless beside soft bodies: shapes.py)."""
     parts = sb._parts
     exact = parts is not None and any(kw.get("flags") == pb.GEOM_FORCE_CONCAVE_TRIMESH for kw in parts.kwargs)
-    return parts is not None and bool(parts.types) and not exact and concave_mesh(sb.body)
+    return parts is not None and bool(parts.types) and not exact and one_hull(sb)

@@ -17,6 +17,7 @@ import pybullet as pb
 from ... import inputs, scratch
 from ...adf.paths import collision_mesh_path, visual_mesh_path
 from ...diagnostics import Diagnostic, warning
+from ...geometry.concave import parts_obj
 from ...geometry.meshcheck import mesh_problem, obj_material_problems
 from ...model.pose import Pose, Quat, Vec3
 from ...model.semantics import (
@@ -29,6 +30,7 @@ from ...model.semantics import (
     shape_kind,
     shortest_arc,
 )
+from ..collisions import convex_stand_in
 from ..plan import mesh_refusal, mesh_skipped, rgba, uncreated
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from .margins import file_margin, give_margin
@@ -212,8 +214,9 @@ def collision_parts(
             )
     elif kind is CollisionMeshType.CONCAVE_MESH and static:
         kw["flags"] = pb.GEOM_FORCE_CONCAVE_TRIMESH  # exact triangles: only static bodies in PyBullet
-    if "flags" not in kw:  # hulls, one per sub-mesh as AMBF makes them (a dynamic concave mesh: an approximation)
-        kw["fileName"] = str(hull_pieces(path, getattr(model, "tree", None)))
+    if "flags" not in kw:  # hulls, one per sub-mesh as AMBF makes them, or a moving concave mesh's convex parts
+        stand_in = None if static else convex_stand_in(model, obj, diags)
+        kw["fileName"] = str(parts_obj(stand_in) if stand_in else hull_pieces(path, getattr(model, "tree", None)))
     parts.add(pb.GEOM_MESH, **kw)
     return parts
 
