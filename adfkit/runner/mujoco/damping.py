@@ -1,7 +1,8 @@
 """ADF body damping (`damping: {linear, angular}`, velocity damping) in the MuJoCo world, which
 has none of its own: Bullet scales a rigid body's velocities by (1 - d)^dt each step, a decay at
-the rate -ln(1 - d) per second. The suturing thread's elements and the needle have 0.9 (2.3/s);
-without it MuJoCo's thread swung freely where AMBF's is drawn as through a viscous medium.
+the rate -ln(1 - d) per second (runner/damping.py). The suturing thread's elements and the
+needle have 0.9 (2.3/s); without it MuJoCo's thread swung freely where AMBF's is drawn as through
+a viscous medium.
 
 Applied each control step as the force that gives the same decay over the step (the exact
 exp(-λ·t) of the velocity, as the hole ghosts' viscous friction), at the centre of mass, to the
@@ -13,18 +14,11 @@ its first 6 s played at 2.1x real time instead of 11-26x); the damping there is 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from ...model.semantics import DEFAULT_ANGULAR_DAMPING, DEFAULT_LINEAR_DAMPING
+from ..damping import decay_rates, gains
 
 SLOW = 10.0  # × the sleep tolerance: below it, in every dof of its tree, a body is not damped
-
-
-def _rate(d: float | None, default: float) -> float:
-    d = default if d is None else float(d)
-    return -math.log(1.0 - d) if 0.0 < d < 1.0 else 0.0
 
 
 class BodyDamping:
@@ -36,9 +30,7 @@ class BodyDamping:
                 continue
             if m.body_treeid[sb.id] < 0:  # welded to the world: it cannot move
                 continue
-            dmp = sb.body.damping
-            a = _rate(getattr(dmp, "linear", None), DEFAULT_LINEAR_DAMPING)
-            b = _rate(getattr(dmp, "angular", None), DEFAULT_ANGULAR_DAMPING)
+            a, b = decay_rates(sb.body)
             if a or b:
                 ids.append(sb.id)
                 lin.append(a)
@@ -46,9 +38,7 @@ class BodyDamping:
         self.world = world
         self.ids = np.array(ids, dtype=int)
         cdt = world.dt * world.opt.control_substeps
-        # F = m·v·(exp(-λ·cdt) - 1)/cdt: the velocity decays over the control step as exp(-λ·t)
-        self.k_lin = (np.exp(-np.array(lin) * cdt) - 1.0) / cdt
-        self.k_ang = (np.exp(-np.array(ang) * cdt) - 1.0) / cdt
+        self.k_lin, self.k_ang = gains(lin, cdt), gains(ang, cdt)
         if len(ids):
             self.mass = np.array(m.body_mass[self.ids])
             self.inertia = np.array(m.body_inertia[self.ids])

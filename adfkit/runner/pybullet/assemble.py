@@ -29,6 +29,7 @@ from ..plan import (
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from . import articulation, egl
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
+from .damping import LinkDamping
 from .interact import SimActuator, SimGhost, SimSensor
 from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
 from .meshfiles import pybullet_reads_quietly
@@ -132,6 +133,7 @@ class Assembly:
             if kind_c is JointKind.FIXED:  # its relative orientation is held too (joint_angle_error)
                 self.fixed_frames.append((j.identifier, parent, child, fa[:3, :3], fb[:3, :3]))
         self.springs = SpringSet(springs, self.cid, self.gravity)
+        self.link_damping = LinkDamping(self)
         build_volumes(self, models)
         known = None
         for m in models:

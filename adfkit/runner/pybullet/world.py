@@ -113,7 +113,8 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         return True
 
     def control(self) -> None:
-        """Per-control-step forces: gravity overrides, springs, ghosts' viscous friction, sensors.
+        """Per-control-step forces: gravity overrides, springs, multibody links' damping (damping.py),
+        ghosts' viscous friction, sensors.
         PyBullet's calls take their arguments by position here (this runs every control step)."""
         cdt = self.dt * self.opt.control_substeps
         cid = self.cid
@@ -130,6 +131,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             for k, f, at in zip(links, forces, coms):
                 push(uid, k, f, at, frame, cid)
         self.springs.apply(cdt)
+        self.link_damping.apply()
         poses.update(self.springs.pq)
         self._update_ghosts(poses)
         for s in self.sensors:
