@@ -61,6 +61,8 @@ string num(double v) {
     return buf;
 }
 
+string vec(const btVector3& v) { return "[" + num(v.x()) + "," + num(v.y()) + "," + num(v.z()) + "]"; }
+
 const char* joint_type(afJointType t) {
     switch (t) {
     case afJointType::REVOLUTE: return "revolute";
@@ -109,6 +111,9 @@ public:
         m_every = env_double("ADFKIT_PARITY_EVERY", 0.0);
         const char* ghosts = getenv("ADFKIT_PARITY_GHOSTS");
         m_followGhosts = !(ghosts && string(ghosts) == "headless");
+        // a measurement's knob: Bullet's solver iterations (AMBF leaves them at Bullet's 10)
+        int iterations = (int)env_double("ADFKIT_PARITY_SOLVER_ITERATIONS", 0.0);
+        if (iterations > 0) m_world->m_bulletWorld->getSolverInfo().m_numIterations = iterations;
         update_global_poses();
         write_created();
         const char* cmds = getenv("ADFKIT_PARITY_COMMANDS");
@@ -173,7 +178,8 @@ private:
         bool first = true;
         for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
             s += (first ? "" : ",") + string("{\"name\":") + json_text(rb->getName()) +
-                 ",\"qname\":" + json_text(rb->getQualifiedName()) + ",\"mass\":" + num(rb->getMass()) + "}";
+                 ",\"qname\":" + json_text(rb->getQualifiedName()) + ",\"mass\":" + num(rb->getMass()) +
+                 ",\"inertia\":" + vec(rb->m_bulletRigidBody->getLocalInertia()) + "}";
             first = false;
         }
         s += "],\"soft_bodies\":[";
@@ -241,12 +247,16 @@ private:
                    ",\"bodies\":[";
         bool first = true;
         for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
-            // what AMBF publishes for a body: its ADF body frame (getLocalPos / getLocalRot)
-            cVector3d p = rb->getLocalPos();
-            cQuaternion q;
-            q.fromRotMat(rb->getLocalRot());
-            s += (first ? "[" : ",[") + num(p.x()) + "," + num(p.y()) + "," + num(p.z()) + "," + num(q.x) + "," +
-                 num(q.y) + "," + num(q.z) + "," + num(q.w) + "]";
+            // the body's ADF body frame at this step, as Bullet holds it. AMBF's own pose
+            // (getLocalPos / getLocalRot, what it publishes) is read from the motion state, which
+            // Bullet's latency interpolation keeps one physics step behind (the pose integrated
+            // back by m_localTime - fixedTimeStep = -dt): a body falling at 29 m/s read 29 mm
+            // behind adfkit's at the same time, while the joint values (getPosition reads the
+            // bodies' transforms) were of the step itself
+            btTransform t = rb->m_bulletRigidBody->getCenterOfMassTransform() * rb->getInverseInertialOffsetTransform();
+            btQuaternion q = t.getRotation();
+            s += (first ? "[" : ",[") + num(t.getOrigin().x()) + "," + num(t.getOrigin().y()) + "," +
+                 num(t.getOrigin().z()) + "," + num(q.x()) + "," + num(q.y()) + "," + num(q.z()) + "," + num(q.w()) + "]";
             first = false;
         }
         s += "],\"ghosts\":[";
