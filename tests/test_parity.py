@@ -143,8 +143,9 @@ def test_a_dropped_box_lands_where_ambf_lands_it(scenes):
     gaps = {g.name: g for g in c.bodies}
     assert sorted(gaps) == ["/ambf/env/Floor", "/ambf/env/drop/box", "/ambf/env/drop/slab"]
     box = gaps["/ambf/env/drop/box"]
-    # measured: 0.98 mm as it lands (the impact a step apart), 0.12 mm at rest, 0.007°
-    assert box.max_position < 1.0e-3 and box.position[-1] < 0.2e-3 and box.max_angle < 0.05
+    # measured: 0.11 mm, at rest as when it lands, 0.007° (0.98 mm as it landed while either side
+    # read its poses a physics step late)
+    assert box.max_position < 0.3e-3 and box.position[-1] < 0.2e-3 and box.max_angle < 0.05
     assert c.only_in_ambf == c.only_in_adfkit == [] and not c.failures()
     assert c.times.size == 26 and c.times[-1] == pytest.approx(0.5)
     # negative control: the box dropped from 1 cm higher on adfkit's side only
@@ -168,7 +169,8 @@ def test_a_dropped_box_lands_where_ambf_lands_it(scenes):
 @needs_ambf
 @pytest.mark.parametrize(
     "commands, tip_mm",
-    [("arm_velocity.txt", 0.5), ("arm_effort.txt", 0.3), ("arm_position.txt", 1.5)],
+    # measured: 0.13, 0.004 and 0.40 mm
+    [("arm_velocity.txt", 0.3), ("arm_effort.txt", 0.1), ("arm_position.txt", 0.6)],
 )
 def test_joint_commands_drive_both_sides_alike(scenes, commands, tip_mm, capsys):
     rc = main(
@@ -391,3 +393,70 @@ def test_the_corpus_suture_replays_in_ambf():
     mine = np.column_stack([np.interp(before[:, 0], rec.tip_path[:, 0], rec.tip_path[:, i]) for i in (1, 2, 3)])
     assert np.linalg.norm(mine - before[:, 1:], axis=1).max() < 0.5e-3
     assert verdicts[0]["verdict"] in ("passed", "failed") and gaps[1] == gaps[1]
+
+
+def _puzzle_on_ambfs_floor(folder):
+    from conftest import CORPUS, require_corpus
+
+    require_corpus()
+    floor_world = BUILD.root / "ambf_models" / "descriptions" / "world" / "world.yaml"
+    if not floor_world.is_file():
+        pytest.skip(f"AMBF's world file is not at {floor_world}")
+    puzzle = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/puzzles/puzzle1.yaml"
+    (folder / "colors.yaml").write_text("{}\n")
+    (folder / "input_devices.yaml").write_text("input devices: []\n")
+    launch = folder / "puzzle_on_floor.yaml"
+    launch.write_text(
+        f"world config: {floor_world}\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
+        f"multibody configs: [{puzzle}]\n"
+    )
+    return launch
+
+
+@needs_ambf
+@pytest.mark.slow
+def test_puzzle1s_torus_stays_on_its_peg_as_in_ambf(tmp_path, monkeypatch):
+    """AMBF collides the Torus (a moving mesh, CONCAVE_MESH by default) as its triangles; adfkit as
+    convex parts in both engines (geometry.concave). Measured over 3 s: the Torus at most 34 mm
+    from AMBF's in PyBullet, on its peg (the largest gap, 43-47 mm, is the CirclePuzzle's); played
+    as its hull (the control: nothing decomposed) it was thrown off, 1.26 m apart (PyBullet)."""
+    from adfkit.geometry import concave
+    from adfkit.parity import session
+
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")
+    launch = _puzzle_on_ambfs_floor(tmp_path)
+    req = session.Request(launch, [0], BUILD, seconds=3.0, every=0.02, engines=("pybullet", "mujoco"))
+    for c in session.run(req, progress=False).comparisons:
+        torus = next(g for g in c.bodies if g.name.endswith("/Torus"))
+        assert torus.max_position < 0.06, (c.adfkit.side, torus.max_position)
+        assert max(g.max_position for g in c.bodies) < 0.1
+    monkeypatch.setattr(concave, "HULL_FILL", 0.0)  # the control: every mesh its hull per sub-mesh
+    monkeypatch.setattr(concave, "_DONE", {})
+    req = session.Request(launch, [0], BUILD, seconds=3.0, every=0.02)
+    (c,) = session.run(req, progress=False).comparisons
+    torus = next(g for g in c.bodies if g.name.endswith("/Torus"))
+    assert torus.max_position > 0.2
+
+
+@needs_ambf
+@pytest.mark.slow
+def test_the_kukas_links_are_damped_as_ambfs_bodies(tmp_path, monkeypatch):
+    """The KUKA's links (damping 0.95) under an effort program: measured 0.03 mm and 0.4° from
+    AMBF with each link's velocity decayed as AMBF's btRigidBody does (runner/pybullet/damping.py);
+    the control, the links undamped, is far apart (PyBullet's own multibody damping was 1.44 mm,
+    5.5°)."""
+    from conftest import CORPUS, require_corpus
+
+    from adfkit.parity import programs, session
+    from adfkit.runner.pybullet import damping
+
+    require_corpus()
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")
+    model = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml"
+    cmd = programs.write_program(model, None, "effort", 1.0, tmp_path / "effort.txt")
+    req = session.Request(model, None, BUILD, seconds=1.0, every=0.02, commands=cmd)
+    (c,) = session.run(req, progress=False).comparisons
+    assert max(g.max_position for g in c.bodies) < 0.2e-3 and max(g.max_angle for g in c.bodies) < 1.0
+    monkeypatch.setattr(damping.LinkDamping, "apply", lambda self: None)
+    (c,) = session.run(req, progress=False).comparisons
+    assert max(g.max_position for g in c.bodies) > 1e-3
