@@ -55,7 +55,7 @@ def own_scenes(folder: Path) -> list[Scene]:
 
 
 def corpus_scenes(build, folder: Path) -> list[Scene]:
-    from adfkit.parity import programs
+    from adfkit.parity import ambf, programs
 
     if not CORPUS.is_dir():
         return []
@@ -68,16 +68,9 @@ def corpus_scenes(build, folder: Path) -> list[Scene]:
             ("pybullet", "mujoco"),
         )
     ]
-    floor_world = build.root / "ambf_models" / "descriptions" / "world" / "world.yaml"
     puzzle = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/puzzles/puzzle1.yaml"
-    if floor_world.is_file():
-        (folder / "colors.yaml").write_text("{}\n")
-        (folder / "input_devices.yaml").write_text("input devices: []\n")
-        launch = folder / "puzzle_on_floor.yaml"
-        launch.write_text(
-            f"world config: {floor_world}\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
-            f"multibody configs: [{puzzle}]\n"
-        )
+    launch = ambf.on_ambfs_floor(build, puzzle, folder)
+    if launch is not None:
         out.append(Scene("puzzle 1 on AMBF's checkered floor", launch, [0], 3.0, ("pybullet", "mujoco")))
     robots = (
         ("KUKA", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml"),

@@ -395,24 +395,6 @@ def test_the_corpus_suture_replays_in_ambf():
     assert verdicts[0]["verdict"] in ("passed", "failed") and gaps[1] == gaps[1]
 
 
-def _puzzle_on_ambfs_floor(folder):
-    from conftest import CORPUS, require_corpus
-
-    require_corpus()
-    floor_world = BUILD.root / "ambf_models" / "descriptions" / "world" / "world.yaml"
-    if not floor_world.is_file():
-        pytest.skip(f"AMBF's world file is not at {floor_world}")
-    puzzle = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/puzzles/puzzle1.yaml"
-    (folder / "colors.yaml").write_text("{}\n")
-    (folder / "input_devices.yaml").write_text("input devices: []\n")
-    launch = folder / "puzzle_on_floor.yaml"
-    launch.write_text(
-        f"world config: {floor_world}\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
-        f"multibody configs: [{puzzle}]\n"
-    )
-    return launch
-
-
 @needs_ambf
 @pytest.mark.slow
 def test_puzzle1s_torus_stays_on_its_peg_as_in_ambf(tmp_path, monkeypatch):
@@ -420,11 +402,18 @@ def test_puzzle1s_torus_stays_on_its_peg_as_in_ambf(tmp_path, monkeypatch):
     convex parts in both engines (geometry.concave). Measured over 3 s: the Torus at most 34 mm
     from AMBF's in PyBullet, on its peg (the largest gap, 43-47 mm, is the CirclePuzzle's); played
     as its hull (the control: nothing decomposed) it was thrown off, 1.26 m apart (PyBullet)."""
+    from conftest import CORPUS, require_corpus
+
     from adfkit.geometry import concave
     from adfkit.parity import session
 
+    require_corpus()
     monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")
-    launch = _puzzle_on_ambfs_floor(tmp_path)
+    launch = ambf.on_ambfs_floor(
+        BUILD, CORPUS / "ambf/ambf_models/descriptions/multi-bodies/puzzles/puzzle1.yaml", tmp_path
+    )
+    if launch is None:
+        pytest.skip(f"{BUILD.root} has no AMBF world file")
     req = session.Request(launch, [0], BUILD, seconds=3.0, every=0.02, engines=("pybullet", "mujoco"))
     for c in session.run(req, progress=False).comparisons:
         torus = next(g for g in c.bodies if g.name.endswith("/Torus"))

@@ -219,6 +219,22 @@ def write_stage(world: Path | None, models: Sequence[Path], floor_z: float | Non
     return Stage(d / "launch.yaml", list(range(len(models))), tmp, (FLOOR_NAME,) if floor_z is not None else ())
 
 
+def on_ambfs_floor(build: AmbfBuild, model: Path, folder: Path) -> Path | None:
+    """A launch file in ``folder`` playing ``model`` in AMBF's own world (its checkered floor,
+    from the AMBF tree), for AMBF and adfkit alike; None where the tree has no world file."""
+    world = build.root / "ambf_models" / "descriptions" / "world" / "world.yaml"
+    if not world.is_file():
+        return None
+    (folder / "colors.yaml").write_text("{}\n")
+    (folder / "input_devices.yaml").write_text("input devices: []\n")
+    launch = folder / f"{model.stem}_on_floor.yaml"
+    launch.write_text(
+        f"world config: {world}\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
+        f"multibody configs: [{model}]\n"
+    )
+    return launch
+
+
 def _floor_model(z: float) -> str:
     """A static PLANE at height ``z``: adfkit's floor under a model played alone (pybullet/
     assemble.py: PyBullet's default friction 0.5, no restitution)."""
