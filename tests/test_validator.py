@@ -131,6 +131,15 @@ EXAMPLES = {
         9,
         "warning",
     ),
+    "inertial-frame-turns-joint": (
+        CLEAN.replace(
+            "BODY b:\n  name: b\n  mass: 1.0\n",
+            "BODY b:\n  name: b\n  mass: 1.0\n"
+            "  inertial offset: {position: {x: 0, y: 0, z: 0}, orientation: {r: 0, p: 0, y: 1.0}}\n",
+        ).replace("type: revolute", "type: fixed"),
+        10,
+        "warning",
+    ),
     "spring-without-limits": (CLEAN.replace("type: revolute", "type: linear spring"), 15, "warning"),
     "dangling-reference": (CLEAN.replace("child: BODY b", "child: BODY nothing"), 14, "warning"),
     "ambiguous-reference": (CLEAN.replace("child: BODY b", "child: BODY"), 14, "warning"),

@@ -18,7 +18,7 @@ from ..model.common import RGBA, Geometry, ShapeEntry
 from ..model.files import ModelFile
 from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
-from ..model.semantics import shortest_arc
+from ..model.semantics import inertial_joint_twist, shortest_arc
 from .losses import Loss
 from .mjcf_cameras import read_cameras, read_lights
 from .mjcf_source import Source, load
@@ -412,6 +412,9 @@ def _add_joint(
         child_axis=axis,
         joint_limits=limits,
     )
+    # AMBF builds the joint's frames in the bodies' inertial frames: a turned one turns the
+    # joint's zero, which the offset takes back
+    offset += inertial_joint_twist(joint, parent, child)
     if abs(offset) > 1e-12:
         joint.offset = offset
     model.joints.append(joint)

@@ -25,11 +25,11 @@ from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import (
     JointKind,
     ShapeKind,
+    body_joint_frames,
     collision_primitives,
     cone_vertices,
     effective_mass,
     inertial_offset,
-    joint_frames,
     plane_pose,
 )
 from ..model.tree import Link, build_tree, joint_ends, motion
@@ -445,7 +445,7 @@ def to_mjcf(
     for j, kind, parent, child in tree.loops:
         if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
             eq = eq if eq is not None else ET.Element("equality")
-            a, _b = joint_frames(j, parent.scale or 1.0, child.scale or 1.0)
+            a, _b = body_joint_frames(j, parent, child)
             pl = by_body[parent.identifier]
             anchor = pl.in_link(a).position
             tag = "weld" if kind is JointKind.FIXED else "connect"

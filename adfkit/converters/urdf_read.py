@@ -14,9 +14,7 @@ from ..model.common import RGBA, Friction, Geometry, ShapeEntry
 from ..model.files import ModelFile
 from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
-from ..model.semantics import (
-    shortest_arc,
-)
+from ..model.semantics import inertial_joint_twist, shortest_arc
 from . import inertia as inertia_math
 from .losses import Loss
 from .safexml import XmlDocument, parse_xml
@@ -476,6 +474,9 @@ def _read_joint(doc, j, links, ground, bodies, frame_in_link, world, model: Mode
         child_pivot=joint_in_child_body.position,
         child_axis=b,
     )
+    # AMBF builds the joint's frames in the bodies' inertial frames: a turned one turns the
+    # joint's zero, which the offset takes back
+    offset += inertial_joint_twist(joint, parent, child)
     if abs(offset) > 1e-12:
         joint.offset = offset
     lim = j.find("limit")

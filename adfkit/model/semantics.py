@@ -4,7 +4,7 @@ the effective defaults it uses for keys a file leaves out (adf-format.md §7–�
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 
 from .common import Geometry, ShapeEntry
@@ -269,15 +269,27 @@ def shortest_arc(u: Vec3, v: Vec3) -> Quat:
     return Quat.from_axis_angle(u.cross(v), angle)
 
 
-def joint_frames(joint, parent_scale: float = 1.0, child_scale: float = 1.0) -> tuple[Pose, Pose]:
-    """Frames A (in the parent body frame) and B (in the child body frame) of §8.2.
+def joint_frames(
+    joint,
+    parent_scale: float = 1.0,
+    child_scale: float = 1.0,
+    parent_inertial: Quat = IDENTITY,
+    child_inertial: Quat = IDENTITY,
+) -> tuple[Pose, Pose]:
+    """Frames A (in the parent body frame) and B (in the child body frame) of §8.2, as AMBF
+    builds them (afJoint::createFromAttribs): the axes are first turned into the bodies'
+    inertial frames (``parent_inertial``, ``child_inertial``: the rotations of their `inertial
+    offset`), the frames are built there (the shortest arc from the reference axis is taken in
+    the inertial frame) and are given here in the body frames. With a turned inertial frame the
+    joint's zero is therefore turned about its axis from the one the body frames would give
+    (:func:`inertial_joint_twist`).
 
     At joint value zero they coincide in the world.
     """
     kind = joint_kind(joint.type) or JointKind.REVOLUTE
     d = reference_axis(kind)
-    a = normalized_or(joint.parent_axis, Vec3(0, 0, 1))
-    b = normalized_or(joint.child_axis, Vec3(0, 0, 1))
+    a = parent_inertial.inverse().rotate(normalized_or(joint.parent_axis, Vec3(0, 0, 1)))
+    b = child_inertial.inverse().rotate(normalized_or(joint.child_axis, Vec3(0, 0, 1)))
     joint_offset = joint.joint_offset or 0.0
     offset = joint.offset if joint.offset is not None else (joint.child_offset or 0.0)
     r_a = Quat.from_axis_angle(a, joint_offset) * shortest_arc(d, a)
@@ -289,7 +301,58 @@ def joint_frames(joint, parent_scale: float = 1.0, child_scale: float = 1.0) -> 
     )
     pa = Vec3(*(joint.parent_pivot or Vec3())).scaled(parent_scale)
     pb = Vec3(*(joint.child_pivot or Vec3())).scaled(child_scale)
-    return Pose(pa, r_a), Pose(pb, r_b)
+    return Pose(pa, (parent_inertial * r_a).normalized()), Pose(pb, (child_inertial * r_b).normalized())
+
+
+def inertial_rotation(body) -> Quat:
+    """The rotation of the body's inertial frame in its body frame (identity for a body
+    without one, e.g. the world)."""
+    if body is None or not hasattr(body, "inertial_offset"):
+        return IDENTITY
+    return inertial_offset(body).orientation
+
+
+def body_joint_frames(joint, parent, child) -> tuple[Pose, Pose]:
+    """:func:`joint_frames` of ``joint`` between the ADF bodies ``parent`` and ``child`` (their
+    scales and inertial frames)."""
+    ps = getattr(parent, "scale", None) or 1.0
+    cs = getattr(child, "scale", None) or 1.0
+    return joint_frames(joint, ps, cs, inertial_rotation(parent), inertial_rotation(child))
+
+
+def _angle_about(q: Quat, axis: Vec3) -> float:
+    """The angle of ``q``, a rotation about ``axis`` (unit)."""
+    return 2.0 * math.atan2(Vec3(q.x, q.y, q.z).dot(axis), q.w)
+
+
+def offsets_for_body_frames(joint, parent, child) -> tuple[float, float]:
+    """(`joint offset`, `offset`) with which AMBF, building the joint's frames in the bodies'
+    inertial frames, builds the ones :func:`joint_frames` gives in the body frames with the
+    joint's own: a file whose inertial frames are turned then means in AMBF what its body
+    frames say. Both are the joint's own when no inertial frame is turned."""
+    a0, b0 = joint_frames(joint)
+    jo = joint.joint_offset or 0.0
+    off = joint.offset if joint.offset is not None else (joint.child_offset or 0.0)
+    a1, _ = body_joint_frames(joint, parent, child)
+    axis_a = a0.orientation.rotate(reference_axis(joint_kind(joint.type) or JointKind.REVOLUTE))
+    jo2 = jo + _angle_about(a0.orientation * a1.orientation.inverse(), axis_a)
+    turned = replace(joint, joint_offset=jo2, offset=off)
+    _, b1 = body_joint_frames(turned, parent, child)
+    axis_b = b0.orientation.rotate(reference_axis(joint_kind(joint.type) or JointKind.REVOLUTE))
+    off2 = off - _angle_about(b0.orientation * b1.orientation.inverse(), axis_b)
+    return math.remainder(jo2, 2 * math.pi), math.remainder(off2, 2 * math.pi)
+
+
+def inertial_joint_twist(joint, parent, child) -> float:
+    """How far (rad, in [-π, π]) AMBF turns the joint's frames about its axis from the ones the
+    body frames give: 0 unless a body's inertial frame is turned. For a revolute joint AMBF
+    reads its value at a pose as the body frames' value plus this; a prismatic or fixed joint
+    holds its child turned by this about the axis from where the body frames hold it."""
+    a0, b0 = joint_frames(joint)
+    a1, b1 = body_joint_frames(joint, parent, child)
+    rel = (a1.orientation.inverse() * a0.orientation) * (b0.orientation.inverse() * b1.orientation)
+    d = reference_axis(joint_kind(joint.type) or JointKind.REVOLUTE)
+    return math.remainder(2.0 * math.atan2(Vec3(rel.x, rel.y, rel.z).dot(d), rel.w), 2 * math.pi)
 
 
 __all__ = [n for n in dir() if not n.startswith("_")] + ["ShapeEntry"]

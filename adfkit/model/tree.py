@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from .files import ModelFile
 from .objects import Body, Joint
 from .pose import Pose, Quat, Vec3
-from .semantics import JointKind, effective_mass, joint_frames, joint_kind, reference_axis
+from .semantics import JointKind, body_joint_frames, effective_mass, joint_kind, reference_axis
 
 ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
 
@@ -116,10 +116,6 @@ def joint_ends(model: ModelFile, joint) -> set[str | None]:
     return {getattr(find_body(model, ref), "identifier", None) for ref in (joint.parent, joint.child)}
 
 
-def _scale(b: Body) -> float:
-    return b.scale if b.scale is not None else 1.0
-
-
 def build_tree(
     model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)
 ) -> KinematicTree:
@@ -161,7 +157,7 @@ def build_tree(
                 if child.identifier in links:
                     continue
                 used.add(id(r))
-                a, b = joint_frames(j, _scale(parent), _scale(child))
+                a, b = body_joint_frames(j, parent, child)
                 node = Link(child, parent=link, joint=j, kind=kind, frame_in_body=b, origin=link.in_link(a))
                 node.q0 = _initial_value(link, node)
                 link.children.append(node)

@@ -129,6 +129,13 @@ _RULES = [
         "a child body 5 cm from its parent's pivot",
     ),
     Rule(
+        "inertial-frame-turns-joint",
+        W,
+        "A jointed body's `inertial offset` is turned: AMBF builds the joint's frames in the inertial "
+        "frames, which turns the joint's zero (a fixed or prismatic joint: its child) about its axis",
+        "`inertial offset: {orientation: {y: 1.57}}` on a link of a revolute joint",
+    ),
+    Rule(
         "spring-without-limits", W, "A spring joint without limits stays locked", "`type: linear spring` and no limits"
     ),
     Rule(

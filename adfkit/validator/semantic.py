@@ -14,7 +14,10 @@ from ..model.semantics import (
     ACTUATOR_TYPES,
     SENSOR_TYPES,
     JointKind,
+    body_joint_frames,
     collision_mesh_type,
+    inertial_joint_twist,
+    inertial_rotation,
     joint_kind,
     shape_kind,
 )
@@ -507,6 +510,8 @@ class Checker:
         for key in ("parent", "child"):
             bodies.append(self.reference(m, j, key, own, earlier, immediate=True))
         parent, child = bodies
+        if parent is not None and child is not None and kind not in (None, JointKind.P2P):
+            self.turned_inertial_frames(j, kind, parent, child)
         if parent is not None and child is not None and kind not in (None, JointKind.FIXED):
             pm, cm = parent.mass, child.mass
             if cm == 0 and pm == 0:
@@ -523,6 +528,43 @@ class Checker:
                     j.where("child"),
                     "give the child a mass",
                 )
+
+    def turned_inertial_frames(self, j, kind: JointKind, parent, child) -> None:
+        """AMBF builds a joint's frames in its bodies' inertial frames (afJoint turns the axes
+        and pivots into them and takes the shortest arc there): a turned `inertial offset`
+        turns the joint's zero about its axis (semantics.inertial_joint_twist)."""
+        twist = inertial_joint_twist(j, parent, child)
+        if abs(twist) < 1e-6:
+            return
+        turned = [b for b in (child, parent) if inertial_rotation(b).angle_to(Quat()) > 1e-9]
+        deg = math.degrees(twist)
+        if kind in (JointKind.REVOLUTE, JointKind.TORSION_SPRING):
+            what = (
+                f"AMBF reads its value {deg:+.1f}° from what the bodies' frames give "
+                "(its zero, its limits and every position command move with it)"
+            )
+        else:
+            off = _held_off(j, parent, child)
+            if off is not None and off < 1e-3:
+                return  # placed as AMBF holds it (e.g. an `offset` that takes the turn back)
+            what = f"AMBF holds the child turned {deg:+.1f}° about the joint's axis from where the body frames hold it"
+            if off is not None:
+                what += f", {math.degrees(off):.1f}° from where the file places it"
+        names = " and ".join(f"'{b.identifier}'" for b in turned)
+        frames = "frames of " + names + " are" if len(turned) > 1 else "frame of " + names + " is"
+        # a revolute joint's turned zero is a note (adfkit reads it as AMBF does; `joint-pose`
+        # warns where it puts the file's pose outside the limits); a child held off its
+        # placement is a warning
+        severity = Severity.INFO if kind in (JointKind.REVOLUTE, JointKind.TORSION_SPRING) else None
+        self.emit(
+            "inertial-frame-turns-joint",
+            f"joint '{j.identifier}': the inertial {frames} turned, and AMBF builds the "
+            f"joint's frames in the bodies' inertial frames: {what}",
+            turned[0].where("inertial offset") if turned else j.where("type"),
+            "write the inertial offset unturned (orientation 0) with the inertia in the body's axes, as "
+            "AMBF's Blender add-on writes it",
+            severity=severity,
+        )
 
     def joint_poses(self, m: ModelFile) -> None:
         """Where the file's `location`s put each revolute/prismatic joint of the kinematic
@@ -747,6 +789,17 @@ class Checker:
                     dev.where(),
                     "add `hardware name:` with the CHAI3D driver's model name",
                 )
+
+
+def _held_off(j, parent, child) -> float | None:
+    """How far (rad) AMBF holds the child of a joint that locks the turn about its axis (fixed,
+    prismatic, ...) from the turn the file's `location`s give it; None without both locations."""
+    if parent.location is None or child.location is None:
+        return None
+    a, b = body_joint_frames(j, parent, child)
+    held = a.orientation * b.orientation.inverse()
+    placed = parent.location.orientation.inverse() * child.location.orientation
+    return held.angle_to(placed)
 
 
 def _within(q: float, low: float, high: float, angular: bool) -> bool:

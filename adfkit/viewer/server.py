@@ -257,7 +257,7 @@ class Viewer:
             self.soft_nodes.append((s, h))
 
     def _draw_joint_frames(self) -> None:
-        from ..model.semantics import joint_frames
+        from ..model.semantics import body_joint_frames
 
         index = {id(sb.body): i for i, sb in enumerate(self.world.bodies)}
         for m in self.scene.all_models():
@@ -266,7 +266,7 @@ class Viewer:
                 if parent is None or id(parent) not in index:
                     continue
                 try:
-                    a, _ = joint_frames(j, parent.scale or 1.0, 1.0)
+                    a, _ = body_joint_frames(j, parent, m.body(j.child) if j.child else None)
                 except (TypeError, ValueError, ZeroDivisionError):
                     continue
                 q = a.orientation

@@ -23,7 +23,7 @@ import numpy as np
 
 from ... import scratch
 from ...converters.mjcf_write import to_mjcf
-from ...model.semantics import JointKind, ShapeKind, collision_primitives, joint_frames, pose_or_identity
+from ...model.semantics import JointKind, ShapeKind, body_joint_frames, collision_primitives, pose_or_identity
 from ...model.tree import ONE_DOF
 from .. import plan as scene_rules
 from ..plan import (
@@ -254,7 +254,7 @@ def build_plan(world) -> Plan:
         for j, kind, pb_, cb in tree.loops:
             parent, child = mine[pb_.identifier], mine[cb.identifier]
             if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
-                a, b = joint_frames(j, pb_.scale or 1.0, cb.scale or 1.0)
+                a, b = body_joint_frames(j, pb_, cb)
                 pa = np.array(parent.link.in_link(a).position, float)
                 pbv = np.array(child.link.in_link(b).position, float)
                 loops.append((j, kind, parent, child, pa, pbv))

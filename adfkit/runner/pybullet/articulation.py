@@ -8,7 +8,7 @@ from collections import defaultdict, deque
 import numpy as np
 import pybullet as pb
 
-from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, joint_frames
+from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, body_joint_frames
 from ..rotations import invert, matrix_to_pq, pose_matrix
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC)
@@ -104,14 +104,8 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
         idx[id(r[3])] = n
     lm, lc, lv, lp, lo, lip, lio, lpi, lt, la = ([] for _ in range(10))
     for joint, kind, parent, child in records:
-        ps = parent.body.scale if parent.body.scale is not None else 1.0
-        cs = child.body.scale if child.body.scale is not None else 1.0
-        if kind is JointKind.FIXED:
-            fa = pose_matrix(*_pose(joint_frames(joint, ps, cs)[0]))
-            fb = pose_matrix(*_pose(joint_frames(joint, ps, cs)[1]))
-        else:
-            a, b = joint_frames(joint, ps, cs)
-            fa, fb = pose_matrix(*_pose(a)), pose_matrix(*_pose(b))
+        a, b = body_joint_frames(joint, parent.body, child.body)
+        fa, fb = pose_matrix(*_pose(a)), pose_matrix(*_pose(b))
         child.ref_in_body = fb  # link frame = joint frame B
         rel = invert(parent.ref_in_body) @ fa  # joint frame in the parent's link frame
         col, vis = shapes_for(child, fb)

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pybullet as pb
 
-from ...model.semantics import JointKind, joint_frames, joint_kind, pose_or_identity
+from ...model.semantics import JointKind, body_joint_frames, joint_kind, pose_or_identity
 from ..cameras import build_cameras
 from ..collisions import HULL_OVERLAP, collision_masks, hull_overlaps, one_hull
 from ..names import Registry, merge_namespace
@@ -98,9 +98,7 @@ class Assembly:
         springs = []
         self.fixed_frames = []  # (joint name, parent, child, joint frame rotation in each)
         for j, kind, parent, child in leftover:
-            ps = parent.body.scale or 1.0
-            cs = child.body.scale or 1.0
-            a, b = joint_frames(j, ps, cs)
+            a, b = body_joint_frames(j, parent.body, child.body)
             fa = invert(parent.com_in_body) @ pose_to_matrix(a)
             fb = invert(child.com_in_body) @ pose_to_matrix(b)
             self.joint_names.append(j.identifier)

@@ -64,3 +64,19 @@ def look_frame(origin, z_axis, x_hint) -> np.ndarray:
     t = np.eye(4)
     t[:3, 0], t[:3, 1], t[:3, 2], t[:3, 3] = x, np.cross(z, x), z, origin
     return t
+
+
+def for_ambf(m):
+    """The model ``m`` (in place) with the `joint offset` and `offset` of every joint on a body
+    whose inertial frame is turned set to those with which AMBF, building joint frames in the
+    bodies' inertial frames, builds the ones the body frames give
+    (semantics.offsets_for_body_frames): the file means in AMBF what it means in its body frames."""
+    from ...model.semantics import inertial_rotation, offsets_for_body_frames
+
+    for j in m.joints:
+        parent, child = m.body(j.parent), m.body(j.child)
+        if all(inertial_rotation(b).angle_to(inertial_rotation(None)) < 1e-12 for b in (parent, child)):
+            continue
+        jo, off = offsets_for_body_frames(j, parent, child)
+        j.joint_offset, j.offset = (r(jo) if abs(jo) > 1e-12 else None), r(off)
+    return m

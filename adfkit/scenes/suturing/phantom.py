@@ -20,7 +20,7 @@ from ...model import (
     Vec3,
 )
 from . import layout as L
-from .frames import look_frame, pose, r, vec
+from .frames import for_ambf, look_frame, pose, r, vec
 from .meshes import boxes_mesh, obj_text
 from .needle import needle_body
 from .thread import thread_bodies_and_joints
@@ -168,7 +168,7 @@ def build_phantom() -> ModelFile:
     bodies, joints = thread_bodies_and_joints(needle)
     m.bodies += bodies
     m.joints += joints
-    return m
+    return for_ambf(m)
 
 
 def hole_ghost(kind: str, k: int) -> Ghost:
