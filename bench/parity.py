@@ -7,7 +7,7 @@ gaps over time there. Asserts nothing; skips, with the reason, without an AMBF b
 
 Scenes: the project's own (`adfkit build-scene parity`: a dropped box, an arm under position,
 velocity and effort commands, a stack of boxes, a cube into a ghost, the thread falling from a
-held needle) and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
+held needle, the arm with a turned inertial frame), the bundled sample scenes at rest and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
 own floor (from the AMBF tree), and the KUKA and a PSM under joint programs (parity.programs).
 Timings are of a shared 2-core box: noisy; compare AMBF's and adfkit's of one row.
 """
@@ -51,7 +51,28 @@ def own_scenes(folder: Path) -> list[Scene]:
     out.append(Scene("cube into a ghost (hole-friction, the default)", launch, [3], 0.6))
     out.append(Scene("cube into a ghost (--ghosts ambf)", launch, [3], 0.6, ghosts="ambf"))
     out.append(Scene("thread falling from a held needle", launch, [4], 2.0, both))
+    out.append(
+        Scene(
+            "arm with a turned inertial frame, position commands",
+            folder / "turned_arm.yaml",
+            None,
+            1.0,
+            commands=folder / "turned_arm_position.txt",
+        )
+    )
     return out
+
+
+def sample_scenes() -> list[Scene]:
+    """adfkit's bundled sample scenes (sample_scenes/, written by `adfkit build-scene`), left
+    alone: they must stand still in AMBF as in adfkit."""
+    both = ("pybullet", "mujoco")
+    root = ROOT / "sample_scenes"
+    return [
+        Scene(f"sample scene {name} at rest", root / name / "launch.yaml", None, 1.0, both)
+        for name in ("suturing", "suturing_pad", "soft_phantom", "drilling")
+        if (root / name / "launch.yaml").is_file()
+    ]
 
 
 def corpus_scenes(build, folder: Path) -> list[Scene]:
@@ -97,7 +118,7 @@ def main(argv: list[str]) -> int:
     rows, results = [], []
     with tempfile.TemporaryDirectory(prefix="adfkit-parity-bench-") as tmp:
         folder = Path(tmp)
-        scenes = own_scenes(folder / "own") + corpus_scenes(build, folder)
+        scenes = own_scenes(folder / "own") + sample_scenes() + corpus_scenes(build, folder)
         for sc in scenes:
             if only and not any(o.lower() in sc.name.lower() for o in only):
                 continue

@@ -187,6 +187,35 @@ def test_joint_commands_drive_both_sides_alike(scenes, commands, tip_mm, capsys)
 
 
 @needs_ambf
+def test_a_turned_inertial_frame_turns_the_joint_in_both(scenes):
+    """The arm with its inertial frame turned 90° about the joint's axis (its inertia turned with
+    it, scenes.parity.build_turned_arm): AMBF builds the joint's frames in that frame."""
+    from adfkit.adf import load_scene
+    from adfkit.parity import session
+    from adfkit.parity.traces import AdfkitPlayer
+    from adfkit.runner import Options, open_world
+
+    req = session.Request(scenes / "turned_arm.yaml", None, BUILD, seconds=1.0, every=0.02)
+    req.commands = scenes / "turned_arm_position.txt"
+    (c,) = session.run(req, progress=False).comparisons
+    k = c.ambf.joint_names.index("/ambf/env/arm/base-arm")
+    # measured: AMBF reads the joint +90° at the file's pose, and adfkit now reads it so too
+    assert c.ambf.joints[0, k] == pytest.approx(math.pi / 2, abs=1e-3)
+    assert c.adfkit.joints[0, c.adfkit.joint_names.index("/ambf/env/arm/base-arm")] == pytest.approx(math.pi / 2)
+    arm = next(g for g in c.bodies if g.name == "/ambf/env/arm/arm")
+    assert arm.max_position < 1.5e-3  # measured 1.38 mm, as the unturned arm's 1.18 mm
+    # negative control: the arm read in its body frames (the unturned file, the same inertia)
+    w = open_world(load_scene(scenes / "arm.yaml"), Options(visuals=False, control_substeps=1))
+    try:
+        player = AdfkitPlayer(w)
+        body_frames = player.play(1.0, 0.02, commandfile.resolved(commandfile.read(req.commands), player.made))
+    finally:
+        w.close()
+    bad = compare.compare(c.ambf, body_frames)
+    assert next(g for g in bad.bodies if g.name.endswith("/arm")).max_position > 0.1
+
+
+@needs_ambf
 def test_an_undriven_arm_differs_from_ambfs_driven_one(scenes):
     # negative control: AMBF's arm under a velocity command against adfkit's left alone
     from adfkit.adf import load_scene

@@ -40,24 +40,8 @@ class Recording:
     needle: str  # the needle's AMBF name
     thread: list[str]  # the thread elements' AMBF names, from the needle on
     grasps: list[tuple[float, str, str | None]] = field(default_factory=list)  # (t, arm, body or None)
-    joint_start: dict[str, tuple[float, str]] = field(default_factory=dict)  # joint -> (adfkit's value at start, kind)
     tools: dict[str, str] = field(default_factory=dict)  # arm -> the AMBF name of the body its actuator is on
     wall_s: float = 0.0
-
-
-def joint_zeros(rec: Recording, build: ambf.AmbfBuild, stage: ambf.Stage) -> dict[str, float]:
-    """AMBF's value of each recorded revolute joint where the scene starts, less adfkit's: where
-    the two read a joint's zero differently (the bundled PSM, whose joints AMBF reads at minus
-    their `offset` at the file's pose, adfkit at 0), a set-point is moved by it. A prismatic
-    joint's position AMBF computes only once it has stepped, so is taken as read alike."""
-    run = ambf.run(build, stage, 0.0, 0.0)
-    names = [j["qname"] for j in run.created["joints"]]
-    values = dict(zip(names, run.samples[0]["joints"])) if run.samples else {}
-    out = {}
-    for name, (q, kind) in rec.joint_start.items():
-        v = values.get(name)
-        out[name] = float(v) - q if kind == "revolute" and v is not None else 0.0
-    return out
 
 
 class _Recorder:
@@ -70,7 +54,6 @@ class _Recorder:
         self.grasps: list[tuple[float, str, str | None]] = []
         self.arms = {id(psm.art): name for name, psm in task.psms.items()}
         self.joint_names = {}
-        self.start: dict[str, tuple[float, str]] = {}  # joint -> (adfkit's value at the start, its kind)
         for j, _p, child in world.joints_made:
             art = getattr(child, "articulation", None)
             if art is None or id(art) not in self.arms:
@@ -79,8 +62,6 @@ class _Recorder:
             if idx is not None:
                 name = ambf_name(joint_key(world, j), j)
                 self.joint_names[(id(art), idx)] = name
-                q = float(world.joint_state(art, [idx])[0][0])
-                self.start[name] = (q, art.kinds[idx].value)
         self.last: dict[tuple, float] = {}
         self.placed = False
         self.forced = False
@@ -203,7 +184,6 @@ def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False) 
             thread,
             grasps=rec.grasps,
             tools=tools,
-            joint_start=rec.start,
             wall_s=wall,
         )
     finally:
@@ -396,12 +376,7 @@ def replay(rec: Recording, build: ambf.AmbfBuild, launch: Path, indices) -> tupl
     from .traces import from_ambf
 
     stage = ambf.Stage(Path(launch).resolve(), list(indices) if indices is not None else _all(launch))
-    zeros = joint_zeros(rec, build, stage)
-    commands = [
-        ambf.Command(c.t, c.kind, c.target, c.value + zeros.get(c.target, 0.0)) if c.kind == "position" else c
-        for c in rec.commands
-    ]
-    run = ambf.run(build, stage, rec.seconds, EVERY, commands, timeout=600 + 10 * rec.seconds)
+    run = ambf.run(build, stage, rec.seconds, EVERY, rec.commands, timeout=600 + 10 * rec.seconds)
     trace = from_ambf(run)
     obs = AmbfObservation(rec, trace)
     verdicts = [pair_verdict(obs, p) for p in rec.task.pairs]

@@ -3,7 +3,10 @@ and adfkit (``adfkit parity``, docs/parity.md): a box dropped onto a slab, an ar
 joint driven by position, velocity and effort commands (a command file for each), three boxes
 settling in a stack, a cube falling into a ghost object, the suture thread falling from a held
 needle. They need nothing but themselves: no corpus, no meshes. The launch file lists one model
-per scene on the same world (a floor); ``-l`` picks one."""
+per scene on the same world (a floor); ``-l`` picks one. Beside them, outside the launch file,
+``turned_arm.yaml``: the arm with its inertial frame turned about the joint's axis (its inertia
+turned with it), which AMBF reads with the joint's zero turned (semantics.joint_frames), and its
+own ``turned_arm_position.txt``."""
 
 from __future__ import annotations
 
@@ -43,6 +46,7 @@ COMMANDS = {
     "arm_position.txt": ("arm", ["0.0, position, base-arm, 0.6", "0.5, position, base-arm, -0.3"]),
     "arm_velocity.txt": ("arm", ["0.0, velocity, base-arm, 1.0", "0.3, velocity, base-arm, -0.5"]),
     "arm_effort.txt": ("arm", ["0.0, effort, base-arm, 0.02", "0.4, effort, base-arm, -0.03"]),
+    "turned_arm_position.txt": ("turned_arm", ["0.0, position, base-arm, 0.6", "0.5, position, base-arm, -0.3"]),
 }
 
 
@@ -100,6 +104,18 @@ def build_arm() -> ModelFile:
             max_motor_impulse=0.05,
         )
     )
+    return m
+
+
+def build_turned_arm() -> ModelFile:
+    """The arm of :func:`build_arm` with its inertial frame turned 90° about the joint's axis
+    (z) and its inertia turned with it: the same body, which AMBF reads with the joint's zero
+    turned +90° (it builds joint frames in the bodies' inertial frames)."""
+    m = build_arm()
+    arm = m.bodies[1]
+    i = arm.inertia
+    arm.inertia = Inertia(ix=i.iy, iy=i.ix, iz=i.iz)
+    arm.inertial_offset = Pose(Vec3(), rpy_to_quat(0.0, 0.0, np.pi / 2))
     return m
 
 
@@ -176,8 +192,10 @@ def write_parity(out_dir: str | Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     for name in SCENES:
         write_file(BUILD[name](), out / f"{name}.yaml")
+    write_file(build_turned_arm(), out / "turned_arm.yaml")
     for fname, (scene, lines) in COMMANDS.items():
-        head = f"# {scene}.yaml (-l {SCENES.index(scene)}): TIME, KIND, JOINT, VALUE (adfkit parity --commands)\n"
+        which = f"-l {SCENES.index(scene)}" if scene in SCENES else "a model file of its own"
+        head = f"# {scene}.yaml ({which}): TIME, KIND, JOINT, VALUE (adfkit parity --commands)\n"
         atomic_write_text(out / fname, head + "\n".join(lines) + "\n")
     write_file(build_floor(), out / "floor.yaml")
     write_file(World(namespace="/ambf/env/", gravity=Vec3(0, 0, -9.81), environment="floor.yaml"), out / "world.yaml")
@@ -198,6 +216,7 @@ __all__ = [
     "write_parity",
     "build_drop",
     "build_arm",
+    "build_turned_arm",
     "build_stack",
     "build_ghost",
     "build_thread",
