@@ -216,6 +216,30 @@ def test_a_turned_inertial_frame_turns_the_joint_in_both(scenes):
 
 
 @needs_ambf
+def test_the_bundled_arms_stand_still_in_ambf_as_in_adfkit(tmp_path):
+    """The bundled PSM keeps its links' inertial frames turned and writes its joints' offsets
+    for AMBF's reading: AMBF reads it as adfkit does and neither moves (measured 0.016 mm in
+    1 s). Negative control: the same files without the `joint offset`s AMBF needs."""
+    import shutil
+    from pathlib import Path
+
+    from adfkit.parity import session
+
+    src = Path(__file__).resolve().parent.parent / "sample_scenes" / "suturing"
+    req = session.Request(src / "launch.yaml", [0, 1], BUILD, seconds=0.3, every=0.02)
+    (c,) = session.run(req, progress=False).comparisons
+    assert max(g.max_position for g in c.bodies) < 1e-4 and max(g.max_angle for g in c.bodies) < 0.05
+    bad = tmp_path / "suturing"
+    shutil.copytree(src, bad)
+    psm = bad / "psm" / "psm1.yaml"
+    text = psm.read_text()
+    assert "  joint offset: " in text
+    psm.write_text("\n".join(ln for ln in text.splitlines() if not ln.startswith("  joint offset: ")) + "\n")
+    (c,) = session.run(session.Request(bad / "launch.yaml", [0, 1], BUILD, seconds=0.3), progress=False).comparisons
+    assert max(g.max_position for g in c.bodies) > 0.01
+
+
+@needs_ambf
 def test_an_undriven_arm_differs_from_ambfs_driven_one(scenes):
     # negative control: AMBF's arm under a velocity command against adfkit's left alone
     from adfkit.adf import load_scene
