@@ -1,6 +1,7 @@
-"""A `fixed` joint between two maximal-coordinate bodies keeps the relative pose the file
-gives them, whatever their inertial frames (PyBullet's own fixed constraint does not: it holds
-the two inertial frames parallel, which turned the suturing thread 90 degrees off its needle)."""
+"""A `fixed` joint between two maximal-coordinate bodies keeps the relative pose its frames
+give them, whatever their inertial frames (PyBullet's own fixed constraint does not: it holds
+the two inertial frames parallel, which turned the suturing thread 90 degrees off its needle).
+The frames are AMBF's, built in the bodies' inertial frames (semantics.joint_frames)."""
 
 from __future__ import annotations
 
@@ -49,16 +50,30 @@ JOINT a-b:
 def test_fixed_joint_keeps_the_relative_pose(tmp_path):
     p = tmp_path / "model.yaml"
     p.write_text(textwrap.dedent(MODEL))
+    from adfkit.adf.reader import load
+    from adfkit.model.semantics import body_joint_frames
+    from adfkit.runner.rotations import invert, pose_to_matrix
+
+    model = load(p)
+    (j,) = model.joints
+    fa, fb = body_joint_frames(j, model.body(j.parent), model.body(j.child))
+    held = pose_to_matrix(fa) @ invert(pose_to_matrix(fb))  # b in a, as AMBF's frames hold it
+
+    def turn(r0, r1) -> float:
+        return float(np.degrees(np.arccos(np.clip((np.trace(r0[:3, :3].T @ r1[:3, :3]) - 1) / 2, -1, 1))))
+
     world = open_world(load_scene(p, None, []))
     try:
         a, b = world.body("BODY a"), world.body("BODY b")
-        rel0 = np.linalg.inv(a.world_matrix()) @ b.world_matrix()  # the file's pose: the joint's own
+        placed = np.linalg.inv(a.world_matrix()) @ b.world_matrix()  # the file's placement
         b.force([0.0, 0.05, 0.0], list(b.com_position()))  # a jolt on the light body
         world.run(0.5)
         rel = np.linalg.inv(a.world_matrix()) @ b.world_matrix()
-        turn = np.degrees(np.arccos(np.clip((np.trace(rel0[:3, :3].T @ rel[:3, :3]) - 1) / 2, -1, 1)))
-        assert turn < 1.0, turn
-        assert np.linalg.norm(rel[:3, 3] - rel0[:3, 3]) < 1e-4
+        assert turn(held, rel) < 1.0, turn(held, rel)
+        assert np.linalg.norm(rel[:3, 3] - held[:3, 3]) < 1e-4
+        # a's inertial frame is turned 1.2 rad about the joint's axis: AMBF (and the runner)
+        # hold b that far from where the file places it
+        assert turn(placed, held) == pytest.approx(np.degrees(1.2), abs=0.01)
     finally:
         world.close()
 
