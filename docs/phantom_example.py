@@ -35,11 +35,19 @@ def phantom_boxes(pairs: int, spacing: float) -> tuple[list, list[float]]:
     return boxes, ys
 
 
+def _bpy(addon):
+    """Blender's module as the add-on holds it (bpy is imported only inside addon/)."""
+    import importlib
+
+    return importlib.import_module(addon.__name__ + ".headless").bpy
+
+
 def _tissue(addon, boxes):
     """The slab and the ridge as one mesh body, static, colliding as its boxes (a hull of the
     whole mesh would fill the channels)."""
-    import bpy
     from mathutils import Matrix
+
+    bpy = _bpy(addon)
 
     verts, faces = [], []
     for lo, hi in boxes:
@@ -71,9 +79,9 @@ def author_phantom(addon, out: Path, pairs: int = 3, spacing: float = 0.012) -> 
     returns the model file."""
     import importlib
 
-    import bpy
-
     from adfkit.diagnostics import AdfError, Severity
+
+    bpy = _bpy(addon)
 
     boxes, ys = phantom_boxes(pairs, spacing)
     _tissue(addon, boxes)
@@ -92,11 +100,12 @@ def pictures(addon, model: Path) -> None:
     import shutil
     import tempfile
 
-    import bpy
     import imageio.v2 as imageio
 
     from adfkit.tasks import hole_figure
     from adfkit.tasks.episode import run_episode
+
+    bpy = _bpy(addon)
 
     docs = ROOT / "docs"
     addon.render.thumbnail(bpy.context.scene, docs / "phantom-blender.png", size=480)
