@@ -61,7 +61,7 @@ def _report(m: dict, seed: int, engine: str) -> None:
         + "; grasp drift while one "
         "arm holds, by phase (mm): "
         + ", ".join(f"{k} {1000 * v:.2f}" for k, v in drift.items())
-        + f"; thread through the tissue {1000 * (m.get('thread_length_through_tissue_m') or 0):.1f} mm"
+        + f"; thread {1000 * (m.get('thread_length_through_tissue_m') or 0):.1f} mm through the tissue"
     )
 
 

@@ -238,8 +238,8 @@ def run(args) -> int:
     angles = (m.get("joint_angle_error_by_phase_deg") or {}).values()
     err = m.get("max_constraint_error_m")
     print(
-        f"simulated {m.get('simulated_time_s', 0):.2f} s, {rtf:.2f}x real time, thread through the tissue "
-        f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm, "
+        f"simulated {m.get('simulated_time_s', 0):.2f} s, {rtf:.2f}x real time, thread "
+        f"{m.get('thread_length_through_tissue_m', 0) * 1000:.1f} mm through the tissue, "
         + (f"max constraint error {err * 1000:.2f} mm" if err is not None else "no loop-closing joint to measure")
         + (f" (fixed joints {max(angles):.1f}° off)" if angles else "")
         + (", EXPLODED" if m.get("exploded") else "")
