@@ -15,6 +15,7 @@ import time
 import numpy as np
 import pybullet as pb
 
+from ...model.semantics import JointKind
 from ..options import Options
 from ..rotations import matrix_to_pq, pose_matrix, quat_to_matrix
 from ..soft import in_scene as soft_in_scene
@@ -92,12 +93,57 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         for i, p, v in zip(idxs, positions, vel):
             pb.resetJointState(art.uid, i, float(p), float(v), physicsClientId=self.cid)
 
-    def joint_motor(self, art, index: int, velocity: float, max_force: float) -> None:
+    def joint_motor(self, art, index: int, velocity: float, max_force: float, gain: float = 1.0) -> None:
         """Joint ``index`` of ``art`` driven at ``velocity`` by a motor of at most ``max_force``
-        (runner/joint_commands.py: AMBF's velocity motor)."""
+        (runner/joint_commands.py: AMBF's velocity motor). With ``gain`` under 1 the motor takes
+        the joint that share of the way from the velocity the step would leave it at toward
+        ``velocity`` (PyBullet's velocity gain: solved with the step's other rows)."""
         pb.setJointMotorControl2(
-            art.uid, index, pb.VELOCITY_CONTROL, targetVelocity=velocity, force=max_force, physicsClientId=self.cid
+            art.uid,
+            index,
+            pb.VELOCITY_CONTROL,
+            targetVelocity=velocity,
+            force=max_force,
+            velocityGain=gain,
+            physicsClientId=self.cid,
         )
+
+    def joint_inertias(self, art) -> np.ndarray:
+        """Each joint's inertia along its axis (kg·m², kg for a prismatic joint) with the
+        articulation's other joints free, now: 1 / (M⁻¹)ᵢᵢ of its joint-space mass matrix M
+        (0 for a fixed joint)."""
+        cid = self.cid
+        dofs = [n for n, k in enumerate(art.kinds) if k in (JointKind.REVOLUTE, JointKind.PRISMATIC)]
+        q = [s[0] for s in pb.getJointStates(art.uid, dofs, physicsClientId=cid)]
+        inverse = np.linalg.inv(np.array(pb.calculateMassMatrix(art.uid, q, physicsClientId=cid)))
+        out = np.zeros(len(art.records))
+        out[dofs] = 1.0 / np.diag(inverse)[len(inverse) - len(dofs) :]  # a floating base's six come first
+        return out
+
+    def joint_row_mass(self, art, index: int) -> float:
+        """The mass (kg·m², kg) a Bullet constraint row along joint ``index``'s axis sees between the
+        joint's two bodies alone, as AMBF's hinge or slider motor row does: 1 / (aᵀ I_p⁻¹ a + aᵀ
+        I_c⁻¹ a) for a hinge, 1 / (1/m_p + 1/m_c) for a slider (a static parent adds nothing)."""
+        cid = self.cid
+        kind = art.kinds[index]
+        parent = pb.getJointInfo(art.uid, index, physicsClientId=cid)[16]
+        link = pb.getLinkState(art.uid, index, computeForwardKinematics=True, physicsClientId=cid)
+        axis = quat_to_matrix(link[5])[:, 2 if kind is JointKind.REVOLUTE else 0]
+        inverse = 0.0
+        for n in (parent, index):
+            mass, _f, diag = pb.getDynamicsInfo(art.uid, n, physicsClientId=cid)[:3]
+            if mass <= 0.0:
+                continue
+            if kind is JointKind.PRISMATIC:
+                inverse += 1.0 / mass
+                continue
+            if n < 0:
+                orn = pb.getBasePositionAndOrientation(art.uid, physicsClientId=cid)[1]
+            else:
+                orn = pb.getLinkState(art.uid, n, computeForwardKinematics=True, physicsClientId=cid)[1]
+            a = quat_to_matrix(orn).T @ axis  # the axis in the body's principal frame
+            inverse += float(sum(a[i] ** 2 / diag[i] for i in range(3) if diag[i] > 0.0))
+        return 1.0 / inverse if inverse > 0.0 else float("inf")
 
     def joint_effort(self, art, index: int, effort: float) -> None:
         """Joint ``index`` of ``art`` pushed by ``effort`` (N·m or N) for the next control step, its

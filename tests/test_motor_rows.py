@@ -1,0 +1,95 @@
+"""Joint motors as soft as AMBF's constraint rows (runner/joint_commands.py, motor_gain): a
+motor reaches its target over several steps when it moves more than its own two bodies, by the
+joint's `joint cfm`; with cfm 0 it reaches it within the step (the control)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pybullet")
+
+from adfkit.adf import load_scene  # noqa: E402
+from adfkit.runner import Options, open_world  # noqa: E402
+from adfkit.runner.joint_commands import JointCommands, motor_gain  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# the parity arm (adfkit.scenes.parity.build_arm): 0.5 kg, iz 0.0037875 kg m² about its centre,
+# 0.2 m from the joint's axis (z), on a static base: the row sees iz, the joint (its only one) iz + m d²
+ARM_ROW = 0.0037875
+ARM_JOINT = 0.0037875 + 0.5 * 0.2**2
+
+
+def test_the_motor_gain_is_the_rows_share():
+    assert motor_gain(0.1, ARM_JOINT, ARM_ROW) == pytest.approx(1 / (1 + 0.1 * ARM_JOINT / ARM_ROW))
+    assert motor_gain(0.0, ARM_JOINT, ARM_ROW) == 1.0
+    assert motor_gain(0.1, ARM_JOINT, float("inf")) == 1.0  # between static bodies: no row to soften
+    assert motor_gain(0.5, 2.0, 0.01) == pytest.approx(1 / 101)
+
+
+def _arm(tmp_path, cfm):
+    from adfkit.scenes.parity import write_parity
+
+    scene = load_scene(write_parity(tmp_path), [1])
+    for m in scene.all_models():
+        for j in m.joints:
+            j.joint_cfm = cfm
+    return open_world(scene, Options(visuals=False, control_substeps=1))
+
+
+@pytest.mark.parametrize("cfm", [None, 0.0])
+def test_a_velocity_command_is_reached_at_the_rows_pace(tmp_path, cfm):
+    w = _arm(tmp_path, cfm)
+    try:
+        commands = JointCommands(w)
+        (joint, _parent, child) = next(r for r in w.joints_made if r[0].name == "base-arm")
+        commands.command(joint, child, "velocity", 1.0)
+        dj = commands.joints[id(joint)]
+        assert dj.row_mass == pytest.approx(ARM_ROW, rel=1e-3)
+        v = []
+        for k in range(3):
+            commands.apply(k * w.dt)
+            w.step(1)
+            v.append(float(w.joint_state(dj.art, [dj.index])[1][0]))
+    finally:
+        w.close()
+    g = motor_gain(0.1, ARM_JOINT, ARM_ROW) if cfm is None else 1.0  # AMBF's joint cfm is 0.1
+    expected = [1 - (1 - g) ** n for n in (1, 2, 3)]  # 0.614, 0.851, 0.943 rad/s at cfm 0.1
+    assert v == pytest.approx(expected, abs=2e-3)
+
+
+@pytest.mark.parametrize("cfm, ring", [(None, False), (0.0, True)])
+def test_a_psm_yaw_held_by_ambfs_controller_does_not_ring(cfm, ring):
+    """The bundled PSM's yaw joint given a position under AMBF's default controller (P 10, D 1, a
+    velocity to its motor): with the row's softness it settles; with a motor that reaches the
+    controller's velocity within the step the D term's kick grows each step, its sign flipping,
+    until the motor's force caps it (±76 rad/s)."""
+    scene = load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml")
+    if cfm is not None:
+        for m in scene.all_models():
+            for j in m.joints:
+                j.joint_cfm = cfm
+    w = open_world(scene, Options(visuals=False, control_substeps=1))
+    try:
+        commands = JointCommands(w)
+        joint, _parent, child = next(
+            r for r in w.joints_made if r[0].name == "base link-yaw link" and "psm1" in r[2].key
+        )
+        commands.command(joint, child, "position", 0.1)
+        dj = commands.joints[id(joint)]
+        v = []
+        for k in range(600):
+            w.step(1)
+            commands.apply((k + 1) * w.dt)
+            v.append(float(w.joint_state(dj.art, [dj.index])[1][0]))
+        q = float(w.joint_state(dj.art, [dj.index])[0][0])
+    finally:
+        w.close()
+    late = float(np.abs(v[300:]).max())
+    if ring:
+        assert late > 50.0  # measured 75.8 rad/s
+    else:
+        assert late < 0.1 and q == pytest.approx(0.1, abs=1e-3)  # measured 0.009 rad/s, 0.09998 rad
