@@ -115,9 +115,13 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         cid = self.cid
         dofs = [n for n, k in enumerate(art.kinds) if k in (JointKind.REVOLUTE, JointKind.PRISMATIC)]
         q = [s[0] for s in pb.getJointStates(art.uid, dofs, physicsClientId=cid)]
-        inverse = np.linalg.inv(np.array(pb.calculateMassMatrix(art.uid, q, physicsClientId=cid)))
+        mass = np.array(pb.calculateMassMatrix(art.uid, q, physicsClientId=cid))
+        try:
+            diag = 1.0 / np.diag(np.linalg.inv(mass))
+        except np.linalg.LinAlgError:  # a massless link: each joint with the others held instead
+            diag = np.diag(mass)
         out = np.zeros(len(art.records))
-        out[dofs] = 1.0 / np.diag(inverse)[len(inverse) - len(dofs) :]  # a floating base's six come first
+        out[dofs] = diag[len(diag) - len(dofs) :]  # a floating base's six come first
         return out
 
     def joint_row_mass(self, art, index: int) -> float:
