@@ -55,7 +55,7 @@ def test_frames_drawn_in_a_process_of_their_own_are_the_same_pictures(world, tmp
     there.close()
     assert there.note is None and there.drawn_in == "a process of its own"
     assert there.video_frames == here.video_frames == 6 and (tmp_path / "there.mp4").is_file()
-    assert not (tmp_path / "there.part.mp4").exists()
+    assert not list(tmp_path.glob(".there.mp4.*")) and not list(tmp_path.glob(".here.mp4.*"))
     assert len(there.gif) == len(here.gif) == 3 and there.gif[0].shape == (120, 160, 3)
     assert all(np.array_equal(a, b) for a, b in zip(here.gif, there.gif))
     a, b = _frames(tmp_path / "here.mp4"), _frames(tmp_path / "there.mp4")
@@ -77,3 +77,20 @@ def test_a_recorder_that_cannot_start_says_why_and_the_frames_are_drawn_here(wor
     rec.close()
     assert rec.drawn_in == "the episode's process" and "could not start" in rec.note and "no-such-gl" in rec.note
     assert rec.video_frames == 3 and len(rec.gif) == 3 and (tmp_path / "v.mp4").is_file()
+
+
+def test_two_recordings_of_one_file_in_one_folder_do_not_trip_over_each_other(tmp_path):
+    """Two runs writing the same video into one output folder (two `adfkit suture` started in one
+    directory): each writes a file of its own name and renames it into place; the second rename
+    used to find the shared temporary file gone (a traceback)."""
+    from adfkit.runner.video import Mp4Writer
+
+    a, b = Mp4Writer(tmp_path / "cameraL.mp4", 10.0), Mp4Writer(tmp_path / "cameraL.mp4", 10.0)
+    for i in range(4):
+        a.add(np.full((32, 48, 3), 40 * i, np.uint8))
+        b.add(np.full((32, 48, 3), 200 - 40 * i, np.uint8))
+    assert a.tmp is not None and b.tmp is not None and a.tmp != b.tmp
+    a.close()
+    b.close()
+    assert [p.name for p in tmp_path.iterdir()] == ["cameraL.mp4"]
+    assert len(_frames(tmp_path / "cameraL.mp4")) == 4

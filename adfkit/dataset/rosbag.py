@@ -14,12 +14,14 @@ closed, so a failed episode leaves no half bag under the final name."""
 
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
 import numpy as np
 
 from ..runner.rotations import matrix_to_quat
+from ..scratch import temp_beside
 from .writer import camera_to_world
 
 TF_MESSAGE = "geometry_msgs/TransformStamped[] transforms"
@@ -46,8 +48,12 @@ class RosbagWriter:
 
         self.world, self.path = world, Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.tmp = self.path.with_name(self.path.name + ".part")
-        self.tmp.unlink(missing_ok=True)
+        # a name of this process's own (two recordings into one folder do not share it); the
+        # writer creates the file itself
+        fd, tmp = temp_beside(self.path, ".part")
+        os.close(fd)
+        self.tmp = Path(tmp)
+        self.tmp.unlink()
         self.ts = _typestore()
         self.types = self.ts.types
         self.cameras = [c for c in world.cameras if cameras is None or c.name in cameras]

@@ -4,9 +4,12 @@ frames shrunk for a GIF."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
+
+from ..scratch import temp_beside
 
 
 class Mp4Writer:
@@ -15,7 +18,7 @@ class Mp4Writer:
 
     def __init__(self, path: Path, fps: float) -> None:
         self.path, self.fps = Path(path), fps
-        self.tmp = self.path.with_name(self.path.stem + ".part.mp4")
+        self.tmp: Path | None = None
         self.w = None
         self.frames = 0
 
@@ -24,6 +27,10 @@ class Mp4Writer:
             import imageio.v2 as imageio
 
             self.path.parent.mkdir(parents=True, exist_ok=True)
+            # a name of this process's own: two runs writing into one folder do not share it
+            fd, tmp = temp_beside(self.path, ".mp4")
+            os.close(fd)
+            self.tmp = Path(tmp)
             self.w = imageio.get_writer(
                 self.tmp,
                 format="FFMPEG",
@@ -40,6 +47,7 @@ class Mp4Writer:
         if self.w is not None:
             self.w.close()
             self.w = None
+            assert self.tmp is not None
             self.tmp.replace(self.path)
 
 

@@ -7,12 +7,14 @@ write metrics.json, trajectory.png, cameraL.gif and (with ``record``) the datase
 from __future__ import annotations
 
 import json
+import os
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from ..scratch import temp_beside
 from .metrics import SutureObserver, finite
 from .suture import SutureError, SutureTask
 
@@ -246,9 +248,10 @@ def write_outputs(out: Path, metrics: dict, obs, task, frames) -> list[str]:
     if frames:
         import imageio.v2 as imageio
 
-        tmp = out / "cameraL.part.gif"
+        fd, tmp = temp_beside(out / "cameraL.gif", ".gif")
+        os.close(fd)
         imageio.mimsave(tmp, frames, duration=GIF_EVERY_S, loop=0)
-        tmp.replace(out / "cameraL.gif")
+        Path(tmp).replace(out / "cameraL.gif")
         written.append("cameraL.gif")
     if metrics.get("video"):
         written.append(metrics["video"]["file"])
