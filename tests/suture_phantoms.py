@@ -136,19 +136,21 @@ def phantom_file(
     line_deg: float = 0.0,
     thicker: float = 0.0,
     at=(0.0, 0.0),
+    numbered_back: bool = False,
 ) -> Path:
     """One model file holding a phantom alone, as the add-on exports one: a slab and a ridge of
     tissue boxes with a gap at each pair (the channel the needle goes through), the hole bodies
     Entry k / Exit k (four capsules each) and their ghosts. ``pairs`` pairs ``spacing`` apart
     along the ridge, 14 mm from entry to exit; the whole phantom turned ``turn_deg`` about the
     vertical and moved to ``at``; the line of pairs slanted ``line_deg`` (each pair still across
-    the ridge); slab and ridge ``thicker`` (the holes on its top). Returns the model file."""
+    the ridge); slab and ridge ``thicker`` (the holes on its top); ``numbered_back``: pair 1 at
+    the other end of the line (where the bundled scene has its last pair). Returns the model file."""
     from adfkit.model import ModelFile
     from adfkit.scenes.suturing.frames import pose, rot_y, rot_z, translation
     from adfkit.scenes.suturing.meshes import boxes_mesh, obj_text
     from adfkit.scenes.suturing.phantom import TEXTURE_SCALE, _hole_body, _phantom_body, hole_ghost
 
-    ys = [((pairs + 1) / 2 - k) * spacing for k in range(1, pairs + 1)]
+    ys = [((pairs + 1) / 2 - k) * spacing * (-1 if numbered_back else 1) for k in range(1, pairs + 1)]
     slant = math.tan(math.radians(line_deg))
     xs = [y * slant for y in ys]
     top = L.RIDGE_TOP + thicker

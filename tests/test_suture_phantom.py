@@ -49,6 +49,28 @@ def test_the_arms_needle_and_camera_stand_to_the_phantoms_holes_as_to_the_bundle
     assert c.lift_m == pytest.approx(TRAY_DEPTH, abs=1e-4)
 
 
+def test_a_phantom_numbered_from_the_other_end_is_sutured_from_the_needles_end(tmp_path):
+    """The needle lies beyond the end of the line where the bundled pair 1 is. A phantom whose
+    pair 1 is at the other end is sutured from its last pair to its first (each pair still from
+    Entry k to Exit k), so the suture starts next to the needle as in the bundled scene; numbered
+    as the bundled one, 1 to N. The needle is placed the same way for both."""
+    fwd = _compose(phantom_file(tmp_path / "fwd", pairs=4, spacing=0.024))
+    back = _compose(phantom_file(tmp_path / "back", pairs=4, spacing=0.024, numbered_back=True))
+    assert fwd.pairs == [1, 2, 3, 4] and back.pairs == [4, 3, 2, 1]
+
+    def needle(c):
+        return next(b for m in c.scene.models for b in m.bodies if b.name == "Needle").location.position
+
+    a, b = needle(fwd), needle(back)
+    assert (a.x, a.y, a.z) == pytest.approx((b.x, b.y, b.z), abs=1e-12)
+    # the first pair visited stands to the needle in both as the bundled pair 1 does
+
+    def entry(c, k):
+        return next(bd for m in c.scene.models for bd in m.bodies if bd.name == f"Entry{k}").location.position
+
+    assert b.y - entry(back, 4).y == pytest.approx(a.y - entry(fwd, 1).y, abs=1e-9) and a.y - entry(fwd, 1).y > 0.015
+
+
 def test_the_swept_arc_is_clear_on_a_good_phantom_and_says_what_blocks_a_bad_one(tmp_path):
     from adfkit.runner import Options, open_world
     from adfkit.tasks.needle import wire_radius
@@ -112,6 +134,7 @@ FAMILY = {
     "turned 30 degrees, moved": dict(pairs=4, spacing=0.011, turn_deg=30.0, at=(0.02, -0.01)),
     "line slanted 30 degrees": dict(pairs=3, spacing=0.010, line_deg=30.0),
     "3 mm thicker": dict(pairs=3, spacing=0.012, thicker=0.003),
+    "numbered from the other end": dict(pairs=4, spacing=0.024, numbered_back=True),
 }
 
 

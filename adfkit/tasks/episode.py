@@ -258,6 +258,11 @@ def write_outputs(out: Path, metrics: dict, obs, task, frames) -> list[str]:
     return written
 
 
+def _order_in(order: list[int]):
+    """Sort key: a pair's place in ``order`` (pairs not in it last, by number)."""
+    return lambda k: (order.index(k), k) if k in order else (len(order), k)
+
+
 def run_episode(
     launch,
     indices=None,
@@ -301,7 +306,9 @@ def run_episode(
     world = open_world(scene, options, gui=gui, engine=engine)
     try:
         try:
-            if pairs is None:
+            if placed is not None:  # a phantom's pairs, from the needle's end of its line of holes
+                pairs = placed.pairs if pairs is None else sorted(pairs, key=_order_in(placed.pairs))
+            elif pairs is None:
                 from .suture import hole_pairs
 
                 pairs = [p.index for p in hole_pairs(world)] or [1]

@@ -13,6 +13,10 @@ stereo camera's frame and both PSMs stay, and are placed for the phantom's holes
   with it, so that they stand to the phantom's holes as they stand to the bundled ones; the
   needle and the thread too, moved along the line of holes to lie as far beyond its end as in
   the bundled scene (24 mm past the pair at the end of the line).
+- **The order of the pairs**: the suture starts at the pair next to the needle and goes along
+  the line, as in the bundled scene, whichever way the phantom numbers its pairs (``pairs``,
+  in that order): a phantom numbered from the other end is sutured from its last pair to its
+  first, each pair still from its Entry k to its Exit k.
 - **The needle's bed.** The needle lies, as in the bundled scene, across a slot (the jaws close
   around the wire in it) of a static tray, ``SutureTray``, the thread on a strip of it; the
   tray's top is where the bundled slab's is, 6 mm below the holes' centre, raised (with the
@@ -205,7 +209,7 @@ class Composed:
     scene: Scene
     placement: np.ndarray  # the bundled frame -> the phantom's
     lift_m: float  # how far the needle's bed was raised onto the phantom's tissue
-    pairs: list[int]
+    pairs: list[int]  # in the order the suture visits them: from the needle's end of the line
     names: dict[int, dict[str, str]]
 
 
@@ -247,8 +251,10 @@ def compose(bundled: Scene, phantom: ModelFile) -> Composed:
     # bundled scene (24 mm past pair 1, along the line): placed from the pairs' centre (60 mm),
     # a short line left them far from its end pair, and the driver's grasp, chosen to reach both,
     # came down onto the needle's bed (the planner found no grasp off it: -0.3 mm; 178 N held)
-    ends = [(np.linalg.inv(t) @ ((f["entry"] + f["exit"]) / 2)[:, 3])[1] for f in holes.frames.values() if len(f) == 2]
-    needle_t = t @ translation(0.0, max(ends) - max(L.HOLE_YS), 0.0)
+    along = {
+        k: (np.linalg.inv(t) @ ((f["entry"] + f["exit"]) / 2)[:, 3])[1] for k, f in holes.frames.items() if len(f) == 2
+    }
+    needle_t = t @ translation(0.0, max(along.values()) - max(L.HOLE_YS), 0.0)
     for m in models:
         for b in m.bodies:
             _moved(b, needle_t if m is needle_file and NEEDLE_PARTS.match(b.name or "") else t)
@@ -272,7 +278,10 @@ def compose(bundled: Scene, phantom: ModelFile) -> Composed:
     needle_file.bodies.append(_tray(rects, bed, translation(0.0, 0.0, lift) @ needle_t))
     models.append(phantom)
     scene.models = models
-    pairs = holes.pairs()
+    # from the needle's end of the line on (the bundled pair 1 is there): a phantom numbered the
+    # other way, sutured 1 to N, started at the far end with the thread drawn back over the pairs
+    # it was to go through last (its pair 4 failed, entry-outside-opening by 4.9 mm)
+    pairs = sorted(holes.pairs(), key=lambda k: (-along[k], k))
     return Composed(scene, t, lift, pairs, holes.names)
 
 
