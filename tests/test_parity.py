@@ -457,12 +457,122 @@ def test_a_replay_whose_ambf_world_blew_up_is_judged_on_what_came_before():
     assert v["rule"] == "entry-missed" and "nan" not in v["reason"] and "1.0 mm" in v["reason"], v["reason"]
 
 
+def test_a_paced_replay_is_judged_and_compared_by_its_command_clock():
+    """A paced AMBF replay stands still while its clock waits: its samples' simulated times run
+    ahead of the recording's, and the events (a crossing, the tip's path) are read at the clock."""
+    from adfkit.parity.suture import AmbfObservation, tip_gaps
+    from adfkit.tasks.verdicts import pair_verdict
+
+    down = [(0.0, 0.0, z) for z in (0.004, 0.002, 0.001, -0.002, -0.005, -0.008, -0.012, -0.014)]
+    rec = _replay_recording()
+    paced = _replay_trace(down)
+    paced.clock = paced.times.copy()  # the recording's time, sampled every 0.02 s of it
+    paced.times = paced.clock * 3.0  # AMBF took three times as long, waiting on its joints
+    obs = AmbfObservation(rec, paced)
+    v = pair_verdict(obs, rec.task.pairs[0])
+    assert v["verdict"] == "passed" and v["entry_passed_s"] == pytest.approx(0.06)  # the clock's, not 0.18
+    mine = np.column_stack([paced.clock, np.asarray(down)])  # adfkit's tip on the same path in its time
+    assert tip_gaps(mine, obs.tip_path, rec.task.phase_log, rec.task.pairs)[1] == pytest.approx(0.0, abs=1e-12)
+    # the control: the same samples read at AMBF's simulated time lag adfkit's path
+    paced.clock = None
+    late = AmbfObservation(rec, paced)
+    assert pair_verdict(late, rec.task.pairs[0])["entry_passed_s"] == pytest.approx(0.18)
+    assert tip_gaps(mine, late.tip_path, rec.task.phase_log, rec.task.pairs)[1] > 5e-3
+
+
+def test_an_ambf_record_without_a_clock_reads_its_time_as_the_clock():
+    """Records of the plugin before the paced clock (and unpaced ones) read as unpaced."""
+    from adfkit.parity.traces import from_ambf
+
+    created = {k: [] for k in ("soft_bodies", "ghosts", "joints", "sensors", "actuators")}
+    created["bodies"] = [{"qname": "/a/B"}]
+    pose = [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]]
+    samples = [{"t": 0.0, "bodies": pose, "joints": []}, {"t": 0.5, "clock": 0.2, "bodies": pose, "joints": []}]
+    tr = from_ambf(ambf.AmbfRecord(created, samples, 0.0, 0.0))
+    assert tr.times.tolist() == [0.0, 0.5] and tr.clock.tolist() == [0.0, 0.2]
+
+
+def test_parity_suture_prints_both_replays(monkeypatch, capsys):
+    """--pace both: the verdicts of the replay at AMBF's own time, the paced one's beside them,
+    and what the paced clock did (a 4-pair run's JSON, cut to one pair)."""
+    from adfkit.parity import suture
+
+    pace = {"ambf_simulated_s": 432.43, "held_steps": 343454, "give_ups": 1119, "clock_reached_end": True}
+    out = {
+        "seconds": 88.976,
+        "commands": 39000,
+        "paced": False,
+        "pace": None,
+        "ambf_not_finite_from_s": None,
+        "wall_s": {"adfkit": 544.7, "ambf": 107.1},
+        "same_verdicts": False,
+        "replays": [{"pace": None}, {"pace": pace}],
+        "pairs": [
+            {
+                "pair": 1,
+                "adfkit": "passed",
+                "ambf": "failed",
+                "ambf_rule": "entry-missed",
+                "ambf_reason": "the tip never went through Entry1",
+                "tip_path_gap_m": 0.0478,
+                "ambf_paced": "failed",
+            }
+        ],
+    }
+    seen = {}
+
+    def fake(launch, indices, pairs, build, seed, progress, paces):
+        seen["paces"] = paces
+        return out
+
+    monkeypatch.setattr(suture, "compare_suture", fake)
+    monkeypatch.setattr(ambf, "find_build", lambda path: None)
+    assert main(["parity", "--suture", "--pairs", "1", "--pace", "both"]) == 1  # the verdicts differ
+    text = capsys.readouterr().out
+    assert seen["paces"] == (None, suture.PACE)
+    assert "pair 1: adfkit passed, AMBF failed (entry-missed" in text and "47.8 mm" in text
+    assert "; paced: AMBF failed" in text and "432.4 s" in text and "1119 wait(s) given up" in text
+    assert main(["parity", "--suture", "--pairs", "1"]) == 1 and seen["paces"] == (None,)
+
+
+@needs_ambf
+def test_the_paced_clock_waits_for_the_joint_to_reach_its_set_point(scenes):
+    """The parity arm's position program (0.6 rad at 0 s, -0.3 rad at 0.5 s) played on the paced
+    clock: it holds while the joint swings to each step (AMBF's controller takes longer than the
+    0.2 s wait for 0.6 rad: given up on once), so AMBF plays past 1 s; unpaced, the clock is
+    AMBF's own time, as before."""
+    from adfkit.parity.traces import from_ambf, made_by_ambf
+
+    stage = ambf.Stage(scenes / "launch.yaml", [1])
+    made = made_by_ambf(ambf.run(BUILD, stage, 0.0, 0.0).created)
+    cmds = commandfile.resolved(commandfile.read(scenes / "arm_position.txt"), made)
+    plain = ambf.run(BUILD, stage, 1.0, 0.05, cmds)
+    assert plain.end["pace"] is None and plain.end["t"] == pytest.approx(1.0)
+    tr = from_ambf(plain)
+    assert np.allclose(tr.clock, tr.times)
+    run = ambf.run(BUILD, stage, 1.0, 0.05, cmds, pace=(0.002, 0.0002, 0.2), pace_max_s=20.0)
+    pace = run.end["pace"]
+    paced = from_ambf(run)
+    assert pace["clock_reached"] and paced.clock[-1] == pytest.approx(1.0)
+    assert pace["held_steps"] >= 200 and run.end["t"] == pytest.approx(1.0 + pace["held_steps"] * ambf.DT)
+    assert pace["given_up_on"] == {"/ambf/env/arm/base-arm": 1}
+    # held at the clock's first step until the wait gave up: the joint nearer 0.6 rad at clock
+    # 0.2 s than unpaced
+    k = int(np.argmin(np.abs(paced.clock - 0.2)))
+    assert paced.joints[k, 0] > tr.joints[int(np.argmin(np.abs(tr.times - 0.2))), 0] + 0.1
+    # the control: a wait of a whole second leaves nothing to give up on: the clock holds longer
+    longer = ambf.run(BUILD, stage, 1.0, 0.05, cmds, pace=(0.002, 0.0002, 1.0), pace_max_s=20.0)
+    assert longer.end["pace"]["held_steps"] > pace["held_steps"]
+
+
 @needs_ambf
 @pytest.mark.slow
 def test_the_corpus_suture_replays_in_ambf():
-    """Pair 1 of the corpus set, recorded in adfkit and replayed in AMBF (minutes). Measured: the
-    two needles agree to 0.04 mm until the first grasp (2.4 s), then AMBF's tool trails adfkit's
-    (its joint controller lags a moving set-point) and AMBF's needle misses Entry1 by 18.6 mm."""
+    """Pair 1 of the corpus set, recorded in adfkit and replayed in AMBF, unpaced and paced
+    (minutes). The two needles agree to 0.04 mm until the first grasp (2.4 s). After it AMBF's
+    arms stand off their set-points (its PSM's joints hold them 13-16 mrad off at rest, farther
+    under load) and its needle misses Entry1, paced or not (measured: the tip paths 47.8 and
+    44.7 mm apart at most); the paced replay plays about four times the recording's time."""
     from conftest import CORPUS, require_corpus
 
     from adfkit.parity import suture
@@ -472,12 +582,18 @@ def test_the_corpus_suture_replays_in_ambf():
     rec = suture.record(launch, [6, 7, 8, 9, 10, 11], [1], seed=0)
     assert [v["verdict"] for v in rec.verdicts] == ["passed"]
     assert sum(c.kind == "grasp" for c in rec.commands) >= 2 and any(c.kind == "place" for c in rec.commands)
-    verdicts, gaps, trace = suture.replay(rec, BUILD, launch, [6, 7, 8, 9, 10, 11])
-    obs = suture.AmbfObservation(rec, trace)
-    before = obs.tip_path[obs.tip_path[:, 0] < rec.grasps[0][0] - 0.05]
-    mine = np.column_stack([np.interp(before[:, 0], rec.tip_path[:, 0], rec.tip_path[:, i]) for i in (1, 2, 3)])
-    assert np.linalg.norm(mine - before[:, 1:], axis=1).max() < 0.5e-3
-    assert verdicts[0]["verdict"] in ("passed", "failed") and gaps[1] == gaps[1]
+    plain = suture.replay(rec, BUILD, launch, [6, 7, 8, 9, 10, 11])
+    paced = suture.replay(rec, BUILD, launch, [6, 7, 8, 9, 10, 11], pace=suture.PACE)
+    for r in (paced, plain):
+        obs = suture.AmbfObservation(rec, r.trace)
+        before = obs.tip_path[obs.tip_path[:, 0] < rec.grasps[0][0] - 0.05]
+        mine = np.column_stack([np.interp(before[:, 0], rec.tip_path[:, 0], rec.tip_path[:, i]) for i in (1, 2, 3)])
+        assert np.linalg.norm(mine - before[:, 1:], axis=1).max() < 0.5e-3
+    assert plain.end["pace"] is None and plain.end["t"] == pytest.approx(rec.seconds, abs=2e-3)
+    assert paced.end["pace"]["clock_reached"] and paced.end["t"] > 2 * rec.seconds
+    assert paced.trace.clock[-1] == pytest.approx(rec.seconds, abs=2e-3)
+    for r in (plain, paced):
+        assert r.verdicts[0]["verdict"] in ("passed", "failed") and math.isfinite(r.gaps[1])
 
 
 @needs_ambf

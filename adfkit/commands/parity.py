@@ -64,6 +64,14 @@ def add_arguments(p) -> None:
     )
     p.add_argument("--pairs", default="1,2,3,4", help="--suture: the hole pairs, e.g. 4 or 1,2 (default 1,2,3,4)")
     p.add_argument("--seed", type=int, default=0, help="--suture: the plan's seed (default 0)")
+    p.add_argument(
+        "--pace",
+        choices=("on", "off", "both"),
+        default="off",
+        help="--suture: off (default) plays the set-points at AMBF's own time; on replays on a command clock "
+        "that waits for AMBF's joints to reach each set-point, as a client waits for measured_js (about 4x "
+        "AMBF's time); both replays twice and reports both (verdicts judged on the unpaced one)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object (a list of them for --engine both)")
 
 
@@ -116,7 +124,7 @@ def _suture(args) -> int:
     from ..adf import parse_indices
     from ..jsonout import dumps
     from ..parity import ambf
-    from ..parity.suture import compare_suture
+    from ..parity.suture import PACE, compare_suture
     from .suture import parse_pairs
 
     bundled = Path(__file__).resolve().parents[2] / "sample_scenes" / "suturing" / "launch.yaml"
@@ -124,12 +132,17 @@ def _suture(args) -> int:
     inputs.check_file(path, what="ADF file")
     pairs = parse_pairs(args.pairs.strip())
     build = ambf.find_build(args.ambf)
-    out = compare_suture(Path(path), parse_indices(args.indices), pairs, build, args.seed, progress=not args.json)
+    paces = {"on": (PACE,), "off": (None,), "both": (None, PACE)}[args.pace]
+    out = compare_suture(
+        Path(path), parse_indices(args.indices), pairs, build, args.seed, progress=not args.json, paces=paces
+    )
     if args.json:
         print(dumps(out, indent=1))
     else:
+        how = "paced" if out["paced"] else "unpaced"
         print(
-            f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF ({out['commands']} commands)"
+            f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF {how} "
+            f"({out['commands']} commands)"
         )
         for p in out["pairs"]:
             gap = p["tip_path_gap_m"]
@@ -137,6 +150,13 @@ def _suture(args) -> int:
                 f"  pair {p['pair']}: adfkit {p['adfkit']}, AMBF {p['ambf']}"
                 + (f" ({p['ambf_rule']}: {p['ambf_reason']})" if p["ambf_rule"] else "")
                 + (f", tip paths {gap * 1e3:.1f} mm apart at most" if gap == gap and gap is not None else "")
+                + (f"; paced: AMBF {p['ambf_paced']}" if "ambf_paced" in p else "")
+            )
+        for pace in (r["pace"] for r in out["replays"] if r["pace"] is not None):
+            print(
+                f"  paced: AMBF played {pace['ambf_simulated_s']:.1f} s for the recording's {out['seconds']:.1f} s, "
+                f"the clock held {pace['held_steps']} steps, {pace['give_ups']} wait(s) given up"
+                + ("" if pace["clock_reached_end"] else " (it did not reach the end)")
             )
         if out["ambf_not_finite_from_s"] is not None:
             print(

@@ -171,6 +171,7 @@ class AmbfRecord:
     wall_s: float  # AMBF's stepping alone (the plugin's clock, first step to last)
     process_s: float  # the whole ambf_simulator process, loading included
     log: str = field(repr=False, default="")
+    end: dict = field(default_factory=dict)  # the plugin's end record (a paced replay's "pace")
 
     def body_names(self) -> list[str]:
         return [b["qname"] for b in self.created["bodies"]]
@@ -255,14 +256,26 @@ def run(
     every: float,
     commands: Sequence[Command] = (),
     timeout: float | None = None,
+    pace: tuple[float, float, float] | None = None,
+    pace_max_s: float | None = None,
 ) -> AmbfRecord:
     """Play ``stage`` in ``ambf_simulator`` for ``seconds`` (0: load only), a sample every
-    ``every`` seconds, driven by ``commands``; AMBF's output goes to a log kept with the record."""
+    ``every`` seconds, driven by ``commands``; AMBF's output goes to a log kept with the record.
+    ``pace`` (rad, m, wait s): the commands read on the plugin's paced command clock, which
+    advances only while the joints under position commands stand within those tolerances of
+    their set-points (``seconds`` and ``every`` are then that clock's), ending at ``pace_max_s``
+    of AMBF's time if the clock has not reached ``seconds`` by then."""
     lib = plugin_library(build)
     with tempfile.TemporaryDirectory(prefix="adfkit-ambf-") as tmp:
         out = Path(tmp) / "record.jsonl"
         env = dict(os.environ, ADFKIT_PARITY_OUT=str(out), ADFKIT_PARITY_SECONDS=repr(float(seconds)))
         env["ADFKIT_PARITY_EVERY"] = repr(float(every))
+        for key in ("ADFKIT_PARITY_PACE", "ADFKIT_PARITY_PACE_MAX"):
+            env.pop(key, None)
+        if pace is not None:
+            env["ADFKIT_PARITY_PACE"] = " ".join(repr(float(v)) for v in pace)
+            if pace_max_s is not None:
+                env["ADFKIT_PARITY_PACE_MAX"] = repr(float(pace_max_s))
         if commands:
             cmd_file = Path(tmp) / "commands.txt"
             cmd_file.write_text("".join(c.line() + "\n" for c in commands))
@@ -311,4 +324,4 @@ def _record(recs: list[dict], rc: int | None, process_s: float, log: str, second
             )
         )
     samples = [r for r in recs if r.get("kind") == "sample"]
-    return AmbfRecord(created, samples, float(end.get("wall_s") or 0.0), process_s, log)
+    return AmbfRecord(created, samples, float(end.get("wall_s") or 0.0), process_s, log, end)

@@ -5,6 +5,13 @@ plugin (the set-points as AMBF's joint position commands, the grasps through AMB
 constraint actuators), and the needle's path on each side is judged by the same verdict code
 (``tasks.verdicts.pair_verdict``).
 
+The set-points are played at AMBF's own time, where its joint controller (P 10, D 1 into a
+velocity motor by default) trails a moving set-point by about a tenth of a second; or paced
+(``PACE``), as a client that sends a set-point and waits for the measured joints: the plugin
+reads the recording on a command clock that advances only while every driven joint stands within
+a tolerance of its set-point, physics running all the while, and the paths are compared by that
+clock.
+
 AMBF's side is judged from the poses the plugin records: the tip's crossings of each hole's
 plane (inside its opening, tip first), the thread through both holes when each pull ended, the
 needle slipping in a grasp. The plugin records no contact force, so the rules that read forces
@@ -24,6 +31,25 @@ from .traces import ambf_name, joint_key
 
 #: a sample of AMBF's poses every so many simulated seconds (the tip's path, the crossings)
 EVERY = 0.02
+
+
+@dataclass(frozen=True)
+class Pace:
+    """A paced replay's rule: the command clock waits while a driven joint stands farther than
+    ``rad`` (revolute) or ``m`` (prismatic) from its set-point, for ``wait_s`` of AMBF's time at
+    most (a jaw closed on the needle never gets there); the replay ends at ``max_factor`` times
+    the recording's length of AMBF's time if its clock has not reached the end by then."""
+
+    rad: float = 0.01
+    m: float = 0.001
+    wait_s: float = 0.1
+    max_factor: float = 20.0
+
+    def plugin(self) -> tuple[float, float, float]:
+        return (self.rad, self.m, self.wait_s)
+
+
+PACE = Pace()
 
 
 @dataclass
@@ -222,7 +248,8 @@ class AmbfObservation:
         idx = {n: i for i, n in enumerate(names)}
         # judged up to where AMBF's world blew up, if it did (its poses not finite from there on)
         n_ok = finite_samples(trace)
-        self.times = trace.times[:n_ok]
+        # a paced replay's events happened on its command clock: the recording's own time
+        self.times = (trace.clock if trace.clock is not None else trace.times)[:n_ok]
         frames = _frames(trace.poses[:n_ok])
         needle = frames[:, idx[rec.needle]]
         tip = needle @ np.r_[geom.tip, 1.0]
@@ -370,18 +397,55 @@ def tip_gaps(adfkit_tip: np.ndarray, ambf_tip: np.ndarray, log, pairs) -> dict[i
     return out
 
 
-def replay(rec: Recording, build: ambf.AmbfBuild, launch: Path, indices) -> tuple[list[dict], dict, object]:
-    """The recording played in AMBF: (its verdicts per pair, tip gaps per pair, the trace)."""
+@dataclass
+class Replay:
+    """The recording played in AMBF, judged."""
+
+    verdicts: list[dict]
+    gaps: dict[int, float]  # the tip paths' largest distance per pair (m), by the command clock
+    trace: object
+    pace: Pace | None
+    end: dict  # the plugin's end record: simulated time, the clock, the pace's figures
+
+    def pace_json(self) -> dict | None:
+        if self.pace is None:
+            return None
+        got = self.end.get("pace") or {}
+        return {
+            "tolerance_rad": self.pace.rad,
+            "tolerance_m": self.pace.m,
+            "wait_s": self.pace.wait_s,
+            "ambf_simulated_s": self.end.get("t"),
+            "held_steps": got.get("held_steps"),
+            "give_ups": got.get("give_ups"),
+            "given_up_on": got.get("given_up_on", {}),
+            "clock_reached_end": got.get("clock_reached"),
+        }
+
+
+def replay(rec: Recording, build: ambf.AmbfBuild, launch: Path, indices, pace: Pace | None = None) -> Replay:
+    """The recording played in AMBF (paced by ``pace``; None: at AMBF's own time), judged by the
+    same verdicts, its tip path compared with adfkit's."""
     from ..tasks.verdicts import pair_verdict
     from .traces import from_ambf
 
     stage = ambf.Stage(Path(launch).resolve(), list(indices) if indices is not None else _all(launch))
-    run = ambf.run(build, stage, rec.seconds, EVERY, rec.commands, timeout=600 + 10 * rec.seconds)
+    longest = rec.seconds * (pace.max_factor if pace is not None else 1.0)
+    run = ambf.run(
+        build,
+        stage,
+        rec.seconds,
+        EVERY,
+        rec.commands,
+        timeout=600 + 10 * longest,
+        pace=None if pace is None else pace.plugin(),
+        pace_max_s=None if pace is None else longest,
+    )
     trace = from_ambf(run)
     obs = AmbfObservation(rec, trace)
     verdicts = [pair_verdict(obs, p) for p in rec.task.pairs]
     gaps = tip_gaps(rec.tip_path, obs.tip_path, rec.phase_log, rec.task.pairs)
-    return verdicts, gaps, trace
+    return Replay(verdicts, gaps, trace, pace, run.end)
 
 
 def _all(launch: Path) -> list[int]:
@@ -391,35 +455,71 @@ def _all(launch: Path) -> list[int]:
     return list(range(len(getattr(doc, "multibody_configs", None) or [])))
 
 
-def compare_suture(launch: Path, indices, pairs, build: ambf.AmbfBuild, seed: int = 0, progress: bool = False) -> dict:
-    """The suture in adfkit and replayed in AMBF, judged alike: the issue's JSON."""
+def compare_suture(
+    launch: Path,
+    indices,
+    pairs,
+    build: ambf.AmbfBuild,
+    seed: int = 0,
+    progress: bool = False,
+    paces: tuple[Pace | None, ...] = (None,),
+) -> dict:
+    """The suture in adfkit and replayed in AMBF (once per entry of ``paces``, the first judged
+    against adfkit's verdicts), judged alike: the issue's JSON."""
     rec = record(launch, indices, pairs, seed, progress)
-    verdicts, gaps, trace = replay(rec, build, launch, indices)
+    return compare_recorded(rec, launch, indices, build, paces) | {"scene": str(launch), "seed": seed}
+
+
+def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuild, paces=(None,)) -> dict:
+    """A recording replayed in AMBF once per pace (None: unpaced), as ``compare_suture`` reports it."""
+    replays = [replay(rec, build, launch, indices, p) for p in paces]
+    first = replays[0]
     mine = {v["pair"]: v for v in rec.verdicts}
-    n_ok = finite_samples(trace)
     out = []
-    for v in verdicts:
+    for k, v in enumerate(first.verdicts):
         a = mine.get(v["pair"], {})
-        out.append(
-            {
-                "pair": v["pair"],
-                "adfkit": a.get("verdict", "not-tried"),
-                "ambf": v["verdict"],
-                "adfkit_rule": a.get("rule"),
-                "ambf_rule": v["rule"],
-                "ambf_reason": v["reason"],
-                "tip_path_gap_m": gaps.get(v["pair"]),
-            }
-        )
+        row = {
+            "pair": v["pair"],
+            "adfkit": a.get("verdict", "not-tried"),
+            "ambf": v["verdict"],
+            "adfkit_rule": a.get("rule"),
+            "ambf_rule": v["rule"],
+            "ambf_reason": v["reason"],
+            "tip_path_gap_m": first.gaps.get(v["pair"]),
+        }
+        for other in replays[1:]:
+            how = "paced" if other.pace is not None else "unpaced"
+            w = other.verdicts[k]
+            row[f"ambf_{how}"] = w["verdict"]
+            row[f"ambf_{how}_rule"] = w["rule"]
+            row[f"tip_path_gap_{how}_m"] = other.gaps.get(v["pair"])
+        out.append(row)
     return {
-        "scene": str(launch),
-        "seed": seed,
         "seconds": rec.seconds,
         "commands": len(rec.commands),
         "pairs": out,
         "same_verdicts": all(p["adfkit"] == p["ambf"] for p in out),
+        "paced": first.pace is not None,
+        "pace": first.pace_json(),
         # AMBF's world blew up there (its poses not finite); judged on what came before
-        "ambf_not_finite_from_s": float(trace.times[n_ok]) if n_ok < len(trace.times) else None,
-        "wall_s": {"adfkit": rec.wall_s, "ambf": trace.wall_s},
+        "ambf_not_finite_from_s": _blew_up(first.trace),
+        "wall_s": {"adfkit": rec.wall_s, "ambf": first.trace.wall_s},
+        "replays": [
+            {
+                "paced": r.pace is not None,
+                "pace": r.pace_json(),
+                "ambf_not_finite_from_s": _blew_up(r.trace),
+                "wall_s": r.trace.wall_s,
+                "verdicts": [x["verdict"] for x in r.verdicts],
+            }
+            for r in replays
+        ],
         "not_judged_on_ambf": ["tool-hit-tissue", "blocked-at-entry by force", "blocked-in-channel by force"],
     }
+
+
+def _blew_up(trace) -> float | None:
+    """The command clock's time at which AMBF's poses stopped being finite, or None."""
+    n_ok = finite_samples(trace)
+    clock = trace.clock if trace.clock is not None else trace.times
+    return float(clock[n_ok]) if n_ok < len(clock) else None

@@ -27,6 +27,7 @@ class Trace:
     joints: np.ndarray  # (S, J), NaN where the side has no value
     wall_s: float  # stepping alone
     notes: list[str] = field(default_factory=list)
+    clock: np.ndarray | None = None  # (S,) a paced AMBF replay's command clock at each sample
 
 
 def ambf_name(key: str, obj) -> str:
@@ -87,7 +88,8 @@ def from_ambf(rec, staged: tuple[str, ...] = ()) -> Trace:
         len(s), len(made["joint"])
     )
     times = np.array([x["t"] for x in s])
-    return Trace("ambf", made, made["body"], times, poses[:, keep], made["joint"], joints, rec.wall_s)
+    clock = np.array([x.get("clock", x["t"]) for x in s])
+    return Trace("ambf", made, made["body"], times, poses[:, keep], made["joint"], joints, rec.wall_s, clock=clock)
 
 
 def _pose(sb) -> list[float]:

@@ -20,8 +20,20 @@
 //                           there at rest), force (TARGET a rigid body, ARG "fx fy fz px py pz": a
 //                           force at a world point, every step until its next force command);
 //                           a joint command holds until the joint's next command
+//   ADFKIT_PARITY_PACE      "RAD M WAIT_S" (default off): a paced replay, as a client that sends a
+//                           set-point and waits for the measured joints. The command file is read on
+//                           a command clock that advances one physics step only while every joint
+//                           under a position command stands within RAD (a revolute joint) or M (a
+//                           prismatic one) of its set-point; physics runs all the while. A joint still
+//                           outside after WAIT_S of simulated time held the clock (a jaw closed on a
+//                           needle) is let go of until it comes within its tolerance again, and each
+//                           such give-up is counted. SECONDS and EVERY are then command-clock time
+//   ADFKIT_PARITY_PACE_MAX  a paced replay ends at this simulated time if its clock has not reached
+//                           SECONDS by then (default 20 x SECONDS)
 //
-// Records: {"kind":"created",...} once, {"kind":"sample",...} per sample, {"kind":"end",...} last,
+// Records: {"kind":"created",...} once, {"kind":"sample",...} per sample (its "clock": the command
+// clock, the simulated time "t" when unpaced), {"kind":"end",...} last (a paced replay's "pace":
+// steps the clock was held, give-ups, the joints given up on),
 // or {"kind":"error","message":...} (and exit status 3) for a command file it cannot follow.
 // The process ends (_exit) once the last sample is written: the simulator has no other way out
 // when it runs headless.
@@ -29,6 +41,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -95,6 +108,15 @@ struct Command {
     int line;
 };
 
+// a joint under a position command, as the paced clock waits on it
+struct Drive {
+    afJointPtr joint = nullptr;
+    bool revolute = true, limited = false;
+    double lo = 0.0, hi = 0.0;
+    double heldSince = -1.0;  // simulated time it began holding the clock (-1: it is not)
+    bool excused = false;     // given up on until it comes within its tolerance again
+};
+
 }  // namespace
 
 class AdfkitParity : public afSimulatorPlugin {
@@ -114,6 +136,14 @@ public:
         // a measurement's knob: Bullet's solver iterations (AMBF leaves them at Bullet's 10)
         int iterations = (int)env_double("ADFKIT_PARITY_SOLVER_ITERATIONS", 0.0);
         if (iterations > 0) m_world->m_bulletWorld->getSolverInfo().m_numIterations = iterations;
+        const char* pace = getenv("ADFKIT_PARITY_PACE");
+        if (pace && *pace) {
+            istringstream ps(pace);
+            if (!(ps >> m_paceRad >> m_paceM >> m_paceWait) || m_paceRad <= 0 || m_paceM <= 0 || m_paceWait <= 0)
+                fail("ADFKIT_PARITY_PACE: expected three positive numbers, RAD M WAIT_S");
+            m_paced = true;
+            m_paceMax = env_double("ADFKIT_PARITY_PACE_MAX", 20.0 * m_seconds);
+        }
         update_global_poses();
         write_created();
         const char* cmds = getenv("ADFKIT_PARITY_COMMANDS");
@@ -130,12 +160,16 @@ public:
         m_steps++;
         update_global_poses();
         double t = m_world->getSimulationTime();
-        activate(t);
+        if (!m_paced) m_cmdClock = t;
+        else if (joints_arrived(t)) m_cmdClock += dt;
+        else m_heldSteps++;
+        activate(m_cmdClock);
         drive();
-        bool last = t + 1e-9 >= m_seconds;
-        if (last || t + 1e-9 >= m_nextSample) {
+        double c = m_cmdClock;
+        bool last = c + 1e-9 >= m_seconds || (m_paced && t + 1e-9 >= m_paceMax);
+        if (last || c + 1e-9 >= m_nextSample) {
             sample(m_steps);
-            while (m_nextSample <= t + 1e-9) m_nextSample += m_every > 0 ? m_every : m_seconds;
+            while (m_nextSample <= c + 1e-9) m_nextSample += m_every > 0 ? m_every : m_seconds;
         }
         if (last) finish(m_steps);
     }
@@ -151,6 +185,36 @@ private:
         for (afModelPtr m : m_world->getModels()) m->updateGlobalPose();
     }
 
+    // the paced clock's rule: every joint under a position command within its tolerance of its
+    // set-point (clamped to its limits, as commandPosition clamps it), or given up on after the
+    // bounded wait
+    bool joints_arrived(double t) {
+        bool all = true;
+        for (auto& kv : m_positionDrives) {
+            Drive& d = kv.second;
+            double target = m_drives[kv.first].value;
+            if (d.limited) target = max(d.lo, min(d.hi, target));
+            double err = d.revolute && !d.limited ? d.joint->getShortestAngle(d.joint->getPosition(), target)
+                                                  : target - d.joint->getPosition();
+            bool within = fabs(err) <= (d.revolute ? m_paceRad : m_paceM);
+            if (within) {
+                d.excused = false;
+                d.heldSince = -1.0;
+                continue;
+            }
+            if (d.excused) continue;
+            if (d.heldSince < 0) d.heldSince = t;
+            if (t - d.heldSince + 1e-9 >= m_paceWait) {
+                d.excused = true;
+                m_giveUps++;
+                m_givenUp[kv.first]++;
+                continue;
+            }
+            all = false;
+        }
+        return all;
+    }
+
     static double env_double(const char* name, double fallback) {
         const char* v = getenv(name);
         return v && *v ? atof(v) : fallback;
@@ -164,8 +228,20 @@ private:
 
     void finish(long steps) {
         double wall = chrono::duration<double>(chrono::steady_clock::now() - m_clock).count();
-        fprintf(m_out, "{\"kind\":\"end\",\"steps\":%ld,\"t\":%s,\"wall_s\":%s}\n", steps,
-                num(m_world->getSimulationTime()).c_str(), num(steps ? wall : 0.0).c_str());
+        string pace = "null";
+        if (m_paced) {
+            pace = "{\"held_steps\":" + to_string(m_heldSteps) + ",\"give_ups\":" + to_string(m_giveUps) +
+                   ",\"clock_reached\":" + (m_cmdClock + 1e-9 >= m_seconds ? "true" : "false") + ",\"given_up_on\":{";
+            bool first = true;
+            for (auto& kv : m_givenUp) {
+                pace += (first ? "" : ",") + json_text(kv.first) + ":" + to_string(kv.second);
+                first = false;
+            }
+            pace += "}}";
+        }
+        fprintf(m_out, "{\"kind\":\"end\",\"steps\":%ld,\"t\":%s,\"clock\":%s,\"wall_s\":%s,\"pace\":%s}\n",
+                steps, num(m_world->getSimulationTime()).c_str(), num(m_paced ? m_cmdClock : m_world->getSimulationTime()).c_str(),
+                num(steps ? wall : 0.0).c_str(), pace.c_str());
         fflush(m_out);
         fclose(m_out);
         _exit(0);
@@ -243,8 +319,9 @@ private:
     // a sample lists the bodies and the joints in the order the created record lists them
     // (two bodies may share a qualified name)
     void sample(long step) {
-        string s = "{\"kind\":\"sample\",\"step\":" + to_string(step) + ",\"t\":" + num(m_world->getSimulationTime()) +
-                   ",\"bodies\":[";
+        double t = m_world->getSimulationTime();
+        string s = "{\"kind\":\"sample\",\"step\":" + to_string(step) + ",\"t\":" + num(t) +
+                   ",\"clock\":" + num(m_paced ? m_cmdClock : t) + ",\"bodies\":[";
         bool first = true;
         for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
             // the body's ADF body frame at this step, as Bullet holds it. AMBF's own pose
@@ -357,8 +434,22 @@ private:
                 m_forces[c.target] = c;
                 m_forceBodies[c.target] = find_body(c.target);
             } else {
+                afJointPtr j = find_joint(c.target);
                 m_drives[c.target] = c;
-                m_driveJoints[c.target] = find_joint(c.target);
+                m_driveJoints[c.target] = j;
+                if (c.kind != "position") {
+                    m_positionDrives.erase(c.target);
+                } else if (m_paced && !m_positionDrives.count(c.target) &&
+                           (j->m_jointType == afJointType::REVOLUTE || j->m_jointType == afJointType::PRISMATIC)) {
+                    Drive d;
+                    d.joint = j;
+                    d.revolute = j->m_jointType == afJointType::REVOLUTE;
+                    afJointAttributes* a = dynamic_cast<afJointAttributes*>(j->getAttributes());
+                    d.limited = a && a->m_enableLimits;
+                    d.lo = j->getLowerLimit();
+                    d.hi = j->getUpperLimit();
+                    m_positionDrives[c.target] = d;
+                }
             }
         }
     }
@@ -407,6 +498,12 @@ private:
     map<string, afJointPtr> m_driveJoints;
     map<string, Command> m_forces;
     map<string, afRigidBodyPtr> m_forceBodies;
+    bool m_paced = false;
+    double m_paceRad = 0.0, m_paceM = 0.0, m_paceWait = 0.0, m_paceMax = 0.0;
+    double m_cmdClock = 0.0;
+    long m_heldSteps = 0, m_giveUps = 0;
+    map<string, Drive> m_positionDrives;
+    map<string, long> m_givenUp;
     chrono::steady_clock::time_point m_clock;
 };
 
