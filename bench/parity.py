@@ -3,12 +3,16 @@ adfkit, the largest gap of any body over the run and at its end, and each side's
 beside the other's. Prints a markdown table (docs/parity.md); with --plots DIR, draws each scene's
 gaps over time there. Asserts nothing; skips, with the reason, without an AMBF build.
 
-    .venv/bin/python bench/parity.py [--plots DIR] [--only NAME ...] [--json OUT]
+    .venv/bin/python bench/parity.py [--plots DIR] [--suture] [--only NAME ...] [--json OUT]
 
 Scenes: the project's own (`adfkit build-scene parity`: a dropped box, an arm under position,
 velocity and effort commands, a stack of boxes, a cube into a ghost, the thread falling from a
 held needle, the arm with a turned inertial frame), the bundled sample scenes at rest and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
 own floor (from the AMBF tree), and the KUKA and a PSM under joint programs (parity.programs).
+With --suture, only the suture replayed in AMBF (``adfkit parity --suture --pace both``, 4 pairs,
+seed 0) on the bundled scene and the corpus set, a row per pair: each side's verdict, paced and
+unpaced, the tip paths' largest gap, and the whole episode's stepping time on each side (tens of
+minutes on a shared box).
 Timings are of a shared 2-core box: noisy; compare AMBF's and adfkit's of one row.
 """
 
@@ -104,6 +108,37 @@ def corpus_scenes(build, folder: Path) -> list[Scene]:
     return out
 
 
+def suture_rows(build) -> list[str]:
+    """The suture replayed in AMBF, paced and unpaced, on the bundled scene and the corpus set."""
+    from adfkit.commands.suture import parse_pairs
+    from adfkit.parity.suture import PACE, compare_suture
+
+    scenes = [("bundled", ROOT / "sample_scenes" / "suturing" / "launch.yaml", None)]
+    if CORPUS.is_dir():
+        scenes.append(("corpus set", CORPUS / "src" / "launch.yaml", [6, 7, 8, 9, 10, 11]))
+    rows = []
+    for label, launch, indices in scenes:
+        out = compare_suture(launch, indices, parse_pairs("1,2,3,4"), build, 0, paces=(None, PACE))
+        plain, paced = out["replays"]
+        walls = (
+            f"{out['wall_s']['adfkit']:.0f} s | {paced['wall_s']:.0f} s "
+            f"({paced['pace']['ambf_simulated_s']:.1f} s played) | {plain['wall_s']:.0f} s"
+        )
+        for p in out["pairs"]:
+            rule = f" (`{p['ambf_rule']}`)" if p["ambf_rule"] else ""
+            rows.append(
+                f"| {label} | {p['pair']} | {p['adfkit']} | {p['ambf']}{rule} | {p['ambf_paced']} "
+                f"(`{p['ambf_paced_rule']}`) | {_mm(p['tip_path_gap_m'])} | {_mm(p['tip_path_gap_paced_m'])} | "
+                f"{walls} |"
+            )
+        print(f"  ({label}: {out['seconds']:.1f} s episode, {out['commands']} commands)", file=sys.stderr)
+    return rows
+
+
+def _mm(m) -> str:
+    return "-" if m is None or m != m else f"{m * 1e3:.1f} mm"
+
+
 def main(argv: list[str]) -> int:
     from adfkit.parity import ambf, session
 
@@ -114,6 +149,14 @@ def main(argv: list[str]) -> int:
     plots = Path(argv[argv.index("--plots") + 1]) if "--plots" in argv else None
     out_json = Path(argv[argv.index("--json") + 1]) if "--json" in argv else None
     only = argv[argv.index("--only") + 1 :] if "--only" in argv else []
+    if "--suture" in argv:
+        print(
+            "| scene | pair | adfkit | AMBF | AMBF paced | tip gap | tip gap paced "
+            "| adfkit stepping (episode) | AMBF paced | AMBF |"
+        )
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        print("\n".join(suture_rows(build)))
+        return 0
     os.environ.setdefault("ADFKIT_INPUT_ROOT", "/")  # the puzzle's launch names AMBF's floor and the corpus
     rows, results = [], []
     with tempfile.TemporaryDirectory(prefix="adfkit-parity-bench-") as tmp:
