@@ -61,6 +61,11 @@ class SuturingPadParams:
     thread_length: float = 0.2  # m
     thread_radius: float = 0.0004
     thread_mass: float = 0.0005  # kg per element
+    #: kg·m² of each element about every axis, not its capsule's (1e-9): AMBF damps the joints
+    #: explicitly, and the chain settles only where an element's inertia passes 4·c·dt (c the
+    #: joints' 0.01 N·m·s/rad, dt AMBF's 1 ms step); at the capsule's the thread turns its needle
+    #: over (scenes/suturing/thread.py, docs/parity.md)
+    thread_inertia: float = 5e-5
     camera_height: float = 0.25  # m above the pad
     eye_separation: float = 0.005  # stereo baseline, m
 
@@ -205,7 +210,7 @@ def build_suturing_pad(p: SuturingPadParams | None = None) -> ModelFile:
                 collision_geometry=g,
                 collision_offset=Pose(),
                 color_rgba=THREAD,
-                inertia=_capsule_inertia(p.thread_mass, p.thread_radius, seg),
+                inertia=Inertia(ix=p.thread_inertia, iy=p.thread_inertia, iz=p.thread_inertia),
                 inertial_offset=Pose(),
                 friction=Friction(static=0.5, rolling=0.01),
                 restitution=0.0,
