@@ -125,14 +125,17 @@ def suture_rows(build) -> list[str]:
             f"({paced['pace']['ambf_simulated_s']:.1f} s played) | {plain['wall_s']:.0f} s"
         )
         for p in out["pairs"]:
-            rule = f" (`{p['ambf_rule']}`)" if p["ambf_rule"] else ""
             rows.append(
-                f"| {label} | {p['pair']} | {p['adfkit']} | {p['ambf']}{rule} | {p['ambf_paced']} "
-                f"(`{p['ambf_paced_rule']}`) | {_mm(p['tip_path_gap_m'])} | {_mm(p['tip_path_gap_paced_m'])} | "
+                f"| {label} | {p['pair']} | {p['adfkit']} | {p['ambf']}{_rule(p['ambf_rule'])} | {p['ambf_paced']}"
+                f"{_rule(p['ambf_paced_rule'])} | {_mm(p['tip_path_gap_m'])} | {_mm(p['tip_path_gap_paced_m'])} | "
                 f"{walls} |"
             )
         print(f"  ({label}: {out['seconds']:.1f} s episode, {out['commands']} commands)", file=sys.stderr)
     return rows
+
+
+def _rule(rule) -> str:
+    return f" (`{rule}`)" if rule else ""
 
 
 def _mm(m) -> str:
