@@ -695,3 +695,29 @@ def test_the_kukas_shoulder_falls_short_as_ambfs_row_does(tmp_path, monkeypatch)
     assert worst < 17e-3
     worst, _ = _program_gaps(model, "velocity", tmp_path, monkeypatch, stiff=True)
     assert worst > 19e-3
+
+
+@needs_ambf
+def test_the_drilling_sample_stands_still_in_ambf_as_in_adfkit(tmp_path):
+    """The drilling sample's drill is weightless (the model's own gravity 0, which AMBF reads):
+    its shaft stays on its free prismatic joint in AMBF as in both engines (measured 0.000 mm in
+    1 s). Control: the same files with the world's gravity on the drill: AMBF leaves the joint's
+    motor off and the shaft slides 68 mm down (through the bone: AMBF's volumes do not collide)."""
+    import shutil
+    from pathlib import Path
+
+    from adfkit.parity import session
+
+    src = Path(__file__).resolve().parent.parent / "sample_scenes" / "drilling"
+    req = session.Request(src / "launch.yaml", None, BUILD, seconds=0.5, engines=("pybullet", "mujoco"))
+    for c in session.run(req, progress=False).comparisons:
+        assert max(g.max_position for g in c.bodies) < 1e-4, c.adfkit.side
+    heavy = tmp_path / "drilling"
+    shutil.copytree(src, heavy)
+    drill = heavy / "drill.yaml"
+    text = drill.read_text()
+    assert "\ngravity: {x: 0.0, y: 0.0, z: 0.0}\n" in text
+    drill.write_text(text.replace("\ngravity: {x: 0.0, y: 0.0, z: 0.0}\n", "\n"))
+    (c,) = session.run(session.Request(heavy / "launch.yaml", None, BUILD, seconds=0.5), progress=False).comparisons
+    shaft = c.ambf.body_names.index("/ambf/env/drilling/Shaft")
+    assert c.ambf.poses[0, shaft, 2] - c.ambf.poses[-1, shaft, 2] > 0.06

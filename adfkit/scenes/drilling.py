@@ -1,6 +1,7 @@
 """The drilling scene: a bone-like voxel volume (two labelled tissues: bone, and a canal of
 softer tissue through it, as a nerve runs through the temporal bone) written as PNG slices, a
-drill (a shaft and a spherical burr) on a prismatic mount above it, stereo cameras and a light.
+drill (a shaft and a spherical burr) on a prismatic mount above it, weightless as a held tool,
+stereo cameras and a light.
 
 Voxel values (8 bit): 0 air, CANAL inside the canal, BONE elsewhere in the bone, with a little
 texture; the iso-surface at 0.5 of full scale (127.5) is the bone's surface, and the canal,
@@ -86,7 +87,11 @@ def write_slices(vox: np.ndarray, folder: Path, prefix: str = "bone_") -> None:
 
 
 def build_drill_model(p: DrillingParams) -> ModelFile:
-    m = ModelFile(namespace="/ambf/env/drilling/")
+    # The drill is held by whoever drills (as the PSM files make their arms weightless): AMBF
+    # leaves the mount's prismatic joint free (its motor off until commanded), so under the
+    # world's gravity the shaft slides down through the bone (AMBF's volumes do not collide) to
+    # the floor, 68 mm in 1 s. The model's own gravity, which AMBF reads, holds it where it is.
+    m = ModelFile(namespace="/ambf/env/drilling/", gravity=Vec3(0.0, 0.0, 0.0))
     m.volumes.append(
         Volume(
             identifier="VOLUME Bone",

@@ -257,7 +257,8 @@ class Assembly:
                 for r in recs:
                     r[3].articulation = art
                 self.articulations.append(art)
-                art.drive()
+                art.retarget()
+                art.free()
 
     def _drive_limits_and_springs(self) -> None:
         """The drives' force limits (drives.DriveLimits); spring stiffness clamped like the

@@ -69,7 +69,7 @@ class MjBody(EngineBody):
 class MjArticulation:
     """A tree of revolute/prismatic(/fixed) joints under one root, as PSM reads it: records
     (joint, kind, parent, child) in depth-first order, position targets, drive() (the joint
-    equalities of drives.py: q - qpos0 = eq_data[0])."""
+    equalities of drives.py: q - qpos0 = eq_data[0]; off until driven, free())."""
 
     def __init__(self, world, root, records):
         self.world, self.root, self.records = world, root, records
@@ -102,6 +102,14 @@ class MjArticulation:
             d.eq_active[self._eq] = 1
             d.qfrc_applied[self.vadr[self._driven]] = 0.0
             self.efforts = False
+
+    def free(self) -> None:
+        """Every drive off until ``drive`` or a joint command: AMBF builds its joints' motors
+        disabled and turns one on only for a position or velocity command."""
+        d = self.world.data
+        d.eq_active[self._eq] = 0
+        d.qfrc_applied[self.vadr[self._driven]] = 0.0
+        self.efforts = True
 
 
 @dataclass(eq=False)

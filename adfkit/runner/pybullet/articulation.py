@@ -57,7 +57,8 @@ def components(joints):
 
 
 class Articulation:
-    """One multibody: its joints, their home values (held by position motors)."""
+    """One multibody: its joints, their position targets, their motors: off until something
+    drives them (``free``), as AMBF leaves a joint's motor until the joint is commanded."""
 
     def __init__(self, uid, root, records, cid):
         self.uid, self.root, self.records, self.cid = uid, root, records, cid
@@ -65,6 +66,7 @@ class Articulation:
         self.kinds = [r[1] for r in records]
         self.targets = [0.0] * len(records)
         self.forces = []
+        self.held = False  # the position motors hold the targets (drive), or every motor is off (free)
 
     def joint_values(self) -> list[float]:
         return [s[0] for s in pb.getJointStates(self.uid, list(range(len(self.records))), physicsClientId=self.cid)]
@@ -78,6 +80,18 @@ class Articulation:
             forces=self.forces,
             physicsClientId=self.cid,
         )
+        self.held = True
+
+    def free(self) -> None:
+        """Every joint's motor off: the joints move as their bodies' forces and contacts move them.
+        AMBF builds each revolute and prismatic joint with its motor disabled
+        (afJoint::createFromAttribs) and turns it on only for a position or velocity command;
+        it applies no joint damping (afJoint::applyDamping is not called)."""
+        n = len(self.records)
+        pb.setJointMotorControlArray(
+            self.uid, list(range(n)), pb.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=self.cid
+        )
+        self.held = False
 
 
 def depth_first(root, records):
@@ -168,7 +182,7 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
         art.targets[n] = q
         impulse = joint.max_motor_impulse if joint.max_motor_impulse is not None else DEFAULT_JOINT_MAX_MOTOR_IMPULSE
         art.forces.append(impulse / dt)
-    art.drive()
+    art.free()
     return art
 
 

@@ -29,7 +29,7 @@ from ..rotations import matrix_to_pq
 @dataclass(eq=False)
 class Snapshot:
     """What save_state took: every free body's and multibody base's pose and velocity, every
-    joint's position and velocity, the joint motors' targets, the clock, Bullet's in-memory state
+    joint's position and velocity, the joint motors' targets and whether they hold them, the clock, Bullet's in-memory state
     (``state_id``, valid in the world that took it: ``world``, a weak reference) and its Bullet
     file (``bullet``, bytes, restorable in a fresh world of the same scene)."""
 
@@ -40,6 +40,7 @@ class Snapshot:
     steps: int
     state_id: int
     bullet: bytes
+    held: list
 
 
 class WorldState:
@@ -65,7 +66,8 @@ class WorldState:
                 bullet = f.read()
         state_id = pb.saveState(physicsClientId=cid)
         targets = [list(a.targets) for a in self.articulations]
-        return Snapshot(weakref.ref(self), bases, joints, targets, self.steps, state_id, bullet)
+        held = [a.held for a in self.articulations]
+        return Snapshot(weakref.ref(self), bases, joints, targets, self.steps, state_id, bullet, held)
 
     def restore_state(self, snap: Snapshot) -> None:
         """Put the world back to ``snap``: every grasp released, bodies and joints at their saved
@@ -82,9 +84,12 @@ class WorldState:
             self._restore_own(snap)
         else:
             self._restore_file(snap)
-        for art, t in zip(self.articulations, snap.targets):
+        for art, t, held in zip(self.articulations, snap.targets, snap.held):
             art.targets[:] = t
-            art.drive()
+            if held:
+                art.drive()
+            else:
+                art.free()
         self.steps, self.sim_time = snap.steps, snap.steps * self.dt
 
     def _restore_own(self, snap: Snapshot) -> None:
