@@ -386,3 +386,29 @@ def test_an_uncommanded_joint_is_free_as_in_ambf(tmp_path, engine):
             assert weight.com_position()[2] == pytest.approx(0.4 - drop, abs=2e-3)
         finally:
             world.close()
+
+
+def test_ambfs_ghost_rule_hangs_a_cube_in_a_ghost_alike_in_both_engines(tmp_path):
+    """AMBF's ghost rule (Options.ghosts "ambf": a body in penetrating contact with a ghost is
+    weightless and keeps 0.9 of its velocity per contact point and physics step) in PyBullet and
+    in MuJoCo: the parity scene's cube, dropped into a ghost slab hung on a post, stops in it at
+    the same height in both (measured 244.83 and 244.90 mm; AMBF 247.76), its twin beside the
+    slab falls to the floor. Control: the suture's hole friction acts in hole ghosts only, and
+    the cube falls through to the floor too."""
+    from adfkit.scenes.parity import write_parity
+
+    launch = write_parity(tmp_path)
+    ends = {}
+    for engine in ("pybullet", "mujoco"):
+        for rule in ("ambf", "hole-friction"):
+            world = open_world(load_scene(launch, [3]), Options(visuals=False, ghosts=rule), engine=engine)
+            try:
+                world.run(0.6)
+                ends[engine, rule] = (world.body("cube").com_position()[2], world.body("twin").com_position()[2])
+            finally:
+                world.close()
+    for engine in ("pybullet", "mujoco"):
+        cube, twin = ends[engine, "ambf"]
+        assert 0.24 < cube < 0.25 and twin < 0.05, engine
+        assert ends[engine, "hole-friction"][0] < 0.05, engine
+    assert ends["pybullet", "ambf"][0] == pytest.approx(ends["mujoco", "ambf"][0], abs=5e-4)

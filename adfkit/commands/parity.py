@@ -49,8 +49,10 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--ghosts",
         choices=("ambf", "hole-friction"),
-        help="what adfkit's ghosts do (default hole-friction: the paper's F = -K·v in hole ghosts; "
-        "ambf: AMBF's own ghost objects, gravity off and 10 %% of the velocity taken per step; PyBullet)",
+        default="ambf",
+        help="what adfkit's ghosts do (default ambf: AMBF's own ghost objects, gravity off and 10 %% of "
+        "the velocity taken per contact point and step; hole-friction: the suture's rule, the paper's "
+        "F = -K·v in hole ghosts)",
     )
     p.add_argument("--no-ground", action="store_true", help="a model file: no floor under it on either side")
     p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")

@@ -45,10 +45,11 @@ def add_arguments(p) -> None:
     p.add_argument("--hole-friction", type=float, default=2.0, help="K of F = -K·v inside hole ghosts, N·s/m")
     p.add_argument(
         "--ghosts",
-        choices=("hole-friction", "ambf"),
-        default="hole-friction",
-        help="what ghosts do: hole-friction (default; the paper's F = -K·v inside hole ghosts) or ambf "
-        "(AMBF's ghost objects: gravity off and 10%% of the velocity taken per step; PyBullet only)",
+        choices=("ambf", "hole-friction"),
+        default="ambf",
+        help="what ghosts do: ambf (default; AMBF's ghost objects: a body in one is weightless and loses "
+        "10%% of its velocity per contact point and step) or hole-friction (the suture's rule, the "
+        "paper's F = -K·v inside hole ghosts only)",
     )
     p.add_argument("--no-frames", action="store_true", help="do not render camera frames")
     p.add_argument(

@@ -27,7 +27,7 @@ class Request:
     commands: Path | None = None
     control_substeps: int | None = None  # None: 4 (adfkit run's), 1 with joint commands (AMBF's rate)
     ground: bool = True
-    ghosts: str | None = None  # adfkit's ghost rule (Options.ghosts); None: its default
+    ghosts: str = "ambf"  # adfkit's ghost rule (Options.ghosts): AMBF's own, unless asked otherwise
     tolerance_m: float = 1e-3
     tolerance_deg: float = 1.0
 
@@ -96,8 +96,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
     if any(d.severity >= Severity.ERROR for d in diags):
         raise AdfError(diags)
     opt = Options(control_substeps=req.control_substeps, ground=req.ground, visuals=False, renderer="tiny")
-    if req.ghosts is not None:
-        opt.ghosts = req.ghosts
+    opt.ghosts = req.ghosts
     worlds = [open_world(scene, opt, engine=e) for e in req.engines]
     try:
         players = [AdfkitPlayer(w) for w in worlds]

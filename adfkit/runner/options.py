@@ -16,7 +16,9 @@ class Options:
     visuals: bool = True
     # what ghost objects do to the bodies inside them (ghost_rules.GHOST_RULES): "ambf", AMBF's afGhostObject
     # (every ghost: gravity off and 0.9 of the velocity kept per step and contact point);
-    # "hole-friction", the paper's F = -K·v_rel inside hole ghosts only (K: hole_friction)
+    # "hole-friction", the paper's F = -K·v_rel inside hole ghosts only (K: hole_friction), which the
+    # suture task was built and accepted on: the default here, for the tasks; `adfkit run` and
+    # `adfkit parity` play AMBF's rule unless asked otherwise
     ghosts: str = "hole-friction"
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")

@@ -130,14 +130,6 @@ class Assembly:
             self.ghosts.append(MjGhost(gp.key, gp.ghost, parent, ids, gp.friction, pose_in_parent=gp.location))
             self.registry.items[gp.key] = None
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
-        if self.opt.ghosts != "hole-friction":
-            self._warn(
-                "runner-ghost-rule",
-                f"ghosts {self.opt.ghosts!r} (AMBF's rule) is played by the PyBullet runner; the MuJoCo engine "
-                "plays the hole ghosts' viscous friction",
-                None,
-                "use --engine pybullet for AMBF's ghosts",
-            )
         self._friction_geoms = np.array([gid for g in self._friction_ghosts for gid in g.geoms], dtype=int)
         self._friction_owner = [g for g in self._friction_ghosts for _ in g.geoms]
         self.actuators = [

@@ -1,5 +1,5 @@
-"""What the MuJoCo world does between steps (the Interaction half of MujocoWorld): hole ghosts
-sensing what is inside them and applying viscous friction, ray sensors, the grasp's weld,
+"""What the MuJoCo world does between steps (the Interaction half of MujocoWorld): ghosts sensing
+what is inside them and acting on it (AMBF's rule, or the hole ghosts' viscous friction), ray sensors, the grasp's weld,
 collision switches at run time, contacts."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from ..ghost_rules import viscous_impulse_force
+from ..ghost_rules import ghost_velocity, viscous_impulse_force
 from ..rotations import invert, matrix_to_quat, pose_matrix
 from .assemble import WAKE_FORCE, _xyzw
 from .collision import EXCLUDE_SPARE
@@ -58,6 +58,55 @@ class Interaction:
         g.overlapping = found
         self._overlaps_cleared = False
         return found
+
+    def _penetrating(self, g: MjGhost) -> list[tuple[MjBody, int]]:
+        """Each dynamic body in penetrating contact with ghost ``g`` (its parent too: AMBF's ghosts
+        sense the body they hang on), with how many of its geoms penetrate one of the ghost's
+        (MuJoCo's exact geom distance below 0; bounding spheres first)."""
+        m, d = self.model, self.data
+        cg = self._cand_geoms
+        if not len(cg):
+            return []
+        gx = d.geom_xpos
+        near = np.zeros(len(cg), dtype=bool)
+        for gid in g.geoms:
+            near |= np.linalg.norm(gx[cg] - gx[gid], axis=1) <= m.geom_rbound[cg] + m.geom_rbound[gid]
+        points: dict[int, list] = {}
+        for k in np.nonzero(near)[0]:
+            sb = self._cand_geom_body[k]
+            n = sum(1 for gid in g.geoms if mujoco.mj_geomDistance(m, d, int(gid), int(cg[k]), 0.0, None) < 0.0)
+            if n:
+                points.setdefault(id(sb), [sb, 0])[1] += n
+        return [(sb, n) for sb, n in points.values()]
+
+    def _ambf_ghosts(self) -> None:
+        """AMBF's ghost objects (ghost_rules: afGhostObject::update after each physics step), for
+        this control step's physics steps: every body in penetrating contact keeps
+        AMBF_GHOST_KEEP per contact and step of its velocity across the ghost parent's (a free
+        body; a jointed one only loses its weight, as in the PyBullet runner) and is weightless
+        until the next control step."""
+        steps = self.opt.control_substeps
+        d, m = self.data, self.model
+        held: dict[int, MjBody] = {}
+        for g in self.ghosts:
+            found = self._penetrating(g)
+            g.overlapping = [sb for sb, _ in found]
+            if not found:
+                continue
+            moving = g.parent is not None and not g.parent.static
+            v_par = self._com_velocity(g.parent) if moving else np.zeros(3)
+            for sb, points in found:
+                held[id(sb)] = sb
+                v6 = self._vel6
+                mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, sb.id, v6, 0)
+                v, w = ghost_velocity(v6[3:], v6[:3], v_par, points * steps)
+                self.set_body_velocity(sb, v, w)
+        if held:
+            self._overlaps_cleared = False
+            for sb in held.values():
+                g = sb.gravity if sb.gravity is not None else np.asarray(self.gravity, float)
+                d.xfrc_applied[sb.id, :3] -= m.body_mass[sb.id] * g
+            self._xfrc_dirty = True
 
     def _viscous(self, g: MjGhost, found) -> None:
         """F = -K·(v_body - v_phantom) on every body inside a hole ghost (held for a control

@@ -99,7 +99,8 @@ class MujocoWorld(Assembly, Interaction, World):
 
     def control(self) -> None:
         """Per-control-step forces and senses: proximity sensors' rays, the bodies' velocity damping
-        (damping.py), hole ghosts' viscous friction.
+        (damping.py), the ghosts: AMBF's rule (Options.ghosts "ambf", every ghost) or the hole
+        ghosts' viscous friction.
         Only awake candidate geoms are looked at (a sleeping body does not move), first against
         one sphere that holds every hole-ghost geom (kept while the ghosts' bodies sleep): all
         of them above it along -gravity (instruments over the tissue: one product and a
@@ -110,6 +111,9 @@ class MujocoWorld(Assembly, Interaction, World):
         for s in self.sensors:
             self._sense(s)
         self.damping.apply()
+        if self.opt.ghosts == "ambf":
+            self._ambf_ghosts()
+            return
         fg = self._friction_geoms
         if not len(fg) or not len(self._cand_geoms):
             return
