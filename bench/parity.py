@@ -3,12 +3,13 @@ adfkit, the largest gap of any body over the run and at its end, and each side's
 beside the other's. Prints a markdown table (docs/parity.md); with --plots DIR, draws each scene's
 gaps over time there. Asserts nothing; skips, with the reason, without an AMBF build.
 
-    .venv/bin/python bench/parity.py [--plots DIR] [--suture] [--only NAME ...] [--json OUT]
+    .venv/bin/python bench/parity.py [--plots DIR] [--suture] [--corpus-at-rest] [--json OUT] [--only NAME ...]
 
 Scenes: the project's own (`adfkit build-scene parity`: a dropped box, an arm under position,
 velocity and effort commands, a stack of boxes, a cube into a ghost, the thread falling from a
 held needle, the arm with a turned inertial frame), the bundled sample scenes at rest and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
-own floor (from the AMBF tree), and the KUKA and a PSM under joint programs (parity.programs).
+own floor (from the AMBF tree), and the KUKA and a PSM under joint programs (parity.programs);
+with --corpus-at-rest, more corpus files AMBF loads (AT_REST), at rest for 1 s in both engines.
 With --suture, only the suture replayed in AMBF (``adfkit parity --suture --pace both``, 4 pairs,
 seed 0) on the bundled scene and the corpus set, a row per pair: each side's verdict, paced and
 unpaced, the tip paths' largest gap, and the whole episode's stepping time on each side (tens of
@@ -142,6 +143,37 @@ def _mm(m) -> str:
     return "-" if m is None or m != m else f"{m * 1e3:.1f} mm"
 
 
+#: corpus files AMBF loads, played at rest for 1 s in both engines (--corpus-at-rest: about two
+#: minutes of adfkit stepping on a quiet 2-core box); paths under the corpus's `ambf/`
+AT_REST = (
+    "ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml",
+    "ambf_models/descriptions/multi-bodies/robots/blender-ecm-springy.yaml",
+    "ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml",
+    "ambf_models/descriptions/multi-bodies/robots/blender-mtm-springy.yaml",
+    "ambf_models/descriptions/multi-bodies/robots/blender-psm.yaml",
+    "ambf_models/descriptions/multi-bodies/robots/blender-psm-springy.yaml",
+    "ambf_models/descriptions/multi-bodies/robots/blender-kuka-springy.yaml",
+    "ambf_models/descriptions/multi-bodies/grippers/resistive/gripper1/gripperA.yaml",
+    "ambf_models/descriptions/multi-bodies/grippers/resistive/gripper1/gripperB.yaml",
+    "ambf_models/descriptions/multi-bodies/grippers/resistive/gripper3/gripper.yaml",
+    "ambf_models/descriptions/multi-bodies/puzzles/puzzle2.yaml",
+    "ambf_models/descriptions/multi-bodies/puzzles/puzzle4.yaml",
+    "ambf_models/descriptions/multi-bodies/puzzles/puzzle5.yaml",
+    "ambf_models/descriptions/multi-bodies/puzzles/puzzle6.yaml",
+    "ambf_models/descriptions/multi-bodies/puzzles/parallel_structure.yaml",
+    "ambf_controller/raven2/launch.yaml",
+)
+
+
+def corpus_at_rest() -> list[Scene]:
+    both = ("pybullet", "mujoco")
+    return [
+        Scene(f"corpus {Path(rel).parent.name}/{Path(rel).name} at rest", CORPUS / "ambf" / rel, None, 1.0, both)
+        for rel in AT_REST
+        if (CORPUS / "ambf" / rel).is_file()
+    ]
+
+
 def main(argv: list[str]) -> int:
     from adfkit.parity import ambf, session
 
@@ -165,6 +197,8 @@ def main(argv: list[str]) -> int:
     with tempfile.TemporaryDirectory(prefix="adfkit-parity-bench-") as tmp:
         folder = Path(tmp)
         scenes = own_scenes(folder / "own") + sample_scenes() + corpus_scenes(build, folder)
+        if "--corpus-at-rest" in argv:
+            scenes += corpus_at_rest()
         for sc in scenes:
             if only and not any(o.lower() in sc.name.lower() for o in only):
                 continue
