@@ -368,6 +368,15 @@ SLIDING_WEIGHT = (
 )
 
 
+FIXED_MOUNT = (
+    "BODY post:\n  name: post\n  mass: 0.0\n"
+    "  location: {position: {x: 0.0, y: 0.0, z: 0.6}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
+    "JOINT post-mount:\n  name: post-mount\n  parent: BODY post\n  child: BODY mount\n  type: fixed\n"
+    "  parent pivot: {x: 0.0, y: 0.0, z: -0.1}\n  child pivot: {x: 0.0, y: 0.0, z: 0.0}\n"
+    "  parent axis: {x: 0.0, y: 0.0, z: 1.0}\n  child axis: {x: 0.0, y: 0.0, z: 1.0}\n"
+)
+
+
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
 def test_an_uncommanded_joint_is_free_as_in_ambf(tmp_path, engine):
     """AMBF builds every revolute and prismatic joint with its motor off and turns it on only for
@@ -378,7 +387,14 @@ def test_an_uncommanded_joint_is_free_as_in_ambf(tmp_path, engine):
     heavy = _model(tmp_path, SLIDING_WEIGHT.format(gravity=""))
     (tmp_path / "weightless").mkdir()
     weightless = _model(tmp_path / "weightless", SLIDING_WEIGHT.format(gravity="gravity: {x: 0.0, y: 0.0, z: 0.0}\n"))
-    for scene, drop in ((heavy, 0.05), (weightless, 0.0)):
+    # the mount fixed to a static body (no articulation of its own in MuJoCo: its drive was left on)
+    (tmp_path / "fixed").mkdir()
+    lists = (
+        "bodies: [BODY mount, BODY weight]\njoints: [JOINT mount-weight]",
+        "bodies: [BODY post, BODY mount, BODY weight]\njoints: [JOINT post-mount, JOINT mount-weight]",
+    )
+    fixed_mount = _model(tmp_path / "fixed", SLIDING_WEIGHT.format(gravity="").replace(*lists) + FIXED_MOUNT)
+    for scene, drop in ((heavy, 0.05), (weightless, 0.0), (fixed_mount, 0.05)):
         world = open_world(scene, Options(visuals=False, ground=False), engine=engine)
         try:
             weight = world.body("BODY weight")

@@ -251,6 +251,12 @@ class Assembly:
                 self.articulations.append(art)
                 art.retarget()
                 art.free()
+        # a drive no articulation holds (its tree hangs from a body fixed to a static one) is never
+        # commanded: off, as AMBF's motors are until a command turns them on
+        owned = {int(e) for a in self.articulations for e in a.eqs if e >= 0}
+        for e in range(m.neq):
+            if e not in owned and (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_EQUALITY, e) or "").startswith("drive:"):
+                self.data.eq_active[e] = 0
 
     def _drive_limits_and_springs(self) -> None:
         """The drives' force limits (drives.DriveLimits); spring stiffness clamped like the
