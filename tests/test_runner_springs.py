@@ -1,7 +1,8 @@
-"""The six-dof-family springs the PyBullet runner applies as forces (runner/pybullet/joints.py)
+"""The six-dof-family springs the PyBullet runner applies as forces (runner/pybullet/spring_forces.py)
 are integrated implicitly over the control step: at small gains the file's -k·x - c·v, at any
 gain never more than what stops the joint's relative motion within the step (the explicit
-spring with clamped gains threw the springy PSM's 1 g tool links past 10 m/s)."""
+spring with clamped gains threw the springy PSM's 1 g tool links past 10 m/s); or, as AMBF's
+Bullet plays them (Options.springs="ambf"), explicit with Bullet's caps at every physics step."""
 
 from __future__ import annotations
 
@@ -10,12 +11,12 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-from adfkit.runner.pybullet.joints import SpringSet  # noqa: E402
+from adfkit.runner.pybullet.spring_forces import SpringSet  # noqa: E402
 
 
 def _after(k, c, x, v, inertia, dt):
     den = 1.0 + (c * dt + k * dt**2) / inertia
-    tau = SpringSet._spring(k, c, x, v, den, dt)
+    tau = SpringSet._spring((k, c + k * dt, den), x, v)
     return tau, v + tau * dt / inertia
 
 
@@ -78,3 +79,132 @@ JOINT {a}-{b}:
         assert names == ["a", "b", "c"] and np.allclose(s.i_eff, [i_b, i_b])
     finally:
         world.close()
+
+
+SPRING_SCENE = """
+bodies: [BODY post, BODY bob]
+joints: [JOINT post-bob]
+BODY post:
+  name: post
+  mass: 0.0
+  location: {{position: {{x: 0.0, y: 0.0, z: 2.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+  collision shape: SPHERE
+  collision geometry: {{radius: 0.001}}
+BODY bob:
+  name: bob
+  mass: 0.1
+  inertia: {{ix: {i}, iy: {i}, iz: {i}}}
+  damping: {{linear: 0.0, angular: 0.0}}
+  location: {{position: {{x: 0.0, y: 0.0, z: 1.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+  collision shape: SPHERE
+  collision geometry: {{radius: 0.001}}
+JOINT post-bob:
+  parent: BODY post
+  child: BODY bob
+  parent pivot: {{x: 0.0, y: 0.0, z: -1.0}}
+  child pivot: {{x: 0.0, y: 0.0, z: 0.0}}
+  parent axis: {{x: 0.0, y: 0.0, z: 1.0}}
+  child axis: {{x: 0.0, y: 0.0, z: 1.0}}
+  type: six dof spring
+  joint limits:
+    linear: {{low: {{x: 0.0, y: 0.0, z: 0.0}}, high: {{x: 0.0, y: 0.0, z: 0.0}}}}
+  stiffness: {{linear: {{x: 0.0, y: 0.0, z: 0.0}}, angular: {{x: 0.0, y: 0.0, z: {k}}}}}
+  damping: {{linear: {{x: 0.0, y: 0.0, z: 0.0}}, angular: {{x: 0.0, y: 0.0, z: {c}}}}}
+"""
+
+
+def _twist_after_one_control_step(tmp_path, springs: str, k: float, c: float, inertia: float, x0: float):
+    """A bob on a six-dof spring about z from a static post (its pivot at the bob's centre of mass,
+    so Bullet's m is the bob's inertia), turned x0 about z at rest: its twist after one control step
+    (4 physics steps of 1 ms)."""
+    import pybullet as pb
+
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+
+    path = tmp_path / f"spring-{springs}.yaml"
+    path.write_text(SPRING_SCENE.format(i=inertia, k=k, c=c))
+    world = open_world(load_scene(path, None, []), Options(ground=False, visuals=False, springs=springs))
+    try:
+        bob = next(b for b in world.springs.bodies if b.key.endswith("bob"))
+        # a step at rest first: PyBullet's first step turns a body with the inertia of its collision
+        # shape (the sphere's 4e-8 kg m², changeDynamics's inertia is in its world tensor from then on)
+        world.step(1)
+        p, _ = pb.getBasePositionAndOrientation(bob.uid, physicsClientId=world.cid)
+        q = pb.getQuaternionFromEuler((0.0, 0.0, x0))
+        pb.resetBasePositionAndOrientation(bob.uid, p, q, physicsClientId=world.cid)
+        world.step(1)
+        _, q = pb.getBasePositionAndOrientation(bob.uid, physicsClientId=world.cid)
+        w = pb.getBaseVelocity(bob.uid, physicsClientId=world.cid)[1]
+        return pb.getEulerFromQuaternion(q)[2], w[2]
+    finally:
+        world.close()
+
+
+def test_ambfs_springs_are_explicit_capped_and_act_every_physics_step(tmp_path):
+    """Options(springs="ambf"), Bullet's btGeneric6DofSpring2Constraint: the torque -K·x - C·w at
+    each 1 ms physics step, semi-implicit Euler (w, then x with the new w), K = min(k, I/(16·dt²))
+    and C = min(c, I/dt). A stiffness 100x its cap plays as the cap. Control: the implicit form,
+    one backward-Euler torque held over the 4 ms control step, lands elsewhere."""
+    inertia, x0, dt, sub = 1e-4, 0.2, 1e-3, 4
+    k_cap, c_cap = inertia / (16 * dt * dt), inertia / dt
+    for k, c in ((100 * k_cap, 0.0), (0.5 * k_cap, 0.3 * c_cap), (0.5 * k_cap, 5 * c_cap)):
+        x, w = x0, 0.0
+        for _ in range(sub):  # by hand
+            w += -(min(k, k_cap) * x + min(c, c_cap) * w) * dt / inertia
+            x += w * dt
+        got_x, got_w = _twist_after_one_control_step(tmp_path, "ambf", k, c, inertia, x0)
+        assert got_x == pytest.approx(x, rel=1e-6) and got_w == pytest.approx(w, rel=1e-6)
+    # the capped stiffness by hand (k·dt²/I = 1/16 a step): 0.2 -> 0.1875, 0.16328, 0.12886, 0.08638 rad;
+    # uncapped (6.25 a step) the explicit spring diverges
+    assert _twist_after_one_control_step(tmp_path, "ambf", 100 * k_cap, 0.0, inertia, x0)[0] == pytest.approx(
+        0.08638, abs=1e-5
+    )
+    # the implicit control: one torque -(k·x0)/(1 + k·T²/I) held over T = 4 ms, its velocity gained
+    # a quarter a physics step (x0 + w·T·(1 + 2 + 3 + 4)/16): 0.0762 rad, not 0.0864
+    k, t = 100 * k_cap, sub * dt
+    w = -(k * x0) / (1 + k * t * t / inertia) * t / inertia
+    got_x, got_w = _twist_after_one_control_step(tmp_path, "implicit", k, 0.0, inertia, x0)
+    assert got_w == pytest.approx(w, rel=1e-6) and got_x == pytest.approx(x0 + w * t * 10 / 16, rel=1e-6)
+    assert abs(got_x - 0.08638) > 0.008
+
+
+def test_forces_of_the_control_step_are_held_while_the_springs_step_alone(tmp_path):
+    """With AMBF's springs PyBullet steps one physics step a call and clears applied forces after
+    each; what the control step applied (here a body's own gravity, pushed as a force) is applied
+    again at each physics step: a body with gravity +9.8 in a world of -9.8, next to the spring,
+    rises as under the implicit springs, where one call holds it over the control step. Control:
+    its fall had the push acted for one physics step of four."""
+    import pybullet as pb
+
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+
+    text = SPRING_SCENE.format(i=1e-4, k=1.0, c=0.0).replace(
+        "bodies: [BODY post, BODY bob]", "bodies: [BODY post, BODY bob, BODY up]"
+    )
+    text += """BODY up:
+  name: up
+  mass: 0.2
+  gravity: {x: 0.0, y: 0.0, z: 9.8}
+  damping: {linear: 0.0, angular: 0.0}
+  location: {position: {x: 1.0, y: 0.0, z: 1.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: SPHERE
+  collision geometry: {radius: 0.01}
+"""
+    (tmp_path / "up.yaml").write_text(text)
+    v = {}
+    for springs in ("ambf", "implicit"):
+        world = open_world(
+            load_scene(tmp_path / "up.yaml", None, []), Options(ground=False, visuals=False, springs=springs)
+        )
+        try:
+            up = next(b for b in world.bodies if b.key.endswith("up"))
+            world.step(5)
+            v[springs] = pb.getBaseVelocity(up.uid, physicsClientId=world.cid)[0][2]
+        finally:
+            world.close()
+    assert v["implicit"] == pytest.approx(9.8 * 0.02, rel=1e-6)  # 5 control steps of 4 ms at +9.8
+    assert v["ambf"] == pytest.approx(v["implicit"], rel=1e-6)  # held for the whole control step
+    # pushed for 1 ms of each 4: -9.8·0.02 + 2·9.8·0.005
+    assert abs(v["ambf"] - (-9.8 * 0.02 + 2 * 9.8 * 0.005)) > 0.2

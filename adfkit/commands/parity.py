@@ -54,6 +54,13 @@ def add_arguments(p) -> None:
         "the velocity taken per contact point and step; hole-friction: the suture's rule, the paper's "
         "F = -K·v in hole ghosts)",
     )
+    p.add_argument(
+        "--springs",
+        choices=("ambf", "implicit"),
+        default="ambf",
+        help="how adfkit's PyBullet runner plays six-dof springs (default ambf: as AMBF's Bullet, explicit "
+        "at every physics step with its caps; implicit: backward Euler over the control step, the suture's)",
+    )
     p.add_argument("--no-ground", action="store_true", help="a model file: no floor under it on either side")
     p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")
     p.add_argument("--tolerance-deg", type=float, default=1.0, help="largest orientation gap that agrees (1°)")
@@ -102,6 +109,7 @@ def run(args) -> int:
         control_substeps=args.control_substeps,  # None: session.Request decides
         ground=not args.no_ground,
         ghosts=args.ghosts,
+        springs=args.springs,
         tolerance_m=args.tolerance_mm / 1e3,
         tolerance_deg=args.tolerance_deg,
     )

@@ -51,6 +51,14 @@ def add_arguments(p) -> None:
         "10%% of its velocity per contact point and step) or hole-friction (the suture's rule, the "
         "paper's F = -K·v inside hole ghosts only)",
     )
+    p.add_argument(
+        "--springs",
+        choices=("ambf", "implicit"),
+        default="ambf",
+        help="how the PyBullet runner plays six-dof springs: ambf (default; as AMBF's Bullet, explicit "
+        "k·x + c·v at every physics step, k and c capped at m/(16·dt²) and m/dt) or implicit (backward "
+        "Euler over the control step, stable at any gain: the suture's)",
+    )
     p.add_argument("--no-frames", action="store_true", help="do not render camera frames")
     p.add_argument(
         "--renderer",
@@ -131,6 +139,7 @@ def run(args) -> int:
         gravity=gravity,
         hole_friction=args.hole_friction,
         ghosts=args.ghosts,
+        springs=args.springs,
         ground=not args.no_ground,
         renderer="tiny" if args.no_frames else args.renderer,
     )

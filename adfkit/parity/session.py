@@ -28,6 +28,7 @@ class Request:
     control_substeps: int | None = None  # None: 4 (adfkit run's), 1 with joint commands (AMBF's rate)
     ground: bool = True
     ghosts: str = "ambf"  # adfkit's ghost rule (Options.ghosts): AMBF's own, unless asked otherwise
+    springs: str = "ambf"  # how the PyBullet runner plays six-dof springs (Options.springs): as AMBF's Bullet
     tolerance_m: float = 1e-3
     tolerance_deg: float = 1.0
 
@@ -97,6 +98,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
         raise AdfError(diags)
     opt = Options(control_substeps=req.control_substeps, ground=req.ground, visuals=False, renderer="tiny")
     opt.ghosts = req.ghosts
+    opt.springs = req.springs
     worlds = [open_world(scene, opt, engine=e) for e in req.engines]
     try:
         players = [AdfkitPlayer(w) for w in worlds]

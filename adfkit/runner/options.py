@@ -20,6 +20,12 @@ class Options:
     # suture task was built and accepted on: the default here, for the tasks; `adfkit run` and
     # `adfkit parity` play AMBF's rule unless asked otherwise
     ghosts: str = "hole-friction"
+    # how the PyBullet runner plays six-dof springs and dampers (spring_forces.SpringSet): "implicit", backward
+    # Euler over the control step (stable at any gain; the default here, which the tasks were built and
+    # accepted on); "ambf", as AMBF's btGeneric6DofSpring2Constraint: explicit k·x + c·v at every
+    # physics step, k and c capped at m/(16·dt²) and m/dt (m the joint's inertia about the axis or its
+    # mass). `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: unused
+    springs: str = "implicit"
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
     ground: bool = True  # a model played without a world gets a floor under it

@@ -1,6 +1,6 @@
 """How the PyBullet world builds the scene (the Assembly half of PyBulletWorld): bodies as
 maximal-coordinate bodies or multibody links (articulation.py), the joints that close loops as
-constraints plus per-step spring forces (joints.py), collision filters, soft bodies, volumes,
+constraints plus per-step spring forces (joints.py, spring_forces.py), collision filters, soft bodies, volumes,
 ghosts, actuators, sensors and cameras, and the floor."""
 
 from __future__ import annotations
@@ -31,9 +31,10 @@ from . import articulation, egl
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .damping import LinkDamping
 from .interact import SimActuator, SimGhost, SimSensor
-from .joints import ConstraintRefused, SpringSet, make_constraint, spring_joint
+from .joints import ConstraintRefused, make_constraint, spring_joint
 from .meshfiles import pybullet_reads_quietly
 from .shapes import collision_parts, create_collision, create_visual
+from .spring_forces import SpringSet
 from .volumes import build_volumes
 
 
@@ -131,7 +132,7 @@ class Assembly:
             if kind_c is JointKind.FIXED:  # its relative orientation is held too (joint_angle_error)
                 self.fixed_frames.append((j.identifier, parent, child, fa[:3, :3], fb[:3, :3]))
         self._hold_closed_loops()
-        self.springs = SpringSet(springs, self.cid, self.gravity)
+        self.springs = SpringSet(springs, self.cid, self.gravity, self.opt.springs)
         self.link_damping = LinkDamping(self)
         build_volumes(self, models)
         known = None

@@ -19,6 +19,7 @@ from ...model.semantics import (
 )
 from ..rotations import pose_to_matrix
 from ..world import EngineBody
+from . import held
 
 
 @dataclass(eq=False)
@@ -75,10 +76,10 @@ class SimBody(EngineBody):
         return pose_matrix(p, q) @ invert(self.com_in_body)
 
     def torque(self, t) -> None:
-        pb.applyExternalTorque(self.uid, self.link, t, pb.WORLD_FRAME, physicsClientId=self.cid)
+        held.twist(self.uid, self.link, t, self.cid)
 
     def force(self, f, at) -> None:
-        pb.applyExternalForce(self.uid, self.link, f, at, pb.WORLD_FRAME, physicsClientId=self.cid)
+        held.push(self.uid, self.link, f, at, self.cid)
 
 
 def make_sim_body(key: str, body, model) -> SimBody:

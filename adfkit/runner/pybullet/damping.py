@@ -14,6 +14,7 @@ import numpy as np
 import pybullet as pb
 
 from ..damping import decay_rates, gains
+from . import held
 
 
 class LinkDamping:
@@ -44,7 +45,7 @@ class LinkDamping:
     def apply(self) -> None:
         """Add this control step's damping forces and torques (cleared by the next step)."""
         cid = self.cid
-        push, twist, frame = pb.applyExternalForce, pb.applyExternalTorque, pb.WORLD_FRAME
+        push, twist = held.push, held.twist
         for uid, links, k_lin, k_ang in self.groups:
             pos, rot, lin, ang = _states(uid, links, cid)
             # the torque k·I·ω with I = R·diag(I)·Rᵀ, R the COM frame's rotation in the world
@@ -52,8 +53,8 @@ class LinkDamping:
             torque = np.einsum("nij,nj->ni", rot, k_ang * local)
             force = k_lin[:, None] * lin
             for n, link in enumerate(links):
-                push(uid, link, force[n].tolist(), pos[n].tolist(), frame, cid)
-                twist(uid, link, torque[n].tolist(), frame, cid)
+                push(uid, link, force[n].tolist(), pos[n].tolist(), cid)
+                twist(uid, link, torque[n].tolist(), cid)
 
 
 def _states(uid: int, links: list[int], cid: int):

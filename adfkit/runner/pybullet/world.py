@@ -2,7 +2,7 @@
 
 Bodies joined by revolute/prismatic trees become multibodies (exact joints, native limits and
 position motors); every other body is a maximal-coordinate rigid body and every other joint a
-createConstraint plus per-step forces (joints.py). docs/runner.md says why. The world is three
+createConstraint plus per-step forces (joints.py, spring_forces.py). docs/runner.md says why. The world is three
 parts: building (assemble.py), what happens between steps (interact.py) and, here, stepping,
 state and the report; what is engine-neutral is in runner/world.py and runner/plan.py.
 """
@@ -22,7 +22,7 @@ from ..soft import in_scene as soft_in_scene
 from ..soft import soft_health
 from ..stability import CHECK_EVERY_S
 from ..world import World
-from . import egl
+from . import egl, held
 from . import stability as pb_stability
 from .assemble import Assembly
 from .bodies import SimBody
@@ -42,6 +42,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         self._setup(scene, options, gui)
         self.mirror = mirror
         self.cid = pb.connect(pb.GUI if gui else pb.DIRECT)
+        held.forget(self.cid)  # a closed world's client id comes back: nothing of its is held
         self.soft = SoftBodies(self) if soft_in_scene(scene) else None  # soft bodies: a deformable world
         if self.soft is not None:
             enable_deformable_world(self.cid)
@@ -70,6 +71,12 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact
         pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
         self._build()
+        # AMBF's springs (Options.springs): explicit, at every physics step; PyBullet then steps one
+        # physics step a call and the control step's other forces are applied again at each (held.py)
+        self._springs_every_step = self.opt.springs == "ambf" and bool(self.springs.joints)
+        if self._springs_every_step:
+            pb.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSubSteps=1, physicsClientId=self.cid)
+            held.record(self.cid)
 
     def move_base(self, sb: SimBody, body_world: np.ndarray) -> None:
         """Put the root of a multibody (e.g. a PSM's base, as its setup joints would) at a new
@@ -168,8 +175,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         PyBullet's calls take their arguments by position here (this runs every control step)."""
         cdt = self.dt * self.opt.control_substeps
         cid = self.cid
-        base_pose, link_states, push = pb.getBasePositionAndOrientation, pb.getLinkStates, pb.applyExternalForce
-        frame = pb.WORLD_FRAME
+        base_pose, link_states, push = pb.getBasePositionAndOrientation, pb.getLinkStates, held.push
         poses = {}  # (uid, link) -> (position, quaternion) read this control step: the ghosts use them
         for uid, links, _sbs, forces in self._gravity_overrides:
             coms = []
@@ -179,8 +185,8 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
                 poses[(uid, k)] = pq
                 coms.append(pq[0])
             for k, f, at in zip(links, forces, coms):
-                push(uid, k, f, at, frame, cid)
-        self.springs.apply(cdt)
+                push(uid, k, f, at, cid)
+        self.springs.apply(self.dt if self._springs_every_step else cdt)
         self.link_damping.apply()
         poses.update(self.springs.pq)
         self._update_ghosts(poses)
@@ -196,6 +202,12 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         for _ in range(n):
             self.control()
             pb.stepSimulation(physicsClientId=self.cid)
+            if self._springs_every_step:  # the springs again at each physics step, the rest held
+                for _ in range(sub - 1):
+                    held.replay(self.cid)
+                    self.springs.apply(self.dt)
+                    pb.stepSimulation(physicsClientId=self.cid)
+                held.clear(self.cid)
         self.steps += n * sub
         self.sim_time = self.steps * self.dt
         if self.sim_time >= self._next_stability_check:  # NaN or a flung body, caught as it happens
@@ -298,6 +310,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             self._mj_view = None
         if self.soft is not None:
             self.soft.close()
+        held.forget(self.cid)
         if pb.isConnected(self.cid):
             with egl.quiet_stdout() if self.renderer == "egl" else contextlib.nullcontext():
                 pb.disconnect(self.cid)

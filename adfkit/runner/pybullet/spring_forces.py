@@ -1,0 +1,292 @@
+"""The spring, damping and limit forces of the joints PyBullet's constraints cannot make (joints.py):
+six-dof springs and the like, evaluated together with numpy (adf-format.md §8).
+
+Springs and dampers are played one of two ways (Options.springs): "implicit", integrated over the
+control step by backward Euler on the two bodies' relative motion (stable at any gain); or "ambf",
+as Bullet's btGeneric6DofSpring2Constraint in AMBF: the explicit k·x + c·v at every physics step,
+k capped at m/(16·dt²) and c at m/dt, m the joint's inertia about the axis (each body's about the
+axis plus its mass times the squared distance from its centre of mass to the joint frame) or its
+mass, both bodies' in series. Limits are velocity corrections with Baumgarte feedback on what the
+spring leaves; they can do no more than stop the joint's relative motion within the step.
+"""
+
+from __future__ import annotations
+
+from itertools import chain
+
+import numpy as np
+import pybullet as pb
+
+from ..rotations import euler_xyz, quat_to_matrix
+from ..springs import SpringJoint
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product of (n, 3) arrays: np.cross's products in np.cross's order,
+    without its axis bookkeeping (a third of the cost at this size)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
+def bullet_spring_masses(bodies, ip, ic, frame_a, frame_b):
+    """The inertia (n, 3) and mass (n, 3) Bullet's btGeneric6DofSpring2Constraint caps each joint's
+    spring and damper with, per axis of joint frame A: each dynamic body's inertia about the axis
+    (1/|I⁻¹·a|, the axis in its principal frame; the child's at the joint's zero angle) plus its
+    mass times the squared distance from its centre of mass to the joint frame, and each body's
+    mass; the two in series (mA·mB/(mA + mB)), one body's alone when the other is static."""
+    mass = np.array([0.0 if b.static else b.mass for b in bodies])
+    inertia = np.array([np.maximum(np.asarray(b.inertia, float), 1e-12) for b in bodies])
+
+    def about(i, frame):  # (n, 3): body i's inertia about each axis of its joint frame
+        axes = frame[:, :3, :3]  # columns: the joint frame's axes in the body's principal frame
+        own = 1.0 / np.linalg.norm(axes / inertia[i][:, :, None], axis=1)
+        return mass[i][:, None] * (frame[:, :3, 3] ** 2).sum(1)[:, None] + own
+
+    def series(a, b, ma, mb):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            both = a * b / (a + b)
+        return np.where((ma == 0)[:, None], b, np.where((mb == 0)[:, None], a, both))
+
+    ma, mb = mass[ip], mass[ic]
+    lin = series(np.repeat(ma[:, None], 3, 1), np.repeat(mb[:, None], 3, 1), ma, mb)
+    return series(about(ip, frame_a), about(ic, frame_b), ma, mb), lin
+
+
+class SpringSet:
+    """All force-driven joints, evaluated together with numpy each control step.
+
+    The per-step cost is mostly PyBullet's: one getBasePositionAndOrientation and one
+    getBaseVelocity per free body (PyBullet has no batched call for them) and one
+    applyExternalTorque per dynamic body. Everything that does not change between steps (the
+    joints' index subsets, gains, limits and incidence blocks) is sliced once here, and the
+    calls pass their arguments by position (keyword parsing is a tenth of a call's cost)."""
+
+    def __init__(self, joints: list[SpringJoint], cid: int, gravity=(0.0, 0.0, 0.0), form: str = "implicit") -> None:
+        """``gravity``: the world's; a body's own (``SimBody.gravity``) replaces it. ``form``: "implicit"
+        or "ambf" (Options.springs; the world applies "ambf" springs at every physics step)."""
+        self.joints = joints
+        self.form = form
+        self.cid = cid
+        self.world_gravity = np.asarray(gravity, dtype=float)
+        self.pq: dict[tuple, tuple] = {}  # (uid, -1) -> (position, quaternion) of each free body, as last read
+        self._order = None
+        n = len(joints)
+        if not n:
+            return
+        st = np.stack
+        fa, fb = st([j.frame_a for j in joints]), st([j.frame_b for j in joints])
+        self.ra_in_p, self.pa_in_p = fa[:, :3, :3], fa[:, :3, 3]
+        self.rb_in_c, self.pb_in_c = fb[:, :3, :3], fb[:, :3, 3]
+        for name in (
+            "lin_low",
+            "lin_high",
+            "ang_low",
+            "ang_high",
+            "k_lin",
+            "c_lin",
+            "eq_lin",
+            "k_ang",
+            "c_ang",
+            "eq_ang",
+        ):
+            setattr(self, name, st([getattr(j, name) for j in joints]))
+        self.free_lin = np.flatnonzero([not j.linear_constrained for j in joints])
+        bodies = []
+        for j in joints:
+            for b in (j.parent, j.child):
+                if b not in bodies:
+                    bodies.append(b)
+        self.bodies = bodies
+        idx = {id(b): i for i, b in enumerate(bodies)}
+        self.ip = np.array([idx[id(j.parent)] for j in joints])
+        self.ic = np.array([idx[id(j.child)] for j in joints])
+        # incidence: a joint's torque acts + on its child and - on its parent; summing per body
+        # is one matrix product (np.add.at is ten times slower at this size)
+        self.to_child = np.zeros((n, len(bodies)))
+        self.to_child[np.arange(n), self.ic] = 1.0
+        self.to_parent = np.zeros((n, len(bodies)))
+        self.to_parent[np.arange(n), self.ip] = 1.0
+        self.net = (self.to_child - self.to_parent).T
+        self.dynamic = np.flatnonzero([not b.static for b in bodies])
+        # bodies that get a net force (joint ends of a spring with free linear axes), the rest a torque only
+        pushed = np.zeros(len(bodies), dtype=bool)
+        pushed[self.ip[self.free_lin]] = True
+        pushed[self.ic[self.free_lin]] = True
+        self.pushed = pushed
+        # each joint's effective inertia (mass) as if each body's were shared among the spring
+        # joints on it: the joints act together (a Jacobi step), and a body between two joints
+        # that each stopped their relative motion alone would be turned twice as far back
+        deg = np.bincount(np.concatenate([self.ip, self.ic]), minlength=len(bodies)).astype(float)
+        inv_m = np.array([0.0 if b.static else 1.0 / b.mass for b in bodies]) * deg
+        inv_i = np.array([0.0 if b.static else 1.0 / max(min(b.inertia), 1e-12) for b in bodies]) * deg
+        self.m_eff = 1.0 / np.maximum(inv_m[self.ip] + inv_m[self.ic], 1e-12)
+        self.i_eff = 1.0 / np.maximum(inv_i[self.ip] + inv_i[self.ic], 1e-12)
+        self.ang_active = self.ang_low <= self.ang_high
+        fl = self.free_lin
+        # the free-linear joints' constant blocks, sliced once (the same values every step)
+        self.fl_ip, self.fl_ic = self.ip[fl], self.ic[fl]
+        self.fl_pa = self.pa_in_p[fl][:, :, None]
+        self.fl_pb = self.pb_in_c[fl][:, :, None]
+        self.fl_eq, self.fl_low, self.fl_high = self.eq_lin[fl], self.lin_low[fl], self.lin_high[fl]
+        self.fl_active = self.fl_low <= self.fl_high
+        self.fl_m = self.m_eff[fl][:, None]
+        self.fl_net = self.net[:, fl]
+        self.fl_child_t, self.fl_parent_t = self.to_child[fl].T, self.to_parent[fl].T
+        # the child's acceleration under gravity relative to the parent's, in the world: the
+        # limits of a free linear axis predict the velocity at the end of the control step with
+        # it, as a constraint row solved with the forces would (below)
+        acc = np.array(
+            [np.zeros(3) if b.static else (b.gravity if b.gravity is not None else self.world_gravity) for b in bodies]
+        )
+        self.fl_g_rel = (acc[self.ic] - acc[self.ip])[fl] if n else np.zeros((0, 3))
+        self.i_eff_col = self.i_eff[:, None]
+        if form == "ambf":
+            # Bullet's m, but never past the joint's share of its bodies' inertia (and mass) that the
+            # implicit form uses: Bullet's counts mass·r² even about an axis through both centres of
+            # mass, and the forces here act all at once (a Jacobi step), where Bullet solves rows one
+            # after another. With Bullet's m alone the corpus thread (capsules: 5e-10 kg m² about
+            # their axis, 90x less than its m) flew apart within the first second
+            m_ang, m_lin = bullet_spring_masses(bodies, self.ip, self.ic, fa, fb)
+            self.m_ang = np.minimum(m_ang, self.i_eff[:, None])
+            self.m_lin = np.minimum(m_lin, self.m_eff[:, None])
+        self._gains_dt = None
+
+    def _gains(self, dt: float) -> None:
+        """Per-joint constants of the spring-damper -(K·x + C·v) / D at this step (_spring).
+        Implicit (backward Euler): K = k, C = c + k·dt, D = 1 + (c·dt + k·dt²)/I (I the joint's
+        effective inertia or mass): the force that leaves the pair moving at the velocity the
+        spring and damper give it at the end of the step, for small gains the explicit -k·x - c·v,
+        for large ones at most what stops the motion. AMBF's (btGeneric6DofSpring2Constraint::
+        get_limit_motor_info2): K = min(k, m/(16·dt²)), C = min(c, m/dt), D = 1."""
+        if self._gains_dt == dt:
+            return
+        if self.form == "ambf":
+            self._ang = (
+                np.minimum(self.k_ang, self.m_ang / (16 * dt * dt)),
+                np.minimum(self.c_ang, self.m_ang / dt),
+                1.0,
+            )
+            self._lin = (
+                np.minimum(self.k_lin, self.m_lin / (16 * dt * dt)),
+                np.minimum(self.c_lin, self.m_lin / dt),
+                1.0,
+            )
+        else:
+            i_eff, m_eff = self.i_eff[:, None], self.m_eff[:, None]
+            den_ang = 1.0 + (self.c_ang * dt + self.k_ang * dt**2) / i_eff
+            den_lin = 1.0 + (self.c_lin * dt + self.k_lin * dt**2) / m_eff
+            self._ang = (self.k_ang, self.c_ang + self.k_ang * dt, den_ang)
+            self._lin = (self.k_lin, self.c_lin + self.k_lin * dt, den_lin)
+        k, c, den = self._lin
+        fl = self.free_lin
+        self._fl = (k[fl], c[fl], den if np.isscalar(den) else den[fl])
+        self._gains_dt = dt
+
+    @staticmethod
+    def _spring(gains, x, v):
+        """The spring-damper's force or torque -(K·x + C·v) / D, ``gains`` (K, C, D) (_gains)."""
+        k, c, den = gains
+        return -(k * x + c * v) / den
+
+    def _read_plan(self):
+        """How to read every body's COM state with the fewest PyBullet calls: free bodies and
+        multibody bases one by one (PyBullet has no batch call for them), the links of each
+        multibody with one getLinkStates. Built on first use (bodies have their uids then)."""
+        bases, links = [], {}
+        for i, b in enumerate(self.bodies):
+            if b.link < 0:
+                bases.append((i, b.uid))
+            else:
+                links.setdefault(b.uid, []).append((i, b.link))
+        order = [i for i, _ in bases] + [i for group in links.values() for i, _ in group]
+        self._bases = [uid for _, uid in bases]
+        self._base_keys = [(uid, -1) for uid in self._bases]
+        self._links = [(uid, [k for _, k in group]) for uid, group in links.items()]
+        self._order = np.argsort(np.array(order, dtype=int))  # read order -> body order
+        self._in_order = bool(np.array_equal(self._order, np.arange(len(order))))
+        self._apply_ids = [(i, self.bodies[i].uid, self.bodies[i].link, bool(self.pushed[i])) for i in self.dynamic]
+
+    def states(self):
+        """(positions, rotation matrices, linear and angular velocities) of every body's COM;
+        the free bodies' (position, quaternion) stay in ``pq`` by (uid, -1) until the next read."""
+        if self._order is None:
+            self._read_plan()
+        cid = self.cid
+        bases = self._bases
+        get_pose, get_vel, get_links = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getLinkStates
+        poses = [get_pose(uid, cid) for uid in bases]
+        rows = [p + q + v + w for (p, q), (v, w) in zip(poses, [get_vel(uid, cid) for uid in bases])]
+        self.pq = dict(zip(self._base_keys, poses))
+        for uid, ks in self._links:  # computeLinkVelocity, computeForwardKinematics
+            rows += [s[0] + s[1] + s[6] + s[7] for s in get_links(uid, ks, 1, 1, cid)]
+        a = np.fromiter(chain.from_iterable(rows), float, 13 * len(rows)).reshape(-1, 13)
+        if not self._in_order:
+            a = a[self._order]
+        return (a[:, 0:3], quat_to_matrix(a[:, 3:7]), a[:, 7:10], a[:, 10:13])
+
+    def apply(self, dt: float, erp: float = 0.2) -> None:
+        if not self.joints:
+            return
+        self._gains(dt)
+        pos, rot, lv, av = self.states()
+        ip, ic = self.ip, self.ic
+        ra = rot[ip] @ self.ra_in_p  # joint frame A in the world
+        rat = ra.transpose(0, 2, 1)
+        rel = rat @ (rot[ic] @ self.rb_in_c)  # frame B in frame A
+        ang = euler_xyz(rel)
+        w_rel = (rat @ (av[ic] - av[ip])[:, :, None])[..., 0]
+        # angular springs and limits, in joint frame A, turned into the world
+        i_eff = self.i_eff_col
+        tau = self._spring(self._ang, ang - self.eq_ang, w_rel)
+        tau += self._limit(ang, w_rel + tau * dt / i_eff, self.ang_low, self.ang_high, i_eff, dt, erp, self.ang_active)
+        torque = self.net @ (ra @ tau[:, :, None])[..., 0]
+        force = None
+        fl = self.free_lin
+        if fl.size:
+            # free linear axes: spring, damper and limits on the pivot offset in frame A; a
+            # force at the pivot = the same force at the COM plus its moment about the COM
+            fp, fc = self.fl_ip, self.fl_ic
+            pa = pos[fp] + (rot[fp] @ self.fl_pa)[..., 0]
+            pbw = pos[fc] + (rot[fc] @ self.fl_pb)[..., 0]
+            raft = rat[fl]
+            d = (raft @ (pbw - pa)[:, :, None])[..., 0]
+            v_rel = (raft @ (lv[fc] - lv[fp])[:, :, None])[..., 0]
+            m_eff = self.fl_m
+            f = self._spring(self._fl, d - self.fl_eq, v_rel)
+            # the limits see the velocity gravity adds over the step too: held for the whole step,
+            # a correction blind to it leaves a limit g·dt²/erp short under gravity (0.78 mm at
+            # 4 ms: the corpus phantom's hole bodies, whose axes are locked or at a limit, sagged
+            # that far below AMBF's, which solves them as constraint rows)
+            g_rel = (raft @ self.fl_g_rel[:, :, None])[..., 0]
+            f += self._limit(
+                d, v_rel + (f / m_eff + g_rel) * dt, self.fl_low, self.fl_high, m_eff, dt, erp, self.fl_active
+            )
+            f_w = (ra[fl] @ f[:, :, None])[..., 0]
+            force = self.fl_net @ f_w
+            torque += self.fl_child_t @ _cross(pbw - pos[fc], f_w) - self.fl_parent_t @ _cross(pbw - pos[fp], f_w)
+        torque = torque.tolist()
+        if force is not None:
+            force, pos = force.tolist(), pos.tolist()
+        cid, frame = self.cid, pb.WORLD_FRAME
+        apply_torque, apply_force = pb.applyExternalTorque, pb.applyExternalForce
+        for i, uid, link, pushed in self._apply_ids:
+            apply_torque(uid, link, torque[i], frame, cid)
+            if pushed:
+                apply_force(uid, link, force[i], pos[i], frame, cid)
+
+    @staticmethod
+    def _limit(x, v, low, high, inertia, dt, erp, active=None):
+        """Velocity-correcting force that keeps x within [low, high] (low > high: free, Bullet):
+        it drives a violation back at -erp·err/dt and only ever pushes, never pulls."""
+        if active is None:
+            active = low <= high
+        over = active & (x > high)
+        under = active & (x < low)
+        if not (over.any() or under.any()):
+            return 0.0
+        err = np.where(over, x - high, np.where(under, x - low, 0.0))
+        f = inertia * (-erp * err / dt - v) / dt
+        return np.where(over, np.minimum(f, 0.0), np.where(under, np.maximum(f, 0.0), 0.0))
