@@ -20,7 +20,11 @@ def ros(tmp_path_factory):
     rs.require_client()
     master = rs.Master()
     paths = rs.ambf_client(tmp_path_factory.mktemp("ambf"))
-    server = rs.Server(master, rs.SAMPLE, "--teleop", "joy:/test_joy=psm2", "--teleop", "geomagic:/test_geo/=psm1")
+    # AMBF's 0.5 s watchdog, given 2 s: a client starved of the CPU for half a second on a loaded
+    # machine (its 120 Hz command thread) let the world's step throttling lapse (3,749 steps for 50)
+    server = rs.Server(
+        master, rs.SAMPLE, "--teleop", "joy:/test_joy=psm2", "--teleop", "geomagic:/test_geo/=psm1", "--watchdog", "2"
+    )
     yield master, paths, server
     err = server.close()
     master.close()

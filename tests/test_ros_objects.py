@@ -84,3 +84,30 @@ def test_a_passive_joint_is_not_served(tmp_path):
     launch = _psm_copy(tmp_path / "a", names, passive="tool yaw link-tool gripper1 link")
     base = next(o for o in _served(launch).values() if o.name == "baselinksimple")
     assert [j.name for j in base.joints] == [n for n in order if n != "toolyawlink-toolgripper1link"]
+
+
+def test_the_watchdog_ends_step_throttling_after_its_time_out():
+    """AMBF's world watchdog: a throttled world waits for the client's step clock while the client
+    keeps sending world commands; once none came for the time out (0.5 s, AMBF's, or what
+    `adfkit ros --watchdog` gives) it runs free again. Decided by the world's handler alone."""
+    import types
+
+    from adfkit.ros.bridge import WATCHDOG_S, WorldHandler
+
+    for timeout in (WATCHDOG_S, 2.0):
+        h = object.__new__(WorldHandler)  # the rule, without a ROS master
+        h.bridge = types.SimpleNamespace(watchdog_s=timeout)
+        h.heard, h.throttle, h.allowed = 100.0, True, 0
+        assert not h.may_step(100.0 + 0.9 * timeout)  # fed: held until the clock grants a step
+        h.allowed = 1
+        assert h.may_step(100.0 + 0.9 * timeout) and h.throttle
+        h.allowed = 0
+        assert h.may_step(100.0 + 1.1 * timeout) and not h.throttle  # silent past the time out: free
+    assert WATCHDOG_S == 0.5
+
+
+def test_adfkit_ros_refuses_a_watchdog_that_is_no_time_out(capsys):
+    from adfkit.cli import main
+
+    assert main(["ros", str(SAMPLE), "--watchdog", "0"]) == 2
+    assert "--watchdog 0 is not a time out" in capsys.readouterr().err

@@ -38,6 +38,14 @@ def add_arguments(p) -> None:
         default=10,
         help="the physics solver's iterations a step (default 10, AMBF's; the scripted suture plays with 50)",
     )
+    p.add_argument(
+        "--watchdog",
+        type=float,
+        default=0.5,
+        metavar="S",
+        help="seconds without a command after which an object's command is reset and a world's "
+        "step throttling ends (default 0.5, AMBF's); longer for clients on a busy machine",
+    )
     p.add_argument("--seconds", type=float, help="stop after this many seconds of wall time")
 
 
@@ -52,6 +60,10 @@ def run(args) -> int:
     if args.solver_iterations < 1:
         raise AdfError(
             error("bad-option", "--solver-iterations must be at least 1", None, "e.g. --solver-iterations 10")
+        )
+    if not 0.0 < args.watchdog < float("inf"):
+        raise AdfError(
+            error("bad-option", f"--watchdog {args.watchdog:g} is not a time out", None, "e.g. --watchdog 0.5")
         )
     if not 1.0 <= args.rate <= 100000.0:
         raise AdfError(error("bad-option", f"--rate {args.rate:g} is not a physics rate", None, "e.g. --rate 1000"))
@@ -69,6 +81,7 @@ def run(args) -> int:
         teleop=args.teleop,
         images=not args.no_images,
         solver_iterations=args.solver_iterations,
+        watchdog_s=args.watchdog,
         log=lambda text: print(text, file=sys.stderr, flush=True),
     )
     try:

@@ -82,7 +82,7 @@ class Handler:
 
     def live(self, now: float) -> bool:
         """A command arrived within the watchdog's time out."""
-        return now - self.heard <= WATCHDOG_S
+        return now - self.heard <= self.bridge.watchdog_s
 
     def apply(self, now: float) -> None:
         """Apply the held command (every physics step)."""
@@ -412,7 +412,7 @@ class WorldHandler:
     def may_step(self, now: float) -> bool:
         """AMBF's step_sim(): free running, or a step the client's clock granted; the watchdog
         (0.5 s without a world command) ends throttling."""
-        if self.throttle and now - self.heard > WATCHDOG_S:
+        if self.throttle and now - self.heard > self.bridge.watchdog_s:
             self.throttle = False
         if not self.throttle:
             return True
@@ -423,7 +423,7 @@ class WorldHandler:
             self.allowed -= 1
 
     def publish(self, now: float, stamp, rate_hz: float) -> None:
-        live = now - self.heard <= WATCHDOG_S
+        live = now - self.heard <= self.bridge.watchdog_s
         if now < self.next_pub and not self.throttle:
             return
         self.next_pub = now + (1.0 / 1000 if live else 1.0 / 50)
@@ -446,8 +446,9 @@ class WorldHandler:
 class Bridge:
     """Every handler of a world (see the module docstring)."""
 
-    def __init__(self, world, rospy, msgs, log=print) -> None:
+    def __init__(self, world, rospy, msgs, log=print, watchdog_s: float = WATCHDOG_S) -> None:
         self.world, self.rospy, self.msgs, self.log = world, rospy, msgs, log
+        self.watchdog_s = watchdog_s  # AMBF's 0.5 s unless asked otherwise (adfkit ros --watchdog)
         self.t0 = time.monotonic()
         self.steps = 0  # loop steps: AMBF's sim_step counts physics updates, however many 1 ms steps each is
         self.graphics_hz = 0.0

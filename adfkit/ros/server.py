@@ -45,11 +45,12 @@ class RosServer:
         images: bool = True,
         log=print,
         solver_iterations: int = 10,
+        watchdog_s: float = 0.5,
     ) -> None:
         self.scene_path, self.indices, self.engine, self.rate = Path(scene_path), indices, engine, float(rate)
         self.master = master or os.environ.get("ROS_MASTER_URI") or "http://localhost:11311"
         self.crtk_on, self.teleop_specs, self.images_on, self.log = crtk, list(teleop or []), images, log
-        self.solver_iterations = solver_iterations
+        self.solver_iterations, self.watchdog_s = solver_iterations, watchdog_s
         self.stop = threading.Event()
         self.world = self.bridge = self.crtk = None
         self.teleops: list = []
@@ -74,7 +75,7 @@ class RosServer:
         from .bridge import Bridge, CameraHandler
         from .images import GRAPHICS_HZ, CameraStream
 
-        self.bridge = Bridge(self.world, rospy, msgs, log=self.log)
+        self.bridge = Bridge(self.world, rospy, msgs, log=self.log, watchdog_s=self.watchdog_s)
         self.snapshot = self.world.save_state() if hasattr(self.world, "save_state") else None
         if self.images_on:
             self.streams = [
