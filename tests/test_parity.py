@@ -512,6 +512,9 @@ def test_a_replay_whose_ambf_world_blew_up_is_judged_on_what_came_before():
     late = _replay_trace(down)
     late.poses[7:, 0] = np.nan  # after the needle went through both holes
     assert finite_samples(late) == 7
+    flung = _replay_trace(down)
+    flung.poses[5:, 0, 0] = 8.6e9  # finite, but flung off before the NaN came
+    assert finite_samples(flung) == 5
     assert pair_verdict(AmbfObservation(rec, late), rec.task.pairs[0])["verdict"] == "passed"
     early = _replay_trace(down)
     early.poses[3:, 0] = np.nan  # before it reached Entry1's plane

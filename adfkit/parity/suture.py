@@ -356,10 +356,17 @@ class AmbfObservation:
                 self.slips.append({"phase": phase, "t": float(t), "arm": arm, "slip_m": slip})
 
 
+#: a body farther than this from the world's origin (m) is in a world that blew up: the last
+#: samples before Bullet's NaN are finite but far off (a needle at 8.6e9 m)
+BLOWN_UP_M = 1000.0
+
+
 def finite_samples(trace) -> int:
-    """How many of the trace's samples come before the first pose that is not finite (a world
-    that blew up: Bullet's NaN spreads to every body it touches)."""
-    ok = np.isfinite(trace.poses).all(axis=(1, 2))
+    """How many of the trace's samples come before the first pose that is not finite or is
+    ``BLOWN_UP_M`` away (a world that blew up: Bullet's NaN spreads to every body it touches,
+    and the steps before it fling them)."""
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(trace.poses).all(axis=(1, 2)) & (np.abs(trace.poses[..., :3]) < BLOWN_UP_M).all(axis=(1, 2))
     return len(ok) if ok.all() else int(np.argmin(ok))
 
 
