@@ -144,8 +144,9 @@ def plugin_library(build: AmbfBuild) -> Path:
 @dataclass
 class Command:
     """One line of the plugin's command file: at ``t`` seconds, ``kind`` (position, velocity,
-    effort, grasp, release, place, force) on ``target`` (a joint's, an actuator's or a body's
-    AMBF name) with ``value`` (a joint command's), ``body`` (a grasp's) or ``numbers``."""
+    effort, grasp, release, place, force, collide) on ``target`` (a joint's, an actuator's or a
+    body's AMBF name) with ``value`` (a joint command's; a collide's 0 or 1), ``body`` (a grasp's
+    or a collide's other body) or ``numbers``."""
 
     t: float
     kind: str
@@ -157,6 +158,8 @@ class Command:
     def line(self) -> str:
         if self.kind in ("place", "force"):
             arg = " ".join(repr(float(v)) for v in self.numbers)
+        elif self.kind == "collide":
+            arg = f"{self.body} {int(self.value)}"
         else:
             arg = self.body if self.kind == "grasp" else ("" if self.kind == "release" else repr(float(self.value)))
         return f"{self.t!r} {self.kind} {self.target} {arg}".rstrip()

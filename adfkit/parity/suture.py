@@ -1,6 +1,6 @@
 """The suture replayed in AMBF (``adfkit parity --suture``): adfkit's scripted suture is played
 and recorded (every PSM joint set-point it gives, each grasp and release, the push that settles
-the needle, where the setup puts the arms), the recording is replayed in AMBF through adfkit's
+the needle, where the setup puts the arms, the body pairs it lets pass through each other), the recording is replayed in AMBF through adfkit's
 plugin (the set-points as AMBF's joint position commands, the grasps through AMBF's own
 constraint actuators), and the needle's path on each side is judged by the same verdict code
 (``tasks.verdicts.pair_verdict``).
@@ -71,8 +71,9 @@ class Recording:
 
 
 class _Recorder:
-    """Wraps a world's step, actuate and release and the needle's force, and writes them down
-    as plugin commands: joint set-points when they change, grasps, releases, forces."""
+    """Wraps a world's step, actuate, release and set_collision and the needle's force, and
+    writes them down as plugin commands: joint set-points when they change, grasps, releases,
+    the pairs let pass through each other, forces."""
 
     def __init__(self, world, task) -> None:
         self.world, self.task = world, task
@@ -92,7 +93,7 @@ class _Recorder:
         self.placed = False
         self.forced = False
         self._force_now = None
-        step, actuate, release = world.step, world.actuate, world.release
+        step, actuate, release, set_collision = world.step, world.actuate, world.release, world.set_collision
         needle = task.needle
         force = needle.force
 
@@ -118,7 +119,14 @@ class _Recorder:
             force(f, at)
             self._force_now = (tuple(map(float, f)), tuple(map(float, at)))
 
+        def rec_set_collision(a, b, enabled: bool) -> None:
+            # the task's own choice (the two arms' links pass through each other): AMBF is told
+            # the same, or its arms push each other off their set-points
+            set_collision(a, b, enabled)
+            self.commands.append(ambf.Command(world.sim_time, "collide", _name(a), float(enabled), body=_name(b)))
+
         world.step, world.actuate, world.release = rec_step, rec_actuate, rec_release
+        world.set_collision = rec_set_collision
         needle.force = rec_force
 
     def _arm_of(self, act) -> str:

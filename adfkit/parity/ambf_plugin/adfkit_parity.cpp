@@ -19,6 +19,8 @@
 //                           place (TARGET a rigid body, ARG its body frame "x y z qx qy qz qw": set
 //                           there at rest), force (TARGET a rigid body, ARG "fx fy fz px py pz": a
 //                           force at a world point, every step until its next force command);
+//                           collide (TARGET a rigid body, ARG "BODY 0|1": 0 lets the two pass through each
+//                           other, as a task's set_collision does; 1 undoes that),
 //                           a joint command holds until the joint's next command
 //   ADFKIT_PARITY_PACE      "RAD M WAIT_S" (default off): a paced replay, as a client that sends a
 //                           set-point and waits for the measured joints. The command file is read on
@@ -30,6 +32,9 @@
 //                           such give-up is counted. SECONDS and EVERY are then command-clock time
 //   ADFKIT_PARITY_PACE_MAX  a paced replay ends at this simulated time if its clock has not reached
 //                           SECONDS by then (default 20 x SECONDS)
+//   ADFKIT_PARITY_CONTACTS  "1": each sample also lists the contact manifolds of the last physics step
+//                           that hold points, [A, B, points, least distance, summed normal impulse]
+//                           (A and B: a rigid body's or ghost's qualified name, "?" for anything else)
 //
 // Records: {"kind":"created",...} once, {"kind":"sample",...} per sample (its "clock": the command
 // clock, the simulated time "t" when unpaced), {"kind":"end",...} last (a paced replay's "pace":
@@ -46,6 +51,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <unistd.h>
@@ -131,6 +137,8 @@ public:
         }
         m_seconds = env_double("ADFKIT_PARITY_SECONDS", 0.0);
         m_every = env_double("ADFKIT_PARITY_EVERY", 0.0);
+        const char* contacts = getenv("ADFKIT_PARITY_CONTACTS");
+        m_contacts = contacts && string(contacts) == "1";
         const char* ghosts = getenv("ADFKIT_PARITY_GHOSTS");
         m_followGhosts = !(ghosts && string(ghosts) == "headless");
         // a measurement's knob: Bullet's solver iterations (AMBF leaves them at Bullet's 10)
@@ -351,9 +359,41 @@ private:
             s += (first ? "" : ",") + (j->getConstraint() ? num(j->getPosition()) : string("null"));
             first = false;
         }
-        s += "]}\n";
+        s += "]";
+        if (m_contacts) s += ",\"contacts\":" + contacts();
+        s += "}\n";
         fputs(s.c_str(), m_out);
         fflush(m_out);
+    }
+
+    string object_name(const btCollisionObject* o) {
+        for (afRigidBodyPtr rb : m_world->getRigidBodies())
+            if (rb->m_bulletRigidBody == o) return json_text(rb->getQualifiedName());
+        for (afGhostObjectPtr g : m_world->getGhostObjects())
+            if (g->m_bulletGhostObject == o) return json_text(g->getQualifiedName());
+        return "\"?\"";
+    }
+
+    // the contact manifolds Bullet kept from the last step, those holding points
+    string contacts() {
+        btDispatcher* d = m_world->m_bulletWorld->getDispatcher();
+        string s = "[";
+        bool first = true;
+        for (int i = 0; i < d->getNumManifolds(); i++) {
+            btPersistentManifold* m = d->getManifoldByIndexInternal(i);
+            int n = m->getNumContacts();
+            if (n == 0) continue;
+            double least = 1e30, impulse = 0.0;
+            for (int k = 0; k < n; k++) {
+                const btManifoldPoint& p = m->getContactPoint(k);
+                least = min(least, (double)p.getDistance());
+                impulse += p.getAppliedImpulse();
+            }
+            s += (first ? "[" : ",[") + object_name(m->getBody0()) + "," + object_name(m->getBody1()) + "," +
+                 to_string(n) + "," + num(least) + "," + num(impulse) + "]";
+            first = false;
+        }
+        return s + "]";
     }
 
     // AMBF 2.0 declares afObjectManager::getActuators but does not define it: its map is read
@@ -405,6 +445,11 @@ private:
                 if (!find_body(c.arg)) fail(where + "no rigid body " + c.arg);
             } else if (c.kind == "release") {
                 if (!find_actuator(c.target)) fail(where + "no constraint actuator " + c.target);
+            } else if (c.kind == "collide") {
+                if (!(ls >> c.arg >> c.value) || (c.value != 0 && c.value != 1))
+                    fail(where + "collide needs a body and 0 or 1");
+                if (!find_body(c.target)) fail(where + "no rigid body " + c.target);
+                if (!find_body(c.arg)) fail(where + "no rigid body " + c.arg);
             } else if (c.kind == "place" || c.kind == "force") {
                 if (!find_body(c.target)) fail(where + "no rigid body " + c.target);
                 double v;
@@ -428,6 +473,8 @@ private:
                 find_actuator(c.target)->actuate(find_body(c.arg));
             } else if (c.kind == "release") {
                 find_actuator(c.target)->deactuate();
+            } else if (c.kind == "collide") {
+                collide(find_body(c.target)->m_bulletRigidBody, find_body(c.arg)->m_bulletRigidBody, c.value != 0);
             } else if (c.kind == "place") {
                 place(find_body(c.target), c.numbers);
             } else if (c.kind == "force") {
@@ -452,6 +499,26 @@ private:
                 }
             }
         }
+    }
+
+    // two bodies let pass through each other (Bullet's per-object ignore list, which AMBF's
+    // collision groups use too: a pair AMBF already ignores is left ignored when one is let
+    // collide again), their contact manifold dropped with their broadphase pair
+    void collide(btRigidBody* a, btRigidBody* b, bool on) {
+        auto key = make_pair(min(a, b), max(a, b));
+        if (on) {
+            if (!m_passing.erase(key)) return;
+            a->setIgnoreCollisionCheck(b, false);
+            b->setIgnoreCollisionCheck(a, false);
+            return;
+        }
+        if (!a->checkCollideWith(b) || !b->checkCollideWith(a)) return;  // already passing
+        m_passing.insert(key);
+        a->setIgnoreCollisionCheck(b, true);
+        b->setIgnoreCollisionCheck(a, true);
+        btBroadphaseProxy *pa = a->getBroadphaseHandle(), *pb = b->getBroadphaseHandle();
+        if (pa && pb)
+            m_world->m_bulletWorld->getPairCache()->removeOverlappingPair(pa, pb, m_world->m_bulletWorld->getDispatcher());
     }
 
     // a body set at a pose (its ADF body frame) at rest; its broadphase box moved with it (a
@@ -492,12 +559,14 @@ private:
     double m_seconds = 0.0, m_every = 0.0, m_nextSample = 0.0;
     long m_steps = 0;
     bool m_followGhosts = true;
+    bool m_contacts = false;
     vector<Command> m_commands;
     size_t m_nextCommand = 0;
     map<string, Command> m_drives;
     map<string, afJointPtr> m_driveJoints;
     map<string, Command> m_forces;
     map<string, afRigidBodyPtr> m_forceBodies;
+    set<pair<btRigidBody*, btRigidBody*>> m_passing;  // pairs a collide command let pass
     bool m_paced = false;
     double m_paceRad = 0.0, m_paceM = 0.0, m_paceWait = 0.0, m_paceMax = 0.0;
     double m_cmdClock = 0.0;
