@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -220,7 +221,10 @@ def test_a_turned_inertial_frame_turns_the_joint_in_both(scenes):
 def test_the_bundled_arms_stand_still_in_ambf_as_in_adfkit(tmp_path):
     """The bundled PSM keeps its links' inertial frames turned and writes its joints' offsets
     for AMBF's reading: AMBF reads it as adfkit does and neither moves (measured 0.016 mm in
-    1 s). Negative control: the same files without the `joint offset`s AMBF needs."""
+    1 s; 0.003 mm in 0.3 s, and as little without the `joint offset`s, which turn only where a
+    joint's angle is read from). Negative control: without them, the links' shapes made in
+    their centre-of-mass frames (Options.link_shapes "com", the tasks' default), which then
+    sit off their bodies and collide: PyBullet's insertion link moved 184 mm, AMBF's 0.002 mm."""
     import shutil
     from pathlib import Path
 
@@ -236,7 +240,10 @@ def test_the_bundled_arms_stand_still_in_ambf_as_in_adfkit(tmp_path):
     text = psm.read_text()
     assert "  joint offset: " in text
     psm.write_text("\n".join(ln for ln in text.splitlines() if not ln.startswith("  joint offset: ")) + "\n")
-    (c,) = session.run(session.Request(bad / "launch.yaml", [0, 1], BUILD, seconds=0.3), progress=False).comparisons
+    req = session.Request(bad / "launch.yaml", [0, 1], BUILD, seconds=0.3)
+    (c,) = session.run(req, progress=False).comparisons
+    assert max(g.max_position for g in c.bodies) < 1e-4
+    (c,) = session.run(replace(req, link_shapes="com"), progress=False).comparisons
     assert max(g.max_position for g in c.bodies) > 0.01
 
 

@@ -140,6 +140,7 @@ def run(args) -> int:
         hole_friction=args.hole_friction,
         ghosts=args.ghosts,
         springs=args.springs,
+        link_shapes="body",
         ground=not args.no_ground,
         renderer="tiny" if args.no_frames else args.renderer,
     )

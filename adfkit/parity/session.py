@@ -29,6 +29,7 @@ class Request:
     ground: bool = True
     ghosts: str = "ambf"  # adfkit's ghost rule (Options.ghosts): AMBF's own, unless asked otherwise
     springs: str = "ambf"  # how the PyBullet runner plays six-dof springs (Options.springs): as AMBF's Bullet
+    link_shapes: str = "body"  # where the PyBullet runner puts a link's shapes (Options.link_shapes): the file's
     tolerance_m: float = 1e-3
     tolerance_deg: float = 1.0
 
@@ -99,6 +100,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
     opt = Options(control_substeps=req.control_substeps, ground=req.ground, visuals=False, renderer="tiny")
     opt.ghosts = req.ghosts
     opt.springs = req.springs
+    opt.link_shapes = req.link_shapes
     worlds = [open_world(scene, opt, engine=e) for e in req.engines]
     try:
         players = [AdfkitPlayer(w) for w in worlds]

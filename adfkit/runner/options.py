@@ -26,6 +26,13 @@ class Options:
     # physics step, k and c capped at m/(16·dt²) and m/dt (m the joint's inertia about the axis or its
     # mass). `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: unused
     springs: str = "implicit"
+    # where the PyBullet runner puts a multibody link's collision shapes: "body", where the file puts
+    # them on the body (AMBF's; the link's frame is its joint's frame, the shapes are made in it);
+    # "com", as if the link's frame were the body's centre-of-mass frame, off by where the joint
+    # frame sits in the body (the corpus gripper3's jaws 0.1-0.3 m off): how the runner built
+    # links when the tasks were built and accepted, the default here for them. `adfkit run` and
+    # `adfkit parity` put them where the file does. MuJoCo: unused (its geoms are where the file puts them)
+    link_shapes: str = "com"
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
     ground: bool = True  # a model played without a world gets a floor under it

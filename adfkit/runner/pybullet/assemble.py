@@ -57,6 +57,7 @@ class Assembly:
                 if sb._parts is None:
                     self.skipped.append(sb.key)
                     continue
+                sb._parts_frame = sb.ref_in_body  # the frame the parts are placed in
                 sb.key = self.registry.add(sb.key, sb)
                 mine.append(sb)
                 self.bodies.append(sb)
@@ -225,10 +226,15 @@ class Assembly:
 
     def _shapes_for(self, sb: SimBody, frame_in_body) -> tuple[int, int]:
         b, m = sb.body, sb.model
-        if frame_in_body is not sb.ref_in_body or sb._parts is None:
+        # a multibody link's frame is its joint's frame (articulation.build sets ref_in_body to
+        # it before asking): its parts are made again in that frame, unless Options.link_shapes
+        # keeps them made in the COM frame (the link's shapes then sit as if its frame were that)
+        made_in = sb.ref_in_body if self.opt.link_shapes == "com" else getattr(sb, "_parts_frame", None)
+        if frame_in_body is not made_in or sb._parts is None:
             sb._parts = collision_parts(
                 m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics, self.soft is not None
             )
+            sb._parts_frame = frame_in_body
         col = create_collision(sb._parts, self.cid, b, self.diagnostics) if sb._parts is not None else -1
         vis = create_visual(m, b, frame_in_body, b.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
         return col, self._plane_visual(sb._parts, col, vis)
