@@ -61,6 +61,15 @@ def add_arguments(p) -> None:
         help="how adfkit's PyBullet runner plays six-dof springs (default ambf: as AMBF's Bullet, explicit "
         "at every physics step with its caps; implicit: backward Euler over the control step, the suture's)",
     )
+    p.add_argument(
+        "--bodies",
+        choices=("ambf", "pybullet"),
+        default="ambf",
+        help="what adfkit's PyBullet bodies are: ambf (default; AMBF's btRigidBodies: AMBF's estimated inertia, "
+        "the box of the collision shape's bounds, where the file gives none, and joints as fast as "
+        "AMBF's bodies may turn, π/4 a physics step) or pybullet (PyBullet's estimate and its "
+        "multibody's 100 rad/s joint cap: the suture's)",
+    )
     p.add_argument("--no-ground", action="store_true", help="a model file: no floor under it on either side")
     p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")
     p.add_argument("--tolerance-deg", type=float, default=1.0, help="largest orientation gap that agrees (1°)")
@@ -110,6 +119,7 @@ def run(args) -> int:
         ground=not args.no_ground,
         ghosts=args.ghosts,
         springs=args.springs,
+        bodies=args.bodies,
         tolerance_m=args.tolerance_mm / 1e3,
         tolerance_deg=args.tolerance_deg,
     )

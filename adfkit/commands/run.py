@@ -59,6 +59,15 @@ def add_arguments(p) -> None:
         "k·x + c·v at every physics step, k and c capped at m/(16·dt²) and m/dt) or implicit (backward "
         "Euler over the control step, stable at any gain: the suture's)",
     )
+    p.add_argument(
+        "--bodies",
+        choices=("ambf", "pybullet"),
+        default="ambf",
+        help="what the PyBullet runner's bodies are: ambf (default; AMBF's btRigidBodies: AMBF's estimated inertia, "
+        "the box of the collision shape's bounds, where the file gives none, and joints as fast as "
+        "AMBF's bodies may turn, π/4 a physics step) or pybullet (PyBullet's estimate and its "
+        "multibody's 100 rad/s joint cap: the suture's)",
+    )
     p.add_argument("--no-frames", action="store_true", help="do not render camera frames")
     p.add_argument(
         "--renderer",
@@ -141,6 +150,7 @@ def run(args) -> int:
         ghosts=args.ghosts,
         springs=args.springs,
         link_shapes="body",
+        bodies=args.bodies,
         ground=not args.no_ground,
         renderer="tiny" if args.no_frames else args.renderer,
     )

@@ -30,6 +30,7 @@ class Request:
     ghosts: str = "ambf"  # adfkit's ghost rule (Options.ghosts): AMBF's own, unless asked otherwise
     springs: str = "ambf"  # how the PyBullet runner plays six-dof springs (Options.springs): as AMBF's Bullet
     link_shapes: str = "body"  # where the PyBullet runner puts a link's shapes (Options.link_shapes): the file's
+    bodies: str = "ambf"  # what the PyBullet runner's bodies are (Options.bodies): AMBF's btRigidBodies
     tolerance_m: float = 1e-3
     tolerance_deg: float = 1.0
 
@@ -101,6 +102,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
     opt.ghosts = req.ghosts
     opt.springs = req.springs
     opt.link_shapes = req.link_shapes
+    opt.bodies = req.bodies
     worlds = [open_world(scene, opt, engine=e) for e in req.engines]
     try:
         players = [AdfkitPlayer(w) for w in worlds]

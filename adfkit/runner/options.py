@@ -33,6 +33,12 @@ class Options:
     # links when the tasks were built and accepted, the default here for them. `adfkit run` and
     # `adfkit parity` put them where the file does. MuJoCo: unused (its geoms are where the file puts them)
     link_shapes: str = "com"
+    # what the PyBullet runner's bodies are (ambf_bodies.py): "pybullet", PyBullet's own (its inertia for a
+    # body whose file gives none, its multibody joints capped at 100 rad/s; the default here, which the
+    # tasks were built and accepted on); "ambf", AMBF's btRigidBodies: AMBF's estimated inertia (the box of
+    # the collision shape's bounds) and joints as fast as AMBF's bodies may turn (π/4 a physics step).
+    # `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: unused
+    bodies: str = "pybullet"
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
     ground: bool = True  # a model played without a world gets a floor under it

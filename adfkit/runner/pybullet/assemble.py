@@ -11,6 +11,7 @@ import numpy as np
 import pybullet as pb
 
 from ...model.semantics import JointKind, body_joint_frames, joint_kind, pose_or_identity
+from .. import ambf_bodies
 from ..cameras import build_cameras
 from ..collisions import HULL_OVERLAP, collision_masks, hull_overlaps, one_hull
 from ..names import Registry, merge_namespace
@@ -93,7 +94,11 @@ class Assembly:
             self.articulations.append(art)
             self.joint_names.extend(art.joint_names)
             for sb in [root] + [r[3] for r in recs]:
-                set_dynamics(sb)
+                set_dynamics(sb, self._ambf_dt)
+            if self._ambf_dt is not None:  # AMBF's bodies' speed (ambf_bodies.py); PyBullet keeps one
+                # for the whole multibody, and given with a link's mass or inertia it sets them on the base
+                speed = ambf_bodies.JOINT_SPEED_TURN / self._ambf_dt
+                pb.changeDynamics(art.uid, -1, maxJointVelocity=speed, physicsClientId=self.cid)
         self._collision_filters(records)
         if self.soft is not None:
             self.soft.build(models)
@@ -263,7 +268,7 @@ class Assembly:
                 sb.mass, col, vis, pos, orn, useMaximalCoordinates=True, physicsClientId=self.cid
             )
         sb.link = -1
-        set_dynamics(sb)
+        set_dynamics(sb, self._ambf_dt)
 
     def _collision_filters(self, records) -> None:
         masks = collision_masks(self, [sb.body for sb in self.bodies])

@@ -17,6 +17,7 @@ from ...model.semantics import (
     effective_mass,
     inertial_offset,
 )
+from .. import ambf_bodies
 from ..rotations import pose_to_matrix
 from ..world import EngineBody
 from . import held
@@ -107,7 +108,10 @@ def body_gravity(body, model, world_g: np.ndarray) -> np.ndarray | None:
     return None if np.allclose(g, world_g) else g
 
 
-def set_dynamics(sb: SimBody) -> None:
+def set_dynamics(sb: SimBody, ambf_dt: float | None = None) -> None:
+    """The body's friction, restitution, damping and inertia; with ``ambf_dt`` (the physics step,
+    Options.bodies == "ambf") AMBF's estimated inertia where the file gives none
+    (runner/ambf_bodies.py)."""
     b = sb.body
     fr = b.friction
     kw = dict(
@@ -130,6 +134,11 @@ def set_dynamics(sb: SimBody) -> None:
     ):
         kw["localInertiaDiagonal"] = [b.inertia.ix, b.inertia.iy, b.inertia.iz]
         kw["mass"] = sb.mass  # PyBullet zeroes a maximal body's mass when only the inertia is given
+    elif ambf_dt is not None and not sb.static and sb.mass > 0:
+        estimate = ambf_bodies.estimated_inertia(sb.model, b, sb.com_in_body)
+        if estimate is not None:
+            kw["localInertiaDiagonal"] = list(estimate)
+            kw["mass"] = sb.mass
     pb.changeDynamics(sb.uid, sb.link, physicsClientId=sb.cid, **kw)
     info = pb.getDynamicsInfo(sb.uid, sb.link, physicsClientId=sb.cid)
     sb.inertia = tuple(info[2]) if not sb.static else (0.0, 0.0, 0.0)

@@ -70,6 +70,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         # the broadphase keeps its overlapping pairs sorted, so a snapshot restored in place
         # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact
         pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
+        self._ambf_dt = self.dt if self.opt.bodies == "ambf" else None  # AMBF's bodies (ambf_bodies.py)
         self._build()
         # AMBF's springs (Options.springs): explicit, at every physics step; PyBullet then steps one
         # physics step a call and the control step's other forces are applied again at each (held.py)
