@@ -408,9 +408,9 @@ def test_ambfs_ghost_rule_hangs_a_cube_in_a_ghost_alike_in_both_engines(tmp_path
     """AMBF's ghost rule (Options.ghosts "ambf": a body in penetrating contact with a ghost is
     weightless and keeps 0.9 of its velocity per contact point and physics step) in PyBullet and
     in MuJoCo: the parity scene's cube, dropped into a ghost slab hung on a post, stops in it at
-    the same height in both (measured 244.83 and 244.90 mm; AMBF 247.76), its twin beside the
-    slab falls to the floor. Control: the suture's hole friction acts in hole ghosts only, and
-    the cube falls through to the floor too."""
+    the same height in both (measured 249.04 and 249.05 mm; AMBF 247.76; counted as one point a
+    shape pair, 244.83 and 244.90), its twin beside the slab falls to the floor. Control: the
+    suture's hole friction acts in hole ghosts only, and the cube falls through to the floor too."""
     from adfkit.scenes.parity import write_parity
 
     launch = write_parity(tmp_path)
@@ -425,9 +425,48 @@ def test_ambfs_ghost_rule_hangs_a_cube_in_a_ghost_alike_in_both_engines(tmp_path
                 world.close()
     for engine in ("pybullet", "mujoco"):
         cube, twin = ends[engine, "ambf"]
-        assert 0.24 < cube < 0.25 and twin < 0.05, engine
+        assert 0.2475 < cube < 0.2505 and twin < 0.05, engine
         assert ends[engine, "hole-friction"][0] < 0.05, engine
     assert ends["pybullet", "ambf"][0] == pytest.approx(ends["mujoco", "ambf"][0], abs=5e-4)
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_ghost_counts_the_engines_contact_points_and_pushes_nothing(tmp_path, engine):
+    """AMBF's ghost acts once per point of Bullet's manifold for a pair (afGhostObject::update), a
+    box in a box four points at once (btBoxBoxDetector). The runners read their engine's own
+    narrowphase for the pair in a collision pass between steps, the ghost colliding for that pass
+    only: the parity scene's cube in its slab counts 4 points in both engines (the closest-point
+    query and MuJoCo's geom distance gave 1). The pass pushes nothing: run at every step in a
+    world where the ghost does not act, the cube falls through the slab to the floor exactly as
+    without it (a ghost left colliding would hold it on the slab)."""
+    from adfkit.scenes.parity import write_parity
+
+    launch = write_parity(tmp_path)
+    world = open_world(load_scene(launch, [3]), Options(visuals=False, ghosts="ambf"), engine=engine)
+    try:
+        world.run(0.2)
+        (g,) = world.ghosts
+        assert [(sb.name, n) for sb, n in g.points] == [("cube", 4)]
+    finally:
+        world.close()
+
+    def fall(passes: bool) -> tuple[float, list[int]]:
+        w = open_world(load_scene(launch, [3]), Options(visuals=False, ghosts="ambf"), engine=engine)
+        w.opt.ghosts = "hole-friction"  # built to sense (MuJoCo's ghost geoms), acting on nothing
+        counts = []
+        try:
+            for _ in range(150):
+                w.step()
+                if passes and engine == "pybullet":
+                    counts.append(sum(n for c in w._manifold_points(w.ghosts, {}).values() for n in c.values()))
+                elif passes:
+                    counts.append(sum(n for found in w._penetrating(w.ghosts) for _, n in found))
+            return w.body("cube").com_position()[2], counts
+        finally:
+            w.close()
+
+    (with_pass, counts), (without, _) = fall(True), fall(False)
+    assert max(counts) == 4 and with_pass == without and with_pass < 0.05
 
 
 @pytest.mark.slow

@@ -14,6 +14,12 @@ GHOST_RULES = ("ambf", "hole-friction")
 #: the next step, its velocity across the ghost parent's keeps this share (along the parent's
 #: velocity it takes the parent's), its angular velocity too; leaving, it gets the world's gravity
 AMBF_GHOST_KEEP = 0.9
+#: the contact points a Bullet manifold holds (btPersistentManifold's MANIFOLD_CACHE_SIZE): AMBF's ghost
+#: acts at most this many times a step for one pair of shapes
+MANIFOLD_POINTS = 4
+#: m (and quaternion or rotation-matrix entries): a ghost and the bodies near it that moved no more
+#: than this since the engine's last collision pass for it keep that pass's contact points
+SAME_PLACE = 1e-9
 
 
 def ghost_velocity(v, w, v_parent, points: int):

@@ -14,7 +14,7 @@ from ...model.tree import ONE_DOF
 from ..collisions import HULL_OVERLAP, hull_overlaps, one_hull
 from ..plan import ALL_GROUPS
 from ..rotations import pose_to_matrix
-from .build import build_plan
+from .build import GHOST_GROUP, build_plan
 from .contacts import set_contacts
 from .damping import BodyDamping
 from .drives import DriveLimits, drive_limit
@@ -97,9 +97,7 @@ class Assembly:
                 bid,
                 self,
             )
-            sb.has_collision = bool(
-                np.any((m.geom_bodyid == bid) & ((m.geom_contype != 0) | (m.geom_conaffinity != 0)))
-            )
+            sb.has_collision = bool(np.any((m.geom_bodyid == bid) & _colliding(m)))
             if bid > 0 and m.body_weldid[bid] == 0:
                 sb.mass = 0.0  # welded to the world: static whatever the file says
             self.registry.items[bp.key] = sb
@@ -130,6 +128,10 @@ class Assembly:
             self.ghosts.append(MjGhost(gp.key, gp.ghost, parent, ids, gp.friction, pose_in_parent=gp.location))
             self.registry.items[gp.key] = None
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
+        self._ghost_geom_ids = np.array([gid for g in self.ghosts for gid in g.geoms], dtype=int)
+        self._ghost_geom_set = set(self._ghost_geom_ids.tolist())
+        self._ghost_bodies = np.unique(m.geom_bodyid[self._ghost_geom_ids]).astype(int)
+        self._collider_key, self._collider_made = None, {}  # interact._collider_points' last pass
         self._friction_geoms = np.array([gid for g in self._friction_ghosts for gid in g.geoms], dtype=int)
         self._friction_owner = [g for g in self._friction_ghosts for _ in g.geoms]
         self.actuators = [
@@ -157,7 +159,7 @@ class Assembly:
         # the bodies the hole ghosts and grasps look for: dynamic ones with collision geoms
         dyn = [i for i, sb in enumerate(self.bodies) if not sb.static and sb.has_collision]
         self._cand_bodies = [self.bodies[i] for i in dyn]
-        gids = [g for g in range(m.ngeom) if (m.geom_contype[g] or m.geom_conaffinity[g])]
+        gids = np.nonzero(_colliding(m))[0].tolist()
         body_of = {sb.id: sb for sb in self._cand_bodies}
         self._cand_geoms = np.array([g for g in gids if m.geom_bodyid[g] in body_of], dtype=int)
         self._cand_geom_body = [body_of[m.geom_bodyid[g]] for g in self._cand_geoms]
@@ -299,9 +301,10 @@ class Assembly:
     def _floor(self) -> float:
         m, d = self.model, self.data
         zs = []
+        colliding = _colliding(m)
         for g in range(m.ngeom):
             b = m.geom_bodyid[g]
-            if m.body_weldid[b] != 0 or not (m.geom_contype[g] or m.geom_conaffinity[g]):
+            if m.body_weldid[b] != 0 or not colliding[g]:
                 continue
             zs.append(d.geom_xpos[g][2] if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE else self._geom_bottom(g))
         return min(zs) if zs else -math.inf
@@ -331,3 +334,8 @@ def jacobian_for(model) -> int:
     if model.nv < 60 or model.nM >= DENSE_FILL * full:
         return mujoco.mjtJacobian.mjJAC_DENSE
     return mujoco.mjtJacobian.mjJAC_SPARSE
+
+
+def _colliding(m) -> np.ndarray:
+    """Which geoms are collision shapes: bits to collide with, and not a ghost's (build.GHOST_CONTYPE)."""
+    return ((m.geom_contype != 0) | (m.geom_conaffinity != 0)) & (m.geom_group != GHOST_GROUP)

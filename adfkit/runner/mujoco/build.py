@@ -7,7 +7,7 @@ runner adds (docs/mujoco.md):
   stiffness, damping, equilibrium and limits as MuJoCo joint stiffness/damping/springref/range;
 - a joint equality on every revolute/prismatic tree joint with a motor (AMBF's joint motors,
   held at the file's initial value, re-targeted each control step);
-- ghost objects as contact-free geoms (contype = conaffinity = 0, group 4, never drawn);
+- ghost objects as contact-free geoms (conaffinity 0; contype 0, or bit 31 under AMBF's rule; group 4, never drawn);
 - one inactive weld equality per constraint actuator (the grasp), re-targeted when grasping;
 - collision groups as contype/conaffinity bits, `ignore inter collision` as excluded pairs;
 - each volume's iso-surface (runner/volumes.py) as a static mesh geom on a body of its own.
@@ -38,13 +38,12 @@ from ..plan import (
 )
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
-from .collision import collision_filters, warn_losses
+from .collision import GHOST_CONTYPE, GHOST_GROUP, collision_filters, warn_losses
 from .drives import add_drive, drive_limit
 from .spec import _parse_spec, _resolve_meshes
 from .textures import apply_textures
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED) + SPRING_KINDS
-GHOST_GROUP = 4
 # the grasp weld's time constant in physics steps: 2, MuJoCo's stiffest stable setting. With the
 # joint drives as constraints (drives.py) the grasp holds at 4 steps as well (the needle within
 # 0.13 mm of the jaws through pair 1, seed 0; the 13 mm slide measured there before was the
@@ -120,7 +119,7 @@ def _spring_axes(joint, kind):
     return out
 
 
-def _ghost_geoms(body_el, gh, pose_in_link: np.ndarray, name: str, warn) -> list[str]:
+def _ghost_geoms(body_el, gh, pose_in_link: np.ndarray, name: str, warn, sensing: bool = False) -> list[str]:
     prims = collision_primitives(gh)
     if not prims:
         warn(
@@ -132,7 +131,8 @@ def _ghost_geoms(body_el, gh, pose_in_link: np.ndarray, name: str, warn) -> list
     for n, p in enumerate(prims):
         t = pose_in_link @ pose_to_matrix(p.pose)
         g = p.geometry
-        kw = dict(contype=0, conaffinity=0, group=GHOST_GROUP, pos=t[:3, 3], rgba=[0, 1, 0, 0.2], name=f"{name}#{n}")
+        kw = dict(contype=GHOST_CONTYPE if sensing else 0, conaffinity=0, group=GHOST_GROUP, pos=t[:3, 3])
+        kw.update(rgba=[0, 1, 0, 0.2], name=f"{name}#{n}")
         if p.kind is ShapeKind.BOX:
             kw.update(type=mujoco.mjtGeom.mjGEOM_BOX, size=[(g.x or 0) / 2, (g.y or 0) / 2, (g.z or 0) / 2])
         elif p.kind is ShapeKind.SPHERE:
@@ -285,7 +285,7 @@ def build_plan(world) -> Plan:
                 key,
                 gh,
                 parent,
-                _ghost_geoms(body_el, gh, loc, f"ghost:{key}", world._warn),
+                _ghost_geoms(body_el, gh, loc, f"ghost:{key}", world._warn, sensing=opt.ghosts == "ambf"),
                 is_hole(gh, opt),
                 location,
             )

@@ -10,6 +10,13 @@ from ...diagnostics import warning
 from ...model.semantics import ShapeKind
 from ..collisions import collision_masks, convex_parts_note
 
+GHOST_GROUP = 4  # a ghost's geoms: never drawn, seen by no ray
+#: a ghost's contype under AMBF's rule: bit 31, which no collision group uses (plan.ALL_GROUPS), so it
+#: meets no geom, yet MuJoCo puts the geom in its body's collision tree, where the ghosts' collision
+#: pass (interact._collider_points) finds it once its conaffinity is opened (a geom compiled without
+#: bits is left out of that tree and never collides, whatever its bits later)
+GHOST_CONTYPE = -(1 << 31)
+
 EXCLUDE_SPARE = 512  # run-time excluded pairs (MujocoWorld.set_collision); the suture turns off ~300
 _SHAPE_FEATURES = {f"collision {k.value}" for k in ShapeKind}
 
@@ -68,7 +75,7 @@ def collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
                 if rgba is not None:
                     g.rgba = rgba
 
-            if g.contype == 0 and g.conaffinity == 0:
+            if (g.contype == 0 and g.conaffinity == 0) or g.group == GHOST_GROUP:
                 continue
             g.contype = g.conaffinity = mask
             if fr is not None and fr.static is not None:

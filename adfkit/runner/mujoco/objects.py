@@ -121,6 +121,7 @@ class MjGhost:
     friction: bool = False
     overlapping: list = field(default_factory=list)
     pose_in_parent: np.ndarray | None = None  # the ghost's frame in its parent's ADF body frame (or the world)
+    points: list = field(default_factory=list)  # (body, penetrating contact points) under AMBF's rule, last step
 
 
 @dataclass(eq=False)

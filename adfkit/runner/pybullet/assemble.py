@@ -165,6 +165,7 @@ class Assembly:
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
         # the ghosts that act on what is inside them each control step (Options.ghosts)
         self._acting_ghosts = self.ghosts if self.opt.ghosts == "ambf" else self._friction_ghosts
+        self._manifold_place, self._manifold_made = None, {}  # interact._manifold_points' last pass
 
     def _hold_closed_loops(self) -> None:
         """A multibody closed by a constraint between two of its own links keeps its joints held

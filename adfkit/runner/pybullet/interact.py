@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import ghost_velocity, viscous_impulse_force
+from ..ghost_rules import SAME_PLACE, ghost_velocity, viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
 
@@ -21,6 +21,8 @@ GRASP_SPAN = 0.02
 # error reduction of the grasp's constraints: the share of their gap closed per step (Bullet's 0.2 let
 # the thread's pull stretch a held needle 2 mm out of the jaws; 0.8 holds it within a fraction of that)
 GRASP_ERP = 0.8
+# collision bits a ghost has during its collision pass (_manifold_points): meeting every body's
+GHOST_PASS_BITS = -1
 
 
 @dataclass(eq=False)
@@ -104,7 +106,9 @@ class Interaction:
                     pos, orn = pb.multiplyTransforms(pq[0], pq[1], *g.pq_in_parent)
                     pb.resetBasePositionAndOrientation(g.uid, pos, orn, cid)
                     g.placed_at = pq
-            found = self._overlap(g, poses, with_parent=ambf)
+        manifolds = self._manifold_points(self._acting_ghosts, poses) if ambf else None
+        for g in self._acting_ghosts:
+            found = self._overlap(g, poses, with_parent=ambf, manifolds=manifolds)
             if found and ambf:
                 self._ambf_ghost(g, held)
             elif found:
@@ -153,12 +157,58 @@ class Interaction:
         self._place(g)
         return self._overlap(g)
 
-    def _overlap(self, g: SimGhost, poses: dict | None = None, with_parent: bool = False) -> list[SimBody]:
+    def _manifold_points(self, ghosts, poses: dict) -> dict[int, dict[tuple[int, int], int]]:
+        """{ghost uid: {(uid, link): its penetrating contact points}} as Bullet's narrowphase makes
+        them for the pair in the dynamics world, where AMBF's ghost reads them (its manifolds: a
+        box in a box gives four points at once, btBoxBoxDetector). A ghost collides with nothing
+        (it would push what enters it), so those near a dynamic body are let collide for one
+        collision pass between steps (performCollisionDetection: no step, so no push) and shut
+        again; a pair GJK answers (hulls) gives one point a pass, where AMBF's persistent manifold
+        gathers up to four over its steps. The last answer stands while the ghosts and the bodies
+        near them stay within SAME_PLACE of where they were (``poses``: those read this control
+        step, as _update_ghosts)."""
+        cid, dynamic = self.cid, self._dynamic_lookup
+        near, where = [], []
+        for g in ghosts:
+            lo, hi = pb.getAABB(g.uid, -1, cid)
+            keys = [key for key in pb.getOverlappingObjects(lo, hi, cid) or () if key in dynamic]
+            if keys:
+                near.append(g)
+                where.append(pb.getBasePositionAndOrientation(g.uid, cid))
+                for key in keys:
+                    if key not in poses:
+                        poses[key] = dynamic[key].state(velocity=False)[:2]
+                    where.append(poses[key])
+        if not near:
+            return {}
+        place = ([g.uid for g in near], np.array([c for pq in where for v in pq for c in v]))
+        last = self._manifold_place
+        if last is not None and last[0] == place[0] and len(last[1]) == len(place[1]):
+            if np.max(np.abs(last[1] - place[1])) <= SAME_PLACE:
+                return self._manifold_made
+        for g in near:
+            pb.setCollisionFilterGroupMask(g.uid, -1, GHOST_PASS_BITS, GHOST_PASS_BITS, physicsClientId=cid)
+        pb.performCollisionDetection(physicsClientId=cid)
+        out: dict[int, dict[tuple[int, int], int]] = {}
+        for g in near:
+            counts = out.setdefault(g.uid, {})
+            for c in pb.getContactPoints(bodyA=g.uid, physicsClientId=cid):
+                if c[8] < 0.0:
+                    key = (c[2], c[4]) if c[1] == g.uid else (c[1], c[3])
+                    counts[key] = counts.get(key, 0) + 1
+            pb.setCollisionFilterGroupMask(g.uid, -1, 0, 0, physicsClientId=cid)
+        self._manifold_place, self._manifold_made = place, out
+        return out
+
+    def _overlap(
+        self, g: SimGhost, poses: dict | None = None, with_parent: bool = False, manifolds: dict | None = None
+    ) -> list[SimBody]:
         """``overlapping`` with the ghost already where its parent is (its parent left out unless
         ``with_parent``: AMBF's ghosts sense the body they hang on). With ``poses`` (see
         _update_ghosts), each answer is kept with the ghost's and the body's poses and reused
         while both stay exactly where they were (and no collision pair or grasp has changed).
-        ``g.points`` gets each body found with its penetrating contact points (distance < 0)."""
+        ``g.points`` gets each body found with its penetrating contact points (distance < 0): from
+        ``manifolds`` (_manifold_points) where given, else the closest-point query's (one a pair)."""
         cid = self.cid
         lo, hi = pb.getAABB(g.uid, -1, cid)
         found, points = [], []
@@ -180,7 +230,7 @@ class Interaction:
                     known[key] = (at, pose, inside, deep)
             if inside:
                 found.append(sb)
-                points.append((sb, deep))
+                points.append((sb, deep if manifolds is None else manifolds.get(g.uid, {}).get(key, 0)))
         g.overlapping = found
         g.points = points
         return found
