@@ -77,3 +77,146 @@ def test_a_links_shapes_sit_where_the_file_puts_its_body(tmp_path):
                 assert world.ground_z > low + 0.02  # the hinged box reaches no lower than the cube
         finally:
             world.close()
+
+
+def _bar(name: str, x: float, z: float, pitch: float, size: str) -> str:
+    return (
+        f"BODY {name}:\n  name: {name}\n  mass: 0.1\n  inertia: {{ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}}\n"
+        f"  location: {{position: {{x: {x}, y: 0.0, z: {z}}}, orientation: {{r: 0.0, p: {pitch}, y: 0.0}}}}\n"
+        "  damping: {linear: 0.0, angular: 0.0}\n"
+        f"  collision shape: BOX\n  collision geometry: {size}\n"
+    )
+
+
+def _hinge(parent: str, child: str, pp, cp, limits: str = "", kind: str = "revolute") -> str:
+    v = lambda p: f"{{x: {p[0]}, y: 0.0, z: {p[1]}}}"  # noqa: E731
+    return (
+        f"JOINT {parent}-{child}:\n  name: {parent}-{child}\n  parent: BODY {parent}\n  child: BODY {child}\n"
+        f"  type: {kind}\n  parent pivot: {v(pp)}\n  child pivot: {v(cp)}\n"
+        "  parent axis: {x: 0.0, y: 1.0, z: 0.0}\n  child axis: {x: 0.0, y: 1.0, z: 0.0}\n" + limits
+    )
+
+
+def four_bar(open_m: float = 0.0, limits: str = "", last_limits: str = "") -> str:
+    """A parallelogram hung from a static top bar l1: sides l2 and l4 (10 cm, 0.1 kg, 1e-4 kg m²)
+    45 degrees from hanging straight down, the bottom bar l3; l1-l4 closes the loop. ``open_m``
+    moves l3's pivot for l4 that far along it, so the bodies where the file puts them leave the
+    loop that far open, as a file's rounding does; ``limits`` goes to l2-l3 and l3-l4,
+    ``last_limits`` to l1-l4."""
+    s = math.sqrt(0.5) * 0.1
+    bar, side = "{x: 0.2, y: 0.01, z: 0.01}", "{x: 0.01, y: 0.01, z: 0.1}"
+    return (
+        "bodies: [BODY world, BODY l1, BODY l2, BODY l3, BODY l4]\n"
+        "joints: [JOINT world-l1, JOINT l1-l2, JOINT l2-l3, JOINT l3-l4, JOINT l1-l4]\n"
+        "ignore inter-collision: true\n"
+        "BODY world:\n  name: world\n  mass: 0.0\n"
+        "  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
+        + _bar("l1", 0.1, 1.0, 0.0, bar).replace("mass: 0.1", "mass: 0.0")
+        + _bar("l2", -s / 2, 1.0 - s / 2, math.pi / 4, side)
+        + _bar("l3", 0.1 - s, 1.0 - s, 0.0, bar)
+        + _bar("l4", 0.2 - s / 2, 1.0 - s / 2, math.pi / 4, side)
+        + _hinge("world", "l1", (0.1, 1.0), (0.0, 0.0), kind="fixed")
+        + _hinge("l1", "l2", (-0.1, 0.0), (0.0, 0.05))
+        + _hinge("l2", "l3", (0.0, -0.05), (-0.1, 0.0), limits)
+        + _hinge("l3", "l4", (0.1 + open_m, 0.0), (0.0, -0.05), limits)
+        + _hinge("l1", "l4", (0.1, 0.0), (0.0, 0.05), last_limits)
+    )
+
+
+def _pendulum(t_end: float, theta0: float, dt: float = 1e-4) -> list[float]:
+    """The parallelogram's side angle from hanging straight down, by hand: the two sides (0.1 kg,
+    1e-4 kg m² about their centres, pivots 5 cm off) swing about their top pivots and the bottom
+    bar (0.1 kg) goes round with their ends, unturned: I = 2 (1e-4 + 0.1·0.05²) + 0.1·0.1² =
+    1.7e-3 kg m², the gravity torque g (2·0.1·0.05 + 0.1·0.1) sin θ; RK4, sampled every 20 ms."""
+    k = 9.81 * (2 * 0.1 * 0.05 + 0.1 * 0.1) / (2 * (1e-4 + 0.1 * 0.05**2) + 0.1 * 0.1**2)
+    f = lambda y: np.array([y[1], -k * math.sin(y[0])])  # noqa: E731
+    y, out = np.array([theta0, 0.0]), []
+    for n in range(int(round(t_end / dt)) + 1):
+        if n % int(round(0.02 / dt)) == 0:
+            out.append(float(y[0]))
+        k1 = f(y)
+        k2 = f(y + dt / 2 * k1)
+        k3 = f(y + dt / 2 * k2)
+        k4 = f(y + dt * k3)
+        y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return out
+
+
+def _side_angle(world) -> float:
+    """l2's angle from hanging straight down (about y; positive: its lower end towards -x, its
+    frame's z axis up along it)."""
+    z = world.body("BODY l2").world_matrix()[:3, 2]
+    return math.atan2(z[0], z[2])
+
+
+def test_a_closed_four_bar_swings_as_a_pendulum_from_a_loop_closed_at_the_start(tmp_path):
+    """A parallelogram whose file puts a pivot 0.3 mm off where its bodies meet (a file's
+    rounding): PyBullet plays it as one multibody whose loop joint is a constraint between two
+    of its links. The runner moves its joint values until the loop's pivots meet (AMBF's bodies
+    start where the file puts them and its constraints pull them together) and leaves its joints
+    free, as AMBF does: it swings as the pendulum worked out by hand (0.3 s, past the bottom and
+    up the other side), its loop closed throughout. Controls: the loop left open by the file's
+    0.3 mm (the runner's closing step skipped) starts 0.3 mm apart; a multibody held at its
+    start (as the runner held every looped one) does not swing."""
+    from adfkit.runner.pybullet import assemble
+
+    path = tmp_path / "four_bar.yaml"
+    path.write_text(four_bar(open_m=3e-4))
+    expected = _pendulum(0.3, math.pi / 4)
+    world = open_world(load_scene(path), Options(visuals=False, ground=False))
+    try:
+        assert world.constraint_error() < 1e-8
+        (art,) = world.articulations
+        assert not art.held
+        played = []
+        for _ in range(15):  # every 20 ms (five control steps)
+            played.append(_side_angle(world))
+            world.run(0.02)
+        played.append(_side_angle(world))
+        assert played[0] == pytest.approx(math.pi / 4, abs=5e-3)
+        assert np.abs(np.array(played) - np.array(expected)).max() < math.radians(2.0)
+        assert min(played) < -0.6  # up the other side
+        assert world.report()["max_constraint_error_m"] < 1e-4
+    finally:
+        world.close()
+    world = open_world(load_scene(path), Options(visuals=False, ground=False))
+    try:  # control: its joints held where they start, it stays
+        world.articulations[0].drive()
+        start = _side_angle(world)
+        world.run(0.1)
+        assert _side_angle(world) == pytest.approx(start, abs=1e-3)
+    finally:
+        world.close()
+    mp = pytest.MonkeyPatch()
+    mp.setattr(assemble, "close_loops", lambda w: {})
+    try:
+        world = open_world(load_scene(path), Options(visuals=False, ground=False))
+        try:
+            assert world.constraint_error() == pytest.approx(3e-4, rel=0.2)
+        finally:
+            world.close()
+    finally:
+        mp.undo()
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_loop_is_closed_by_its_joint_without_limits(tmp_path, engine):
+    """A four-bar whose loop can be closed by a limited joint (l3-l4) or by one without limits
+    (l1-l4, as the corpus parallel structure's continuous one): the one without limits closes it,
+    as a constraint, which plays none, and l3-l4's limits are the tree joint's. Control: all four
+    limited, the tree takes the one it meets first (l1-l4) and l3-l4 closes the loop."""
+    from adfkit.model.tree import build_tree
+
+    lim = "  joint limits: {low: -0.5, high: 0.5}\n"
+    for last, closes in (("", "JOINT l1-l4"), (lim, "JOINT l3-l4")):
+        path = tmp_path / f"four_bar{len(last)}.yaml"
+        path.write_text(four_bar(limits=lim, last_limits=last))
+        scene = load_scene(path)
+        (model,) = scene.all_models()
+        assert [j.identifier for j, *_ in build_tree(model).loops] == [closes]
+        world = open_world(scene, Options(visuals=False, ground=False), engine=engine)
+        try:
+            # (PyBullet holds l1's weld to the static world by constraints too)
+            assert {n for n, *_ in world.constraints} - {"JOINT world-l1"} == {closes}
+        finally:
+            world.close()

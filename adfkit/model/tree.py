@@ -139,32 +139,68 @@ def build_tree(
         if r[1] in tree_kinds:
             edges[id(r[2])].append(r)
             is_child.add(id(r[3]))
+    into = defaultdict(list)
+    for r in records:
+        if r[1] in tree_kinds:
+            into[id(r[3])].append(r)
     order = sorted(model.bodies, key=lambda b: (id(b) in is_child, effective_mass(b) != 0.0))
     links: dict[str, Link] = {}
     roots: list[Link] = []
     used: set[int] = set()
+
+    def attach(link: Link, r) -> Link:
+        j, kind, parent, child = r
+        used.add(id(r))
+        a, b = body_joint_frames(j, parent, child)
+        node = Link(child, parent=link, joint=j, kind=kind, frame_in_body=b, origin=link.in_link(a))
+        node.q0 = _initial_value(link, node)
+        link.children.append(node)
+        links[child.identifier] = node
+        return node
+
     for start in order:
         if start.identifier in links:
             continue
         root = Link(start, origin=_location(start))
         links[start.identifier] = root
         roots.append(root)
-        stack = [root]
-        while stack:
+        stack: list[Link] = [root]
+        later: list[tuple[Link, tuple]] = []
+        while stack or later:
+            if not stack:  # a joint left for last reaches its child only if nothing else did
+                link, r = later.pop(0)
+                if r[3].identifier not in links:
+                    stack.append(attach(link, r))
+                continue
             link = stack.pop()
             for r in edges[id(link.body)]:
-                j, kind, parent, child = r
-                if child.identifier in links:
+                if r[3].identifier in links:
                     continue
-                used.add(id(r))
-                a, b = body_joint_frames(j, parent, child)
-                node = Link(child, parent=link, joint=j, kind=kind, frame_in_body=b, origin=link.in_link(a))
-                node.q0 = _initial_value(link, node)
-                link.children.append(node)
-                links[child.identifier] = node
-                stack.append(node)
+                if left_for_last(r, into[id(r[3])]):
+                    later.append((link, r))
+                    continue
+                stack.append(attach(link, r))
     loops = [r for r in records if id(r) not in used]
     return KinematicTree(roots, links, loops, unresolved)
+
+
+def limited(joint) -> bool:
+    """Whether AMBF enables the joint's limits (both `low` and `high` given)."""
+    lim = joint.joint_limits
+    return lim is not None and lim.low is not None and lim.high is not None
+
+
+def left_for_last(record, into) -> bool:
+    """Whether a spanning tree should reach a body through the joint of ``record`` (joint,
+    kind, parent, child) only when no other joint of ``into`` (the tree joints into the same
+    child) does: a revolute or prismatic joint without limits, where another into its child has
+    them. The joint a tree leaves out closes the loop as a constraint, which plays no limits: a
+    limited one left out loses them (the corpus parallel structure's l3-l4 swung past its -1.047
+    rad, where AMBF's stops, while l1-l4, a continuous joint, held a place in the tree)."""
+    joint, kind = record[0], record[1]
+    if kind not in ONE_DOF or limited(joint):
+        return False
+    return any(limited(x[0]) for x in into if x is not record and x[1] in ONE_DOF)
 
 
 def _location(b: Body) -> Pose:

@@ -9,6 +9,7 @@ import numpy as np
 import pybullet as pb
 
 from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, body_joint_frames
+from ...model.tree import left_for_last
 from ..rotations import invert, matrix_to_pq, pose_matrix
 
 TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC)
@@ -26,6 +27,10 @@ def components(joints):
     used: set[int] = set()
     trees = []
     children = {id(r[3]) for r in joints if r[1] in TREE_KINDS}
+    into = defaultdict(list)  # the tree joints into each body
+    for r in joints:
+        if r[1] in TREE_KINDS:
+            into[id(r[3])].append(r)
     for r in joints:
         if r[1] not in TREE_KINDS or id(r[2]) in seen_bodies:
             continue
@@ -37,14 +42,25 @@ def components(joints):
             guard += 1
         if id(root) in seen_bodies:
             continue
-        order, queue = [], deque([root])
+        order, queue, later = [], deque([root]), deque()
         seen_bodies.add(id(root))
-        while queue:
+        while queue or later:
+            if not queue:  # a joint left for last (tree.left_for_last) where nothing else reached its child
+                rec = later.popleft()
+                if id(rec[3]) not in seen_bodies:
+                    used.add(id(rec))
+                    seen_bodies.add(id(rec[3]))
+                    order.append(rec)
+                    queue.append(rec[3])
+                continue
             b = queue.popleft()
             for rec in adj[id(b)] + [x for x in joints if x[1] is JointKind.FIXED and x[2] is b]:
                 if id(rec) in used or rec[2] is not b or id(rec[3]) in seen_bodies:
                     continue
                 if rec[3].static:
+                    continue
+                if left_for_last(rec, into[id(rec[3])]):
+                    later.append(rec)
                     continue
                 used.add(id(rec))
                 seen_bodies.add(id(rec[3]))

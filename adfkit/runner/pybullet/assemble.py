@@ -33,6 +33,7 @@ from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .damping import LinkDamping
 from .interact import SimActuator, SimGhost, SimSensor
 from .joints import ConstraintRefused, make_constraint, spring_joint
+from .loops import close_loops
 from .meshfiles import pybullet_reads_quietly
 from .shapes import collision_parts, create_collision, create_visual
 from .spring_forces import SpringSet
@@ -137,7 +138,7 @@ class Assembly:
                 self.constraints.append((j.identifier, c, parent, child, pa, pbv, axis))
             if kind_c is JointKind.FIXED:  # its relative orientation is held too (joint_angle_error)
                 self.fixed_frames.append((j.identifier, parent, child, fa[:3, :3], fb[:3, :3]))
-        self._hold_closed_loops()
+        self.loop_gaps = close_loops(self)  # by multibody: its loops' pivot gaps before
         self.springs = SpringSet(springs, self.cid, self.gravity, self.opt.springs)
         self.link_damping = LinkDamping(self)
         build_volumes(self, models)
@@ -166,18 +167,6 @@ class Assembly:
         # the ghosts that act on what is inside them each control step (Options.ghosts)
         self._acting_ghosts = self.ghosts if self.opt.ghosts == "ambf" else self._friction_ghosts
         self._manifold_place, self._manifold_made = None, {}  # interact._manifold_points' last pass
-
-    def _hold_closed_loops(self) -> None:
-        """A multibody closed by a constraint between two of its own links keeps its joints held
-        where they start (its motors on; every other multibody's joints are free, as AMBF's).
-        Its links start on their joints, a fraction of a millimetre off the file's loop pivots,
-        which AMBF's bodies, placed where the file places them, meet; left free, the constraint
-        pushing that gap drives the whole mechanism (measured: the corpus ECM's pitch
-        parallelogram 121 mm in 1 s, 0.37 mm from AMBF held)."""
-        for _name, _c, parent, child, *_rest in self.constraints:
-            art = parent.articulation
-            if art is not None and art is child.articulation and not art.held:
-                art.drive()
 
     def _group_gravity_overrides(self):
         """Bodies whose gravity differs from the world's, grouped per multibody so each control
