@@ -1,6 +1,7 @@
-"""Joint motors as soft as AMBF's constraint rows (runner/joint_commands.py, motor_gain): a
+"""Joint motors as soft as AMBF's constraint rows (runner/joint_commands.py, soft_row_impulses): a
 motor reaches its target over several steps when it moves more than its own two bodies, by the
-joint's `joint cfm`; with cfm 0 it reaches it within the step (the control)."""
+joint's `joint cfm`, and a chain's rows settle together; with cfm 0 it reaches it within the step
+(the control)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ pytest.importorskip("pybullet")
 
 from adfkit.adf import load_scene  # noqa: E402
 from adfkit.runner import Options, open_world  # noqa: E402
-from adfkit.runner.joint_commands import JointCommands, motor_gain  # noqa: E402
+from adfkit.runner.joint_commands import JointCommands, soft_row_impulses  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -23,11 +24,30 @@ ARM_ROW = 0.0037875
 ARM_JOINT = 0.0037875 + 0.5 * 0.2**2
 
 
-def test_the_motor_gain_is_the_rows_share():
-    assert motor_gain(0.1, ARM_JOINT, ARM_ROW) == pytest.approx(1 / (1 + 0.1 * ARM_JOINT / ARM_ROW))
-    assert motor_gain(0.0, ARM_JOINT, ARM_ROW) == 1.0
-    assert motor_gain(0.1, ARM_JOINT, float("inf")) == 1.0  # between static bodies: no row to soften
-    assert motor_gain(0.5, 2.0, 0.01) == pytest.approx(1 / 101)
+def _share(cfm, inertia, row_mass):
+    """How far one soft row takes its joint in a step: r·(v_t − v) = cfm·λ, λ = I·(v − v_free)."""
+    return 1 / (1 + cfm * inertia / row_mass)
+
+
+def test_one_soft_row_goes_its_share_of_the_way():
+    (lam,) = soft_row_impulses(np.array([[1 / ARM_JOINT]]), [ARM_ROW], [0.1], [1.0], [0.0])
+    assert lam / ARM_JOINT == pytest.approx(_share(0.1, ARM_JOINT, ARM_ROW))  # 0.614 of the way
+    (lam,) = soft_row_impulses(np.array([[1 / ARM_JOINT]]), [ARM_ROW], [0.0], [1.0], [0.0])
+    assert lam / ARM_JOINT == pytest.approx(1.0)  # cfm 0: all the way
+
+
+def test_a_chains_soft_rows_settle_together():
+    """Two joints, M = [[1, 1], [1, 2]] (W = M⁻¹ = [[2, -1], [-1, 1]]), rows of mass 1 and 0.5,
+    cfm 0.1, the first driven at 1 from rest, the second held at 0: by hand λ = (0.6, 0.5)/0.76,
+    v = W·λ = (0.921, -0.132): the second joint, pushed by its neighbour's row, falls behind its
+    target too, which one row at a time (the first alone, I = 1/W₁₁: 1/(1 + 0.1·0.5) = 0.952) misses."""
+    w = np.array([[2.0, -1.0], [-1.0, 1.0]])
+    lam = soft_row_impulses(w, [1.0, 0.5], [0.1, 0.1], [1.0, 0.0], [0.0, 0.0])
+    assert lam == pytest.approx([0.6 / 0.76, 0.5 / 0.76])
+    v = w @ lam
+    assert v == pytest.approx([0.92105, -0.13158], abs=1e-5)
+    assert [1.0, 0.5] * (np.array([1.0, 0.0]) - v) == pytest.approx(0.1 * lam)  # each row r·(v_t − v) = cfm·λ
+    assert abs(v[0] - _share(0.1, 1 / 2.0, 1.0)) > 0.01
 
 
 def _arm(tmp_path, cfm):
@@ -56,7 +76,7 @@ def test_a_velocity_command_is_reached_at_the_rows_pace(tmp_path, cfm):
             v.append(float(w.joint_state(dj.art, [dj.index])[1][0]))
     finally:
         w.close()
-    g = motor_gain(0.1, ARM_JOINT, ARM_ROW) if cfm is None else 1.0  # AMBF's joint cfm is 0.1
+    g = _share(0.1, ARM_JOINT, ARM_ROW) if cfm is None else 1.0  # AMBF's joint cfm is 0.1
     expected = [1 - (1 - g) ** n for n in (1, 2, 3)]  # 0.614, 0.851, 0.943 rad/s at cfm 0.1
     assert v == pytest.approx(expected, abs=2e-3)
 

@@ -116,21 +116,16 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             physicsClientId=self.cid,
         )
 
-    def joint_inertias(self, art) -> np.ndarray:
-        """Each joint's inertia along its axis (kg·m², kg for a prismatic joint) with the
-        articulation's other joints free, now: 1 / (M⁻¹)ᵢᵢ of its joint-space mass matrix M
-        (0 for a fixed joint)."""
+    def joint_mobility(self, art, idxs) -> np.ndarray:
+        """(M⁻¹) over joints ``idxs`` (revolute or prismatic record indices) of an articulation, now,
+        M its joint-space mass matrix: the velocity change of those joints per unit of impulse on
+        each (rad/s per N·m·s, m/s per N·s), the articulation's other joints free."""
         cid = self.cid
         dofs = [n for n, k in enumerate(art.kinds) if k in (JointKind.REVOLUTE, JointKind.PRISMATIC)]
         q = [s[0] for s in pb.getJointStates(art.uid, dofs, physicsClientId=cid)]
         mass = np.array(pb.calculateMassMatrix(art.uid, q, physicsClientId=cid))
-        try:
-            diag = 1.0 / np.diag(np.linalg.inv(mass))
-        except np.linalg.LinAlgError:  # a massless link: each joint with the others held instead
-            diag = np.diag(mass)
-        out = np.zeros(len(art.records))
-        out[dofs] = diag[len(diag) - len(dofs) :]  # a floating base's six come first
-        return out
+        at = [len(mass) - len(dofs) + dofs.index(i) for i in idxs]  # a floating base's six come first
+        return np.linalg.pinv(mass)[np.ix_(at, at)]  # pinv: a massless link leaves M singular
 
     def joint_row_mass(self, art, index: int) -> float:
         """The mass (kg·m², kg) a Bullet constraint row along joint ``index``'s axis sees between the
