@@ -115,17 +115,18 @@ def test_a_psm_yaw_held_by_ambfs_controller_does_not_ring(cfm, ring):
         assert late < 0.1 and q == pytest.approx(0.1, abs=1e-3)  # measured 0.009 rad/s, 0.09998 rad
 
 
-@pytest.mark.parametrize("leaving", [True, False])
-def test_a_limit_holds_an_effort_one_way_only(tmp_path, leaving):
-    """The arm 0.01 rad past its lower limit (-2 rad), pushed further on by an effort: AMBF's limit
-    row drives it back at erp·error a step, and only pushes: a joint already leaving its limit
-    faster than that (5 rad/s) goes on, slowed by the effort alone. Control: the joint moving
-    further past its limit is driven back at erp·error/dt."""
+@pytest.mark.parametrize("leaving, effort", [(True, -0.5), (False, -0.5), (False, 0.5)])
+def test_a_limit_holds_an_effort_one_way_only(tmp_path, leaving, effort):
+    """The arm 0.01 rad past its lower limit (-2 rad) under an effort: AMBF's limit row drives it
+    back at erp·error a step, and only pushes: a joint already leaving its limit faster than that
+    (5 rad/s) goes on, slowed by the effort alone (-0.5 N·m, pushing it further on). Controls: the
+    joint moving further past its limit (5 rad/s) is driven back at erp·error/dt, whether the
+    effort pushes it out or pulls it in (the limit, not the effort, holds it)."""
     w = _arm(tmp_path, None)
     try:
         commands = JointCommands(w)
         (joint, _parent, child) = next(r for r in w.joints_made if r[0].name == "base-arm")
-        commands.command(joint, child, "effort", -0.5)
+        commands.command(joint, child, "effort", effort)
         dj = commands.joints[id(joint)]
         w.reset_joints(dj.art, [dj.index], [-2.01], [5.0 if leaving else -5.0])
         commands.apply(w.dt)
@@ -134,6 +135,6 @@ def test_a_limit_holds_an_effort_one_way_only(tmp_path, leaving):
     finally:
         w.close()
     if leaving:  # 5 - 0.5·dt/I, I the arm's 0.0238 kg m² about the joint (and AMBF's damping)
-        assert v == pytest.approx(5.0 - 0.5 * w.dt / ARM_JOINT, rel=2e-3)
+        assert v == pytest.approx(5.0 + effort * w.dt / ARM_JOINT, rel=2e-3)
     else:
         assert v == pytest.approx(dj.erp * 0.01 / w.dt, rel=2e-2)  # 1 rad/s back toward the limit

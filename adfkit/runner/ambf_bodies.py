@@ -9,8 +9,10 @@ grown by the margin on every side, mass/12·(ly² + lz², ...). PyBullet's estim
 adds the margin twice (btPolyhedralConvexShape's box of its bounds, which already hold it, grown by
 it again): measured on the corpus KUKA's link7 (1 kg), AMBF 6.512e-4, 6.512e-4, 1.1206e-3 kg·m²,
 this estimate 6.509e-4, 6.511e-4, 1.1204e-3, PyBullet's 6.90e-4, 6.90e-4, 1.176e-3. A body of
-primitives keeps the engine's estimate (Bullet's boxes, spheres, cylinders and capsules are
-AMBF's).
+primitives is boxed too (AMBF puts even a single primitive in a compound): the corpus LND PSM's
+pitch end link, a cylinder, 0.135 kg·m² about x in AMBF and here, 0.0049 in PyBullet when its
+shape is made in its centre of mass (the cylinder's own inertia); every link of that PSM within
+1e-15 of AMBF's.
 
 **Joint speed.** AMBF integrates each btRigidBody with a rotation of at most π/4 a physics step
 (Bullet's ANGULAR_MOTION_THRESHOLD in btTransformUtil::integrateTransform) and caps no velocity;

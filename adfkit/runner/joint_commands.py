@@ -223,19 +223,21 @@ class JointCommands:
 
     def _effort(self, dj: DrivenJoint, effort: float) -> None:
         """An effort, held at the joint's limits as AMBF's hinge and slider hold them (hard rows):
-        past a limit and pushed on, the joint is driven back at erp·error per step instead
-        (PyBullet drops a multibody link's limits while others of it are driven; the LND PSM's
-        jaw, pushed on its stop, turned 141° past it). A limit row only pushes: a joint already
-        leaving its limit faster than that is left to the effort (the PSM's effort program: a
-        jaw pushed shut, its yaw link kicked by the other jaw's stop, opened 0.52 rad in AMBF and
-        stayed shut under a motor that held it both ways)."""
+        past a limit, the joint is driven back at erp·error per step instead, whatever took it
+        there (PyBullet drops a multibody link's limits while others of it are driven; the LND
+        PSM's jaw, pushed on its stop, turned 141° past it; the KUKA flailing under its
+        controllers' efforts, its base joint 5.3 rad where AMBF's stay within their ±2.09).
+        A limit row only pushes: a joint already leaving its limit faster than that is left to
+        the effort (the PSM's effort program: a jaw pushed shut, its yaw link kicked by the
+        other jaw's stop, opened 0.52 rad in AMBF and stayed shut under a motor that held it both
+        ways)."""
         w = self.world
         if dj.limits is not None:
             q, v = (float(x[0]) for x in w.joint_state(dj.art, [dj.index]))
             lo, hi = dj.limits
             err = q - hi if q > hi else (q - lo if q < lo else 0.0)
             back = -dj.erp * err / w.dt
-            if err * effort > 0.0 and (v - back) * err > 0.0:
+            if err != 0.0 and (v - back) * err > 0.0:
                 w.joint_motor(dj.art, dj.index, back, LIMIT_FORCE)
                 return
         w.joint_effort(dj.art, dj.index, effort)
