@@ -643,9 +643,10 @@ def test_the_paced_clock_waits_for_the_joint_to_reach_its_set_point(scenes):
 def test_the_corpus_suture_replays_in_ambf():
     """Pair 1 of the corpus set, recorded in adfkit and replayed in AMBF, unpaced and paced
     (minutes). The two needles agree to 0.04 mm until the first grasp (2.4 s). After it AMBF's
-    arms stand off their set-points (its PSM's joints hold them 13-16 mrad off at rest, farther
-    under load) and its needle misses Entry1, paced or not (measured: the tip paths 47.8 and
-    44.7 mm apart at most); the paced replay plays about four times the recording's time."""
+    arms stand off their set-points (AMBF's ghost rule drags each arm's pitch end link, which
+    lies in its own finger ghosts, towards its jaws) and its needle misses Entry1, paced or not
+    (measured: the tip paths 44.7 and 43.6 mm apart at most); the paced replay plays about four
+    times the recording's time. The arms' links pass each other in AMBF as in adfkit (81 pairs)."""
     from conftest import CORPUS, require_corpus
 
     from adfkit.parity import suture
@@ -655,6 +656,7 @@ def test_the_corpus_suture_replays_in_ambf():
     rec = suture.record(launch, [6, 7, 8, 9, 10, 11], [1], seed=0)
     assert [v["verdict"] for v in rec.verdicts] == ["passed"]
     assert sum(c.kind == "grasp" for c in rec.commands) >= 2 and any(c.kind == "place" for c in rec.commands)
+    assert sum(c.kind == "collide" for c in rec.commands) == 81
     plain = suture.replay(rec, BUILD, launch, [6, 7, 8, 9, 10, 11])
     paced = suture.replay(rec, BUILD, launch, [6, 7, 8, 9, 10, 11], pace=suture.PACE)
     for r in (paced, plain):
