@@ -1,9 +1,9 @@
 """The suture replayed in AMBF (``adfkit parity --suture``): adfkit's scripted suture is played
 and recorded (every PSM joint set-point it gives, each grasp and release, the push that settles
-the needle, where the setup puts the arms, the body pairs it lets pass through each other), the recording is replayed in AMBF through adfkit's
-plugin (the set-points as AMBF's joint position commands, the grasps through AMBF's own
-constraint actuators), and the needle's path on each side is judged by the same verdict code
-(``tasks.verdicts.pair_verdict``).
+the needle, where the setup puts the arms, the body pairs it lets pass through each other), the
+recording is replayed in AMBF through adfkit's plugin (the set-points as AMBF's joint position
+commands, the grasps through AMBF's own constraint actuators), and the needle's path on each
+side is judged by the same verdict code (``tasks.verdicts.pair_verdict``).
 
 The set-points are played at AMBF's own time, where its joint controller (P 10, D 1 into a
 velocity motor by default) trails a moving set-point by about a tenth of a second; or paced
