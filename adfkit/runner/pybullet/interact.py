@@ -164,16 +164,17 @@ class Interaction:
         (it would push what enters it), so those near a dynamic body are let collide for one
         collision pass between steps (performCollisionDetection: no step, so no push) and shut
         again; a pair GJK answers (hulls) gives one point a pass, where AMBF's persistent manifold
-        gathers up to four over its steps. The last answer stands while the ghosts and the bodies
-        near them stay within SAME_PLACE of where they were (``poses``: those read this control
-        step, as _update_ghosts)."""
+        gathers up to four over its steps. The last answer stands while the same bodies are near
+        the same ghosts, within SAME_PLACE of where they were, and no collision pair or grasp has
+        changed (``poses``: those read this control step, as _update_ghosts)."""
         cid, dynamic = self.cid, self._dynamic_lookup
-        near, where = [], []
+        near, which, where = [], [self._pairs_epoch], []
         for g in ghosts:
             lo, hi = pb.getAABB(g.uid, -1, cid)
             keys = [key for key in pb.getOverlappingObjects(lo, hi, cid) or () if key in dynamic]
             if keys:
                 near.append(g)
+                which.append((g.uid, keys))
                 where.append(pb.getBasePositionAndOrientation(g.uid, cid))
                 for key in keys:
                     if key not in poses:
@@ -181,9 +182,9 @@ class Interaction:
                     where.append(poses[key])
         if not near:
             return {}
-        place = ([g.uid for g in near], np.array([c for pq in where for v in pq for c in v]))
+        place = (which, np.array([c for pq in where for v in pq for c in v]))
         last = self._manifold_place
-        if last is not None and last[0] == place[0] and len(last[1]) == len(place[1]):
+        if last is not None and last[0] == which:
             if np.max(np.abs(last[1] - place[1])) <= SAME_PLACE:
                 return self._manifold_made
         for g in near:
