@@ -59,6 +59,8 @@ MAX_BODY_DEPTH = 496
 # Moving bodies need mass and inertia above MuJoCo's mjMINVAL; massless ADF links get this.
 MIN_MASS = 1e-6
 MIN_INERTIA = 1e-9
+#: joints closing a loop that MJCF can write: an equality (a weld, or a connect at the pivot)
+LOOP_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P, JointKind.TORSION_SPRING)
 
 _LOSSY_OBJECTS = (
     ("ghost_objects", "ghost object"),
@@ -443,7 +445,7 @@ def to_mjcf(
             names_out[lk.body.identifier] = ("world" if elements[id(lk)] is world else names[id(lk)], lk)
     eq = None
     for j, kind, parent, child in tree.loops:
-        if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
+        if kind in LOOP_KINDS:
             eq = eq if eq is not None else ET.Element("equality")
             a, _b = body_joint_frames(j, parent, child)
             pl = by_body[parent.identifier]
@@ -458,13 +460,14 @@ def to_mjcf(
             )
             if tag == "connect":
                 e.set("anchor", _vec(anchor))
-            if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+            if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.TORSION_SPRING):
+                spring = "; its limits and spring are not written" if kind is JointKind.TORSION_SPRING else ""
                 losses.append(
                     Loss(
                         j.identifier,
                         "joint axis",
                         f"a {kind.value} joint closing a loop is written as "
-                        "equality/connect: a ball joint at the pivot",
+                        f"equality/connect: a ball joint at the pivot{spring}",
                     )
                 )
         else:
@@ -492,4 +495,4 @@ def write(model: ModelFile, path: Path) -> list[Loss]:
     return losses
 
 
-__all__ = ["to_mjcf", "write", "MIN_MASS", "MIN_INERTIA"]
+__all__ = ["to_mjcf", "write", "LOOP_KINDS", "MIN_MASS", "MIN_INERTIA"]

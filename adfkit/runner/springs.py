@@ -28,6 +28,7 @@ class SpringJoint:
     c_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
     eq_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
     linear_constrained: bool = True  # a p2p holds the pivots together
+    in_multibody: bool = False  # a multibody's joint plays its limits and locked axes (spring_alone)
 
 
 def _vec(v, default: float) -> np.ndarray:
@@ -93,4 +94,17 @@ def spring_joint(joint, kind: JointKind, parent, child, frame_a, frame_b) -> Spr
                 sj.k_lin, sj.c_lin, sj.eq_lin = np.array([0, 0, k]), np.array([0, 0, c]), np.array([0, 0, eq])
             else:
                 sj.k_ang, sj.c_ang, sj.eq_ang = np.array([0, 0, k]), np.array([0, 0, c]), np.array([0, 0, eq])
+    return sj
+
+
+def spring_alone(sj: SpringJoint) -> SpringJoint | None:
+    """``sj`` with its spring and damper only, its limits and locked axes left to an exact joint
+    that plays them (a limited torsion or linear spring in a multibody: a revolute or prismatic
+    joint with its limits); None when it has neither stiffness nor damping (nothing is left)."""
+    if not (np.any(sj.k_lin) or np.any(sj.c_lin) or np.any(sj.k_ang) or np.any(sj.c_ang)):
+        return None
+    free_low, free_high = np.ones(3), -np.ones(3)  # low > high: free (Bullet's convention)
+    sj.lin_low, sj.lin_high, sj.ang_low, sj.ang_high = free_low, free_high, free_low.copy(), free_high.copy()
+    sj.linear_constrained = not (np.any(sj.k_lin) or np.any(sj.c_lin))
+    sj.in_multibody = True
     return sj

@@ -212,9 +212,16 @@ class Assembly:
         return min(z) if z else 0.0
 
     def _geom_bottom(self, g: int) -> float:
-        """Lowest z of a geom's world bounding box (its local AABB turned into the world)."""
+        """Lowest z of a geom: a mesh's lowest vertex (as PyBullet's bounds of its hull, so that
+        a model played alone gets its floor at one height in both engines), else of its world
+        bounding box (its local AABB turned into the world)."""
         m, d = self.model, self.data
         r = d.geom_xmat[g].reshape(3, 3)
+        mesh = m.geom_dataid[g] if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH else -1
+        if mesh >= 0:
+            first = m.mesh_vertadr[mesh]
+            verts = m.mesh_vert[first : first + m.mesh_vertnum[mesh]]
+            return float(np.min(verts @ r[2]) + d.geom_xpos[g][2])
         c, h = m.geom_aabb[g, :3], m.geom_aabb[g, 3:]
         return float((r @ c + d.geom_xpos[g])[2] - np.abs(r[2]) @ h)
 

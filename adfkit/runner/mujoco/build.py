@@ -22,7 +22,7 @@ import mujoco
 import numpy as np
 
 from ... import scratch
-from ...converters.mjcf_write import to_mjcf
+from ...converters.mjcf_write import LOOP_KINDS, to_mjcf
 from ...model.semantics import JointKind, ShapeKind, body_joint_frames, collision_primitives, pose_or_identity
 from ...model.tree import ONE_DOF
 from .. import plan as scene_rules
@@ -253,7 +253,7 @@ def build_plan(world) -> Plan:
             joints.append((lk.joint, lk.kind, parent, child, jn))
         for j, kind, pb_, cb in tree.loops:
             parent, child = mine[pb_.identifier], mine[cb.identifier]
-            if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
+            if kind in LOOP_KINDS:
                 a, b = body_joint_frames(j, pb_, cb)
                 pa = np.array(parent.link.in_link(a).position, float)
                 pbv = np.array(child.link.in_link(b).position, float)

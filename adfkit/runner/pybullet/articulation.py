@@ -1,5 +1,11 @@
 """Trees of revolute/prismatic(/fixed) joints as PyBullet multibodies: exact joints with
-native limits and position motors; no constraint drift. Loops stay outside (joints.py)."""
+native limits and position motors; no constraint drift. Loops stay outside (joints.py).
+
+A `torsion spring` or `linear spring` with limits joins the tree as a revolute or prismatic
+joint about or along its frame's z axis: AMBF builds it as a btGeneric6DofSpring2Constraint whose
+other five axes are locked and whose z axis is limited to the joint's limits (afJoint::
+createFromAttribs), a hinge or slider with limits; its spring is a force (spring_forces.py). One
+without limits has all six axes locked in AMBF: a fixed joint of the tree."""
 
 from __future__ import annotations
 
@@ -12,33 +18,52 @@ from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, body_
 from ...model.tree import left_for_last
 from ..rotations import invert, matrix_to_pq, pose_matrix
 
-TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+TREE_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
+#: the tree joints that turn about their frame's z axis (the others slide)
+ROTARY = (JointKind.REVOLUTE, JointKind.TORSION_SPRING)
+#: the axis of each tree joint in its frame: a prismatic joint slides along x (Bullet's slider), a
+#: linear spring along z (the spring axis AMBF gives its btGeneric6DofSpring2Constraint)
+AXIS = {JointKind.PRISMATIC: 0}
+
+
+def tree_kind(record) -> JointKind | None:
+    """The joint a (joint, kind, parent, child) record is in a multibody, None if it joins none:
+    a revolute or prismatic joint as it is, a torsion or linear spring as one when it has both
+    limits and as a fixed joint without them (AMBF locks all six axes of such a spring)."""
+    joint, kind = record[0], record[1]
+    if kind in (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING):
+        lim = joint.joint_limits
+        return kind if lim is not None and lim.low is not None and lim.high is not None else JointKind.FIXED
+    return kind if kind in TREE_KINDS else None
 
 
 def components(joints):
     """Group (joint, kind, parent SimBody, child SimBody) records joined by revolute/prismatic
-    joints into trees. Returns [(root, [records in BFS order])] and the leftover records."""
+    joints (and torsion and linear springs, tree_kind) into trees. Returns [(root, [records in BFS order])]
+    and the leftover records."""
+    joints = list(joints)
+    tree_ids = {id(r) for r in joints if tree_kind(r) is not None}
     adj = defaultdict(list)
     for r in joints:
-        if r[1] in TREE_KINDS:
+        if id(r) in tree_ids:
             adj[id(r[2])].append(r)
             adj[id(r[3])].append(r)
     seen_bodies: set[int] = set()
     used: set[int] = set()
     trees = []
-    children = {id(r[3]) for r in joints if r[1] in TREE_KINDS}
+    children = {id(r[3]) for r in joints if id(r) in tree_ids}
     into = defaultdict(list)  # the tree joints into each body
     for r in joints:
-        if r[1] in TREE_KINDS:
+        if id(r) in tree_ids:
             into[id(r[3])].append(r)
     for r in joints:
-        if r[1] not in TREE_KINDS or id(r[2]) in seen_bodies:
+        if id(r) not in tree_ids or id(r[2]) in seen_bodies:
             continue
         # walk up to a root: a body that is no tree joint's child
         root = r[2]
         guard = 0
         while id(root) in children and guard < 1000:
-            root = next(x[2] for x in joints if x[1] in TREE_KINDS and x[3] is root)
+            root = next(x[2] for x in joints if id(x) in tree_ids and x[3] is root)
             guard += 1
         if id(root) in seen_bodies:
             continue
@@ -128,7 +153,7 @@ def depth_first(root, records):
 
 def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) -> Articulation:
     """Create the multibody. ``shapes_for(simbody, frame_in_body) -> (collision, visual)``."""
-    records = depth_first(root, records)
+    records = [(j, tree_kind((j, k)) or k, p, c) for j, k, p, c in depth_first(root, records)]
     idx = {id(root): -1}
     for n, r in enumerate(records):
         idx[id(r[3])] = n
@@ -150,7 +175,7 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
         lio.append(iorn)
         lpi.append(idx[id(parent)] + 1)
         lt.append(
-            {JointKind.REVOLUTE: pb.JOINT_REVOLUTE, JointKind.PRISMATIC: pb.JOINT_PRISMATIC}.get(kind, pb.JOINT_FIXED)
+            pb.JOINT_FIXED if kind not in TREE_KINDS else pb.JOINT_REVOLUTE if kind in ROTARY else pb.JOINT_PRISMATIC
         )
         la.append([1, 0, 0] if kind is JointKind.PRISMATIC else [0, 0, 1])
     bcol, bvis = shapes_for(root, root.ref_in_body)
@@ -190,7 +215,7 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
         if kind in TREE_KINDS:
             rel = invert(parent.body_world_matrix @ parent.ref_in_body) @ (child.body_world_matrix @ child.ref_in_body)
             rel = invert(pose_matrix(lp[n], lo[n])) @ rel
-            q = float(np.arctan2(rel[1, 0], rel[0, 0])) if kind is JointKind.REVOLUTE else float(rel[0, 3])
+            q = float(np.arctan2(rel[1, 0], rel[0, 0])) if kind in ROTARY else float(rel[AXIS.get(kind, 2), 3])
             lim = joint.joint_limits
             if lim is not None and lim.low is not None and lim.high is not None and lim.low <= lim.high:
                 pb.changeDynamics(uid, n, jointLowerLimit=lim.low, jointUpperLimit=lim.high, physicsClientId=cid)

@@ -28,6 +28,7 @@ from ..plan import (
     resolve_parent,
 )
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
+from ..springs import spring_alone
 from . import articulation, egl
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .damping import LinkDamping
@@ -38,6 +39,12 @@ from .meshfiles import pybullet_reads_quietly
 from .shapes import collision_parts, create_collision, create_visual
 from .spring_forces import SpringSet
 from .volumes import build_volumes
+
+
+def _com_frames(joint, parent, child):
+    """The joint's frames in its parent's and its child's centre-of-mass frames."""
+    a, b = body_joint_frames(joint, parent.body, child.body)
+    return invert(parent.com_in_body) @ pose_to_matrix(a), invert(child.com_in_body) @ pose_to_matrix(b)
 
 
 class Assembly:
@@ -104,11 +111,14 @@ class Assembly:
         if self.soft is not None:
             self.soft.build(models)
         springs = []
+        for _root, recs in trees:  # limited springs in a multibody: their limits are its joints'
+            for j, kind, parent, child in recs:
+                if kind in SPRING_KINDS:
+                    sj = spring_alone(spring_joint(j, kind, parent, child, *_com_frames(j, parent, child)))
+                    springs += [sj] if sj is not None else []
         self.fixed_frames = []  # (joint name, parent, child, joint frame rotation in each)
         for j, kind, parent, child in leftover:
-            a, b = body_joint_frames(j, parent.body, child.body)
-            fa = invert(parent.com_in_body) @ pose_to_matrix(a)
-            fb = invert(child.com_in_body) @ pose_to_matrix(b)
+            fa, fb = _com_frames(j, parent, child)
             self.joint_names.append(j.identifier)
             sj = None
             if kind in SPRING_KINDS:

@@ -143,15 +143,21 @@ class SpringSet:
         )
         self.fl_g_rel = (acc[self.ic] - acc[self.ip])[fl] if n else np.zeros((0, 3))
         self.i_eff_col = self.i_eff[:, None]
-        if form == "ambf":
-            # Bullet's m, but never past the joint's share of its bodies' inertia (and mass) that the
-            # implicit form uses: Bullet's counts mass·r² even about an axis through both centres of
-            # mass, and the forces here act all at once (a Jacobi step), where Bullet solves rows one
-            # after another. With Bullet's m alone the corpus thread (capsules: 5e-10 kg m² about
-            # their axis, 90x less than its m) flew apart within the first second
-            m_ang, m_lin = bullet_spring_masses(bodies, self.ip, self.ic, fa, fb)
-            self.m_ang = np.minimum(m_ang, self.i_eff[:, None])
-            self.m_lin = np.minimum(m_lin, self.m_eff[:, None])
+        # Bullet's m, but never past the joint's share of its bodies' inertia (and mass) that the
+        # implicit form uses: Bullet's counts mass·r² even about an axis through both centres of
+        # mass, and the forces here act all at once (a Jacobi step), where Bullet solves rows one
+        # after another. With Bullet's m alone the corpus thread (capsules: 5e-10 kg m² about
+        # their axis, 90x less than its m) flew apart within the first second. A spring of a
+        # multibody's joint (SpringJoint.in_multibody) turns its child about its joint alone, the
+        # joint holding the rest: its m is Bullet's (a rod's mass·r² about its pivot, not its own
+        # inertia about its centre of mass, 1000x less for the test's pendulum, which its spring
+        # then could not hold up)
+        m_ang, m_lin = bullet_spring_masses(bodies, self.ip, self.ic, fa, fb)
+        exact = np.array([j.in_multibody for j in joints])[:, None]
+        self.m_ang = np.where(exact, m_ang, np.minimum(m_ang, self.i_eff[:, None]))
+        self.m_lin = np.where(exact, m_lin, np.minimum(m_lin, self.m_eff[:, None]))
+        self.i_implicit = np.where(exact, m_ang, self.i_eff[:, None])  # what the implicit form integrates
+        self.m_implicit = np.where(exact, m_lin, self.m_eff[:, None])
         self._gains_dt = None
 
     def _gains(self, dt: float) -> None:
@@ -175,9 +181,8 @@ class SpringSet:
                 1.0,
             )
         else:
-            i_eff, m_eff = self.i_eff[:, None], self.m_eff[:, None]
-            den_ang = 1.0 + (self.c_ang * dt + self.k_ang * dt**2) / i_eff
-            den_lin = 1.0 + (self.c_lin * dt + self.k_lin * dt**2) / m_eff
+            den_ang = 1.0 + (self.c_ang * dt + self.k_ang * dt**2) / self.i_implicit
+            den_lin = 1.0 + (self.c_lin * dt + self.k_lin * dt**2) / self.m_implicit
             self._ang = (self.k_ang, self.c_ang + self.k_ang * dt, den_ang)
             self._lin = (self.k_lin, self.c_lin + self.k_lin * dt, den_lin)
         k, c, den = self._lin

@@ -15,7 +15,6 @@ import time
 import numpy as np
 import pybullet as pb
 
-from ...model.semantics import JointKind
 from ..options import Options
 from ..rotations import matrix_to_pq, pose_matrix, quat_to_matrix
 from ..soft import in_scene as soft_in_scene
@@ -24,6 +23,7 @@ from ..stability import CHECK_EVERY_S
 from ..world import World
 from . import egl, held
 from . import stability as pb_stability
+from .articulation import AXIS, ROTARY, TREE_KINDS
 from .assemble import Assembly
 from .bodies import SimBody
 from .cameras import choose_renderer, render
@@ -121,7 +121,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         M its joint-space mass matrix: the velocity change of those joints per unit of impulse on
         each (rad/s per N·m·s, m/s per N·s), the articulation's other joints free."""
         cid = self.cid
-        dofs = [n for n, k in enumerate(art.kinds) if k in (JointKind.REVOLUTE, JointKind.PRISMATIC)]
+        dofs = [n for n, k in enumerate(art.kinds) if k in TREE_KINDS]
         q = [s[0] for s in pb.getJointStates(art.uid, dofs, physicsClientId=cid)]
         mass = np.array(pb.calculateMassMatrix(art.uid, q, physicsClientId=cid))
         at = [len(mass) - len(dofs) + dofs.index(i) for i in idxs]  # a floating base's six come first
@@ -135,13 +135,13 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         kind = art.kinds[index]
         parent = pb.getJointInfo(art.uid, index, physicsClientId=cid)[16]
         link = pb.getLinkState(art.uid, index, computeForwardKinematics=True, physicsClientId=cid)
-        axis = quat_to_matrix(link[5])[:, 2 if kind is JointKind.REVOLUTE else 0]
+        axis = quat_to_matrix(link[5])[:, 2 if kind in ROTARY else AXIS.get(kind, 2)]
         inverse = 0.0
         for n in (parent, index):
             mass, _f, diag = pb.getDynamicsInfo(art.uid, n, physicsClientId=cid)[:3]
             if mass <= 0.0:
                 continue
-            if kind is JointKind.PRISMATIC:
+            if kind not in ROTARY:
                 inverse += 1.0 / mass
                 continue
             if n < 0:
