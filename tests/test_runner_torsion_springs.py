@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 from scipy.optimize import brentq
-from test_runner import FOUR_BAR, _model
+from test_runner import _model
 
 from adfkit.runner import Options, open_world
 
@@ -83,23 +83,33 @@ def test_a_torsion_springs_limit_stops_it_short_of_its_balance(tmp_path, engine,
     assert abs(turn) < 0.01
 
 
-# FOUR_BAR's loop closed by a torsion spring instead of a hinge
-TORSION_LOOP = FOUR_BAR.replace(
-    "child: BODY l4\n  type: revolute\n  parent pivot: {x: 0.1,",
-    "child: BODY l4\n  type: torsion spring\n  joint limits: {low: -1.5, high: 1.5}\n  parent pivot: {x: 0.1,",
-)
+def _four_bar_with_a_torsion_spring(tmp_path, joint: str):
+    """test_runner_links' four-bar, l2-l3, l3-l4 and l1-l4 limited, ``joint`` a torsion spring."""
+    from test_runner_links import four_bar
+
+    from adfkit.adf import load_scene
+
+    lim = "  joint limits: {low: -0.5, high: 0.5}\n"
+    plain = four_bar(limits=lim, last_limits=lim)
+    cut = plain.index(f"JOINT {joint}:\n")
+    text = plain[:cut] + plain[cut:].replace("type: revolute", "type: torsion spring", 1)
+    assert text.count("type: torsion spring") == 1
+    path = tmp_path / "four_bar.yaml"
+    path.write_text(text)
+    return load_scene(path)
 
 
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
 def test_a_torsion_spring_closing_a_loop_holds_the_loop(tmp_path, engine):
-    """The parallelogram closed by a torsion spring: its sides swing down and its bottom bar stays
-    level, as a parallelogram's does (MuJoCo left a torsion spring closing a loop out, with its
-    runner-loop warning, and the open chain folded: the bar turned). In PyBullet the loop's
-    pivots meet where the multibody's links start, and its joints are free."""
-    assert TORSION_LOOP != FOUR_BAR
-    world = open_world(_model(tmp_path, TORSION_LOOP), Options(visuals=False, ground=False), engine=engine)
+    """The four-bar's joints all limited, l3-l4 a torsion spring: the tree takes l1-l4, met first,
+    and the spring closes the loop. The sides swing down and the bottom bar stays level, as a
+    parallelogram's does (MuJoCo left a torsion spring closing a loop out, with its runner-loop
+    warning, and the open chain folded: the bar turned)."""
+    scene = _four_bar_with_a_torsion_spring(tmp_path, "l3-l4")
+    world = open_world(scene, Options(visuals=False, ground=False), engine=engine)
     try:
         assert not [d for d in world.diagnostics if d.rule == "runner-loop"]
+        assert {n for n, *_ in world.constraints} - {"JOINT world-l1"} == {"JOINT l3-l4"}
         l3 = world.body("BODY l3")
         z0 = l3.com_position()[2]
         world.run(0.1)
@@ -168,16 +178,37 @@ def test_the_springy_kuka_folds_under_gravity_as_in_ambf(monkeypatch):
 
 
 @pytest.mark.slow
-def test_the_springy_ecms_loop_is_closed_in_mujoco(monkeypatch):
-    """The corpus springy ECM's pitch parallelogram is closed by a torsion spring: MuJoCo plays it
-    as a point constraint at its pivot (it was left out, with its runner-loop warning). Its arm
-    falls onto its pitch limits under gravity; measured 55 mm from AMBF at most (AMBF's pitch
-    links bend faster at first: docs/parity.md). Control: the loop left out, 181 mm."""
-    from adfkit.converters import mjcf_write
-    from adfkit.runner.mujoco import build
+def test_the_springy_ecms_loops_are_closed_by_its_joints_without_limits(monkeypatch):
+    """The corpus springy ECM's pitch parallelogram has continuous joints and limited torsion
+    springs into the same links: the continuous ones close its loops (their constraints play no
+    limits) and the springs keep theirs in the tree. Measured 32 mm from AMBF at most (PyBullet;
+    its arm falls onto its pitch limits). Control: springs not counted as limited joints, the
+    tree took the joint it met first and a spring closed a loop without its limits: 59 mm."""
+    from adfkit.model import tree
 
-    assert _at_rest("ecm-springy", "mujoco") < 80e-3
-    open_loops = tuple(k for k in build.LOOP_KINDS if k is not build.JointKind.TORSION_SPRING)
-    monkeypatch.setattr(build, "LOOP_KINDS", open_loops)
-    monkeypatch.setattr(mjcf_write, "LOOP_KINDS", open_loops)
-    assert _at_rest("ecm-springy", "mujoco") > 150e-3
+    assert _at_rest("ecm-springy", "pybullet") < 45e-3
+    monkeypatch.setattr(tree, "LIMITED_KINDS", tree.ONE_DOF)
+    assert _at_rest("ecm-springy", "pybullet") > 50e-3
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_loop_is_closed_by_its_joint_without_limits_not_by_a_limited_spring(tmp_path, engine):
+    """The four-bar with l3-l4 a limited torsion spring and l1-l4 without limits: l1-l4 closes
+    the loop, as a constraint, which plays no limits, and the spring's limits are the tree
+    joint's (the rule counted only revolute and prismatic joints as limited: the tree took l1-l4,
+    met first, and the spring closed the loop without its limits)."""
+    from test_runner_links import four_bar
+
+    from adfkit.adf import load_scene
+
+    lim = "  joint limits: {low: -0.5, high: 0.5}\n"
+    plain = four_bar(limits=lim)
+    text = plain.replace("child: BODY l4\n  type: revolute", "child: BODY l4\n  type: torsion spring", 1)
+    assert text != plain and "type: torsion spring" in text.split("JOINT l3-l4:")[1].split("JOINT l1-l4:")[0]
+    path = tmp_path / "four_bar.yaml"
+    path.write_text(text)
+    world = open_world(load_scene(path), Options(visuals=False, ground=False), engine=engine)
+    try:
+        assert {n for n, *_ in world.constraints} - {"JOINT world-l1"} == {"JOINT l1-l4"}
+    finally:
+        world.close()

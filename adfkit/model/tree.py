@@ -22,6 +22,9 @@ from .pose import Pose, Quat, Vec3
 from .semantics import JointKind, body_joint_frames, effective_mass, joint_kind, reference_axis
 
 ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+#: the joints whose `joint limits` bound one axis: the one-DOF joints and the torsion and linear
+#: springs (a limited spring is a hinge or a slider with its limits, runner.md)
+LIMITED_KINDS = ONE_DOF + (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
 
 
 @dataclass(eq=False)
@@ -200,7 +203,7 @@ def left_for_last(record, into) -> bool:
     joint, kind = record[0], record[1]
     if kind not in ONE_DOF or limited(joint):
         return False
-    return any(limited(x[0]) for x in into if x is not record and x[1] in ONE_DOF)
+    return any(limited(x[0]) for x in into if x is not record and x[1] in LIMITED_KINDS)
 
 
 def _location(b: Body) -> Pose:
