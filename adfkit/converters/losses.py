@@ -21,3 +21,19 @@ class Loss:
 def loss_keys(losses) -> list[tuple[str, str]]:
     """(element, feature) pairs, sorted: what tests compare."""
     return sorted((l.element, l.feature) for l in losses)
+
+
+def axis_tilt(joint, parent, child) -> Loss | None:
+    """The loss of a joint read into ADF whose axes AMBF's shortest arcs snap (identity below
+    1e-3 rad, taken in the bodies' inertial frames: semantics.snapped_axis_tilt); None if none."""
+    from ..model.semantics import snapped_axis_tilt
+
+    tilt = snapped_axis_tilt(joint, parent, child)
+    if not tilt:
+        return None
+    return Loss(
+        joint.identifier,
+        "axis tilt",
+        f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
+        "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away",
+    )

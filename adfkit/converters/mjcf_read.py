@@ -19,7 +19,7 @@ from ..model.files import ModelFile
 from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import inertial_joint_twist, shortest_arc
-from .losses import Loss
+from .losses import Loss, axis_tilt
 from .mjcf_cameras import read_cameras, read_lights
 from .mjcf_source import Source, load
 from .urdf import _unique
@@ -387,17 +387,6 @@ def _add_joint(
     who = f"JOINT {name}"
     a = rel0.orientation.rotate(axis)
     pa = rel0.transform(pivot)
-    d = Vec3(1.0, 0.0, 0.0) if jtype == "prismatic" else Vec3(0.0, 0.0, 1.0)
-    tilt = sum(t for t in (d.cross(a).norm(), a.cross(axis).norm()) if 1e-12 < t < 1e-3)
-    if tilt:
-        losses.append(
-            Loss(
-                who,
-                "axis tilt",
-                f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
-                "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away",
-            )
-        )
     twist = rel0.orientation * shortest_arc(axis, a).inverse()
     offset = _angle_about(a, twist)
     joint = Joint(
@@ -415,6 +404,9 @@ def _add_joint(
     # AMBF builds the joint's frames in the bodies' inertial frames: a turned one turns the
     # joint's zero, which the offset takes back
     offset += inertial_joint_twist(joint, parent, child)
+    tilt = axis_tilt(joint, parent, child)
+    if tilt is not None:
+        losses.append(tilt)
     if abs(offset) > 1e-12:
         joint.offset = offset
     model.joints.append(joint)

@@ -16,7 +16,7 @@ from ..model.objects import Body, Inertia, Joint, JointLimits
 from ..model.pose import Pose, Quat, Vec3
 from ..model.semantics import inertial_joint_twist, shortest_arc
 from . import inertia as inertia_math
-from .losses import Loss
+from .losses import Loss, axis_tilt
 from .safexml import XmlDocument, parse_xml
 from .urdf_write import _vec
 
@@ -445,21 +445,6 @@ def _read_joint(doc, j, links, ground, bodies, frame_in_link, world, model: Mode
     joint_in_child_body = frame_in_link[cname].inverse()  # J (= child link) in the child body
     a = joint_in_parent_body.orientation.rotate(u)
     b = joint_in_child_body.orientation.rotate(u)
-    # AMBF's shortest arc is the identity below 1e-3 rad (§8.2): an axis that close to the
-    # reference axis, or to the other body's axis, is snapped onto it
-    d = Vec3(1.0, 0.0, 0.0) if kinds[jtype] == "prismatic" else Vec3(0.0, 0.0, 1.0)
-    tilt = sum(
-        t for t in (d.cross(a.normalized()).norm(), a.normalized().cross(b.normalized()).norm()) if 1e-12 < t < 1e-3
-    )
-    if tilt:
-        losses.append(
-            Loss(
-                who,
-                "axis tilt",
-                f"an axis differs by {tilt:.3g} rad from one AMBF snaps it to "
-                "(shortest arcs below 1e-3 rad are the identity): ADF rounds it away",
-            )
-        )
     rel = parent.location.inverse() * child.location
     twist = rel.orientation * shortest_arc(b, a).inverse()
     offset = _twist(a.normalized(), twist)
@@ -477,6 +462,9 @@ def _read_joint(doc, j, links, ground, bodies, frame_in_link, world, model: Mode
     # AMBF builds the joint's frames in the bodies' inertial frames: a turned one turns the
     # joint's zero, which the offset takes back
     offset += inertial_joint_twist(joint, parent, child)
+    tilt = axis_tilt(joint, parent, child)
+    if tilt is not None:
+        losses.append(tilt)
     if abs(offset) > 1e-12:
         joint.offset = offset
     lim = j.find("limit")

@@ -343,6 +343,18 @@ def offsets_for_body_frames(joint, parent, child) -> tuple[float, float]:
     return math.remainder(jo2, 2 * math.pi), math.remainder(off2, 2 * math.pi)
 
 
+def snapped_axis_tilt(joint, parent, child) -> float:
+    """How far (rad) AMBF's shortest arcs, the identity below 1e-3 rad (§8.2), tilt the joint
+    from what its file says: the arcs AMBF takes from the reference axis to the parent's axis and
+    from the child's axis to the parent's, both in the bodies' inertial frames (as
+    :func:`joint_frames` builds them), summed where one is snapped (between 1e-12 and 1e-3 rad);
+    0 for a joint whose arcs are exact or large enough to be kept."""
+    d = reference_axis(joint_kind(joint.type) or JointKind.REVOLUTE)
+    a = inertial_rotation(parent).inverse().rotate(normalized_or(joint.parent_axis, Vec3(0, 0, 1)))
+    b = inertial_rotation(child).inverse().rotate(normalized_or(joint.child_axis, Vec3(0, 0, 1)))
+    return sum(t for t in (d.cross(a).norm(), a.cross(b).norm()) if 1e-12 < t < 1e-3)
+
+
 def inertial_joint_twist(joint, parent, child) -> float:
     """How far (rad, in [-π, π]) AMBF turns the joint's frames about its axis from the ones the
     body frames give: 0 unless a body's inertial frame is turned. For a revolute joint AMBF
