@@ -223,7 +223,7 @@ def test_the_bundled_arms_stand_still_in_ambf_as_in_adfkit(tmp_path):
     for AMBF's reading: AMBF reads it as adfkit does and neither moves (measured 0.016 mm in
     1 s; 0.003 mm in 0.3 s, and as little without the `joint offset`s, which turn only where a
     joint's angle is read from). Negative control: without them, the links' shapes made in
-    their centre-of-mass frames (Options.link_shapes "com"), which then
+    their centre-of-mass frames (Options.link_shapes "com", the tasks' default), which then
     sit off their bodies and collide: PyBullet's insertion link moved 184 mm, AMBF's 0.002 mm."""
     import shutil
     from pathlib import Path

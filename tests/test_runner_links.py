@@ -59,20 +59,19 @@ def test_a_links_shapes_sit_where_the_file_puts_its_body(tmp_path):
     that frame and collides where the file puts the arm (the corpus gripper3's jaws collided
     0.1-0.3 m off, inside its base, and the gripper slid 337 mm over the floor and turned over),
     and the floor a model played alone gets is 1 mm under the arm's lowest corner. Control: the
-    shapes made in the arm's centre-of-mass frame (Options.link_shapes "com")
+    shapes made in the arm's centre-of-mass frame (Options.link_shapes "com", the tasks' default)
     sit on the hinge instead."""
     path = tmp_path / "arm.yaml"
     path.write_text(ARM)
     low = -_C - (0.1 * math.sqrt(0.5) + 0.01 * math.sqrt(0.5))  # the arm's lowest edge
-    for shapes, off in ((None, 0.0), ("body", 0.0), ("com", 0.1)):  # None: the default, the file's
-        given = {} if shapes is None else {"link_shapes": shapes}
-        world = open_world(load_scene(path), Options(visuals=False, **given))
+    for shapes, off in (("body", 0.0), ("com", 0.1)):
+        world = open_world(load_scene(path), Options(visuals=False, link_shapes=shapes))
         try:
             arm = world.body("BODY arm")
             assert arm.link >= 0  # a link of the cube's multibody
             gap = float(np.linalg.norm(_centre(world, "BODY arm") - np.array([0.02 + _C, 0.0, -_C])))
             assert gap == pytest.approx(off, abs=2e-3), shapes
-            if shapes != "com":
+            if shapes == "body":
                 assert world.ground_z == pytest.approx(low - 1e-3, abs=2e-4)
             else:
                 assert world.ground_z > low + 0.02  # the hinged box reaches no lower than the cube

@@ -29,9 +29,11 @@ class Options:
     # where the PyBullet runner puts a multibody link's collision shapes: "body", where the file puts
     # them on the body (AMBF's; the link's frame is its joint's frame, the shapes are made in it);
     # "com", as if the link's frame were the body's centre-of-mass frame, off by where the joint
-    # frame sits in the body (the corpus gripper3's jaws 0.1-0.3 m off; the corpus PSMs' links too),
-    # kept to compare. MuJoCo: unused (its geoms are where the file puts them)
-    link_shapes: str = "body"
+    # frame sits in the body (the corpus gripper3's jaws 0.1-0.3 m off; the bundled PSMs' insertion
+    # links 16-17 mm, their second jaws 1.1-1.3 mm): how the runner built links when the tasks were
+    # built and accepted, the default here for them. `adfkit run` and
+    # `adfkit parity` put them where the file does. MuJoCo: unused (its geoms are where the file puts them)
+    link_shapes: str = "com"
     # what the PyBullet runner's bodies are (ambf_bodies.py): "pybullet", PyBullet's own (its inertia for a
     # body whose file gives none, its multibody joints capped at 100 rad/s; the default here, which the
     # tasks were built and accepted on); "ambf", AMBF's btRigidBodies: AMBF's estimated inertia (the box of
