@@ -138,3 +138,29 @@ def test_a_limit_holds_an_effort_one_way_only(tmp_path, leaving, effort):
         assert v == pytest.approx(5.0 + effort * w.dt / ARM_JOINT, rel=2e-3)
     else:
         assert v == pytest.approx(dj.erp * 0.01 / w.dt, rel=2e-2)  # 1 rad/s back toward the limit
+
+
+@pytest.mark.parametrize("start", [-2.1, -1.9])
+def test_a_joint_outside_its_limits_is_pushed_back_in_as_ambfs_hinge_row(tmp_path, start):
+    """The arm at rest, no command on it, 0.1 rad past its lower limit (-2 rad): AMBF's hinge
+    limit row (bias 0.3, erp 0.1) kicks it back in at 0.3·erp·0.1/dt = 3 rad/s within the step,
+    and it coasts on into its limits (PyBullet's own limit held it where it started). Control:
+    0.1 rad inside its limits it is left where it is."""
+    from adfkit.runner.pybullet.limit_rows import HINGE_LIMIT_BIAS
+
+    w = _arm(tmp_path, None)
+    try:
+        (joint, _parent, child) = next(r for r in w.joints_made if r[0].name == "base-arm")
+        art, index = child.articulation, child.link
+        w.reset_joints(art, [index], [start])
+        w.step(1)
+        v = float(w.joint_state(art, [index])[1][0])
+        w.step(99)
+        q = float(w.joint_state(art, [index])[0][0])
+    finally:
+        w.close()
+    if start < -2.0:
+        assert v == pytest.approx(HINGE_LIMIT_BIAS * 0.1 * 0.1 / w.dt, rel=2e-2)  # 3 rad/s
+        assert -2.0 < q < -1.6  # 0.1 s later, inside its limits (about 0.3 rad on)
+    else:
+        assert v == pytest.approx(0.0, abs=1e-6) and q == pytest.approx(start, abs=1e-6)

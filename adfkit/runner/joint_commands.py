@@ -219,6 +219,9 @@ class JointCommands:
             if dj is None:
                 raise ValueError(f"{joint.identifier}: not a revolute or prismatic joint of an articulation")
             self.joints[id(joint)] = dj
+            rows = getattr(self.world, "limit_rows", None)  # the engine's own hold past a limit
+            if rows is not None:
+                rows.leave(dj.art, dj.index)
         dj.command = (kind, float(value))
 
     def _effort(self, dj: DrivenJoint, effort: float) -> None:

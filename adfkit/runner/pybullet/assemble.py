@@ -34,6 +34,7 @@ from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .damping import LinkDamping
 from .interact import SimActuator, SimGhost, SimSensor
 from .joints import ConstraintRefused, make_constraint, spring_joint
+from .limit_rows import LimitRows
 from .loops import close_loops
 from .meshfiles import pybullet_reads_quietly
 from .shapes import collision_parts, create_collision, create_visual
@@ -151,6 +152,7 @@ class Assembly:
         self.loop_gaps = close_loops(self)  # by multibody: its loops' pivot gaps before
         self.springs = SpringSet(springs, self.cid, self.gravity, self.opt.springs)
         self.link_damping = LinkDamping(self)
+        self.limit_rows = LimitRows(self)
         build_volumes(self, models)
         known = None
         for m in models:

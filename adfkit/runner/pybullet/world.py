@@ -167,6 +167,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
 
     def control(self) -> None:
         """Per-control-step forces: gravity overrides, springs, multibody links' damping (damping.py),
+        joints past their limits pushed back (limit_rows.py),
         ghosts' viscous friction, sensors.
         PyBullet's calls take their arguments by position here (this runs every control step)."""
         cdt = self.dt * self.opt.control_substeps
@@ -184,6 +185,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
                 push(uid, k, f, at, cid)
         self.springs.apply(self.dt if self._springs_every_step else cdt)
         self.link_damping.apply()
+        self.limit_rows.apply()
         poses.update(self.springs.pq)
         self._update_ghosts(poses)
         for s in self.sensors:
