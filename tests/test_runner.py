@@ -430,6 +430,61 @@ def test_ambfs_ghost_rule_hangs_a_cube_in_a_ghost_alike_in_both_engines(tmp_path
     assert ends["pybullet", "ambf"][0] == pytest.approx(ends["mujoco", "ambf"][0], abs=5e-4)
 
 
+HINGED_IN_GHOST = (
+    "bodies: [BODY mount, BODY arm]\njoints: [JOINT mount-arm]\nghost objects: [GHOST cell]\n"
+    "BODY mount:\n  name: mount\n  mass: 0.0\n"
+    "  location: {{position: {{x: 0.0, y: 0.0, z: 0.5}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
+    "BODY arm:\n  name: arm\n  mass: 0.2\n  inertia: {{ix: 2.0e-5, iy: 1.0e-4, iz: 1.0e-4}}\n"
+    "  damping: {{linear: 0.0, angular: 0.0}}\n"
+    "  collision shape: BOX\n  collision geometry: {{x: 0.06, y: 0.01, z: 0.01}}\n"
+    "  location: {{position: {{x: 0.05, y: 0.0, z: 0.5}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
+    "JOINT mount-arm:\n  name: mount-arm\n  parent: BODY mount\n  child: BODY arm\n  type: revolute\n"
+    "  parent pivot: {{x: 0.0, y: 0.0, z: 0.0}}\n  child pivot: {{x: -0.05, y: 0.0, z: 0.0}}\n"
+    "  parent axis: {{x: 0.0, y: 0.0, z: 1.0}}\n  child axis: {{x: 0.0, y: 0.0, z: 1.0}}\n  damping: 0.0\n"
+    "GHOST cell:\n  name: cell\n  parent: BODY mount\n  shape: BOX\n  geometry: {{x: 0.2, y: 0.2, z: 0.02}}\n"
+    "  collision shape: BOX\n  collision geometry: {{x: 0.2, y: 0.2, z: 0.02}}\n"
+    "  location: {{position: {{x: {ghost_x}, y: 0.0, z: 0.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
+)
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_ambfs_ghost_rule_slows_a_hinged_link_inside_it(tmp_path, engine):
+    """AMBF's ghost rule on a jointed body (AMBF's every body is a btRigidBody, whose velocities
+    the rule sets; a multibody link's cannot be set, so the runners give it the force at its
+    centre of mass and the torque that take them there over the control step): an arm turning
+    at 2 rad/s about a hinge on a static mount, inside a ghost parented to the mount, keeps
+    0.9^(points·physics steps) of its joint velocity each control step, points the contact
+    points the engine counted for the pair (F = m·a at the COM and I·α move the hinge's whole
+    inertia I + m·r² by the same share). Control: the ghost 1 m away, the arm keeps its speed."""
+    from adfkit.runner.ghost_rules import AMBF_GHOST_KEEP
+    from adfkit.runner.joint_commands import JointCommands
+
+    for ghost_x, inside in ((0.05, True), (1.0, False)):
+        (tmp_path / str(ghost_x)).mkdir()
+        scene = _model(tmp_path / str(ghost_x), HINGED_IN_GHOST.format(ghost_x=ghost_x))
+        w = open_world(scene, Options(visuals=False, ground=False, gravity=(0, 0, 0), ghosts="ambf"), engine=engine)
+        try:
+            (joint, _parent, child) = next(r for r in w.joints_made if r[0].name == "mount-arm")
+            dj = JointCommands(w).drivable(joint, child)
+            w.reset_joints(dj.art, [dj.index], [0.0], [2.0])
+            (g,) = w.ghosts
+            ratios, predicted = [], []
+            for _ in range(3):
+                before = float(w.joint_state(dj.art, [dj.index])[1][0])
+                w.step(1)
+                after = float(w.joint_state(dj.art, [dj.index])[1][0])
+                points = sum(n for _, n in g.points)
+                ratios.append(after / before)
+                predicted.append(AMBF_GHOST_KEEP ** (points * w.opt.control_substeps))
+        finally:
+            w.close()
+        if inside:
+            assert all(p < 0.8 for p in predicted), predicted  # the engine counts the pair's points
+            assert ratios == pytest.approx(predicted, rel=0.03), (ratios, predicted)
+        else:
+            assert predicted == [1.0] * 3 and ratios == pytest.approx([1.0] * 3, abs=1e-3), ratios
+
+
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
 def test_a_ghost_counts_the_engines_contact_points_and_pushes_nothing(tmp_path, engine):
     """AMBF's ghost acts once per point of Bullet's manifold for a pair (afGhostObject::update), a

@@ -33,6 +33,16 @@ def ghost_velocity(v, w, v_parent, points: int):
     return keep * (v - along) + va, keep * w
 
 
+def ghost_accelerations(v, w, v_parent, points: int, cdt: float):
+    """(linear, angular) accelerations that, held over a control step ``cdt``, take a body's
+    velocities where ``points`` of AMBF's ghost updates set them (ghost_velocity): a jointed
+    body's velocities cannot be set, so the engines give it the force m·a at its centre of mass
+    and the torque I·α (the links' damping is given the same way, damping.gains)."""
+    v, w = np.asarray(v, float), np.asarray(w, float)
+    v2, w2 = ghost_velocity(v, w, v_parent, points)
+    return (v2 - v) / cdt, (w2 - w) / cdt
+
+
 def viscous_impulse_force(mass: float, v_rel: np.ndarray, k: float, cdt: float) -> np.ndarray:
     """F = -K·v_rel held for a control step ``cdt`` as the exact exp(-K·t/m) decay of
     dv/dt = -K·v/m (the paper's needle friction in the hole ghosts), never overshooting."""

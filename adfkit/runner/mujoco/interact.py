@@ -7,7 +7,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from ..ghost_rules import MANIFOLD_POINTS, SAME_PLACE, ghost_velocity, viscous_impulse_force
+from ..ghost_rules import MANIFOLD_POINTS, SAME_PLACE, ghost_accelerations, ghost_velocity, viscous_impulse_force
 from ..plan import ALL_GROUPS
 from ..rotations import invert, matrix_to_quat, pose_matrix
 from .assemble import WAKE_FORCE, _xyzw
@@ -135,15 +135,20 @@ class Interaction:
         """AMBF's ghost objects (ghost_rules: afGhostObject::update after each physics step), for
         this control step's physics steps: every body in penetrating contact keeps
         AMBF_GHOST_KEEP per contact and step of its velocity across the ghost parent's (a free
-        body; a jointed one only loses its weight, as in the PyBullet runner) and is weightless
-        until the next control step."""
+        body's is set; a jointed one is given the force at its centre of mass and the torque that
+        take it there over the control step, as in the PyBullet runner) and is weightless until
+        the next control step."""
         steps = self.opt.control_substeps
+        cdt = self.dt * steps
         d, m = self.data, self.model
         held: dict[int, MjBody] = {}
         for g, found in zip(self.ghosts, self._penetrating(self.ghosts)):
             g.overlapping, g.points = [sb for sb, _ in found], found
             if not found:
                 continue
+            if not held:  # the velocities now: mj_step left those of its last physics step's start
+                mujoco.mj_comPos(m, d)
+                mujoco.mj_comVel(m, d)
             moving = g.parent is not None and not g.parent.static
             v_par = self._com_velocity(g.parent) if moving else np.zeros(3)
             for sb, points in found:
@@ -151,7 +156,11 @@ class Interaction:
                 v6 = self._vel6
                 mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, sb.id, v6, 0)
                 v, w = ghost_velocity(v6[3:], v6[:3], v_par, points * steps)
-                self.set_body_velocity(sb, v, w)
+                if not self.set_body_velocity(sb, v, w):
+                    a, alpha = ghost_accelerations(v6[3:], v6[:3], v_par, points * steps, cdt)
+                    rot = d.ximat[sb.id].reshape(3, 3)  # the inertial frame's, about the COM
+                    d.xfrc_applied[sb.id, :3] += m.body_mass[sb.id] * a
+                    d.xfrc_applied[sb.id, 3:] += rot @ (m.body_inertia[sb.id] * (rot.T @ alpha))
         if held:
             self._overlaps_cleared = False
             for sb in held.values():

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import SAME_PLACE, ghost_velocity, viscous_impulse_force
+from ..ghost_rules import SAME_PLACE, ghost_accelerations, ghost_velocity, viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
 
@@ -119,8 +119,10 @@ class Interaction:
     def _ambf_ghost(self, g: SimGhost, held: dict) -> None:
         """AMBF's ghost on the bodies in penetrating contact with it (ghost_rules.ghost_velocity), for
         the physics steps of this control step: their velocities reset (a multibody link's cannot
-        be, only its weight is taken off) and their gravity off until the next control step."""
+        be: it is given the force at its centre of mass and the torque that take its velocities
+        there over the control step) and their gravity off until the next control step."""
         steps = self.opt.control_substeps
+        cdt = self.dt * steps
         cid = self.cid
         parent = g.parent
         v_par = parent.state()[2] if parent is not None and not parent.static else (0.0, 0.0, 0.0)
@@ -132,6 +134,12 @@ class Interaction:
                 v, w = pb.getBaseVelocity(sb.uid, cid)
                 v2, w2 = ghost_velocity(v, w, v_par, points * steps)
                 pb.resetBaseVelocity(sb.uid, v2.tolist(), w2.tolist(), cid)
+            else:
+                p, q, v, w = sb.state()
+                a, alpha = ghost_accelerations(v, w, v_par, points * steps, cdt)
+                rot = np.array(pb.getMatrixFromQuaternion(q)).reshape(3, 3)  # the COM frame's
+                sb.force((sb.mass * a).tolist(), list(p))
+                sb.torque((rot @ (np.asarray(sb.inertia) * (rot.T @ alpha))).tolist())
 
     def _weightless(self, bodies) -> None:
         """Each body's weight taken off for this control step (AMBF switches its gravity off)."""
