@@ -594,8 +594,8 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     }
     seen = {}
 
-    def fake(launch, indices, pairs, build, seed, progress, paces):
-        seen["paces"] = paces
+    def fake(launch, indices, pairs, build, seed, progress, paces, follow):
+        seen["paces"], seen["follow"] = paces, follow
         return out
 
     monkeypatch.setattr(suture, "compare_suture", fake)
@@ -606,6 +606,13 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     assert "pair 1: adfkit passed, AMBF failed (entry-missed" in text and "47.8 mm" in text
     assert "; paced: AMBF failed" in text and "432.4 s" in text and "1119 wait(s) given up" in text
     assert main(["parity", "--suture", "--pairs", "1"]) == 1 and seen["paces"] == (None,)
+    assert seen["follow"] == "commands"
+    assert main(["parity", "--suture", "--pairs", "1", "--follow", "both", "--pace", "both"]) == 1
+    assert seen["follow"] == "both" and seen["paces"] == (None, suture.PACE)
+    seen.clear()
+    # following the measured joints plays at AMBF's own time: a pace with it is a usage error
+    assert main(["parity", "--suture", "--pairs", "1", "--follow", "measured", "--pace", "on"]) == 2
+    assert "error[bad-option]" in capsys.readouterr().err and not seen
 
 
 @needs_ambf

@@ -90,6 +90,15 @@ def add_arguments(p) -> None:
         "that waits for AMBF's joints to reach each set-point, as a client waits for measured_js (about 4x "
         "AMBF's time); both replays twice and reports both (verdicts judged on the unpaced one)",
     )
+    p.add_argument(
+        "--follow",
+        choices=("commands", "measured", "both"),
+        default="commands",
+        help="--suture: commands (default) replays the set-points adfkit's planner gave as AMBF's position "
+        "commands; measured has each PSM joint follow the path adfkit's joint took (recorded each control "
+        "step), a velocity command each 1 ms step closing the loop on AMBF's measured joint, as a client "
+        "servoing measured_js would (no --pace); both replays measured first (its verdicts judged), then commands",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object (a list of them for --engine both)")
 
 
@@ -142,6 +151,7 @@ def run(args) -> int:
 def _suture(args) -> int:
     from .. import inputs
     from ..adf import parse_indices
+    from ..diagnostics import AdfError, error
     from ..jsonout import dumps
     from ..parity import ambf
     from ..parity.suture import PACE, compare_suture
@@ -153,13 +163,30 @@ def _suture(args) -> int:
     pairs = parse_pairs(args.pairs.strip())
     build = ambf.find_build(args.ambf)
     paces = {"on": (PACE,), "off": (None,), "both": (None, PACE)}[args.pace]
+    if args.follow == "measured" and args.pace != "off":
+        raise AdfError(
+            error(
+                "bad-option",
+                "--follow measured plays at AMBF's own time: it takes no --pace",
+                None,
+                "use --follow both to replay the set-points paced beside it",
+            )
+        )
     out = compare_suture(
-        Path(path), parse_indices(args.indices), pairs, build, args.seed, progress=not args.json, paces=paces
+        Path(path),
+        parse_indices(args.indices),
+        pairs,
+        build,
+        args.seed,
+        progress=not args.json,
+        paces=paces,
+        follow=args.follow,
     )
     if args.json:
         print(dumps(out, indent=1))
     else:
-        how = "paced" if out["paced"] else "unpaced"
+        how = "following adfkit's measured joints" if out.get("follow") == "measured" else "unpaced"
+        how = "paced" if out["paced"] else how
         print(
             f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF {how} "
             f"({out['commands']} commands)"
@@ -170,8 +197,19 @@ def _suture(args) -> int:
                 f"  pair {p['pair']}: adfkit {p['adfkit']}, AMBF {p['ambf']}"
                 + (f" ({p['ambf_rule']}: {p['ambf_reason']})" if p["ambf_rule"] else "")
                 + (f", tip paths {gap * 1e3:.1f} mm apart at most" if gap == gap and gap is not None else "")
-                + (f"; paced: AMBF {p['ambf_paced']}" if "ambf_paced" in p else "")
+                + "".join(
+                    f"; {label}: AMBF {p[f'ambf_{label}']}"
+                    for label in ("measured", "unpaced", "paced")
+                    if f"ambf_{label}" in p
+                )
             )
+        for r in out["replays"]:
+            worst = max(r.get("tracking", {}).items(), key=lambda kv: kv[1]["median"], default=None)
+            if worst is not None:
+                print(
+                    f"  {r.get('follow', 'commands')}: AMBF's PSM joints a median {worst[1]['median']:.4g} at most "
+                    f"({worst[0]}) from adfkit's, {max(v['max'] for v in r['tracking'].values()):.4g} at worst"
+                )
         for pace in (r["pace"] for r in out["replays"] if r["pace"] is not None):
             print(
                 f"  paced: AMBF played {pace['ambf_simulated_s']:.1f} s for the recording's {out['seconds']:.1f} s, "

@@ -12,6 +12,12 @@ reads the recording on a command clock that advances only while every driven joi
 a tolerance of its set-point, physics running all the while, and the paths are compared by that
 clock.
 
+Or the arms follow the path adfkit's arms took (``follow="measured"``): the recording also holds
+every PSM joint's measured position each control step (``follow`` lines), and the plugin, each
+1 ms step, gives each such joint AMBF's velocity command of that path's slope plus a gain times
+the path less AMBF's measured joint, as a client servoing the measured joint state would; its
+set-points are then left unplayed (grasps, releases and the push are played as recorded).
+
 AMBF's side is judged from the poses the plugin records: the tip's crossings of each hole's
 plane (inside its opening, tip first), the thread through both holes when each pull ended, the
 needle slipping in a grasp. The plugin records no contact force, so the rules that read forces
@@ -51,6 +57,10 @@ class Pace:
 
 PACE = Pace()
 
+#: how a replay drives AMBF's PSM joints: the set-points adfkit's planner gave (AMBF's position
+#: commands), or the path adfkit's joints took, followed on AMBF's measured joints
+FOLLOWS = ("commands", "measured")
+
 
 @dataclass
 class Recording:
@@ -69,14 +79,35 @@ class Recording:
     tools: dict[str, str] = field(default_factory=dict)  # arm -> the AMBF name of the body its actuator is on
     wall_s: float = 0.0
 
+    def commands_for(self, follow: str) -> list[ambf.Command]:
+        """The commands a replay plays: ``commands``, the set-points (no ``follow`` lines);
+        ``measured``, the measured paths instead of the set-points of the joints they cover."""
+        followed = {c.target for c in self.commands if c.kind == "follow"}
+        if follow == "commands":
+            return [c for c in self.commands if c.kind != "follow"]
+        if follow != "measured":
+            raise ValueError(f"follow is one of {FOLLOWS}, not {follow!r}")
+        if not followed:
+            raise ValueError("the recording holds no measured joint paths (record it with measured=True)")
+        return [c for c in self.commands if not (c.kind == "position" and c.target in followed)]
+
+    def measured_paths(self) -> dict[str, np.ndarray]:
+        """Each PSM joint's measured path in adfkit, (n, 2): time, position."""
+        out: dict[str, list] = {}
+        for c in self.commands:
+            if c.kind == "follow":
+                out.setdefault(c.target, []).append((c.t, c.value))
+        return {k: np.array(v, float) for k, v in out.items()}
+
 
 class _Recorder:
     """Wraps a world's step, actuate, release and set_collision and the needle's force, and
     writes them down as plugin commands: joint set-points when they change, grasps, releases,
-    the pairs let pass through each other, forces."""
+    the pairs let pass through each other, forces; with ``measured``, each PSM joint's measured
+    position every control step too (``follow`` lines)."""
 
-    def __init__(self, world, task) -> None:
-        self.world, self.task = world, task
+    def __init__(self, world, task, measured: bool = False) -> None:
+        self.world, self.task, self.measured = world, task, measured
         self.commands: list[ambf.Command] = []
         self.grasps: list[tuple[float, str, str | None]] = []
         self.arms = {id(psm.art): name for name, psm in task.psms.items()}
@@ -150,6 +181,11 @@ class _Recorder:
                 if name is not None and self.last.get(key) != v:
                     self.last[key] = v
                     self.commands.append(ambf.Command(t, "position", name, float(v)))
+            if self.measured:
+                for i, q in enumerate(art.joint_values()):
+                    name = self.joint_names.get((id(art), i))
+                    if name is not None:
+                        self.commands.append(ambf.Command(t, "follow", name, float(q)))
         needle = _name(self.task.needle)
         if self._force_now is not None:
             f, at = self._force_now
@@ -167,8 +203,9 @@ def _name(obj) -> str:
     return ambf_name(obj.key, inner)
 
 
-def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False) -> Recording:
-    """Play adfkit's scripted suture (PyBullet) and record it for AMBF."""
+def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False, measured: bool = False) -> Recording:
+    """Play adfkit's scripted suture (PyBullet) and record it for AMBF (with ``measured``, its
+    PSM joints' measured paths too)."""
     import time
 
     from ..adf import load_scene
@@ -180,7 +217,7 @@ def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False) 
     world = open_world(scene, Options(renderer="tiny", visuals=False, solver_iterations=SOLVER_ITERATIONS))
     try:
         task = SutureTask(world, list(pairs), seed=seed)
-        rec = _Recorder(world, task)
+        rec = _Recorder(world, task, measured)
         t0 = time.perf_counter()
         try:
             metrics, obs, _ = play_task(world, task, None, gif=False, progress=progress)
@@ -421,6 +458,26 @@ class Replay:
     trace: object
     pace: Pace | None
     end: dict  # the plugin's end record: simulated time, the clock, the pace's figures
+    follow: str = "commands"
+    tracking: dict = field(default_factory=dict)  # joint -> how far AMBF's stood from adfkit's measured path
+
+    @property
+    def label(self) -> str:
+        """How it was played: ``measured`` (following adfkit's measured joints), ``paced`` or
+        ``unpaced`` (the set-points)."""
+        return "measured" if self.follow == "measured" else ("paced" if self.pace is not None else "unpaced")
+
+    def json(self) -> dict:
+        return {
+            "follow": self.follow,
+            "paced": self.pace is not None,
+            "pace": self.pace_json(),
+            "ambf_not_finite_from_s": _blew_up(self.trace),
+            "wall_s": self.trace.wall_s,
+            "verdicts": [x["verdict"] for x in self.verdicts],
+            "tip_path_gap_m": {str(k): v for k, v in self.gaps.items()},
+            "tracking": self.tracking,
+        }
 
     def pace_json(self) -> dict | None:
         if self.pace is None:
@@ -438,20 +495,50 @@ class Replay:
         }
 
 
-def replay(rec: Recording, build: ambf.AmbfBuild, launch: Path, indices, pace: Pace | None = None) -> Replay:
-    """The recording played in AMBF (paced by ``pace``; None: at AMBF's own time), judged by the
-    same verdicts, its tip path compared with adfkit's."""
+def tracking(rec: Recording, trace) -> dict:
+    """How far each PSM joint in AMBF stood from the path adfkit's took, at AMBF's samples (by
+    the command clock) within the path: ``{joint: {"median": .., "max": ..}}`` (rad or m; empty
+    where the recording holds no measured paths)."""
+    clock = trace.clock if trace.clock is not None else trace.times
+    n_ok = finite_samples(trace)
+    out = {}
+    for name, path in sorted(rec.measured_paths().items()):
+        if name not in trace.joint_names or len(path) < 2:
+            continue
+        t = clock[:n_ok]
+        inside = (t >= path[0, 0]) & (t <= path[-1, 0])
+        d = trace.joints[:n_ok, trace.joint_names.index(name)][inside] - np.interp(t[inside], path[:, 0], path[:, 1])
+        d = np.abs((d + math.pi) % (2 * math.pi) - math.pi)  # a revolute joint's turn either way
+        d = d[np.isfinite(d)]
+        if len(d):
+            out[name] = {"median": float(np.median(d)), "max": float(d.max())}
+    return out
+
+
+def replay(
+    rec: Recording,
+    build: ambf.AmbfBuild,
+    launch: Path,
+    indices,
+    pace: Pace | None = None,
+    follow: str = "commands",
+) -> Replay:
+    """The recording played in AMBF (its set-points paced by ``pace``, None: at AMBF's own time;
+    or ``follow="measured"``: the joints following adfkit's measured paths), judged by the same
+    verdicts, its tip path compared with adfkit's."""
     from ..tasks.verdicts import pair_verdict
     from .traces import from_ambf
 
     stage = ambf.Stage(Path(launch).resolve(), list(indices) if indices is not None else _all(launch))
+    if follow == "measured" and pace is not None:
+        raise ValueError("a replay following the measured joints plays at AMBF's own time: no pace")
     longest = rec.seconds * (pace.max_factor if pace is not None else 1.0)
     run = ambf.run(
         build,
         stage,
         rec.seconds,
         EVERY,
-        rec.commands,
+        rec.commands_for(follow),
         timeout=600 + 10 * longest,
         pace=None if pace is None else pace.plugin(),
         pace_max_s=None if pace is None else longest,
@@ -460,7 +547,7 @@ def replay(rec: Recording, build: ambf.AmbfBuild, launch: Path, indices, pace: P
     obs = AmbfObservation(rec, trace)
     verdicts = [pair_verdict(obs, p) for p in rec.task.pairs]
     gaps = tip_gaps(rec.tip_path, obs.tip_path, rec.phase_log, rec.task.pairs)
-    return Replay(verdicts, gaps, trace, pace, run.end)
+    return Replay(verdicts, gaps, trace, pace, run.end, follow, tracking(rec, trace))
 
 
 def _all(launch: Path) -> list[int]:
@@ -468,6 +555,19 @@ def _all(launch: Path) -> list[int]:
 
     doc, _ = read_file(launch)
     return list(range(len(getattr(doc, "multibody_configs", None) or [])))
+
+
+def replay_modes(paces: tuple[Pace | None, ...] = (None,), follow: str = "commands") -> list[tuple]:
+    """The replays asked for, ``(pace, follow)`` each, the first judged against adfkit: the
+    set-points once per pace (``follow="commands"``), the measured paths at AMBF's own time
+    (``"measured"``, no pace), or the measured paths first and then the set-points (``"both"``)."""
+    if follow == "commands":
+        return [(p, "commands") for p in paces]
+    if follow not in ("measured", "both"):
+        raise ValueError(f"follow is one of commands, measured, both, not {follow!r}")
+    if follow == "measured" and any(p is not None for p in paces):
+        raise ValueError("a replay following the measured joints plays at AMBF's own time: no pace")
+    return [(None, "measured")] + ([(p, "commands") for p in paces] if follow == "both" else [])
 
 
 def compare_suture(
@@ -478,16 +578,19 @@ def compare_suture(
     seed: int = 0,
     progress: bool = False,
     paces: tuple[Pace | None, ...] = (None,),
+    follow: str = "commands",
 ) -> dict:
-    """The suture in adfkit and replayed in AMBF (once per entry of ``paces``, the first judged
-    against adfkit's verdicts), judged alike: the issue's JSON."""
-    rec = record(launch, indices, pairs, seed, progress)
-    return compare_recorded(rec, launch, indices, build, paces) | {"scene": str(launch), "seed": seed}
+    """The suture in adfkit and replayed in AMBF (as ``replay_modes(paces, follow)`` lists, the
+    first judged against adfkit's verdicts), judged alike: the issue's JSON."""
+    modes = replay_modes(paces, follow)
+    rec = record(launch, indices, pairs, seed, progress, measured=any(f == "measured" for _, f in modes))
+    return compare_recorded(rec, launch, indices, build, modes) | {"scene": str(launch), "seed": seed}
 
 
-def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuild, paces=(None,)) -> dict:
-    """A recording replayed in AMBF once per pace (None: unpaced), as ``compare_suture`` reports it."""
-    replays = [replay(rec, build, launch, indices, p) for p in paces]
+def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuild, modes=((None, "commands"),)) -> dict:
+    """A recording replayed in AMBF once per ``(pace, follow)`` mode, as ``compare_suture``
+    reports it."""
+    replays = [replay(rec, build, launch, indices, p, f) for p, f in modes]
     first = replays[0]
     mine = {v["pair"]: v for v in rec.verdicts}
     out = []
@@ -503,7 +606,7 @@ def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuil
             "tip_path_gap_m": first.gaps.get(v["pair"]),
         }
         for other in replays[1:]:
-            how = "paced" if other.pace is not None else "unpaced"
+            how = other.label
             w = other.verdicts[k]
             row[f"ambf_{how}"] = w["verdict"]
             row[f"ambf_{how}_rule"] = w["rule"]
@@ -511,7 +614,8 @@ def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuil
         out.append(row)
     return {
         "seconds": rec.seconds,
-        "commands": len(rec.commands),
+        "commands": len(rec.commands_for(first.follow)),
+        "follow": first.follow,
         "pairs": out,
         "same_verdicts": all(p["adfkit"] == p["ambf"] for p in out),
         "paced": first.pace is not None,
@@ -519,16 +623,7 @@ def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuil
         # AMBF's world blew up there (its poses not finite); judged on what came before
         "ambf_not_finite_from_s": _blew_up(first.trace),
         "wall_s": {"adfkit": rec.wall_s, "ambf": first.trace.wall_s},
-        "replays": [
-            {
-                "paced": r.pace is not None,
-                "pace": r.pace_json(),
-                "ambf_not_finite_from_s": _blew_up(r.trace),
-                "wall_s": r.trace.wall_s,
-                "verdicts": [x["verdict"] for x in r.verdicts],
-            }
-            for r in replays
-        ],
+        "replays": [r.json() for r in replays],
         "not_judged_on_ambf": ["tool-hit-tissue", "blocked-at-entry by force", "blocked-in-channel by force"],
     }
 

@@ -21,7 +21,15 @@
 //                           force at a world point, every step until its next force command);
 //                           collide (TARGET a rigid body, ARG "BODY 0|1": 0 lets the two pass through each
 //                           other, as a task's set_collision does; 1 undoes that),
-//                           a joint command holds until the joint's next command
+//                           follow (TARGET a revolute or prismatic joint, ARG a position: a point
+//                           of a path the joint is to follow; a joint's follow points, taken in
+//                           time order, make its path, linear between points, held at its last),
+//                           a joint command holds until the joint's next command. From its first
+//                           follow point on, a joint is driven as a client servoing the measured
+//                           joint does: each physics step a velocity command of the path's slope
+//                           plus FOLLOW_GAIN times the path's position less the measured one (its
+//                           position, velocity and effort commands are then left unplayed)
+//   ADFKIT_PARITY_FOLLOW_GAIN  the follow's feedback gain, 1/s (default 100)
 //   ADFKIT_PARITY_PACE      "RAD M WAIT_S" (default off): a paced replay, as a client that sends a
 //                           set-point and waits for the measured joints. The command file is read on
 //                           a command clock that advances one physics step only while every joint
@@ -114,6 +122,17 @@ struct Command {
     int line;
 };
 
+// a joint's path to follow: points (t, position) in time order, the segment now played
+struct Path {
+    afJointPtr joint = nullptr;
+    bool revolute = true, limited = false;
+    double lo = 0.0, hi = 0.0;
+    vector<pair<double, double>> points;
+    size_t at = 0;
+    double worst = 0.0, sum = 0.0;  // the tracking error (|path - measured|) before each command
+    long n = 0;
+};
+
 // a joint under a position command, as the paced clock waits on it
 struct Drive {
     afJointPtr joint = nullptr;
@@ -136,6 +155,8 @@ public:
             _exit(3);
         }
         m_seconds = env_double("ADFKIT_PARITY_SECONDS", 0.0);
+        m_followGain = env_double("ADFKIT_PARITY_FOLLOW_GAIN", 100.0);
+        if (!(m_followGain > 0)) fail("ADFKIT_PARITY_FOLLOW_GAIN: expected a positive number");
         m_every = env_double("ADFKIT_PARITY_EVERY", 0.0);
         const char* contacts = getenv("ADFKIT_PARITY_CONTACTS");
         m_contacts = contacts && string(contacts) == "1";
@@ -247,9 +268,18 @@ private:
             }
             pace += "}}";
         }
-        fprintf(m_out, "{\"kind\":\"end\",\"steps\":%ld,\"t\":%s,\"clock\":%s,\"wall_s\":%s,\"pace\":%s}\n",
+        string follow = "{";
+        bool firstPath = true;
+        for (auto& kv : m_paths) {
+            const Path& p = kv.second;
+            follow += (firstPath ? "" : ",") + json_text(kv.first) + ":{\"steps\":" + to_string(p.n) +
+                      ",\"max_error\":" + num(p.worst) + ",\"mean_error\":" + num(p.n ? p.sum / p.n : 0.0) + "}";
+            firstPath = false;
+        }
+        follow += "}";
+        fprintf(m_out, "{\"kind\":\"end\",\"steps\":%ld,\"t\":%s,\"clock\":%s,\"wall_s\":%s,\"pace\":%s,\"follow\":%s}\n",
                 steps, num(m_world->getSimulationTime()).c_str(), num(m_paced ? m_cmdClock : m_world->getSimulationTime()).c_str(),
-                num(steps ? wall : 0.0).c_str(), pace.c_str());
+                num(steps ? wall : 0.0).c_str(), pace.c_str(), follow.c_str());
         fflush(m_out);
         fclose(m_out);
         _exit(0);
@@ -404,9 +434,10 @@ private:
     }
 
     afJointPtr find_joint(const string& qname) {
-        for (afJointPtr j : m_world->getJoints())
-            if (j->getQualifiedName() == qname) return j;
-        return nullptr;
+        if (m_jointsByName.empty())
+            for (afJointPtr j : m_world->getJoints()) m_jointsByName.emplace(j->getQualifiedName(), j);
+        auto it = m_jointsByName.find(qname);
+        return it == m_jointsByName.end() ? nullptr : it->second;
     }
 
     afConstraintActuator* find_actuator(const string& qname) {
@@ -439,6 +470,23 @@ private:
             if (c.kind == "position" || c.kind == "velocity" || c.kind == "effort") {
                 if (!(ls >> c.value)) fail(where + "a joint command needs a value");
                 if (!find_joint(c.target)) fail(where + "no joint " + c.target);
+            } else if (c.kind == "follow") {  // a path's point: kept with its joint's path, not as a command
+                if (!(ls >> c.value)) fail(where + "follow needs a position");
+                afJointPtr j = find_joint(c.target);
+                if (!j) fail(where + "no joint " + c.target);
+                if (j->m_jointType != afJointType::REVOLUTE && j->m_jointType != afJointType::PRISMATIC)
+                    fail(where + "follow needs a revolute or prismatic joint: " + c.target);
+                Path& p = m_paths[c.target];
+                if (!p.joint) {
+                    p.joint = j;
+                    p.revolute = j->m_jointType == afJointType::REVOLUTE;
+                    afJointAttributes* a = dynamic_cast<afJointAttributes*>(j->getAttributes());
+                    p.limited = a && a->m_enableLimits;
+                    p.lo = j->getLowerLimit();
+                    p.hi = j->getUpperLimit();
+                }
+                p.points.emplace_back(c.t, c.value);
+                continue;
             } else if (c.kind == "grasp") {
                 if (!(ls >> c.arg)) fail(where + "grasp needs a body");
                 if (!find_actuator(c.target)) fail(where + "no constraint actuator " + c.target);
@@ -463,6 +511,9 @@ private:
         }
         stable_sort(m_commands.begin(), m_commands.end(),
                     [](const Command& a, const Command& b) { return a.t < b.t; });
+        for (auto& kv : m_paths)
+            stable_sort(kv.second.points.begin(), kv.second.points.end(),
+                        [](const pair<double, double>& a, const pair<double, double>& b) { return a.first < b.first; });
     }
 
     // commands due by simulated time t take effect (a joint's command replaces its last)
@@ -546,11 +597,44 @@ private:
             b->applyForce(btVector3(n[0], n[1], n[2]), at);
         }
         for (auto& kv : m_drives) {
+            if (following(kv.first)) continue;
             afJointPtr j = m_driveJoints[kv.first];
             double v = kv.second.value;
             if (kv.second.kind == "position") j->commandPosition(v);
             else if (kv.second.kind == "velocity") j->commandVelocity(v);
             else j->commandEffort(v);
+        }
+        follow(m_cmdClock);
+    }
+
+    bool following(const string& joint) {
+        auto it = m_paths.find(joint);
+        return it != m_paths.end() && it->second.points.front().first <= m_cmdClock + 1e-9;
+    }
+
+    // each path begun: a velocity command, the path's slope at t plus the gain times the path's
+    // position at t less the measured one (the joint's limits clamp the path, as commandPosition
+    // clamps a set-point; a revolute joint without limits takes the shortest angle)
+    void follow(double t) {
+        for (auto& kv : m_paths) {
+            Path& p = kv.second;
+            const auto& pts = p.points;
+            if (pts.front().first > t + 1e-9) continue;
+            while (p.at + 1 < pts.size() && pts[p.at + 1].first <= t + 1e-9) p.at++;
+            double q = pts[p.at].second, slope = 0.0;
+            if (p.at + 1 < pts.size()) {
+                double t0 = pts[p.at].first, t1 = pts[p.at + 1].first;
+                slope = t1 > t0 ? (pts[p.at + 1].second - q) / (t1 - t0) : 0.0;
+                q += slope * (t - t0);
+            }
+            if (p.limited) q = max(p.lo, min(p.hi, q));
+            double now = p.joint->getPosition();
+            double err = p.revolute && !p.limited ? p.joint->getShortestAngle(now, q) : q - now;
+            p.worst = max(p.worst, fabs(err));
+            p.sum += fabs(err);
+            p.n++;
+            double v = slope + m_followGain * err;
+            p.joint->commandVelocity(v);
         }
     }
 
@@ -564,6 +648,9 @@ private:
     size_t m_nextCommand = 0;
     map<string, Command> m_drives;
     map<string, afJointPtr> m_driveJoints;
+    map<string, afJointPtr> m_jointsByName;
+    map<string, Path> m_paths;  // joints following a path (follow commands)
+    double m_followGain = 100.0;
     map<string, Command> m_forces;
     map<string, afRigidBodyPtr> m_forceBodies;
     set<pair<btRigidBody*, btRigidBody*>> m_passing;  // pairs a collide command let pass
