@@ -38,7 +38,8 @@ class Options:
     # body whose file gives none, its multibody joints capped at 100 rad/s; the default here, which the
     # tasks were built and accepted on); "ambf", AMBF's btRigidBodies: AMBF's estimated inertia (the box of
     # the collision shape's bounds) and joints as fast as AMBF's bodies may turn (π/4 a physics step).
-    # `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: unused
+    # `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: "ambf" gives the
+    # floor of a model played alone Bullet's friction, the product of the two (mujoco/contacts.py)
     bodies: str = "pybullet"
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")

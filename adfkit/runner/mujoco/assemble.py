@@ -15,7 +15,7 @@ from ..collisions import HULL_OVERLAP, hull_overlaps, one_hull
 from ..plan import ALL_GROUPS
 from ..rotations import pose_to_matrix
 from .build import GHOST_GROUP, build_plan
-from .contacts import set_contacts
+from .contacts import ground_pairs, set_contacts
 from .damping import BodyDamping
 from .drives import DriveLimits, drive_limit
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
@@ -66,7 +66,7 @@ class Assembly:
             self.ground_z = self._lowest_point() - 1e-3
             # the floor stands in for a world's, which has no collision groups: every bit, so
             # that it meets every body whatever its groups (the default bit met group 0's only)
-            spec.worldbody.add_geom(
+            floor = spec.worldbody.add_geom(
                 type=mujoco.mjtGeom.mjGEOM_PLANE,
                 size=[0, 0, 1],
                 pos=[0, 0, self.ground_z],
@@ -74,6 +74,8 @@ class Assembly:
                 contype=ALL_GROUPS,
                 conaffinity=ALL_GROUPS,
             )
+            if self.opt.bodies == "ambf" and self.soft is None:  # Bullet's friction on it (contacts.py)
+                ground_pairs(spec, floor, self.model, ALL_GROUPS)
             self.model = compile_spec(self, spec)
             self.data = mujoco.MjData(self.model)
             mujoco.mj_forward(self.model, self.data)

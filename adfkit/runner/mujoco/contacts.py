@@ -17,19 +17,49 @@ the two bodies' frictions combined so that a frictionless body is frictionless t
   otherwise (the suture's thread on the phantom: 0.5 against Bullet's 0.5 × 0.8 = 0.4). The
   suturing scene's hole boundaries are frictionless; with the larger (the thread's 0.5) the
   thread, drawn through two holes, held the pull with 50-80 N where Bullet's needs 2-3 N.
+  The floor a model played alone gets, where AMBF's bodies are asked for (``Options.bodies``
+  "ambf": ``adfkit run``, ``adfkit parity``), meets each body by an explicit pair of its own
+  whose friction is Bullet's product, GROUND_FRICTION times the body's (the floor AMBF and the
+  PyBullet runner are given: friction 0.5). With the lower of the two, the corpus springy PSM's
+  tool shaft, landing on the floor, held the arm's pitch at 7° on 0.5 where Bullet's 0.25 lets
+  it slide and the arm fall 47° as AMBF's does.
 """
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 
 #: contacts' time constant in physics steps: 2, the stiffest MuJoCo keeps stable
 CONTACT_TIMECONST_STEPS = 2
+#: the friction of the floor a model played alone gets: PyBullet's default, which the PyBullet
+#: runner's floor and the one AMBF is given by ``adfkit parity`` have (parity/ambf.py)
+GROUND_FRICTION = 0.5
 
 
 def set_contacts(model, dt: float) -> None:
     """Every geom's contact time constant and its friction priority (see the module docstring)."""
     model.geom_solref[:, 0] = CONTACT_TIMECONST_STEPS * dt
+    model.pair_solref[:, 0] = CONTACT_TIMECONST_STEPS * dt
     mu = np.round(model.geom_friction[:, 0], 9)
     levels = np.unique(mu)  # ascending
     model.geom_priority[:] = len(levels) - 1 - np.searchsorted(levels, mu)
+
+
+def ground_pairs(spec, ground, model, all_groups: int) -> None:
+    """The floor ``ground`` (a plane in ``spec``, not yet in the compiled ``model``) meeting each
+    geom of a moving body that collides with every group by an explicit pair whose friction is
+    GROUND_FRICTION times the geom's (Bullet's product), the floor itself colliding with nothing
+    else. A geom without a name is given one (a pair names its geoms)."""
+    ground.friction = [GROUND_FRICTION, ground.friction[1], 0.0]
+    ground.contype = ground.conaffinity = 0
+    for n, g in enumerate(spec.geoms):
+        if g is ground or g.type == mujoco.mjtGeom.mjGEOM_PLANE or not ((g.contype | g.conaffinity) & all_groups):
+            continue
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, g.parent.name)
+        if body <= 0 or model.body_weldid[body] == 0:
+            continue  # static: nothing for the floor to push
+        if not g.name:
+            g.name = f"adfkit:geom{n}"
+        mu = GROUND_FRICTION * g.friction[0]
+        spec.add_pair(geomname1=ground.name, geomname2=g.name, condim=3, friction=[mu, mu, 0.0, 0.0, 0.0])
