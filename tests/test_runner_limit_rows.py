@@ -1,0 +1,127 @@
+"""AMBF's limit rows on spring and prismatic joints of the PyBullet runner's multibodies
+(runner/pybullet/limit_rows.py). A limited torsion spring is AMBF's btGeneric6DofSpring2Constraint,
+whose limit rows are there whenever low < high: a joint moves toward a limit at a gap g at most
+erp·g/dt, not at all where it would cross it within the step, and is driven back at erp·|g|/dt
+from past it (erp the joint's, 0.1). A prismatic joint is AMBF's btSliderConstraint, whose row
+drives a joint past its limit back at the world's erp (0.2)·depth/dt. PyBullet's own limit stops a
+joint on a limit it reaches and leaves one that starts past it where it is."""
+
+from __future__ import annotations
+
+import pytest
+from test_runner import _model
+
+from adfkit.runner import Options, open_world
+
+MASS, REACH = 0.1, 0.1  # kg, m: the rod's centre of mass from the pivot
+
+
+def _rod(joint: str, limits: str) -> str:
+    """A rod on a ``joint`` (torsion spring: about y, gravity turns it + from level; prismatic:
+    along the level x axis, gravity across it) with neither stiffness nor damping, as every
+    joint of the corpus's springy robots."""
+    return (
+        "bodies: [BODY mount, BODY rod]\njoints: [JOINT mount-rod]\n"
+        "BODY mount:\n  name: mount\n  mass: 0.0\n"
+        "  location: {position: {x: 0.0, y: 0.0, z: 1.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
+        f"BODY rod:\n  name: rod\n  mass: {MASS}\n  inertia: {{ix: 1.0e-6, iy: 1.0e-6, iz: 1.0e-6}}\n"
+        "  collision shape: SPHERE\n  collision geometry: {radius: 0.005}\n"
+        f"  location: {{position: {{x: {REACH}, y: 0.0, z: 1.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
+        f"JOINT mount-rod:\n  name: mount-rod\n  parent: BODY mount\n  child: BODY rod\n  type: {joint}\n"
+        f"  parent pivot: {{x: 0.0, y: 0.0, z: 0.0}}\n  child pivot: {{x: {-REACH}, y: 0.0, z: 0.0}}\n"
+        f"  {limits}\n"
+    )
+
+
+SPRING = ("torsion spring", "parent axis: {x: 0.0, y: 1.0, z: 0.0}\n  child axis: {x: 0.0, y: 1.0, z: 0.0}")
+SLIDER = ("prismatic", "parent axis: {x: 1.0, y: 0.0, z: 0.0}\n  child axis: {x: 1.0, y: 0.0, z: 0.0}")
+LIMITS = "joint limits: {low: -0.2, high: 0.2}"
+
+
+def _world(tmp_path, joint, springs: str = "ambf"):
+    kind, axes = joint
+    text = _rod(kind, f"{axes}\n  {LIMITS}")
+    world = open_world(
+        _model(tmp_path, text), Options(visuals=False, ground=False, springs=springs, control_substeps=1)
+    )
+    (_j, _parent, child) = world.joints_made[0]
+    return world, child.articulation, child.link
+
+
+def _after_a_step(tmp_path, joint, q0: float, v0: float, springs: str = "ambf") -> tuple[float, float]:
+    """The joint's (position, velocity) one 1 ms step after it was put at ``q0`` moving at ``v0``."""
+    world, art, index = _world(tmp_path, joint, springs)
+    try:
+        world.reset_joints(art, [index], [q0], [v0])
+        world.step(1)
+        q, v = world.joint_state(art, [index])
+        return float(q[0]), float(v[0])
+    finally:
+        world.close()
+
+
+def test_a_spring_nearing_its_limit_is_slowed_to_erp_times_the_gap(tmp_path):
+    """0.05 rad from its upper limit at 10 rad/s (0.01 rad a step: not crossing it): the rows let
+    it on at 0.1·0.05/1 ms = 5 rad/s. Control: the implicit springs (no rows), it goes on at
+    10 rad/s and a little more (gravity: 0.1 rad/s in the step)."""
+    _q, v = _after_a_step(tmp_path, SPRING, 0.15, 10.0)
+    assert v == pytest.approx(5.0, rel=1e-3)
+    (tmp_path / "control").mkdir()
+    _q, v = _after_a_step(tmp_path / "control", SPRING, 0.15, 10.0, springs="implicit")
+    assert v == pytest.approx(10.1, abs=0.02)
+
+
+def test_a_spring_that_would_cross_its_limit_within_the_step_stops_short_of_it(tmp_path):
+    """5 mrad from the limit at 10 rad/s (10 mrad a step): the rows stop it where it is. Control:
+    PyBullet's own limit lets it through, 5 mrad past the limit after the step (measured 0.2051 rad)."""
+    q, v = _after_a_step(tmp_path, SPRING, 0.195, 10.0)
+    assert q == pytest.approx(0.195, abs=1e-5) and v == pytest.approx(0.0, abs=1e-3)
+    (tmp_path / "control").mkdir()
+    q, _v = _after_a_step(tmp_path / "control", SPRING, 0.195, 10.0, springs="implicit")
+    assert q == pytest.approx(0.205, abs=1e-3)
+
+
+def test_a_spring_falling_onto_its_limit_is_slowed_onto_it(tmp_path):
+    """Released level, the rod falls (+) onto its upper limit (0.2 rad) at ~1.2 rad/s: the rows
+    slow it from ten steps' travel out (its gap shrinking by 1 - erp a step) and it never goes
+    past the limit by more than one step of gravity that the rows did not see (the row reads the
+    velocity at the step's start, Bullet's after gravity: m·g·L/I·dt² = 0.096 mrad, measured
+    0.0960). Control: PyBullet's own limit (the implicit springs, no rows) lets it 3.2 mrad
+    through (measured 0.20318 rad) and brings it back over ~20 ms."""
+    tops = []
+    for springs in ("ambf", "implicit"):
+        (tmp_path / springs).mkdir()
+        world, art, index = _world(tmp_path / springs, SPRING, springs)
+        try:
+            top = 0.0
+            for _ in range(500):
+                world.step(1)
+                top = max(top, float(world.joint_state(art, [index])[0][0]))
+            end = float(world.joint_state(art, [index])[0][0])
+        finally:
+            world.close()
+        tops.append(top)
+        assert end == pytest.approx(0.2, abs=1e-6)
+    rows, plain = tops
+    assert rows - 0.2 == pytest.approx(MASS * 9.81 * REACH / (MASS * REACH**2 + 1e-6) * 1e-6, rel=0.05)
+    assert plain - 0.2 > 3e-3
+
+
+@pytest.mark.parametrize("joint, back", [(SPRING, 0.1 * 0.1 / 1e-3), (SLIDER, 0.2 * 0.1 / 1e-3)])
+def test_a_joint_starting_past_its_limit_is_driven_back_by_its_row(tmp_path, joint, back):
+    """0.1 (rad, m) past the upper limit at rest: the spring's rows drive it back at its erp (0.1)
+    ·0.1/dt = 10 rad/s, the slider's at the world's (0.2): 20 m/s. Control: without AMBF's
+    springs a spring has no rows and PyBullet's limit leaves it where it started."""
+    q, v = _after_a_step(tmp_path, joint, 0.3, 0.0)
+    assert v == pytest.approx(-back, rel=1e-3)
+    if joint is SPRING:
+        (tmp_path / "control").mkdir()
+        q, v = _after_a_step(tmp_path / "control", joint, 0.3, 0.0, springs="implicit")
+        assert q == pytest.approx(0.3, abs=1e-3) and abs(v) < 0.2
+
+
+def test_a_slider_inside_its_limits_is_left_alone(tmp_path):
+    """Control for the slider's row: 0.1 m inside its upper limit at rest, gravity across its
+    axis, it stays put (the row is there only past a limit)."""
+    q, v = _after_a_step(tmp_path, SLIDER, 0.1, 0.0)
+    assert q == pytest.approx(0.1, abs=1e-6) and v == pytest.approx(0.0, abs=1e-6)
