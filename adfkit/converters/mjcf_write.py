@@ -396,7 +396,8 @@ def to_mjcf(
         kept = [j for j in model.joints if not joint_ends(model, j) & leave_out]
         model = replace(model, bodies=[b for b in model.bodies if b.identifier not in leave_out], joints=kept)
     model = usable_scales(model, losses)
-    tree = build_tree(model) if tree_kinds is None else build_tree(model, tree_kinds)
+    # a loop is closed at a point (connect) or welded: a slide closing one would be locked
+    tree = build_tree(model, slides_first=True) if tree_kinds is None else build_tree(model, tree_kinds, True)
     has_volume = volumes and any(v.defined for v in model.volumes)
     if not tree.roots and not any(sb.defined for sb in model.soft_bodies) and not has_volume:
         raise AdfError(

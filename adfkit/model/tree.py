@@ -120,14 +120,18 @@ def joint_ends(model: ModelFile, joint) -> set[str | None]:
 
 
 def build_tree(
-    model: ModelFile, tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)
+    model: ModelFile,
+    tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED),
+    slides_first: bool = False,
 ) -> KinematicTree:
     """Spanning tree over the joints whose kind is in ``tree_kinds``.
 
     Roots, in file order: bodies that are no joint's child (static ones, mass 0, first), then
     the rest;
     a body reached twice closes a loop (that joint goes to ``loops``); bodies no joint reaches
-    are roots of their own."""
+    are roots of their own. ``slides_first``: a prismatic joint into a body keeps its place in
+    the tree before a revolute one into it (left_for_last), for a format that closes a loop only
+    at a point (MJCF's connect, which would lock a slide)."""
     records, unresolved = [], []
     for j in model.joints:
         kind = joint_kind(j.type)
@@ -179,7 +183,7 @@ def build_tree(
             for r in edges[id(link.body)]:
                 if r[3].identifier in links:
                     continue
-                if left_for_last(r, into[id(r[3])]):
+                if left_for_last(r, into[id(r[3])], slides_first):
                     later.append((link, r))
                     continue
                 stack.append(attach(link, r))
@@ -193,13 +197,27 @@ def limited(joint) -> bool:
     return lim is not None and lim.low is not None and lim.high is not None
 
 
-def left_for_last(record, into) -> bool:
+def left_for_last(record, into, slides_first: bool = False) -> bool:
     """Whether a spanning tree should reach a body through the joint of ``record`` (joint,
     kind, parent, child) only when no other joint of ``into`` (the tree joints into the same
     child) does: a revolute or prismatic joint without limits, where another into its child has
     them. The joint a tree leaves out closes the loop as a constraint, which plays no limits: a
     limited one left out loses them (the corpus parallel structure's l3-l4 swung past its -1.047
-    rad, where AMBF's stops, while l1-l4, a continuous joint, held a place in the tree)."""
+    rad, where AMBF's stops, while l1-l4, a continuous joint, held a place in the tree).
+    ``slides_first``: also a revolute joint where a prismatic one (not itself left for last)
+    goes into the same child, the revolute closing the loop at its pivot: the corpus gripper3's
+    slider between its jaws, closing the loop as a point, locked the slide AMBF's jaws take
+    (117 mm in 0.3 s)."""
+    if _without_limits_last(record, into):
+        return True
+    return (
+        slides_first
+        and record[1] is JointKind.REVOLUTE
+        and any(x[1] is JointKind.PRISMATIC and not _without_limits_last(x, into) for x in into if x is not record)
+    )
+
+
+def _without_limits_last(record, into) -> bool:
     joint, kind = record[0], record[1]
     if kind not in ONE_DOF or limited(joint):
         return False
