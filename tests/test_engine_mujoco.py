@@ -884,3 +884,42 @@ def test_the_floor_of_a_model_played_alone_has_bullets_friction_where_ambf_is_as
             assert slid == pytest.approx(2.0 * 0.2 - 0.5 * mu * G * 0.2**2, rel=rel), (engine.__name__, bodies, slid)
         finally:
             world.close()
+
+
+def _arm_past_its_limit(tmp_path, kind: str):
+    """The parity arm (0.5 kg, 30 cm, on a joint about z from a static post: gravity across the
+    axis) whose joint's limits [0.2, 1.0] rad put its start 0.2 rad past the lower one."""
+    from adfkit.adf.writer import write_file
+    from adfkit.model import JointLimits
+    from adfkit.scenes.parity import build_arm
+
+    m = build_arm()
+    m.joints[0].type = kind
+    m.joints[0].joint_limits = JointLimits(low=0.2, high=1.0)
+    path = write_file(m, tmp_path / f"arm_{kind.replace(' ', '_')}.yaml")
+    return load_scene(path)
+
+
+@pytest.mark.parametrize(("kind", "rate"), [("revolute", 0.3 * 0.1), ("torsion spring", 0.1)])
+def test_a_joint_started_past_its_limit_is_kicked_in_as_ambfs_limit_row_asks(tmp_path, kind, rate):
+    """Under AMBF's bodies (adfkit run / parity) a MuJoCo limit asks, as Bullet's limit row,
+    for the inward velocity c·error in one physics step and then lets the joint coast: c·dt is
+    0.3·erp for a hinge (setLimit's bias 0.3, AMBF's joint erp 0.1) and erp for a torsion
+    spring (its 6-dof spring constraint's stop ERP). Measured in AMBF (adfkit parity): this
+    hinge turns in at 6.0 rad/s from its first step (0.0240 rad in 4 ms), the torsion spring
+    at 17.6 rad/s over its first 4 ms (20 by the formula). Control: MuJoCo's own limit (a 20 ms
+    time constant, Options' default) eases the hinge in, 0.0045 rad in 4 ms."""
+    speed = rate * 0.2 / 1e-3  # 6 or 20 rad/s
+    for bodies in ("ambf", "pybullet"):
+        world = MujocoWorld(_arm_past_its_limit(tmp_path, kind), Options(visuals=False, ground=False, bodies=bodies))
+        try:
+            q0 = world.data.qpos[0]
+            world.step(1)  # 4 ms
+            q, v = world.data.qpos[0] - q0, world.data.qvel[0]
+            if bodies == "ambf":
+                assert v == pytest.approx(speed, rel=0.02), (kind, v)
+                assert q == pytest.approx(4e-3 * speed, rel=0.02), (kind, q)
+            elif kind == "revolute":
+                assert q < 0.3 * 4e-3 * speed, q  # 0.0045 rad
+        finally:
+            world.close()

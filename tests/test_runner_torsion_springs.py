@@ -145,8 +145,9 @@ def test_mujocos_floor_under_a_model_played_alone_is_1_mm_under_its_lowest_corne
         world.close()
 
 
-def _at_rest(name: str, engine: str) -> float:
-    """The largest position gap (m) of the corpus robot ``name`` from AMBF's over 1 s at rest."""
+def _at_rest(name: str, engine: str, rel: str = "robots/blender-{}.yaml") -> float:
+    """The largest position gap (m) of the corpus robot ``name`` (a file under the corpus's
+    multi-bodies, ``rel``) from AMBF's over 1 s at rest."""
     from conftest import CORPUS, require_corpus
 
     from adfkit.parity import ambf, session
@@ -155,7 +156,7 @@ def _at_rest(name: str, engine: str) -> float:
     build, why = ambf.available()
     if build is None:
         pytest.skip(why)
-    model = CORPUS / f"ambf/ambf_models/descriptions/multi-bodies/robots/blender-{name}.yaml"
+    model = CORPUS / "ambf/ambf_models/descriptions/multi-bodies" / rel.format(name)
     req = session.Request(model, None, build, seconds=1.0, every=0.02, engines=(engine,), springs="ambf")
     (c,) = session.run(req, progress=False).comparisons
     return max(g.max_position for g in c.bodies)
@@ -212,3 +213,33 @@ def test_a_loop_is_closed_by_its_joint_without_limits_not_by_a_limited_spring(tm
         assert {n for n, *_ in world.constraints} - {"JOINT world-l1"} == {"JOINT l1-l4"}
     finally:
         world.close()
+
+
+@pytest.mark.slow
+def test_the_springy_psm_falls_onto_its_pitch_limits_in_mujoco_as_in_ambf(monkeypatch):
+    """The corpus springy PSM's tool shaft lands on the floor at once (its tool roll link's mesh
+    reaches 187 mm below the wrist); AMBF's arm pitches over it 47° onto its limits, the shaft
+    sliding on the floor (Bullet's friction: 0.5 × 0.5). MuJoCo under AMBF's bodies gives the
+    floor's pairs that product: measured 208 mm from AMBF at most (the fall trails AMBF's by
+    about 0.1 s). Control: MuJoCo's own friction rule, the lower of the two (0.5): the shaft
+    sticks, the pitch stops at 7°: 356 mm."""
+    from adfkit.runner.mujoco import assemble
+
+    assert _at_rest("psm-springy", "mujoco") < 0.25
+    monkeypatch.setattr(assemble, "ground_pairs", lambda *a: None)
+    assert _at_rest("psm-springy", "mujoco") > 0.3
+
+
+@pytest.mark.slow
+def test_gripper3s_jaws_slide_in_mujoco_as_in_ambf(monkeypatch):
+    """The corpus gripper3 starts its fingers 0.12 rad past their limits; AMBF's hinge limit
+    rows kick them in, the slider between its jaws slides 117 mm and the gripper slides over
+    the floor. MuJoCo (its tree keeping the slider, AMBF's limit rows): measured 11.2 mm from
+    AMBF at most. Control: the slider closing the loop as a point (locked), 60.5 mm."""
+    from adfkit.converters import mjcf_write
+    from adfkit.model.tree import build_tree
+
+    rel = "grippers/resistive/gripper3/{}.yaml"
+    assert _at_rest("gripper", "mujoco", rel) < 0.02
+    monkeypatch.setattr(mjcf_write, "build_tree", lambda m, kinds=None, _s=False: build_tree(m, kinds))
+    assert _at_rest("gripper", "mujoco", rel) > 0.05

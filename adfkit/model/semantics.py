@@ -172,6 +172,9 @@ DEFAULT_GRAVITY = Vec3(0.0, 0.0, -9.8)
 DEFAULT_MAX_ITERATIONS = 10
 DEFAULT_JOINT_MAX_MOTOR_IMPULSE = 0.1
 DEFAULT_JOINT_ERP = 0.1
+#: btHingeConstraint::setLimit's default bias factor, which AMBF's hinges keep: a hinge's limit row
+#: asks for 0.3·erp·error/dt
+HINGE_LIMIT_BIAS = 0.3
 DEFAULT_JOINT_CFM = 0.1
 DEFAULT_SENSOR_RANGE = 0.5
 DEFAULT_ACTUATOR_MAX_IMPULSE = 10.0

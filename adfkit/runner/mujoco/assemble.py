@@ -18,6 +18,7 @@ from .build import GHOST_GROUP, build_plan
 from .contacts import ground_pairs, set_contacts
 from .damping import BodyDamping
 from .drives import DriveLimits, drive_limit
+from .limits import ambf_limits
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
 
@@ -118,6 +119,8 @@ class Assembly:
         self.joints_made = [(j, by_plan[id(p)], by_plan[id(c)]) for j, _k, p, c, *_ in plan.joints + plan.loops]
         self._build_articulations(plan, by_plan)
         self._drive_limits_and_springs()
+        if self.opt.bodies == "ambf":
+            ambf_limits(m, plan.joints, self.dt)
         self._gravity_overrides()
         self._base_xfrc = np.array(d.xfrc_applied)
         # every writer of xfrc_applied beyond this base (damping, hole ghosts, wake, a body's

@@ -30,11 +30,9 @@ from functools import partial
 
 import pybullet as pb
 
-from ...model.semantics import JointKind, joint_kind
+from ...model.semantics import HINGE_LIMIT_BIAS, JointKind, joint_kind
 from ..joint_commands import AMBF_JOINT_ERP, LIMIT_FORCE, limits_of
 
-#: btHingeConstraint::setLimit's default bias factor, which AMBF's hinges keep
-HINGE_LIMIT_BIAS = 0.3
 #: the world's ERP (btContactSolverInfo's default, which AMBF keeps): btSliderConstraint's limit rows'
 SLIDER_LIMIT_ERP = 0.2
 

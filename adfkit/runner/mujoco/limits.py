@@ -1,0 +1,46 @@
+"""Joint limits in the MuJoCo world as AMBF's Bullet constraints hold them, where AMBF's bodies
+are asked for (``Options.bodies`` "ambf": ``adfkit run``, ``adfkit parity``).
+
+Past a limit, Bullet's limit row asks for an inward joint velocity c·error in one physics step
+and only pushes: a joint started outside is kicked in and coasts on; a joint resting on a limit
+is held there. c is 0.3·erp/dt for a revolute joint (btHingeConstraint: setLimit's bias factor
+0.3 times the joint's `joint erp`, 0.1 unless the file says otherwise) and erp/dt for the axes of
+a `torsion spring` or `linear spring` (btGeneric6DofSpring2Constraint's stop ERP). Measured in
+AMBF: a 0.5 kg arm on a hinge about z started 0.2 rad past its lower limit turns in at 6.0 rad/s
+(0.3·0.1·0.2/1 ms) from the first step; on a torsion spring at 17.6 rad/s over the first 4 ms
+(20 by the formula). MuJoCo's default (a 20 ms time constant, damping ratio 1) eased the hinge
+in, 3.7 rad/s after 50 ms. A MuJoCo limit given the stiffness and damping c/dt and 1/dt
+(solref's negative form) asks for the same velocity in one step: the hinge turns in at 6.0 rad/s.
+A prismatic joint (btSliderConstraint) keeps MuJoCo's default: not measured.
+"""
+
+from __future__ import annotations
+
+import mujoco
+
+from ...model.semantics import DEFAULT_JOINT_ERP, HINGE_LIMIT_BIAS, JointKind
+
+#: AMBF's btGeneric6DofSpring2Constraint joints (afJoint::createFromAttribs)
+SPRING2_KINDS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
+
+
+def limit_rate(joint, kind) -> float | None:
+    """c·dt of Bullet's limit row on ``joint``, None where MuJoCo's default is kept."""
+    erp = joint.joint_erp if joint.joint_erp is not None else DEFAULT_JOINT_ERP
+    if kind is JointKind.REVOLUTE:
+        return HINGE_LIMIT_BIAS * erp
+    if kind in SPRING2_KINDS:
+        return erp
+    return None
+
+
+def ambf_limits(model, joints, dt: float) -> None:
+    """The limited MuJoCo joints of ``joints`` (build.Plan.joints) given Bullet's limit rows."""
+    for j, kind, _parent, _child, names in joints:
+        rate = limit_rate(j, kind)
+        if rate is None:
+            continue
+        for name in names:
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+            if jid >= 0 and model.jnt_limited[jid]:
+                model.jnt_solref[jid] = [-rate / dt**2, -1.0 / dt]
