@@ -42,6 +42,9 @@ class Scene:
     ghosts: str = "ambf"  # adfkit parity's default
     note: str = ""
     rows: list = field(default_factory=list)
+    # each engine in a run of its own, AMBF given that engine's floor (a model played alone: the
+    # engines put the floor 1 mm under their own lowest point, MuJoCo under a mesh's lowest vertex)
+    apart: bool = False
 
 
 def own_scenes(folder: Path) -> list[Scene]:
@@ -168,7 +171,14 @@ AT_REST = (
 def corpus_at_rest() -> list[Scene]:
     both = ("pybullet", "mujoco")
     return [
-        Scene(f"corpus {Path(rel).parent.name}/{Path(rel).name} at rest", CORPUS / "ambf" / rel, None, 1.0, both)
+        Scene(
+            f"corpus {Path(rel).parent.name}/{Path(rel).name} at rest",
+            CORPUS / "ambf" / rel,
+            None,
+            1.0,
+            both,
+            apart=True,
+        )
         for rel in AT_REST
         if (CORPUS / "ambf" / rel).is_file()
     ]
@@ -202,12 +212,15 @@ def main(argv: list[str]) -> int:
         for sc in scenes:
             if only and not any(o.lower() in sc.name.lower() for o in only):
                 continue
-            req = session.Request(
-                sc.path, sc.indices, build, seconds=sc.seconds, every=0.02, engines=sc.engines,
-                commands=sc.commands, ghosts=sc.ghosts,
-            )  # fmt: skip
             t0 = time.perf_counter()
-            out = session.run(req, progress=False)
+            comparisons = []
+            for engines in [(e,) for e in sc.engines] if sc.apart else [sc.engines]:
+                req = session.Request(
+                    sc.path, sc.indices, build, seconds=sc.seconds, every=0.02, engines=engines,
+                    commands=sc.commands, ghosts=sc.ghosts,
+                )  # fmt: skip
+                out = session.run(req, progress=False)
+                comparisons += out.comparisons
             wall = time.perf_counter() - t0
             if plots is not None:
                 from adfkit.parity.plot import plot_gaps
@@ -216,8 +229,8 @@ def main(argv: list[str]) -> int:
                 slug = "".join(c if c.isalnum() else "-" for c in sc.name.lower()).strip("-")
                 while "--" in slug:
                     slug = slug.replace("--", "-")
-                plot_gaps(out.comparisons, plots / f"parity-{slug}.png", sc.name, top=5)
-            for c in out.comparisons:
+                plot_gaps(comparisons, plots / f"parity-{slug}.png", sc.name, top=5)
+            for c in comparisons:
                 pos, ang = c.worst
                 end = max(c.bodies, key=lambda g: g.position[-1]) if c.bodies else None
                 row = {
