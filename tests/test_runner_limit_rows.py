@@ -4,7 +4,8 @@ whose limit rows are there whenever low < high: a joint moves toward a limit at 
 erp·g/dt, not at all where it would cross it within the step, and is driven back at erp·|g|/dt
 from past it (erp the joint's, 0.1). A prismatic joint is AMBF's btSliderConstraint, whose row
 drives a joint past its limit back at the world's erp (0.2)·depth/dt. PyBullet's own limit stops a
-joint on a limit it reaches and leaves one that starts past it where it is."""
+joint on a limit it reaches and leaves one that starts past it where it is. The slow tests measure
+both rows with AMBF."""
 
 from __future__ import annotations
 
@@ -125,3 +126,61 @@ def test_a_slider_inside_its_limits_is_left_alone(tmp_path):
     axis, it stays put (the row is there only past a limit)."""
     q, v = _after_a_step(tmp_path, SLIDER, 0.1, 0.0)
     assert q == pytest.approx(0.1, abs=1e-6) and v == pytest.approx(0.0, abs=1e-6)
+
+
+def _arm_as(tmp_path, kind: str, axis: str, limits: str, at_x: float = 0.2):
+    """The parity scene's arm (write_parity) with its joint made a ``kind`` about or along ``axis``
+    with ``limits``, the arm's centre at ``at_x`` (0.2: the joint at 0)."""
+    from adfkit.scenes.parity import write_parity
+
+    write_parity(tmp_path)
+    text = (tmp_path / "arm.yaml").read_text()
+    for old, new in (
+        ("type: revolute", f"type: {kind}"),
+        ("parent axis: {x: 0.0, y: 0.0, z: 1.0}", f"parent axis: {axis}"),
+        ("child axis: {x: 0.0, y: 0.0, z: 1.0}", f"child axis: {axis}"),
+        ("joint limits: {low: -2.0, high: 2.0}", f"joint limits: {limits}"),
+        ("position: {x: 0.2, y: 0.0, z: 0.5}", f"position: {{x: {at_x}, y: 0.0, z: 0.5}}"),
+    ):
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / f"arm_{kind.replace(' ', '_')}.yaml"
+    path.write_text(text)
+    return path
+
+
+def _ambf_gap(path, seconds: float, springs: str = "ambf") -> float:
+    from adfkit.parity import ambf, session
+
+    build, why = ambf.available()
+    if build is None:
+        pytest.skip(why)
+    req = session.Request(path, None, build, seconds=seconds, every=0.004, springs=springs, ground=False)
+    (c,) = session.run(req, progress=False).comparisons
+    return max(g.max_position for g in c.bodies)
+
+
+@pytest.mark.slow
+def test_the_arm_on_a_torsion_spring_falls_onto_its_limit_as_in_ambf(tmp_path):
+    """The parity arm on a torsion spring about y without stiffness, released level, falls onto
+    its 0.2 rad limit. In AMBF it is slowed onto it (0.1893, 0.1989, 0.1997 rad at 0.10, 0.12,
+    0.13 s; adfkit's rows 0.1889, 0.1986, 0.1995): measured 0.42 mm from AMBF at most. Control:
+    PyBullet's own limit (the implicit springs, no rows) lets it 3.3 mrad through and back: 2.7 mm."""
+    path = _arm_as(tmp_path, "torsion spring", "{x: 0.0, y: 1.0, z: 0.0}", "{low: -0.2, high: 0.2}")
+    assert _ambf_gap(path, 0.5) < 1e-3
+    assert _ambf_gap(path, 0.5, springs="implicit") > 2e-3
+
+
+@pytest.mark.slow
+def test_a_prismatic_joint_past_its_limit_is_driven_back_as_in_ambf(tmp_path, monkeypatch):
+    """The parity arm on a prismatic joint along x, started 0.05 m past its upper limit (0.05):
+    AMBF's slider drives it back at 0.2·0.05/1 ms = 10 m/s (0.09, 0.08, 0.07 m on its first
+    steps, the rows' to 10 nm with 1 ms control steps) and it bounces between its limits:
+    measured 4.6 mm from AMBF at most over 0.2 s at adfkit's 4 ms control step. Control: without
+    the slider's row PyBullet leaves it where it started: 160 mm."""
+    from adfkit.runner.pybullet import limit_rows
+
+    path = _arm_as(tmp_path, "prismatic", "{x: 1.0, y: 0.0, z: 0.0}", "{low: -0.05, high: 0.05}", at_x=0.3)
+    assert _ambf_gap(path, 0.2) < 0.01
+    monkeypatch.setattr(limit_rows, "slider_row_velocity", lambda *a, **k: None)
+    assert _ambf_gap(path, 0.2) > 0.1
