@@ -900,14 +900,15 @@ def _arm_past_its_limit(tmp_path, kind: str):
     return load_scene(path)
 
 
-@pytest.mark.parametrize(("kind", "rate"), [("revolute", 0.3 * 0.1), ("torsion spring", 0.1)])
+@pytest.mark.parametrize(("kind", "rate"), [("revolute", 0.3 * 0.1), ("torsion spring", 0.1), ("prismatic", 0.2)])
 def test_a_joint_started_past_its_limit_is_kicked_in_as_ambfs_limit_row_asks(tmp_path, kind, rate):
     """Under AMBF's bodies (adfkit run / parity) a MuJoCo limit asks, as Bullet's limit row,
     for the inward velocity c·error in one physics step and then lets the joint coast: c·dt is
     0.3·erp for a hinge (setLimit's bias 0.3, AMBF's joint erp 0.1) and erp for a torsion
-    spring (its 6-dof spring constraint's stop ERP). Measured in AMBF (adfkit parity): this
-    hinge turns in at 6.0 rad/s from its first step (0.0240 rad in 4 ms), the torsion spring
-    at 17.6 rad/s over its first 4 ms (20 by the formula). Control: MuJoCo's own limit (a 20 ms
+    spring (its 6-dof spring constraint's stop ERP), 0.2 for a slider (the world's ERP). Measured
+    in AMBF (adfkit parity): this hinge turns in at 6.0 rad/s from its first step (0.0240 rad in
+    4 ms), the torsion spring at 17.6 rad/s over its first 4 ms (20 by the formula), a slider
+    0.05 m past at 10 m/s (0.2·0.05/1 ms); made a slider along z, 0.2 m past: 40 m/s. Control: MuJoCo's own limit (a 20 ms
     time constant, Options' default) eases the hinge in, 0.0045 rad in 4 ms."""
     speed = rate * 0.2 / 1e-3  # 6 or 20 rad/s
     for bodies in ("ambf", "pybullet"):

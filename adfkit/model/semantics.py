@@ -175,6 +175,8 @@ DEFAULT_JOINT_ERP = 0.1
 #: btHingeConstraint::setLimit's default bias factor, which AMBF's hinges keep: a hinge's limit row
 #: asks for 0.3·erp·error/dt
 HINGE_LIMIT_BIAS = 0.3
+#: the world's ERP (btContactSolverInfo's default, which AMBF keeps): btSliderConstraint's limit rows'
+SLIDER_LIMIT_ERP = 0.2
 DEFAULT_JOINT_CFM = 0.1
 DEFAULT_SENSOR_RANGE = 0.5
 DEFAULT_ACTUATOR_MAX_IMPULSE = 10.0

@@ -5,20 +5,22 @@ Past a limit, Bullet's limit row asks for an inward joint velocity c·error in o
 and only pushes: a joint started outside is kicked in and coasts on; a joint resting on a limit
 is held there. c is 0.3·erp/dt for a revolute joint (btHingeConstraint: setLimit's bias factor
 0.3 times the joint's `joint erp`, 0.1 unless the file says otherwise) and erp/dt for the axes of
-a `torsion spring` or `linear spring` (btGeneric6DofSpring2Constraint's stop ERP). Measured in
+a `torsion spring` or `linear spring` (btGeneric6DofSpring2Constraint's stop ERP), 0.2 for a
+prismatic joint (btSliderConstraint's rows at the world's ERP, not the joint's). Measured in
 AMBF: a 0.5 kg arm on a hinge about z started 0.2 rad past its lower limit turns in at 6.0 rad/s
 (0.3·0.1·0.2/1 ms) from the first step; on a torsion spring at 17.6 rad/s over the first 4 ms
 (20 by the formula). MuJoCo's default (a 20 ms time constant, damping ratio 1) eased the hinge
 in, 3.7 rad/s after 50 ms. A MuJoCo limit given the stiffness and damping c/dt and 1/dt
 (solref's negative form) asks for the same velocity in one step: the hinge turns in at 6.0 rad/s.
-A prismatic joint (btSliderConstraint) keeps MuJoCo's default: not measured.
+A prismatic joint started 0.05 m past its limit is driven back at 10 m/s in AMBF (measured with
+the PyBullet runner's slider rows, runner/pybullet/limit_rows.py).
 """
 
 from __future__ import annotations
 
 import mujoco
 
-from ...model.semantics import DEFAULT_JOINT_ERP, HINGE_LIMIT_BIAS, JointKind
+from ...model.semantics import DEFAULT_JOINT_ERP, HINGE_LIMIT_BIAS, SLIDER_LIMIT_ERP, JointKind
 
 #: AMBF's btGeneric6DofSpring2Constraint joints (afJoint::createFromAttribs)
 SPRING2_KINDS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
@@ -31,6 +33,8 @@ def limit_rate(joint, kind) -> float | None:
         return HINGE_LIMIT_BIAS * erp
     if kind in SPRING2_KINDS:
         return erp
+    if kind is JointKind.PRISMATIC:
+        return SLIDER_LIMIT_ERP
     return None
 
 

@@ -30,11 +30,8 @@ from functools import partial
 
 import pybullet as pb
 
-from ...model.semantics import HINGE_LIMIT_BIAS, JointKind, joint_kind
+from ...model.semantics import HINGE_LIMIT_BIAS, SLIDER_LIMIT_ERP, JointKind, joint_kind
 from ..joint_commands import AMBF_JOINT_ERP, LIMIT_FORCE, limits_of
-
-#: the world's ERP (btContactSolverInfo's default, which AMBF keeps): btSliderConstraint's limit rows'
-SLIDER_LIMIT_ERP = 0.2
 
 
 def limit_row_velocity(q: float, v: float, limits: tuple[float, float], erp: float, dt: float) -> float:
