@@ -447,6 +447,28 @@ HINGED_IN_GHOST = (
 )
 
 
+def test_ghost_velocity_under_a_resting_parent_is_the_general_sum_to_the_bit():
+    """A ghost whose parent is at rest (a static phantom's hole ghosts) takes ghost_velocity's
+    short path, which must give what the general one gives, keep·(v - along) + v_parent with
+    nothing along, to the last bit (the runner's results may not move); a parent's -0.0 is
+    kept as the general sum keeps it. Control: a moving parent takes the general path, which
+    gives the parent's velocity along it, not the kept share."""
+    from adfkit.runner.ghost_rules import AMBF_GHOST_KEEP, ghost_velocity
+
+    rng = np.random.default_rng(7)
+    for points in (1, 4, 16):
+        keep = AMBF_GHOST_KEEP**points
+        for parent in ((0.0, 0.0, 0.0), (-0.0, 0.0, -0.0)):
+            v, w = rng.normal(size=3).tolist(), rng.normal(size=3).tolist()
+            v[0] = -0.0  # -0.0 + -0.0 stays -0.0 where + 0.0 would not
+            v2, w2 = ghost_velocity(v, w, parent, points)
+            va = np.asarray(parent, float)
+            want_v, want_w = keep * (np.asarray(v) - np.zeros(3)) + va, keep * np.asarray(w)
+            assert v2.tobytes() == want_v.tobytes() and w2.tobytes() == want_w.tobytes()
+    v2, _ = ghost_velocity([1.0, 2.0, 0.0], [0.0, 0.0, 0.0], (0.5, 0.0, 0.0), 16)
+    assert v2[0] == pytest.approx(0.5) and v2[1] == pytest.approx(2.0 * AMBF_GHOST_KEEP**16)
+
+
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
 def test_ambfs_ghost_rule_slows_a_hinged_link_inside_it(tmp_path, engine):
     """AMBF's ghost rule on a jointed body (AMBF's every body is a btRigidBody, whose velocities
@@ -527,6 +549,74 @@ def test_a_ghost_counts_the_engines_contact_points_and_pushes_nothing(tmp_path, 
     (with_pass, counts, _), (without, _, twin_alone) = fall(True), fall(False)
     assert max(counts) == 4 and with_pass == without and with_pass < 0.05
     assert list(twin) == list(twin_alone) and twin[2] < 0.05
+
+
+def _both_passes(w) -> tuple[dict, dict]:
+    """(the ghosts' collision pass in their own world, ghost_pass.py; the dynamics world's own
+    pass, which it stands in for), each made afresh now."""
+    w._manifold_place = None
+    own_world = w._manifold_points(w._acting_ghosts, {})
+    w._manifold_place = None
+    w._ghost_pass.counts = lambda *_: None  # the dynamics world's pass
+    try:
+        in_world = w._manifold_points(w._acting_ghosts, {})
+    finally:
+        del w._ghost_pass.counts
+    return own_world, in_world
+
+
+def test_the_ghost_pass_in_its_own_world_counts_as_the_dynamics_world_and_follows_bodies(tmp_path):
+    """The ghosts' collision pass runs in a world of the ghosts and copies of the bodies near
+    them (ghost_pass.py): it counts what the dynamics world's own pass counts, a cube in the
+    parity scene's slab 4 points (box-box) and a hinged arm's link (a multibody link, its shapes
+    off its centre of mass) the points of its box in the cell, step after step. Its copies follow
+    the bodies: the twin put into the slab where the cube was (it had no copy: it was never
+    near) counts 4 points at once and stays in the slab while the cube, taken out, falls (before,
+    the twin fell beside the slab), and a copy left in the slab whose body is far from every
+    ghost counts for nothing."""
+    import pybullet as pb
+
+    from adfkit.scenes.parity import write_parity
+
+    launch = write_parity(tmp_path)
+    w = open_world(load_scene(launch, [3]), Options(visuals=False, ghosts="ambf"))
+    try:
+        cube, twin = w.body("cube"), w.body("twin")
+        (g,) = w.ghosts
+        for _ in range(5):
+            w.step(10)
+            own_world, in_world = _both_passes(w)
+            assert own_world == in_world
+        assert own_world == {g.uid: {(cube.uid, -1): 4}} and twin.com_position()[2] < 0.2
+        p, q = pb.getBasePositionAndOrientation(cube.uid, physicsClientId=w.cid)
+        pb.resetBasePositionAndOrientation(twin.uid, p, q, physicsClientId=w.cid)
+        pb.resetBasePositionAndOrientation(cube.uid, (0.2, 0.0, 0.5), q, physicsClientId=w.cid)
+        for v in (twin, cube):
+            pb.resetBaseVelocity(v.uid, (0, 0, 0), (0, 0, 0), physicsClientId=w.cid)
+        own_world, in_world = _both_passes(w)
+        assert own_world == in_world == {g.uid: {(twin.uid, -1): 4}}
+        w.step(150)
+        assert 0.2475 < twin.com_position()[2] < 0.2505 and cube.com_position()[2] < 0.05
+        # a copy left in the slab by an earlier pass (its body far from every ghost) counts for nothing
+        stale = w._ghost_pass.copies[(cube.uid, -1)]
+        p, q = pb.getBasePositionAndOrientation(twin.uid, physicsClientId=w.cid)
+        pb.resetBasePositionAndOrientation(stale, p, q, physicsClientId=w._ghost_pass.cid)
+        own_world, in_world = _both_passes(w)
+        assert own_world == in_world == {g.uid: {(twin.uid, -1): 4}}
+    finally:
+        w.close()
+
+    scene = _model(tmp_path, HINGED_IN_GHOST.format(ghost_x=0.05))
+    w = open_world(scene, Options(visuals=False, ground=False, ghosts="ambf"))
+    try:
+        arm = w.body("arm")
+        assert arm.link >= 0
+        for _ in range(5):
+            w.step(20)
+            own_world, in_world = _both_passes(w)
+            assert own_world == in_world and own_world[w.ghosts[0].uid][(arm.uid, arm.link)] > 0
+    finally:
+        w.close()
 
 
 @pytest.mark.slow

@@ -26,11 +26,22 @@ def ghost_velocity(v, w, v_parent, points: int):
     """(linear, angular) velocity of a body after ``points`` of AMBF's ghost updates (one per
     penetrating contact point and physics step): keep^points of what is across the parent's
     velocity, plus the parent's."""
+    if not any(v_parent):
+        v2, w2 = kept_at_rest(v, w, v_parent, points)
+        return np.array(v2, dtype=float), np.array(w2, dtype=float)
     keep = AMBF_GHOST_KEEP**points
     v, w, va = np.asarray(v, float), np.asarray(w, float), np.asarray(v_parent, float)
     mag = float(np.linalg.norm(va))
     along = va * (float(v @ va) / (mag * mag)) if mag > 1e-5 else np.zeros(3)
     return keep * (v - along) + va, keep * w
+
+
+def kept_at_rest(v, w, v_parent, points: int) -> tuple[list[float], list[float]]:
+    """ghost_velocity under a parent at rest (every component of ``v_parent`` zero: nothing is
+    along its velocity), as lists: the same sums, keep·(v - 0) + v_parent and keep·w, in
+    floats, without numpy's cost (a static phantom's hole ghosts, each control step)."""
+    keep = AMBF_GHOST_KEEP**points
+    return [keep * (x - 0.0) + p for x, p in zip(v, v_parent)], [keep * x for x in w]
 
 
 def ghost_accelerations(v, w, v_parent, points: int, cdt: float):

@@ -32,6 +32,7 @@ from ..springs import spring_alone
 from . import articulation, egl
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .damping import LinkDamping
+from .ghost_pass import GhostPass
 from .interact import SimActuator, SimGhost, SimSensor
 from .joints import ConstraintRefused, make_constraint, spring_joint
 from .limit_rows import LimitRows
@@ -179,6 +180,7 @@ class Assembly:
         # the ghosts that act on what is inside them each control step (Options.ghosts)
         self._acting_ghosts = self.ghosts if self.opt.ghosts == "ambf" else self._friction_ghosts
         self._manifold_place, self._manifold_made = None, {}  # interact._manifold_points' last pass
+        self._ghost_pass = GhostPass(self)  # where that pass is run (ghost_pass.py)
 
     def _group_gravity_overrides(self):
         """Bodies whose gravity differs from the world's, grouped per multibody so each control
@@ -314,7 +316,7 @@ class Assembly:
             key = self.registry.add(key_of(ns, gh), None)
             moves = parent is not None and not parent.static
             self.ghosts.append(
-                SimGhost(key, gh, uid, parent, rel, friction, pq_in_parent=matrix_to_pq(rel), moves=moves)
+                SimGhost(key, gh, uid, parent, rel, friction, pq_in_parent=matrix_to_pq(rel), moves=moves, parts=parts)
             )
 
     def _build_actuators(self, m, known) -> None:

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import SAME_PLACE, ghost_accelerations, ghost_velocity, viscous_impulse_force
+from ..ghost_rules import SAME_PLACE, ghost_accelerations, ghost_velocity, kept_at_rest, viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
 
@@ -39,6 +39,7 @@ class SimGhost:
     moves: bool = False  # a dynamic parent: the ghost follows it every step
     placed_at: tuple | None = None  # the parent's (position, quaternion) the ghost was last placed at
     distances: dict = field(default_factory=dict)  # (uid, link) -> (placement, body pose, inside, points): _overlap
+    parts: object = None  # its collision parts (shapes.ShapeParts): ghost_pass.py's copy is made of them
 
 
 @dataclass(eq=False)
@@ -114,7 +115,7 @@ class Interaction:
             elif found:
                 self._viscous(g, found)
         if ambf:
-            self._weightless(held.values())
+            self._weightless(held.values(), poses)
 
     def _ambf_ghost(self, g: SimGhost, held: dict) -> None:
         """AMBF's ghost on the bodies in penetrating contact with it (ghost_rules.ghost_velocity), for
@@ -126,14 +127,18 @@ class Interaction:
         cid = self.cid
         parent = g.parent
         v_par = parent.state()[2] if parent is not None and not parent.static else (0.0, 0.0, 0.0)
+        resting = not any(v_par)
         for sb, points in g.points:
             if points == 0:
                 continue
             held[id(sb)] = sb
             if sb.link < 0:
                 v, w = pb.getBaseVelocity(sb.uid, cid)
-                v2, w2 = ghost_velocity(v, w, v_par, points * steps)
-                pb.resetBaseVelocity(sb.uid, v2.tolist(), w2.tolist(), cid)
+                if resting:
+                    v2, w2 = kept_at_rest(v, w, v_par, points * steps)
+                else:
+                    v2, w2 = (x.tolist() for x in ghost_velocity(v, w, v_par, points * steps))
+                pb.resetBaseVelocity(sb.uid, v2, w2, cid)
             else:
                 p, q, v, w = sb.state()
                 a, alpha = ghost_accelerations(v, w, v_par, points * steps, cdt)
@@ -141,11 +146,14 @@ class Interaction:
                 sb.force((sb.mass * a).tolist(), list(p))
                 sb.torque((rot @ (np.asarray(sb.inertia) * (rot.T @ alpha))).tolist())
 
-    def _weightless(self, bodies) -> None:
-        """Each body's weight taken off for this control step (AMBF switches its gravity off)."""
+    def _weightless(self, bodies, poses: dict | None = None) -> None:
+        """Each body's weight taken off for this control step (AMBF switches its gravity off).
+        ``poses``: as _update_ghosts' (read this control step; the ghosts set velocities, not
+        positions), its centre of mass read again where it has none."""
         for sb in bodies:
             g = sb.gravity if sb.gravity is not None else self.gravity
-            sb.force((-sb.mass * np.asarray(g)).tolist(), list(sb.com_position()))
+            pq = poses.get((sb.uid, sb.link)) if poses else None
+            sb.force([-sb.mass * c for c in g], list(pq[0] if pq is not None else sb.com_position()))
 
     def place_ghosts(self) -> None:
         """Move every ghost with a moving parent to it (before a picture is taken)."""
@@ -176,14 +184,16 @@ class Interaction:
         the same ghosts, within SAME_PLACE of where they were, and no collision pair or grasp has
         changed (``poses``: those read this control step, as _update_ghosts)."""
         cid, dynamic = self.cid, self._dynamic_lookup
-        near, which, where = [], [self._pairs_epoch], []
+        near, which, where, passes = [], [self._pairs_epoch], [], []
         for g in ghosts:
             lo, hi = pb.getAABB(g.uid, -1, cid)
             keys = [key for key in pb.getOverlappingObjects(lo, hi, cid) or () if key in dynamic]
             if keys:
                 near.append(g)
                 which.append((g.uid, keys))
-                where.append(pb.getBasePositionAndOrientation(g.uid, cid))
+                pq = pb.getBasePositionAndOrientation(g.uid, cid)
+                passes.append((g, pq, keys))
+                where.append(pq)
                 for key in keys:
                     if key not in poses:
                         poses[key] = dynamic[key].state(velocity=False)[:2]
@@ -195,6 +205,11 @@ class Interaction:
         if last is not None and last[0] == which:
             if np.max(np.abs(last[1] - place[1])) <= SAME_PLACE:
                 return self._manifold_made
+        # the pass in a world of the ghosts and the bodies near them alone (ghost_pass.py), else here
+        made = self._ghost_pass.counts(passes, poses)
+        if made is not None:
+            self._manifold_place, self._manifold_made = place, made
+            return made
         for g in near:
             pb.setCollisionFilterGroupMask(g.uid, -1, GHOST_PASS_BITS, GHOST_PASS_BITS, physicsClientId=cid)
         pb.performCollisionDetection(physicsClientId=cid)

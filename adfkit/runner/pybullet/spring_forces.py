@@ -166,19 +166,19 @@ class SpringSet:
         effective inertia or mass): the force that leaves the pair moving at the velocity the
         spring and damper give it at the end of the step, for small gains the explicit -k·x - c·v,
         for large ones at most what stops the motion. AMBF's (btGeneric6DofSpring2Constraint::
-        get_limit_motor_info2): K = min(k, m/(16·dt²)), C = min(c, m/dt), D = 1."""
+        get_limit_motor_info2): K = min(k, m/(16·dt²)), C = min(c, m/dt), D = 1 (None: not divided by)."""
         if self._gains_dt == dt:
             return
         if self.form == "ambf":
             self._ang = (
                 np.minimum(self.k_ang, self.m_ang / (16 * dt * dt)),
                 np.minimum(self.c_ang, self.m_ang / dt),
-                1.0,
+                None,
             )
             self._lin = (
                 np.minimum(self.k_lin, self.m_lin / (16 * dt * dt)),
                 np.minimum(self.c_lin, self.m_lin / dt),
-                1.0,
+                None,
             )
         else:
             den_ang = 1.0 + (self.c_ang * dt + self.k_ang * dt**2) / self.i_implicit
@@ -187,14 +187,15 @@ class SpringSet:
             self._lin = (self.k_lin, self.c_lin + self.k_lin * dt, den_lin)
         k, c, den = self._lin
         fl = self.free_lin
-        self._fl = (k[fl], c[fl], den if np.isscalar(den) else den[fl])
+        self._fl = (k[fl], c[fl], den if den is None else den[fl])
         self._gains_dt = dt
 
     @staticmethod
     def _spring(gains, x, v):
-        """The spring-damper's force or torque -(K·x + C·v) / D, ``gains`` (K, C, D) (_gains)."""
+        """The spring-damper's force or torque -(K·x + C·v) / D, ``gains`` (K, C, D) (_gains; D None: 1)."""
         k, c, den = gains
-        return -(k * x + c * v) / den
+        out = -(k * x + c * v)
+        return out if den is None else out / den
 
     def _read_plan(self):
         """How to read every body's COM state with the fewest PyBullet calls: free bodies and

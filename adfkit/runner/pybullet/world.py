@@ -309,6 +309,8 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         if self.soft is not None:
             self.soft.close()
         held.forget(self.cid)
+        if getattr(self, "_ghost_pass", None) is not None:
+            self._ghost_pass.close()
         if pb.isConnected(self.cid):
             with egl.quiet_stdout() if self.renderer == "egl" else contextlib.nullcontext():
                 pb.disconnect(self.cid)

@@ -1,0 +1,123 @@
+"""The ghosts' collision pass (interact._manifold_points) in a PyBullet world of its own.
+
+AMBF's ghost acts once per penetrating contact point of its manifold with a body, which only
+Bullet's narrowphase makes in a collision pass (a box in a box gives four points at once). Run
+in the dynamics world (each ghost near a body let collide, performCollisionDetection, shut
+again), the pass also went over every other pair of the scene, the thread on the phantom and the
+rest, which the next step does again: on the corpus suturing set that was half of the pass. Here
+the ghosts and copies of the bodies near them stand in a second PyBullet world, made on the
+first pass, where only a ghost and a body can meet (their collision bits). Each pass puts them
+where they are in the dynamics world and starts every ghost's pairs afresh, as the world's pass
+did (changing a ghost's collision bits drops its pairs): the same shapes, margins and poses give
+the same points. The dynamics world's own pass left nothing behind (replaying its counts without
+it leaves every body where it was, to the bit): its other pairs' points are the step's to make.
+
+A ghost or a body that cannot be copied (a volume's surface pieces, one without collision parts)
+leaves the pass to the dynamics world (``counts`` returns None).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as pb
+
+from ..rotations import invert, matrix_to_pq
+from .shapes import create_collision
+
+# the copies' collision bits: a ghost meets bodies, a body meets ghosts, never another body
+BODY_BIT, GHOST_BIT = 1, 2
+COPY_MASS = 1.0  # kg: a copy must be dynamic (Bullet leaves a pair of static objects alone); never stepped
+
+
+class GhostPass:
+    def __init__(self, world) -> None:
+        self.world = world
+        self.cid: int | None = None
+        self.ghosts: dict[int, int] = {}  # ghost uid in the world -> its copy
+        self.copies: dict[tuple[int, int], int | None] = {}  # (uid, link) -> its copy (None: cannot be)
+        self.owner: dict[int, tuple[int, int]] = {}  # copy uid -> (uid, link) in the world
+
+    def _connect(self) -> int:
+        if self.cid is None:
+            self.cid = pb.connect(pb.DIRECT)
+            threshold = self.world.opt.contact_threshold
+            if threshold is not None:
+                pb.setPhysicsEngineParameter(contactBreakingThreshold=threshold, physicsClientId=self.cid)
+        return self.cid
+
+    def _copy_ghost(self, g) -> int:
+        uid = self.ghosts.get(g.uid)
+        if uid is None:
+            cid = self._connect()
+            col = create_collision(g.parts, cid)
+            uid = pb.createMultiBody(0, col, -1, useMaximalCoordinates=True, physicsClientId=cid)
+            pb.setCollisionFilterGroupMask(uid, -1, 0, 0, physicsClientId=cid)
+            self.ghosts[g.uid] = uid
+        return uid
+
+    def _copy_body(self, key: tuple[int, int], sb) -> int | None:
+        """The body's copy: its collision parts, in its link's inertial frame as PyBullet puts a
+        multibody link's shapes (a free body's and a base's frame is their centre of mass)."""
+        if key in self.copies:
+            return self.copies[key]
+        uid = None
+        if sb._parts is not None and (sb._parts.types or sb._parts.plane is not None) and not sb.piece_links:
+            cid = self._connect()
+            col = create_collision(sb._parts, cid)
+            if col >= 0:
+                inertial = invert(sb.ref_in_body) @ sb.com_in_body if sb.link >= 0 else np.eye(4)
+                ipos, iorn = matrix_to_pq(inertial)
+                uid = pb.createMultiBody(
+                    COPY_MASS,
+                    col,
+                    -1,
+                    baseInertialFramePosition=ipos,
+                    baseInertialFrameOrientation=iorn,
+                    useMaximalCoordinates=True,
+                    physicsClientId=cid,
+                )
+                pb.setCollisionFilterGroupMask(uid, -1, BODY_BIT, GHOST_BIT, physicsClientId=cid)
+                self.owner[uid] = key
+        self.copies[key] = uid
+        return uid
+
+    def counts(self, near, poses: dict) -> dict[int, dict[tuple[int, int], int]] | None:
+        """{ghost uid: {(uid, link): penetrating contact points}} for ``near``, [(ghost, its pose,
+        the keys of the dynamic bodies near it)], ``poses`` holding each key's (position,
+        quaternion) of its centre of mass; None where a body near a ghost cannot be copied."""
+        dynamic = self.world._dynamic_lookup
+        placed: dict[int, tuple] = {}
+        for g, _pq, keys in near:
+            if g.parts is None:
+                return None
+            for key in keys:
+                if key not in placed and self._copy_body(key, dynamic[key]) is None:
+                    return None
+                placed[key] = poses[key]
+        cid = self._connect()
+        reset = pb.resetBasePositionAndOrientation
+        for key, (p, q) in placed.items():
+            reset(self.copies[key], p, q, cid)
+        on = []
+        for g, (p, q), _keys in near:
+            uid = self._copy_ghost(g)
+            reset(uid, p, q, cid)
+            pb.setCollisionFilterGroupMask(uid, -1, GHOST_BIT, BODY_BIT, physicsClientId=cid)
+            on.append((g, uid, _keys))
+        pb.performCollisionDetection(physicsClientId=cid)
+        out: dict[int, dict[tuple[int, int], int]] = {}
+        for g, uid, keys in on:
+            counts = out.setdefault(g.uid, {})
+            wanted = set(keys)  # a copy left where an earlier pass put it is no body near this ghost now
+            for c in pb.getContactPoints(bodyA=uid, physicsClientId=cid):
+                if c[8] < 0.0:
+                    key = self.owner.get(c[2] if c[1] == uid else c[1])
+                    if key in wanted:
+                        counts[key] = counts.get(key, 0) + 1
+            pb.setCollisionFilterGroupMask(uid, -1, 0, 0, physicsClientId=cid)  # its pairs dropped
+        return out
+
+    def close(self) -> None:
+        if self.cid is not None and pb.isConnected(self.cid):
+            pb.disconnect(self.cid)
+        self.cid = None
