@@ -10,9 +10,10 @@ velocity and effort commands, a stack of boxes, a cube into a ghost, the thread 
 held needle, the arm with a turned inertial frame), the bundled sample scenes at rest and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
 own floor (from the AMBF tree), and the KUKA and a PSM under joint programs (parity.programs);
 with --corpus-at-rest, more corpus files AMBF loads (AT_REST), at rest for 1 s in both engines.
-With --suture, only the suture replayed in AMBF (``adfkit parity --suture --pace both``, 4 pairs,
-seed 0) on the bundled scene and the corpus set, a row per pair: each side's verdict, paced and
-unpaced, the tip paths' largest gap, and the whole episode's stepping time on each side (tens of
+With --suture, only the suture replayed in AMBF (``adfkit parity --suture --follow both --pace
+both``, 4 pairs, seed 0) on the bundled scene and the corpus set, a row per pair: each side's
+verdict (AMBF following adfkit's measured joints, its set-points unpaced and paced), the tip
+paths' largest gap in each replay, and the whole episode's stepping time on each side (tens of
 minutes on a shared box).
 Timings are of a shared 2-core box: noisy; compare AMBF's and adfkit's of one row.
 """
@@ -113,7 +114,8 @@ def corpus_scenes(build, folder: Path) -> list[Scene]:
 
 
 def suture_rows(build) -> list[str]:
-    """The suture replayed in AMBF, paced and unpaced, on the bundled scene and the corpus set."""
+    """The suture replayed in AMBF (following the measured joints; the set-points unpaced and
+    paced) on the bundled scene and the corpus set."""
     from adfkit.commands.suture import parse_pairs
     from adfkit.parity.suture import PACE, compare_suture
 
@@ -122,16 +124,17 @@ def suture_rows(build) -> list[str]:
         scenes.append(("corpus set", CORPUS / "src" / "launch.yaml", [6, 7, 8, 9, 10, 11]))
     rows = []
     for label, launch, indices in scenes:
-        out = compare_suture(launch, indices, parse_pairs("1,2,3,4"), build, 0, paces=(None, PACE))
-        plain, paced = out["replays"]
+        out = compare_suture(launch, indices, parse_pairs("1,2,3,4"), build, 0, paces=(None, PACE), follow="both")
+        measured, plain, paced = out["replays"]
         walls = (
-            f"{out['wall_s']['adfkit']:.0f} s | {paced['wall_s']:.0f} s "
-            f"({paced['pace']['ambf_simulated_s']:.1f} s played) | {plain['wall_s']:.0f} s"
+            f"{out['wall_s']['adfkit']:.0f} s | {measured['wall_s']:.0f} s | {plain['wall_s']:.0f} s | "
+            f"{paced['wall_s']:.0f} s ({paced['pace']['ambf_simulated_s']:.1f} s played)"
         )
         for p in out["pairs"]:
             rows.append(
-                f"| {label} | {p['pair']} | {p['adfkit']} | {p['ambf']}{_rule(p['ambf_rule'])} | {p['ambf_paced']}"
-                f"{_rule(p['ambf_paced_rule'])} | {_mm(p['tip_path_gap_m'])} | {_mm(p['tip_path_gap_paced_m'])} | "
+                f"| {label} | {p['pair']} | {p['adfkit']} | {p['ambf']}{_rule(p['ambf_rule'])} | "
+                f"{p['ambf_unpaced']}{_rule(p['ambf_unpaced_rule'])} | {p['ambf_paced']}{_rule(p['ambf_paced_rule'])} | "
+                f"{_mm(p['tip_path_gap_m'])} | {_mm(p['tip_path_gap_unpaced_m'])} | {_mm(p['tip_path_gap_paced_m'])} | "
                 f"{walls} |"
             )
         print(f"  ({label}: {out['seconds']:.1f} s episode, {out['commands']} commands)", file=sys.stderr)
@@ -196,10 +199,10 @@ def main(argv: list[str]) -> int:
     only = argv[argv.index("--only") + 1 :] if "--only" in argv else []
     if "--suture" in argv:
         print(
-            "| scene | pair | adfkit | AMBF | AMBF paced | tip gap | tip gap paced "
-            "| adfkit stepping (episode) | AMBF paced | AMBF |"
+            "| scene | pair | adfkit | AMBF following | AMBF set-points | AMBF paced | tip gap following "
+            "| tip gap set-points | tip gap paced | adfkit stepping (episode) | AMBF following | AMBF | AMBF paced |"
         )
-        print("|---|---|---|---|---|---|---|---|---|---|")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         print("\n".join(suture_rows(build)))
         return 0
     os.environ.setdefault("ADFKIT_INPUT_ROOT", "/")  # the puzzle's launch names AMBF's floor and the corpus

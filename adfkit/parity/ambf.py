@@ -144,7 +144,7 @@ def plugin_library(build: AmbfBuild) -> Path:
 @dataclass
 class Command:
     """One line of the plugin's command file: at ``t`` seconds, ``kind`` (position, velocity,
-    effort, grasp, release, place, force, collide) on ``target`` (a joint's, an actuator's or a
+    effort, grasp, release, place, force, collide, follow: a point of a joint's path) on ``target`` (a joint's, an actuator's or a
     body's AMBF name) with ``value`` (a joint command's; a collide's 0 or 1), ``body`` (a grasp's
     or a collide's other body) or ``numbers``."""
 
@@ -261,20 +261,24 @@ def run(
     timeout: float | None = None,
     pace: tuple[float, float, float] | None = None,
     pace_max_s: float | None = None,
+    follow_gain: float | None = None,
 ) -> AmbfRecord:
     """Play ``stage`` in ``ambf_simulator`` for ``seconds`` (0: load only), a sample every
     ``every`` seconds, driven by ``commands``; AMBF's output goes to a log kept with the record.
     ``pace`` (rad, m, wait s): the commands read on the plugin's paced command clock, which
     advances only while the joints under position commands stand within those tolerances of
     their set-points (``seconds`` and ``every`` are then that clock's), ending at ``pace_max_s``
-    of AMBF's time if the clock has not reached ``seconds`` by then."""
+    of AMBF's time if the clock has not reached ``seconds`` by then. ``follow_gain`` (1/s): the
+    feedback gain of the joints following a path (``follow`` commands; None: the plugin's)."""
     lib = plugin_library(build)
     with tempfile.TemporaryDirectory(prefix="adfkit-ambf-") as tmp:
         out = Path(tmp) / "record.jsonl"
         env = dict(os.environ, ADFKIT_PARITY_OUT=str(out), ADFKIT_PARITY_SECONDS=repr(float(seconds)))
         env["ADFKIT_PARITY_EVERY"] = repr(float(every))
-        for key in ("ADFKIT_PARITY_PACE", "ADFKIT_PARITY_PACE_MAX"):
+        for key in ("ADFKIT_PARITY_PACE", "ADFKIT_PARITY_PACE_MAX", "ADFKIT_PARITY_FOLLOW_GAIN"):
             env.pop(key, None)
+        if follow_gain is not None:
+            env["ADFKIT_PARITY_FOLLOW_GAIN"] = repr(float(follow_gain))
         if pace is not None:
             env["ADFKIT_PARITY_PACE"] = " ".join(repr(float(v)) for v in pace)
             if pace_max_s is not None:
