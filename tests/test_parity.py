@@ -602,11 +602,12 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     monkeypatch.setattr(ambf, "find_build", lambda path: None)
     assert main(["parity", "--suture", "--pairs", "1", "--pace", "both"]) == 1  # the verdicts differ
     text = capsys.readouterr().out
-    assert seen["paces"] == (None, suture.PACE)
+    assert seen["paces"] == (None, suture.PACE) and seen["follow"] == "commands"
     assert "pair 1: adfkit passed, AMBF failed (entry-missed" in text and "47.8 mm" in text
     assert "; paced: AMBF failed" in text and "432.4 s" in text and "1119 wait(s) given up" in text
     assert main(["parity", "--suture", "--pairs", "1"]) == 1 and seen["paces"] == (None,)
-    assert seen["follow"] == "commands"
+    assert seen["follow"] == "measured"  # the default without a pace: following adfkit's measured joints
+    assert main(["parity", "--suture", "--pairs", "1", "--pace", "on"]) == 1 and seen["follow"] == "commands"
     assert main(["parity", "--suture", "--pairs", "1", "--follow", "both", "--pace", "both"]) == 1
     assert seen["follow"] == "both" and seen["paces"] == (None, suture.PACE)
     seen.clear()

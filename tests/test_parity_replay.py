@@ -101,6 +101,11 @@ def _as_recording(rec) -> suture.Recording:
     return suture.Recording(rec.commands, 0.0, [], np.zeros((0, 4)), [], None, [], "", [])
 
 
+class _Commands:
+    def __init__(self, commands) -> None:
+        self.commands = commands
+
+
 def test_the_recording_holds_the_measured_joints_each_control_step():
     """Recorded with ``measured``, each PSM joint's position is written every control step
     (``follow`` lines), the value adfkit's joint had at that step's start; the replay that
@@ -134,6 +139,22 @@ def test_the_recording_holds_the_measured_joints_each_control_step():
     assert not [c for c in bare.commands if c.kind == "follow"]
     with pytest.raises(ValueError, match="no measured joint paths"):
         _as_recording(bare).commands_for("measured")
+
+
+def test_tracking_is_read_against_the_measured_path_after_its_first_point():
+    """AMBF's joint against adfkit's path (linear between its points) at each sample after the
+    path's first point: 0.6 at 0.5 s on a path through 0.5 is 0.1 off; the sample at 0 s, before
+    any command, and the one past the path's end are not read."""
+    from adfkit.parity.traces import Trace
+
+    rec = _as_recording(_Commands([ambf.Command(0.0, "follow", "j", 0.0), ambf.Command(1.0, "follow", "j", 1.0)]))
+    times = np.array([0.0, 0.5, 1.0, 1.5])
+    joints = np.array([[5.0], [0.6], [1.0], [9.0]])
+    tr = Trace("ambf", {}, ["b"], times, np.zeros((4, 1, 7)), ["j"], joints, 0.0)
+    assert suture.tracking(rec, tr) == {"j": {"median": pytest.approx(0.05), "max": pytest.approx(0.1)}}
+    # a revolute joint read a turn away is where the path is
+    tr.joints[1, 0] = 0.5 + 2 * np.pi
+    assert suture.tracking(rec, tr)["j"]["max"] == pytest.approx(0.0, abs=1e-12)
 
 
 def test_the_replay_modes():

@@ -93,11 +93,12 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--follow",
         choices=("commands", "measured", "both"),
-        default="commands",
-        help="--suture: commands (default) replays the set-points adfkit's planner gave as AMBF's position "
-        "commands; measured has each PSM joint follow the path adfkit's joint took (recorded each control "
-        "step), a velocity command each 1 ms step closing the loop on AMBF's measured joint, as a client "
-        "servoing measured_js would (no --pace); both replays measured first (its verdicts judged), then commands",
+        default=None,
+        help="--suture: measured (the default without --pace) has each PSM joint follow the path adfkit's joint "
+        "took (recorded each control step), a velocity command each 1 ms step closing the loop on AMBF's "
+        "measured joint, as a client servoing measured_js would; commands (the default with --pace on or both) "
+        "replays the set-points adfkit's planner gave as AMBF's position commands; both replays measured "
+        "first (its verdicts judged), then the set-points",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object (a list of them for --engine both)")
 
@@ -163,7 +164,8 @@ def _suture(args) -> int:
     pairs = parse_pairs(args.pairs.strip())
     build = ambf.find_build(args.ambf)
     paces = {"on": (PACE,), "off": (None,), "both": (None, PACE)}[args.pace]
-    if args.follow == "measured" and args.pace != "off":
+    follow = args.follow or ("measured" if args.pace == "off" else "commands")
+    if follow == "measured" and args.pace != "off":
         raise AdfError(
             error(
                 "bad-option",
@@ -180,7 +182,7 @@ def _suture(args) -> int:
         args.seed,
         progress=not args.json,
         paces=paces,
-        follow=args.follow,
+        follow=follow,
     )
     if args.json:
         print(dumps(out, indent=1))

@@ -504,8 +504,9 @@ class Replay:
 
 def tracking(rec: Recording, trace) -> dict:
     """How far each PSM joint in AMBF stood from the path adfkit's took, at AMBF's samples (by
-    the command clock) within the path: ``{joint: {"median": .., "max": ..}}`` (rad or m; empty
-    where the recording holds no measured paths)."""
+    the command clock) after the path's first point (the sample there comes before any command)
+    and up to its last: ``{joint: {"median": .., "max": ..}}`` (rad or m; empty where the
+    recording holds no measured paths)."""
     clock = trace.clock if trace.clock is not None else trace.times
     n_ok = finite_samples(trace)
     out = {}
@@ -513,7 +514,7 @@ def tracking(rec: Recording, trace) -> dict:
         if name not in trace.joint_names or len(path) < 2:
             continue
         t = clock[:n_ok]
-        inside = (t >= path[0, 0]) & (t <= path[-1, 0])
+        inside = (t > path[0, 0]) & (t <= path[-1, 0])
         d = trace.joints[:n_ok, trace.joint_names.index(name)][inside] - np.interp(t[inside], path[:, 0], path[:, 1])
         d = np.abs((d + math.pi) % (2 * math.pi) - math.pi)  # a revolute joint's turn either way
         d = d[np.isfinite(d)]
@@ -586,7 +587,7 @@ def compare_suture(
     seed: int = 0,
     progress: bool = False,
     paces: tuple[Pace | None, ...] = (None,),
-    follow: str = "commands",
+    follow: str = "measured",
 ) -> dict:
     """The suture in adfkit and replayed in AMBF (as ``replay_modes(paces, follow)`` lists, the
     first judged against adfkit's verdicts), judged alike: the issue's JSON."""
