@@ -20,26 +20,31 @@ MANIFOLD_POINTS = 4
 #: m (and quaternion or rotation-matrix entries): a ghost and the bodies near it that moved no more
 #: than this since the engine's last collision pass for it keep that pass's contact points
 SAME_PLACE = 1e-9
+#: m/s: a ghost's parent slower than this takes nothing along its velocity (ghost_velocity)
+ALONG_FROM = 1e-5
 
 
 def ghost_velocity(v, w, v_parent, points: int):
     """(linear, angular) velocity of a body after ``points`` of AMBF's ghost updates (one per
     penetrating contact point and physics step): keep^points of what is across the parent's
     velocity, plus the parent's."""
-    if not any(v_parent):
-        v2, w2 = kept_at_rest(v, w, v_parent, points)
-        return np.array(v2, dtype=float), np.array(w2, dtype=float)
+    kept = kept_under_slow_parent(v, w, v_parent, points)
+    if kept is not None:
+        return np.array(kept[0], dtype=float), np.array(kept[1], dtype=float)
     keep = AMBF_GHOST_KEEP**points
     v, w, va = np.asarray(v, float), np.asarray(w, float), np.asarray(v_parent, float)
     mag = float(np.linalg.norm(va))
-    along = va * (float(v @ va) / (mag * mag)) if mag > 1e-5 else np.zeros(3)
+    along = va * (float(v @ va) / (mag * mag)) if mag > ALONG_FROM else np.zeros(3)
     return keep * (v - along) + va, keep * w
 
 
-def kept_at_rest(v, w, v_parent, points: int) -> tuple[list[float], list[float]]:
-    """ghost_velocity under a parent at rest (every component of ``v_parent`` zero: nothing is
-    along its velocity), as lists: the same sums, keep·(v - 0) + v_parent and keep·w, in
-    floats, without numpy's cost (a static phantom's hole ghosts, each control step)."""
+def kept_under_slow_parent(v, w, v_parent, points: int) -> tuple[list[float], list[float]] | None:
+    """ghost_velocity, as lists, where the parent is slower than ALONG_FROM (nothing is taken
+    along its velocity: a static phantom's hole ghosts, a resting arm's finger ghosts): the same
+    sums, keep·(v - 0) + v_parent and keep·w, in floats, without numpy's cost; None where the
+    parent is faster, or so near ALONG_FROM that numpy's norm, rounded its own way, decides."""
+    if sum(c * c for c in v_parent) > ALONG_FROM * ALONG_FROM * (1.0 - 1e-9):
+        return None
     keep = AMBF_GHOST_KEEP**points
     return [keep * (x - 0.0) + p for x, p in zip(v, v_parent)], [keep * x for x in w]
 

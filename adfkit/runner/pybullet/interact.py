@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import SAME_PLACE, ghost_accelerations, ghost_velocity, kept_at_rest, viscous_impulse_force
+from ..ghost_rules import SAME_PLACE, ghost_accelerations, ghost_velocity, kept_under_slow_parent, viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
 
@@ -63,6 +63,18 @@ class SimSensor:
     ends: np.ndarray
     sensed: list = field(default_factory=list)
     rays: list = field(default_factory=list)  # per ray: (body hit or None, fraction of the range)
+
+
+def _within(a: list, b: list, tol: float) -> bool:
+    """Whether every number of the (position, quaternion) pairs ``b`` lies within ``tol`` of
+    ``a``'s (NaN never does); the first that does not ends the search (something near a ghost
+    moves almost every step)."""
+    for pq_a, pq_b in zip(a, b):
+        for va, vb in zip(pq_a, pq_b):
+            for x, y in zip(va, vb):
+                if not abs(x - y) <= tol:
+                    return False
+    return True
 
 
 class Interaction:
@@ -127,18 +139,16 @@ class Interaction:
         cid = self.cid
         parent = g.parent
         v_par = parent.state()[2] if parent is not None and not parent.static else (0.0, 0.0, 0.0)
-        resting = not any(v_par)
         for sb, points in g.points:
             if points == 0:
                 continue
             held[id(sb)] = sb
             if sb.link < 0:
                 v, w = pb.getBaseVelocity(sb.uid, cid)
-                if resting:
-                    v2, w2 = kept_at_rest(v, w, v_par, points * steps)
-                else:
-                    v2, w2 = (x.tolist() for x in ghost_velocity(v, w, v_par, points * steps))
-                pb.resetBaseVelocity(sb.uid, v2, w2, cid)
+                kept = kept_under_slow_parent(v, w, v_par, points * steps)
+                if kept is None:
+                    kept = tuple(x.tolist() for x in ghost_velocity(v, w, v_par, points * steps))
+                pb.resetBaseVelocity(sb.uid, kept[0], kept[1], cid)
             else:
                 p, q, v, w = sb.state()
                 a, alpha = ghost_accelerations(v, w, v_par, points * steps, cdt)
@@ -200,11 +210,10 @@ class Interaction:
                     where.append(poses[key])
         if not near:
             return {}
-        place = (which, np.array([c for pq in where for v in pq for c in v]))
+        place = (which, where)
         last = self._manifold_place
-        if last is not None and last[0] == which:
-            if np.max(np.abs(last[1] - place[1])) <= SAME_PLACE:
-                return self._manifold_made
+        if last is not None and last[0] == which and _within(last[1], where, SAME_PLACE):
+            return self._manifold_made
         # the pass in a world of the ghosts and the bodies near them alone (ghost_pass.py), else here
         made = self._ghost_pass.counts(passes, poses)
         if made is not None:
