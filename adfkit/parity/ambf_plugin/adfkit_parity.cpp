@@ -122,11 +122,32 @@ struct Command {
     int line;
 };
 
-// a joint's path to follow: points (t, position) in time order, the segment now played
-struct Path {
+// a revolute or prismatic joint driven to a position: its limits, and how far it stands from a
+// position (clamped to the limits, as commandPosition clamps a set-point; a revolute joint without
+// limits the shortest angle)
+struct Driven {
     afJointPtr joint = nullptr;
     bool revolute = true, limited = false;
     double lo = 0.0, hi = 0.0;
+
+    void take(afJointPtr j) {
+        joint = j;
+        revolute = j->m_jointType == afJointType::REVOLUTE;
+        afJointAttributes* a = dynamic_cast<afJointAttributes*>(j->getAttributes());
+        limited = a && a->m_enableLimits;
+        lo = j->getLowerLimit();
+        hi = j->getUpperLimit();
+    }
+
+    double error(double target) const {
+        if (limited) target = max(lo, min(hi, target));
+        double now = joint->getPosition();
+        return revolute && !limited ? joint->getShortestAngle(now, target) : target - now;
+    }
+};
+
+// a joint's path to follow: points (t, position) in time order, the segment now played
+struct Path : Driven {
     vector<pair<double, double>> points;
     size_t at = 0;
     double worst = 0.0, sum = 0.0;  // the tracking error (|path - measured|) before each command
@@ -134,10 +155,7 @@ struct Path {
 };
 
 // a joint under a position command, as the paced clock waits on it
-struct Drive {
-    afJointPtr joint = nullptr;
-    bool revolute = true, limited = false;
-    double lo = 0.0, hi = 0.0;
+struct Drive : Driven {
     double heldSince = -1.0;  // simulated time it began holding the clock (-1: it is not)
     bool excused = false;     // given up on until it comes within its tolerance again
 };
@@ -221,10 +239,7 @@ private:
         bool all = true;
         for (auto& kv : m_positionDrives) {
             Drive& d = kv.second;
-            double target = m_drives[kv.first].value;
-            if (d.limited) target = max(d.lo, min(d.hi, target));
-            double err = d.revolute && !d.limited ? d.joint->getShortestAngle(d.joint->getPosition(), target)
-                                                  : target - d.joint->getPosition();
+            double err = d.error(m_drives[kv.first].value);
             bool within = fabs(err) <= (d.revolute ? m_paceRad : m_paceM);
             if (within) {
                 d.excused = false;
@@ -477,14 +492,7 @@ private:
                 if (j->m_jointType != afJointType::REVOLUTE && j->m_jointType != afJointType::PRISMATIC)
                     fail(where + "follow needs a revolute or prismatic joint: " + c.target);
                 Path& p = m_paths[c.target];
-                if (!p.joint) {
-                    p.joint = j;
-                    p.revolute = j->m_jointType == afJointType::REVOLUTE;
-                    afJointAttributes* a = dynamic_cast<afJointAttributes*>(j->getAttributes());
-                    p.limited = a && a->m_enableLimits;
-                    p.lo = j->getLowerLimit();
-                    p.hi = j->getUpperLimit();
-                }
+                if (!p.joint) p.take(j);
                 p.points.emplace_back(c.t, c.value);
                 continue;
             } else if (c.kind == "grasp") {
@@ -539,14 +547,7 @@ private:
                     m_positionDrives.erase(c.target);
                 } else if (m_paced && !m_positionDrives.count(c.target) &&
                            (j->m_jointType == afJointType::REVOLUTE || j->m_jointType == afJointType::PRISMATIC)) {
-                    Drive d;
-                    d.joint = j;
-                    d.revolute = j->m_jointType == afJointType::REVOLUTE;
-                    afJointAttributes* a = dynamic_cast<afJointAttributes*>(j->getAttributes());
-                    d.limited = a && a->m_enableLimits;
-                    d.lo = j->getLowerLimit();
-                    d.hi = j->getUpperLimit();
-                    m_positionDrives[c.target] = d;
+                    m_positionDrives[c.target].take(j);
                 }
             }
         }
@@ -627,9 +628,7 @@ private:
                 slope = t1 > t0 ? (pts[p.at + 1].second - q) / (t1 - t0) : 0.0;
                 q += slope * (t - t0);
             }
-            if (p.limited) q = max(p.lo, min(p.hi, q));
-            double now = p.joint->getPosition();
-            double err = p.revolute && !p.limited ? p.joint->getShortestAngle(now, q) : q - now;
+            double err = p.error(q);
             p.worst = max(p.worst, fabs(err));
             p.sum += fabs(err);
             p.n++;
