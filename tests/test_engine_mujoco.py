@@ -430,6 +430,16 @@ def test_a_drive_past_its_motor_limit_is_named(tmp_path):
         world.close()
 
 
+def _box_body(mass: float, inertia: float, location: str, side: float, friction: float) -> str:
+    """An undamped cube ``BODY box`` of ``side`` m, ``mass`` kg, ``inertia`` kg·m² about each axis."""
+    return (
+        f"BODY box:\n  name: box\n  mass: {mass}\n"
+        f"  inertia: {{ix: {inertia}, iy: {inertia}, iz: {inertia}}}\n  location: {location}\n"
+        f"  collision shape: BOX\n  collision geometry: {{x: {side}, y: {side}, z: {side}}}\n"
+        f"  friction: {{static: {friction}, rolling: 0.0}}\n  damping: {{linear: 0.0, angular: 0.0}}\n"
+    )
+
+
 def _slope(tmp_path, slope_friction: float, box_friction: float, tilt: float = 0.17453):
     """A 20 g box at rest on a static slab tilted ``tilt`` rad (10°) about y."""
     return _model(
@@ -443,16 +453,7 @@ BODY slab:
   collision shape: BOX
   collision geometry: {{x: 0.4, y: 0.1, z: 0.02}}
   friction: {{static: {slope_friction}, rolling: 0.0}}
-BODY box:
-  name: box
-  mass: 0.02
-  inertia: {{ix: 1.0e-6, iy: 1.0e-6, iz: 1.0e-6}}
-  location: {_pose(x=-0.01 * math.sin(tilt), z=0.5 + 0.02 * math.cos(tilt), p=tilt)}
-  collision shape: BOX
-  collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
-  friction: {{static: {box_friction}, rolling: 0.0}}
-  damping: {{linear: 0.0, angular: 0.0}}
-""",
+{_box_body(0.02, 1.0e-6, _pose(x=-0.01 * math.sin(tilt), z=0.5 + 0.02 * math.cos(tilt), p=tilt), 0.02, box_friction)}""",
     )
 
 
@@ -851,16 +852,7 @@ def _box_alone(tmp_path, friction: float):
         tmp_path,
         f"""
 bodies: [BODY box]
-BODY box:
-  name: box
-  mass: 0.2
-  inertia: {{ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}}
-  location: {_pose(z=0.3)}
-  collision shape: BOX
-  collision geometry: {{x: 0.05, y: 0.05, z: 0.05}}
-  friction: {{static: {friction}, rolling: 0.0}}
-  damping: {{linear: 0.0, angular: 0.0}}
-""",
+{_box_body(0.2, 1.0e-4, _pose(z=0.3), 0.05, friction)}""",
     )
 
 
