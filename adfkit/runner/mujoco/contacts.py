@@ -22,7 +22,8 @@ the two bodies' frictions combined so that a frictionless body is frictionless t
   whose friction is Bullet's product, GROUND_FRICTION times the body's (the floor AMBF and the
   PyBullet runner are given: friction 0.5). With the lower of the two, the corpus springy PSM's
   tool shaft, landing on the floor, held the arm's pitch at 7° on 0.5 where Bullet's 0.25 lets
-  it slide and the arm fall 47° as AMBF's does.
+  it slide and the arm fall 47° as AMBF's does. A scene with soft bodies keeps MuJoCo's rule on
+  the floor (their nodes collide with it by its contact bits, which the pairs turn off).
 """
 
 from __future__ import annotations

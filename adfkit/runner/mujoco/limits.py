@@ -5,7 +5,7 @@ Past a limit, Bullet's limit row asks for an inward joint velocity c·error in o
 and only pushes: a joint started outside is kicked in and coasts on; a joint resting on a limit
 is held there. c is 0.3·erp/dt for a revolute joint (btHingeConstraint: setLimit's bias factor
 0.3 times the joint's `joint erp`, 0.1 unless the file says otherwise) and erp/dt for the axes of
-a `torsion spring` or `linear spring` (btGeneric6DofSpring2Constraint's stop ERP), 0.2 for a
+a `torsion spring` or `linear spring` (btGeneric6DofSpring2Constraint's stop ERP), 0.2/dt for a
 prismatic joint (btSliderConstraint's rows at the world's ERP, not the joint's). Measured in
 AMBF: a 0.5 kg arm on a hinge about z started 0.2 rad past its lower limit turns in at 6.0 rad/s
 (0.3·0.1·0.2/1 ms) from the first step; on a torsion spring at 17.6 rad/s over the first 4 ms
