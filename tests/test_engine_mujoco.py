@@ -900,9 +900,10 @@ def test_a_joint_started_past_its_limit_is_kicked_in_as_ambfs_limit_row_asks(tmp
     spring (its 6-dof spring constraint's stop ERP), 0.2 for a slider (the world's ERP). Measured
     in AMBF (adfkit parity): this hinge turns in at 6.0 rad/s from its first step (0.0240 rad in
     4 ms), the torsion spring at 17.6 rad/s over its first 4 ms (20 by the formula), a slider
-    0.05 m past at 10 m/s (0.2·0.05/1 ms); made a slider along z, 0.2 m past: 40 m/s. Control: MuJoCo's own limit (a 20 ms
-    time constant, Options' default) eases the hinge in, 0.0045 rad in 4 ms."""
-    speed = rate * 0.2 / 1e-3  # 6 or 20 rad/s
+    0.05 m past its limit at 10 m/s (0.2·0.05/1 ms); this one, along z and 0.2 m past, is asked
+    for 40 m/s. Control: MuJoCo's own limit (a 20 ms time constant, Options' default) eases the
+    hinge in, 0.0045 rad in 4 ms."""
+    speed = rate * 0.2 / 1e-3  # 6 rad/s, 20 rad/s, 40 m/s
     for bodies in ("ambf", "pybullet"):
         world = MujocoWorld(_arm_past_its_limit(tmp_path, kind), Options(visuals=False, ground=False, bodies=bodies))
         try:
