@@ -41,7 +41,7 @@ class Options:
     # `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: "ambf" gives the
     # floor of a model played alone Bullet's friction, the product of the two (mujoco/contacts.py),
     # hinge, slider and spring limits Bullet's limit rows (mujoco/limits.py) and a body without
-    # inertia AMBF's estimate (mujoco/build.py)
+    # inertia AMBF's estimate (mujoco/inertia.py)
     bodies: str = "pybullet"
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")

@@ -22,15 +22,8 @@ import mujoco
 import numpy as np
 
 from ... import scratch
-from ...converters.mjcf_write import LOOP_KINDS, MIN_INERTIA, to_mjcf
-from ...model.semantics import (
-    JointKind,
-    ShapeKind,
-    body_joint_frames,
-    collision_primitives,
-    inertial_offset,
-    pose_or_identity,
-)
+from ...converters.mjcf_write import LOOP_KINDS, to_mjcf
+from ...model.semantics import JointKind, ShapeKind, body_joint_frames, collision_primitives, pose_or_identity
 from ...model.tree import ONE_DOF
 from .. import plan as scene_rules
 from ..plan import (
@@ -47,6 +40,7 @@ from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
 from .collision import GHOST_CONTYPE, GHOST_GROUP, collision_filters, warn_losses
 from .drives import add_drive, drive_limit
+from .inertia import ambf_inertia
 from .spec import _parse_spec, _resolve_meshes
 from .textures import apply_textures
 
@@ -271,8 +265,7 @@ def build_plan(world) -> Plan:
                     f"{j.identifier}: a {kind.value} joint closing a loop is not played by the MuJoCo engine; skipped",
                     j,
                 )
-    if opt.bodies == "ambf":
-        _ambf_inertia(spec, bodies)
+    ambf_inertia(opt, spec, bodies)
     if world.soft is not None:
         world.soft.attach(spec, scene.all_models(), {bp.key: bp for bp in bodies})
     _lights(world, spec)
@@ -319,21 +312,6 @@ def build_plan(world) -> Plan:
             add_drive(spec, jn[0], child.mjname, world.dt)
     volumes = _volumes(world, spec, scene.all_models())
     return Plan(spec, bodies, ghosts, actuators, joints, loops, springs, losses, tmp, sensors, volumes)
-
-
-def _ambf_inertia(spec, bodies: list[BodyPlan]) -> None:
-    """A moving body whose file gives a mass and no `inertia` gets the inertia AMBF estimates
-    (ambf_bodies.estimated_inertia: the box of its collision shape's bounds grown by its collision
-    margin) in place of the MJCF writer's (the bounds alone), as the PyBullet runner does."""
-    from ..ambf_bodies import estimated_inertia
-
-    for bp in bodies:
-        if bp.mjname == "world":
-            continue
-        est = estimated_inertia(bp.model, bp.body, pose_to_matrix(inertial_offset(bp.body)))
-        if est is not None:
-            el = spec.body(bp.mjname)
-            el.inertia = np.maximum(est, MIN_INERTIA)
 
 
 def _volumes(world, spec, models) -> list[tuple]:
