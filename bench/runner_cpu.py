@@ -2,14 +2,14 @@
 settings `adfkit run` and `adfkit parity` play (AMBF's ghosts, springs, bodies, the file's link
 shapes) and under the legacy flags (``--springs implicit --ghosts hole-friction --bodies
 pybullet``), alternated ``--rounds`` times on freshly built worlds so that both see the same load;
-then, with ``--profile``, where one second of each goes, by cProfile.
+then, with ``--profile``, where one second of each goes, by cProfile on CPU time.
 
     .venv/bin/python bench/runner_cpu.py [--seconds S] [--rounds R] [--profile]
 
 The figure is this process's CPU time (``time.process_time``) of the stepping alone, as
 ``adfkit parity`` times its side (building the world and reading the samples left out). The
 profile's parts: Bullet's own step (``stepSimulation``: the floor no runner change removes), the
-ghosts' collision pass (``performCollisionDetection`` and the collision masks it switches), the
+ghosts' collision pass (``interact._manifold_points``, wherever it runs the pass), the
 springs (``SpringSet.apply``, at every physics step under AMBF's springs), the forces applied
 again before each physics step (``held.replay``) and the rest of the control step. cProfile adds
 its cost to every Python call, so the Python shares are upper bounds. The suturing set is the
@@ -38,7 +38,7 @@ LEGACY = {"ghosts": "hole-friction", "springs": "implicit", "bodies": "pybullet"
 #: the profile's parts: (label, the functions whose cumulative time it is)
 PARTS = (
     ("Bullet's step (stepSimulation)", ("stepSimulation",)),
-    ("ghost collision pass", ("performCollisionDetection", "setCollisionFilterGroupMask")),
+    ("ghost collision pass", ("interact.py:_manifold_points",)),
     ("springs (SpringSet.apply)", ("spring_forces.py:apply",)),
     ("forces applied again (held.replay)", ("held.py:replay",)),
 )
@@ -84,7 +84,7 @@ def profile(scene, rules: dict, seconds: float) -> None:
     world = open_world(scene, options(rules), engine="pybullet")
     try:
         n = int(round(seconds / (world.dt * world.opt.control_substeps)))
-        prof = cProfile.Profile()
+        prof = cProfile.Profile(time.process_time)  # CPU time: a loaded machine's waits left out
         prof.runcall(world.step, n)
     finally:
         world.close()
