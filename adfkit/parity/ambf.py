@@ -144,9 +144,10 @@ def plugin_library(build: AmbfBuild) -> Path:
 @dataclass
 class Command:
     """One line of the plugin's command file: at ``t`` seconds, ``kind`` (position, velocity,
-    effort, grasp, release, place, force, collide, follow: a point of a joint's path) on ``target`` (a joint's, an actuator's or a
-    body's AMBF name) with ``value`` (a joint command's; a collide's 0 or 1), ``body`` (a grasp's
-    or a collide's other body) or ``numbers``."""
+    effort, grasp, release, place, force, collide; follow: a point of a joint's path) on
+    ``target`` (a joint's, an actuator's or a body's AMBF name) with ``value`` (a joint
+    command's, a path point's position; a collide's 0 or 1), ``body`` (a grasp's or a collide's
+    other body) or ``numbers``."""
 
     t: float
     kind: str
