@@ -579,7 +579,10 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
         "ambf_not_finite_from_s": None,
         "wall_s": {"adfkit": 544.7, "ambf": 107.1},
         "same_verdicts": False,
-        "replays": [{"pace": None}, {"pace": pace}],
+        "replays": [
+            {"pace": None, "follow": "measured", "tracking": {"/psm1/yaw": {"median": 0.00064, "max": 0.0316}}},
+            {"pace": pace},
+        ],
         "pairs": [
             {
                 "pair": 1,
@@ -605,6 +608,7 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     assert seen["paces"] == (None, suture.PACE) and seen["follow"] == "commands"
     assert "pair 1: adfkit passed, AMBF failed (entry-missed" in text and "47.8 mm" in text
     assert "; paced: AMBF failed" in text and "432.4 s" in text and "1119 wait(s) given up" in text
+    assert "measured: AMBF's PSM joints a median 0.00064 at most (/psm1/yaw) from adfkit's, 0.0316 at worst" in text
     assert main(["parity", "--suture", "--pairs", "1"]) == 1 and seen["paces"] == (None,)
     assert seen["follow"] == "measured"  # the default without a pace: following adfkit's measured joints
     assert main(["parity", "--suture", "--pairs", "1", "--pace", "on"]) == 1 and seen["follow"] == "commands"
