@@ -23,7 +23,10 @@ given enough solver iterations (measured: AMBF at 100 iterations, the KUKA's vel
 v_free, where the step would leave the joints without the rows, is this step's velocity plus
 what the other forces changed in the step before (read back from the velocities it left). An
 engine that supplies ``joint_mobility(art, idxs)`` and ``joint_row_mass(art, index)`` plays
-that; another drives its motors to the targets themselves."""
+that; another drives its motors to the targets themselves. AMBF's own ten solver iterations do
+not settle a chain's rows: an engine that supplies ``chain_velocities(art, motors, efforts)``
+(the PyBullet runner under AMBF's bodies: runner/chain_rows.py) tells where they leave the joints
+instead, and the impulses take them there."""
 
 from __future__ import annotations
 
@@ -258,8 +261,11 @@ class JointCommands:
         soft.setdefault(id(dj.art), []).append((dj, target))
 
     def _soft_rows(self, rows: list[tuple[DrivenJoint, float]]) -> None:
-        """The soft motor rows of one articulation settled together (``soft_row_impulses``), each
-        joint pushed with its impulse over the control step, within its motor's force."""
+        """The soft motor rows of one articulation: where the engine plays AMBF's solver on the
+        chain's bodies (``chain_velocities``) and these rows drive every joint of it, the impulses
+        that take the joints where its ten iterations leave them; otherwise settled together
+        (``soft_row_impulses``). Each joint is pushed with its impulse over the control step,
+        within its motor's force."""
         w = self.world
         art = rows[0][0].art
         idx = [dj.index for dj, _ in rows]
@@ -270,9 +276,16 @@ class JointCommands:
             _idx, mobility, impulse, before = last
             free = v + (v - mobility @ impulse - before)
         mobility = w.joint_mobility(art, idx)
-        impulse = soft_row_impulses(
-            mobility, [dj.row_mass for dj, _ in rows], [dj.cfm for dj, _ in rows], [t for _, t in rows], free
-        )
+        chain = getattr(w, "chain_velocities", None)
+        after = None
+        if chain is not None and len(rows) == len(art.records):
+            after = chain(art, {dj.index: (t, dj.cfm, dj.max_force * w.dt) for dj, t in rows}, {})
+        if after is not None:
+            impulse = np.linalg.lstsq(mobility, after[idx] - free, rcond=None)[0]
+        else:
+            impulse = soft_row_impulses(
+                mobility, [dj.row_mass for dj, _ in rows], [dj.cfm for dj, _ in rows], [t for _, t in rows], free
+            )
         cdt = w.dt * w.opt.control_substeps
         cap = np.array([dj.max_force * cdt for dj, _ in rows])  # the motor's `max motor impulse`
         impulse = np.clip(impulse, -cap, cap)

@@ -27,6 +27,7 @@ from .articulation import AXIS, ROTARY, TREE_KINDS
 from .assemble import Assembly
 from .bodies import SimBody
 from .cameras import choose_renderer, render
+from .chain import ChainModel
 from .interact import Interaction
 from .softbodies import SoftBodies, enable_deformable_world
 from .state import WorldState
@@ -71,6 +72,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact
         pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
         self._ambf_dt = self.dt if self.opt.bodies == "ambf" else None  # AMBF's bodies (ambf_bodies.py)
+        self._chains: dict[int, ChainModel] = {}  # per multibody, AMBF's chain of bodies (chain.py)
         self._build()
         # AMBF's springs (Options.springs): explicit, at every physics step; PyBullet then steps one
         # physics step a call and the control step's other forces are applied again at each (held.py)
@@ -151,6 +153,20 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             a = quat_to_matrix(orn).T @ axis  # the axis in the body's principal frame
             inverse += float(sum(a[i] ** 2 / diag[i] for i in range(3) if diag[i] > 0.0))
         return 1.0 / inverse if inverse > 0.0 else float("inf")
+
+    def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
+        """The joints' velocities (by record index) one physics step of AMBF's solver leaves
+        them at: the multibody as AMBF's btRigidBodies, its hinges' and sliders' locking, motor
+        (``motors``: record index -> target, cfm, max impulse) and limit rows solved in AMBF's
+        ten iterations, ``efforts`` (record index -> effort) on the joints (chain.py). None
+        where AMBF's bodies are not asked for (Options.bodies), the control step is more than
+        one physics step, or the multibody has joints other than revolute and prismatic ones."""
+        if self.opt.bodies != "ambf" or self.opt.control_substeps != 1:
+            return None
+        model = self._chains.get(art.uid)
+        if model is None:
+            model = self._chains[art.uid] = ChainModel(self, art)
+        return model.velocities(motors, efforts, self.steps) if model.ok else None
 
     def joint_effort(self, art, index: int, effort: float) -> None:
         """Joint ``index`` of ``art`` pushed by ``effort`` (N·m or N) for the next control step, its
