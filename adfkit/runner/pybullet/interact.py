@@ -189,7 +189,8 @@ class Interaction:
         box in a box gives four points at once, btBoxBoxDetector). A ghost collides with nothing
         (it would push what enters it), so those near a dynamic body are let collide for one
         collision pass between steps (performCollisionDetection: no step, so no push) and shut
-        again; a pair GJK answers (hulls) gives one point a pass, where AMBF's persistent manifold
+        again, in a world of the ghosts and copies of those bodies alone where they can be copied
+        (ghost_pass.py: the same points), else in the dynamics world; a pair GJK answers (hulls) gives one point a pass, where AMBF's persistent manifold
         gathers up to four over its steps. The last answer stands while the same bodies are near
         the same ghosts, within SAME_PLACE of where they were, and no collision pair or grasp has
         changed (``poses``: those read this control step, as _update_ghosts)."""
