@@ -625,6 +625,37 @@ def test_the_ghost_pass_in_its_own_world_counts_as_the_dynamics_world_and_follow
         w.close()
 
 
+def test_a_body_the_ghost_pass_cannot_copy_is_counted_in_the_dynamics_world(tmp_path, monkeypatch):
+    """Where a shape cannot be made again in the ghosts' own world (PyBullet refuses it: a mesh
+    file gone since the world was built), the pass runs in the dynamics world, as it did before
+    there was a world of the ghosts' own: the parity cube still counts 4 points in its slab and
+    hangs there. Control: with the copy, the same count from the ghosts' world."""
+    import pybullet as pb
+
+    from adfkit.runner.pybullet import ghost_pass
+    from adfkit.scenes.parity import write_parity
+
+    launch = write_parity(tmp_path)
+    for refused in (True, False):
+        with monkeypatch.context() as m:
+            if refused:
+
+                def refuse(*_a, **_k):
+                    raise pb.error("cannot extract mesh")
+
+                m.setattr(ghost_pass, "create_collision", refuse)
+            w = open_world(load_scene(launch, [3]), Options(visuals=False, ghosts="ambf"))
+            try:
+                w.step(50)
+                (g,) = w.ghosts
+                assert [(sb.name, n) for sb, n in g.points] == [("cube", 4)]
+                assert (w._ghost_pass.ghosts[g.uid] is None) is refused
+                w.step(100)
+                assert 0.2475 < w.body("cube").com_position()[2] < 0.2505
+            finally:
+                w.close()
+
+
 @pytest.mark.slow
 def test_a_multibody_closed_by_a_constraint_starts_closed_and_stays_free(monkeypatch):
     """The corpus ECM (weightless in its file) is one multibody whose pitch parallelogram is

@@ -33,7 +33,7 @@ class GhostPass:
     def __init__(self, world) -> None:
         self.world = world
         self.cid: int | None = None
-        self.ghosts: dict[int, int] = {}  # ghost uid in the world -> its copy
+        self.ghosts: dict[int, int | None] = {}  # ghost uid in the world -> its copy (None: cannot be)
         self.copies: dict[tuple[int, int], int | None] = {}  # (uid, link) -> its copy (None: cannot be)
         self.owner: dict[int, tuple[int, int]] = {}  # copy uid -> (uid, link) in the world
 
@@ -45,15 +45,23 @@ class GhostPass:
                 pb.setPhysicsEngineParameter(contactBreakingThreshold=threshold, physicsClientId=self.cid)
         return self.cid
 
-    def _copy_ghost(self, g) -> int:
-        uid = self.ghosts.get(g.uid)
-        if uid is None:
-            cid = self._connect()
-            col = create_collision(g.parts, cid)
-            uid = pb.createMultiBody(0, col, -1, useMaximalCoordinates=True, physicsClientId=cid)
-            pb.setCollisionFilterGroupMask(uid, -1, 0, 0, physicsClientId=cid)
+    def _shape(self, parts) -> int:
+        """The collision shape of ``parts`` in this world; -1 where PyBullet refuses it now (a
+        mesh file gone since the world was built)."""
+        try:
+            return create_collision(parts, self._connect())
+        except pb.error:
+            return -1
+
+    def _copy_ghost(self, g) -> int | None:
+        if g.uid not in self.ghosts:
+            col = self._shape(g.parts) if g.parts is not None else -1
+            uid = None
+            if col >= 0:
+                uid = pb.createMultiBody(0, col, -1, useMaximalCoordinates=True, physicsClientId=self.cid)
+                pb.setCollisionFilterGroupMask(uid, -1, 0, 0, physicsClientId=self.cid)
             self.ghosts[g.uid] = uid
-        return uid
+        return self.ghosts[g.uid]
 
     def _copy_body(self, key: tuple[int, int], sb) -> int | None:
         """The body's copy: its collision parts, in its link's inertial frame as PyBullet puts a
@@ -62,8 +70,7 @@ class GhostPass:
             return self.copies[key]
         uid = None
         if sb._parts is not None and (sb._parts.types or sb._parts.plane is not None) and not sb.piece_links:
-            cid = self._connect()
-            col = create_collision(sb._parts, cid)
+            col = self._shape(sb._parts)
             if col >= 0:
                 inertial = invert(sb.ref_in_body) @ sb.com_in_body if sb.link >= 0 else np.eye(4)
                 ipos, iorn = matrix_to_pq(inertial)
@@ -74,9 +81,9 @@ class GhostPass:
                     baseInertialFramePosition=ipos,
                     baseInertialFrameOrientation=iorn,
                     useMaximalCoordinates=True,
-                    physicsClientId=cid,
+                    physicsClientId=self.cid,
                 )
-                pb.setCollisionFilterGroupMask(uid, -1, BODY_BIT, GHOST_BIT, physicsClientId=cid)
+                pb.setCollisionFilterGroupMask(uid, -1, BODY_BIT, GHOST_BIT, physicsClientId=self.cid)
                 self.owner[uid] = key
         self.copies[key] = uid
         return uid
@@ -88,7 +95,7 @@ class GhostPass:
         dynamic = self.world._dynamic_lookup
         placed: dict[int, tuple] = {}
         for g, _pq, keys in near:
-            if g.parts is None:
+            if self._copy_ghost(g) is None:
                 return None
             for key in keys:
                 if key not in placed and self._copy_body(key, dynamic[key]) is None:
@@ -99,11 +106,11 @@ class GhostPass:
         for key, (p, q) in placed.items():
             reset(self.copies[key], p, q, cid)
         on = []
-        for g, (p, q), _keys in near:
-            uid = self._copy_ghost(g)
+        for g, (p, q), keys in near:
+            uid = self.ghosts[g.uid]
             reset(uid, p, q, cid)
             pb.setCollisionFilterGroupMask(uid, -1, GHOST_BIT, BODY_BIT, physicsClientId=cid)
-            on.append((g, uid, _keys))
+            on.append((g, uid, keys))
         pb.performCollisionDetection(physicsClientId=cid)
         out: dict[int, dict[tuple[int, int], int]] = {}
         for g, uid, keys in on:
