@@ -24,6 +24,18 @@ SAME_PLACE = 1e-9
 ALONG_FROM = 1e-5
 
 
+def in_same_place(a: list, b: list) -> bool:
+    """Whether every number of the (position, quaternion) pairs ``b`` lies within SAME_PLACE of
+    ``a``'s (NaN never does); the first that does not ends the search (something near a ghost
+    moves almost every step)."""
+    for pq_a, pq_b in zip(a, b):
+        for va, vb in zip(pq_a, pq_b):
+            for x, y in zip(va, vb):
+                if not abs(x - y) <= SAME_PLACE:
+                    return False
+    return True
+
+
 def ghost_velocity(v, w, v_parent, points: int):
     """(linear, angular) velocity of a body after ``points`` of AMBF's ghost updates (one per
     penetrating contact point and physics step): keep^points of what is across the parent's

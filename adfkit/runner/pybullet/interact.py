@@ -9,7 +9,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import SAME_PLACE, ghost_accelerations, ghost_velocity, kept_under_slow_parent, viscous_impulse_force
+from ..ghost_rules import (
+    ghost_accelerations,
+    ghost_velocity,
+    in_same_place,
+    kept_under_slow_parent,
+    viscous_impulse_force,
+)
 from ..rotations import invert
 from .bodies import SimBody
 
@@ -63,18 +69,6 @@ class SimSensor:
     ends: np.ndarray
     sensed: list = field(default_factory=list)
     rays: list = field(default_factory=list)  # per ray: (body hit or None, fraction of the range)
-
-
-def _within(a: list, b: list, tol: float) -> bool:
-    """Whether every number of the (position, quaternion) pairs ``b`` lies within ``tol`` of
-    ``a``'s (NaN never does); the first that does not ends the search (something near a ghost
-    moves almost every step)."""
-    for pq_a, pq_b in zip(a, b):
-        for va, vb in zip(pq_a, pq_b):
-            for x, y in zip(va, vb):
-                if not abs(x - y) <= tol:
-                    return False
-    return True
 
 
 class Interaction:
@@ -213,7 +207,7 @@ class Interaction:
             return {}
         place = (which, where)
         last = self._manifold_place
-        if last is not None and last[0] == which and _within(last[1], where, SAME_PLACE):
+        if last is not None and last[0] == which and in_same_place(last[1], where):
             return self._manifold_made
         # the pass in a world of the ghosts and the bodies near them alone (ghost_pass.py), else here
         made = self._ghost_pass.counts(passes, poses)
