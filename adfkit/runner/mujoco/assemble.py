@@ -58,7 +58,16 @@ class Assembly:
         cams = prepare_cameras(self, plan)
         ground = self.opt.ground and self.scene.world is None and self.scene.environment is None
         self._plan = plan  # (compile_spec finds the ADF body of what MuJoCo refuses in it)
+        ghost_gravity = self.opt.ghosts == "ambf" and bool(plan.ghosts)
+        if ghost_gravity:
+            # AMBF's ghosts switch a body's gravity off: by MuJoCo's gravity compensation, which a
+            # resting tree sleeps under (a force in xfrc_applied wakes it every control step); the
+            # model counts the bodies that may have it when compiled, so every body is one, then 0
+            for b in spec.bodies[1:]:
+                b.gravcomp = 1.0
         self.model = compile_spec(self, spec)
+        if ghost_gravity:
+            self.model.body_gravcomp[:] = 0.0
         self.model.opt.jacobian = jacobian_for(self.model)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
@@ -78,6 +87,8 @@ class Assembly:
             if self.opt.bodies == "ambf" and self.soft is None:  # Bullet's friction on it (contacts.py)
                 ground_pairs(spec, floor, self.model, ALL_GROUPS)
             self.model = compile_spec(self, spec)
+            if ghost_gravity:
+                self.model.body_gravcomp[:] = 0.0
             self.data = mujoco.MjData(self.model)
             mujoco.mj_forward(self.model, self.data)
         self._plan = plan
@@ -133,10 +144,7 @@ class Assembly:
             self.ghosts.append(MjGhost(gp.key, gp.ghost, parent, ids, gp.friction, pose_in_parent=gp.location))
             self.registry.items[gp.key] = None
         self._friction_ghosts = [g for g in self.ghosts if g.friction]
-        self._ghost_geom_ids = np.array([gid for g in self.ghosts for gid in g.geoms], dtype=int)
-        self._ghost_geom_set = set(self._ghost_geom_ids.tolist())
-        self._ghost_bodies = np.unique(m.geom_bodyid[self._ghost_geom_ids]).astype(int)
-        self._collider_key, self._collider_made = None, {}  # interact._collider_points' last pass
+        self._collider_key, self._collider_made = None, {}  # ghosts._collider_points' last pass
         self._friction_geoms = np.array([gid for g in self._friction_ghosts for gid in g.geoms], dtype=int)
         self._friction_owner = [g for g in self._friction_ghosts for _ in g.geoms]
         self.actuators = [

@@ -13,7 +13,7 @@ from ..collisions import collision_masks, convex_parts_note
 GHOST_GROUP = 4  # a ghost's geoms: never drawn, seen by no ray
 #: a ghost's contype under AMBF's rule: bit 31, which no collision group uses (plan.ALL_GROUPS), so it
 #: meets no geom, yet MuJoCo puts the geom in its body's collision tree, where the ghosts' collision
-#: pass (interact._collider_points) finds it once its conaffinity is opened (a geom compiled without
+#: pass (ghosts._collider_points) finds it once its conaffinity is opened (a geom compiled without
 #: bits is left out of that tree and never collides, whatever its bits later)
 GHOST_CONTYPE = -(1 << 31)
 

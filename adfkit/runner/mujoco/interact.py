@@ -1,21 +1,21 @@
 """What the MuJoCo world does between steps (the Interaction half of MujocoWorld): ghosts sensing
-what is inside them and acting on it (AMBF's rule, or the hole ghosts' viscous friction), ray sensors, the grasp's weld,
-collision switches at run time, contacts."""
+what is inside them and acting on it (the hole ghosts' viscous friction; AMBF's rule in
+ghosts.py), ray sensors, the grasp's weld, collision switches at run time, contacts."""
 
 from __future__ import annotations
 
 import mujoco
 import numpy as np
 
-from ..ghost_rules import MANIFOLD_POINTS, SAME_PLACE, ghost_accelerations, ghost_velocity, viscous_impulse_force
-from ..plan import ALL_GROUPS
+from ..ghost_rules import viscous_impulse_force
 from ..rotations import invert, matrix_to_quat, pose_matrix
 from .assemble import WAKE_FORCE, _xyzw
 from .collision import EXCLUDE_SPARE
+from .ghosts import AmbfGhosts
 from .objects import MjActuator, MjBody, MjGhost, MjSensor
 
 
-class Interaction:
+class Interaction(AmbfGhosts):
     def _sense(self, s: MjSensor) -> None:
         m, d = self.model, self.data
         t = s.parent.world_matrix() @ s.location
@@ -59,114 +59,6 @@ class Interaction:
         g.overlapping = found
         self._overlaps_cleared = False
         return found
-
-    def _penetrating(self, ghosts) -> list[list[tuple[MjBody, int]]]:
-        """For each ghost, each dynamic body in penetrating contact with it (its parent too: AMBF's
-        ghosts sense the body they hang on), with its contact points: for each of its geoms that
-        penetrates one of the ghost's (MuJoCo's exact geom distance below 0; bounding spheres
-        first), the points MuJoCo's collider makes for the pair (_collider_points), at most
-        MANIFOLD_POINTS (a Bullet manifold's: AMBF's ghost acts once per point of it) and at
-        least one."""
-        m, d = self.model, self.data
-        cg = self._cand_geoms
-        if not len(cg):
-            return [[] for _ in ghosts]
-        gx = d.geom_xpos
-        pairs = []  # per ghost: (body, ghost geom, body geom) penetrating
-        for g in ghosts:
-            near = np.zeros(len(cg), dtype=bool)
-            for gid in g.geoms:
-                near |= np.linalg.norm(gx[cg] - gx[gid], axis=1) <= m.geom_rbound[cg] + m.geom_rbound[gid]
-            pairs.append(
-                [
-                    (self._cand_geom_body[k], int(gid), int(cg[k]))
-                    for k in np.nonzero(near)[0]
-                    for gid in g.geoms
-                    if mujoco.mj_geomDistance(m, d, int(gid), int(cg[k]), 0.0, None) < 0.0
-                ]
-            )
-        made = self._collider_points([p for found in pairs for p in found]) if any(pairs) else {}
-        out = []
-        for found in pairs:
-            points: dict[int, list] = {}
-            for sb, a, b in found:
-                n = min(max(made.get((min(a, b), max(a, b)), 0), 1), MANIFOLD_POINTS)
-                points.setdefault(id(sb), [sb, 0])[1] += n
-            out.append([(sb, n) for sb, n in points.values()])
-        return out
-
-    def _collider_points(self, pairs) -> dict[tuple[int, int], int]:
-        """{(geom, geom): penetrating contacts} that MuJoCo's collision pass makes between the
-        ghosts' geoms and every other, with the ghosts let collide for that pass only (mj_collision
-        between control steps; the step's own pass, which they do not join, writes the contacts
-        the solver and every reader see). A box in a box gives several, as Bullet's box-box
-        manifold does. A ghost's geom never meets its own body's (MuJoCo collides no body with
-        itself, nor with its parent): those pairs keep the distance query's one point. The last
-        answer stands while the geoms of ``pairs`` (body, ghost geom, body geom) stay within
-        SAME_PLACE of where they were (a resting body inside a ghost, the phantom's holes, jaws
-        held still with round-off's 1e-16 m jitter: no pass)."""
-        m, d = self.model, self.data
-        geoms = sorted({g for _, a, b in pairs for g in (a, b)})
-        where = np.concatenate([d.geom_xpos[geoms].ravel(), d.geom_xmat[geoms].ravel()])
-        last = self._collider_key
-        if last is not None and last[0] == geoms and np.max(np.abs(last[1] - where)) <= SAME_PLACE:
-            return self._collider_made
-        key = (geoms, where)
-        ids, bodies = self._ghost_geom_ids, self._ghost_bodies
-        saved = m.body_conaffinity[bodies].copy()
-        m.geom_conaffinity[ids] = ALL_GROUPS  # their contype (build.GHOST_CONTYPE) meets no geom's conaffinity
-        m.body_conaffinity[bodies] |= ALL_GROUPS  # the broadphase filters bodies by these first
-        try:
-            mujoco.mj_collision(m, d)
-        finally:
-            m.geom_conaffinity[ids] = 0
-            m.body_conaffinity[bodies] = saved
-        ghost = self._ghost_geom_set
-        out: dict[tuple[int, int], int] = {}
-        for c in d.contact[: d.ncon]:
-            a, b = int(c.geom[0]), int(c.geom[1])
-            if c.dist < 0.0 and (a in ghost) != (b in ghost):
-                pair = (min(a, b), max(a, b))
-                out[pair] = out.get(pair, 0) + 1
-        self._collider_key, self._collider_made = key, out
-        return out
-
-    def _ambf_ghosts(self) -> None:
-        """AMBF's ghost objects (ghost_rules: afGhostObject::update after each physics step), for
-        this control step's physics steps: every body in penetrating contact keeps
-        AMBF_GHOST_KEEP per contact and step of its velocity across the ghost parent's (a free
-        body's is set; a jointed one is given the force at its centre of mass and the torque that
-        take it there over the control step, as in the PyBullet runner) and is weightless until
-        the next control step."""
-        steps = self.opt.control_substeps
-        cdt = self.dt * steps
-        d, m = self.data, self.model
-        held: dict[int, MjBody] = {}
-        for g, found in zip(self.ghosts, self._penetrating(self.ghosts)):
-            g.overlapping, g.points = [sb for sb, _ in found], found
-            if not found:
-                continue
-            if not held:  # the velocities now: mj_step left those of its last physics step's start
-                mujoco.mj_comPos(m, d)
-                mujoco.mj_comVel(m, d)
-            moving = g.parent is not None and not g.parent.static
-            v_par = self._com_velocity(g.parent) if moving else np.zeros(3)
-            for sb, points in found:
-                held[id(sb)] = sb
-                v6 = self._vel6
-                mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, sb.id, v6, 0)
-                v, w = ghost_velocity(v6[3:], v6[:3], v_par, points * steps)
-                if not self.set_body_velocity(sb, v, w):
-                    a, alpha = ghost_accelerations(v6[3:], v6[:3], v_par, points * steps, cdt)
-                    rot = d.ximat[sb.id].reshape(3, 3)  # the inertial frame's, about the COM
-                    d.xfrc_applied[sb.id, :3] += m.body_mass[sb.id] * a
-                    d.xfrc_applied[sb.id, 3:] += rot @ (m.body_inertia[sb.id] * (rot.T @ alpha))
-        if held:
-            self._overlaps_cleared = False
-            for sb in held.values():
-                g = sb.gravity if sb.gravity is not None else np.asarray(self.gravity, float)
-                d.xfrc_applied[sb.id, :3] -= m.body_mass[sb.id] * g
-            self._xfrc_dirty = True
 
     def _viscous(self, g: MjGhost, found) -> None:
         """F = -K·(v_body - v_phantom) on every body inside a hole ghost (held for a control

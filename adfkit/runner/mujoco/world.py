@@ -2,7 +2,8 @@
 back end (runner/world.py): step, run, body(name) with world_matrix/com_position/state/force/
 torque, grasp, overlapping, place_ghosts, ghosts/actuators/sensors/cameras/articulations,
 joint_state/reset_joints, report, constraint_error, close. The model comes from build.py, is
-built into the world by assemble.py and acted on between steps by interact.py;
+built into the world by assemble.py and acted on between steps by interact.py (AMBF's ghost rule:
+ghosts.py);
 docs/mujoco.md says what is approximated.
 """
 
@@ -43,6 +44,9 @@ class MujocoWorld(Assembly, Interaction, World):
         self._vel6 = np.zeros(6)
         self._runtime_excludes: set[int] = set()
         self._contacts_key, self._contacts = None, ()  # interact._contact_table, once a step
+        self._ghost_row_of = None  # ghosts._ghost_rows, made on the first look into the ghosts
+        self._weightless_ids: set[int] = set()  # the bodies a ghost holds weightless (ghosts._plan_ghosts)
+        self._ghost_plan, self._ghost_changed = None, False  # ghosts._ambf_ghosts' plan, while it holds
         self.camera_problem = ""
         self._build()
 

@@ -1,0 +1,343 @@
+"""AMBF's ghost rule in the MuJoCo world (Options.ghosts "ambf": adfkit run / parity), the
+AmbfGhosts half of Interaction: which bodies penetrate each ghost and at how many contact points
+(MuJoCo's geom distance and collider), what the rule does to them each control step, and what is
+kept between control steps so that a scene at rest costs little (docs/speed.md)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from ..ghost_rules import AMBF_GHOST_KEEP, MANIFOLD_POINTS, SAME_PLACE
+from ..plan import ALL_GROUPS
+from .objects import MjBody
+
+_SLEEP_BIT = int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
+
+
+@dataclass
+class _GhostPlan:
+    """What AMBF's ghost rule does each control step while the ghosts' answers and the bodies'
+    sleep states stay (Interaction._plan_ghosts)."""
+
+    key: bytes  # the bodies' sleep states it was made for
+    overlapping: dict  # each ghost's (by id) bodies in it
+    ids: np.ndarray  # the bodies acted on, one per (ghost, body), in AMBF's order
+    both: np.ndarray  # those bodies, then each one's moving ghost parent (itself where none)
+    has_parent: np.ndarray  # (n, 1): a moving ghost parent whose velocity it takes
+    keep: np.ndarray  # AMBF_GHOST_KEEP^(points·physics steps)
+    free: list  # (index, first dof, body id) of the free bodies: velocities set
+    jointed: np.ndarray  # indices of the others: force and torque
+    jointed_ids: np.ndarray
+    mass: np.ndarray
+    inertia: np.ndarray
+    weight_ids: np.ndarray  # held bodies whose weight (or a gravity of their own) is taken off as a force
+    weights: np.ndarray  # (n, 3) that weight, m·g
+
+
+class AmbfGhosts:
+    def _penetrating(self, ghosts) -> list[list[tuple[MjBody, int]]]:
+        """For each ghost, each dynamic body in penetrating contact with it (its parent too: AMBF's
+        ghosts sense the body they hang on), with its contact points: for each of its geoms that
+        penetrates one of the ghost's (MuJoCo's exact geom distance below 0; bounding spheres
+        first, every ghost geom against every candidate in one array), the points MuJoCo's
+        collider makes for the pair (_collider_points), at most MANIFOLD_POINTS (a Bullet
+        manifold's: AMBF's ghost acts once per point of it) and at least one.
+
+        A pair's distance is taken again only when its answer may have changed (_pair_distances):
+        the ghosts' answers are made again only for a ghost whose pairs or points changed."""
+        cg = self._cand_geoms
+        if not len(cg) or not ghosts:
+            return [[] for _ in ghosts]
+        gg, starts = self._ghost_rows()
+        gx = self.data.geom_xpos
+        diff = gx[gg][:, None, :] - gx[cg][None, :, :]
+        near = np.einsum("ijk,ijk->ij", diff, diff) <= self._ghost_reach
+        rows, ks = np.nonzero(near)
+        hit, flipped = self._pair_distances(rows, ks)
+        dirty = np.zeros(len(gg), dtype=bool)
+        dirty[rows[flipped]] = True
+        if self._ghost_near is None:
+            dirty[:] = True
+        else:
+            dirty |= (near != self._ghost_near).any(axis=1)
+        self._ghost_near = near
+        rows, ks = rows[hit], ks[hit]
+        cross = self._ghost_geom_body[rows] != self._cand_geom_bodyid[ks]
+        # only pairs of two bodies can have the collider's points (MuJoCo collides no body with itself)
+        made = self._collider_points(
+            [(self._cand_geom_body[k], int(gg[r]), int(cg[k])) for r, k in zip(rows[cross], ks[cross])]
+        )
+        if made != self._ghost_made:
+            dirty[rows[cross]] = True
+            self._ghost_made = made
+        answers = self._ghost_answers
+        remade = np.flatnonzero(np.logical_or.reduceat(dirty, starts))
+        self._ghost_changed = len(remade) > 0
+        for i in remade:
+            mine = (rows >= starts[i]) & (rows < starts[i] + len(ghosts[i].geoms))
+            r, k = rows[mine], ks[mine]
+            order = np.lexsort((r, k))  # the candidates in turn, each against the ghost's geoms
+            points: dict[int, list] = {}
+            for a, c, kk in zip(gg[r[order]].tolist(), cg[k[order]].tolist(), k[order].tolist()):
+                n = min(max(made.get((min(a, c), max(a, c)), 0), 1), MANIFOLD_POINTS)
+                sb = self._cand_geom_body[kk]
+                points.setdefault(id(sb), [sb, 0])[1] += n
+            answers[i] = [(sb, n) for sb, n in points.values()]
+        return answers
+
+    def _pair_distances(self, rows: np.ndarray, ks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(penetrating, changed since the last step) for the pairs (ghost geom ``rows``,
+        candidate geom ``ks``). MuJoCo's distance is taken again only where its sign may differ
+        from the one it last gave: not for two geoms of one body (rigid), nor for a pair whose
+        relative pose is the one it was taken at to the last bit (asleep, static, or both
+        still), nor for a pair that penetrated by more than all its relative motion since could
+        undo (the second geom's points move by at most the change of its position in the first's
+        frame plus that of its rotation matrix there times its bounding radius; twice MuJoCo's
+        convex-collision tolerance on top): a PSM's jaws in its finger ghosts, 6 mm deep, moving
+        0.1 µm a control step."""
+        m, d = self.model, self.data
+        gg, _ = self._ghost_row_of
+        cg = self._cand_geoms
+        ga, gb = gg[rows], cg[ks]
+        ra, rb = d.geom_xmat[ga].reshape(-1, 3, 3), d.geom_xmat[gb].reshape(-1, 3, 3)
+        rel = np.empty((len(rows), 12))
+        rel[:, :3] = np.einsum("nji,nj->ni", ra, d.geom_xpos[gb] - d.geom_xpos[ga])
+        rel[:, 3:] = np.einsum("nji,njk->nik", ra, rb).reshape(-1, 9)
+        dist = self._pair_dist[rows, ks]
+        seen = ~np.isnan(dist)
+        change = np.abs(rel - self._pair_rel[rows, ks])
+        move = np.sqrt(np.einsum("ij,ij->i", change[:, :3], change[:, :3]))
+        move += np.sqrt(np.einsum("ij,ij->i", change[:, 3:], change[:, 3:])) * m.geom_rbound[gb]
+        keep = seen & (
+            (self._ghost_geom_body[rows] == self._cand_geom_bodyid[ks])
+            | (move == 0.0)
+            | (move + self._ccd_slack < -np.where(seen, dist, 0.0))
+        )
+        was = dist < 0.0
+        for i in np.flatnonzero(~keep):
+            dist[i] = mujoco.mj_geomDistance(m, d, int(ga[i]), int(gb[i]), 0.0, None)
+            self._pair_rel[rows[i], ks[i]] = rel[i]
+        self._pair_dist[rows, ks] = dist
+        hit = dist < 0.0
+        return hit, hit != was
+
+    def _ghost_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every ghost's geoms one after the other and where each ghost's begin (made once; a
+        ghost has one geom at least); with them what _penetrating keeps: the squared reach of
+        each (ghost geom, candidate geom) pair, the bodies of the ghost geoms, each pair's last
+        distance and the relative pose it was taken at, each ghost's last answer."""
+        if self._ghost_row_of is None:
+            m = self.model
+            gg = np.array([gid for g in self.ghosts for gid in g.geoms], dtype=int)
+            starts = np.cumsum([0] + [len(g.geoms) for g in self.ghosts[:-1]]).astype(int)
+            self._ghost_reach = (m.geom_rbound[gg][:, None] + m.geom_rbound[self._cand_geoms][None, :]) ** 2
+            self._ghost_geom_body = np.array(m.geom_bodyid[gg], dtype=int)
+            self._is_ghost_geom = np.zeros(m.ngeom, dtype=bool)
+            self._is_ghost_geom[gg] = True
+            self._pair_dist = np.full((len(gg), len(self._cand_geoms)), np.nan)
+            self._pair_rel = np.zeros((len(gg), len(self._cand_geoms), 12))
+            self._ccd_slack = 2.0 * float(m.opt.ccd_tolerance)
+            # each body's free joint's first dof, -1 for a body without one (set_body_velocity's test)
+            self._free_dof = np.full(m.nbody, -1, dtype=int)
+            for j in np.flatnonzero(m.jnt_type == mujoco.mjtJoint.mjJNT_FREE):
+                self._free_dof[m.jnt_bodyid[j]] = m.jnt_dofadr[j]
+            self._ghost_near, self._ghost_made = None, None
+            self._ghost_answers: list = [[] for _ in self.ghosts]
+            self._ghost_row_of = (gg, starts)
+        return self._ghost_row_of
+
+    def _collider_points(self, pairs) -> dict[tuple[int, int], int]:
+        """{(geom, geom): penetrating contacts} that MuJoCo's collision pass makes between the
+        ghost geoms and the body geoms of ``pairs``, the ghosts let collide for that pass only (mj_collision
+        between control steps; the step's own pass, which they do not join, writes the contacts
+        the solver and every reader see). A box in a box gives several, as Bullet's box-box
+        manifold does. A ghost's geom never meets its own body's (MuJoCo collides no body with
+        itself, nor with its parent): those pairs keep the distance query's one point. The last
+        answer stands while the geoms of ``pairs`` (body, ghost geom, body geom) stay within
+        SAME_PLACE of where they were (a resting body inside a ghost, the phantom's holes, jaws
+        held still with round-off's 1e-16 m jitter: no pass)."""
+        if not pairs:
+            return {}
+        m, d = self.model, self.data
+        geoms = sorted({g for _, a, b in pairs for g in (a, b)})
+        where = np.concatenate([d.geom_xpos[geoms].ravel(), d.geom_xmat[geoms].ravel()])
+        last = self._collider_key
+        if last is not None and last[0] == geoms and np.max(np.abs(last[1] - where)) <= SAME_PLACE:
+            return self._collider_made
+        key = (geoms, where)
+        # the pass collides only the geoms of ``pairs``: every other geom's and body's collision
+        # bits off for it (those of a pair's body geom kept; its ghost geom, whose contype
+        # (build.GHOST_CONTYPE) meets no conaffinity, given every one), as the whole scene's
+        # pass would collide those pairs (MuJoCo makes a pair's contacts from its two geoms alone)
+        ghost_side = np.array(sorted({a for _, a, _ in pairs}), dtype=int)
+        body_side = np.array(sorted({b for _, _, b in pairs}), dtype=int)
+        saved = [np.array(x) for x in (m.geom_contype, m.geom_conaffinity, m.body_contype, m.body_conaffinity)]
+        for x in (m.geom_contype, m.geom_conaffinity, m.body_contype, m.body_conaffinity):
+            x[:] = 0
+        m.geom_contype[body_side] = saved[0][body_side]
+        m.geom_conaffinity[ghost_side] = ALL_GROUPS
+        m.body_contype[m.geom_bodyid[body_side]] = saved[2][m.geom_bodyid[body_side]]
+        m.body_conaffinity[m.geom_bodyid[ghost_side]] = ALL_GROUPS  # the broadphase filters bodies first
+        # with island sleeping on, MuJoCo collides no pair without an awake body: a body asleep in a
+        # ghost on a static one (a cube come to rest in it, weightless) keeps its points
+        flags = m.opt.enableflags
+        m.opt.enableflags = flags & ~_SLEEP_BIT
+        try:
+            mujoco.mj_collision(m, d)
+        finally:
+            m.opt.enableflags = flags
+            m.geom_contype[:], m.geom_conaffinity[:], m.body_contype[:], m.body_conaffinity[:] = saved
+        out: dict[tuple[int, int], int] = {}
+        if d.ncon:
+            c = d.contact
+            ab = np.sort(c.geom, axis=1)
+            is_ghost = self._is_ghost_geom[ab]
+            keep = (c.dist < 0.0) & (is_ghost[:, 0] != is_ghost[:, 1])
+            for a, b in ab[keep].tolist():
+                out[(a, b)] = out.get((a, b), 0) + 1
+        self._collider_key, self._collider_made = key, out
+        return out
+
+    def _ambf_ghosts(self) -> None:
+        """AMBF's ghost objects (ghost_rules: afGhostObject::update after each physics step), for
+        this control step's physics steps: every body in penetrating contact keeps
+        AMBF_GHOST_KEEP per contact and step of its velocity across the ghost parent's (a free
+        body's is set; a jointed one is given the force at its centre of mass and the torque that
+        take it there over the control step, as in the PyBullet runner) and is weightless until
+        the next control step. What the rule does is planned again only when a ghost's answer or
+        a body's sleep state changes (_plan_ghosts)."""
+        if not self.ghosts or not len(self._cand_geoms):
+            return  # nothing a ghost could hold
+        answers = self._penetrating(self.ghosts)
+        key = self._body_awake.tobytes() if self.sleep else b""
+        plan = self._ghost_plan
+        if plan is None or self._ghost_changed or key != plan.key:
+            plan = self._ghost_plan = self._plan_ghosts(answers, key)
+        for g, found in zip(self.ghosts, answers):  # (overlapping() may have written its own)
+            g.overlapping, g.points = plan.overlapping[id(g)], found
+        if len(plan.ids):
+            self._ghost_velocities(plan)
+        if len(plan.weight_ids):  # the weight taken off as a force: AMBF's gravity off
+            self.data.xfrc_applied[plan.weight_ids, :3] -= plan.weights
+            self._xfrc_dirty = True
+
+    def _plan_ghosts(self, answers, key: bytes) -> _GhostPlan:
+        """What AMBF's ghost rule does while the ghosts' answers and the bodies' sleep states stay
+        as they are now: the ghosts' overlapping bodies; the bodies acted on, in the order AMBF's
+        updates come, each with the ghost parent whose velocity it takes (a moving one) and its
+        share kept; the held bodies weightless. A body asleep in a ghost whose parent does not
+        move is at rest (velocity 0, which the rule keeps 0) and left out; one asleep in a moving
+        ghost is woken."""
+        m = self.model
+        awake, AWAKE = self._body_awake, self._AWAKE
+        held: dict[int, MjBody] = {}
+        acts = []  # (moving ghost parent or None, body, points)
+        overlapping = {}
+        for g, found in zip(self.ghosts, answers):
+            overlapping[id(g)] = [sb for sb, _ in found]
+            moving = g.parent is not None and not g.parent.static and awake[g.parent.id] == AWAKE
+            for sb, points in found:
+                held[id(sb)] = sb
+                if moving or awake[sb.id] == AWAKE:
+                    acts.append((g.parent if moving else None, sb, points))
+                    if self.sleep and awake[sb.id] != AWAKE:
+                        self.wake(sb)  # asleep in a moving ghost: it is moved again
+        # a tree that may sleep is held weightless by MuJoCo's gravity compensation (a gravity of
+        # its own, which the base forces give it, taken off as a force besides); one that never
+        # sleeps (driven) by the force -m·g, as before the compensation was used
+        sleeps = [sb for sb in held.values() if self._may_sleep(sb)]
+        now = {sb.id for sb in sleeps}
+        for i in self._weightless_ids - now:
+            m.body_gravcomp[i] = 0.0
+            sb = self._body_of_id.get(i)
+            if sb is not None:
+                self.wake(sb)
+        for i in now:
+            m.body_gravcomp[i] = 1.0
+        self._weightless_ids = now
+        g_world = np.asarray(self.gravity, float)
+        weights = []
+        for sb in held.values():
+            if sb.id not in now:
+                weights.append((sb.id, m.body_mass[sb.id] * (sb.gravity if sb.gravity is not None else g_world)))
+            elif sb.gravity is not None:
+                weights.append((sb.id, m.body_mass[sb.id] * (sb.gravity - g_world)))
+        if held:
+            self._overlaps_cleared = False
+        ids = np.array([sb.id for _, sb, _ in acts], dtype=int)
+        pids = np.array([p.id if p is not None else -1 for p, _, _ in acts], dtype=int)
+        dof = self._free_dof[ids]
+        jointed = ids[dof < 0]
+        return _GhostPlan(
+            key=key,
+            overlapping=overlapping,
+            ids=ids,
+            both=np.concatenate([ids, np.where(pids >= 0, pids, ids)]),
+            has_parent=(pids >= 0)[:, None],
+            # (Python's power, not numpy's, which can differ in the last bit)
+            keep=np.array([AMBF_GHOST_KEEP ** (n * self.opt.control_substeps) for _, _, n in acts], dtype=float),
+            free=[(i, int(dof[i]), int(ids[i])) for i in np.flatnonzero(dof >= 0)],
+            jointed=np.flatnonzero(dof < 0),
+            jointed_ids=jointed,
+            mass=np.array(m.body_mass[jointed])[:, None],
+            inertia=np.array(m.body_inertia[jointed]),
+            weight_ids=np.array([i for i, _ in weights], dtype=int),
+            weights=np.array([f for _, f in weights], dtype=float).reshape(-1, 3),
+        )
+
+    def _may_sleep(self, sb: MjBody) -> bool:
+        """Whether MuJoCo may put the tree of ``sb`` to sleep (a driven tree never sleeps)."""
+        m = self.model
+        never = (int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER), int(mujoco.mjtSleepPolicy.mjSLEEP_AUTO_NEVER))
+        return self.sleep and int(m.tree_sleep_policy[m.body_treeid[sb.id]]) not in never
+
+    def _ghost_velocities(self, plan: _GhostPlan) -> None:
+        """AMBF's ghost rule on the bodies of ``plan``, all from the velocities at this control
+        step's start (mj_step left those of its last physics step's start): free bodies'
+        velocities set (the last ghost's stands), the others' forces and torques that take them
+        there over the control step added to xfrc_applied."""
+        m, d = self.model, self.data
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_comVel(m, d)
+        n = len(plan.ids)
+        vel = _com_velocities(d, m, plan.both)
+        w, v = vel[:n, :3], vel[:n, 3:]
+        v_par = np.where(plan.has_parent, vel[n:, 3:], 0.0)
+        mag = np.sqrt(np.einsum("ij,ij->i", v_par, v_par))
+        fast = mag > 1e-5
+        share = np.einsum("ij,ij->i", v, v_par) / np.where(fast, mag * mag, 1.0)
+        along = np.where(fast[:, None], v_par * share[:, None], 0.0)
+        keep = plan.keep[:, None]
+        v2 = keep * (v - along) + v_par
+        w2 = keep * w
+        for i, a, b in plan.free:  # in order: the last ghost's velocity stands
+            d.qvel[a : a + 3] = v2[i]
+            d.qvel[a + 3 : a + 6] = d.xmat[b].reshape(3, 3).T @ w2[i]  # body frame
+        j = plan.jointed
+        if len(j):
+            b = plan.jointed_ids
+            cdt = self.dt * self.opt.control_substeps
+            a, alpha = (v2[j] - v[j]) / cdt, (w2[j] - w[j]) / cdt
+            np.add.at(d.xfrc_applied, (b, slice(0, 3)), plan.mass * a)
+            xf, ximat, inertia = d.xfrc_applied, d.ximat, plan.inertia
+            for k, i in enumerate(b.tolist()):
+                # the inertial frame's, about the COM; matrix products one body at a time, as the
+                # PyBullet runner's (a stacked product can round the last bit otherwise)
+                rot = ximat[i].reshape(3, 3)
+                xf[i, 3:] += rot @ (inertia[k] * (rot.T @ alpha[k]))
+            self._xfrc_dirty = True
+
+
+def _com_velocities(d, m, ids: np.ndarray) -> np.ndarray:
+    """[ω, v] of bodies ``ids`` at their centres of mass in the world frame (mj_objectVelocity's,
+    from cvel: mj_comVel must have run)."""
+    cvel = d.cvel[ids]
+    om = cvel[:, :3]
+    r = d.xipos[ids] - d.subtree_com[m.body_rootid[ids]]
+    cvel[:, 3] += om[:, 1] * r[:, 2] - om[:, 2] * r[:, 1]
+    cvel[:, 4] += om[:, 2] * r[:, 0] - om[:, 0] * r[:, 2]
+    cvel[:, 5] += om[:, 0] * r[:, 1] - om[:, 1] * r[:, 0]
+    return cvel
