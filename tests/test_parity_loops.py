@@ -8,6 +8,7 @@ from dataclasses import replace
 import pytest
 from conftest import CORPUS, require_corpus
 
+from adfkit.adf import load_scene
 from adfkit.parity import ambf
 
 BUILD, WHY = ambf.available()
@@ -53,3 +54,35 @@ def test_a_gripper_resting_on_the_floor_stays_as_in_ambf():
     gaps = _largest_gaps(path, ("pybullet", "mujoco"))
     assert gaps["pybullet"] < 4e-3 and gaps["mujoco"] < 4e-3, gaps
     assert _largest_gaps(path, link_shapes="com")["pybullet"] > 0.02
+
+
+def test_a_command_on_a_joint_closing_a_loop_is_a_located_error(tmp_path):
+    """AMBF drives every hinge's motor; adfkit plays the joint that closes a loop as a
+    constraint without one. A command file that drives it is a located error before anything is
+    played (it raised a traceback from inside the player: the corpus ECM's and MTM's joint
+    programs), and the programs `parity` writes leave such a joint out. In this four-bar, none of
+    whose joints has limits, l3-l4 closes the loop. Control: the loop's tree joint l1-l2 is
+    driven and is in the program."""
+    from test_runner_links import four_bar
+
+    from adfkit.diagnostics import AdfError
+    from adfkit.parity import programs, session
+    from adfkit.runner import Options, open_world
+
+    path = tmp_path / "four_bar.yaml"
+    path.write_text(four_bar())
+    cmds = tmp_path / "cmds.txt"
+    cmds.write_text("0.0, velocity, l1-l2, 0.1\n0.0, velocity, l3-l4, 0.1\n")
+    nowhere = ambf.AmbfBuild(tmp_path / "no-ambf")  # never reached: the check comes first
+    req = session.Request(path, None, nowhere, seconds=0.1, commands=cmds)
+    with pytest.raises(AdfError) as e:
+        session.run(req, progress=False)
+    (d,) = e.value.diagnostics
+    assert d.rule == "command-target" and "l3-l4" in d.message and "closes a kinematic loop" in d.message
+    assert (d.location.line, d.location.column) == (2, 1)
+    world = open_world(load_scene(path), Options(visuals=False, ground=False))
+    try:
+        names = [n.rsplit("/", 1)[-1] for n, _j, _k in programs.driven_joints(world)]
+    finally:
+        world.close()
+    assert "l1-l2" in names and "l3-l4" not in names

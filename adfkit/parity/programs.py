@@ -40,15 +40,18 @@ def program(joints, kind: str, seconds: float, size: float = 0.3) -> list[str]:
 
 
 def driven_joints(world) -> list[tuple[str, object, str]]:
-    """The motorised revolute and prismatic joints an adfkit world made, by AMBF's names."""
+    """The motorised revolute and prismatic joints an adfkit world made and can drive (not a
+    joint closing a kinematic loop), by AMBF's names."""
     from ..model.semantics import JointKind, joint_kind
+    from ..runner.joint_commands import JointCommands
     from .traces import made_by
 
     names = made_by(world)["joint"]
+    drives = JointCommands(world)
     out = []
-    for name, (j, _p, _c) in zip(names, world.joints_made):
+    for name, (j, _p, child) in zip(names, world.joints_made):
         k = joint_kind(j.type)
-        if k in (JointKind.REVOLUTE, JointKind.PRISMATIC) and motor_enabled(j):
+        if k in (JointKind.REVOLUTE, JointKind.PRISMATIC) and motor_enabled(j) and drives.drivable(j, child):
             out.append((name, j, k.value))
     return out
 

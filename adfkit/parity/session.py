@@ -109,6 +109,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
         for w in worlds:
             diags.extend(w.diagnostics)
         commands = commandfile.resolved(commands_read, players[0].made)
+        _check_drivable(commands_read, commands, players[0])
         if commands:
             if any(c.kind in commandfile.JOINT_KINDS for c in commands) and "mujoco" in req.engines:
                 raise AdfError(
@@ -134,6 +135,38 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
     finally:
         for w in worlds:
             w.close()
+
+
+def _check_drivable(read, commands, player: AdfkitPlayer) -> None:
+    """A located error for each joint command whose joint adfkit's world cannot drive: AMBF
+    gives every hinge and slider a motor, adfkit drives the joints of its articulations only (a
+    joint closing a kinematic loop is a constraint there, without a motor)."""
+    from ..model.semantics import JointKind, joint_kind
+
+    diags = []
+    for (_, where), c in zip(read, commands):
+        if c.kind not in commandfile.JOINT_KINDS:
+            continue
+        joint, child = player.by_name["joint"][c.target]
+        if player.commands.drivable(joint, child) is not None:
+            continue
+        kind = joint_kind(joint.type)
+        if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+            why = "it closes a kinematic loop, which adfkit plays as a constraint without a motor"
+            hint = "drive the loop's other joints (those of its tree), or leave this one out"
+        else:
+            why = f"adfkit drives revolute and prismatic joints only, and this one is {joint.type!r}"
+            hint = "leave this joint out of the command file"
+        diags.append(
+            error(
+                "command-target",
+                f"adfkit cannot drive joint {c.target!r}: {why}",
+                where,
+                hint,
+            )
+        )
+    if diags:
+        raise AdfError(diags)
 
 
 def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
