@@ -177,6 +177,8 @@ DEFAULT_JOINT_ERP = 0.1
 HINGE_LIMIT_BIAS = 0.3
 #: the world's ERP (btContactSolverInfo's default, which AMBF keeps): btSliderConstraint's limit rows'
 SLIDER_LIMIT_ERP = 0.2
+#: the one-axis springs, which AMBF makes btGeneric6DofSpring2Constraints (their limit rows at the joint's erp)
+ONE_AXIS_SPRINGS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
 DEFAULT_JOINT_CFM = 0.1
 DEFAULT_SENSOR_RANGE = 0.5
 DEFAULT_ACTUATOR_MAX_IMPULSE = 10.0

@@ -20,10 +20,7 @@ from __future__ import annotations
 
 import mujoco
 
-from ...model.semantics import DEFAULT_JOINT_ERP, HINGE_LIMIT_BIAS, SLIDER_LIMIT_ERP, JointKind
-
-#: AMBF's btGeneric6DofSpring2Constraint joints (afJoint::createFromAttribs)
-SPRING2_KINDS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
+from ...model.semantics import DEFAULT_JOINT_ERP, HINGE_LIMIT_BIAS, ONE_AXIS_SPRINGS, SLIDER_LIMIT_ERP, JointKind
 
 
 def limit_rate(joint, kind) -> float | None:
@@ -31,7 +28,7 @@ def limit_rate(joint, kind) -> float | None:
     erp = joint.joint_erp if joint.joint_erp is not None else DEFAULT_JOINT_ERP
     if kind is JointKind.REVOLUTE:
         return HINGE_LIMIT_BIAS * erp
-    if kind in SPRING2_KINDS:
+    if kind in ONE_AXIS_SPRINGS:
         return erp
     if kind is JointKind.PRISMATIC:
         return SLIDER_LIMIT_ERP

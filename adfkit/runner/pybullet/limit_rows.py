@@ -30,7 +30,7 @@ from functools import partial
 
 import pybullet as pb
 
-from ...model.semantics import HINGE_LIMIT_BIAS, SLIDER_LIMIT_ERP, JointKind, joint_kind
+from ...model.semantics import HINGE_LIMIT_BIAS, ONE_AXIS_SPRINGS, SLIDER_LIMIT_ERP, JointKind, joint_kind
 from ..joint_commands import AMBF_JOINT_ERP, LIMIT_FORCE, limits_of
 
 
@@ -81,9 +81,6 @@ def spring_row_velocity(q: float, v: float, limits: tuple[float, float], erp: fl
     return None
 
 
-_SPRINGS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
-
-
 class LimitRows:
     def __init__(self, world) -> None:
         self.world = world
@@ -105,7 +102,7 @@ class LimitRows:
                     rows.append((n, lim, partial(_hinge_row, erp=erp)))
                 elif kind is JointKind.PRISMATIC:
                     rows.append((n, lim, slider_row_velocity))
-                elif kind in _SPRINGS and springs:
+                elif kind in ONE_AXIS_SPRINGS and springs:
                     rows.append((n, lim, partial(spring_row_velocity, erp=erp)))
             if rows:
                 self.joints.append((art, rows))
