@@ -89,7 +89,7 @@ _Z = np.zeros(3)
 class Rows:
     a: list[int] = field(default_factory=list)
     b: list[int] = field(default_factory=list)
-    j: list[np.ndarray] = field(default_factory=list)  # 12: J1 linear, J1 angular, J2 linear, J2 angular
+    j: list[tuple] = field(default_factory=list)  # J1 linear, J1 angular, J2 linear, J2 angular (3 each)
     c: list[float] = field(default_factory=list)
     cfm: list[float] = field(default_factory=list)
     lo: list[float] = field(default_factory=list)
@@ -98,7 +98,7 @@ class Rows:
     def add(self, a, b, j1l, j1a, j2l, j2a, c=0.0, cfm=0.0, lo=-math.inf, hi=math.inf):
         self.a.append(a)
         self.b.append(b)
-        self.j.append(np.concatenate([j1l, j1a, j2l, j2a]))
+        self.j.append((j1l, j1a, j2l, j2a))
         self.c.append(c)
         self.cfm.append(cfm)
         self.lo.append(lo)
@@ -279,9 +279,11 @@ def solve(
         (hinge_rows if jt.kind == "revolute" else slider_rows)(rows, bodies, jt, dt)
     n, m = len(bodies), len(rows.c)
     J = np.zeros((m, 6 * n))
-    for r, (a, b, j) in enumerate(zip(rows.a, rows.b, rows.j)):
-        J[r, 6 * a : 6 * a + 6] += j[:6]
-        J[r, 6 * b : 6 * b + 6] += j[6:]
+    r = np.arange(m)[:, None]
+    six = np.arange(6)
+    j12 = np.array(rows.j).reshape(m, 12)
+    J[r, 6 * np.array(rows.a)[:, None] + six] = j12[:, :6]  # a row's two bodies differ
+    J[r, 6 * np.array(rows.b)[:, None] + six] = j12[:, 6:]
     minv = np.zeros((6 * n, 6 * n))
     v0 = np.zeros(6 * n)
     for k, bd in enumerate(bodies):
@@ -295,11 +297,14 @@ def solve(
     rhs = ((np.asarray(rows.c) - J @ v0) * jinv).tolist()
     cfm, lo, hi, jin = rows.cfm, rows.lo, rows.hi, jinv.tolist()
     lam = np.zeros(m)
-    rows_a = list(A)
+    now = [0.0] * m  # lam's values as Python floats: the sweep's scalar arithmetic without numpy's
+    rows_a = [a.dot for a in A]
     for _ in range(iterations):
         for i in range(m):
-            s = lam[i] + rhs[i] - lam[i] * cfm[i] - jin[i] * float(rows_a[i] @ lam)
-            lam[i] = min(max(s, lo[i]), hi[i])
+            li = now[i]
+            s = li + rhs[i] - li * cfm[i] - jin[i] * float(rows_a[i](lam))
+            s = lo[i] if s < lo[i] else s
+            lam[i] = now[i] = hi[i] if s > hi[i] else s
     return (v0 + B @ lam).reshape(n, 6)
 
 

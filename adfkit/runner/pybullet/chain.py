@@ -75,16 +75,10 @@ class ChainModel:
         base_p, base_q = pb.getBasePositionAndOrientation(uid, physicsClientId=cid)
         base_v, base_w = pb.getBaseVelocity(uid, physicsClientId=cid)
         frames = [(base_p, base_q, base_v, base_w)] + [(s[0], s[1], s[6], s[7]) for s in links]
-        bodies, coms, rots = [], [], []
+        bodies, coms = [], []
+        rots = quat_to_matrix(np.array([f[1] for f in frames]))
         # the carried state is kept in each body's own frame: it turns with the body
-        apart = np.zeros_like(self.apart)
-        drift = np.zeros_like(self.drift)
-        for k, (_p, q, _v, _w) in enumerate(frames):
-            rot = quat_to_matrix(q)
-            rots.append(rot)
-            for s0 in (0, 3):
-                apart[k, s0 : s0 + 3] = rot @ self.apart[k, s0 : s0 + 3]
-                drift[k, s0 : s0 + 3] = rot @ self.drift[k, s0 : s0 + 3]
+        apart, drift = _turned(rots, self.apart), _turned(rots, self.drift)
         for k, (p, _q, v, w) in enumerate(frames):
             rot = rots[k]
             dv, dw = self.decay[k]
@@ -103,8 +97,9 @@ class ChainModel:
         states = pb.getJointStates(uid, list(range(n)), physicsClientId=cid)
         joints, fk = [], []  # fk: the joints where the multibody has them
         d = drift
+        link_rots = quat_to_matrix(np.array([s[5] for s in links]))  # the link frames: the children's joint frames
         for k, ((parent, kind, lim, erp), s) in enumerate(zip(self.joints, states)):
-            rot = quat_to_matrix(links[k][5])  # the link frame: the child's joint frame
+            rot = link_rots[k]
             qk = s[0]
             if kind == "revolute":  # the parent's joint frame is the child's turned back by q
                 axis, y = rot[:, 2], rot @ np.array([math.sin(qk), math.cos(qk), 0.0])
@@ -145,8 +140,11 @@ class ChainModel:
         apart = after - together
         apart[[k for k in range(n + 1) if self.inv_mass[k] <= 0.0]] = 0.0
         drift += apart * self.dt
-        for k, rot in enumerate(rots):
-            for s0 in (0, 3):
-                self.apart[k, s0 : s0 + 3] = rot.T @ apart[k, s0 : s0 + 3]
-                self.drift[k, s0 : s0 + 3] = rot.T @ drift[k, s0 : s0 + 3]
+        back = rots.transpose(0, 2, 1)
+        self.apart, self.drift = _turned(back, apart), _turned(back, drift)
         return qd
+
+
+def _turned(rots: np.ndarray, six: np.ndarray) -> np.ndarray:
+    """Each row of ``six`` (n, 6: two 3-vectors) turned by its body's rotation ``rots`` (n, 3, 3)."""
+    return (rots @ six.reshape(-1, 2, 3).transpose(0, 2, 1)).transpose(0, 2, 1).reshape(-1, 6)

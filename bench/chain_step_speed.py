@@ -1,0 +1,84 @@
+"""CPU time of the PyBullet runner playing a robot's joint program as ``adfkit parity --commands``
+plays it: AMBF's bodies, 1 ms control steps, every driven chain through AMBF's ten-sweep solver
+step (runner/chain_rows.py, runner/pybullet/chain.py). The robots are the corpus KUKA and LND
+400006 PSM with the programs ``adfkit.parity.programs`` writes (the dynamic-parity table's rows);
+without ``../shared/corpus`` there is nothing to play and it says so.
+
+    .venv/bin/python bench/chain_step_speed.py [--seconds S] [--rounds R]
+
+The figure is this process's CPU time (``time.process_time``) of the stepping alone, per second
+simulated, the median of R rounds on freshly built worlds; and the share of it in the chain step
+(``ChainModel.velocities``), by cProfile on one more round. Prints figures, asserts nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import pstats
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CORPUS = ROOT.parent / "shared" / "corpus"
+ROBOTS = (
+    ("KUKA", "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml", "velocity"),
+    ("PSM (LND 400006)", "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", "position"),
+    ("PSM (LND 400006)", "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", "velocity"),
+)
+
+
+def _player(model: Path, kind: str, folder: Path):
+    from adfkit.adf import load_scene
+    from adfkit.parity import commandfile, programs
+    from adfkit.parity.traces import AdfkitPlayer
+    from adfkit.runner import Options, open_world
+
+    cmd = programs.write_program(model, None, kind, 1.0, folder / f"{model.stem}_{kind}.txt")
+    opt = Options(control_substeps=1, visuals=False, renderer="tiny")
+    opt.ghosts, opt.springs, opt.link_shapes, opt.bodies = "ambf", "ambf", "body", "ambf"
+    world = open_world(load_scene(model, None, []), opt, engine="pybullet")
+    player = AdfkitPlayer(world)
+    return world, player, commandfile.resolved(commandfile.read(cmd), player.made)
+
+
+def main(argv: list[str]) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seconds", type=float, default=1.0)
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+    if not CORPUS.is_dir():
+        print(f"skipped: no corpus at {CORPUS} (the robots played are the corpus's)")
+        return 0
+    print("| robot | program | CPU s per simulated s (median) | rounds | in the chain step |")
+    print("|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory(prefix="adfkit-chain-bench-") as tmp:
+        for label, rel, kind in ROBOTS:
+            cpu = []
+            for _ in range(args.rounds):
+                world, player, cmds = _player(CORPUS / rel, kind, Path(tmp))
+                t0 = time.process_time()
+                player.play(args.seconds, 0.02, cmds)
+                cpu.append((time.process_time() - t0) / args.seconds)
+                world.close()
+            world, player, cmds = _player(CORPUS / rel, kind, Path(tmp))
+            prof = cProfile.Profile(time.process_time)
+            prof.enable()
+            player.play(args.seconds, 0.02, cmds)
+            prof.disable()
+            world.close()
+            stats = pstats.Stats(prof).stats  # type: ignore[attr-defined]
+            total = sum(s[2] for s in stats.values())
+            chain = sum(s[3] for (_f, _l, name), s in stats.items() if name == "velocities")
+            print(
+                f"| {label} | {kind} | {statistics.median(cpu):.2f} s | {args.rounds} | "
+                f"{100 * chain / total if total else 0:.0f} % |"
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
