@@ -61,6 +61,9 @@ def own_scenes(folder: Path) -> list[Scene]:
     out.append(Scene("cube into a ghost (--ghosts hole-friction)", launch, [3], 0.6, ghosts="hole-friction"))
     out.append(Scene("thread falling from a held needle", launch, [4], 2.0, both))
     out.append(
+        Scene("slider pushed onto its limits by efforts", launch, [5], 1.0, commands=folder / "slider_effort.txt")
+    )
+    out.append(
         Scene(
             "arm with a turned inertial frame, position commands",
             folder / "turned_arm.yaml",

@@ -37,8 +37,37 @@ def test_the_parity_scenes_are_valid_and_play(scenes, capsys):
     assert "0 error(s), 0 warning(s)" in capsys.readouterr().out
     assert main(["run", str(scenes / "launch.yaml"), "--seconds", "0.2", "--no-frames"]) == 0
     # the floor; slab and box; post and arm; three boxes; post, cube and twin; the needle's stand-in
-    # and 40 thread elements; the arm's joint and the thread's 40
-    assert "52 bodies, 41 joints" in capsys.readouterr().out
+    # and 40 thread elements; post and block; the arm's joint, the thread's 40 and the slider
+    assert "54 bodies, 42 joints" in capsys.readouterr().out
+
+
+def test_efforts_hold_the_slider_on_its_limits(scenes):
+    """The slider scene's block, pushed by 2 N onto its +5 cm limit, then by 3 N onto its -5 cm
+    one (slider_effort.txt), stays on each within 0.2 mm (measured: at most 0.12 mm past); with
+    its limits taken off (a negative control) the same efforts take it 0.5 m out in 0.5 s."""
+    from pathlib import Path
+
+    from adfkit.adf import load_scene
+    from adfkit.parity.traces import AdfkitPlayer
+    from adfkit.runner import Options, open_world
+
+    def joint_path(limits: bool) -> np.ndarray:
+        scene = load_scene(Path(scenes) / "launch.yaml", [5])
+        if not limits:
+            next(m for m in scene.all_models() if m.joints).joints[0].joint_limits = None
+        world = open_world(scene, Options(visuals=False, control_substeps=1, bodies="ambf"))
+        try:
+            player = AdfkitPlayer(world)
+            cmds = commandfile.resolved(commandfile.read(Path(scenes) / "slider_effort.txt"), player.made)
+            return player.play(1.0, 0.02, cmds).joints[:, 0]
+        finally:
+            world.close()
+
+    q = joint_path(True)
+    assert q[25] == pytest.approx(0.05, abs=2e-4) and q[-1] == pytest.approx(-0.05, abs=2e-4)
+    assert q.max() < 0.0502 and q.min() > -0.0502
+    free = joint_path(False)
+    assert free[25] == pytest.approx(0.5, abs=0.01)  # ½·(2 N / 0.5 kg)·(0.5 s)², less its damping
 
 
 def test_parity_without_an_ambf_build_is_a_located_error(scenes, tmp_path, capsys):
@@ -186,6 +215,21 @@ def test_joint_commands_drive_both_sides_alike(scenes, commands, tip_mm, capsys)
     (joint,) = out["joints"]
     assert joint["name"] == "/ambf/env/arm/base-arm" and joint["max_value_gap"] < 4e-3  # rad
     assert out["only_in_ambf"] == out["only_in_adfkit"] == []
+
+
+@needs_ambf
+def test_a_slider_pushed_onto_its_limits_by_efforts_as_in_ambf(scenes, capsys):
+    """AMBF's slider holds its limit with a row at the world's erp (0.2): the block, pushed onto
+    +5 cm and then onto -5 cm, is within 0.6 mm of AMBF's all the way (measured 0.41 mm, as it
+    arrives at -5 cm)."""
+    rc = main(
+        ["parity", str(scenes / "launch.yaml"), "-l", "5", "--seconds", "1", "--json"]
+        + ["--commands", str(scenes / "slider_effort.txt")]
+    )
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0, out
+    block = next(b for b in out["bodies"] if b["name"] == "/ambf/env/slider/block")
+    assert 0 < block["max_position_gap_m"] < 6e-4
 
 
 @needs_ambf

@@ -39,13 +39,14 @@ GREY = RGBA(r=0.6, g=0.6, b=0.65, a=1.0)
 ORANGE = RGBA(r=0.9, g=0.5, b=0.1, a=1.0)
 
 #: the launch file's models, in order (-l INDEX)
-SCENES = ("drop", "arm", "stack", "ghost", "thread")
+SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider")
 
 #: command files beside the scenes: (file, scene, lines)
 COMMANDS = {
     "arm_position.txt": ("arm", ["0.0, position, base-arm, 0.6", "0.5, position, base-arm, -0.3"]),
     "arm_velocity.txt": ("arm", ["0.0, velocity, base-arm, 1.0", "0.3, velocity, base-arm, -0.5"]),
     "arm_effort.txt": ("arm", ["0.0, effort, base-arm, 0.02", "0.4, effort, base-arm, -0.03"]),
+    "slider_effort.txt": ("slider", ["0.0, effort, post-block, 2.0", "0.5, effort, post-block, -3.0"]),
     "turned_arm_position.txt": ("turned_arm", ["0.0, position, base-arm, 0.6", "0.5, position, base-arm, -0.3"]),
 }
 
@@ -102,6 +103,30 @@ def build_arm() -> ModelFile:
             child_axis=Vec3(0.0, 0.0, 1.0),
             joint_limits=JointLimits(low=-2.0, high=2.0),
             max_motor_impulse=0.05,
+        )
+    )
+    return m
+
+
+def build_slider() -> ModelFile:
+    """A 0.5 kg, 10 cm block on a prismatic joint along x (gravity across it) from a static post,
+    its limits ±5 cm: an effort pushes it onto a limit and holds it there, then the other way
+    (``slider_effort.txt``): how a limit holds a slider against an effort."""
+    m = ModelFile(namespace="/ambf/env/slider/")
+    m.bodies.append(_box("post", (0.05, 0.05, 0.05), (0.0, 0.0, 0.5)))
+    m.bodies.append(_box("block", (0.1, 0.04, 0.04), (0.15, 0.0, 0.5), mass=0.5, color=ORANGE))
+    m.joints.append(
+        Joint(
+            identifier="JOINT post-block",
+            name="post-block",
+            parent="BODY post",
+            child="BODY block",
+            type="prismatic",
+            parent_pivot=Vec3(0.0, 0.0, 0.0),
+            parent_axis=Vec3(1.0, 0.0, 0.0),
+            child_pivot=Vec3(-0.15, 0.0, 0.0),
+            child_axis=Vec3(1.0, 0.0, 0.0),
+            joint_limits=JointLimits(low=-0.05, high=0.05),
         )
     )
     return m
@@ -181,7 +206,14 @@ def build_thread() -> ModelFile:
     return m
 
 
-BUILD = {"drop": build_drop, "arm": build_arm, "stack": build_stack, "ghost": build_ghost, "thread": build_thread}
+BUILD = {
+    "drop": build_drop,
+    "arm": build_arm,
+    "stack": build_stack,
+    "ghost": build_ghost,
+    "thread": build_thread,
+    "slider": build_slider,
+}
 
 
 def write_parity(out_dir: str | Path) -> Path:
@@ -220,4 +252,5 @@ __all__ = [
     "build_stack",
     "build_ghost",
     "build_thread",
+    "build_slider",
 ]
