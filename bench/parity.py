@@ -63,6 +63,7 @@ def own_scenes(folder: Path) -> list[Scene]:
     out.append(
         Scene("slider pushed onto its limits by efforts", launch, [5], 1.0, commands=folder / "slider_effort.txt")
     )
+    out.append(Scene("pendulums on p2p, cone-twist, six-dof and six-dof-spring joints", launch, [6], 1.0, both))
     out.append(
         Scene(
             "arm with a turned inertial frame, position commands",

@@ -31,7 +31,7 @@ from ..model import (
     Vec3,
     World,
 )
-from ..model.objects import Inertia
+from ..model.objects import AxesGains, Inertia, Vec3Range
 from ..model.pose import rpy_to_quat
 from .suturing_pad import build_floor
 
@@ -39,7 +39,7 @@ GREY = RGBA(r=0.6, g=0.6, b=0.65, a=1.0)
 ORANGE = RGBA(r=0.9, g=0.5, b=0.1, a=1.0)
 
 #: the launch file's models, in order (-l INDEX)
-SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider")
+SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider", "pendulums")
 
 #: command files beside the scenes: (file, scene, lines)
 COMMANDS = {
@@ -132,6 +132,61 @@ def build_slider() -> ModelFile:
     return m
 
 
+#: the pendulums: (name, joint type, where its pivot hangs on the post (y), its tilt (roll, pitch))
+PENDULUMS = (
+    ("p2p", "p2p", -0.4, (0.0, 0.5)),
+    ("cone", "cone twist", -0.15, (0.2, 0.0)),
+    ("six", "six dof", 0.15, (0.0, 0.3)),
+    ("spring", "six dof spring", 0.4, (0.3, 0.0)),
+)
+
+
+def build_pendulums() -> ModelFile:
+    """Four 20 cm, 0.3 kg bobs hanging from a static rail 1 m up, each on a joint of a kind the
+    corpus hardly uses (p2p, cone twist, six dof, six dof spring), each tilted in the file about
+    its pivot (which sits on the joint): they swing from where the file puts them."""
+    m = ModelFile(namespace="/ambf/env/pendulums/")
+    m.bodies.append(_box("rail", (0.02, 1.0, 0.02), (0.0, 0.0, 1.0)))
+    z = Vec3(0.0, 0.0, 1.0)
+    for name, kind, y, (roll, pitch) in PENDULUMS:
+        rot = _rpy_matrix(roll, pitch)
+        centre = np.array([0.0, y, 1.0]) - rot @ np.array([0.0, 0.0, 0.1])
+        bob = _box(f"{name}bob", (0.03, 0.03, 0.2), tuple(round(float(c), 9) for c in centre), (roll, pitch, 0.0), 0.3)
+        bob.collision_groups = [1]
+        m.bodies.append(bob)
+        joint = Joint(
+            identifier=f"JOINT rail-{name}bob",
+            name=f"rail-{name}bob",
+            parent="BODY rail",
+            child=f"BODY {name}bob",
+            type=kind,
+            parent_pivot=Vec3(0.0, y, 0.0),
+            child_pivot=Vec3(0.0, 0.0, 0.1),
+            parent_axis=z,
+            child_axis=z,
+        )
+        if kind == "cone twist":
+            joint.joint_limits = JointLimits(x=0.3, y=0.3, z=0.2)
+        elif kind.startswith("six dof"):
+            zero = Vec3(0.0, 0.0, 0.0)
+            joint.joint_limits = JointLimits(
+                linear=Vec3Range(low=Vec3(0.0, 0.0, -0.02 if "spring" in kind else 0.0),
+                                 high=Vec3(0.0, 0.0, 0.02 if "spring" in kind else 0.0)),
+                angular=Vec3Range(low=Vec3(-0.5, -0.5, 0.0), high=Vec3(0.5, 0.5, 0.0)),
+            )  # fmt: skip
+            if "spring" in kind:
+                joint.stiffness = AxesGains(linear=Vec3(0.0, 0.0, 50.0), angular=Vec3(0.5, 0.5, 0.0))
+                joint.damping = AxesGains(linear=Vec3(0.0, 0.0, 0.5), angular=Vec3(0.01, 0.01, 0.0))
+                joint.equilibrium_point = AxesGains(linear=zero, angular=zero)
+        m.joints.append(joint)
+    return m
+
+
+def _rpy_matrix(roll: float, pitch: float) -> np.ndarray:
+    cr, sr, cp, sp = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch)
+    return np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+
+
 def build_turned_arm() -> ModelFile:
     """The arm of :func:`build_arm` with its inertial frame turned 90° about the joint's axis
     (z) and its inertia turned with it: the same body, which AMBF reads with the joint's zero
@@ -213,6 +268,7 @@ BUILD = {
     "ghost": build_ghost,
     "thread": build_thread,
     "slider": build_slider,
+    "pendulums": build_pendulums,
 }
 
 
@@ -253,4 +309,5 @@ __all__ = [
     "build_ghost",
     "build_thread",
     "build_slider",
+    "build_pendulums",
 ]

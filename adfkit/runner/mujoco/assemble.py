@@ -21,6 +21,7 @@ from .drives import DriveLimits, drive_limit
 from .limits import ambf_limits
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
+from .start import six_dof_start
 
 SOLVER_TOLERANCE = 1e-6
 WAKE_FORCE = 1e-12  # N
@@ -130,6 +131,8 @@ class Assembly:
         self.joints_made = [(j, by_plan[id(p)], by_plan[id(c)]) for j, _k, p, c, *_ in plan.joints + plan.loops]
         self._build_articulations(plan, by_plan)
         self._drive_limits_and_springs()
+        if self.opt.bodies == "ambf" and six_dof_start(m, self.data, plan.joints):
+            mujoco.mj_forward(m, self.data)
         if self.opt.bodies == "ambf":
             ambf_limits(m, plan.joints, self.dt)
         self._gravity_overrides()

@@ -269,7 +269,7 @@ def build_plan(world) -> Plan:
     if world.soft is not None:
         world.soft.attach(spec, scene.all_models(), {bp.key: bp for bp in bodies})
     _lights(world, spec)
-    collision_filters(world, spec, bodies, joints, plans_by_model)
+    collision_filters(world, spec, bodies, joints + loops, plans_by_model)
     apply_textures(world, spec, bodies)
     ghosts, actuators, sensors = [], [], []
     known = None

@@ -60,8 +60,8 @@ def _shape_left_out(world, m, loss) -> None:
 
 def collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
     """ADF collision groups as contype/conaffinity bits (bodies collide when they share a
-    group, as in the PyBullet runner); joints and models that ignore inter-collision as
-    excluded body pairs."""
+    group, as in the PyBullet runner); joints (the tree's and those closing loops) and models
+    that ignore inter-collision as excluded body pairs."""
     masks = collision_masks(world, [bp.body for bp in bodies])
     for bp in bodies:
         mask = masks[id(bp.body)]
@@ -81,7 +81,7 @@ def collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
             if fr is not None and fr.static is not None:
                 g.friction = [fr.static, g.friction[1], fr.rolling if fr.rolling is not None else g.friction[2]]
     pairs = set()
-    for j, _kind, parent, child, _jn in joints:
+    for j, _kind, parent, child, *_ in joints:
         if j.ignore_inter_collision is not False:
             pairs.add((parent.mjname, child.mjname))
     for m, mine, _tree in plans_by_model:
