@@ -917,3 +917,25 @@ def test_a_joint_started_past_its_limit_is_kicked_in_as_ambfs_limit_row_asks(tmp
                 assert q < 0.3 * 4e-3 * speed, q  # 0.0045 rad
         finally:
             world.close()
+
+
+def test_a_cone_twist_joint_between_bodies_without_a_location_plays(tmp_path):
+    """`location` is optional (the body frame is then the model's): a six-dof-family joint's start
+    (runner/mujoco/start.py, AMBF's bodies) reads such a body at the origin instead of failing.
+    The ball hangs from the post's pivot 0.1 m below it, as its joint puts it."""
+    f = tmp_path / "cone.yaml"
+    f.write_text(
+        "bodies: [BODY a, BODY b]\njoints: [JOINT a-b]\n"
+        "BODY a:\n  name: a\n  mass: 0.0\n  collision shape: BOX\n  collision geometry: {x: 0.05, y: 0.05, z: 0.05}\n"
+        "BODY b:\n  name: b\n  mass: 0.2\n  collision shape: SPHERE\n  collision geometry: {radius: 0.02}\n"
+        "JOINT a-b:\n  name: a-b\n  parent: BODY a\n  child: BODY b\n  type: cone twist\n"
+        "  parent pivot: {x: 0.0, y: 0.0, z: -0.1}\n  child pivot: {x: 0.0, y: 0.0, z: 0.0}\n"
+        "  parent axis: {x: 0.0, y: 0.0, z: 1.0}\n  child axis: {x: 0.0, y: 0.0, z: 1.0}\n"
+        "  joint limits: {x: 0.3, y: 0.3, z: 0.2}\n"
+    )
+    world = MujocoWorld(load_scene(f), Options(visuals=False, bodies="ambf"))
+    try:
+        world.run(0.1)
+        assert np.asarray(world.body("b").com_position()) == pytest.approx([0.0, 0.0, -0.1], abs=1e-3)
+    finally:
+        world.close()

@@ -19,6 +19,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from ...model.pose import Pose
 from ...model.semantics import body_joint_frames
 from ..rotations import euler_xyz, pose_to_matrix
 
@@ -35,8 +36,8 @@ def six_dof_start(model, data, joints) -> bool:
         if not any("#" in n for n in names):
             continue  # a one-DOF joint: the writer's `ref` already starts it where the file does
         a, b = body_joint_frames(joint, parent.body, child.body)
-        in_a = np.linalg.inv(pose_to_matrix(parent.body.location) @ pose_to_matrix(a))
-        rel = in_a @ pose_to_matrix(child.body.location) @ pose_to_matrix(b)
+        in_a = np.linalg.inv(pose_to_matrix(parent.body.location or Pose()) @ pose_to_matrix(a))
+        rel = in_a @ pose_to_matrix(child.body.location or Pose()) @ pose_to_matrix(b)
         values = {"slide": rel[:3, 3], "hinge": euler_xyz(rel[:3, :3])}
         for name in names:
             suffix = name.rpartition("#")[2]  # build.py's "slidex" ... "hingez"
