@@ -83,53 +83,48 @@ def build_drop() -> ModelFile:
     return m
 
 
+def _on_a_post(ns: str, post: Body, moving: Body, kind: str, axis: Vec3, child_pivot: Vec3, **joint) -> ModelFile:
+    """A model of a static ``post`` and a ``moving`` body on one joint of ``kind`` from the
+    post's origin, its axis ``axis`` in both bodies."""
+    m = ModelFile(namespace=f"/ambf/env/{ns}/")
+    m.bodies += [post, moving]
+    p, c = post.name, moving.name
+    m.joints.append(
+        Joint(
+            identifier=f"JOINT {p}-{c}",
+            name=f"{p}-{c}",
+            parent=f"BODY {p}",
+            child=f"BODY {c}",
+            type=kind,
+            parent_pivot=Vec3(0.0, 0.0, 0.0),
+            parent_axis=axis,
+            child_pivot=child_pivot,
+            child_axis=axis,
+            **joint,
+        )
+    )
+    return m
+
+
 def build_arm() -> ModelFile:
     """A 30 cm, 0.5 kg arm on a revolute joint about z (gravity across the axis) from a static
     post: what a joint command does is all that moves it. No `controller`: AMBF's position
     commands go through its default P 10, D 1 velocity controller."""
-    m = ModelFile(namespace="/ambf/env/arm/")
-    m.bodies.append(_box("base", (0.05, 0.05, 0.05), (0.0, 0.0, 0.5)))
-    m.bodies.append(_box("arm", (0.3, 0.03, 0.03), (0.2, 0.0, 0.5), mass=0.5, color=ORANGE))
-    m.joints.append(
-        Joint(
-            identifier="JOINT base-arm",
-            name="base-arm",
-            parent="BODY base",
-            child="BODY arm",
-            type="revolute",
-            parent_pivot=Vec3(0.0, 0.0, 0.0),
-            parent_axis=Vec3(0.0, 0.0, 1.0),
-            child_pivot=Vec3(-0.2, 0.0, 0.0),
-            child_axis=Vec3(0.0, 0.0, 1.0),
-            joint_limits=JointLimits(low=-2.0, high=2.0),
-            max_motor_impulse=0.05,
-        )
-    )
-    return m
+    base = _box("base", (0.05, 0.05, 0.05), (0.0, 0.0, 0.5))
+    arm = _box("arm", (0.3, 0.03, 0.03), (0.2, 0.0, 0.5), mass=0.5, color=ORANGE)
+    limits = JointLimits(low=-2.0, high=2.0)
+    z, pivot = Vec3(0.0, 0.0, 1.0), Vec3(-0.2, 0.0, 0.0)
+    return _on_a_post("arm", base, arm, "revolute", z, pivot, joint_limits=limits, max_motor_impulse=0.05)
 
 
 def build_slider() -> ModelFile:
     """A 0.5 kg, 10 cm block on a prismatic joint along x (gravity across it) from a static post,
     its limits ±5 cm: an effort pushes it onto a limit and holds it there, then the other way
     (``slider_effort.txt``): how a limit holds a slider against an effort."""
-    m = ModelFile(namespace="/ambf/env/slider/")
-    m.bodies.append(_box("post", (0.05, 0.05, 0.05), (0.0, 0.0, 0.5)))
-    m.bodies.append(_box("block", (0.1, 0.04, 0.04), (0.15, 0.0, 0.5), mass=0.5, color=ORANGE))
-    m.joints.append(
-        Joint(
-            identifier="JOINT post-block",
-            name="post-block",
-            parent="BODY post",
-            child="BODY block",
-            type="prismatic",
-            parent_pivot=Vec3(0.0, 0.0, 0.0),
-            parent_axis=Vec3(1.0, 0.0, 0.0),
-            child_pivot=Vec3(-0.15, 0.0, 0.0),
-            child_axis=Vec3(1.0, 0.0, 0.0),
-            joint_limits=JointLimits(low=-0.05, high=0.05),
-        )
-    )
-    return m
+    post = _box("post", (0.05, 0.05, 0.05), (0.0, 0.0, 0.5))
+    block = _box("block", (0.1, 0.04, 0.04), (0.15, 0.0, 0.5), mass=0.5, color=ORANGE)
+    x, pivot = Vec3(1.0, 0.0, 0.0), Vec3(-0.15, 0.0, 0.0)
+    return _on_a_post("slider", post, block, "prismatic", x, pivot, joint_limits=JointLimits(low=-0.05, high=0.05))
 
 
 #: the pendulums: (name, joint type, where its pivot hangs on the post (y), its tilt (roll, pitch))
