@@ -939,3 +939,26 @@ def test_a_cone_twist_joint_between_bodies_without_a_location_plays(tmp_path):
         assert np.asarray(world.body("b").com_position()) == pytest.approx([0.0, 0.0, -0.1], abs=1e-3)
     finally:
         world.close()
+
+
+def test_a_hinge_named_with_a_hash_is_not_read_as_a_six_dof_axis(tmp_path):
+    """The six-dof start picks its joints by kind, not by the `#` in the names it gives their
+    axes: a revolute joint named `a#b` plays (it failed with a KeyError), its arm falling about
+    its hinge (y) from level: 0.1 s later its centre has dropped (gravity across the axis)."""
+    f = tmp_path / "hash.yaml"
+    f.write_text(
+        "bodies: [BODY a, BODY b]\njoints: [JOINT a#b]\n"
+        "BODY a:\n  name: a\n  mass: 0.0\n  collision shape: BOX\n  collision geometry: {x: 0.05, y: 0.05, z: 0.05}\n"
+        "BODY b:\n  name: b\n  mass: 0.2\n  collision shape: BOX\n  collision geometry: {x: 0.2, y: 0.02, z: 0.02}\n"
+        "  location: {position: {x: 0.1, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
+        "JOINT a#b:\n  name: a#b\n  parent: BODY a\n  child: BODY b\n  type: revolute\n"
+        "  parent pivot: {x: 0.0, y: 0.0, z: 0.0}\n  child pivot: {x: -0.1, y: 0.0, z: 0.0}\n"
+        "  parent axis: {x: 0.0, y: 1.0, z: 0.0}\n  child axis: {x: 0.0, y: 1.0, z: 0.0}\n"
+    )
+    world = MujocoWorld(load_scene(f), Options(visuals=False, bodies="ambf", ground=False))
+    try:
+        world.run(0.1)
+        x, _y, z = np.asarray(world.body("b").com_position())
+        assert z < -0.01 and math.hypot(x, z) == pytest.approx(0.1, abs=1e-3)
+    finally:
+        world.close()

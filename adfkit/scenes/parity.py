@@ -2,11 +2,12 @@
 and adfkit (``adfkit parity``, docs/parity.md): a box dropped onto a slab, an arm on a revolute
 joint driven by position, velocity and effort commands (a command file for each), three boxes
 settling in a stack, a cube falling into a ghost object, the suture thread falling from a held
-needle. They need nothing but themselves: no corpus, no meshes. The launch file lists one model
-per scene on the same world (a floor); ``-l`` picks one. Beside them, outside the launch file,
-``turned_arm.yaml``: the arm with its inertial frame turned about the joint's axis (its inertia
-turned with it), which AMBF reads with the joint's zero turned (semantics.joint_frames), and its
-own ``turned_arm_position.txt``."""
+needle, a slider pushed onto its limits by efforts (a command file), four pendulums on p2p,
+cone-twist, six-dof and six-dof-spring joints. They need nothing but themselves: no corpus, no
+meshes. The launch file lists one model per scene on the same world (a floor); ``-l`` picks
+one. Beside them, outside the launch file, ``turned_arm.yaml``: the arm with its inertial frame
+turned about the joint's axis (its inertia turned with it), which AMBF reads with the joint's
+zero turned (semantics.joint_frames), and its own ``turned_arm_position.txt``."""
 
 from __future__ import annotations
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from ...model.pose import Pose
 from ...model.semantics import body_joint_frames
+from ..plan import SPRING_KINDS
 from ..rotations import euler_xyz, pose_to_matrix
 
 #: m or rad: a start value this near the joint's zero is its zero
@@ -32,8 +33,8 @@ def six_dof_start(model, data, joints) -> bool:
     parent BodyPlan, child BodyPlan, MuJoCo joint names) to the file's placements; whether any
     moved (then the caller runs mj_forward)."""
     moved = False
-    for joint, _kind, parent, child, names in joints:
-        if not any("#" in n for n in names):
+    for joint, kind, parent, child, names in joints:
+        if kind not in SPRING_KINDS:
             continue  # a one-DOF joint: the writer's `ref` already starts it where the file does
         a, b = body_joint_frames(joint, parent.body, child.body)
         in_a = np.linalg.inv(pose_to_matrix(parent.body.location or Pose()) @ pose_to_matrix(a))
