@@ -71,7 +71,7 @@ class SpringSet:
         self.form = form
         self.cid = cid
         self.world_gravity = np.asarray(gravity, dtype=float)
-        self.pq: dict[tuple, tuple] = {}  # (uid, -1) -> (position, quaternion) of each free body, as last read
+        self._poses: list = []  # each free body's (position, quaternion) as last read, in _base_keys' order
         self._order = None
         n = len(joints)
         if not n:
@@ -197,6 +197,12 @@ class SpringSet:
         out = -(k * x + c * v)
         return out if den is None else out / den
 
+    @property
+    def pq(self) -> dict[tuple, tuple]:
+        """{(uid, -1): (position, quaternion)} of each free body as last read (states()); made when
+        asked (the ghosts ask once a control step, the springs read at every physics step)."""
+        return dict(zip(self._base_keys, self._poses)) if self._poses else {}
+
     def _read_plan(self):
         """How to read every body's COM state with the fewest PyBullet calls: free bodies and
         multibody bases one by one (PyBullet has no batch call for them), the links of each
@@ -217,7 +223,7 @@ class SpringSet:
 
     def states(self):
         """(positions, rotation matrices, linear and angular velocities) of every body's COM;
-        the free bodies' (position, quaternion) stay in ``pq`` by (uid, -1) until the next read."""
+        the free bodies' (position, quaternion) stay for ``pq`` until the next read."""
         if self._order is None:
             self._read_plan()
         cid = self.cid
@@ -225,7 +231,7 @@ class SpringSet:
         get_pose, get_vel, get_links = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getLinkStates
         poses = [get_pose(uid, cid) for uid in bases]
         rows = [p + q + v + w for (p, q), (v, w) in zip(poses, [get_vel(uid, cid) for uid in bases])]
-        self.pq = dict(zip(self._base_keys, poses))
+        self._poses = poses
         for uid, ks in self._links:  # computeLinkVelocity, computeForwardKinematics
             rows += [s[0] + s[1] + s[6] + s[7] for s in get_links(uid, ks, 1, 1, cid)]
         a = np.fromiter(chain.from_iterable(rows), float, 13 * len(rows)).reshape(-1, 13)
