@@ -561,6 +561,7 @@ def _both_passes(w) -> tuple[dict, dict]:
     """(the ghosts' collision pass in their own world, ghost_pass.py; the dynamics world's own
     pass, which it stands in for), each made afresh now."""
     w._manifold_place = None
+    w._ghost_pass.last.clear()  # no ghost keeps its last answer
     own_world = w._manifold_points(w._acting_ghosts, {})
     w._manifold_place = None
     w._ghost_pass.counts = lambda *_: None  # the dynamics world's pass

@@ -1,0 +1,93 @@
+"""The ghosts' collision pass (runner/pybullet/ghost_pass.py) runs again only for the ghosts
+whose own pose or whose near bodies' poses moved by more than SAME_PLACE since their last pass:
+what it returns is what a pass of every ghost afresh returns."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+pb = pytest.importorskip("pybullet")
+
+from adfkit.adf import load_scene  # noqa: E402
+from adfkit.runner import Options, open_world  # noqa: E402
+from adfkit.runner.ghost_rules import SAME_PLACE  # noqa: E402
+from adfkit.runner.pybullet.ghost_pass import GhostPass  # noqa: E402
+
+BUNDLED = Path(__file__).resolve().parent.parent / "sample_scenes" / "suturing" / "launch.yaml"
+#: the options adfkit run and adfkit parity play a scene with (AMBF's ghosts, springs and bodies)
+AMBF = dict(visuals=False, ghosts="ambf", springs="ambf", bodies="ambf", control_substeps=4, ground=True)
+
+
+def _afresh(w, near, poses) -> dict:
+    """The counts of a pass of every ghost in ``near`` in a new ghosts' world (nothing kept)."""
+    fresh = GhostPass(w)
+    try:
+        return fresh.counts(near, poses)
+    finally:
+        fresh.close()
+
+
+def test_a_pass_of_the_ghosts_that_moved_counts_as_a_pass_of_all():
+    """The bundled suturing scene at rest under adfkit run's options: nine ghosts have bodies near
+    them (the thread in the phantom's holes, the PSMs' jaws in their fingers' ghosts), 20
+    penetrating points among them. Each control step some ghosts keep their last answer and the
+    others are passed again; every step the counts are those of a pass of all nine afresh."""
+    w = open_world(load_scene(BUNDLED, None), Options(**AMBF))
+    try:
+        w.step(100)
+        own, seen = w._ghost_pass, []
+        counts = own.counts
+
+        def checked(near, poses):
+            before = {uid: last[3] for uid, last in own.last.items()}
+            made = counts(near, poses)
+            kept = sum(1 for g, _pq, _keys in near if made[g.uid] is before.get(g.uid))
+            seen.append((len(near), kept, made == _afresh(w, near, poses), sum(sum(c.values()) for c in made.values())))
+            return made
+
+        own.counts = checked
+        w.step(20)
+    finally:
+        w.close()
+    assert len(seen) == 20 and all(same for _n, _k, same, _p in seen), seen
+    assert {(n, points) for n, _k, _s, points in seen} == {(9, 20)}, seen
+    kept = [k for _n, k, _s, _p in seen]
+    assert max(kept) > 0 and min(kept) < 9, kept  # some kept, some passed again
+
+
+def test_a_ghost_passes_again_once_a_body_near_it_moves_past_same_place(tmp_path):
+    """The parity scene's cube resting in its ghost slab (4 points, box-box): moved by half of
+    SAME_PLACE the ghost keeps its answer (the same dict, no pass); moved by twice SAME_PLACE, or
+    after a collision pair changed, it is passed again. Control: the cube moved out past the slab's
+    side to 1 mm from it (still near: within the contact threshold) gets what a pass afresh
+    makes, no penetrating point, not the 4 kept."""
+    from adfkit.scenes.parity import write_parity
+
+    w = open_world(load_scene(write_parity(tmp_path), [3]), Options(visuals=False, ghosts="ambf"))
+    try:
+        w.step(60)
+        (g,) = w.ghosts
+        cube = w.body("cube")
+        key = (cube.uid, -1)
+        gp = w._ghost_pass
+        ghost_pq = pb.getBasePositionAndOrientation(g.uid, physicsClientId=w.cid)
+        p, q = pb.getBasePositionAndOrientation(cube.uid, physicsClientId=w.cid)
+
+        def counts(dx: float = 0.0) -> dict:
+            at = ((p[0] + dx, p[1], p[2]), q)
+            return gp.counts([(g, ghost_pq, [key])], {key: at})
+
+        first = counts()
+        assert first == {g.uid: {key: 4}}
+        assert counts(0.5 * SAME_PLACE)[g.uid] is first[g.uid]  # kept: no pass
+        moved = counts(2 * SAME_PLACE)
+        assert moved == first and moved[g.uid] is not first[g.uid]  # passed again: the same points
+        w._pairs_epoch += 1  # as set_collision or a grasp does
+        assert counts(2 * SAME_PLACE)[g.uid] is not moved[g.uid]
+        out = counts(dx=0.071)  # the slab's side at x 0.05, the cube 20 mm from its centre to its side
+        afresh = _afresh(w, [(g, ghost_pq, [key])], {key: ((p[0] + 0.071, p[1], p[2]), q)})
+        assert out == afresh == {g.uid: {}}, (out, afresh)
+    finally:
+        w.close()
