@@ -3,11 +3,12 @@ and adfkit (``adfkit parity``, docs/parity.md): a box dropped onto a slab, an ar
 joint driven by position, velocity and effort commands (a command file for each), three boxes
 settling in a stack, a cube falling into a ghost object, the suture thread falling from a held
 needle, a slider pushed onto its limits by efforts (a command file), four pendulums on p2p,
-cone-twist, six-dof and six-dof-spring joints. They need nothing but themselves: no corpus, no
-meshes. The launch file lists one model per scene on the same world (a floor); ``-l`` picks
-one. Beside them, outside the launch file, ``turned_arm.yaml``: the arm with its inertial frame
-turned about the joint's axis (its inertia turned with it), which AMBF reads with the joint's
-zero turned (semantics.joint_frames), and its own ``turned_arm_position.txt``."""
+cone-twist, six-dof and six-dof-spring joints, a ball, a cylinder, a capsule and a cone dropped
+tilted on the floor. They need nothing but themselves: no corpus, no meshes. The launch file
+lists one model per scene on the same world (a floor); ``-l`` picks one. Beside them, outside
+the launch file, ``turned_arm.yaml``: the arm with its inertial frame turned about the joint's
+axis (its inertia turned with it), which AMBF reads with the joint's zero turned
+(semantics.joint_frames), and its own ``turned_arm_position.txt``."""
 
 from __future__ import annotations
 
@@ -40,7 +41,7 @@ GREY = RGBA(r=0.6, g=0.6, b=0.65, a=1.0)
 ORANGE = RGBA(r=0.9, g=0.5, b=0.1, a=1.0)
 
 #: the launch file's models, in order (-l INDEX)
-SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider", "pendulums")
+SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider", "pendulums", "primitives")
 
 #: command files beside the scenes: (file, scene, lines)
 COMMANDS = {
@@ -257,6 +258,70 @@ def build_thread() -> ModelFile:
     return m
 
 
+def _primitive(ident: str, shape: str, geometry: Geometry, inertia: Inertia, position, rpy) -> Body:
+    """A 0.2 kg body of one primitive shape (sphere, cylinder, capsule, cone), its inertia given."""
+    return Body(
+        identifier=f"BODY {ident}",
+        name=ident,
+        mass=0.2,
+        inertia=inertia,
+        location=Pose(Vec3(*position), rpy_to_quat(*rpy)),
+        shape=shape,
+        geometry=geometry,
+        collision_shape=shape,
+        collision_geometry=geometry,
+        color_rgba=ORANGE,
+    )
+
+
+def _about_axis(along: float, across: float) -> Inertia:
+    """A body's inertia about its centre with ``along`` about its axis (z) and ``across`` about
+    the two others, rounded as the files write it."""
+    return Inertia(ix=round(across, 9), iy=round(across, 9), iz=round(along, 9))
+
+
+#: the primitives: (name, shape, geometry, inertia of 0.2 kg, where its centre starts, its tilt (roll, pitch, yaw))
+PRIMITIVES = (
+    ("ball", "SPHERE", Geometry(radius=0.03), _about_axis(7.2e-5, 7.2e-5), (-0.3, 0.0, 0.06), (0.0, 0.0, 0.0)),
+    (
+        "cylinder",
+        "CYLINDER",
+        Geometry(radius=0.03, height=0.1, axis="z"),
+        _about_axis(0.2 * 0.03**2 / 2, 0.2 * (3 * 0.03**2 + 0.1**2) / 12),
+        (-0.1, 0.0, 0.08),
+        (1.0, 0.3, 0.0),
+    ),
+    (
+        "capsule",
+        "CAPSULE",
+        Geometry(radius=0.02, height=0.12, axis="z"),
+        _about_axis(0.2 * 0.02**2 / 2, 0.2 * (3 * 0.02**2 + 0.12**2) / 12),
+        (0.1, 0.0, 0.1),
+        (0.0, 0.45, 0.0),
+    ),
+    (
+        "cone",
+        "CONE",
+        Geometry(radius=0.03, height=0.1, axis="z"),
+        _about_axis(0.2 * 3 * 0.03**2 / 10, 0.2 * (3 * 0.03**2 / 20 + 3 * 0.1**2 / 80)),
+        (0.3, 0.0, 0.08),
+        (0.9, 0.0, 0.2),
+    ),
+)
+
+
+def build_primitives() -> ModelFile:
+    """A ball, a cylinder, a capsule and a cone, each 0.2 kg and 20 cm apart, dropped tilted
+    from a few centimetres onto the floor: the ball lands and stays, the cylinder lands on its
+    rim and topples onto its side, the capsule on one end and rolls over it onto its side, the
+    cone on its rim and onto its side, AMBF's default rolling friction (0.01) slowing each: how
+    each primitive collides and rolls."""
+    m = ModelFile(namespace="/ambf/env/primitives/")
+    for name, shape, geometry, inertia, position, rpy in PRIMITIVES:
+        m.bodies.append(_primitive(name, shape, geometry, inertia, position, rpy))
+    return m
+
+
 BUILD = {
     "drop": build_drop,
     "arm": build_arm,
@@ -265,6 +330,7 @@ BUILD = {
     "thread": build_thread,
     "slider": build_slider,
     "pendulums": build_pendulums,
+    "primitives": build_primitives,
 }
 
 
@@ -306,4 +372,5 @@ __all__ = [
     "build_thread",
     "build_slider",
     "build_pendulums",
+    "build_primitives",
 ]
