@@ -9,6 +9,7 @@ from ...converters.urdf import _material
 from ...diagnostics import warning
 from ...model.semantics import ShapeKind
 from ..collisions import collision_masks, convex_parts_note
+from .contacts import ambf_surface
 
 GHOST_GROUP = 4  # a ghost's geoms: never drawn, seen by no ray
 #: a ghost's contype under AMBF's rule: bit 31, which no collision group uses (plan.ALL_GROUPS), so it
@@ -78,7 +79,9 @@ def collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
             if (g.contype == 0 and g.conaffinity == 0) or g.group == GHOST_GROUP:
                 continue
             g.contype = g.conaffinity = mask
-            if fr is not None and fr.static is not None:
+            if world.opt.bodies == "ambf":  # AMBF's surfaces (contacts.ambf_surface)
+                ambf_surface(g, fr)
+            elif fr is not None and fr.static is not None:
                 g.friction = [fr.static, g.friction[1], fr.rolling if fr.rolling is not None else g.friction[2]]
     pairs = set()
     for j, _kind, parent, child, *_ in joints:

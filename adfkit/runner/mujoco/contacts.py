@@ -31,6 +31,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from ...model.semantics import DEFAULT_FRICTION_ROLLING, DEFAULT_FRICTION_STATIC
+
 #: contacts' time constant in physics steps: 2, the stiffest MuJoCo keeps stable
 CONTACT_TIMECONST_STEPS = 2
 #: the friction of the floor a model played alone gets: PyBullet's default, which the PyBullet
@@ -62,5 +64,14 @@ def ground_pairs(spec, ground, model, all_groups: int) -> None:
             continue  # static: nothing for the floor to push
         if not g.name:
             g.name = f"adfkit:geom{n}"
-        mu = GROUND_FRICTION * g.friction[0]
-        spec.add_pair(geomname1=ground.name, geomname2=g.name, condim=3, friction=[mu, mu, 0.0, 0.0, 0.0])
+        mu, roll = GROUND_FRICTION * g.friction[0], GROUND_FRICTION * g.friction[2]
+        spec.add_pair(geomname1=ground.name, geomname2=g.name, condim=6, friction=[mu, mu, 0.0, roll, roll])
+
+
+def ambf_surface(geom, friction) -> None:
+    """A body's geom as AMBF's btRigidBody: the file's friction, else AMBF's (static 0.5, rolling
+    0.01), no spinning friction, and its rolling friction played (condim 6)."""
+    static = friction.static if friction is not None and friction.static is not None else DEFAULT_FRICTION_STATIC
+    rolling = friction.rolling if friction is not None and friction.rolling is not None else DEFAULT_FRICTION_ROLLING
+    geom.friction = [static, 0.0, rolling]
+    geom.condim = 6
