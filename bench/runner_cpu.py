@@ -4,7 +4,12 @@ shapes) and under the legacy flags (``--springs implicit --ghosts hole-friction 
 pybullet``), alternated ``--rounds`` times on freshly built worlds so that both see the same load;
 then, with ``--profile``, where one second of each goes, by cProfile on CPU time.
 
-    .venv/bin/python bench/runner_cpu.py [--seconds S] [--rounds R] [--profile]
+    .venv/bin/python bench/runner_cpu.py [--seconds S] [--rounds R] [--profile] [--against REV]
+
+With ``--against REV`` it times, under the run / parity settings only, this tree's runner and the
+one at git revision REV (``git archive`` into a temporary folder) in fresh processes, alternated
+round by round, and prints both, their ratio and whether every body ended where the other's did
+(a change that only reorganises the runner keeps them bit for bit).
 
 The figure is this process's CPU time (``time.process_time``) of the stepping alone, as
 ``adfkit parity`` times its side (building the world and reading the samples left out). The
@@ -22,9 +27,13 @@ from __future__ import annotations
 import argparse
 import cProfile
 import dataclasses
+import hashlib
+import json
 import pstats
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -60,7 +69,8 @@ def run_defaults() -> dict:
     return {f.name: f.default for f in dataclasses.fields(Request) if f.name in RULES}
 
 
-def step_cpu(scene, rules: dict, seconds: float) -> float:
+def step_cpu(scene, rules: dict, seconds: float, digest: bool = False):
+    """CPU seconds of stepping; with ``digest``, (those, a digest of every body's final state)."""
     from adfkit.runner import open_world
 
     world = open_world(scene, options(rules), engine="pybullet")
@@ -68,9 +78,50 @@ def step_cpu(scene, rules: dict, seconds: float) -> float:
         n = int(round(seconds / (world.dt * world.opt.control_substeps)))
         c0 = time.process_time()
         world.step(n)
-        return time.process_time() - c0
+        cpu = time.process_time() - c0
+        if not digest:
+            return cpu
+        h = hashlib.sha256(repr([sb.state() for sb in world.bodies]).encode())
+        return cpu, h.hexdigest()[:12]
     finally:
         world.close()
+
+
+def child(root: str, seconds: float) -> int:
+    """One side of ``--against``: the runner under ``root`` (first on the path), run / parity settings."""
+    sys.path.insert(0, root)
+    from speed import scene_and_label
+
+    import adfkit
+
+    if not Path(adfkit.__file__).resolve().is_relative_to(Path(root).resolve()):
+        raise SystemExit(f"adfkit came from {adfkit.__file__}, not {root}")
+
+    scene, _ = scene_and_label()
+    cpu, digest = step_cpu(scene, run_defaults(), seconds, digest=True)
+    print(json.dumps({"cpu": cpu, "digest": digest}))
+    return 0
+
+
+def against(rev: str, seconds: float, rounds: int) -> None:
+    """This tree's runner and REV's, in fresh processes, alternated round by round."""
+    with tempfile.TemporaryDirectory() as old:
+        tar = subprocess.run(["git", "archive", rev, "adfkit"], cwd=ROOT, capture_output=True, check=True).stdout
+        subprocess.run(["tar", "-x", "-C", old], input=tar, check=True)
+        sides = {f"at {rev}": old, "this tree": str(ROOT)}
+        runs: dict[str, list] = {name: [] for name in sides}
+        for r in range(rounds):
+            for name in list(sides)[:: 1 if r % 2 == 0 else -1]:
+                cmd = [sys.executable, __file__, "--seconds", str(seconds), "--child", sides[name]]
+                out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
+                runs[name].append(json.loads(out.strip().splitlines()[-1]))
+    for name, got in runs.items():
+        cpu = [g["cpu"] for g in got]
+        print(f"  {name}: CPU {statistics.median(cpu):.2f} s (runs: {' '.join(f'{c:.2f}' for c in cpu)})")
+    new, base = ([g["cpu"] for g in runs[k]] for k in ("this tree", f"at {rev}"))
+    print(f"  this tree / {rev}: {statistics.median(new) / statistics.median(base):.3f} (median over median)")
+    same = {g["digest"] for got in runs.values() for g in got}
+    print(f"  final states: {'the same to the bit' if len(same) == 1 else 'differ: ' + ', '.join(sorted(same))}")
 
 
 def _name(key) -> str:
@@ -105,9 +156,17 @@ def main() -> int:
     ap.add_argument("--seconds", type=float, default=10.0)
     ap.add_argument("--rounds", type=int, default=1)
     ap.add_argument("--profile", action="store_true", help="also profile 1 s of each")
+    ap.add_argument("--against", metavar="REV", help="time this tree's runner against git revision REV's")
+    ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.child:
+        return child(args.child, args.seconds)
     from speed import scene_and_label
 
+    if args.against:
+        print(f"{args.seconds:g} s simulated, PyBullet, run / parity settings, {args.rounds} round(s) alternated")
+        against(args.against, args.seconds, args.rounds)
+        return 0
     scene, label = scene_and_label()
     settings = (("adfkit run / parity defaults", run_defaults()), ("legacy flags", LEGACY))
     print(f"scene: {label}; {args.seconds:g} s simulated, PyBullet, {args.rounds} round(s) alternated")

@@ -451,10 +451,17 @@ def test_ghost_velocity_under_a_slow_parent_is_the_general_sum_to_the_bit():
     """A ghost whose parent is at rest or slower than ALONG_FROM (a static phantom's hole ghosts,
     a resting arm's finger ghosts) takes ghost_velocity's short path, which must give what the
     general one gives, keep·(v - along) + v_parent with nothing along, to the last bit (the
-    runner's results may not move); a parent's -0.0 is kept as the general sum keeps it.
-    Control: a parent just faster than ALONG_FROM takes the general path, which gives the
-    parent's velocity along it, not the kept share."""
-    from adfkit.runner.ghost_rules import ALONG_FROM, AMBF_GHOST_KEEP, ghost_velocity, kept_under_slow_parent
+    runner's results may not move); a parent's -0.0 is kept as the general sum keeps it. So
+    must ghost_accelerations' (a jointed body's), (v' - v) / cdt in floats. Control: a parent
+    just faster than ALONG_FROM takes the general path, which gives the parent's velocity
+    along it, not the kept share."""
+    from adfkit.runner.ghost_rules import (
+        ALONG_FROM,
+        AMBF_GHOST_KEEP,
+        ghost_accelerations,
+        ghost_velocity,
+        kept_under_slow_parent,
+    )
 
     rng = np.random.default_rng(7)
     slow = ALONG_FROM * 0.999 / np.sqrt(3.0)
@@ -469,10 +476,15 @@ def test_ghost_velocity_under_a_slow_parent_is_the_general_sum_to_the_bit():
             assert float(np.linalg.norm(va)) <= ALONG_FROM  # the general path takes nothing along
             want_v, want_w = keep * (np.asarray(v) - np.zeros(3)) + va, keep * np.asarray(w)
             assert v2.tobytes() == want_v.tobytes() and w2.tobytes() == want_w.tobytes()
+            a, alpha = ghost_accelerations(v, w, parent, points, 0.004)
+            assert a.tobytes() == ((want_v - np.asarray(v)) / 0.004).tobytes()
+            assert alpha.tobytes() == ((want_w - np.asarray(w)) / 0.004).tobytes()
     fast = (ALONG_FROM * 1.001, 0.0, 0.0)
     assert kept_under_slow_parent([1.0, 2.0, 0.0], [0.0] * 3, fast, 16) is None
     v2, _ = ghost_velocity([1.0, 2.0, 0.0], [0.0, 0.0, 0.0], fast, 16)
     assert v2[0] == pytest.approx(fast[0]) and v2[1] == pytest.approx(2.0 * AMBF_GHOST_KEEP**16)
+    a, _ = ghost_accelerations([1.0, 2.0, 0.0], [0.0, 0.0, 0.0], fast, 16, 0.004)
+    assert a[0] == pytest.approx((fast[0] - 1.0) / 0.004)  # along the parent: its velocity, not the kept share
 
 
 @pytest.mark.parametrize("engine", ["pybullet", "mujoco"])

@@ -80,6 +80,7 @@ class SpringSet:
         fa, fb = st([j.frame_a for j in joints]), st([j.frame_b for j in joints])
         self.ra_in_p, self.pa_in_p = fa[:, :3, :3], fa[:, :3, 3]
         self.rb_in_c, self.pb_in_c = fb[:, :3, :3], fb[:, :3, 3]
+        self.r_in_ends = np.concatenate((self.ra_in_p, self.rb_in_c))  # frames A then B, in their bodies
         for name in (
             "lin_low",
             "lin_high",
@@ -103,6 +104,7 @@ class SpringSet:
         idx = {id(b): i for i, b in enumerate(bodies)}
         self.ip = np.array([idx[id(j.parent)] for j in joints])
         self.ic = np.array([idx[id(j.child)] for j in joints])
+        self.ends = np.concatenate((self.ip, self.ic))  # each joint's parent, then each joint's child
         # incidence: a joint's torque acts + on its child and - on its parent; summing per body
         # is one matrix product (np.add.at is ten times slower at this size)
         self.to_child = np.zeros((n, len(bodies)))
@@ -128,8 +130,11 @@ class SpringSet:
         fl = self.free_lin
         # the free-linear joints' constant blocks, sliced once (the same values every step)
         self.fl_ip, self.fl_ic = self.ip[fl], self.ic[fl]
-        self.fl_pa = self.pa_in_p[fl][:, :, None]
-        self.fl_pb = self.pb_in_c[fl][:, :, None]
+        # the pivots in their bodies (A in the parent's, then B in the child's), and the bodies the
+        # force at pivot B turns (the child's, then the parent's): each block one product
+        self.fl_ends = np.concatenate((self.fl_ip, self.fl_ic))
+        self.fl_p_ends = np.concatenate((self.pa_in_p[fl], self.pb_in_c[fl]))[:, :, None]
+        self.fl_arms = np.concatenate((self.fl_ic, self.fl_ip))
         self.fl_eq, self.fl_low, self.fl_high = self.eq_lin[fl], self.lin_low[fl], self.lin_high[fl]
         self.fl_active = self.fl_low <= self.fl_high
         self.fl_m = self.m_eff[fl][:, None]
@@ -244,25 +249,29 @@ class SpringSet:
             return
         self._gains(dt)
         pos, rot, lv, av = self.states()
-        ip, ic = self.ip, self.ic
-        ra = rot[ip] @ self.ra_in_p  # joint frame A in the world
+        ip, ic, n = self.ip, self.ic, len(self.joints)
+        frames = rot[self.ends] @ self.r_in_ends  # joint frames A, then B, in the world
+        ra = frames[:n]
         rat = ra.transpose(0, 2, 1)
-        rel = rat @ (rot[ic] @ self.rb_in_c)  # frame B in frame A
+        rel = rat @ frames[n:]  # frame B in frame A
         ang = euler_xyz(rel)
         w_rel = (rat @ (av[ic] - av[ip])[:, :, None])[..., 0]
         # angular springs and limits, in joint frame A, turned into the world
         i_eff = self.i_eff_col
         tau = self._spring(self._ang, ang - self.eq_ang, w_rel)
-        tau += self._limit(ang, w_rel + tau * dt / i_eff, self.ang_low, self.ang_high, i_eff, dt, erp, self.ang_active)
+        tau += self._limit(
+            ang, lambda: w_rel + tau * dt / i_eff, self.ang_low, self.ang_high, i_eff, dt, erp, self.ang_active
+        )
         torque = self.net @ (ra @ tau[:, :, None])[..., 0]
         force = None
         fl = self.free_lin
         if fl.size:
             # free linear axes: spring, damper and limits on the pivot offset in frame A; a
             # force at the pivot = the same force at the COM plus its moment about the COM
-            fp, fc = self.fl_ip, self.fl_ic
-            pa = pos[fp] + (rot[fp] @ self.fl_pa)[..., 0]
-            pbw = pos[fc] + (rot[fc] @ self.fl_pb)[..., 0]
+            fp, fc, k = self.fl_ip, self.fl_ic, fl.size
+            ends = self.fl_ends
+            pivots = pos[ends] + (rot[ends] @ self.fl_p_ends)[..., 0]
+            pa, pbw = pivots[:k], pivots[k:]
             raft = rat[fl]
             d = (raft @ (pbw - pa)[:, :, None])[..., 0]
             v_rel = (raft @ (lv[fc] - lv[fp])[:, :, None])[..., 0]
@@ -278,7 +287,10 @@ class SpringSet:
             )
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
             force = self.fl_net @ f_w
-            torque += self.fl_child_t @ _cross(pbw - pos[fc], f_w) - self.fl_parent_t @ _cross(pbw - pos[fp], f_w)
+            moments = _cross(
+                np.tile(pbw, (2, 1)) - pos[self.fl_arms], np.tile(f_w, (2, 1))
+            )  # about the child's, the parent's COM
+            torque += self.fl_child_t @ moments[:k] - self.fl_parent_t @ moments[k:]
         torque = torque.tolist()
         if force is not None:
             force, pos = force.tolist(), pos.tolist()
@@ -292,13 +304,16 @@ class SpringSet:
     @staticmethod
     def _limit(x, v, low, high, inertia, dt, erp, active=None):
         """Velocity-correcting force that keeps x within [low, high] (low > high: free, Bullet):
-        it drives a violation back at -erp·err/dt and only ever pushes, never pulls."""
+        it drives a violation back at -erp·err/dt and only ever pushes, never pulls. ``v`` may be
+        a callable giving it, called only where a limit is crossed."""
         if active is None:
             active = low <= high
         over = active & (x > high)
         under = active & (x < low)
         if not (over.any() or under.any()):
             return 0.0
+        if callable(v):
+            v = v()
         err = np.where(over, x - high, np.where(under, x - low, 0.0))
         f = inertia * (-erp * err / dt - v) / dt
         return np.where(over, np.minimum(f, 0.0), np.where(under, np.maximum(f, 0.0), 0.0))
