@@ -9,7 +9,7 @@ Scenes: the project's own (`adfkit build-scene parity`: a dropped box, an arm un
 velocity and effort commands, a stack of boxes, a cube into a ghost, the thread falling from a
 held needle, a slider on its limits, pendulums, primitives dropped tilted on the floor, the arm with a
 turned inertial frame), the bundled sample scenes at rest and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
-own floor (from the AMBF tree), and the KUKA and a PSM under joint programs (parity.programs);
+own floor (from the AMBF tree), and the KUKA, a PSM, the ECM and the MTM under joint programs (parity.programs);
 with --corpus-at-rest, more corpus files AMBF loads (AT_REST), at rest for 1 s in both engines.
 With --suture, only the suture replayed in AMBF (``adfkit parity --suture --follow both --pace
 both``, 4 pairs, seed 0) on the bundled scene and the corpus set, a row per pair: each side's
@@ -111,6 +111,8 @@ def corpus_scenes(build, folder: Path) -> list[Scene]:
     robots = (
         ("KUKA", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml"),
         ("PSM (LND 400006)", CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml"),
+        ("ECM (loops)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml"),
+        ("MTM (loop)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml"),
     )
     for label, model in robots:
         for kind in ("position", "velocity", "effort"):

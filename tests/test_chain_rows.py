@@ -168,3 +168,29 @@ def test_a_chain_of_three_hinges_solves_as_bullets_sweeps_written_out():
     ten = solve(bodies, joints, 1e-3)
     assert ten == pytest.approx(_reference_pgs(bodies, joints, 1e-3, 10), abs=1e-12)
     assert not np.allclose(ten, solve(bodies, joints, 1e-3, iterations=1), atol=1e-6)
+
+
+def _hung(cfm: float, gap: float = 0.0):
+    """A 2 kg body (0.01 kg·m²) hung by a p2p joint 0.1 m above its centre from a static body,
+    moving 1 m/s sideways; ``gap``: the child's pivot that far (along x) from the parent's."""
+    base = Body(np.zeros(3), 0.0, np.zeros((3, 3)), np.zeros(3), np.zeros(3))
+    bob = Body(np.array([gap, 0.0, -R]), 1 / M, np.eye(3) / I, np.array([1.0, 0.0, 0.0]), np.zeros(3))
+    x = np.eye(3)[0]
+    point = Joint("p2p", 0, 1, np.array([gap, 0.0, 0.0]), x, x, 0.0, 0.0, 0.1, cfm=cfm)
+    point.pivot_a = np.zeros(3)
+    return [base, bob], [point]
+
+
+def test_a_point_joint_stops_its_pivot_as_worked_by_hand():
+    """btPoint2PointConstraint's rows on a bob moving 1 m/s across its pivot: the x row pushes at
+    the pivot with P, v = 1 + P/m, ω_y = 0.1·P/I; the pivot still: 1 + P (1/m + 0.01/I) = 0,
+    P = −2/3: v = 2/3 m/s, ω_y = −20/3 rad/s. AMBF sets the joint's cfm (0.1 unless the file
+    gives one) on its rows, unscaled: (−1 − 1.5·P) / 1.5 = 0.1·P, P = −1/1.65 (the bob keeps
+    0.697 m/s). A pivot 1 mm open is closed at erp/dt: the pivot moves back at 0.1 m/s."""
+    bodies, joints = _hung(0.0)
+    v = solve(bodies, joints, 1e-3, iterations=50)[1]
+    assert v == pytest.approx([2 / 3, 0, 0, 0, -20 / 3, 0], abs=1e-9)
+    soft = solve(*_hung(0.1), 1e-3, iterations=400)[1]
+    assert soft[0] == pytest.approx(1 - 1 / 1.65 / M, rel=1e-9)
+    opened = solve(*_hung(0.0, gap=1e-3), 1e-3, iterations=50)[1]
+    assert opened[0] + opened[4] * R == pytest.approx(-0.1 * 1e-3 / 1e-3, abs=1e-9)

@@ -50,7 +50,7 @@ class Body:
 
 @dataclass
 class Joint:
-    """A hinge ("revolute") or slider ("prismatic") from body ``parent`` (Bullet's A) to
+    """A hinge ("revolute"), slider ("prismatic") or point joint ("p2p") from body ``parent`` (Bullet's A) to
     ``child`` (B). ``pivot``: the child's joint frame origin in the world; ``axis``: the hinge
     axis or the slide direction; ``y``: the parent's joint frame y axis (a hinge's fallback
     direction). ``position``/``velocity``: the joint's; ``limits`` when enabled; ``motor``:
@@ -73,6 +73,7 @@ class Joint:
     pivot_a: np.ndarray | None = None
     axis_b: np.ndarray | None = None
     twist: float = 0.0
+    cfm: float = 0.0  # a point joint's rows' (AMBF sets the joint's cfm on a btPoint2PointConstraint)
 
     def errors(self) -> tuple[np.ndarray, np.ndarray]:
         """The pivots' gap (child's less parent's) and the axes' cross product (parent's ×
@@ -240,6 +241,21 @@ def slider_rows(rows: Rows, bodies, jt: Joint, dt: float) -> None:
     rows.add(a, b, _Z, ax, _Z, -ax, k * jt.twist)
 
 
+def point_rows(rows: Rows, bodies, jt: Joint, dt: float) -> None:
+    """btPoint2PointConstraint::getInfo2NonVirtual, AMBF's p2p joint: three rows holding the
+    child's pivot on the parent's, at the joint's erp and cfm."""
+    A, B = bodies[jt.parent], bodies[jt.child]
+    pivot_a = jt.pivot if jt.pivot_a is None else jt.pivot_a
+    rel_a, rel_b = pivot_a - A.com, jt.pivot - B.com
+    ofs = jt.pivot - pivot_a
+    k = jt.erp / dt
+    for e in np.eye(3):
+        rows.add(jt.parent, jt.child, e, cross3(rel_a, e), -e, -cross3(rel_b, e), k * float(e @ ofs), jt.cfm)
+
+
+_ROWS = {"revolute": hinge_rows, "prismatic": slider_rows, "p2p": point_rows}
+
+
 def island_order(n: int) -> list[int]:
     """The order Bullet's solver takes ``n`` constraints of one island in: the world's list
     sorted by island (btAlignedObjectArray::quickSort, not stable: equal keys are swapped), the
@@ -276,7 +292,7 @@ def solve(
     rows = Rows()
     for k in island_order(len(joints)):
         jt = joints[added[k]]
-        (hinge_rows if jt.kind == "revolute" else slider_rows)(rows, bodies, jt, dt)
+        _ROWS[jt.kind](rows, bodies, jt, dt)
     n, m = len(bodies), len(rows.c)
     J = np.zeros((m, 6 * n))
     r = np.arange(m)[:, None]

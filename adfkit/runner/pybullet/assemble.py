@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pybullet as pb
 
-from ...model.semantics import JointKind, body_joint_frames, joint_kind, pose_or_identity
+from ...model.semantics import JointKind, joint_kind, pose_or_identity
 from .. import ambf_bodies
 from ..cameras import build_cameras
 from ..collisions import HULL_OVERLAP, collision_masks, hull_overlaps, one_hull
@@ -34,19 +34,13 @@ from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
 from .damping import LinkDamping
 from .ghost_pass import GhostPass
 from .interact import SimActuator, SimGhost, SimSensor
-from .joints import ConstraintRefused, make_constraint, spring_joint
+from .joints import ConstraintRefused, com_frames, make_constraint, spring_joint
 from .limit_rows import LimitRows
 from .loops import close_loops
 from .meshfiles import pybullet_reads_quietly
 from .shapes import collision_parts, create_collision, create_visual
 from .spring_forces import SpringSet
 from .volumes import build_volumes
-
-
-def _com_frames(joint, parent, child):
-    """The joint's frames in its parent's and its child's centre-of-mass frames."""
-    a, b = body_joint_frames(joint, parent.body, child.body)
-    return invert(parent.com_in_body) @ pose_to_matrix(a), invert(child.com_in_body) @ pose_to_matrix(b)
 
 
 class Assembly:
@@ -116,11 +110,11 @@ class Assembly:
         for _root, recs in trees:  # limited springs in a multibody: their limits are its joints'
             for j, kind, parent, child in recs:
                 if kind in SPRING_KINDS:
-                    sj = spring_alone(spring_joint(j, kind, parent, child, *_com_frames(j, parent, child)))
+                    sj = spring_alone(spring_joint(j, kind, parent, child, *com_frames(j, parent, child)))
                     springs += [sj] if sj is not None else []
         self.fixed_frames = []  # (joint name, parent, child, joint frame rotation in each)
         for j, kind, parent, child in leftover:
-            fa, fb = _com_frames(j, parent, child)
+            fa, fb = com_frames(j, parent, child)
             self.joint_names.append(j.identifier)
             sj = None
             if kind in SPRING_KINDS:

@@ -1,8 +1,11 @@
 """A multibody read as AMBF's chain of btRigidBodies for one physics step of its solver
 (runner/chain_rows.py): each link and the base a body at its centre of mass with its
-velocities, damped over the step as Bullet damps them and given the step's gravity; each
-revolute or prismatic joint a hinge or slider at the link's joint frame. Only for a multibody
-whose joints are all revolute or prismatic; anything else is left to the joint-space rows."""
+velocities, damped over the step as Bullet damps them and given the step's gravity and the
+last step's contact forces; each revolute or prismatic joint a hinge or slider at the link's
+joint frame; each hinge or p2p joint closing a loop between two of its links (a parallelogram,
+the ECM's remote centre) the btHingeConstraint or btPoint2PointConstraint AMBF makes of it, its
+motor off. Only for a multibody whose joints are all revolute or prismatic and whose loops are
+closed by hinges or points; anything else is left to the joint-space rows."""
 
 from __future__ import annotations
 
@@ -11,12 +14,13 @@ import math
 import numpy as np
 import pybullet as pb
 
-from ...model.semantics import JointKind
-from ..chain_rows import Body, Joint, cross3, joint_velocities, solve
+from ...model.semantics import JointKind, joint_kind
+from ..chain_rows import Body, Joint, cross3, joint_velocities, plane_space, solve
 from ..damping import decay_rates
-from ..joint_commands import AMBF_JOINT_ERP, limits_of
+from ..joint_commands import AMBF_JOINT_ERP, DEFAULT_JOINT_CFM, limits_of
 from ..rotations import quat_to_matrix
 from .articulation import ROTARY
+from .joints import com_frames
 
 
 class ChainModel:
@@ -49,15 +53,30 @@ class ChainModel:
         self.apart = np.zeros((n + 1, 6))
         self.drift = np.zeros((n + 1, 6))
         self.step = -2  # the physics step it was last played at: a step missed, nothing is carried
-        in_file = {id(j): i for i, j in enumerate(j for m in world.scene.all_models() for j in m.joints)}
-        self.added = sorted(range(n), key=lambda k: in_file.get(id(art.records[k][0]), k))
         self.joints = []  # (parent body, kind, limits, erp)
         for k, rec in enumerate(art.records):
             joint = rec[0]
             parent = pb.getJointInfo(art.uid, k, physicsClientId=cid)[16]
-            erp = joint.joint_erp if joint.joint_erp is not None else AMBF_JOINT_ERP
             kind = "revolute" if art.kinds[k] in ROTARY else "prismatic"
-            self.joints.append((parent + 1, kind, limits_of(joint), erp))
+            self.joints.append((parent + 1, kind, limits_of(joint), _erp(joint)))
+        self.loops = _loops(world, art)
+        if self.loops is None:
+            self.ok = False
+            return
+        in_file = {id(j): i for i, j in enumerate(j for m in world.scene.all_models() for j in m.joints)}
+        joints = [rec[0] for rec in art.records] + [loop[0] for loop in self.loops]
+        self.added = sorted(range(len(joints)), key=lambda k: in_file.get(id(joints[k]), k))
+
+    def _contacts(self, bodies, coms) -> None:
+        """The contacts' impulses of the last step given to the chain's bodies for this one:
+        AMBF solves its contact rows with the joints' rows, so its motors do not push through a
+        contact; the chain's rows see the contact as the push it gave (the corpus ECM's yaw link
+        on the floor under a velocity program: 51.8 mm from AMBF without it, 8.2 mm with it)."""
+        for k, force, at in _contact_pushes(self.uid, self.cid):
+            bd = bodies[k]
+            if bd.inv_mass > 0.0:
+                bd.v = bd.v + force * self.dt * bd.inv_mass
+                bd.w = bd.w + bd.inv_inertia @ cross3(at - coms[k], force) * self.dt
 
     def velocities(
         self, motors: dict[int, tuple[float, float, float]], efforts: dict[int, float], step: int
@@ -123,6 +142,26 @@ class ChainModel:
             if kind == "revolute":  # the limit's bounce reads the bodies' own (damped) turn
                 jt.velocity = float((bodies[b].w - bodies[a].w) @ axis_a)
             joints.append(jt)
+        for kind, joint, a, pa, axis_a, b, pbv, fa, fb in self.loops:  # the joints closing loops
+            ta, tb = d[a, 3:], d[b, 3:]
+            pivot_a, pivot_b = coms[a] + rots[a] @ pa, coms[b] + rots[b] @ pbv
+            pivot_a = pivot_a + d[a, :3] + cross3(ta, pivot_a - coms[a])
+            pivot_b = pivot_b + d[b, :3] + cross3(tb, pivot_b - coms[b])
+            if kind == "p2p":
+                jt = Joint("p2p", a, b, pivot_b, _X, _X, 0.0, 0.0, _erp(joint), cfm=_cfm(joint))
+                jt.pivot_a = pivot_a
+                joints.append(jt)
+                continue
+            axis, axis_b = rots[a] @ axis_a, rots[b] @ fb[:3, 2]
+            axis, axis_b = axis + cross3(ta, axis), axis_b + cross3(tb, axis_b)
+            axis, axis_b = axis / np.linalg.norm(axis), axis_b / np.linalg.norm(axis_b)
+            xa, xb = rots[a] @ fa[:3, 0], rots[b] @ fb[:3, 0]  # the hinge's angle, as the joint reads
+            angle = math.atan2(float(cross3(xa, xb) @ axis), float(xa @ xb)) + float((tb - ta) @ axis)
+            jt = Joint("revolute", a, b, pivot_b, axis, plane_space(axis)[0], angle, 0.0, _erp(joint), limits_of(joint))
+            jt.pivot_a, jt.axis_b = pivot_a, axis_b
+            jt.velocity = float((bodies[b].w - bodies[a].w) @ axis)
+            joints.append(jt)
+        self._contacts(bodies, coms)
         for k, effort in efforts.items():  # AMBF's commandEffort: the torque (force) on both bodies
             jt = joints[k]
             for b, sign in ((jt.child, 1.0), (jt.parent, -1.0)):
@@ -143,6 +182,60 @@ class ChainModel:
         back = rots.transpose(0, 2, 1)
         self.apart, self.drift = _turned(back, apart), _turned(back, drift)
         return qd
+
+
+def _contact_pushes(uid: int, cid: int) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """(body index, force, point) of every contact on the multibody ``uid`` in the last step:
+    the normal force and both friction forces, on each of its links a contact touches."""
+    out = []
+    for c in pb.getContactPoints(bodyA=uid, physicsClientId=cid):
+        force = c[9] * np.asarray(c[7]) + c[10] * np.asarray(c[11]) + c[12] * np.asarray(c[13])
+        if c[1] == uid:
+            out.append((c[3] + 1, force, np.asarray(c[5])))
+        if c[2] == uid:
+            out.append((c[4] + 1, -force, np.asarray(c[6])))
+    return out
+
+
+def _erp(joint) -> float:
+    return joint.joint_erp if joint.joint_erp is not None else AMBF_JOINT_ERP
+
+
+def _cfm(joint) -> float:
+    return joint.joint_cfm if joint.joint_cfm is not None else DEFAULT_JOINT_CFM
+
+
+_X = np.array([1.0, 0.0, 0.0])
+
+
+def _loops(world, art) -> list[tuple] | None:
+    """The joints that close loops of ``art``, AMBF's btHingeConstraints (motor off) and
+    btPoint2PointConstraints solved with the chain's rows: (kind, joint, parent body, its
+    pivot and axis in the parent's COM frame, child body, its pivot in the child's (where the
+    loop was closed, loops.py), the joint's frames' rotations in each). None where a loop is
+    closed by another kind of joint."""
+    ends: dict[str, list] = {}
+    for name, _c, parent, child, pa, pbv, axis in world.constraints:
+        if parent.articulation is art and child.articulation is art:
+            ends.setdefault(name, []).append((parent, child, pa, pbv, axis))
+    joints = {j.identifier: j for j, _p, _c in world.joints_made}
+    loops = []
+    for name, rows in ends.items():
+        joint = joints.get(name)
+        kind = joint_kind(joint.type) if joint is not None else None
+        parent, child = rows[0][:2]
+        if kind is JointKind.P2P and len(rows) == 1:  # built as one point constraint (joints.py)
+            loops.append(("p2p", joint, parent.link + 1, rows[0][2], None, child.link + 1, rows[0][3], None, None))
+            continue
+        if kind is not JointKind.REVOLUTE or len(rows) != 2 or rows[0][4] is not None:
+            return None
+        (pa0, pb0), (pa1, pb1) = (r[2:4] for r in rows)  # two points along its axis (joints.py)
+        fa, fb = com_frames(joint, parent, child)
+        axis = (pa1 - pa0) / np.linalg.norm(pa1 - pa0)
+        loops.append(
+            ("revolute", joint, parent.link + 1, (pa0 + pa1) / 2, axis, child.link + 1, (pb0 + pb1) / 2, fa, fb)
+        )
+    return loops
 
 
 def _turned(rots: np.ndarray, six: np.ndarray) -> np.ndarray:

@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from ...model.semantics import JointKind
-from ..rotations import matrix_to_pq, pose_matrix
+from ...model.semantics import JointKind, body_joint_frames
+from ..rotations import invert, matrix_to_pq, pose_matrix, pose_to_matrix
 from ..springs import spring_joint  # noqa: F401 - built here for PyBullet
 
 FIXED_SPAN = 0.005  # m: the pivots' span of a fixed joint whose origin is at the child's centre of mass
@@ -50,6 +50,12 @@ _JTYPE_NAMES = {
     pb.JOINT_PRISMATIC: "prismatic",
     pb.JOINT_GEAR: "gear",
 }
+
+
+def com_frames(joint, parent, child) -> tuple[np.ndarray, np.ndarray]:
+    """The joint's frames (4x4) in its parent's and its child's centre-of-mass frames."""
+    a, b = body_joint_frames(joint, parent.body, child.body)
+    return invert(parent.com_in_body) @ pose_to_matrix(a), invert(child.com_in_body) @ pose_to_matrix(b)
 
 
 def make_constraint(
