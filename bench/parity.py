@@ -7,8 +7,8 @@ gaps over time there. Asserts nothing; skips, with the reason, without an AMBF b
 
 Scenes: the project's own (`adfkit build-scene parity`: a dropped box, an arm under position,
 velocity and effort commands, a stack of boxes, a cube into a ghost, the thread falling from a
-held needle, a slider on its limits, pendulums, primitives dropped tilted on the floor, the arm with a
-turned inertial frame), the bundled sample scenes at rest and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
+held needle, a slider on its limits, pendulums, primitives dropped tilted on the floor, a ramp,
+two boxes on a fixed joint, the arm with a turned inertial frame), the bundled sample scenes at rest and, where the corpus is beside the checkout, the suturing set, the puzzle on AMBF's
 own floor (from the AMBF tree), and the KUKA, a PSM, the ECM and the MTM under joint programs (parity.programs);
 with --corpus-at-rest, more corpus files AMBF loads (AT_REST), at rest for 1 s in both engines.
 With --suture, only the suture replayed in AMBF (``adfkit parity --suture --follow both --pace
@@ -66,6 +66,8 @@ def own_scenes(folder: Path) -> list[Scene]:
     )
     out.append(Scene("pendulums on p2p, cone-twist, six-dof and six-dof-spring joints", launch, [6], 1.0, both))
     out.append(Scene("ball, cylinder, capsule and cone dropped tilted on the floor", launch, [7], 1.0, both))
+    out.append(Scene("balls and a cylinder sliding down a 25° ramp", launch, [8], 1.0, both))
+    out.append(Scene("two boxes on a fixed joint dropped onto an edge", launch, [9], 1.0, both))
     out.append(
         Scene(
             "arm with a turned inertial frame, position commands",

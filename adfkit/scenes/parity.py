@@ -33,6 +33,7 @@ from ..model import (
     Vec3,
     World,
 )
+from ..model.common import Friction
 from ..model.objects import AxesGains, Inertia, Vec3Range
 from ..model.pose import rpy_to_quat
 from .suturing_pad import build_floor
@@ -41,7 +42,7 @@ GREY = RGBA(r=0.6, g=0.6, b=0.65, a=1.0)
 ORANGE = RGBA(r=0.9, g=0.5, b=0.1, a=1.0)
 
 #: the launch file's models, in order (-l INDEX)
-SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider", "pendulums", "primitives")
+SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider", "pendulums", "primitives", "ramp", "fixed_pair")
 
 #: command files beside the scenes: (file, scene, lines)
 COMMANDS = {
@@ -258,7 +259,7 @@ def build_thread() -> ModelFile:
     return m
 
 
-def _primitive(ident: str, shape: str, geometry: Geometry, inertia: Inertia, position, rpy) -> Body:
+def _primitive(ident: str, shape: str, geometry: Geometry, inertia: Inertia, position, rpy, **keys) -> Body:
     """A 0.2 kg body of one primitive shape (sphere, cylinder, capsule, cone), its inertia given."""
     return Body(
         identifier=f"BODY {ident}",
@@ -271,6 +272,7 @@ def _primitive(ident: str, shape: str, geometry: Geometry, inertia: Inertia, pos
         collision_shape=shape,
         collision_geometry=geometry,
         color_rgba=ORANGE,
+        **keys,
     )
 
 
@@ -282,13 +284,13 @@ def _about_axis(along: float, across: float) -> Inertia:
 
 #: the primitives: (name, shape, geometry, inertia of 0.2 kg, where its centre starts, its tilt (roll, pitch, yaw))
 PRIMITIVES = (
-    ("ball", "SPHERE", Geometry(radius=0.03), _about_axis(7.2e-5, 7.2e-5), (-0.3, 0.0, 0.06), (0.0, 0.0, 0.0)),
+    ("ball", "SPHERE", Geometry(radius=0.03), _about_axis(7.2e-5, 7.2e-5), (-0.3, -0.6, 0.06), (0.0, 0.0, 0.0)),
     (
         "cylinder",
         "CYLINDER",
         Geometry(radius=0.03, height=0.1, axis="z"),
         _about_axis(0.2 * 0.03**2 / 2, 0.2 * (3 * 0.03**2 + 0.1**2) / 12),
-        (-0.1, 0.0, 0.08),
+        (-0.1, -0.6, 0.08),
         (1.0, 0.3, 0.0),
     ),
     (
@@ -296,7 +298,7 @@ PRIMITIVES = (
         "CAPSULE",
         Geometry(radius=0.02, height=0.12, axis="z"),
         _about_axis(0.2 * 0.02**2 / 2, 0.2 * (3 * 0.02**2 + 0.12**2) / 12),
-        (0.1, 0.0, 0.1),
+        (0.1, -0.6, 0.1),
         (0.0, 0.45, 0.0),
     ),
     (
@@ -304,7 +306,7 @@ PRIMITIVES = (
         "CONE",
         Geometry(radius=0.03, height=0.1, axis="z"),
         _about_axis(0.2 * 3 * 0.03**2 / 10, 0.2 * (3 * 0.03**2 / 20 + 3 * 0.1**2 / 80)),
-        (0.3, 0.0, 0.08),
+        (0.3, -0.6, 0.08),
         (0.9, 0.0, 0.2),
     ),
 )
@@ -322,6 +324,61 @@ def build_primitives() -> ModelFile:
     return m
 
 
+#: the ramp's slope (rad, 25°): past atan(0.01 / 0.03), where AMBF's default rolling friction
+#: (0.01 m) no longer holds a 3 cm ball still on it
+RAMP_SLOPE = 0.44
+
+
+def build_ramp() -> ModelFile:
+    """A 3 cm ball and a 3 cm cylinder lying across the slope, each 0.2 kg, released 1 mm above
+    a static 1.6 m ramp at 25°, 60 cm up it, and beside them a ball without rolling friction: in
+    AMBF the first two slide down it without turning, their rolling friction (AMBF's default 0.01
+    m, the ball's times the ramp's friction and the ramp's times the ball's: 0.01) holding them
+    against the friction's torque (0.25 × 3 cm × the normal force), where the third's (0.005)
+    does not; all stay on it for 1 s."""
+    m = ModelFile(namespace="/ambf/env/ramp/")
+    m.bodies.append(_box("ramp", (1.6, 0.5, 0.02), (0.0, 0.6, 0.4), (0.0, RAMP_SLOPE, 0.0)))
+    r = 0.03
+    normal = np.array([np.sin(RAMP_SLOPE), 0.0, np.cos(RAMP_SLOPE)])
+    up_the_slope = np.array([-np.cos(RAMP_SLOPE), 0.0, np.sin(RAMP_SLOPE)])
+    ball = Geometry(radius=r), _about_axis(7.2e-5, 7.2e-5)
+    roller = Geometry(radius=r, height=0.06, axis="y"), _about_axis(0.2 * r * r / 2, 0.2 * (3 * r * r + 0.06**2) / 12)
+    roller = roller[0], Inertia(ix=roller[1].ix, iy=roller[1].iz, iz=roller[1].iy)  # its axis along y
+    for ident, y, shape, (geometry, inertia), rolling in (
+        ("ball", 0.45, "SPHERE", ball, None),
+        ("roller", 0.6, "CYLINDER", roller, None),
+        ("rolling", 0.75, "SPHERE", ball, 0.0),
+    ):
+        centre = np.array([0.0, y, 0.4]) + (0.01 + r + 0.001) * normal + 0.6 * up_the_slope
+        keys = {"friction": Friction(static=0.5, rolling=rolling)} if rolling is not None else {}
+        position = tuple(round(float(c), 9) for c in centre)
+        m.bodies.append(_primitive(ident, shape, geometry, inertia, position, (0.0, RAMP_SLOPE, 0.0), **keys))
+    return m
+
+
+def build_fixed_pair() -> ModelFile:
+    """Two free boxes (0.3 and 0.1 kg) held together by a fixed joint, an L turned 0.4 rad about
+    x, dropped 3 cm onto the floor: the pair falls, lands on an edge and settles as one body."""
+    m = ModelFile(namespace="/ambf/env/fixed_pair/")
+    rpy = (0.4, 0.0, 0.0)
+    m.bodies.append(_box("block", (0.1, 0.1, 0.1), (0.6, -0.6, 0.12), rpy, mass=0.3, color=ORANGE))
+    m.bodies.append(_box("lug", (0.06, 0.04, 0.04), (0.68, -0.6, 0.12), rpy, mass=0.1, color=ORANGE))
+    m.joints.append(
+        Joint(
+            identifier="JOINT block-lug",
+            name="block-lug",
+            parent="BODY block",
+            child="BODY lug",
+            type="fixed",
+            parent_pivot=Vec3(0.08, 0.0, 0.0),
+            parent_axis=Vec3(0.0, 0.0, 1.0),
+            child_pivot=Vec3(0.0, 0.0, 0.0),
+            child_axis=Vec3(0.0, 0.0, 1.0),
+        )
+    )
+    return m
+
+
 BUILD = {
     "drop": build_drop,
     "arm": build_arm,
@@ -331,6 +388,8 @@ BUILD = {
     "slider": build_slider,
     "pendulums": build_pendulums,
     "primitives": build_primitives,
+    "ramp": build_ramp,
+    "fixed_pair": build_fixed_pair,
 }
 
 
@@ -373,4 +432,6 @@ __all__ = [
     "build_slider",
     "build_pendulums",
     "build_primitives",
+    "build_ramp",
+    "build_fixed_pair",
 ]
