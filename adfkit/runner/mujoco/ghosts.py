@@ -318,16 +318,16 @@ class AmbfGhosts:
             d.qvel[a + 3 : a + 6] = d.xmat[b].reshape(3, 3).T @ w2[i]  # body frame
         j = plan.jointed
         if len(j):
-            b = plan.jointed_ids
             cdt = self.dt * self.opt.control_substeps
             a, alpha = (v2[j] - v[j]) / cdt, (w2[j] - w[j]) / cdt
-            np.add.at(d.xfrc_applied, (b, slice(0, 3)), plan.mass * a)
-            xf, ximat, inertia = d.xfrc_applied, d.ximat, plan.inertia
-            for k, i in enumerate(b.tolist()):
-                # the inertial frame's, about the COM; matrix products one body at a time, as the
-                # PyBullet runner's (a stacked product can round the last bit otherwise)
-                rot = ximat[i].reshape(3, 3)
-                xf[i, 3:] += rot @ (inertia[k] * (rot.T @ alpha[k]))
+            # the torque in the inertial frame, about the COM: R (I (Rᵀ α)), each product a stacked
+            # matmul (numpy's gemv body by body: the PyBullet runner's bits, which einsum's are not)
+            rot = d.ximat[plan.jointed_ids].reshape(-1, 3, 3)
+            local = np.matmul(rot.transpose(0, 2, 1), alpha[:, :, None])
+            wrench = np.empty((len(j), 6))
+            wrench[:, :3] = plan.mass * a
+            wrench[:, 3:] = np.matmul(rot, plan.inertia[:, :, None] * local)[:, :, 0]
+            np.add.at(d.xfrc_applied, plan.jointed_ids, wrench)  # in order: a body in two ghosts
             self._xfrc_dirty = True
 
 
