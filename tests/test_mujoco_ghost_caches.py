@@ -1,10 +1,11 @@
 """What the MuJoCo runner keeps between control steps under AMBF's ghost rule (ghosts.py:
-each ghost pair's distance while its relative pose cannot have changed its sign, the ghosts'
-answers and the rule's plan while nothing changed them, the held bodies weightless through
-MuJoCo's gravity compensation, under which they may sleep) must follow what moves."""
+each ghost pair's distance while neither of its bodies moves, the ghosts' answers and the
+rule's plan while nothing changed them, the held bodies weightless through MuJoCo's gravity
+compensation, under which they may sleep) must follow what moves."""
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -90,3 +91,51 @@ def test_the_plan_follows_a_body_that_enters_a_ghost(ghost_world):
     w.step(1)
     after = float(d.qvel[dof + 2])
     assert after == pytest.approx(before * 0.9 ** (points * w.opt.control_substeps), rel=0.05)
+
+
+def _afresh(world, fresh) -> list:
+    """The ghosts' answers for ``world``'s state made by ``fresh`` (a world of the same scene)
+    with nothing kept: its state set to ``world``'s, its caches dropped."""
+    m, d = fresh.model, fresh.data
+    d.qpos[:], d.qvel[:] = world.data.qpos, world.data.qvel
+    mujoco.mj_forward(m, d)
+    fresh._ghost_row_of, fresh._collider_key = None, None
+    return [[(sb.name, n) for sb, n in found] for found in fresh._penetrating(fresh.ghosts)]
+
+
+def test_kept_answers_are_those_made_afresh_step_by_step(tmp_path):
+    """Step by step, while the cube falls into the slab and comes to rest and the twin is put
+    into it beside the cube, the ghost's answer (with its rigid pairs looked at
+    once, a pair's distance taken again only when one of its bodies moved, the collision pass's
+    masks kept per set of pairs) is the one made with nothing kept. Control: a world whose pairs
+    never take their distances again (as if no body moved) misses the cube entering."""
+    from adfkit.scenes.parity import write_parity
+
+    launch = write_parity(tmp_path)
+    scene = load_scene(launch, [3])
+    opt = Options(visuals=False, ghosts="ambf")
+    world, fresh, stale = (open_world(scene, opt, engine="mujoco") for _ in range(3))
+    try:
+        twin = world.body("twin")
+        m, d = world.model, world.data
+        adr = m.jnt_qposadr[m.body_jntadr[twin.id]]
+        seen, missed = set(), 0
+        for k in range(160):
+            if k == 100:  # the twin into the slab beside the cube, by its free joint
+                d.qpos[adr : adr + 3] = np.array(d.xipos[world.body("cube").id]) + np.array([0.0, 0.06, 0.0])
+                mujoco.mj_kinematics(m, d)
+                world.wake(twin)
+            # the answer made afresh for the state the next control step starts from
+            expected, stale_expected = _afresh(world, fresh)[0], _afresh(stale, fresh)[0]
+            world.step(1)
+            stale.step(1)
+            if k == 0:
+                stale._pair_at[:] = 1 << 60  # every distance "taken" after any move
+            assert _points(world) == expected
+            seen.add(tuple(expected))
+            missed += _points(stale) != stale_expected
+        assert {(), (("cube", 4),)} <= seen and any(len(a) == 2 for a in seen)
+        assert missed > 0
+    finally:
+        for w in (world, fresh, stale):
+            w.close()

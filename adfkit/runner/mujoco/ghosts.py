@@ -15,6 +15,8 @@ from ..plan import ALL_GROUPS
 from .objects import MjBody
 
 _SLEEP_BIT = int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
+#: sets of colliding ghost pairs whose pass masks (_collider_masks) are kept at most
+COLLIDER_MASKS_KEPT = 64
 
 
 @dataclass
@@ -46,8 +48,10 @@ class AmbfGhosts:
         collider makes for the pair (_collider_points), at most MANIFOLD_POINTS (a Bullet
         manifold's: AMBF's ghost acts once per point of it) and at least one.
 
-        A pair's distance is taken again only when its answer may have changed (_pair_distances):
-        the ghosts' answers are made again only for a ghost whose pairs or points changed."""
+        A ghost geom and a geom of its own body are one rigid pair, looked at once (_ghost_rows);
+        the other pairs' distances are taken again only when one of their bodies moved
+        (_pair_distances); the ghosts' answers are made again only for a ghost whose pairs or
+        points changed."""
         cg = self._cand_geoms
         if not len(cg) or not ghosts:
             return [[] for _ in ghosts]
@@ -55,27 +59,27 @@ class AmbfGhosts:
         gx = self.data.geom_xpos
         diff = gx[gg][:, None, :] - gx[cg][None, :, :]
         near = np.einsum("ijk,ijk->ij", diff, diff) <= self._ghost_reach
+        near &= self._ghost_cross
         rows, ks = np.nonzero(near)
         hit, flipped = self._pair_distances(rows, ks)
-        dirty = np.zeros(len(gg), dtype=bool)
-        dirty[rows[flipped]] = True
         if self._ghost_near is None:
-            dirty[:] = True
+            dirty = np.ones(len(gg), dtype=bool)
         else:
-            dirty |= (near != self._ghost_near).any(axis=1)
+            dirty = (near != self._ghost_near).any(axis=1)
+            dirty[rows[flipped]] = True
         self._ghost_near = near
         rows, ks = rows[hit], ks[hit]
-        cross = self._ghost_geom_body[rows] != self._cand_geom_bodyid[ks]
         # only pairs of two bodies can have the collider's points (MuJoCo collides no body with itself)
-        made = self._collider_points(
-            [(self._cand_geom_body[k], int(gg[r]), int(cg[k])) for r, k in zip(rows[cross], ks[cross])]
-        )
+        made = self._collider_points(rows, ks)
         if made != self._ghost_made:
-            dirty[rows[cross]] = True
+            dirty[rows] = True
             self._ghost_made = made
         answers = self._ghost_answers
         remade = np.flatnonzero(np.logical_or.reduceat(dirty, starts))
         self._ghost_changed = len(remade) > 0
+        if self._ghost_changed:
+            rigid_rows, rigid_ks = self._rigid_hits
+            rows, ks = np.concatenate([rigid_rows, rows]), np.concatenate([rigid_ks, ks])
         for i in remade:
             mine = (rows >= starts[i]) & (rows < starts[i] + len(ghosts[i].geoms))
             r, k = rows[mine], ks[mine]
@@ -89,107 +93,112 @@ class AmbfGhosts:
         return answers
 
     def _pair_distances(self, rows: np.ndarray, ks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(penetrating, changed since the last step) for the pairs (ghost geom ``rows``,
-        candidate geom ``ks``). MuJoCo's distance is taken again only where its sign may differ
-        from the one it last gave: not for two geoms of one body (rigid), nor for a pair whose
-        relative pose is the one it was taken at to the last bit (asleep, static, or both
-        still), nor for a pair that penetrated by more than all its relative motion since could
-        undo (the second geom's points move by at most the change of its position in the first's
-        frame plus that of its rotation matrix there times its bounding radius; twice MuJoCo's
-        convex-collision tolerance on top): a PSM's jaws in its finger ghosts, 6 mm deep, moving
-        0.1 µm a control step."""
+        """(penetrating, changed since it was last taken) for the pairs of two bodies (ghost geom
+        ``rows``, candidate geom ``ks``). MuJoCo's distance is taken again only for a pair one
+        of whose bodies is not where it was, to the last bit, when the pair's was last taken
+        (asleep, static and resting bodies keep theirs): each body's pose is compared with the
+        one the last call saw (one array test for all of them), and the call at which it last
+        moved is kept."""
         m, d = self.model, self.data
-        gg, _ = self._ghost_row_of
-        cg = self._cand_geoms
-        ga, gb = gg[rows], cg[ks]
-        ra, rb = d.geom_xmat[ga].reshape(-1, 3, 3), d.geom_xmat[gb].reshape(-1, 3, 3)
-        rel = np.empty((len(rows), 12))
-        rel[:, :3] = np.einsum("nji,nj->ni", ra, d.geom_xpos[gb] - d.geom_xpos[ga])
-        rel[:, 3:] = np.einsum("nji,njk->nik", ra, rb).reshape(-1, 9)
+        self._ghost_tick += 1
+        tick = self._ghost_tick
+        pose = np.hstack((d.xpos, d.xquat))
+        self._moved_at[(pose != self._last_pose).any(axis=1)] = tick
+        self._last_pose = pose
+        moved = self._moved_at
+        taken = self._pair_at[rows, ks]
+        stale = (taken < moved[self._ghost_geom_body[rows]]) | (taken < moved[self._cand_geom_bodyid[ks]])
         dist = self._pair_dist[rows, ks]
-        seen = ~np.isnan(dist)
-        change = np.abs(rel - self._pair_rel[rows, ks])
-        move = np.sqrt(np.einsum("ij,ij->i", change[:, :3], change[:, :3]))
-        move += np.sqrt(np.einsum("ij,ij->i", change[:, 3:], change[:, 3:])) * m.geom_rbound[gb]
-        keep = seen & (
-            (self._ghost_geom_body[rows] == self._cand_geom_bodyid[ks])
-            | (move == 0.0)
-            | (move + self._ccd_slack < -np.where(seen, dist, 0.0))
-        )
         was = dist < 0.0
-        for i in np.flatnonzero(~keep):
-            dist[i] = mujoco.mj_geomDistance(m, d, int(ga[i]), int(gb[i]), 0.0, None)
-            self._pair_rel[rows[i], ks[i]] = rel[i]
-        self._pair_dist[rows, ks] = dist
+        if stale.any():
+            r, k = rows[stale], ks[stale]
+            ga, gb = self._ghost_row_of[0][r].tolist(), self._cand_geoms[k].tolist()
+            dist[stale] = [mujoco.mj_geomDistance(m, d, a, b, 0.0, None) for a, b in zip(ga, gb)]
+            self._pair_dist[r, k] = dist[stale]
+            self._pair_at[r, k] = tick
         hit = dist < 0.0
         return hit, hit != was
 
     def _ghost_rows(self) -> tuple[np.ndarray, np.ndarray]:
         """Every ghost's geoms one after the other and where each ghost's begin (made once; a
         ghost has one geom at least); with them what _penetrating keeps: the squared reach of
-        each (ghost geom, candidate geom) pair, the bodies of the ghost geoms, each pair's last
-        distance and the relative pose it was taken at, each ghost's last answer."""
+        each (ghost geom, candidate geom) pair, which pairs are of two bodies, the rigid pairs
+        (a ghost geom and a geom of its own body) that penetrate, the bodies of the ghost
+        geoms, each pair's last distance and the call it was taken at, each ghost's last
+        answer."""
         if self._ghost_row_of is None:
-            m = self.model
+            m, d = self.model, self.data
+            cg = self._cand_geoms
             gg = np.array([gid for g in self.ghosts for gid in g.geoms], dtype=int)
             starts = np.cumsum([0] + [len(g.geoms) for g in self.ghosts[:-1]]).astype(int)
-            self._ghost_reach = (m.geom_rbound[gg][:, None] + m.geom_rbound[self._cand_geoms][None, :]) ** 2
+            self._ghost_reach = (m.geom_rbound[gg][:, None] + m.geom_rbound[cg][None, :]) ** 2
             self._ghost_geom_body = np.array(m.geom_bodyid[gg], dtype=int)
+            self._ghost_cross = self._ghost_geom_body[:, None] != self._cand_geom_bodyid[None, :]
+            # a rigid pair's distance never changes: taken once, where the bounding spheres meet
+            diff = d.geom_xpos[gg][:, None, :] - d.geom_xpos[cg][None, :, :]
+            rigid = (np.einsum("ijk,ijk->ij", diff, diff) <= self._ghost_reach) & ~self._ghost_cross
+            pairs = [
+                (r, k)
+                for r, k in zip(*np.nonzero(rigid))
+                if mujoco.mj_geomDistance(m, d, int(gg[r]), int(cg[k]), 0.0, None) < 0.0
+            ]
+            self._rigid_hits = tuple(np.array([p[i] for p in pairs], dtype=int) for i in (0, 1))
             self._is_ghost_geom = np.zeros(m.ngeom, dtype=bool)
             self._is_ghost_geom[gg] = True
-            self._pair_dist = np.full((len(gg), len(self._cand_geoms)), np.nan)
-            self._pair_rel = np.zeros((len(gg), len(self._cand_geoms), 12))
-            self._ccd_slack = 2.0 * float(m.opt.ccd_tolerance)
+            self._pair_dist = np.full((len(gg), len(cg)), np.nan)
+            self._pair_at = np.full((len(gg), len(cg)), -1, dtype=int)
+            self._ghost_tick = 0
+            self._moved_at = np.zeros(m.nbody, dtype=int)
+            self._last_pose = np.full((m.nbody, 7), np.nan)
             # each body's free joint's first dof, -1 for a body without one (set_body_velocity's test)
             self._free_dof = np.full(m.nbody, -1, dtype=int)
             for j in np.flatnonzero(m.jnt_type == mujoco.mjtJoint.mjJNT_FREE):
                 self._free_dof[m.jnt_bodyid[j]] = m.jnt_dofadr[j]
             self._ghost_near, self._ghost_made = None, None
             self._ghost_answers: list = [[] for _ in self.ghosts]
+            self._collider_pairs: dict = {}
             self._ghost_row_of = (gg, starts)
         return self._ghost_row_of
 
-    def _collider_points(self, pairs) -> dict[tuple[int, int], int]:
+    def _collider_points(self, rows: np.ndarray, ks: np.ndarray) -> dict[tuple[int, int], int]:
         """{(geom, geom): penetrating contacts} that MuJoCo's collision pass makes between the
-        ghost geoms and the body geoms of ``pairs``, the ghosts let collide for that pass only (mj_collision
-        between control steps; the step's own pass, which they do not join, writes the contacts
-        the solver and every reader see). A box in a box gives several, as Bullet's box-box
-        manifold does. A ghost's geom never meets its own body's (MuJoCo collides no body with
-        itself, nor with its parent): those pairs keep the distance query's one point. The last
-        answer stands while the geoms of ``pairs`` (body, ghost geom, body geom) stay within
-        SAME_PLACE of where they were (a resting body inside a ghost, the phantom's holes, jaws
-        held still with round-off's 1e-16 m jitter: no pass)."""
-        if not pairs:
+        ghost geoms ``rows`` and the candidate geoms ``ks`` (pairs of two bodies), the ghosts let
+        collide for that pass only (mj_collision between control steps; the step's own pass,
+        which they do not join, writes the contacts the solver and every reader see). A box in a
+        box gives several, as Bullet's box-box manifold does. A ghost's geom never meets its
+        own body's (MuJoCo collides no body with itself, nor with its parent): those pairs keep
+        the distance query's one point. The last answer stands while the pairs' geoms stay
+        within SAME_PLACE of where they were (a resting body inside a ghost, the phantom's holes,
+        jaws held still with round-off's 1e-16 m jitter: no pass)."""
+        if not len(rows):
             return {}
         m, d = self.model, self.data
-        geoms = sorted({g for _, a, b in pairs for g in (a, b)})
-        where = np.concatenate([d.geom_xpos[geoms].ravel(), d.geom_xmat[geoms].ravel()])
+        key = rows.tobytes() + ks.tobytes()
+        masks = self._collider_pairs.get(key)
+        if masks is None:
+            if len(self._collider_pairs) >= COLLIDER_MASKS_KEPT:
+                self._collider_pairs.clear()
+            masks = self._collider_pairs[key] = self._collider_masks(rows, ks)
+        geoms = masks[0]
+        where = np.concatenate((d.geom_xpos[geoms].ravel(), d.geom_xmat[geoms].ravel()))
         last = self._collider_key
-        if last is not None and last[0] == geoms and np.max(np.abs(last[1] - where)) <= SAME_PLACE:
+        if last is not None and last[0] is geoms and np.max(np.abs(last[1] - where)) <= SAME_PLACE:
             return self._collider_made
-        key = (geoms, where)
-        # the pass collides only the geoms of ``pairs``: every other geom's and body's collision
-        # bits off for it (those of a pair's body geom kept; its ghost geom, whose contype
-        # (build.GHOST_CONTYPE) meets no conaffinity, given every one), as the whole scene's
-        # pass would collide those pairs (MuJoCo makes a pair's contacts from its two geoms alone)
-        ghost_side = np.array(sorted({a for _, a, _ in pairs}), dtype=int)
-        body_side = np.array(sorted({b for _, _, b in pairs}), dtype=int)
-        saved = [np.array(x) for x in (m.geom_contype, m.geom_conaffinity, m.body_contype, m.body_conaffinity)]
-        for x in (m.geom_contype, m.geom_conaffinity, m.body_contype, m.body_conaffinity):
-            x[:] = 0
-        m.geom_contype[body_side] = saved[0][body_side]
-        m.geom_conaffinity[ghost_side] = ALL_GROUPS
-        m.body_contype[m.geom_bodyid[body_side]] = saved[2][m.geom_bodyid[body_side]]
-        m.body_conaffinity[m.geom_bodyid[ghost_side]] = ALL_GROUPS  # the broadphase filters bodies first
-        # with island sleeping on, MuJoCo collides no pair without an awake body: a body asleep in a
-        # ghost on a static one (a cube come to rest in it, weightless) keeps its points
+        # the pass collides only the geoms of the pairs (_collider_masks); with island sleeping
+        # on, MuJoCo collides no pair without an awake body: a body asleep in a ghost on a static
+        # one (a cube come to rest in it, weightless) keeps its points
+        live = (m.geom_contype, m.geom_conaffinity, m.body_contype, m.body_conaffinity)
+        saved = [np.array(x) for x in live]
+        for x, y in zip(live, masks[1:]):
+            x[:] = y
         flags = m.opt.enableflags
         m.opt.enableflags = flags & ~_SLEEP_BIT
         try:
             mujoco.mj_collision(m, d)
         finally:
             m.opt.enableflags = flags
-            m.geom_contype[:], m.geom_conaffinity[:], m.body_contype[:], m.body_conaffinity[:] = saved
+            for x, y in zip(live, saved):
+                x[:] = y
         out: dict[tuple[int, int], int] = {}
         if d.ncon:
             c = d.contact
@@ -198,8 +207,25 @@ class AmbfGhosts:
             keep = (c.dist < 0.0) & (is_ghost[:, 0] != is_ghost[:, 1])
             for a, b in ab[keep].tolist():
                 out[(a, b)] = out.get((a, b), 0) + 1
-        self._collider_key, self._collider_made = key, out
+        self._collider_key, self._collider_made = (geoms, where), out
         return out
+
+    def _collider_masks(self, rows: np.ndarray, ks: np.ndarray) -> tuple:
+        """(the geoms of the pairs (ghost geom ``rows``, candidate geom ``ks``), and the geoms'
+        contype and conaffinity and the bodies' for _collider_points' pass): every other geom's
+        and body's bits off (those of a pair's body geom kept; its ghost geom, whose contype
+        (build.GHOST_CONTYPE) meets no conaffinity, given every one), as the whole scene's pass
+        would collide those pairs (MuJoCo makes a pair's contacts from its two geoms alone)."""
+        m = self.model
+        ghost_side = np.unique(self._ghost_row_of[0][rows])
+        body_side = np.unique(self._cand_geoms[ks])
+        geoms = np.union1d(ghost_side, body_side)
+        masks = [np.zeros_like(x) for x in (m.geom_contype, m.geom_conaffinity, m.body_contype, m.body_conaffinity)]
+        masks[0][body_side] = m.geom_contype[body_side]
+        masks[1][ghost_side] = ALL_GROUPS
+        masks[2][m.geom_bodyid[body_side]] = m.body_contype[m.geom_bodyid[body_side]]
+        masks[3][m.geom_bodyid[ghost_side]] = ALL_GROUPS  # the broadphase filters bodies first
+        return (geoms, *masks)
 
     def _ambf_ghosts(self) -> None:
         """AMBF's ghost objects (ghost_rules: afGhostObject::update after each physics step), for
