@@ -18,6 +18,7 @@ from .build import GHOST_GROUP, build_plan
 from .contacts import ground_pairs, set_contacts
 from .damping import BodyDamping
 from .drives import DriveLimits, drive_limit
+from .integrator import integrator_for
 from .limits import ambf_limits
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
@@ -70,6 +71,7 @@ class Assembly:
         if ghost_gravity:
             self.model.body_gravcomp[:] = 0.0
         self.model.opt.jacobian = jacobian_for(self.model)
+        self.model.opt.integrator = integrator_for(self.model)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self.ground_z = None
