@@ -8,8 +8,11 @@ then, with ``--profile``, where one second of each goes, by cProfile on CPU time
 
 With ``--against REV`` it times, under the run / parity settings only, this tree's runner and the
 one at git revision REV (``git archive`` into a temporary folder) in fresh processes, alternated
-round by round, and prints both, their ratio and whether every body ended where the other's did
-(a change that only reorganises the runner keeps them bit for bit).
+round by round, and prints both (split into Bullet's steps, the springs, the ghosts, the forces
+applied again and the rest, timed around their calls), their ratio, the sum over each 0.1 s
+chunk of its least CPU time over the rounds (a shared machine's load only ever adds to a chunk)
+and whether every body ended where the other's did (a change that only reorganises the runner
+keeps them bit for bit).
 
 The figure is this process's CPU time (``time.process_time``) of the stepping alone, as
 ``adfkit parity`` times its side (building the world and reading the samples left out). The
@@ -69,21 +72,53 @@ def run_defaults() -> dict:
     return {f.name: f.default for f in dataclasses.fields(Request) if f.name in RULES}
 
 
+#: --against's split of the CPU time, unprofiled: each part timed around its calls
+SPLIT = ("Bullet's steps", "springs", "ghosts", "forces again")
+#: --against times the stepping in chunks of so many control steps (0.1 s)
+CHUNK = 25
+
+
+def _timed(split: dict, part: str, fn):
+    def timed(*args, **kw):
+        t = time.process_time()
+        try:
+            return fn(*args, **kw)
+        finally:
+            split[part] += time.process_time() - t
+
+    return timed
+
+
 def step_cpu(scene, rules: dict, seconds: float, digest: bool = False):
-    """CPU seconds of stepping; with ``digest``, (those, a digest of every body's final state)."""
+    """CPU seconds of stepping; with ``digest``, (those, a digest of every body's final state,
+    {part: CPU seconds} of SPLIT)."""
+    import pybullet as pb
+
     from adfkit.runner import open_world
+    from adfkit.runner.pybullet import held
 
     world = open_world(scene, options(rules), engine="pybullet")
+    split = dict.fromkeys(SPLIT, 0.0)
+    step, replay = pb.stepSimulation, held.replay
+    if digest:  # stepSimulation and held.replay are looked up in their modules at each call
+        pb.stepSimulation, held.replay = _timed(split, SPLIT[0], step), _timed(split, SPLIT[3], replay)
+        world.springs.apply = _timed(split, SPLIT[1], world.springs.apply)
+        world._update_ghosts = _timed(split, SPLIT[2], world._update_ghosts)
     try:
         n = int(round(seconds / (world.dt * world.opt.control_substeps)))
-        c0 = time.process_time()
-        world.step(n)
-        cpu = time.process_time() - c0
         if not digest:
-            return cpu
+            c0 = time.process_time()
+            world.step(n)
+            return time.process_time() - c0
+        chunks = []  # CPU seconds of each CHUNK control steps
+        for done in range(0, n, CHUNK):
+            c0 = time.process_time()
+            world.step(min(CHUNK, n - done))
+            chunks.append(time.process_time() - c0)
         h = hashlib.sha256(repr([sb.state() for sb in world.bodies]).encode())
-        return cpu, h.hexdigest()[:12]
+        return sum(chunks), h.hexdigest()[:12], split, chunks
     finally:
+        pb.stepSimulation, held.replay = step, replay
         world.close()
 
 
@@ -98,8 +133,8 @@ def child(root: str, seconds: float) -> int:
         raise SystemExit(f"adfkit came from {adfkit.__file__}, not {root}")
 
     scene, _ = scene_and_label()
-    cpu, digest = step_cpu(scene, run_defaults(), seconds, digest=True)
-    print(json.dumps({"cpu": cpu, "digest": digest}))
+    cpu, digest, split, chunks = step_cpu(scene, run_defaults(), seconds, digest=True)
+    print(json.dumps({"cpu": cpu, "digest": digest, "split": split, "chunks": chunks}))
     return 0
 
 
@@ -118,8 +153,16 @@ def against(rev: str, seconds: float, rounds: int) -> None:
     for name, got in runs.items():
         cpu = [g["cpu"] for g in got]
         print(f"  {name}: CPU {statistics.median(cpu):.2f} s (runs: {' '.join(f'{c:.2f}' for c in cpu)})")
+        parts = {p: statistics.median(g["split"][p] for g in got) for p in SPLIT}
+        rest = statistics.median(cpu) - sum(parts.values())
+        print("    " + ", ".join(f"{p} {t:.2f} s" for p, t in parts.items()) + f", the rest {rest:.2f} s (medians)")
     new, base = ([g["cpu"] for g in runs[k]] for k in ("this tree", f"at {rev}"))
     print(f"  this tree / {rev}: {statistics.median(new) / statistics.median(base):.3f} (median over median)")
+    # each 0.1 s chunk's least CPU time over the rounds, summed: what a quiet machine would take
+    # (a chunk does the same work in every round; another process's load only ever adds)
+    least = {k: sum(map(min, zip(*(g["chunks"] for g in got)))) for k, got in runs.items()}
+    new_l, base_l = least["this tree"], least[f"at {rev}"]
+    print(f"  least per chunk, summed: at {rev} {base_l:.2f} s, this tree {new_l:.2f} s, ratio {new_l / base_l:.3f}")
     same = {g["digest"] for got in runs.values() for g in got}
     print(f"  final states: {'the same to the bit' if len(same) == 1 else 'differ: ' + ', '.join(sorted(same))}")
 
