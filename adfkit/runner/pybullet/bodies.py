@@ -50,16 +50,16 @@ class SimBody(EngineBody):
 
     def state(self, velocity: bool = True):
         """(position, quaternion, linear velocity, angular velocity) of the COM frame; the
-        velocities are None when ``velocity`` is False (cheaper for multibody links)."""
+        velocities are None when ``velocity`` is False (cheaper for multibody links). The calls take
+        their arguments by position (the ghosts ask each control step; keywords cost a tenth of a call)."""
         if self.link < 0:
-            p, q = pb.getBasePositionAndOrientation(self.uid, physicsClientId=self.cid)
+            p, q = pb.getBasePositionAndOrientation(self.uid, self.cid)
             if not velocity:
                 return p, q, None, None
-            v, w = pb.getBaseVelocity(self.uid, physicsClientId=self.cid)
+            v, w = pb.getBaseVelocity(self.uid, self.cid)
             return p, q, v, w
-        s = pb.getLinkState(
-            self.uid, self.link, computeLinkVelocity=int(velocity), computeForwardKinematics=1, physicsClientId=self.cid
-        )
+        # computeLinkVelocity, computeForwardKinematics
+        s = pb.getLinkState(self.uid, self.link, int(velocity), 1, self.cid)
         if not velocity:
             return s[0], s[1], None, None
         return s[0], s[1], s[6], s[7]  # the COM frame: constraint pivots are relative to it
