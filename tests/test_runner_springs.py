@@ -38,6 +38,24 @@ def test_any_gain_at_most_stops_the_motion(k, c):
     assert v2 <= 0.0 and -v2 * dt <= 0.5 + 1e-12
 
 
+def test_a_limits_velocity_is_asked_for_only_where_a_limit_is_crossed():
+    """SpringSet._limit takes the joints' velocity as an array or as a callable giving it (the
+    angular limits, never crossed at rest on the corpus thread, make it only then): crossed, the
+    two give the same forces to the bit, pushing back in (over the high limit down, under the
+    low one up, the free axis nothing); inside the limits the callable is never called."""
+    x = np.array([[0.1, 0.0, -0.2], [0.01, 0.02, 0.0]])
+    v = np.array([[0.3, -0.1, 0.2], [0.5, 0.5, 0.5]])
+    low, high = np.full((2, 3), -0.1), np.full((2, 3), 0.05)
+    low[0, 1], high[0, 1] = 1.0, -1.0  # low > high: a free axis (Bullet)
+    inertia = np.array([[2e-5], [3e-5]])
+    want = SpringSet._limit(x, v, low, high, inertia, 0.001, 0.2)
+    assert np.array_equal(SpringSet._limit(x, lambda: v, low, high, inertia, 0.001, 0.2), want)
+    assert want[0, 0] < 0.0 < want[0, 2] and want[0, 1] == 0.0 and not want[1].any()
+    asked = []
+    inside = SpringSet._limit(x[1:], lambda: asked.append(v) or v[1:], low[1:], high[1:], inertia[1:], 0.001, 0.2)
+    assert inside == 0.0 and not asked
+
+
 def test_a_body_between_two_joints_shares_its_inertia(tmp_path):
     """A chain element between two spring joints gives each half of its inertia, so the two,
     acting in the same step, cannot turn it back twice as far as either would."""
