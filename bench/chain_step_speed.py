@@ -1,7 +1,7 @@
 """CPU time of the PyBullet runner playing a robot's joint program as ``adfkit parity --commands``
 plays it: AMBF's bodies, 1 ms control steps, every driven chain through AMBF's ten-sweep solver
 step (runner/chain_rows.py, runner/pybullet/chain.py). The robots are the corpus KUKA and LND
-400006 PSM with the programs ``adfkit.parity.programs`` writes (the dynamic-parity table's rows);
+400006 PSM, and the ECM and MTM (closed loops), with the programs ``adfkit.parity.programs`` writes (the dynamic-parity table's rows);
 without ``../shared/corpus`` there is nothing to play and it says so.
 
     .venv/bin/python bench/chain_step_speed.py [--seconds S] [--rounds R]
@@ -28,6 +28,8 @@ ROBOTS = (
     ("KUKA", "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml", "velocity"),
     ("PSM (LND 400006)", "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", "position"),
     ("PSM (LND 400006)", "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", "velocity"),
+    ("ECM (loops)", "ambf/ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml", "velocity"),
+    ("MTM (loop)", "ambf/ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml", "position"),
 )
 
 
