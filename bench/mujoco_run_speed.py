@@ -2,7 +2,7 @@
 ghost rule, springs, link shapes and bodies; a 4 ms control step): the CPU time of S seconds of
 the suturing set, and where it goes.
 
-    .venv/bin/python bench/mujoco_run_speed.py [--seconds S] [--rounds R] [--digest]
+    .venv/bin/python bench/mujoco_run_speed.py [--seconds S] [--rounds R] [--digest] [--against REV]
 
 Each round builds the world anew and plays S seconds (default 10, the issue's figure) one
 control step at a time, as `adfkit parity` does; it prints this process's CPU time (user +
@@ -12,6 +12,11 @@ the CPU time into MuJoCo's own step (mj_step, timed call by call), the per-contr
 ``--digest`` also prints the largest distance of any body from where the first round left it
 (0 when the rounds agree) and a digest of every body's pose at the end.
 
+``--against REV`` measures this tree and the adfkit of git revision REV (exported into a
+temporary directory) in the same minutes: each round plays both, each in a fresh process, the
+order alternating, and prints both trees' medians, their ratio and whether their poses' digests
+agree (the same poses to the last bit).
+
 The suturing set is the corpus's (launch indices 6-11) when ``../shared/corpus`` is there, else
 the project's bundled suturing scene. Asserts nothing; prints figures.
 """
@@ -20,8 +25,11 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import json
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -80,33 +88,86 @@ def one_round(scene, seconds: float) -> dict:
     return {"cpu": cpu, "wall": wall, "mj_step": engine[0], "control": control[0], "poses": poses}
 
 
+def digest(poses: np.ndarray) -> str:
+    return hashlib.sha1(poses.tobytes()).hexdigest()[:12]
+
+
+def report(rounds: list[dict], seconds: float, indent: str = "  ") -> None:
+    def med(k: str) -> float:
+        return statistics.median(r[k] for r in rounds)
+
+    cpu = med("cpu")
+    low, high = min(r["cpu"] for r in rounds), max(r["cpu"] for r in rounds)
+    print(
+        f"{indent}CPU {cpu:.3f} s ({low:.3f}-{high:.3f}; wall {med('wall'):.3f} s); real-time factor {seconds / cpu:.1f}"
+    )
+    for name, key in (("mj_step (MuJoCo)", "mj_step"), ("control (ghosts, damping, sensors)", "control")):
+        print(f"{indent}{name:<36} {med(key):7.3f} s  {100 * med(key) / cpu:4.0f} %")
+    rest = cpu - med("mj_step") - med("control")
+    print(f"{indent}{'the rest of world.step':<36} {rest:7.3f} s  {100 * rest / cpu:4.0f} %")
+
+
+def in_process(tree: str, seconds: float) -> dict:
+    """One round played by the adfkit of ``tree`` in a fresh process (its figures as JSON)."""
+    out = subprocess.run(
+        [sys.executable, __file__, "--tree", tree, "--seconds", str(seconds), "--json"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def against(rev: str, seconds: float, rounds: int) -> int:
+    with tempfile.TemporaryDirectory() as tmp:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "adfkit"], check=True, capture_output=True)
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
+        trees = {"this tree": str(ROOT), rev: tmp}
+        got: dict[str, list[dict]] = {k: [] for k in trees}
+        for i in range(rounds):
+            for name in list(trees)[:: 1 if i % 2 == 0 else -1]:
+                got[name].append(in_process(trees[name], seconds))
+    from speed import scene_and_label
+
+    print(f"scene: {scene_and_label()[1]}; adfkit run/parity options, MuJoCo, {seconds:g} s, median of {rounds}")
+    for name, rows in got.items():
+        print(f"{name}: poses' digest {rows[0]['digest']}")
+        report(rows, seconds, "    ")
+    cpu = {k: statistics.median(r["cpu"] for r in v) for k, v in got.items()}
+    same = {r["digest"] for v in got.values() for r in v}
+    print(
+        f"this tree / {rev}: CPU {cpu['this tree'] / cpu[rev]:.3f}; poses {'the same' if len(same) == 1 else 'differ'}"
+    )
+    return 0
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seconds", type=float, default=10.0)
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--digest", action="store_true")
+    ap.add_argument("--against", metavar="REV", help="also measure the adfkit of this git revision, alternately")
+    ap.add_argument("--tree", help=argparse.SUPPRESS)  # (--against's rounds: the adfkit to import)
+    ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.against:
+        return against(args.against, args.seconds, args.rounds)
+    if args.tree:
+        sys.path.insert(0, args.tree)
     from speed import scene_and_label
 
     scene, label = scene_and_label()
+    if args.json:
+        r = one_round(scene, args.seconds)
+        print(json.dumps({k: r[k] for k in ("cpu", "wall", "mj_step", "control")} | {"digest": digest(r["poses"])}))
+        return 0
     rounds = [one_round(scene, args.seconds) for _ in range(args.rounds)]
-
-    def med(k: str) -> float:
-        return statistics.median(r[k] for r in rounds)
-
-    cpu = med("cpu")
     print(f"scene: {label}; adfkit run/parity options, MuJoCo, {args.seconds:g} s, median of {args.rounds}")
-    print(f"  CPU {cpu:.3f} s (wall {med('wall'):.3f} s); real-time factor {args.seconds / cpu:.1f}")
-    for name, key in (("mj_step (MuJoCo)", "mj_step"), ("control (ghosts, damping, sensors)", "control")):
-        print(f"  {name:<36} {med(key):7.3f} s  {100 * med(key) / cpu:4.0f} %")
-    rest = cpu - med("mj_step") - med("control")
-    print(f"  {'the rest of world.step':<36} {rest:7.3f} s  {100 * rest / cpu:4.0f} %")
+    report(rounds, args.seconds)
     if args.digest:
         first = rounds[0]["poses"]
         spread = max(float(np.max(np.abs(r["poses"][:, :3] - first[:, :3]))) for r in rounds)
-        print(
-            f"  poses: digest {hashlib.sha1(first.tobytes()).hexdigest()[:12]}, rounds apart by {spread * 1e3:.6f} mm"
-        )
+        print(f"  poses: digest {digest(first)}, rounds apart by {spread * 1e3:.6f} mm")
     return 0
 
 
