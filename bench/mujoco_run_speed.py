@@ -154,6 +154,10 @@ def main() -> int:
         return against(args.against, args.seconds, args.rounds)
     if args.tree:
         sys.path.insert(0, args.tree)
+        import adfkit
+
+        if not Path(adfkit.__file__).resolve().is_relative_to(Path(args.tree).resolve()):
+            raise SystemExit(f"adfkit came from {adfkit.__file__}, not {args.tree}")
     from speed import scene_and_label
 
     scene, label = scene_and_label()
