@@ -91,7 +91,7 @@ def _timed(split: dict, part: str, fn):
 
 def step_cpu(scene, rules: dict, seconds: float, digest: bool = False):
     """CPU seconds of stepping; with ``digest``, (those, a digest of every body's final state,
-    {part: CPU seconds} of SPLIT)."""
+    {part: CPU seconds} of SPLIT, the CPU seconds of each CHUNK control steps)."""
     import pybullet as pb
 
     from adfkit.runner import open_world

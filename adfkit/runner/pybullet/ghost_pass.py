@@ -15,8 +15,8 @@ it leaves every body where it was, to the bit): its other pairs' points are the 
 A ghost whose pose and whose near bodies' poses are each within SAME_PLACE of those of its last
 pass (the same bodies near it, no collision pair or grasp changed since) keeps that pass's points
 and leaves this pass: its pairs meet nothing else here, so the others' points are those the pass
-of all of them gives. At rest on the corpus suturing set, over half of the ghosts keep theirs
-each control step (the phantom's holes; the PSMs' fingers move with their jittering links).
+of all of them gives. At rest on the corpus suturing set about 7 of the 12 ghosts keep theirs
+each control step (PSM 2's finger ghosts move with its jittering links almost every step).
 
 A ghost or a body that cannot be copied (a volume's surface pieces, one without collision parts)
 leaves the pass to the dynamics world (``counts`` returns None).
