@@ -29,7 +29,6 @@ import json
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -119,14 +118,9 @@ def in_process(tree: str, seconds: float) -> dict:
 
 
 def against(rev: str, seconds: float, rounds: int) -> int:
-    with tempfile.TemporaryDirectory() as tmp:
-        archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "adfkit"], check=True, capture_output=True)
-        subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
-        trees = {"this tree": str(ROOT), rev: tmp}
-        got: dict[str, list[dict]] = {k: [] for k in trees}
-        for i in range(rounds):
-            for name in list(trees)[:: 1 if i % 2 == 0 else -1]:
-                got[name].append(in_process(trees[name], seconds))
+    from against import alternated
+
+    got = alternated(rev, rounds, lambda tree: in_process(tree, seconds))
     from speed import scene_and_label
 
     print(f"scene: {scene_and_label()[1]}; adfkit run/parity options, MuJoCo, {seconds:g} s, median of {rounds}")
@@ -156,11 +150,9 @@ def main() -> int:
     if args.against:
         return against(args.against, args.seconds, args.rounds)
     if args.tree:
-        sys.path.insert(0, args.tree)
-        import adfkit
+        from against import use_tree
 
-        if not Path(adfkit.__file__).resolve().is_relative_to(Path(args.tree).resolve()):
-            raise SystemExit(f"adfkit came from {adfkit.__file__}, not {args.tree}")
+        use_tree(args.tree)
     from speed import scene_and_label
 
     scene, label = scene_and_label()

@@ -36,7 +36,6 @@ import pstats
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -124,13 +123,10 @@ def step_cpu(scene, rules: dict, seconds: float, digest: bool = False):
 
 def child(root: str, seconds: float) -> int:
     """One side of ``--against``: the runner under ``root`` (first on the path), run / parity settings."""
-    sys.path.insert(0, root)
+    from against import use_tree
+
+    use_tree(root)
     from speed import scene_and_label
-
-    import adfkit
-
-    if not Path(adfkit.__file__).resolve().is_relative_to(Path(root).resolve()):
-        raise SystemExit(f"adfkit came from {adfkit.__file__}, not {root}")
 
     scene, _ = scene_and_label()
     cpu, digest, split, chunks = step_cpu(scene, run_defaults(), seconds, digest=True)
@@ -140,28 +136,26 @@ def child(root: str, seconds: float) -> int:
 
 def against(rev: str, seconds: float, rounds: int) -> None:
     """This tree's runner and REV's, in fresh processes, alternated round by round."""
-    with tempfile.TemporaryDirectory() as old:
-        tar = subprocess.run(["git", "archive", rev, "adfkit"], cwd=ROOT, capture_output=True, check=True).stdout
-        subprocess.run(["tar", "-x", "-C", old], input=tar, check=True)
-        sides = {f"at {rev}": old, "this tree": str(ROOT)}
-        runs: dict[str, list] = {name: [] for name in sides}
-        for r in range(rounds):
-            for name in list(sides)[:: 1 if r % 2 == 0 else -1]:
-                cmd = [sys.executable, __file__, "--seconds", str(seconds), "--child", sides[name]]
-                out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
-                runs[name].append(json.loads(out.strip().splitlines()[-1]))
+    from against import alternated
+
+    def one_round(tree: str) -> dict:
+        cmd = [sys.executable, __file__, "--seconds", str(seconds), "--child", tree]
+        out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
+        return json.loads(out.strip().splitlines()[-1])
+
+    runs = alternated(rev, rounds, one_round)
     for name, got in runs.items():
         cpu = [g["cpu"] for g in got]
         print(f"  {name}: CPU {statistics.median(cpu):.2f} s (runs: {' '.join(f'{c:.2f}' for c in cpu)})")
         parts = {p: statistics.median(g["split"][p] for g in got) for p in SPLIT}
         rest = statistics.median(cpu) - sum(parts.values())
         print("    " + ", ".join(f"{p} {t:.2f} s" for p, t in parts.items()) + f", the rest {rest:.2f} s (medians)")
-    new, base = ([g["cpu"] for g in runs[k]] for k in ("this tree", f"at {rev}"))
+    new, base = ([g["cpu"] for g in runs[k]] for k in ("this tree", rev))
     print(f"  this tree / {rev}: {statistics.median(new) / statistics.median(base):.3f} (median over median)")
     # each 0.1 s chunk's least CPU time over the rounds, summed: what a quiet machine would take
     # (a chunk does the same work in every round; another process's load only ever adds)
     least = {k: sum(map(min, zip(*(g["chunks"] for g in got)))) for k, got in runs.items()}
-    new_l, base_l = least["this tree"], least[f"at {rev}"]
+    new_l, base_l = least["this tree"], least[rev]
     print(f"  least per chunk, summed: at {rev} {base_l:.2f} s, this tree {new_l:.2f} s, ratio {new_l / base_l:.3f}")
     same = {g["digest"] for got in runs.values() for g in got}
     print(f"  final states: {'the same to the bit' if len(same) == 1 else 'differ: ' + ', '.join(sorted(same))}")
