@@ -56,7 +56,7 @@ def own_scenes(folder: Path) -> list[Scene]:
     both = ("pybullet", "mujoco")
     out = [Scene("box dropped on a slab", launch, [0], 0.5, both)]
     for kind in ("position", "velocity", "effort"):
-        out.append(Scene(f"arm, {kind} commands", launch, [1], 1.0, commands=folder / f"arm_{kind}.txt"))
+        out.append(Scene(f"arm, {kind} commands", launch, [1], 1.0, both, commands=folder / f"arm_{kind}.txt"))
     out.append(Scene("three boxes settling in a stack", launch, [2], 1.0, both))
     out.append(Scene("cube into a ghost (AMBF's rule, the default)", launch, [3], 0.6, both))
     out.append(Scene("cube into a ghost (--ghosts hole-friction)", launch, [3], 0.6, ghosts="hole-friction"))

@@ -110,16 +110,6 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
             diags.extend(w.diagnostics)
         commands = commandfile.resolved(commands_read, players[0].made)
         _check_drivable(commands_read, commands, players[0])
-        if commands:
-            if any(c.kind in commandfile.JOINT_KINDS for c in commands) and "mujoco" in req.engines:
-                raise AdfError(
-                    error(
-                        "parity-engine",
-                        "joint commands are played by the PyBullet runner only",
-                        None,
-                        "use --engine pybullet with a command file that drives joints",
-                    )
-                )
         floor_z = worlds[0].ground_z if req.ground else None
         stage = _stage(scene, req, floor_z)
         rec = ambf_run.run(req.build, stage, req.seconds, req.every, commands)

@@ -19,6 +19,7 @@ from ..rotations import invert, matrix_to_quat
 from ..soft import in_scene as soft_in_scene
 from ..soft import soft_health
 from ..world import World
+from . import motor_rows
 from . import stability as mj_stability
 from .assemble import Assembly
 from .interact import Interaction
@@ -78,6 +79,14 @@ class MujocoWorld(Assembly, Interaction, World):
             d.qfrc_applied[a] = 0.0
         art.targets[index] = float(d.qpos[art.qadr[index]]) + float(velocity) * self.dt * self.opt.control_substeps
         art.retarget()
+
+    def joint_mobility(self, art, idxs) -> np.ndarray:
+        """M⁻¹ over joints ``idxs`` of ``art`` (motor_rows.py: AMBF's motor rows)."""
+        return motor_rows.joint_mobility(self, art, idxs)
+
+    def joint_row_mass(self, art, index: int) -> float:
+        """The mass AMBF's motor row along joint ``index`` sees (motor_rows.py)."""
+        return motor_rows.joint_row_mass(self, art, index)
 
     def joint_effort(self, art, index: int, effort: float) -> None:
         """Joint ``index`` of ``art`` pushed by ``effort`` (N·m or N), its drive off, until the next
