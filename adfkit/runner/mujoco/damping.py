@@ -7,7 +7,10 @@ a viscous medium.
 Applied each control step as the force that gives the same decay over the step (the exact
 exp(-λ·t) of the velocity, as the hole ghosts' viscous friction), at the centre of mass, to the
 awake bodies outside a driven articulation (free bodies and six-dof-spring chains; a driven
-arm's joints hold it anyway, and a force would wake a sleeping body). A tree whose every joint
+arm's joints hold it anyway, and a force would wake a sleeping body), and where AMBF's bodies are
+asked for (Options.bodies "ambf") to an articulation's bodies too: AMBF damps every btRigidBody,
+and its motors are soft rows that leave a jointed body its damping (the corpus KUKA's effort
+program 2.96 -> 0.005 mm from AMBF, its velocity program 14.2 -> 3.5 mm). A tree whose every joint
 moves slower than SLOW × MuJoCo's sleep tolerance is left alone, so that it can fall asleep (a
 force keeps a tree awake: applied down to rest, the corpus suturing set's thread never slept and
 its first 6 s played at 2.1x real time instead of 11-26x); the damping there is a 5e-4 N drag."""
@@ -26,7 +29,8 @@ class BodyDamping:
         m = world.model
         ids, lin, ang = [], [], []
         for sb in world.bodies:
-            if sb.static or sb.articulation is not None or sb.id <= 0 or m.body_mass[sb.id] <= 0:
+            jointed = sb.articulation is not None and world.opt.bodies != "ambf"
+            if sb.static or jointed or sb.id <= 0 or m.body_mass[sb.id] <= 0:
                 continue
             if m.body_treeid[sb.id] < 0:  # welded to the world: it cannot move
                 continue
