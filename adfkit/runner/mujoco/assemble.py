@@ -60,6 +60,13 @@ class Assembly:
         cams = prepare_cameras(self, plan)
         ground = self.opt.ground and self.scene.world is None and self.scene.environment is None
         self._plan = plan  # (compile_spec finds the ADF body of what MuJoCo refuses in it)
+        if self.opt.bodies == "ambf":
+            # AMBF never applies a hinge's or a slider's `damping` (afJoint::applyDamping is not
+            # called); the MJCF writer keeps it, as MJCF means it
+            for _j, kind, _p, _c, names in plan.joints:
+                if kind in ONE_DOF:
+                    for name in names:
+                        spec.joint(name).damping = [0.0, 0.0, 0.0]
         ghost_gravity = self.opt.ghosts == "ambf" and bool(plan.ghosts)
         if ghost_gravity:
             # AMBF's ghosts switch a body's gravity off: by MuJoCo's gravity compensation, which a
