@@ -110,16 +110,18 @@ def corpus_scenes(build, folder: Path) -> list[Scene]:
     launch = ambf.on_ambfs_floor(build, puzzle, folder)
     if launch is not None:
         out.append(Scene("puzzle 1 on AMBF's checkered floor", launch, [0], 3.0, ("pybullet", "mujoco")))
+    both, pybullet = ("pybullet", "mujoco"), ("pybullet",)
     robots = (
-        ("KUKA", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml"),
-        ("PSM (LND 400006)", CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml"),
-        ("ECM (loops)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml"),
-        ("MTM (loop)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml"),
+        ("KUKA", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml", both),
+        ("PSM (LND 400006)", CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", both),
+        # MuJoCo closes their loops at other joints, which the programs drive
+        ("ECM (loops)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml", pybullet),
+        ("MTM (loop)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml", pybullet),
     )
-    for label, model in robots:
+    for label, model, engines in robots:
         for kind in ("position", "velocity", "effort"):
             cmd = programs.write_program(model, None, kind, 1.0, folder / f"{model.stem}_{kind}.txt")
-            out.append(Scene(f"{label}, {kind} program", model, None, 1.0, commands=cmd))
+            out.append(Scene(f"{label}, {kind} program", model, None, 1.0, engines, commands=cmd, apart=True))
     return out
 
 

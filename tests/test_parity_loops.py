@@ -120,3 +120,26 @@ def test_loop_robots_under_joint_programs_move_as_in_ambf(tmp_path, monkeypatch)
         assert _program_gap(tmp_path, "blender-mtm", "position") > 6e-3
     monkeypatch.setattr(chain, "_contact_pushes", lambda uid, cid: [])
     assert _program_gap(tmp_path, "blender-ecm", "velocity") > 0.03
+
+
+def test_a_joint_one_engine_cannot_drive_is_a_located_error_naming_it(tmp_path):
+    """MuJoCo closes the corpus ECM's pitch parallelogram at another joint than PyBullet does:
+    with both engines, a command on a joint PyBullet drives and MuJoCo plays as the loop's
+    constraint is an error at its line that names MuJoCo, before anything is played (it was a
+    traceback from inside MuJoCo's player). Control: the yaw joint, which both drive, is not."""
+    from adfkit.diagnostics import AdfError
+    from adfkit.parity import session
+
+    require_corpus()
+    path = CORPUS / MODELS / "robots/blender-ecm.yaml"
+    cmds = tmp_path / "cmds.txt"
+    cmds.write_text(
+        "0.0, velocity, /ambf/env/ecm/baselink-yawlink, 0.1\n0.0, velocity, /ambf/env/ecm/pitchbottomlink-pitchendlink, 0.1\n"
+    )
+    nowhere = ambf.AmbfBuild(tmp_path / "no-ambf")  # never reached: the check comes first
+    req = session.Request(path, None, nowhere, seconds=0.1, commands=cmds, engines=("pybullet", "mujoco"))
+    with pytest.raises(AdfError) as e:
+        session.run(req, progress=False)
+    (d,) = e.value.diagnostics
+    assert d.rule == "command-target" and "pitchbottomlink-pitchendlink' in mujoco" in d.message
+    assert (d.location.line, d.location.column) == (2, 1)

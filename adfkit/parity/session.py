@@ -109,7 +109,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
         for w in worlds:
             diags.extend(w.diagnostics)
         commands = commandfile.resolved(commands_read, players[0].made)
-        _check_drivable(commands_read, commands, players[0])
+        _check_drivable(commands_read, commands, players)
         floor_z = worlds[0].ground_z if req.ground else None
         stage = _stage(scene, req, floor_z)
         rec = ambf_run.run(req.build, stage, req.seconds, req.every, commands)
@@ -127,18 +127,22 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
             w.close()
 
 
-def _check_drivable(read, commands, player: AdfkitPlayer) -> None:
-    """A located error for each joint command whose joint adfkit's world cannot drive: AMBF
+def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
+    """A located error for each joint command whose joint an adfkit world cannot drive: AMBF
     gives every hinge and slider a motor, adfkit drives the joints of its articulations only (a
-    joint closing a kinematic loop is a constraint there, without a motor)."""
+    joint closing a kinematic loop is a constraint there, without a motor; the two engines may
+    close a loop at different joints)."""
     from ..model.semantics import JointKind, joint_kind
 
     diags = []
     for (_, where), c in zip(read, commands):
         if c.kind not in commandfile.JOINT_KINDS:
             continue
-        joint, child = player.by_name["joint"][c.target]
-        if player.commands.drivable(joint, child) is not None:
+        for player in players:
+            joint, child = player.by_name["joint"][c.target]
+            if player.commands.drivable(joint, child) is None:
+                break
+        else:
             continue
         kind = joint_kind(joint.type)
         if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
@@ -147,14 +151,8 @@ def _check_drivable(read, commands, player: AdfkitPlayer) -> None:
         else:
             why = f"adfkit drives revolute and prismatic joints only, and this one is {joint.type!r}"
             hint = "leave this joint out of the command file"
-        diags.append(
-            error(
-                "command-target",
-                f"adfkit cannot drive joint {c.target!r}: {why}",
-                where,
-                hint,
-            )
-        )
+        engine = f" in {player.world.engine}" if len(players) > 1 else ""
+        diags.append(error("command-target", f"adfkit cannot drive joint {c.target!r}{engine}: {why}", where, hint))
     if diags:
         raise AdfError(diags)
 
