@@ -62,7 +62,7 @@ def own_scenes(folder: Path) -> list[Scene]:
     out.append(Scene("cube into a ghost (--ghosts hole-friction)", launch, [3], 0.6, ghosts="hole-friction"))
     out.append(Scene("thread falling from a held needle", launch, [4], 2.0, both))
     out.append(
-        Scene("slider pushed onto its limits by efforts", launch, [5], 1.0, commands=folder / "slider_effort.txt")
+        Scene("slider pushed onto its limits by efforts", launch, [5], 1.0, both, commands=folder / "slider_effort.txt")
     )
     out.append(Scene("pendulums on p2p, cone-twist, six-dof and six-dof-spring joints", launch, [6], 1.0, both))
     out.append(Scene("ball, cylinder, capsule and cone dropped tilted on the floor", launch, [7], 1.0, both))
@@ -74,6 +74,7 @@ def own_scenes(folder: Path) -> list[Scene]:
             folder / "turned_arm.yaml",
             None,
             1.0,
+            both,
             commands=folder / "turned_arm_position.txt",
         )
     )
