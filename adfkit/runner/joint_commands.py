@@ -115,6 +115,22 @@ def motor_factor(
     return 0.0
 
 
+def row_mass(axis, ends, prismatic: bool) -> float:
+    """The mass (kg·m², kg) a Bullet constraint row along a joint's world ``axis`` sees between
+    the joint's two bodies alone, as AMBF's hinge or slider motor row does: 1 / (aᵀ I_p⁻¹ a +
+    aᵀ I_c⁻¹ a) for a hinge, 1 / (1/m_p + 1/m_c) for a slider. ``ends``: (mass, principal
+    inertia (3,), rotation of the principal frame in the world (3x3)) of each body that can move
+    (a static one adds nothing); infinite where neither can."""
+    inverse = 0.0
+    for mass, inertia, rot in ends:
+        if prismatic:
+            inverse += 1.0 / mass
+            continue
+        a = np.asarray(rot).T @ np.asarray(axis)  # the axis in the body's principal frame
+        inverse += float(sum(a[i] ** 2 / inertia[i] for i in range(3) if inertia[i] > 0.0))
+    return 1.0 / inverse if inverse > 0.0 else math.inf
+
+
 def soft_row_impulses(mobility, row_mass, cfm, target, free) -> np.ndarray:
     """The impulses with which soft motor rows on joints of one chain settle together: W =
     ``mobility`` (M⁻¹ over those joints), R = diag(``row_mass``), C = diag(``cfm``): λ = (R·W +

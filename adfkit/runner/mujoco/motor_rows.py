@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 
 from ...model.semantics import JointKind
+from ..joint_commands import row_mass
 
 
 def joint_mobility(world, art, idxs) -> np.ndarray:
@@ -29,25 +30,17 @@ def joint_mobility(world, art, idxs) -> np.ndarray:
 
 
 def joint_row_mass(world, art, index: int) -> float:
-    """The mass (kg·m², kg) a Bullet row along joint ``index``'s axis sees between the joint's two
-    bodies alone, as AMBF's hinge or slider motor row does: 1 / (aᵀ I_p⁻¹ a + aᵀ I_c⁻¹ a) for a
-    hinge, 1 / (1/m_p + 1/m_c) for a slider; a body welded to the world adds nothing. Infinite
-    (no motor row) where AMBF's bodies are not asked for."""
+    """The mass AMBF's motor row along joint ``index`` sees between the joint's two bodies
+    (joint_commands.row_mass; a body welded to the world adds nothing). Infinite (no motor row)
+    where AMBF's bodies are not asked for."""
     if world.opt.bodies != "ambf":
         return math.inf
     m, d = world.model, world.data
     jid = int(m.dof_jntid[art.vadr[index]])
     child = int(m.jnt_bodyid[jid])
-    axis = d.xaxis[jid]
-    slider = art.kinds[index] is JointKind.PRISMATIC
-    inverse = 0.0
-    for body in (int(m.body_parentid[child]), child):
-        if m.body_weldid[body] == 0 or m.body_mass[body] <= 0.0:
-            continue
-        if slider:
-            inverse += 1.0 / float(m.body_mass[body])
-            continue
-        a = d.ximat[body].reshape(3, 3).T @ axis  # the axis in the body's principal frame
-        inertia = m.body_inertia[body]
-        inverse += float(sum(a[i] ** 2 / inertia[i] for i in range(3) if inertia[i] > 0.0))
-    return 1.0 / inverse if inverse > 0.0 else math.inf
+    ends = [
+        (float(m.body_mass[b]), m.body_inertia[b], d.ximat[b].reshape(3, 3))
+        for b in (int(m.body_parentid[child]), child)
+        if m.body_weldid[b] != 0 and m.body_mass[b] > 0.0  # welded to the world: it cannot move
+    ]
+    return row_mass(d.xaxis[jid], ends, art.kinds[index] is JointKind.PRISMATIC)

@@ -15,6 +15,7 @@ import time
 import numpy as np
 import pybullet as pb
 
+from ..joint_commands import row_mass
 from ..options import Options
 from ..rotations import matrix_to_pq, pose_matrix, quat_to_matrix
 from ..soft import in_scene as soft_in_scene
@@ -130,29 +131,24 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         return np.linalg.pinv(mass)[np.ix_(at, at)]  # pinv: a massless link leaves M singular
 
     def joint_row_mass(self, art, index: int) -> float:
-        """The mass (kg·m², kg) a Bullet constraint row along joint ``index``'s axis sees between the
-        joint's two bodies alone, as AMBF's hinge or slider motor row does: 1 / (aᵀ I_p⁻¹ a + aᵀ
-        I_c⁻¹ a) for a hinge, 1 / (1/m_p + 1/m_c) for a slider (a static parent adds nothing)."""
+        """The mass AMBF's motor row along joint ``index`` sees between the joint's two bodies
+        (joint_commands.row_mass; a static parent adds nothing)."""
         cid = self.cid
         kind = art.kinds[index]
         parent = pb.getJointInfo(art.uid, index, physicsClientId=cid)[16]
         link = pb.getLinkState(art.uid, index, computeForwardKinematics=True, physicsClientId=cid)
         axis = quat_to_matrix(link[5])[:, 2 if kind in ROTARY else AXIS.get(kind, 2)]
-        inverse = 0.0
+        ends = []
         for n in (parent, index):
             mass, _f, diag = pb.getDynamicsInfo(art.uid, n, physicsClientId=cid)[:3]
             if mass <= 0.0:
-                continue
-            if kind not in ROTARY:
-                inverse += 1.0 / mass
                 continue
             if n < 0:
                 orn = pb.getBasePositionAndOrientation(art.uid, physicsClientId=cid)[1]
             else:
                 orn = pb.getLinkState(art.uid, n, computeForwardKinematics=True, physicsClientId=cid)[1]
-            a = quat_to_matrix(orn).T @ axis  # the axis in the body's principal frame
-            inverse += float(sum(a[i] ** 2 / diag[i] for i in range(3) if diag[i] > 0.0))
-        return 1.0 / inverse if inverse > 0.0 else float("inf")
+            ends.append((mass, diag, quat_to_matrix(orn)))
+        return row_mass(axis, ends, kind not in ROTARY)
 
     def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
         """The joints' velocities (by record index) one physics step of AMBF's solver leaves
