@@ -64,6 +64,15 @@ class PSM:
     def measured_cp(self) -> np.ndarray:
         return self.kd.fk(self.measured_jp())
 
+    def wait_until_at(self, T_t_b: np.ndarray, tolerance: float = 5e-4, timeout: float = 5.0) -> None:
+        """Wait for the measured tool pose to come within ``tolerance`` (m) of ``T_t_b``: a simulator
+        behind the wall clock (a loaded machine) still gets there before the script goes on."""
+        t = time.time()
+        while time.time() - t < timeout:
+            if np.linalg.norm(self.measured_cp()[:3, 3] - T_t_b[:3, 3]) < tolerance:
+                return
+            time.sleep(1.0 / RATE)
+
     def move_cp(self, T_t_b: np.ndarray, seconds: float) -> None:
         """servo_cp along a straight line at the control rate (the challenge's move_cp interpolates)."""
         start = self.measured_cp()
@@ -133,18 +142,21 @@ def main() -> int:
     psm.set_jaw_angle(0.4)
     psm.move_cp(above, 1.0)
     psm.move_cp(grasp, 0.6)
+    psm.wait_until_at(grasp, 2e-3)
     time.sleep(0.4)
     reached = float(np.linalg.norm(psm.measured_cp()[:3, 3] - grasp[:3, 3]))
     triggered = [bool(psm.sensor.is_triggered(r)) for r in range(psm.sensor.get_count())]
     psm.set_jaw_angle(0.0)
     time.sleep(0.3)
     psm.move_cp(above, 0.8)
+    psm.wait_until_at(above, 2e-3)
     time.sleep(0.4)
     needle1 = scene.needle_measured_cp()
     entry1 = scene.entry_measured_cp(1)
     carry = above.copy()
     carry[:3, 3] = (to_base @ np.r_[entry1[:3, 3] + [0.0, 0.0, 0.03], 1.0])[:3]
     psm.move_cp(carry, 1.0)
+    psm.wait_until_at(carry, 2e-3)
     time.sleep(0.4)
     needle2 = scene.needle_measured_cp()
     out = {
