@@ -1,0 +1,156 @@
+"""One physics step of AMBF's solver on a driven chain, engine-neutral: an articulation read as
+AMBF's chain of btRigidBodies (each link and the base a body at its centre of mass with its
+velocities, damped over the step as Bullet damps them and given the step's gravity and the last
+step's contact forces), its hinges and sliders and the joints closing its loops solved as
+runner/chain_rows.py solves them, and the joints' velocities read back out. What AMBF's bodies
+carry apart from the joints' motion, which a reduced-coordinate articulation cannot (their
+velocities and their displacement off where the joints put them, left by ten iterations that
+did not settle), is carried from step to step here. The engines read their own state into it
+(runner/pybullet/chain.py, runner/mujoco/chain.py)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .chain_rows import Body, Joint, cross3, joint_velocities, solve
+from .damping import decay_rates
+from .joint_commands import AMBF_JOINT_ERP, limits_of
+
+
+@dataclass
+class ChainState:
+    """What the engine reads of a chain at a step's start, bodies in chain order (the base
+    first, then each joint's child): centres of mass, inertial frames' rotations (n+1, 3, 3),
+    linear and angular velocities; per joint its child's joint frame origin, its axis, a
+    direction across the axis fixed in the parent (a hinge's fallback), its position and
+    velocity; the contacts' pushes (body index, force, point) of the last step."""
+
+    coms: np.ndarray
+    rots: np.ndarray
+    v: np.ndarray
+    w: np.ndarray
+    joints: list[tuple[np.ndarray, np.ndarray, np.ndarray, float, float]]
+    pushes: list[tuple[int, np.ndarray, np.ndarray]]
+
+
+class ChainStep:
+    """A chain's constants (masses, principal inertias, damping, gravity, joints) and what its
+    bodies carry from step to step."""
+
+    def __init__(self, dt: float, bodies: list[tuple], joints: list[tuple], added: list[int]) -> None:
+        """``bodies``: (ADF body, mass, principal inertia, static, gravity) in chain order;
+        ``joints``: (parent body index, "revolute" or "prismatic", ADF joint); ``added``: the
+        order the solver takes the joints in (indices past the joints' are the loops')."""
+        self.dt = dt
+        self.inv_mass, self.inv_inertia, self.inertia, self.decay, self.gravity = [], [], [], [], []
+        for body, mass, diag, static, g in bodies:
+            static = static or mass <= 0.0
+            self.inv_mass.append(0.0 if static else 1.0 / mass)
+            self.inv_inertia.append(np.array([0.0 if static or x <= 0.0 else 1.0 / x for x in diag]))
+            self.inertia.append(np.zeros(3) if static else np.asarray(diag, dtype=float))
+            lin, ang = decay_rates(body)
+            self.decay.append((math.exp(-lin * dt), math.exp(-ang * dt)))
+            self.gravity.append(np.zeros(3) if static else np.asarray(g, dtype=float) * dt)
+        self.joints = [(parent, kind, limits_of(j), _erp(j)) for parent, kind, j in joints]
+        self.added = added
+        n = len(bodies)
+        self.apart = np.zeros((n, 6))
+        self.drift = np.zeros((n, 6))
+        self.step = -2  # the physics step it was last played at: a step missed, nothing is carried
+
+    def velocities(
+        self,
+        state: ChainState,
+        motors: dict[int, tuple[float, float, float]],
+        efforts: dict[int, float],
+        step: int,
+        loops: Callable | None = None,
+    ) -> np.ndarray:
+        """The joints' velocities after one step of AMBF's solver (physics step ``step``), with
+        the motors ``motors`` (joint index -> target, cfm, max impulse) on and the joints'
+        ``efforts`` (joint index -> N·m or N) pushing their two bodies apart; ``loops(bodies,
+        coms, rots, drift)`` gives the joints closing the chain's loops."""
+        if step != self.step + 1:
+            self.apart[:] = 0.0
+            self.drift[:] = 0.0
+        self.step = step
+        rots, coms = state.rots, state.coms
+        # the carried state is kept in each body's own frame: it turns with the body
+        apart, drift = _turned(rots, self.apart), _turned(rots, self.drift)
+        bodies = []
+        for k in range(len(coms)):
+            rot = rots[k]
+            dv, dw = self.decay[k]
+            moving = self.inv_mass[k] > 0.0
+            bodies.append(
+                Body(
+                    coms[k] + drift[k, :3],
+                    self.inv_mass[k],
+                    rot @ np.diag(self.inv_inertia[k]) @ rot.T,
+                    (state.v[k] + apart[k, :3]) * dv + self.gravity[k] if moving else np.zeros(3),
+                    (state.w[k] + apart[k, 3:]) * dw if moving else np.zeros(3),
+                    rot @ np.diag(self.inertia[k]) @ rot.T,
+                )
+            )
+        joints, fk = [], []  # fk: the joints where the articulation has them
+        d = drift
+        for k, ((parent, kind, lim, erp), (pivot, axis, y, qk, qdk)) in enumerate(zip(self.joints, state.joints)):
+            a, b = parent, k + 1
+            # each body's pivot and axis where its drift has taken them
+            pivot_b = pivot + d[b, :3] + cross3(d[b, 3:], pivot - coms[b])
+            pivot_a = pivot + d[a, :3] + cross3(d[a, 3:], pivot - coms[a])
+            turn = (d[b, 3:] - d[a, 3:]) @ axis
+            axis_a = axis + cross3(d[a, 3:], axis)
+            axis_b = axis + cross3(d[b, 3:], axis)
+            axis_a /= np.linalg.norm(axis_a)
+            axis_b /= np.linalg.norm(axis_b)
+            gap = (pivot_b - pivot_a) @ axis_a
+            position = qk + (turn if kind == "revolute" else gap)
+            jt = Joint(kind, a, b, pivot_b, axis_a, y, position, qdk, erp, lim, motors.get(k))
+            fk.append(Joint(kind, a, b, pivot, axis, y, qk, qdk, erp))
+            jt.pivot_a, jt.axis_b, jt.twist = pivot_a, axis_b, turn
+            if kind == "revolute":  # the limit's bounce reads the bodies' own (damped) turn
+                jt.velocity = float((bodies[b].w - bodies[a].w) @ axis_a)
+            joints.append(jt)
+        if loops is not None:
+            joints += loops(bodies, coms, rots, d)
+        for k, force, at in state.pushes:
+            # AMBF solves its contact rows with the joints' rows, so its motors do not push
+            # through a contact; the chain's rows see the contact as the push it gave
+            bd = bodies[k]
+            if bd.inv_mass > 0.0:
+                bd.v = bd.v + force * self.dt * bd.inv_mass
+                bd.w = bd.w + bd.inv_inertia @ cross3(at - coms[k], force) * self.dt
+        for k, effort in efforts.items():  # AMBF's commandEffort: the torque (force) on both bodies
+            jt = joints[k]
+            for b, sign in ((jt.child, 1.0), (jt.parent, -1.0)):
+                bd = bodies[b]
+                if bd.inv_mass > 0.0:
+                    if jt.kind == "revolute":
+                        bd.w = bd.w + sign * effort * self.dt * (bd.inv_inertia @ jt.axis)
+                    else:
+                        bd.v = bd.v + sign * effort * self.dt * bd.inv_mass * jt.axis
+        after = solve(bodies, joints, self.dt, self.added)
+        # read as the articulation's joints, which carry the bodies where their joints put them
+        # (what is apart is measured from there: the next step starts from the same velocities)
+        at = [Body(c, bd.inv_mass, bd.inv_inertia, bd.v, bd.w, bd.inertia) for c, bd in zip(coms, bodies)]
+        qd, together = joint_velocities(at, fk, after)
+        apart = after - together
+        apart[[k for k in range(len(coms)) if self.inv_mass[k] <= 0.0]] = 0.0
+        drift += apart * self.dt
+        back = rots.transpose(0, 2, 1)
+        self.apart, self.drift = _turned(back, apart), _turned(back, drift)
+        return qd
+
+
+def _erp(joint) -> float:
+    return joint.joint_erp if joint.joint_erp is not None else AMBF_JOINT_ERP
+
+
+def _turned(rots: np.ndarray, six: np.ndarray) -> np.ndarray:
+    """Each row of ``six`` (n, 6: two 3-vectors) turned by its body's rotation ``rots`` (n, 3, 3)."""
+    return (rots @ six.reshape(-1, 2, 3).transpose(0, 2, 1)).transpose(0, 2, 1).reshape(-1, 6)
