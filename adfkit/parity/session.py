@@ -103,8 +103,12 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
     opt.springs = req.springs
     opt.link_shapes = req.link_shapes
     opt.bodies = req.bodies
-    worlds = [open_world(scene, opt, engine=e) for e in req.engines]
+    worlds = []
     try:
+        for e in req.engines:  # one floor for every side: the first engine's, which AMBF gets too
+            worlds.append(open_world(scene, opt, engine=e))
+            if opt.ground_z is None and worlds[0].ground_z is not None:
+                opt = replace(opt, ground_z=worlds[0].ground_z)
         players = [AdfkitPlayer(w) for w in worlds]
         for w in worlds:
             diags.extend(w.diagnostics)

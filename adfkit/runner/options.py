@@ -46,6 +46,7 @@ class Options:
     hole_friction: float = 2.0  # K of F = -K·v_rel inside hole ghosts, N·s/m
     hole_ghost_words: tuple = ("entry", "exit", "hole")
     ground: bool = True  # a model played without a world gets a floor under it
+    ground_z: float | None = None  # that floor's height; None: 1 mm under its lowest body
     # cameras (cameras.choose_renderer): "tiny" (TinyRenderer, CPU; nothing to set up, best for a
     # frame or two), "mujoco" (MuJoCo's renderer on a mirror of the scene: ~1 s to build, then
     # ~15x faster frames), "egl" (PyBullet's EGL plugin), "auto" (mujoco, else egl, else tiny)

@@ -83,7 +83,7 @@ class Assembly:
         mujoco.mj_forward(self.model, self.data)
         self.ground_z = None
         if ground and (plan.bodies or (self.soft is not None and self.soft.items)):
-            self.ground_z = self._lowest_point() - 1e-3
+            self.ground_z = self._lowest_point() - 1e-3 if self.opt.ground_z is None else self.opt.ground_z
             # the floor stands in for a world's, which has no collision groups: every bit, so
             # that it meets every body whatever its groups (the default bit met group 0's only)
             floor = spec.worldbody.add_geom(

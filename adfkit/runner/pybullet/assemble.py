@@ -209,13 +209,18 @@ class Assembly:
 
     def _add_ground(self) -> None:
         """A model played without a world gets what AMBF's worlds give it: a floor, here a
-        static plane 1 mm below the lowest point of every body."""
-        lows = [pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2] for sb in self.bodies if sb.uid is not None]
+        static plane 1 mm below the lowest point of every body with a collision shape (a body
+        without one has no extent: its bounds are its origin's, wherever the file puts it)."""
+        lows = [
+            pb.getAABB(sb.uid, sb.link, physicsClientId=self.cid)[0][2]
+            for sb in self.bodies
+            if sb.uid is not None and not self._shapeless(sb)
+        ]
         if self.soft is not None and self.soft.items:
             lows.append(self.soft.lowest_z())
         if not lows:
             return
-        self.ground_z = min(lows) - 1e-3
+        self.ground_z = min(lows) - 1e-3 if self.opt.ground_z is None else self.opt.ground_z
         if self.soft is None:
             shape = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=self.cid)
             vis = egl.plane_visual(self.cid, (0, 0, 1), 0.0) if self.renderer == "egl" else -1
