@@ -4,6 +4,8 @@ rule, or the challenge paper's viscous friction inside hole ghosts."""
 from __future__ import annotations
 
 import math
+from itertools import repeat
+from operator import le, sub
 
 import numpy as np
 
@@ -32,10 +34,9 @@ def in_same_place(a: list, b: list) -> bool:
     for pq_a, pq_b in zip(a, b):
         if pq_a == pq_b:
             continue
-        for va, vb in zip(pq_a, pq_b):
-            for x, y in zip(va, vb):
-                if not abs(x - y) <= SAME_PLACE:
-                    return False
+        for va, vb in zip(pq_a, pq_b):  # |x - y| <= SAME_PLACE for each number, iterated in C
+            if not all(map(le, map(abs, map(sub, va, vb)), repeat(SAME_PLACE))):
+                return False
     return True
 
 

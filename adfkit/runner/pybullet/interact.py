@@ -128,14 +128,14 @@ class Interaction:
         the physics steps of this control step: their velocities reset (a multibody link's cannot
         be: it is given the force at its centre of mass and the torque that take its velocities
         there over the control step) and their gravity off until the next control step."""
-        steps = self.opt.control_substeps
+        steps, cid = self.opt.control_substeps, self.cid
         cdt = self.dt * steps
-        cid = self.cid
-        parent = g.parent
-        v_par = parent.state()[2] if parent is not None and not parent.static else (0.0, 0.0, 0.0)
+        parent, v_par = g.parent, None
         for sb, points in g.points:
             if points == 0:
                 continue
+            if v_par is None:  # read where a body is in contact (the PSMs' finger ghosts mostly are not)
+                v_par = parent.state()[2] if parent is not None and not parent.static else (0.0, 0.0, 0.0)
             held[id(sb)] = sb
             if sb.link < 0:
                 v, w = pb.getBaseVelocity(sb.uid, cid)
@@ -178,21 +178,22 @@ class Interaction:
         return self._overlap(g)
 
     def _manifold_points(self, ghosts, poses: dict) -> dict[int, dict[tuple[int, int], int]]:
-        """{ghost uid: {(uid, link): its penetrating contact points}} as Bullet's narrowphase makes
-        them for the pair in the dynamics world, where AMBF's ghost reads them (its manifolds: a
-        box in a box gives four points at once, btBoxBoxDetector). A ghost collides with nothing
-        (it would push what enters it), so those near a dynamic body are let collide for one
-        collision pass between steps (performCollisionDetection: no step, so no push) and shut
-        again, in a world of the ghosts and copies of those bodies alone where they can be copied
-        (ghost_pass.py: the same points), else in the dynamics world; a pair GJK answers (hulls) gives one point a pass, where AMBF's persistent manifold
-        gathers up to four over its steps. The last answer stands while the same bodies are near
-        the same ghosts, within SAME_PLACE of where they were, and no collision pair or grasp has
-        changed (``poses``: those read this control step, as _update_ghosts)."""
+        """{ghost uid: {(uid, link): its penetrating contact points}} as Bullet's narrowphase makes them for
+        the pair in the dynamics world, where AMBF's ghost reads them (its manifolds: a box in a box gives
+        four points at once, btBoxBoxDetector). A ghost collides with nothing (it would push what enters
+        it), so those near a dynamic body are let collide for one collision pass between steps
+        (performCollisionDetection: no step, so no push) and shut again, in a world of the ghosts and
+        copies of those bodies alone where they can be copied (ghost_pass.py: the same points), else in
+        the dynamics world; a pair GJK answers (hulls) gives one point a pass, where AMBF's persistent
+        manifold gathers up to four over its steps. The last answer stands while the same bodies are near
+        the same ghosts, within SAME_PLACE of where they were, and no collision pair or grasp has changed
+        (``poses``: those read this control step). ``_near_keys``: each ghost's box's bodies, for _overlap."""
         cid, dynamic = self.cid, self._dynamic_lookup
         near, which, where, passes = [], [self._pairs_epoch], [], []
+        self._near_keys = overlaps = {}  # None after a pass in this world (it updates the boxes)
         for g in ghosts:
             lo, hi = pb.getAABB(g.uid, -1, cid)
-            keys = [key for key in pb.getOverlappingObjects(lo, hi, cid) or () if key in dynamic]
+            keys = overlaps[g.uid] = [key for key in pb.getOverlappingObjects(lo, hi, cid) or () if key in dynamic]
             if keys:
                 near.append(g)
                 which.append((g.uid, keys))
@@ -214,6 +215,7 @@ class Interaction:
         if made is not None:
             self._manifold_place, self._manifold_made = place, made
             return made
+        self._near_keys = None
         for g in near:
             pb.setCollisionFilterGroupMask(g.uid, -1, GHOST_PASS_BITS, GHOST_PASS_BITS, physicsClientId=cid)
         pb.performCollisionDetection(physicsClientId=cid)
@@ -238,12 +240,13 @@ class Interaction:
         ``g.points`` gets each body found with its penetrating contact points (distance < 0): from
         ``manifolds`` (_manifold_points) where given, else the closest-point query's (one a pair)."""
         cid = self.cid
-        lo, hi = pb.getAABB(g.uid, -1, cid)
+        keys = self._near_keys.get(g.uid) if manifolds is not None and self._near_keys else None  # _manifold_points'
+        keys = pb.getOverlappingObjects(*pb.getAABB(g.uid, -1, cid), cid) or () if keys is None else keys
         found, points = [], []
         dynamic, parent, closest = self._dynamic_lookup, g.parent, pb.getClosestPoints
         at = (self._pairs_epoch, g.placed_at)
         known = g.distances
-        for key in pb.getOverlappingObjects(lo, hi, cid) or ():
+        for key in keys:
             sb = dynamic.get(key)
             if sb is None or (sb is parent and not with_parent):
                 continue
