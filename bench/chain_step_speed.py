@@ -8,13 +8,16 @@ without ``../shared/corpus`` there is nothing to play and it says so.
 
 The figure is this process's CPU time (``time.process_time``) of the stepping alone, per second
 simulated, the median of R rounds on freshly built worlds; and the share of it in the chain step
-(``ChainModel.velocities``), by cProfile on one more round. Prints figures, asserts nothing.
+(``ChainModel.velocities``), by cProfile on one more round; and a digest of every body's state at
+the end of the first round (a change that only reorganises the chain step keeps it to the bit).
+Prints figures, asserts nothing.
 """
 
 from __future__ import annotations
 
 import argparse
 import cProfile
+import hashlib
 import pstats
 import statistics
 import sys
@@ -55,16 +58,17 @@ def main(argv: list[str]) -> int:
     if not CORPUS.is_dir():
         print(f"skipped: no corpus at {CORPUS} (the robots played are the corpus's)")
         return 0
-    print("| robot | program | CPU s per simulated s (median) | rounds | in the chain step |")
-    print("|---|---|---|---|---|")
+    print("| robot | program | CPU s per simulated s (median) | rounds | in the chain step | final states |")
+    print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory(prefix="adfkit-chain-bench-") as tmp:
         for label, rel, kind in ROBOTS:
-            cpu = []
+            cpu, digests = [], []
             for _ in range(args.rounds):
                 world, player, cmds = _player(CORPUS / rel, kind, Path(tmp))
                 t0 = time.process_time()
                 player.play(args.seconds, 0.02, cmds)
                 cpu.append((time.process_time() - t0) / args.seconds)
+                digests.append(hashlib.sha256(repr([sb.state() for sb in world.bodies]).encode()).hexdigest()[:12])
                 world.close()
             world, player, cmds = _player(CORPUS / rel, kind, Path(tmp))
             prof = cProfile.Profile(time.process_time)
@@ -77,7 +81,7 @@ def main(argv: list[str]) -> int:
             chain = sum(s[3] for (_f, _l, name), s in stats.items() if name == "velocities")
             print(
                 f"| {label} | {kind} | {statistics.median(cpu):.2f} s | {args.rounds} | "
-                f"{100 * chain / total if total else 0:.0f} % |"
+                f"{100 * chain / total if total else 0:.0f} % | {digests[0]}{'' if len(set(digests)) == 1 else ' (rounds differ)'} |"
             )
     return 0
 
