@@ -91,3 +91,23 @@ def test_a_ghost_passes_again_once_a_body_near_it_moves_past_same_place(tmp_path
         assert out == afresh == {g.uid: {}}, (out, afresh)
     finally:
         w.close()
+
+
+def test_same_place_is_within_same_place_in_every_number_and_never_for_nan():
+    """in_same_place, which decides whether a ghost keeps its last pass's points: every number of
+    every (position, quaternion) within SAME_PLACE, NaN never (a body read afresh as NaN), equal
+    pairs skipped; one number past the bound, anywhere, is enough to pass again."""
+    from adfkit.runner.ghost_rules import in_same_place
+
+    a = [((0.1, 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), ((1.0, 2.0, 3.0), (0.5, 0.5, 0.5, 0.5))]
+    assert in_same_place(a, [tuple(map(tuple, pq)) for pq in a])
+    near = [((0.1 + 0.9 * SAME_PLACE, 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]]
+    assert in_same_place(a, near)
+    for i in range(2):  # the last number of either pair, position or quaternion, past the bound
+        for part in range(2):
+            moved = [list(map(list, pq)) for pq in a]
+            moved[i][part][-1] += 1.1 * SAME_PLACE
+            assert not in_same_place(a, [tuple(map(tuple, pq)) for pq in moved]), (i, part)
+    nan = [((float("nan"), 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]]
+    assert not in_same_place(a, nan)
+    assert not in_same_place(nan, [((float("nan"), 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]])
