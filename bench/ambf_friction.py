@@ -13,12 +13,12 @@ largest gaps between them (any body, any 20 ms sample):
 - the same again, its friction rows started from zero each step (Bullet since 2019, and so
   PyBullet, no longer restarts them: "it can cause artifacts"), from a copy of AMBF's solver
   source changed at that one place;
-- adfkit's PyBullet world under `adfkit parity`'s options.
+- adfkit's PyBullet and MuJoCo worlds under `adfkit parity`'s options.
 
 The first gap says the program plays AMBF's scene as AMBF does; the others say how much of
 adfkit's gap from AMBF the two differences are. PyBullet has no setting for either.
 
-    .venv/bin/python bench/ambf_friction.py [SCENE -l N] [--seconds S]
+    .venv/bin/python bench/ambf_friction.py [SCENE -l N] [--seconds S] [--engine pybullet|mujoco|both]
 
 Default: the parity scenes' primitives dropped tilted (`adfkit build-scene parity`, -l 7) and
 the two boxes on a fixed joint (-l 9). Needs an AMBF build (`make ambf`) and g++; skips, with
@@ -152,33 +152,35 @@ def worst(c) -> str:
     return f"{pos.max_position * 1e3:.2f} mm ({pos.name.rsplit('/', 1)[-1]})" if pos is not None else "-"
 
 
-def play(path: Path, indices: list[int], seconds: float, build, exe: Path) -> list[str]:
+def play(path: Path, indices: list[int], seconds: float, build, exe: Path, engines: list[str]) -> list[list[str]]:
+    """A table row for each engine: the scene's largest gaps between the four ways it is played."""
     from adfkit.adf import load_scene
     from adfkit.parity import ambf as ambf_run
     from adfkit.parity.compare import compare
     from adfkit.parity.traces import AdfkitPlayer, from_ambf
     from adfkit.runner import Options, open_world
 
-    scene = load_scene(path, indices, [])
     opt = Options(control_substeps=4, visuals=False, renderer="tiny")
     opt.ghosts, opt.springs, opt.link_shapes, opt.bodies = "ambf", "ambf", "body", "ambf"  # adfkit parity's
-    world = open_world(scene, opt, engine="pybullet")
-    try:
-        text = scene_text(world, seconds)
-        stage = ambf_run.Stage(path.resolve(), indices)
-        ambf = from_ambf(ambf_run.run(build, stage, seconds, EVERY * world.dt), stage.staged_bodies)
-        one, two, fresh = (lab_trace(exe, text, world, *m) for m in ((), ("two",), ("two", "fresh")))
-        adfkit = AdfkitPlayer(world).play(seconds, EVERY * world.dt)
-    finally:
-        world.close()
-    cells = [
-        compare(ambf, one),
-        compare(ambf, two),
-        compare(two, adfkit),
-        compare(fresh, adfkit),
-        compare(ambf, adfkit),
-    ]
-    return [f"{path.name} -l {','.join(map(str, indices))}", *(worst(c) for c in cells)]
+    played = {}
+    for engine in ["pybullet", *(e for e in engines if e != "pybullet")]:
+        world = open_world(load_scene(path, indices, []), opt, engine=engine)
+        try:
+            if engine == "pybullet":  # the bodies as the PyBullet runner made them
+                text = scene_text(world, seconds)
+                stage = ambf_run.Stage(path.resolve(), indices)
+                ambf = from_ambf(ambf_run.run(build, stage, seconds, EVERY * world.dt), stage.staged_bodies)
+                one, two, fresh = (lab_trace(exe, text, world, *m) for m in ((), ("two",), ("two", "fresh")))
+            played[engine] = AdfkitPlayer(world).play(seconds, EVERY * world.dt)
+        finally:
+            world.close()
+    rows = []
+    for engine in engines:
+        adfkit = played[engine]
+        cells = [compare(ambf, one), compare(ambf, two), compare(two, adfkit), compare(fresh, adfkit)]
+        cells.append(compare(ambf, adfkit))
+        rows.append([f"{path.name} -l {','.join(map(str, indices))}", engine, *(worst(c) for c in cells)])
+    return rows
 
 
 def main(argv=None) -> int:
@@ -186,7 +188,9 @@ def main(argv=None) -> int:
     ap.add_argument("scene", nargs="?", type=Path, help="a launch file (default: the parity scenes, -l 7 and 9)")
     ap.add_argument("-l", "--indices", default=None, help="its models to load, e.g. 7")
     ap.add_argument("--seconds", type=float, default=1.0)
+    ap.add_argument("--engine", choices=("pybullet", "mujoco", "both"), default="both", help="adfkit's engine")
     args = ap.parse_args(argv)
+    engines = ["pybullet", "mujoco"] if args.engine == "both" else [args.engine]
     from adfkit.parity import ambf as ambf_run
 
     build, why = ambf_run.available()
@@ -202,11 +206,12 @@ def main(argv=None) -> int:
             runs = [(launch, [7]), (launch, [9])]
         else:
             runs = [(args.scene, [int(i) for i in args.indices.split(",")] if args.indices else [0])]
-        head = ["scene", "AMBF / its Bullet", "AMBF / + 2nd direction", "+ 2nd direction / adfkit"]
+        head = ["scene", "adfkit", "AMBF / its Bullet", "AMBF / + 2nd direction", "+ 2nd direction / adfkit"]
         head += ["+ friction from zero / adfkit", "AMBF / adfkit"]
         print("| " + " | ".join(head) + " |\n|" + "---|" * len(head))
         for path, indices in runs:
-            print("| " + " | ".join(play(path, indices, args.seconds, build, exe)) + " |", flush=True)
+            for row in play(path, indices, args.seconds, build, exe, engines):
+                print("| " + " | ".join(row) + " |", flush=True)
     return 0
 
 
