@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import os
 import shutil
 import subprocess
 import sys
@@ -59,11 +60,13 @@ def program(build) -> Path:
             if old not in text:
                 raise SystemExit(f"{solver}: no friction restart to switch off (not Bullet 2.88's solver)")
             text = text.replace(old, f"(gFrictionFromZero ? 0 : {old})")
-        copy = exe.parent / "solver.cpp"
+        copy = exe.parent / f"solver.{os.getpid()}.cpp"
         copy.write_text("bool gFrictionFromZero = false;\n" + text)
         inc = [f"-I{src}", f"-I{solver.parent}"]
-        cmd = ["g++", "-O2", "-DBT_USE_DOUBLE_PRECISION", *inc, str(SOURCE), str(copy), str(lib), "-o", str(exe)]
+        part = exe.with_name(f"{exe.name}.{os.getpid()}")  # two processes may build it at once
+        cmd = ["g++", "-O2", "-DBT_USE_DOUBLE_PRECISION", *inc, str(SOURCE), str(copy), str(lib), "-o", str(part)]
         subprocess.run(cmd, check=True)
+        os.replace(part, exe)
     return exe
 
 
