@@ -219,7 +219,7 @@ def main(argv: list[str]) -> int:
         print("\n".join(suture_rows(build)))
         return 0
     os.environ.setdefault("ADFKIT_INPUT_ROOT", "/")  # the puzzle's launch names AMBF's floor and the corpus
-    rows, results = [], []
+    rows, results, tip_rows = [], [], []
     with tempfile.TemporaryDirectory(prefix="adfkit-parity-bench-") as tmp:
         folder = Path(tmp)
         scenes = own_scenes(folder / "own") + sample_scenes() + corpus_scenes(build, folder)
@@ -264,6 +264,16 @@ def main(argv: list[str]) -> int:
                     "agree": not c.failures(),
                     "made_alike": not (c.only_in_ambf or c.only_in_adfkit),
                 }
+                tips = c.tip_gaps
+                if tips:  # a driven scene's tool tips (the 0.5 mm for a driven tool tip)
+                    tip = max(tips, key=lambda g: g.max_position)
+                    row["tip_mm"], row["tip_body"] = tip.max_position * 1e3, tip.name
+                    names = ", ".join("`" + g.name.rsplit("/", 1)[-1] + "`" for g in tips)
+                    tip_rows.append(
+                        f"| {sc.name} | {row['engine']} | {names} | "
+                        f"**{row['tip_mm']:.2f} mm** (`{tip.name.rsplit('/', 1)[-1]}`) | "
+                        f"{'within' if row['tip_mm'] <= 0.5 else 'past'} |"
+                    )
                 results.append(row)
                 rows.append(
                     f"| {sc.name} | {row['engine']} | {sc.seconds:g} s | **{row['max_mm']:.2f} mm** "
@@ -277,6 +287,10 @@ def main(argv: list[str]) -> int:
     )
     print("|---|---|---|---|---|---|---|---|")
     print("\n".join(rows))
+    if tip_rows:
+        print("\n| scene | adfkit | tool tips | largest tip gap over the run | 0.5 mm |")
+        print("|---|---|---|---|---|")
+        print("\n".join(tip_rows))
     if out_json is not None:
         out_json.write_text(json.dumps(results, indent=1) + "\n")
     return 0

@@ -567,8 +567,8 @@ def test_a_psms_motors_fall_short_as_ambfs_rows_do(tmp_path, monkeypatch):
 def test_mujoco_moves_a_driven_chain_as_ambfs_ten_iterations_do(tmp_path, monkeypatch):
     """Under AMBF's bodies MuJoCo plays AMBF's ten solver iterations on a driven chain (the chain
     step, as PyBullet): the KUKA's velocity program 0.70 mm from AMBF and the LND PSM's 1.15 mm
-    (measured; 3.49 and 7.78 mm with the motor rows settled together). Control: the chain step
-    off, the PSM's rows settled, 7.8 mm."""
+    (measured; 3.49 and 7.78 mm with the motor rows settled together), the PSM's jaws, its tool
+    tips, 0.08 mm. Control: the chain step off, the PSM's rows settled, 7.8 mm."""
     from conftest import CORPUS, require_corpus
 
     from adfkit.parity import programs, session
@@ -576,17 +576,20 @@ def test_mujoco_moves_a_driven_chain_as_ambfs_ten_iterations_do(tmp_path, monkey
 
     require_corpus()
 
-    def worst(model) -> float:
+    def played(model):
         cmd = programs.write_program(model, None, "velocity", 1.0, tmp_path / f"{model.stem}.txt")
         req = session.Request(model, None, BUILD, seconds=1.0, commands=cmd, engines=("mujoco",))
         (c,) = session.run(req, progress=False).comparisons
-        return max(g.max_position for g in c.bodies)
+        return max(g.max_position for g in c.bodies), c.tip_gaps
 
     psm = CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml"
-    assert worst(CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml") < 1e-3
-    assert worst(psm) < 2e-3
+    assert played(CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml")[0] < 1e-3
+    worst, tips = played(psm)
+    assert worst < 2e-3
+    assert {g.name.rsplit("/", 1)[-1] for g in tips} == {"toolgripper1simple", "toolgripper2simple"}
+    assert max(g.max_position for g in tips) < 5e-4
     monkeypatch.setattr(MujocoWorld, "chain_velocities", lambda self, art, motors, efforts: None)
-    assert worst(psm) > 5e-3
+    assert played(psm)[0] > 5e-3
 
 
 @needs_ambf
@@ -1051,3 +1054,25 @@ def test_the_drilling_sample_stands_still_in_ambf_as_in_adfkit(tmp_path):
     (c,) = session.run(session.Request(heavy / "launch.yaml", None, BUILD, seconds=0.5), progress=False).comparisons
     shaft = c.ambf.body_names.index("/ambf/env/drilling/Shaft")
     assert c.ambf.poses[0, shaft, 2] - c.ambf.poses[-1, shaft, 2] > 0.06
+
+
+def test_the_tool_tips_are_the_ends_of_the_longest_chains():
+    """A PSM-like tree (base, yaw, pitch and a loop back to yaw through a parallel link, then
+    the tool with two jaws) and a one-joint arm: the tips are the two jaws, the farthest from
+    the base (a loop's body counted at its shortest distance), and the arm; a static body with
+    no joint is nobody's tip."""
+    from types import SimpleNamespace
+
+    from adfkit.parity.traces import tool_tips
+
+    b = {
+        n: SimpleNamespace(n=n)
+        for n in ("base", "yaw", "pitch", "parallel", "tool", "jaw1", "jaw2", "post", "arm", "table")
+    }
+    pairs = [("base", "yaw"), ("yaw", "pitch"), ("yaw", "parallel"), ("parallel", "pitch"), ("pitch", "tool")]
+    pairs += [("tool", "jaw1"), ("tool", "jaw2"), ("post", "arm")]
+    joints = [(None, b[p], b[c]) for p, c in pairs]
+    names = [(f"/ambf/env/{n}", sb) for n, sb in b.items()]
+    assert tool_tips(names, joints) == ["/ambf/env/jaw1", "/ambf/env/jaw2", "/ambf/env/arm"]
+    assert tool_tips(names, joints[:2]) == ["/ambf/env/pitch"]
+    assert tool_tips(names, []) == []

@@ -40,6 +40,12 @@ class Comparison:
     tolerance_m: float
     tolerance_deg: float
     notes: list[str] = field(default_factory=list)
+    tips: list[str] = field(default_factory=list)  # the tool tips' names (traces.tool_tips)
+
+    @property
+    def tip_gaps(self) -> list[Gap]:
+        """The tool tips' gaps, the worst first."""
+        return [g for g in self.bodies if g.name in self.tips]
 
     @property
     def worst(self) -> tuple[Gap | None, Gap | None]:
@@ -82,6 +88,10 @@ class Comparison:
             "largest_position_gap": {"name": pos.name, "m": pos.max_position} if pos else None,
             "largest_angle_gap": {"name": ang.name, "deg": ang.max_angle} if ang else None,
             "joints": [{"name": g.name, "max_value_gap": g.max_position} for g in self.joints],
+            "tool_tips": [
+                {"name": g.name, "max_position_gap_m": g.max_position, "max_angle_gap_deg": g.max_angle}
+                for g in self.tip_gaps
+            ],
             "only_in_ambf": self.only_in_ambf,
             "only_in_adfkit": self.only_in_adfkit,
             "wall_s": {"ambf": self.ambf.wall_s, self.adfkit.side: self.adfkit.wall_s},

@@ -13,7 +13,7 @@ from ..diagnostics import AdfError, Diagnostic, Severity, error
 from . import ambf as ambf_run
 from . import commandfile
 from .compare import Comparison, compare
-from .traces import AdfkitPlayer, from_ambf
+from .traces import AdfkitPlayer, from_ambf, tool_tips
 
 
 @dataclass
@@ -124,7 +124,10 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
             bar = Progress(steps, f"parity {p.world.engine}", enabled=progress)
             trace = p.play(req.seconds, req.every, commands, bar)
             bar.close()
-            out.comparisons.append(compare(ambf_trace, trace, req.tolerance_m, req.tolerance_deg))
+            c = compare(ambf_trace, trace, req.tolerance_m, req.tolerance_deg)
+            if any(cmd.kind in commandfile.JOINT_KINDS for cmd, _ in commands_read):  # driven: its tips
+                c.tips = tool_tips(list(zip(p.made["body"], p.bodies)), p.joints)
+            out.comparisons.append(c)
         return out
     finally:
         for w in worlds:
@@ -188,6 +191,14 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
                 )
             if len(c.bodies) > rows:
                 print(f"  … {len(c.bodies) - rows} more (--json lists every body)", file=stream)
+        tips = c.tip_gaps
+        if tips:
+            tip = max(tips, key=lambda g: g.max_position)
+            print(
+                f"  tool tips ({', '.join(g.name.rsplit('/', 1)[-1] for g in tips)}): at most "
+                f"{tip.max_position * 1e3:.3f} mm ({tip.name.rsplit('/', 1)[-1]})",
+                file=stream,
+            )
         for label, items in (("only in AMBF", c.only_in_ambf), ("only in adfkit", c.only_in_adfkit)):
             for d in items:
                 print(f"  {label}: {d['kind']} {d['name']}", file=stream)

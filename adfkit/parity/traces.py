@@ -99,6 +99,35 @@ def _pose(sb) -> list[float]:
     return [*p, *q]
 
 
+def tool_tips(bodies: list[str], joints: list[tuple]) -> list[str]:
+    """The tool tips of the scene's jointed trees: the bodies ending its longest chains, each
+    a joint's child and no joint's parent, the most joints from its tree's root (a PSM's two
+    jaws, the KUKA's link7). ``bodies``: (name, engine body) pairs; ``joints``: (joint, parent
+    body, child body) as the world made them."""
+    name = {id(sb): n for n, sb in bodies}
+    children: dict[int, list[int]] = {}
+    is_child = set()
+    for _j, parent, child in joints:
+        children.setdefault(id(parent), []).append(id(child))
+        is_child.add(id(child))
+    tips = []
+    for root in [k for k in children if k not in is_child]:
+        depth, frontier, seen = {root: 0}, [root], {root}
+        while frontier:  # breadth first: a loop's body at its shortest distance from the root
+            nxt = []
+            for k in frontier:
+                for c in children.get(k, []):
+                    if c not in seen:
+                        seen.add(c)
+                        depth[c] = depth[k] + 1
+                        nxt.append(c)
+            frontier = nxt
+        leaves = [k for k in depth if k not in children and k in name]
+        deepest = max((depth[k] for k in leaves), default=0)
+        tips += [name[k] for k in leaves if deepest > 0 and depth[k] == deepest]
+    return tips
+
+
 class AdfkitPlayer:
     """A scene played in an adfkit world, sampled as the AMBF plugin samples it, driven by the
     same commands: each takes effect at the first control step at or after its time (AMBF: the
