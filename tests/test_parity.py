@@ -1076,3 +1076,20 @@ def test_the_tool_tips_are_the_ends_of_the_longest_chains():
     assert tool_tips(names, joints) == ["/ambf/env/jaw1", "/ambf/env/jaw2", "/ambf/env/arm"]
     assert tool_tips(names, joints[:2]) == ["/ambf/env/pitch"]
     assert tool_tips(names, []) == []
+
+
+def test_a_sliders_reading_before_ambfs_first_step_is_unknown():
+    """Bullet's btSliderConstraint computes its position in its solver step: AMBF's first sample,
+    before any step, reads memory (1.0 and 2.9e-311 measured on the LND PSM's insertion), which
+    read as a 1 m gap in the joint gaps. It is unknown there; later samples and a hinge's first
+    one are kept."""
+    from types import SimpleNamespace
+
+    from adfkit.parity.traces import from_ambf
+
+    kinds = {"bodies": [], "soft_bodies": [], "ghosts": [], "sensors": [], "actuators": []}
+    created = {**kinds, "joints": [{"qname": "/a/slide", "type": "prismatic"}, {"qname": "/a/turn", "type": "revolute"}]}
+    samples = [{"t": 0.0, "bodies": [], "joints": [1.0, 0.2]}, {"t": 0.02, "bodies": [], "joints": [0.01, 0.21]}]
+    tr = from_ambf(SimpleNamespace(created=created, samples=samples, wall_s=0.0))
+    assert np.isnan(tr.joints[0, 0]) and tr.joints[1, 0] == 0.01
+    assert tr.joints[0, 1] == 0.2

@@ -88,6 +88,11 @@ def from_ambf(rec, staged: tuple[str, ...] = ()) -> Trace:
         len(s), len(made["joint"])
     )
     times = np.array([x["t"] for x in s])
+    # Bullet's btSliderConstraint computes its position in its solver step: before AMBF's first,
+    # a prismatic joint reads whatever its memory held (measured: 1.0, 2.9e-311)
+    sliders = [k for k, j in enumerate(rec.created["joints"]) if j.get("type") == "prismatic"]
+    if sliders and times.size and times[0] == 0.0:
+        joints[0, sliders] = np.nan
     clock = np.array([x.get("clock", x["t"]) for x in s])
     return Trace("ambf", made, made["body"], times, poses[:, keep], made["joint"], joints, rec.wall_s, clock=clock)
 
