@@ -1088,7 +1088,10 @@ def test_a_sliders_reading_before_ambfs_first_step_is_unknown():
     from adfkit.parity.traces import from_ambf
 
     kinds = {"bodies": [], "soft_bodies": [], "ghosts": [], "sensors": [], "actuators": []}
-    created = {**kinds, "joints": [{"qname": "/a/slide", "type": "prismatic"}, {"qname": "/a/turn", "type": "revolute"}]}
+    created = {
+        **kinds,
+        "joints": [{"qname": "/a/slide", "type": "prismatic"}, {"qname": "/a/turn", "type": "revolute"}],
+    }
     samples = [{"t": 0.0, "bodies": [], "joints": [1.0, 0.2]}, {"t": 0.02, "bodies": [], "joints": [0.01, 0.21]}]
     tr = from_ambf(SimpleNamespace(created=created, samples=samples, wall_s=0.0))
     assert np.isnan(tr.joints[0, 0]) and tr.joints[1, 0] == 0.01
