@@ -41,6 +41,8 @@ class Comparison:
     tolerance_deg: float
     notes: list[str] = field(default_factory=list)
     tips: list[str] = field(default_factory=list)  # the tool tips' names (traces.tool_tips)
+    # each side's joints standing open (openings.py), by side: "ambf" and the engine's
+    opening: dict = field(default_factory=dict)
 
     @property
     def tip_gaps(self) -> list[Gap]:
@@ -96,6 +98,7 @@ class Comparison:
             "only_in_adfkit": self.only_in_adfkit,
             "wall_s": {"ambf": self.ambf.wall_s, self.adfkit.side: self.adfkit.wall_s},
             "notes": self.notes,
+            "joint_opening": {side: o.as_json() for side, o in self.opening.items()},
         }
 
 

@@ -13,6 +13,7 @@ from ..diagnostics import AdfError, Diagnostic, Severity, error
 from . import ambf as ambf_run
 from . import commandfile
 from .compare import Comparison, compare
+from .openings import opening, shut_pivots
 from .traces import AdfkitPlayer, from_ambf, tool_tips
 
 
@@ -127,6 +128,11 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
             c = compare(ambf_trace, trace, req.tolerance_m, req.tolerance_deg)
             if any(cmd.kind in commandfile.JOINT_KINDS for cmd, _ in commands_read):  # driven: its tips
                 c.tips = tool_tips(list(zip(p.made["body"], p.bodies)), p.joints)
+            pivots = shut_pivots(p.world, p.made)
+            for t in (ambf_trace, trace):
+                o = opening(t, pivots)
+                if o is not None:
+                    c.opening[t.side] = o
             out.comparisons.append(c)
         return out
     finally:
@@ -199,6 +205,18 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
                 f"{tip.max_position * 1e3:.3f} mm ({tip.name.rsplit('/', 1)[-1]})",
                 file=stream,
             )
+        if c.opening:
+            sides = "; ".join(
+                f"{'AMBF' if side == 'ambf' else side} "
+                + (
+                    f"{o.widest_m * 1e3:.3f} mm ({o.widest}), {o.summed_m * 1e3:.3f} mm summed at most, "
+                    f"{o.summed_end_m * 1e3:.3f} at the end"
+                    if o.widest_m >= 1e-6
+                    else "shut"
+                )
+                for side, o in c.opening.items()
+            )
+            print(f"  joints standing open (pivots apart), widest: {sides}", file=stream)
         for label, items in (("only in AMBF", c.only_in_ambf), ("only in adfkit", c.only_in_adfkit)):
             for d in items:
                 print(f"  {label}: {d['kind']} {d['name']}", file=stream)
