@@ -55,6 +55,9 @@ class ChainStep:
             lin, ang = decay_rates(body)
             self.decay.append((math.exp(-lin * dt), math.exp(-ang * dt)))
             self.gravity.append(np.zeros(3) if static else np.asarray(g, dtype=float) * dt)
+        # the principal inertias and their inverses as diagonal matrices, made once
+        self.inv_inertia_diag = [np.diag(x) for x in self.inv_inertia]
+        self.inertia_diag = [np.diag(x) for x in self.inertia]
         self.joints = [(parent, kind, limits_of(j), _erp(j)) for parent, kind, j in joints]
         self.added = added
         n = len(bodies)
@@ -90,10 +93,10 @@ class ChainStep:
                 Body(
                     coms[k] + drift[k, :3],
                     self.inv_mass[k],
-                    rot @ np.diag(self.inv_inertia[k]) @ rot.T,
+                    rot @ self.inv_inertia_diag[k] @ rot.T,
                     (state.v[k] + apart[k, :3]) * dv + self.gravity[k] if moving else np.zeros(3),
                     (state.w[k] + apart[k, 3:]) * dw if moving else np.zeros(3),
-                    rot @ np.diag(self.inertia[k]) @ rot.T,
+                    rot @ self.inertia_diag[k] @ rot.T,
                 )
             )
         joints, fk = [], []  # fk: the joints where the articulation has them
@@ -106,8 +109,8 @@ class ChainStep:
             turn = (d[b, 3:] - d[a, 3:]) @ axis
             axis_a = axis + cross3(d[a, 3:], axis)
             axis_b = axis + cross3(d[b, 3:], axis)
-            axis_a /= np.linalg.norm(axis_a)
-            axis_b /= np.linalg.norm(axis_b)
+            axis_a /= math.sqrt(axis_a @ axis_a)  # np.linalg.norm's sum and root, without its checks
+            axis_b /= math.sqrt(axis_b @ axis_b)
             gap = (pivot_b - pivot_a) @ axis_a
             position = qk + (turn if kind == "revolute" else gap)
             jt = Joint(kind, a, b, pivot_b, axis_a, y, position, qdk, erp, lim, motors.get(k))

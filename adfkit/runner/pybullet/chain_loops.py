@@ -101,7 +101,7 @@ def _moved(at: np.ndarray, com: np.ndarray, drift: np.ndarray) -> np.ndarray:
 
 def _turned(v: np.ndarray, turn: np.ndarray) -> np.ndarray:
     v = v + cross3(turn, v)
-    return v / np.linalg.norm(v)
+    return v / math.sqrt(v @ v)  # np.linalg.norm's sum and root
 
 
 _X = np.array([1.0, 0.0, 0.0])
