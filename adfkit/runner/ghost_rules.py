@@ -59,7 +59,8 @@ def kept_under_slow_parent(v, w, v_parent, points: int) -> tuple[list[float], li
     along its velocity: a static phantom's hole ghosts, a resting arm's finger ghosts): the same
     sums, keep·(v - 0) + v_parent and keep·w, in floats, without numpy's cost; None where the
     parent is faster, or so near ALONG_FROM that numpy's norm, rounded its own way, decides."""
-    if sum(c * c for c in v_parent) > ALONG_FROM * ALONG_FROM * (1.0 - 1e-9):
+    x, y, z = v_parent
+    if x * x + y * y + z * z > ALONG_FROM * ALONG_FROM * (1.0 - 1e-9):  # sum()'s order, without its generator
         return None
     keep = AMBF_GHOST_KEEP**points
     return [keep * (x - 0.0) + p for x, p in zip(v, v_parent)], [keep * x for x in w]

@@ -130,21 +130,21 @@ class Interaction:
         there over the control step) and their gravity off until the next control step."""
         steps, cid = self.opt.control_substeps, self.cid
         cdt = self.dt * steps
-        parent, v_par = g.parent, None
+        parent = g.parent  # its state read once, and used again where the ghost holds its own parent
+        ps = parent.state() if parent is not None and not parent.static else (None, None, (0.0, 0.0, 0.0), None)
+        v_par = ps[2]
         for sb, points in g.points:
             if points == 0:
                 continue
-            if v_par is None:  # read where a body is in contact (the PSMs' finger ghosts mostly are not)
-                v_par = parent.state()[2] if parent is not None and not parent.static else (0.0, 0.0, 0.0)
             held[id(sb)] = sb
             if sb.link < 0:
-                v, w = pb.getBaseVelocity(sb.uid, cid)
+                v, w = ps[2:] if sb is parent else pb.getBaseVelocity(sb.uid, cid)
                 kept = kept_under_slow_parent(v, w, v_par, points * steps)
                 if kept is None:
                     kept = tuple(x.tolist() for x in ghost_velocity(v, w, v_par, points * steps))
                 pb.resetBaseVelocity(sb.uid, kept[0], kept[1], cid)
             else:
-                p, q, v, w = sb.state()
+                p, q, v, w = ps if sb is parent else sb.state()
                 a, alpha = ghost_accelerations(v, w, v_par, points * steps, cdt)
                 rot = np.array(pb.getMatrixFromQuaternion(q)).reshape(3, 3)  # the COM frame's
                 sb.force((sb.mass * a).tolist(), list(p))
