@@ -65,7 +65,10 @@ def program(build) -> Path:
         inc = [f"-I{src}", f"-I{solver.parent}"]
         part = exe.with_name(f"{exe.name}.{os.getpid()}")  # two processes may build it at once
         cmd = ["g++", "-O2", "-DBT_USE_DOUBLE_PRECISION", *inc, str(SOURCE), str(copy), str(lib), "-o", str(part)]
-        subprocess.run(cmd, check=True)
+        try:
+            subprocess.run(cmd, check=True)
+        finally:
+            copy.unlink()
         os.replace(part, exe)
     return exe
 
