@@ -45,7 +45,8 @@ class Scene:
     note: str = ""
     rows: list = field(default_factory=list)
     # each engine in a run of its own, AMBF given that engine's floor (a model played alone: the
-    # engines put the floor 1 mm under their own lowest point, MuJoCo under a mesh's lowest vertex)
+    # engines put the floor 1 mm under their own lowest point, MuJoCo under a mesh's lowest vertex);
+    # otherwise every side on the first engine's floor
     apart: bool = False
 
 
@@ -115,14 +116,14 @@ def corpus_scenes(build, folder: Path) -> list[Scene]:
     robots = (
         ("KUKA", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml", both),
         ("PSM (LND 400006)", CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", both),
-        # MuJoCo closes their loops at other joints, which the programs drive
+        # MuJoCo closes the ECM's loops at other joints, which the programs drive
         ("ECM (loops)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml", pybullet),
-        ("MTM (loop)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml", pybullet),
+        ("MTM (loop)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml", both),
     )
     for label, model, engines in robots:
         for kind in ("position", "velocity", "effort"):
             cmd = programs.write_program(model, None, kind, 1.0, folder / f"{model.stem}_{kind}.txt")
-            out.append(Scene(f"{label}, {kind} program", model, None, 1.0, engines, commands=cmd, apart=True))
+            out.append(Scene(f"{label}, {kind} program", model, None, 1.0, engines, commands=cmd))
     return out
 
 

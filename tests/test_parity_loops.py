@@ -143,3 +143,29 @@ def test_a_joint_one_engine_cannot_drive_is_a_located_error_naming_it(tmp_path):
     (d,) = e.value.diagnostics
     assert d.rule == "command-target" and "pitchbottomlink-pitchendlink' in mujoco" in d.message
     assert (d.location.line, d.location.column) == (2, 1)
+
+
+@pytest.mark.slow
+@needs_ambf
+def test_mujoco_moves_the_mtm_with_its_loop_as_ambf(tmp_path, monkeypatch):
+    """MuJoCo closes the corpus MTM's parallelogram at the same hinge as PyBullet (a connect
+    equality); the chain step solves that hinge with the arm's rows, its pivots where MuJoCo's
+    connect holds the two links. On one floor (``--engine both``: PyBullet's, which AMBF gets
+    too) the position program is 3.5 mm from AMBF in MuJoCo (PyBullet 2.5 mm), the velocity
+    program 2.1 mm (1.3 mm). Control: the loop not read, the arm's rows settled instead, the
+    position program 12.4 mm."""
+    from adfkit.parity import programs
+    from adfkit.runner.mujoco import chain
+
+    require_corpus()
+    path = CORPUS / MODELS / "robots/blender-mtm.yaml"
+
+    def gaps(kind):
+        cmds = programs.write_program(path, None, kind, 1.0, tmp_path / f"mtm_{kind}.txt")
+        return _largest_gaps(path, ("pybullet", "mujoco"), commands=cmds)
+
+    assert gaps("velocity")["mujoco"] < 3e-3
+    position = gaps("position")
+    assert position["mujoco"] < 5e-3 and position["pybullet"] < 3.5e-3, position
+    monkeypatch.setattr(chain, "_loops", lambda world, bodies, index: None)
+    assert gaps("position")["mujoco"] > 8e-3

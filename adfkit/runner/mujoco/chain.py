@@ -11,8 +11,10 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from ...model.semantics import JointKind
+from ...model.semantics import JointKind, body_joint_frames, joint_kind
 from ..chain_step import ChainState, ChainStep
+from ..loop_rows import Loop, loop_joints
+from ..rotations import invert, pose_to_matrix
 
 _TIES = (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD)
 
@@ -28,7 +30,8 @@ class ChainModel:
         self.ids = np.array([sb.id for sb in chain], dtype=int)
         index = {id(sb): k for k, sb in enumerate(chain)}
         self.ok = all(k in kinds for k in art.kinds) and bool(np.all(art.vadr >= 0))
-        self.ok = self.ok and not _tied(m, set(self.ids.tolist()))
+        self.loops = _loops(world, chain, index)
+        self.ok = self.ok and self.loops is not None and not _tied(m, set(self.ids.tolist()))
         if not self.ok:
             return
         self.jids = np.array([int(m.dof_jntid[a]) for a in art.vadr], dtype=int)
@@ -42,6 +45,7 @@ class ChainModel:
         joints = [(index[id(rec[2])], kinds[kind], rec[0]) for rec, kind in zip(art.records, art.kinds)]
         in_file = {id(j): i for i, j in enumerate(j for mf in world.scene.all_models() for j in mf.joints)}
         added = sorted(range(len(joints)), key=lambda k: in_file.get(id(art.records[k][0]), k))
+        added += range(len(joints), len(joints) + len(self.loops))  # the loops' rows after the chain's own
         self.parents = [self.ids[p] for p, _k, _j in joints]
         self.core = ChainStep(world.dt, bodies, joints, added)
 
@@ -71,15 +75,68 @@ class ChainModel:
             joints,
             _contact_pushes(m, d, self.ids),
         )
-        return self.core.velocities(state, motors, efforts, step)
+        loops = self.loops
+
+        def closing(bodies, coms, rots, drift):
+            return loop_joints(loops, bodies, coms, rots, drift)
+
+        return self.core.velocities(state, motors, efforts, step, closing if loops else None)
+
+
+def _loops(world, chain: list, index: dict[int, int]) -> list[Loop] | None:
+    """The hinges and points closing loops between two of the chain's bodies (MuJoCo closes each
+    with a connect equality), as AMBF's btHingeConstraint and btPoint2PointConstraint read them:
+    the joint's frames AMBF builds, in each body's inertial frame now; None where a loop is
+    closed by another kind of joint."""
+    m, d = world.model, world.data
+    joints = {j.identifier: j for j, _p, _c in world.joints_made}
+    loops = []
+    for name, _c, parent, child, _pa, _pb, _axis in world.constraints:
+        if id(parent) not in index or id(child) not in index:
+            continue
+        joint = joints.get(name)
+        kind = joint_kind(joint.type) if joint is not None else None
+        if kind not in (JointKind.REVOLUTE, JointKind.P2P):
+            return None
+        eq = _connect(m, parent.id, child.id)
+        if eq is None:
+            return None
+        ends = []
+        for sb, frame, anchor in zip(
+            (parent, child), body_joint_frames(joint, parent.body, child.body), (m.eq_data[eq, :3], m.eq_data[eq, 3:6])
+        ):
+            com = np.eye(4)
+            com[:3, :3], com[:3, 3] = d.ximat[sb.id].reshape(3, 3), d.xipos[sb.id]
+            end = invert(com) @ sb.world_matrix() @ pose_to_matrix(frame)
+            # the pivot where MuJoCo's connect holds the two bodies together (each anchor in its
+            # body's frame): the rows and the equality hold the same points
+            end[:3, 3] = invert(com)[:3] @ np.append(d.xmat[sb.id].reshape(3, 3) @ anchor + d.xpos[sb.id], 1.0)
+            ends.append(end)
+        fa, fb = ends
+        a, b = index[id(parent)], index[id(child)]
+        if kind is JointKind.P2P:
+            loops.append(Loop("p2p", joint, a, b, fa[:3, 3], fb[:3, 3], None, None, None))
+        else:
+            loops.append(Loop("revolute", joint, a, b, fa[:3, 3], fb[:3, 3], fa[:3, 2], fa, fb))
+    return loops
+
+
+def _connect(m, a: int, b: int) -> int | None:
+    """The connect equality MuJoCo closes a loop between bodies ``a`` and ``b`` with."""
+    for e in range(m.neq):
+        if m.eq_type[e] == mujoco.mjtEq.mjEQ_CONNECT and (int(m.eq_obj1id[e]), int(m.eq_obj2id[e])) == (a, b):
+            return e
+    return None
 
 
 def _tied(m, ids: set[int]) -> bool:
-    """Whether an equality active from the start (a loop's connect or weld) holds one of the
-    bodies ``ids``."""
+    """Whether an equality active from the start other than a connect between two of the
+    bodies ``ids`` (a loop the chain step solves: ``_loops``) holds one of them."""
     for e in range(m.neq):
-        if m.eq_type[e] in _TIES and m.eq_active0[e]:
-            if int(m.eq_obj1id[e]) in ids or int(m.eq_obj2id[e]) in ids:
+        kind = int(m.eq_type[e])  # numpy's integer is no pybind enum's equal in a tuple
+        if kind in _TIES and m.eq_active0[e]:
+            one, two = int(m.eq_obj1id[e]) in ids, int(m.eq_obj2id[e]) in ids
+            if (one or two) and not (one and two and kind == mujoco.mjtEq.mjEQ_CONNECT):
                 return True
     return False
 

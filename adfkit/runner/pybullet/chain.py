@@ -16,9 +16,10 @@ import pybullet as pb
 
 from ...model.semantics import JointKind
 from ..chain_step import ChainState, ChainStep
+from ..loop_rows import loop_joints
 from ..rotations import quat_to_matrix
 from .articulation import ROTARY
-from .chain_loops import find_loops, loop_joints
+from .chain_loops import find_loops
 
 
 class ChainModel:
