@@ -112,12 +112,11 @@ def corpus_scenes(build, folder: Path) -> list[Scene]:
     launch = ambf.on_ambfs_floor(build, puzzle, folder)
     if launch is not None:
         out.append(Scene("puzzle 1 on AMBF's checkered floor", launch, [0], 3.0, ("pybullet", "mujoco")))
-    both, pybullet = ("pybullet", "mujoco"), ("pybullet",)
+    both = ("pybullet", "mujoco")
     robots = (
         ("KUKA", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml", both),
         ("PSM (LND 400006)", CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml", both),
-        # MuJoCo closes the ECM's loops at other joints, which the programs drive
-        ("ECM (loops)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml", pybullet),
+        ("ECM (loops)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-ecm.yaml", both),
         ("MTM (loop)", CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-mtm.yaml", both),
     )
     for label, model, engines in robots:

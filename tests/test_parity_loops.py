@@ -123,26 +123,58 @@ def test_loop_robots_under_joint_programs_move_as_in_ambf(tmp_path, monkeypatch)
 
 
 def test_a_joint_one_engine_cannot_drive_is_a_located_error_naming_it(tmp_path):
-    """MuJoCo closes the corpus ECM's pitch parallelogram at another joint than PyBullet does:
-    with both engines, a command on a joint PyBullet drives and MuJoCo plays as the loop's
-    constraint is an error at its line that names MuJoCo, before anything is played (it was a
-    traceback from inside MuJoCo's player). Control: the yaw joint, which both drive, is not."""
+    """The corpus gripper3's jaws are joined by a slider; PyBullet closes that loop at the slider,
+    MuJoCo at the revolute joint into the right jaw (a connect at a slider would lock the slide):
+    with both engines, a command on that revolute joint, which PyBullet drives and MuJoCo plays as
+    the loop's constraint, is an error at its line that names MuJoCo, before anything is played.
+    Control: the left jaw's joint, which both drive, is not."""
     from adfkit.diagnostics import AdfError
     from adfkit.parity import session
 
     require_corpus()
-    path = CORPUS / MODELS / "robots/blender-ecm.yaml"
+    path = CORPUS / MODELS / "grippers/resistive/gripper3/gripper.yaml"
     cmds = tmp_path / "cmds.txt"
     cmds.write_text(
-        "0.0, velocity, /ambf/env/ecm/baselink-yawlink, 0.1\n0.0, velocity, /ambf/env/ecm/pitchbottomlink-pitchendlink, 0.1\n"
+        "0.0, velocity, /ambf/env/gripper/LeftL1-LeftL2, 0.1\n0.0, velocity, /ambf/env/gripper/RightL1-RightL2, 0.1\n"
     )
     nowhere = ambf.AmbfBuild(tmp_path / "no-ambf")  # never reached: the check comes first
     req = session.Request(path, None, nowhere, seconds=0.1, commands=cmds, engines=("pybullet", "mujoco"))
     with pytest.raises(AdfError) as e:
         session.run(req, progress=False)
     (d,) = e.value.diagnostics
-    assert d.rule == "command-target" and "pitchbottomlink-pitchendlink' in mujoco" in d.message
+    assert d.rule == "command-target" and "RightL1-RightL2' in mujoco" in d.message
     assert (d.location.line, d.location.column) == (2, 1)
+
+
+def test_both_engines_close_a_robots_loops_at_the_same_joints():
+    """MuJoCo's tree is the PyBullet runner's (breadth first from the root): the corpus ECM's,
+    PSM's and MTM's loops are closed at the same joints in both engines, so joint programs drive
+    the same joints in each (MuJoCo's tree was depth first: the ECM's and PSM's parallelograms
+    closed at the pitch back link instead). Control: the MJCF writer's own tree, depth first."""
+    from adfkit.model.tree import build_tree
+    from adfkit.runner import Options, open_world
+
+    require_corpus()
+    for robot, expected in (
+        (
+            "blender-ecm",
+            {"base link-pitch end link", "pitch front link-pitch bottom link", "pitch top link-pitch end link"},
+        ),
+        (
+            "blender-psm",
+            {"pitch front link-pitch bottom link", "pitch top link-pitch end link", "yaw link-pitch end link"},
+        ),
+        ("blender-mtm", {"ArmFront-BottomArm"}),
+    ):
+        scene = load_scene(CORPUS / MODELS / f"robots/{robot}.yaml", None)
+        for engine in ("pybullet", "mujoco"):
+            w = open_world(scene, Options(visuals=False), engine=engine)
+            try:
+                assert {c[0].removeprefix("JOINT ") for c in w.constraints} == expected, (robot, engine)
+            finally:
+                w.close()
+    ecm = load_scene(CORPUS / MODELS / "robots/blender-ecm.yaml", None).all_models()[0]
+    assert "pitch back link-pitch bottom link" in {r[0].name for r in build_tree(ecm, slides_first=True).loops}
 
 
 @pytest.mark.slow

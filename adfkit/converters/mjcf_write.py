@@ -380,6 +380,7 @@ def to_mjcf(
     leave_out: frozenset[str] = frozenset(),
     lights: bool = True,
     flexes_out: dict | None = None,
+    breadth_first: bool = False,
 ) -> tuple[str, list[Loss]]:
     """MJCF text and losses. ``tree_kinds``: joint kinds that join the tree (default revolute,
     prismatic, fixed); a link joined by another kind is written welded to its parent, for the
@@ -397,7 +398,8 @@ def to_mjcf(
         model = replace(model, bodies=[b for b in model.bodies if b.identifier not in leave_out], joints=kept)
     model = usable_scales(model, losses)
     # a loop is closed at a point (connect) or welded: a slide closing one would be locked
-    tree = build_tree(model, slides_first=True) if tree_kinds is None else build_tree(model, tree_kinds, True)
+    kinds = tree_kinds if tree_kinds is not None else (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)
+    tree = build_tree(model, kinds, True, breadth_first)
     has_volume = volumes and any(v.defined for v in model.volumes)
     if not tree.roots and not any(sb.defined for sb in model.soft_bodies) and not has_volume:
         raise AdfError(

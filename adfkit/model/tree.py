@@ -123,6 +123,7 @@ def build_tree(
     model: ModelFile,
     tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED),
     slides_first: bool = False,
+    breadth_first: bool = False,
 ) -> KinematicTree:
     """Spanning tree over the joints whose kind is in ``tree_kinds``.
 
@@ -131,7 +132,9 @@ def build_tree(
     a body reached twice closes a loop (that joint goes to ``loops``); bodies no joint reaches
     are roots of their own. ``slides_first``: a prismatic joint into a body keeps its place in
     the tree before a revolute one into it (left_for_last), for a format that closes a loop only
-    at a point (MJCF's connect, which would lock a slide)."""
+    at a point (MJCF's connect, which would lock a slide). ``breadth_first``: bodies reached
+    nearest the root first (the PyBullet runner's multibodies: a loop is closed at the same joint
+    in both engines), else depth first."""
     records, unresolved = [], []
     for j in model.joints:
         kind = joint_kind(j.type)
@@ -179,7 +182,7 @@ def build_tree(
                 if r[3].identifier not in links:
                     stack.append(attach(link, r))
                 continue
-            link = stack.pop()
+            link = stack.pop(0) if breadth_first else stack.pop()
             for r in edges[id(link.body)]:
                 if r[3].identifier in links:
                     continue

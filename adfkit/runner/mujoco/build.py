@@ -184,8 +184,7 @@ def build_plan(world) -> Plan:
         uncreated = scene_rules.uncreated_bodies(world, m)  # skipped, warned about, with the joints naming them
         soft = world.soft is not None and any(sb.defined for sb in m.soft_bodies)
         if len(uncreated) < len(m.bodies) or soft:
-            names: dict = {}
-            flexes: dict = {}
+            names, flexes = {}, {}  # type: ignore[var-annotated]
             text, ls = to_mjcf(
                 m,
                 out_dir,
@@ -196,6 +195,7 @@ def build_plan(world) -> Plan:
                 leave_out=uncreated,
                 lights=False,
                 flexes_out=flexes,
+                breadth_first=True,  # the PyBullet runner's tree, its loops closed at the same joints
             )
             losses += ls
             warn_losses(world, m, ls)
