@@ -195,3 +195,18 @@ def test_a_joint_follows_a_path_on_its_measured_position_in_ambf(tmp_path):
     assert trailing.max() > 0.1 and end["follow"] == {}
     with pytest.raises(AdfError, match="no joint /ambf/env/arm/elbow"):
         ambf.run(BUILD, stage, 0.1, 0.05, [ambf.Command(0.0, "follow", "/ambf/env/arm/elbow", 0.1)])
+
+
+@needs_ambf
+def test_a_scene_without_a_suture_is_a_setup_error_not_a_traceback(tmp_path, capsys):
+    """`adfkit parity --suture` on a scene with no needle, holes or PSMs (the parity arm) says
+    what the suture needs, exit 2, as `adfkit suture` does (it raised a KeyError from the
+    suture's setup). Control: the message names what is missing."""
+    from adfkit.cli import main
+    from adfkit.scenes.parity import write_parity
+
+    launch = write_parity(tmp_path)
+    assert main(["parity", "--suture", str(launch), "-l", "1", "--pairs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "error[suture-setup]: no unique body matches 'Needle'" in err and "Traceback" not in err
+    assert "the scene needs a Needle" in err

@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..diagnostics import AdfError, error
 from ..runner.rotations import invert, matrix_to_pq, pose_matrix
 from . import ambf
 from .traces import ambf_name, joint_key
@@ -222,7 +223,17 @@ def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False, 
     scene = load_scene(Path(launch), indices)
     world = open_world(scene, Options(renderer="tiny", visuals=False, solver_iterations=SOLVER_ITERATIONS))
     try:
-        task = SutureTask(world, list(pairs), seed=seed)
+        try:
+            task = SutureTask(world, list(pairs), seed=seed)
+        except (SutureError, KeyError, ValueError) as exc:  # as `adfkit suture` says it
+            raise AdfError(
+                error(
+                    "suture-setup",
+                    str(exc).strip('"'),
+                    None,
+                    "the scene needs a Needle, Entry k/Exit k hole ghosts and two PSMs",
+                )
+            ) from None
         rec = _Recorder(world, task, measured)
         t0 = time.perf_counter()
         try:
