@@ -111,3 +111,34 @@ def test_same_place_is_within_same_place_in_every_number_and_never_for_nan():
     nan = [((float("nan"), 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]]
     assert not in_same_place(a, nan)
     assert not in_same_place(nan, [((float("nan"), 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]])
+
+
+def test_the_ghosts_read_the_bodies_in_their_boxes_from_the_pass_as_a_query_afresh_finds_them():
+    """The bundled suturing scene at rest under adfkit run's options: each control step each ghost's
+    overlapping bodies and their points are read from the box queries the collision pass made
+    (``_near_keys``) rather than queried again; after each of 20 control steps they are what
+    ``_overlap`` finds querying every ghost's box afresh (``_near_keys`` None, as a pass in the
+    dynamics world, which moves the boxes, leaves it): four ghosts hold bodies. Control: read from
+    queries that found nothing, the four hold none."""
+    w = open_world(load_scene(BUNDLED, None), Options(**AMBF))
+    try:
+        w.step(100)
+        seen = []
+        for _ in range(20):
+            w.step(1)
+            assert w._near_keys is not None  # the pass ran in the ghosts' own world
+            read = {g.uid: (list(g.overlapping), list(g.points)) for g in w._acting_ghosts}
+            manifolds = w._manifold_made
+            near, w._near_keys = w._near_keys, None
+            afresh = {}
+            for g in w._acting_ghosts:
+                found = w._overlap(g, None, with_parent=True, manifolds=manifolds)
+                afresh[g.uid] = (found, list(g.points))
+            w._near_keys = near
+            seen.append(sum(1 for found, _p in read.values() if found))
+            assert read == afresh
+        w._near_keys = {uid: [] for uid in w._near_keys}
+        assert not any(w._overlap(g, None, True, w._manifold_made) for g in w._acting_ghosts)
+    finally:
+        w.close()
+    assert set(seen) == {4}, seen
