@@ -272,7 +272,9 @@ def test_mujoco_keeps_a_slide_in_the_tree_and_closes_the_loop_at_a_hinge(tmp_pat
     assert [j.identifier for j, *_ in build_tree(model, slides_first=True).loops] == ["JOINT l4-l3"]
     for rule in (True, False):
         if not rule:
-            monkeypatch.setattr(mjcf_write, "build_tree", lambda m, kinds=None, _s=False, _b=False: build_tree(m, kinds))
+            monkeypatch.setattr(
+                mjcf_write, "build_tree", lambda m, kinds=None, _s=False, _b=False: build_tree(m, kinds)
+            )
         world = open_world(load_scene(path), Options(visuals=False, ground=False), engine="mujoco")
         try:
             block, crank = world.body("BODY l3"), world.body("BODY l2")
