@@ -1,10 +1,12 @@
 """A MuJoCo articulation read as AMBF's chain of btRigidBodies for one physics step of its
 solver (runner/chain_step.py): each link and the base a body at its centre of mass (MuJoCo's
 inertial frame, where its principal inertia is), with the velocities MuJoCo gives it there; each
-hinge or slide joint a btHingeConstraint or btSliderConstraint at the joint's anchor. Only for
-an articulation whose joints are all revolute or prismatic and whose bodies no equality ties
-elsewhere (a loop MuJoCo closes with a connect or weld equality is left to the joint-space
-rows), and only where AMBF's bodies are asked for (MujocoWorld.chain_velocities)."""
+hinge or slide joint a btHingeConstraint or btSliderConstraint at the joint's anchor; a hinge or
+p2p joint MuJoCo closes a loop with (a connect between two of the chain's links) AMBF's
+btHingeConstraint or btPoint2PointConstraint at the connect's pivot (runner/loop_rows.py). Only
+for an articulation whose joints are all revolute or prismatic and which no other equality ties
+(a weld, a connect to a body outside it: left to the joint-space rows), and only where AMBF's
+bodies are asked for (MujocoWorld.chain_velocities)."""
 
 from __future__ import annotations
 
