@@ -31,6 +31,7 @@ from .cameras import choose_renderer, render
 from .chain import ChainModel
 from .interact import Interaction
 from .softbodies import SoftBodies, enable_deformable_world
+from .solver_info import set_ambf_solver_info
 from .state import WorldState
 
 
@@ -67,6 +68,8 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             # a millimetre-sized scene plays ~1.4x faster at 0.001 (bench/run_suturing.py)
             params["contactBreakingThreshold"] = self.opt.contact_threshold
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
+        if self.opt.bodies == "ambf":
+            set_ambf_solver_info(self.cid)  # AMBF's contact solver settings (solver_info.py)
         # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self._next_stability_check = 0.0
         # the broadphase keeps its overlapping pairs sorted, so a snapshot restored in place
