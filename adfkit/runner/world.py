@@ -34,6 +34,9 @@ class EngineBody:
 class World:
     engine = ""
     body_type: type = object  # the engine's body class (what ``body()`` answers)
+    # the engine's reading of an articulation for AMBF's solver step (its chain.py's ChainModel:
+    # ``ok``, ``velocities(motors, efforts, step)``), or None
+    chain_model: type | None = None
 
     def _setup(self, scene, options: Options | None, gui: bool) -> None:
         """What every world holds before its engine builds the scene."""
@@ -62,6 +65,22 @@ class World:
         self.not_played: list[dict] = []  # every part of the scene not played, with why
         self.ground_z = None
         self._floor_z = -math.inf
+        self._chains: dict[int, object] = {}  # per articulation, its chain_model
+
+    def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
+        """The joints' velocities (by record index) one physics step of AMBF's solver leaves them
+        at: the articulation as AMBF's btRigidBodies, its hinges' and sliders' locking, motor
+        (``motors``: record index -> target, cfm, max impulse) and limit rows and the joints closing
+        its loops solved in AMBF's ten iterations, ``efforts`` (record index -> effort) on the joints
+        (runner/chain_step.py; runner/joint_commands.py). None where AMBF's bodies are not asked for
+        (Options.bodies), the control step is more than one physics step, or the engine's
+        chain_model cannot read the articulation."""
+        if self.chain_model is None or self.opt.bodies != "ambf" or self.opt.control_substeps != 1:
+            return None
+        model = self._chains.get(id(art))
+        if model is None:
+            model = self._chains[id(art)] = self.chain_model(self, art)
+        return model.velocities(motors, efforts, self.steps) if model.ok else None
 
     def _warn(self, rule, msg, obj, hint="") -> None:
         self.diagnostics.append(warning(rule, msg, getattr(obj, "source", None), hint or None))

@@ -31,6 +31,7 @@ from .soft import MjSoftBodies
 class MujocoWorld(Assembly, Interaction, World):
     engine = "mujoco"
     body_type = MjBody
+    chain_model = ChainModel  # AMBF's solver step on an articulation (chain.py)
 
     def __init__(self, scene, options: Options | None = None, gui: bool = False, sleep: bool = True) -> None:
         """``sleep``: MuJoCo's island sleeping (resting trees are not integrated until a contact,
@@ -49,7 +50,6 @@ class MujocoWorld(Assembly, Interaction, World):
         self._ghost_row_of = None  # ghosts._ghost_rows, made on the first look into the ghosts
         self._weightless_ids: set[int] = set()  # the bodies a ghost holds weightless (ghosts._plan_ghosts)
         self._ghost_plan, self._ghost_changed = None, False  # ghosts._ambf_ghosts' plan, while it holds
-        self._chains: dict[int, ChainModel] = {}  # per articulation, AMBF's chain of bodies (chain.py)
         self.camera_problem = ""
         self._build()
 
@@ -89,17 +89,6 @@ class MujocoWorld(Assembly, Interaction, World):
     def joint_row_mass(self, art, index: int) -> float:
         """The mass AMBF's motor row along joint ``index`` sees (motor_rows.py)."""
         return motor_rows.joint_row_mass(self, art, index)
-
-    def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
-        """The joints' velocities (by record index) one physics step of AMBF's solver leaves them
-        at (chain.py; runner/joint_commands.py). None where AMBF's bodies are not asked for, the
-        control step is more than one physics step, or chain.py cannot read the articulation."""
-        if self.opt.bodies != "ambf" or self.opt.control_substeps != 1:
-            return None
-        model = self._chains.get(id(art))
-        if model is None:
-            model = self._chains[id(art)] = ChainModel(self, art)
-        return model.velocities(motors, efforts, self.steps) if model.ok else None
 
     def joint_effort(self, art, index: int, effort: float) -> None:
         """Joint ``index`` of ``art`` pushed by ``effort`` (N·m or N), its drive off, until the next

@@ -2,12 +2,11 @@
 
 AMBF's world keeps Bullet 2.88's btContactSolverInfo as it is made; PyBullet's server changes
 some of it when it makes its world (PhysicsServerCommandProcessor). Where AMBF's bodies are
-asked for (Options.bodies "ambf") the runner gives back AMBF's values that PyBullet can set.
+asked for (Options.bodies "ambf") the runner gives back AMBF's values that PyBullet can set
+(PyBulletWorld passes them to setPhysicsEngineParameter with its own).
 """
 
 from __future__ import annotations
-
-import pybullet as pb
 
 # btContactSolverInfo's values in AMBF (PyBullet's own in the comments)
 AMBF_SOLVER_INFO: dict[str, float] = {
@@ -16,8 +15,3 @@ AMBF_SOLVER_INFO: dict[str, float] = {
     "contactSlop": 0.0,  # m_linearSlop (1e-5 m)
     "solverResidualThreshold": 0.0,  # m_leastSquaresResidualThreshold (1e-7)
 }
-
-
-def set_ambf_solver_info(cid: int) -> None:
-    """Set AMBF's btContactSolverInfo values in the PyBullet world ``cid``."""
-    pb.setPhysicsEngineParameter(physicsClientId=cid, **AMBF_SOLVER_INFO)

@@ -31,13 +31,14 @@ from .cameras import choose_renderer, render
 from .chain import ChainModel
 from .interact import Interaction
 from .softbodies import SoftBodies, enable_deformable_world
-from .solver_info import set_ambf_solver_info
+from .solver_info import AMBF_SOLVER_INFO
 from .state import WorldState
 
 
 class PyBulletWorld(Assembly, Interaction, WorldState, World):
     engine = "pybullet"
     body_type = SimBody
+    chain_model = ChainModel  # AMBF's solver step on a multibody (chain.py)
 
     def __init__(self, scene, options: Options | None = None, gui: bool = False, mirror=None) -> None:
         """``mirror``: a callable making the MuJoCo mirror that draws the cameras with
@@ -67,16 +68,15 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             # AABBs grow by it and contact points are made within (a size-scaled share of) it;
             # a millimetre-sized scene plays ~1.4x faster at 0.001 (bench/run_suturing.py)
             params["contactBreakingThreshold"] = self.opt.contact_threshold
-        pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         if self.opt.bodies == "ambf":
-            set_ambf_solver_info(self.cid)  # AMBF's contact solver settings (solver_info.py)
+            params.update(AMBF_SOLVER_INFO)  # AMBF's contact solver settings (solver_info.py)
+        pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self._next_stability_check = 0.0
         # the broadphase keeps its overlapping pairs sorted, so a snapshot restored in place
         # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact
         pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
         self._ambf_dt = self.dt if self.opt.bodies == "ambf" else None  # AMBF's bodies (ambf_bodies.py)
-        self._chains: dict[int, ChainModel] = {}  # per multibody, AMBF's chain of bodies (chain.py)
         self._build()
         # AMBF's springs (Options.springs): explicit, at every physics step; PyBullet then steps one
         # physics step a call and the control step's other forces are applied again at each (held.py)
@@ -152,20 +152,6 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
                 orn = pb.getLinkState(art.uid, n, computeForwardKinematics=True, physicsClientId=cid)[1]
             ends.append((mass, diag, quat_to_matrix(orn)))
         return row_mass(axis, ends, kind not in ROTARY)
-
-    def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
-        """The joints' velocities (by record index) one physics step of AMBF's solver leaves
-        them at: the multibody as AMBF's btRigidBodies, its hinges' and sliders' locking, motor
-        (``motors``: record index -> target, cfm, max impulse) and limit rows solved in AMBF's
-        ten iterations, ``efforts`` (record index -> effort) on the joints (chain.py). None
-        where AMBF's bodies are not asked for (Options.bodies), the control step is more than
-        one physics step, or the multibody has joints other than revolute and prismatic ones."""
-        if self.opt.bodies != "ambf" or self.opt.control_substeps != 1:
-            return None
-        model = self._chains.get(art.uid)
-        if model is None:
-            model = self._chains[art.uid] = ChainModel(self, art)
-        return model.velocities(motors, efforts, self.steps) if model.ok else None
 
     def joint_effort(self, art, index: int, effort: float) -> None:
         """Joint ``index`` of ``art`` pushed by ``effort`` (N·m or N) for the next control step, its
