@@ -542,6 +542,30 @@ def test_a_psm_jaw_stops_at_its_limit_under_velocity_commands(tmp_path):
     assert roll.max_position < 2e-3  # a distal joint follows its velocity in both
 
 
+@needs_ambf
+def test_a_psm_in_its_finger_ghosts_follows_ambfs_under_a_velocity_program(tmp_path, monkeypatch):
+    """The challenge's PSM (LND 400006) with its finger ghosts and actuator (the corpus launch
+    file, -l 6,7): its jaws and pitch end link lie in the ghosts throughout, and AMBF's ghost
+    acts on them inside the step of AMBF's solver that adfkit plays on the driven chain. Measured
+    (PyBullet, 1 s): the insertion link 0.84 mm from AMBF's, the jaws 0.13 mm (48.2 and 0.97 mm
+    when the ghosts' pushes were left out of that step)."""
+    from conftest import require_corpus
+
+    require_corpus()
+    from conftest import CORPUS
+
+    from adfkit.parity import programs, session
+
+    monkeypatch.setenv("ADFKIT_INPUT_ROOT", "/")
+    launch = CORPUS / "src/launch.yaml"
+    cmd = programs.write_program(launch, [6], "velocity", 1.0, tmp_path / "v.txt")
+    req = session.Request(launch, [6, 7], BUILD, seconds=1.0, commands=cmd)
+    (c,) = session.run(req, progress=False).comparisons
+    gaps = {g.name.rsplit("/", 1)[-1]: g.max_position for g in c.bodies}
+    assert gaps["maininsertionlinksimple"] < 2e-3, gaps
+    assert max(gaps["toolgripper1simple"], gaps["toolgripper2simple"]) < 5e-4, gaps
+
+
 def _program_gaps(model, kind, tmp_path, monkeypatch, stiff=False):
     """The largest body gap and the joints' gaps of a joint program (parity.programs) on a
     corpus robot, 1 s; ``stiff``: adfkit's motors reaching their targets within the step."""

@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .chain_rows import Body, Joint, cross3, joint_velocities, solve
 from .damping import decay_rates
+from .ghost_rules import ghost_velocity
 from .joint_commands import AMBF_JOINT_ERP, limits_of
 
 
@@ -27,7 +28,9 @@ class ChainState:
     first, then each joint's child): centres of mass, inertial frames' rotations (n+1, 3, 3),
     linear and angular velocities; per joint its child's joint frame origin, its axis, a
     direction across the axis fixed in the parent (a hinge's fallback), its position and
-    velocity; the contacts' pushes (body index, force, point) of the last step."""
+    velocity; the contacts' pushes (body index, force, point) of the last step; the bodies AMBF's
+    ghosts act on before the step (body index -> [(contact points, the ghost parent's velocity)],
+    in the ghosts' order: ghost_rules.ghost_velocity, and no gravity in the step)."""
 
     coms: np.ndarray
     rots: np.ndarray
@@ -35,6 +38,7 @@ class ChainState:
     w: np.ndarray
     joints: list[tuple[np.ndarray, np.ndarray, np.ndarray, float, float]]
     pushes: list[tuple[int, np.ndarray, np.ndarray]]
+    ghosted: dict[int, list[tuple[int, tuple]]] = field(default_factory=dict)
 
 
 class ChainStep:
@@ -89,13 +93,17 @@ class ChainStep:
             rot = rots[k]
             dv, dw = self.decay[k]
             moving = self.inv_mass[k] > 0.0
+            v, w, g = state.v[k] + apart[k, :3], state.w[k] + apart[k, 3:], self.gravity[k]
+            for points, v_parent in state.ghosted.get(k, ()):  # AMBF's ghosts, after the last step
+                v, w = ghost_velocity(v, w, v_parent, points)
+                g = 0.0
             bodies.append(
                 Body(
                     coms[k] + drift[k, :3],
                     self.inv_mass[k],
                     rot @ self.inv_inertia_diag[k] @ rot.T,
-                    (state.v[k] + apart[k, :3]) * dv + self.gravity[k] if moving else np.zeros(3),
-                    (state.w[k] + apart[k, 3:]) * dw if moving else np.zeros(3),
+                    v * dv + g if moving else np.zeros(3),
+                    w * dw if moving else np.zeros(3),
                     rot @ self.inertia_diag[k] @ rot.T,
                 )
             )

@@ -66,6 +66,7 @@ class World:
         self.ground_z = None
         self._floor_z = -math.inf
         self._chains: dict[int, object] = {}  # per articulation, its chain_model
+        self._chain_stepped: dict[int, int] = {}  # per articulation, the physics step chain_velocities played
 
     def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
         """The joints' velocities (by record index) one physics step of AMBF's solver leaves them
@@ -80,7 +81,20 @@ class World:
         model = self._chains.get(id(art))
         if model is None:
             model = self._chains[id(art)] = self.chain_model(self, art)
-        return model.velocities(motors, efforts, self.steps) if model.ok else None
+        if not model.ok:
+            return None
+        self._chain_stepped[id(art)] = self.steps  # AMBF's ghosts act on its links in the chain's step
+        return model.velocities(motors, efforts, self.steps, self.chain_ghosts(art))
+
+    def chain_ghosts(self, art) -> dict:
+        """The bodies of ``art`` (chain index: the base 0, link k at k + 1) AMBF's ghosts act on
+        before this physics step: [(contact points, the ghost parent's velocity)] each
+        (ChainState.ghosted). None here; an engine that plays AMBF's ghosts gives them."""
+        return {}
+
+    def chain_stepped(self, art) -> bool:
+        """Whether AMBF's solver on ``art`` (chain_velocities) was played for this physics step."""
+        return self._chain_stepped.get(id(art)) == self.steps
 
     def _warn(self, rule, msg, obj, hint="") -> None:
         self.diagnostics.append(warning(rule, msg, getattr(obj, "source", None), hint or None))

@@ -52,7 +52,7 @@ class ChainModel:
         self.core = ChainStep(world.dt, bodies, joints, added)
 
     def velocities(
-        self, motors: dict[int, tuple[float, float, float]], efforts: dict[int, float], step: int
+        self, motors: dict[int, tuple[float, float, float]], efforts: dict[int, float], step: int, ghosted=None
     ) -> np.ndarray:
         """The joints' velocities (by record index) after one step of AMBF's solver (physics
         step ``step``): ChainStep.velocities on MuJoCo's state now."""
@@ -76,6 +76,7 @@ class ChainModel:
             vel[:, :3].copy(),
             joints,
             _contact_pushes(m, d, self.ids),
+            ghosted or {},
         )
         loops = self.loops
 
@@ -163,3 +164,37 @@ def _contact_pushes(m, d, ids: np.ndarray) -> list[tuple[int, np.ndarray, np.nda
         if b1 in at:
             out.append((at[b1], -force, point))
     return out
+
+
+def chain_ghosts(world, art) -> dict:
+    """World.chain_ghosts in MuJoCo: the bodies of ``art`` AMBF's ghosts hold at a 1 ms control
+    step, with the points found a physics step before (what the rule acts with in this step:
+    ghosts._ambf_ghosts), and each ghost parent's velocity at its centre of mass."""
+    before = world._ghost_before
+    model = world._chains.get(id(art))
+    if world.opt.ghosts != "ambf" or world.opt.control_substeps != 1 or before is None or model is None:
+        return {}
+    index = {int(b): k for k, b in enumerate(model.ids)}
+    m, d = world.model, world.data
+    out: dict[int, list] = {}
+    for g, found in zip(world.ghosts, before[0]):
+        acts = [(index[sb.id], n) for sb, n in found if n and sb.id in index]
+        if not acts:
+            continue
+        v_par = np.zeros(3)
+        if g.parent is not None and not g.parent.static:
+            mujoco.mj_comPos(m, d)
+            mujoco.mj_comVel(m, d)
+            vel = np.zeros(6)
+            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, int(g.parent.id), vel, 0)
+            v_par = vel[3:]
+        for k, n in acts:
+            out.setdefault(k, []).append((n, v_par))
+    return out
+
+
+def chain_stepped_ids(world) -> np.ndarray:
+    """The bodies of the articulations AMBF's solver was played on for this physics step
+    (World.chain_stepped): AMBF's ghosts act on them in their chain's step (chain_ghosts)."""
+    ids = [world._chains[a].ids for a, at in world._chain_stepped.items() if at == world.steps and a in world._chains]
+    return np.concatenate(ids) if ids else np.zeros(0, dtype=int)

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..ghost_rules import AMBF_GHOST_KEEP, MANIFOLD_POINTS, SAME_PLACE
 from ..plan import ALL_GROUPS
+from .chain import chain_stepped_ids
 from .objects import MjBody
 
 _SLEEP_BIT = int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
@@ -237,17 +238,24 @@ class AmbfGhosts:
         a body's sleep state changes (_plan_ghosts)."""
         if not self.ghosts or not len(self._cand_geoms):
             return  # nothing a ghost could hold
-        answers = self._penetrating(self.ghosts)
+        now = answers = self._penetrating(self.ghosts)
+        changed = self._ghost_changed
+        if self.opt.control_substeps == 1:  # AMBF acts with the points its last step's pass found
+            before, self._ghost_before = self._ghost_before, (list(answers), changed)
+            answers, changed = before if before is not None else ([[] for _ in self.ghosts], True)
         key = self._body_awake.tobytes() if self.sleep else b""
         plan = self._ghost_plan
-        if plan is None or self._ghost_changed or key != plan.key:
+        if plan is None or changed or key != plan.key:
             plan = self._ghost_plan = self._plan_ghosts(answers, key)
-        for g, found in zip(self.ghosts, answers):  # (overlapping() may have written its own)
-            g.overlapping, g.points = plan.overlapping[id(g)], found
+        for g, found in zip(self.ghosts, now):  # what each ghost holds now (overlapping() may have written its own)
+            g.overlapping = plan.overlapping[id(g)] if now is answers else [sb for sb, _ in found]
+            g.points = found
+        stepped = chain_stepped_ids(self)  # AMBF's solver on a chain holds its bodies' ghosts (chain_ghosts)
         if len(plan.ids):
-            self._ghost_velocities(plan)
+            self._ghost_velocities(plan, stepped)
         if len(plan.weight_ids):  # the weight taken off as a force: AMBF's gravity off
-            self.data.xfrc_applied[plan.weight_ids, :3] -= plan.weights
+            kept = ~np.isin(plan.weight_ids, stepped) if len(stepped) else slice(None)
+            self.data.xfrc_applied[plan.weight_ids[kept], :3] -= plan.weights[kept]
             self._xfrc_dirty = True
 
     def _plan_ghosts(self, answers, key: bytes) -> _GhostPlan:
@@ -320,7 +328,7 @@ class AmbfGhosts:
         never = (int(mujoco.mjtSleepPolicy.mjSLEEP_NEVER), int(mujoco.mjtSleepPolicy.mjSLEEP_AUTO_NEVER))
         return self.sleep and int(m.tree_sleep_policy[m.body_treeid[sb.id]]) not in never
 
-    def _ghost_velocities(self, plan: _GhostPlan) -> None:
+    def _ghost_velocities(self, plan: _GhostPlan, stepped: np.ndarray) -> None:
         """AMBF's ghost rule on the bodies of ``plan``, all from the velocities at this control
         step's start (mj_step left those of its last physics step's start): free bodies'
         velocities set (the last ghost's stands), the others' forces and torques that take them
@@ -353,6 +361,8 @@ class AmbfGhosts:
             wrench = np.empty((len(j), 6))
             wrench[:, :3] = plan.mass * a
             wrench[:, 3:] = np.matmul(rot, plan.inertia[:, :, None] * local)[:, :, 0]
+            if len(stepped):
+                wrench[np.isin(plan.jointed_ids, stepped)] = 0.0
             np.add.at(d.xfrc_applied, plan.jointed_ids, wrench)  # in order: a body in two ghosts
             self._xfrc_dirty = True
 

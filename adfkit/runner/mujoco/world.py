@@ -22,7 +22,7 @@ from ..world import World
 from . import motor_rows
 from . import stability as mj_stability
 from .assemble import Assembly
-from .chain import ChainModel
+from .chain import ChainModel, chain_ghosts
 from .interact import Interaction
 from .objects import MjBody
 from .soft import MjSoftBodies
@@ -32,6 +32,9 @@ class MujocoWorld(Assembly, Interaction, World):
     engine = "mujoco"
     body_type = MjBody
     chain_model = ChainModel  # AMBF's solver step on an articulation (chain.py)
+
+    def chain_ghosts(self, art) -> dict:
+        return chain_ghosts(self, art)
 
     def __init__(self, scene, options: Options | None = None, gui: bool = False, sleep: bool = True) -> None:
         """``sleep``: MuJoCo's island sleeping (resting trees are not integrated until a contact,
@@ -50,6 +53,7 @@ class MujocoWorld(Assembly, Interaction, World):
         self._ghost_row_of = None  # ghosts._ghost_rows, made on the first look into the ghosts
         self._weightless_ids: set[int] = set()  # the bodies a ghost holds weightless (ghosts._plan_ghosts)
         self._ghost_plan, self._ghost_changed = None, False  # ghosts._ambf_ghosts' plan, while it holds
+        self._ghost_before = None  # at a 1 ms control step: the answers a physics step before, and changed
         self.camera_problem = ""
         self._build()
 

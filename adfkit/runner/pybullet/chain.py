@@ -59,7 +59,7 @@ class ChainModel:
         self.kinds = [kind for _p, kind, _j in joints]
 
     def velocities(
-        self, motors: dict[int, tuple[float, float, float]], efforts: dict[int, float], step: int
+        self, motors: dict[int, tuple[float, float, float]], efforts: dict[int, float], step: int, ghosted=None
     ) -> np.ndarray:
         """The joints' velocities (by record index) after one step of AMBF's solver (physics
         step ``step``), with the motors ``motors`` (record index -> target, cfm, max impulse) on
@@ -87,6 +87,7 @@ class ChainModel:
             np.array([f[3] for f in frames], dtype=float),
             joints,
             _contact_pushes(uid, cid),
+            ghosted or {},
         )
         loops = self.loops
 

@@ -9,15 +9,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import (
-    ghost_accelerations,
-    ghost_velocity,
-    in_same_place,
-    kept_under_slow_parent,
-    viscous_impulse_force,
-)
+from ..ghost_rules import in_same_place, viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
+from .ghost_steps import ambf_ghost, chain_ghosts, weightless, weightless_for_a_step
 
 # m between the three point constraints of a grasp (PyBulletWorld.actuate): the solver leaves each
 # pivot a fraction of a millimetre open under load, which turns the held body by gap/span; at 5 mm
@@ -42,6 +37,7 @@ class SimGhost:
     overlapping: list = field(default_factory=list)
     pq_in_parent: tuple = ()  # pose_in_parent as PyBullet (position, quaternion)
     points: list = field(default_factory=list)  # (body, penetrating contact points) at the last query
+    before: list = field(default_factory=list)  # points at the physics step before (ghost_steps.py)
     moves: bool = False  # a dynamic parent: the ghost follows it every step
     placed_at: tuple | None = None  # the parent's (position, quaternion) the ghost was last placed at
     distances: dict = field(default_factory=dict)  # (uid, link) -> (placement, body pose, inside, points): _overlap
@@ -114,50 +110,21 @@ class Interaction:
                     pb.resetBasePositionAndOrientation(g.uid, pos, orn, cid)
                     g.placed_at = pq
         manifolds = self._manifold_points(self._acting_ghosts, poses) if ambf else None
+        fine = self._ghost_steps.decide(poses) if ambf and self._ghost_steps is not None else ()
+        a_step: dict[int, SimBody] = {}  # free bodies weightless for the next physics step alone
         for g in self._acting_ghosts:
             found = self._overlap(g, poses, with_parent=ambf, manifolds=manifolds)
-            if found and ambf:
-                self._ambf_ghost(g, held)
+            if ambf and (found or g.before):  # the points found now or a step before
+                ambf_ghost(self, g, held, a_step if g in fine else None)
             elif found:
                 self._viscous(g, found)
         if ambf:
-            self._weightless(held.values(), poses)
+            weightless(self, held.values(), poses)
+            for sb in a_step.values():
+                weightless_for_a_step(self, sb)
 
-    def _ambf_ghost(self, g: SimGhost, held: dict) -> None:
-        """AMBF's ghost on the bodies in penetrating contact with it (ghost_rules.ghost_velocity), for
-        the physics steps of this control step: their velocities reset (a multibody link's cannot
-        be: it is given the force at its centre of mass and the torque that take its velocities
-        there over the control step) and their gravity off until the next control step."""
-        steps, cid = self.opt.control_substeps, self.cid
-        cdt = self.dt * steps
-        parent = g.parent  # its state read once, and used again where the ghost holds its own parent
-        ps = parent.state() if parent is not None and not parent.static else (None, None, (0.0, 0.0, 0.0), None)
-        v_par = ps[2]
-        for sb, points in g.points:
-            if points == 0:
-                continue
-            held[id(sb)] = sb
-            if sb.link < 0:
-                v, w = ps[2:] if sb is parent else pb.getBaseVelocity(sb.uid, cid)
-                kept = kept_under_slow_parent(v, w, v_par, points * steps)
-                if kept is None:
-                    kept = tuple(x.tolist() for x in ghost_velocity(v, w, v_par, points * steps))
-                pb.resetBaseVelocity(sb.uid, kept[0], kept[1], cid)
-            else:
-                p, q, v, w = ps if sb is parent else sb.state()
-                a, alpha = ghost_accelerations(v, w, v_par, points * steps, cdt)
-                rot = np.array(pb.getMatrixFromQuaternion(q)).reshape(3, 3)  # the COM frame's
-                sb.force((sb.mass * a).tolist(), list(p))
-                sb.torque((rot @ (np.asarray(sb.inertia) * (rot.T @ alpha))).tolist())
-
-    def _weightless(self, bodies, poses: dict | None = None) -> None:
-        """Each body's weight taken off for this control step (AMBF switches its gravity off).
-        ``poses``: as _update_ghosts' (read this control step; the ghosts set velocities, not
-        positions), its centre of mass read again where it has none."""
-        for sb in bodies:
-            g = sb.gravity if sb.gravity is not None else self.gravity
-            pq = poses.get((sb.uid, sb.link)) if poses else None
-            sb.force([-sb.mass * c for c in g], list(pq[0] if pq is not None else sb.com_position()))
+    def chain_ghosts(self, art) -> dict:
+        return chain_ghosts(self, art)
 
     def place_ghosts(self) -> None:
         """Move every ghost with a moving parent to it (before a picture is taken)."""

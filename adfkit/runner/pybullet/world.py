@@ -29,6 +29,7 @@ from .assemble import Assembly
 from .bodies import SimBody
 from .cameras import choose_renderer, render
 from .chain import ChainModel
+from .ghost_steps import GhostSteps
 from .interact import Interaction
 from .softbodies import SoftBodies, enable_deformable_world
 from .solver_info import AMBF_SOLVER_INFO
@@ -81,7 +82,12 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         # AMBF's springs (Options.springs): explicit, at every physics step; PyBullet then steps one
         # physics step a call and the control step's other forces are applied again at each (held.py)
         self._springs_every_step = self.opt.springs == "ambf" and bool(self.springs.joints)
-        if self._springs_every_step:
+        # AMBF's ghosts on free bodies at every physics step (ghost_steps.py): stepped the same way
+        acting = self.opt.ghosts == "ambf" and self._acting_ghosts and self.opt.control_substeps > 1
+        self._ghost_steps = GhostSteps(self) if acting else None
+        if self._ghost_steps is not None and not self._ghost_steps.free:
+            self._ghost_steps = None
+        if self._springs_every_step or self._ghost_steps is not None:
             pb.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSubSteps=1, physicsClientId=self.cid)
             held.record(self.cid)
 
@@ -201,10 +207,14 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         for _ in range(n):
             self.control()
             pb.stepSimulation(physicsClientId=self.cid)
-            if self._springs_every_step:  # the springs again at each physics step, the rest held
-                for _ in range(sub - 1):
+            fine = self._ghost_steps is not None and self._ghost_steps.fine
+            if self._springs_every_step or self._ghost_steps is not None:
+                for _ in range(sub - 1):  # the springs and ghosts again at each physics step, the rest held
                     held.replay(self.cid)
-                    self.springs.apply(self.dt)
+                    if fine:
+                        self._ghost_steps.between()
+                    if self._springs_every_step:
+                        self.springs.apply(self.dt)
                     pb.stepSimulation(physicsClientId=self.cid)
                 held.clear(self.cid)
         self.steps += n * sub
