@@ -12,10 +12,12 @@ import pytest
 
 pytest.importorskip("pybullet")
 import pybullet as pb  # noqa: E402
+from conftest import CORPUS, SKIP_CORPUS  # noqa: E402
 
 from adfkit.adf import load_scene  # noqa: E402
 from adfkit.model.common import PID  # noqa: E402
 from adfkit.model.pose import Pose, Vec3, rpy_to_quat  # noqa: E402
+from adfkit.model.semantics import inertial_offset  # noqa: E402
 from adfkit.runner import Options, open_world  # noqa: E402
 from adfkit.runner.ambf_bodies import box_inertia, estimated_inertia  # noqa: E402
 from adfkit.runner.joint_commands import JointCommands  # noqa: E402
@@ -73,6 +75,31 @@ def test_a_mesh_bodys_inertia_is_the_box_of_its_bounds_grown_by_its_margin(tmp_p
     expected = (2.0 / 12 * (0.204**2 + 0.304**2), 2.0 / 12 * (0.104**2 + 0.304**2), 2.0 / 12 * (0.104**2 + 0.204**2))
     assert estimated_inertia(model, body, np.eye(4)) == pytest.approx(expected, rel=1e-6)  # STL: float32
     assert box_inertia(2.0, (0.104, 0.204, 0.304)) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "mesh_type, grow", [("CONVEX_HULL", 0.04 + 0.002), ("CONCAVE_MESH", 0.002), ("CONVEX_MESH", 0.002)]
+)
+def test_a_convex_hulls_bounds_keep_bullets_default_margin(tmp_path, mesh_type, grow):
+    # AMBF's btConvexHullShape caches its bounds when made, with Bullet's 0.04 m margin, and
+    # gets the file's margin after: each side 42 mm further out; its other meshes' bounds hold
+    # the file's margin only
+    model, body = _block_body(_block(tmp_path))
+    body.collision_mesh_type = mesh_type
+    lengths = np.array([0.1, 0.2, 0.3]) + 2 * grow
+    assert estimated_inertia(model, body, np.eye(4)) == pytest.approx(box_inertia(2.0, lengths), rel=1e-6)
+
+
+def test_the_corpus_needle_gets_the_inertia_ambf_gives_it():
+    phantom = CORPUS / "src/ADF/Phantoms/Simple/phantom.yaml"
+    if not phantom.is_file():
+        pytest.skip(SKIP_CORPUS)
+    (model,) = load_scene(phantom).all_models()
+    needle = next(b for b in model.bodies if b.name == "Needle")  # nine hulls, 0.5 kg, no `inertia`
+    com = pose_to_matrix(inertial_offset(needle))
+    # measured in AMBF (the parity plugin's created record: btRigidBody::getLocalInertia)
+    ambf = (6.140087690750581e-4, 6.649296550641597e-4, 7.29255000024469e-4)
+    assert estimated_inertia(model, needle, com) == pytest.approx(ambf, rel=1e-6)
 
 
 def test_a_turned_inertial_frame_turns_the_bounds(tmp_path):
