@@ -13,6 +13,7 @@ import numpy as np
 from ..ghost_rules import AMBF_GHOST_KEEP, MANIFOLD_POINTS, SAME_PLACE
 from ..plan import ALL_GROUPS
 from .chain import chain_stepped_ids
+from .ghost_rigid import rigid_points
 from .objects import MjBody
 
 _SLEEP_BIT = int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
@@ -87,7 +88,8 @@ class AmbfGhosts:
             order = np.lexsort((r, k))  # the candidates in turn, each against the ghost's geoms
             points: dict[int, list] = {}
             for a, c, kk in zip(gg[r[order]].tolist(), cg[k[order]].tolist(), k[order].tolist()):
-                n = min(max(made.get((min(a, c), max(a, c)), 0), 1), MANIFOLD_POINTS)
+                pair = (min(a, c), max(a, c))
+                n = min(max(made.get(pair, 0) or self._rigid_made.get(pair, 0), 1), MANIFOLD_POINTS)
                 sb = self._cand_geom_body[kk]
                 points.setdefault(id(sb), [sb, 0])[1] += n
             answers[i] = [(sb, n) for sb, n in points.values()]
@@ -144,6 +146,7 @@ class AmbfGhosts:
                 if mujoco.mj_geomDistance(m, d, int(gg[r]), int(cg[k]), 0.0, None) < 0.0
             ]
             self._rigid_hits = tuple(np.array([p[i] for p in pairs], dtype=int) for i in (0, 1))
+            self._rigid_made = rigid_points(m, d, [(int(gg[r]), int(cg[k])) for r, k in pairs])  # ghost_rigid.py
             self._is_ghost_geom = np.zeros(m.ngeom, dtype=bool)
             self._is_ghost_geom[gg] = True
             self._pair_dist = np.full((len(gg), len(cg)), np.nan)
