@@ -12,7 +12,8 @@ spring leaves; they can do no more than stop the joint's relative motion within 
 
 from __future__ import annotations
 
-from itertools import chain
+from collections import deque
+from itertools import chain, repeat
 
 import numpy as np
 import pybullet as pb
@@ -224,7 +225,10 @@ class SpringSet:
         self._links = [(uid, [k for _, k in group]) for uid, group in links.items()]
         self._order = np.argsort(np.array(order, dtype=int))  # read order -> body order
         self._in_order = bool(np.array_equal(self._order, np.arange(len(order))))
-        self._apply_ids = [(i, self.bodies[i].uid, self.bodies[i].link, bool(self.pushed[i])) for i in self.dynamic]
+        # the dynamic bodies' uids and links (each gets a torque), and the pushed ones' (a force too)
+        dyn, pushed = [self.bodies[i] for i in self.dynamic], self.dynamic[self.pushed[self.dynamic]]
+        self._twisted = ([b.uid for b in dyn], [b.link for b in dyn])
+        self._pushed = (pushed, [self.bodies[i].uid for i in pushed], [self.bodies[i].link for i in pushed])
 
     def states(self):
         """(positions, rotation matrices, linear and angular velocities) of every body's COM;
@@ -290,15 +294,15 @@ class SpringSet:
             # the force's moments about the child's, then the parent's, centre of mass
             moments = _cross(np.concatenate((pbw, pbw)) - pos[self.fl_arms], np.concatenate((f_w, f_w)))
             torque += self.fl_child_t @ moments[:k] - self.fl_parent_t @ moments[k:]
-        torque = torque.tolist()
-        if force is not None:
-            force, pos = force.tolist(), pos.tolist()
+        # each body's torque, then each pushed body's force at its centre of mass (whose moment
+        # PyBullet adds to the torque after it, as one body's calls in turn did), looped in C
         cid, frame = self.cid, pb.WORLD_FRAME
-        apply_torque, apply_force = pb.applyExternalTorque, pb.applyExternalForce
-        for i, uid, link, pushed in self._apply_ids:
-            apply_torque(uid, link, torque[i], frame, cid)
-            if pushed:
-                apply_force(uid, link, force[i], pos[i], frame, cid)
+        uids, links = self._twisted
+        deque(map(pb.applyExternalTorque, uids, links, torque[self.dynamic].tolist(), repeat(frame), repeat(cid)), 0)
+        if force is not None:
+            at, uids, links = self._pushed
+            forces, coms = force[at].tolist(), pos[at].tolist()
+            deque(map(pb.applyExternalForce, uids, links, forces, coms, repeat(frame), repeat(cid)), 0)
 
     @staticmethod
     def _limit(x, v, low, high, inertia, dt, erp, active=None):
