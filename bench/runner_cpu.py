@@ -4,7 +4,7 @@ shapes) and under the legacy flags (``--springs implicit --ghosts hole-friction 
 pybullet``), alternated ``--rounds`` times on freshly built worlds so that both see the same load;
 then, with ``--profile``, where one second of each goes, by cProfile on CPU time.
 
-    .venv/bin/python bench/runner_cpu.py [--seconds S] [--rounds R] [--profile] [--against REV]
+    .venv/bin/python bench/runner_cpu.py [--seconds S] [--rounds R] [--profile] [--against REV] [--each]
 
 With ``--against REV`` it times, under the run / parity settings only, this tree's runner and the
 one at git revision REV (``git archive`` into a temporary folder) in fresh processes, alternated
@@ -13,6 +13,11 @@ applied again and the rest, timed around their calls), their ratio, the sum over
 chunk of its least CPU time over the rounds (a shared machine's load only ever adds to a chunk)
 and whether every body ended where the other's did (a change that only reorganises the runner
 keeps them bit for bit).
+
+With ``--each`` it prints what each of AMBF's behaviours costs: the run / parity settings, then
+the same with one rule put back to its legacy flag (the others as ``adfkit run`` plays them), then
+all four legacy, alternated ``--rounds`` times in one process, each with its split (as
+``--against``'s) and its difference from the run / parity settings' median.
 
 The figure is this process's CPU time (``time.process_time``) of the stepping alone, as
 ``adfkit parity`` times its side (building the world and reading the samples left out). The
@@ -161,6 +166,25 @@ def against(rev: str, seconds: float, rounds: int) -> None:
     print(f"  final states: {'the same to the bit' if len(same) == 1 else 'differ: ' + ', '.join(sorted(same))}")
 
 
+def each(scene, seconds: float, rounds: int) -> None:
+    """--each: the run / parity settings, each rule alone back to its legacy flag, all legacy."""
+    run = run_defaults()
+    sets = [("run / parity settings", run)]
+    sets += [(f"{k} {LEGACY[k]}", {**run, k: LEGACY[k]}) for k in RULES if LEGACY[k] != run[k]]
+    sets.append(("all legacy", dict(LEGACY)))
+    got: dict[str, list[tuple]] = {name: [] for name, _ in sets}
+    for r in range(rounds):
+        for name, rules in sets[:: 1 if r % 2 == 0 else -1]:
+            cpu, _digest, split, _chunks = step_cpu(scene, rules, seconds, digest=True)
+            got[name].append((cpu, split))
+    base = statistics.median(c for c, _ in got[sets[0][0]])
+    for name, _ in sets:
+        cpu = statistics.median(c for c, _ in got[name])
+        parts = ", ".join(f"{p} {statistics.median(s[p] for _, s in got[name]):.2f}" for p in SPLIT)
+        runs = " ".join(f"{c:.2f}" for c, _ in got[name])
+        print(f"  {name:28s} CPU {cpu:6.2f} s, {cpu - base:+.2f} s (runs: {runs}; {parts})")
+
+
 def _name(key) -> str:
     file, _line, name = key
     return name.rstrip(">") if file == "~" else f"{Path(file).name}:{name}"
@@ -194,6 +218,7 @@ def main() -> int:
     ap.add_argument("--rounds", type=int, default=1)
     ap.add_argument("--profile", action="store_true", help="also profile 1 s of each")
     ap.add_argument("--against", metavar="REV", help="time this tree's runner against git revision REV's")
+    ap.add_argument("--each", action="store_true", help="what each of AMBF's behaviours costs")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
@@ -205,6 +230,10 @@ def main() -> int:
         against(args.against, args.seconds, args.rounds)
         return 0
     scene, label = scene_and_label()
+    if args.each:
+        print(f"scene: {label}; {args.seconds:g} s simulated, PyBullet, {args.rounds} round(s) alternated")
+        each(scene, args.seconds, args.rounds)
+        return 0
     settings = (("adfkit run / parity defaults", run_defaults()), ("legacy flags", LEGACY))
     print(f"scene: {label}; {args.seconds:g} s simulated, PyBullet, {args.rounds} round(s) alternated")
     cpu: dict[str, list[float]] = {name: [] for name, _ in settings}
