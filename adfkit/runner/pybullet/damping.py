@@ -41,13 +41,15 @@ class LinkDamping:
                     np.array([sb.inertia for sb in sbs]) * k[:, 1:2],  # principal torque per rad/s
                 )
             )
+        # (uid, link) -> (COM position, quaternion, linear and angular velocity) as read this control step
+        self.read: dict[tuple[int, int], tuple] = {}
 
     def apply(self) -> None:
         """Add this control step's damping forces and torques (cleared by the next step)."""
         cid = self.cid
-        push, twist = held.push, held.twist
+        push, twist, read = held.push, held.twist, self.read
         for uid, links, k_lin, k_ang in self.groups:
-            pos, rot, lin, ang = _states(uid, links, cid)
+            pos, rot, lin, ang = _states(uid, links, cid, read)
             # the torque k·I·ω with I = R·diag(I)·Rᵀ, R the COM frame's rotation in the world
             local = np.einsum("nji,nj->ni", rot, ang)
             torque = np.einsum("nij,nj->ni", rot, k_ang * local)
@@ -57,9 +59,10 @@ class LinkDamping:
                 twist(uid, link, torque[n].tolist(), cid)
 
 
-def _states(uid: int, links: list[int], cid: int):
+def _states(uid: int, links: list[int], cid: int, read: dict):
     """(COM positions, COM frame rotations, COM velocities, angular velocities) of ``links``
-    (-1: the base), world frame."""
+    (-1: the base), world frame; each link's (position, quaternion, velocities) also into ``read``,
+    keyed (uid, link), as SimBody.state() gives them."""
     out = {}
     kids = [k for k in links if k >= 0]
     if kids:  # computeLinkVelocity 1, computeForwardKinematics 1
@@ -70,6 +73,7 @@ def _states(uid: int, links: list[int], cid: int):
         v, w = pb.getBaseVelocity(uid, physicsClientId=cid)
         out[-1] = (p, q, v, w)
     rows = [out[k] for k in links]
+    read.update(((uid, k), r) for k, r in zip(links, rows))
     rot = np.array([pb.getMatrixFromQuaternion(r[1]) for r in rows]).reshape(-1, 3, 3)
     return (
         np.array([r[0] for r in rows]),

@@ -102,16 +102,16 @@ def ambf_ghost(world, g, held: dict, a_step: dict | None) -> None:
     cdt = world.dt * steps
     before, g.before = g.before, g.points
     per_step = a_step is not None or steps == 1
-    parent = g.parent  # its state read once, and used again where the ghost holds its own parent
-    ps = parent.state() if parent is not None and not parent.static else (None, None, (0.0, 0.0, 0.0), None)
-    for sb in act_on_free(world, g, ps, before if per_step else g.points, 1 if per_step else steps):
+    parent, now = g.parent, world._state_now  # (the states this control step read: PyBulletWorld)
+    ps = now(parent) if parent is not None and not parent.static else (None, None, (0.0, 0.0, 0.0), None)
+    for sb in act_on_free(world, g, ps, before if per_step else g.points, 1 if per_step else steps, now):
         (a_step if a_step is not None else held)[id(sb)] = sb
     v_par = ps[2]
     for sb, points in before if steps == 1 else g.points:
         if points == 0 or sb.link < 0 or world.chain_stepped(sb.articulation):  # (chain_ghosts: in its step)
             continue
         held[id(sb)] = sb
-        p, q, v, w = ps if sb is parent else sb.state()
+        p, q, v, w = ps if sb is parent else now(sb)
         a, alpha = ghost_accelerations(v, w, v_par, points * steps, cdt)
         rot = np.array(pb.getMatrixFromQuaternion(q)).reshape(3, 3)  # the COM frame's
         sb.force((sb.mass * a).tolist(), list(p))
@@ -134,20 +134,24 @@ def chain_ghosts(world, art) -> dict:
     return out
 
 
-def act_on_free(world, g, ps, points, steps: int = 1) -> list:
+def act_on_free(world, g, ps, points, steps: int = 1, now=None) -> list:
     """AMBF's rule on the free bodies of ``points`` [(body, contact points)] for ``steps`` physics
     steps (``ps``: the ghost parent's state, or a static one's): their velocities set; returns
-    those it acted on (their gravity is to be taken off)."""
+    those it acted on (their gravity is to be taken off). ``now``: in a control step's first
+    physics step, PyBulletWorld._state_now (the states it read, told of the velocities set here)."""
     cid, parent, v_par = world.cid, g.parent, ps[2]
     acted = []
     for sb, n in points:
         if n == 0 or sb.link >= 0 or (sb.articulation is not None and world.chain_stepped(sb.articulation)):
             continue
-        v, w = ps[2:] if sb is parent else pb.getBaseVelocity(sb.uid, cid)
+        s = ps if sb is parent else now(sb) if now is not None else None
+        v, w = s[2:] if s is not None else pb.getBaseVelocity(sb.uid, cid)
         kept = kept_under_slow_parent(v, w, v_par, n * steps)
         if kept is None:
             kept = tuple(x.tolist() for x in ghost_velocity(v, w, v_par, n * steps))
         pb.resetBaseVelocity(sb.uid, kept[0], kept[1], cid)
+        if now is not None:  # what getBaseVelocity gives back now
+            world._reset_now[(sb.uid, -1)] = (*s[:2], tuple(kept[0]), tuple(kept[1]))
         acted.append(sb)
     return acted
 

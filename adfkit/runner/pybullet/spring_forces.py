@@ -73,6 +73,8 @@ class SpringSet:
         self.cid = cid
         self.world_gravity = np.asarray(gravity, dtype=float)
         self._poses: list = []  # each free body's (position, quaternion) as last read, in _base_keys' order
+        self._vels: list = []  # and its (linear, angular) velocity
+        self._base_index: dict[tuple[int, int], int] = {}  # (uid, -1) -> its place in those
         self._order = None
         n = len(joints)
         if not n:
@@ -209,6 +211,12 @@ class SpringSet:
         asked (the ghosts ask once a control step, the springs read at every physics step)."""
         return dict(zip(self._base_keys, self._poses)) if self._poses else {}
 
+    def last_state(self, key: tuple[int, int]) -> tuple | None:
+        """(position, quaternion, linear velocity, angular velocity) of free body ``key`` (uid, -1) as
+        states() last read it, as SimBody.state() gives them; None for a body it does not read."""
+        i = self._base_index.get(key)
+        return None if i is None or not self._poses else self._poses[i] + self._vels[i]
+
     def _read_plan(self):
         """How to read every body's COM state with the fewest PyBullet calls: free bodies and
         multibody bases one by one (PyBullet has no batch call for them), the links of each
@@ -222,6 +230,7 @@ class SpringSet:
         order = [i for i, _ in bases] + [i for group in links.values() for i, _ in group]
         self._bases = [uid for _, uid in bases]
         self._base_keys = [(uid, -1) for uid in self._bases]
+        self._base_index = {key: i for i, key in enumerate(self._base_keys)}
         self._links = [(uid, [k for _, k in group]) for uid, group in links.items()]
         self._order = np.argsort(np.array(order, dtype=int))  # read order -> body order
         self._in_order = bool(np.array_equal(self._order, np.arange(len(order))))
@@ -239,8 +248,9 @@ class SpringSet:
         bases = self._bases
         get_pose, get_vel, get_links = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getLinkStates
         poses = [get_pose(uid, cid) for uid in bases]
-        rows = [p + q + v + w for (p, q), (v, w) in zip(poses, [get_vel(uid, cid) for uid in bases])]
-        self._poses = poses
+        vels = [get_vel(uid, cid) for uid in bases]
+        rows = [p + q + v + w for (p, q), (v, w) in zip(poses, vels)]
+        self._poses, self._vels = poses, vels
         for uid, ks in self._links:  # computeLinkVelocity, computeForwardKinematics
             rows += [s[0] + s[1] + s[6] + s[7] for s in get_links(uid, ks, 1, 1, cid)]
         a = np.fromiter(chain.from_iterable(rows), float, 13 * len(rows)).reshape(-1, 13)

@@ -194,11 +194,19 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         self.link_damping.apply()
         self.limit_rows.apply()
         poses.update(self.springs.pq)
+        self._reset_now = {}  # (uid, link) -> a state with the velocity the ghosts set this control step
         self._update_ghosts(poses)
         for s in self.sensors:
             self._sense(s)
         if self._parting:
             self.parting()
+
+    def _state_now(self, sb) -> tuple:
+        """SimBody.state() of ``sb`` as this control step read it (the springs' free bodies, the damped
+        links; a velocity the ghosts set since: _reset_now), else read now (the ghosts ask)."""
+        key = (sb.uid, sb.link)
+        s = self._reset_now.get(key) or self.springs.last_state(key) or self.link_damping.read.get(key)
+        return s if s is not None else sb.state()
 
     def step(self, n: int = 1) -> None:
         """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
