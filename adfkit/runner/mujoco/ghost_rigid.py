@@ -42,7 +42,10 @@ def rigid_points(m, d, pairs) -> dict[tuple[int, int], int]:
                 margin=0.0,
                 mass=1.0,
             )
-        model = spec.compile()
+        try:
+            model = spec.compile()
+        except ValueError:  # MuJoCo refused the pair's model: the distance query's one point stands
+            continue
         data = mujoco.MjData(model)
         mujoco.mj_forward(model, data)
         n = int(np.count_nonzero(data.contact.dist[: data.ncon] < 0.0))

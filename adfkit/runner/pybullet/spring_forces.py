@@ -141,6 +141,14 @@ class SpringSet:
         self.fl_eq, self.fl_low, self.fl_high = self.eq_lin[fl], self.lin_low[fl], self.lin_high[fl]
         self.fl_active = self.fl_low <= self.fl_high
         self.fl_m = self.m_eff[fl][:, None]
+        # each body's 1/m and principal 1/I, shared as m_eff's are, for the pivots' mass (_pivot_mass)
+        self.inv_m_shared = inv_m
+        self.inv_i_shared = (
+            np.array(
+                [np.zeros(3) if b.static else 1.0 / np.maximum(np.asarray(b.inertia, float), 1e-12) for b in bodies]
+            )
+            * deg[:, None]
+        )
         self.fl_net = self.net[:, fl]
         self.fl_child_t, self.fl_parent_t = self.to_child[fl].T, self.to_parent[fl].T
         # the child's acceleration under gravity relative to the parent's, in the world: the
@@ -289,7 +297,7 @@ class SpringSet:
             raft = rat[fl]
             d = (raft @ (pbw - pa)[:, :, None])[..., 0]
             v_rel = (raft @ (lv[fc] - lv[fp])[:, :, None])[..., 0]
-            m_eff = self.fl_m
+            m_eff = self._pivot_mass(pos, rot, pbw, ra[fl]) if self.form == "ambf" else self.fl_m
             f = self._spring(self._fl, d - self.fl_eq, v_rel)
             # the limits see the velocity gravity adds over the step too: held for the whole step,
             # a correction blind to it leaves a limit g·dt²/erp short under gravity (0.78 mm at
@@ -313,6 +321,24 @@ class SpringSet:
             at, uids, links = self._pushed
             forces, coms = force[at].tolist(), pos[at].tolist()
             deque(map(pb.applyExternalForce, uids, links, forces, coms, repeat(frame), repeat(cid)), 0)
+
+    def _pivot_mass(self, pos, rot, pivot, axes) -> np.ndarray:
+        """(k, 3): the mass each free-linear joint's pivot B has along each axis of its frame A
+        (``axes``: columns, in the world), its two bodies pushed there (as a constraint row's:
+        1 / Σ (1/m + (r×a)·I⁻¹·(r×a)), r from a body's centre of mass to the pivot). The body's
+        mass alone, where the pivot is off its centre of mass, overshot: a pendulum bob pushed
+        sideways at its pivot 0.1 m above its centre turned 20x as far as the push meant, and a
+        bob resting on the floor so flew apart."""
+        total = np.zeros(axes.shape[0:1] + (3,))
+        for ends in (self.fl_ip, self.fl_ic):
+            r = pivot - pos[ends]  # (k, 3)
+            inv_i = self.inv_i_shared[ends]  # (k, 3), principal, in the body's frame
+            rt = rot[ends].transpose(0, 2, 1)
+            for j in range(3):
+                a = axes[:, :, j]
+                rxa = (rt @ _cross(r, a)[:, :, None])[..., 0]  # in the principal frame
+                total[:, j] += self.inv_m_shared[ends] + (rxa * rxa * inv_i).sum(1)
+        return 1.0 / np.maximum(total, 1e-12)
 
     @staticmethod
     def _limit(x, v, low, high, inertia, dt, erp, active=None):
