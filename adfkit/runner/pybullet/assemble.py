@@ -135,7 +135,7 @@ class Assembly:
                 )
                 kind_c = JointKind.FIXED
             try:
-                made = make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5)
+                made = make_constraint(self.cid, kind_c, parent, child, fa, fb, 1e5, self._ambf_dt is not None)
             except ConstraintRefused as exc:
                 self._warn("runner-constraint", f"{j.identifier}: {exc}; the joint is left out", j)
                 self.joints_made = [r for r in self.joints_made if r[0] is not j]

@@ -59,10 +59,18 @@ def com_frames(joint, parent, child) -> tuple[np.ndarray, np.ndarray]:
 
 
 def make_constraint(
-    cid: int, kind: JointKind, parent, child, frame_a: np.ndarray, frame_b: np.ndarray, max_force: float
+    cid: int,
+    kind: JointKind,
+    parent,
+    child,
+    frame_a: np.ndarray,
+    frame_b: np.ndarray,
+    max_force: float,
+    gyration_span: bool = False,
 ) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray | None]]:
     """PyBullet constraints for a joint: [(constraint id, pivot in parent frame, pivot in child
-    frame, slide axis in the parent frame or None)]."""
+    frame, slide axis in the parent frame or None)]. ``gyration_span``: a fixed joint's pivots
+    span at least the child's radius of gyration (fixed_pivots; AMBF's bodies asked for)."""
     out = []
 
     def create(a, b, jtype, axis, pa, pb_, oa, ob):
@@ -142,7 +150,8 @@ def make_constraint(
         # PyBullet's fixed constraint ignores both frame orientations and holds the two
         # inertial frames parallel (measured: the corpus needle's thread turns 90 degrees off
         # the needle in 0.1 s); point pivots keep the file's relative pose exactly.
-        for e in fixed_pivots(frame_b):
+        least = gyration_radius(child) if gyration_span else 0.0
+        for e in fixed_pivots(frame_b, least):
             add(pb.JOINT_POINT2POINT, frame_a[:3, :3] @ e + frame_a[:3, 3], frame_b[:3, :3] @ e + frame_b[:3, 3])
     elif kind is JointKind.PRISMATIC:
         # between multibody links only (the caller checks): btMultiBodySliderConstraint, its
@@ -159,18 +168,36 @@ def make_constraint(
     return out
 
 
-def fixed_pivots(frame_b: np.ndarray) -> list[np.ndarray]:
+def gyration_radius(body) -> float:
+    """m, sqrt(largest principal inertia / mass) of a moving body (0 for a static one)."""
+    mass, inertia = float(getattr(body, "mass", 0.0) or 0.0), getattr(body, "inertia", None)
+    if mass <= 0.0 or not inertia:
+        return 0.0
+    return float(np.sqrt(max(inertia) / mass))
+
+
+def fixed_pivots(frame_b: np.ndarray, least: float = 0.0) -> list[np.ndarray]:
     """The three pivots of a fixed joint, in the joint frame: its origin, the point as far beyond
     the child's centre of mass (the child's far end: where a chain hung from it pulls) and that
     point moved as far again across. Pivots spanning the child hold it where its load comes in:
     pivots 5 mm to the side of the joint origin, off a 2.4 mm thread element, let Bullet's
     solver leave the element 27° off the needle as the thread hung from it (its 50 iterations
     do not converge a 40-element chain, whose joint impulses start from zero every step), and
-    the joint 2.3 mm open at those pivots; spanning the element: under 3°."""
+    the joint 2.3 mm open at those pivots; spanning the element: under 3°.
+
+    ``least``: the span the pivots reach at least, along the same directions. An impulse at a
+    pivot r from the centre of mass turns the child by r·P/I and moves it by P/m: pivots much
+    nearer than its radius of gyration (sqrt(I/m)) barely turn it, and Bullet's solver leaves its
+    orientation off where AMBF's fixed constraint (btFixedConstraint: three angular rows besides
+    the three linear) holds it. The corpus suturing set's thread (elements 2.4 mm long, 0.03 kg,
+    5e-5 kg·m²: 4.1 cm) at rest on the phantom: its first element 0.77° off the needle with
+    pivots spanning the element, 0.01° with them spanning 2.4 cm, AMBF's 0.001°."""
     com = -frame_b[:3, :3].T @ frame_b[:3, 3]  # the child's centre of mass in the joint frame
-    reach = 2.0 * float(np.linalg.norm(com))
-    if reach < 1e-4:  # the joint at the child's centre of mass: any span will do
-        return [np.zeros(3), np.array([FIXED_SPAN, 0.0, 0.0]), np.array([0.0, FIXED_SPAN, 0.0])]
-    far = 2.0 * com
+    dist = float(np.linalg.norm(com))
+    if dist < 5e-5:  # the joint at the child's centre of mass: any span will do
+        span = max(FIXED_SPAN, least)
+        return [np.zeros(3), np.array([span, 0.0, 0.0]), np.array([0.0, span, 0.0])]
+    reach = max(2.0 * dist, least)
+    far = reach * com / dist
     across = np.cross(far, np.eye(3)[int(np.argmin(np.abs(far)))])
     return [np.zeros(3), far, far + reach * across / np.linalg.norm(across)]
