@@ -79,3 +79,31 @@ def test_a_velocity_a_ghost_set_is_the_state_asked_after_it(tmp_path):
         assert cube.state()[:2] == before[:2] and cube.state()[2:] != before[2:]
     finally:
         w.close()
+
+
+def test_the_ghosts_ask_no_distance_of_a_body_without_points_in_their_pass(monkeypatch):
+    """AMBF's rule acts on the points of the ghosts' pass alone: on the bundled suturing set at rest
+    a ghost asks PyBullet's distance query only of the bodies near it with penetrating points, and
+    finds the bodies the query over all of them finds inside. Control: without the pass's points
+    (the ghosts' friction, overlapping()) every body near it is asked."""
+    w = open_world(load_scene(BUNDLED, None), Options(**AMBF))
+    try:
+        w.step(100)
+        manifolds = w._manifold_points(w._acting_ghosts, {})
+        real, asked = pb.getClosestPoints, []
+        monkeypatch.setattr(pb, "getClosestPoints", lambda *a, **kw: asked.append(a[:2]) or real(*a, **kw))
+        near = skipped = 0
+        for g in w._acting_ghosts:
+            keys = [k for k in w._near_keys[g.uid] if k in w._dynamic_lookup]
+            inside = {k for k in keys if real(g.uid, k[0], 0.0, -1, k[1], physicsClientId=w.cid)}
+            del asked[:]
+            found = w._overlap(g, None, with_parent=True, manifolds=manifolds)
+            assert {(sb.uid, sb.link) for sb in found} == inside, g.key
+            assert all(n > 0 for _sb, n in g.points)
+            near, skipped = near + len(keys), skipped + len(keys) - len(asked)
+            del asked[:]
+            w._overlap(g, None, with_parent=True)
+            assert len(asked) == len(keys)
+        assert near > 0 and skipped > near // 2, (near, skipped)
+    finally:
+        w.close()
