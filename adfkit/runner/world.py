@@ -67,6 +67,7 @@ class World:
         self._floor_z = -math.inf
         self._chains: dict[int, object] = {}  # per articulation, its chain_model
         self._chain_stepped: dict[int, int] = {}  # per articulation, the physics step chain_velocities played
+        self._ghosts_passed = False  # the ghosts have had their first collision pass (before the first step)
 
     def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
         """The joints' velocities (by record index) one physics step of AMBF's solver leaves them

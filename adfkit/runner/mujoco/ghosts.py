@@ -242,14 +242,19 @@ class AmbfGhosts:
         if not self.ghosts or not len(self._cand_geoms):
             return  # nothing a ghost could hold
         now = answers = self._penetrating(self.ghosts)
-        changed = self._ghost_changed
+        changed, first = self._ghost_changed, not self._ghosts_passed
+        self._ghosts_passed = True
+        if first:  # nothing before the first step for a ghost with a parent (pybullet/ghost_steps.first_points)
+            answers, changed = [[] if g.parent is not None else a for g, a in zip(self.ghosts, answers)], True
         if self.opt.control_substeps == 1:  # AMBF acts with the points its last step's pass found
-            before, self._ghost_before = self._ghost_before, (list(answers), changed)
-            answers, changed = before if before is not None else ([[] for _ in self.ghosts], True)
+            before, self._ghost_before = self._ghost_before, (list(answers), changed, first)
+            answers, changed, first = before if before is not None else ([[] for _ in self.ghosts], True, True)
         key = self._body_awake.tobytes() if self.sleep else b""
         plan = self._ghost_plan
         if plan is None or changed or key != plan.key:
             plan = self._ghost_plan = self._plan_ghosts(answers, key)
+        if first:
+            self._ghost_plan = None  # planned on the first step's answers: the next control step plans afresh
         for g, found in zip(self.ghosts, now):  # what each ghost holds now (overlapping() may have written its own)
             g.overlapping = plan.overlapping[id(g)] if now is answers else [sb for sb, _ in found]
             g.points = found

@@ -118,6 +118,7 @@ class Interaction:
                 ambf_ghost(self, g, held, a_step if g in fine else None)
             elif found:
                 self._viscous(g, found)
+        self._ghosts_passed = True  # (ghost_steps.first_points)
         if ambf:
             weightless(self, held.values(), poses)
             for sb in a_step.values():
