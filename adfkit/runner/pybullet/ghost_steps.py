@@ -11,10 +11,11 @@ rule acted on the points of the moment (measured with ``adfkit parity``).
 At adfkit's 1 ms control step the rule acts at every control step with the points found at the
 one before (links too). At a longer control step (the default 4 ms) a free body near an acting
 ghost (in its broadphase box, so that one entering it is caught on the step it enters) has its
-control step played one physics step at a time while it moves (faster than SLOW), the rule acting between the physics steps with
-the points of the step before: its velocity set, its gravity taken off for that step alone. A
-multibody link's velocities cannot be set; links keep the force over the control step
-(interact._ambf_ghost)."""
+control step played one physics step at a time while it moves (faster than SLOW), the rule
+acting between the physics steps with the points of the step before: its velocity set, its
+gravity taken off for that step alone. A multibody link's velocities cannot be set; links keep
+the force over the control step (ambf_ghost), or, on a chain AMBF's solver is played on, the
+rule acts inside that step (chain_ghosts)."""
 
 from __future__ import annotations
 
@@ -35,7 +36,7 @@ class GhostSteps:
         self.world = world
         self.free = {key: sb for key, sb in world._dynamic_lookup.items() if key[1] < 0}
         self.ghosts: list = []  # the ghosts whose control step is played a physics step at a time
-        self.fine = False  # any
+        self.fine = False  # any ghost is: the world plays this control step a physics step at a time
         self.was: dict = {}  # (uid, link) -> position of the free bodies near a ghost at the last control step
 
     def decide(self, poses: dict) -> list:
