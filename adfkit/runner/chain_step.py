@@ -103,7 +103,7 @@ class ChainStep:
                     self.inv_mass[k],
                     rot @ self.inv_inertia_diag[k] @ rot.T,
                     v * dv + g if moving else np.zeros(3),
-                    w * dw if moving else np.zeros(3),
+                    gyroscopic(w * dw, rot, self.inertia[k], self.dt) if moving else np.zeros(3),
                     rot @ self.inertia_diag[k] @ rot.T,
                 )
             )
@@ -156,6 +156,31 @@ class ChainStep:
         back = rots.transpose(0, 2, 1)
         self.apart, self.drift = _turned(back, apart), _turned(back, drift)
         return qd
+
+
+def gyroscopic(w: np.ndarray, rot: np.ndarray, diag: np.ndarray, dt: float) -> np.ndarray:
+    """The angular velocity ``w`` after Bullet's implicit gyroscopic step, which AMBF's
+    btRigidBodies take before the solver's rows (btRigidBody's default flag
+    BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY, computeGyroscopicImpulseImplicit_Body): one
+    Newton step of I·(ω' − ω) + dt·ω'×(I·ω') = 0 in the body's principal frame (``rot``, its
+    principal inertias ``diag``)."""
+    wb = rot.T @ w
+    ib = diag * wb
+    f = dt * cross3(wb, ib)
+    x, y, z = wb.tolist()
+    a, b, c = ib.tolist()
+    # the Jacobian I + (skew(ω)·I − skew(I·ω))·dt
+    i0, i1, i2 = diag.tolist()
+    jac = np.array(
+        [
+            [i0, (-z * i1 + c) * dt, (y * i2 - b) * dt],
+            [(z * i0 - c) * dt, i1, (-x * i2 + a) * dt],
+            [(-y * i0 + b) * dt, (x * i1 - a) * dt, i2],
+        ]
+    )
+    if not np.any(f) or abs(np.linalg.det(jac)) <= 1.1920929e-07:  # btMatrix3x3::solve33's tiny step
+        return w
+    return rot @ (wb - np.linalg.solve(jac, f))
 
 
 def _erp(joint) -> float:
