@@ -409,8 +409,8 @@ def test_ambfs_ghost_rule_hangs_a_cube_in_a_ghost_alike_in_both_engines(tmp_path
     weightless and keeps 0.9 of its velocity per contact point and physics step) in PyBullet and
     in MuJoCo: the parity scene's cube, dropped into a ghost slab hung on a post, stops in it at
     the same height in both at a 1 ms control step, where both act as AMBF does at every physics
-    step (measured 247.761 and 247.760 mm; AMBF 247.761; the PyBullet runner at 4 ms too:
-    test_ghost_timing.py), its twin beside the slab falls to the floor. Control: the suture's hole
+    step (measured 247.761 and 247.760 mm; AMBF 247.761; at 4 ms too: test_ghost_timing.py),
+    its twin beside the slab falls to the floor. Control: the suture's hole
     friction acts in hole ghosts only, and the cube falls through to the floor too."""
     from adfkit.scenes.parity import write_parity
 

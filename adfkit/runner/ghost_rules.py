@@ -24,6 +24,9 @@ MANIFOLD_POINTS = 4
 SAME_PLACE = 1e-9
 #: m/s: a ghost's parent slower than this takes nothing along its velocity (ghost_velocity)
 ALONG_FROM = 1e-5
+#: m/s: a free body near a ghost that moved slower than this keeps the rule once a control step;
+#: a faster one has its control step played a physics step at a time (the engines' ghost_steps.py)
+SLOW = 1e-3
 
 
 def in_same_place(a: list, b: list) -> bool:

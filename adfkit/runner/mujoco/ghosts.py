@@ -14,6 +14,7 @@ from ..ghost_rules import AMBF_GHOST_KEEP, MANIFOLD_POINTS, SAME_PLACE
 from ..plan import ALL_GROUPS
 from .chain import chain_stepped_ids
 from .ghost_rigid import rigid_points
+from .ghost_steps import MjGhostSteps
 from .objects import MjBody
 
 _SLEEP_BIT = int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
@@ -255,10 +256,20 @@ class AmbfGhosts:
             plan = self._ghost_plan = self._plan_ghosts(answers, key)
         if first:
             self._ghost_plan = None  # planned on the first step's answers: the next control step plans afresh
+        steps = self._ghost_steps
+        if steps is None and self.opt.control_substeps > 1:
+            steps = self._ghost_steps = MjGhostSteps(self)
+        fine = np.zeros(0, dtype=int)  # free bodies the rule acts on a physics step at a time (ghost_steps.py)
+        if steps is not None and steps.decide():
+            fine = steps.free_of(answers)
+            steps.begin(answers, fine)
+        elif steps is not None:
+            steps.before = list(answers)
         for g, found in zip(self.ghosts, now):  # what each ghost holds now (overlapping() may have written its own)
             g.overlapping = plan.overlapping[id(g)] if now is answers else [sb for sb, _ in found]
             g.points = found
         stepped = chain_stepped_ids(self)  # AMBF's solver on a chain holds its bodies' ghosts (chain_ghosts)
+        stepped = np.union1d(stepped, fine) if len(fine) else stepped
         if len(plan.ids):
             self._ghost_velocities(plan, stepped)
         if len(plan.weight_ids):  # the weight taken off as a force: AMBF's gravity off
@@ -356,6 +367,8 @@ class AmbfGhosts:
         v2 = keep * (v - along) + v_par
         w2 = keep * w
         for i, a, b in plan.free:  # in order: the last ghost's velocity stands
+            if len(stepped) and b in stepped:
+                continue
             d.qvel[a : a + 3] = v2[i]
             d.qvel[a + 3 : a + 6] = d.xmat[b].reshape(3, 3).T @ w2[i]  # body frame
         j = plan.jointed

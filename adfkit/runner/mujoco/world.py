@@ -54,6 +54,7 @@ class MujocoWorld(Assembly, Interaction, World):
         self._weightless_ids: set[int] = set()  # the bodies a ghost holds weightless (ghosts._plan_ghosts)
         self._ghost_plan, self._ghost_changed = None, False  # ghosts._ambf_ghosts' plan, while it holds
         self._ghost_before = None  # at a 1 ms control step: the answers a physics step before, and changed
+        self._ghost_steps = None  # longer control steps: a moving free body's physics steps (ghost_steps.py)
         self.camera_problem = ""
         self._build()
 
@@ -234,7 +235,16 @@ class MujocoWorld(Assembly, Interaction, World):
         limits = self.drive_limits.check
         for k in range(n):
             control()
-            step(m, d, sub)
+            fine = self._ghost_steps
+            if fine is not None and fine.ghosts:  # AMBF's ghosts at every physics step (ghost_steps.py)
+                for i in range(sub):
+                    step(m, d, 1)
+                    if i < sub - 1:
+                        kinematics(m, d)
+                        fine.between()
+                fine.end()
+            else:
+                step(m, d, sub)
             # mj_step computes the poses (xpos, xquat, geom_xpos) before it integrates: without
             # this, every pose read after a step was the one a physics step earlier (a body
             # falling at 29 m/s read 29 mm high against AMBF, measured on puzzle1's Occulus)

@@ -22,11 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import ghost_accelerations, ghost_velocity, kept_under_slow_parent
-
-#: m/s: a free body near a ghost that moved slower than this keeps the rule once a control step
-#: (4 µm in a 4 ms control step)
-SLOW = 1e-3
+from ..ghost_rules import SLOW, ghost_accelerations, ghost_velocity, kept_under_slow_parent
 
 
 class GhostSteps:
