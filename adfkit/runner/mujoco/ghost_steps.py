@@ -135,3 +135,15 @@ class MjGhostSteps:
         if acted:
             w._xfrc_dirty = True
         self.before = list(now)
+
+
+def com_velocities(d, m, ids: np.ndarray) -> np.ndarray:
+    """[ω, v] of bodies ``ids`` at their centres of mass in the world frame (mj_objectVelocity's,
+    from cvel: mj_comVel must have run)."""
+    cvel = d.cvel[ids]
+    om = cvel[:, :3]
+    r = d.xipos[ids] - d.subtree_com[m.body_rootid[ids]]
+    cvel[:, 3] += om[:, 1] * r[:, 2] - om[:, 2] * r[:, 1]
+    cvel[:, 4] += om[:, 2] * r[:, 0] - om[:, 0] * r[:, 2]
+    cvel[:, 5] += om[:, 0] * r[:, 1] - om[:, 1] * r[:, 0]
+    return cvel

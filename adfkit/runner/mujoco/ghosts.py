@@ -14,7 +14,7 @@ from ..ghost_rules import AMBF_GHOST_KEEP, MANIFOLD_POINTS, SAME_PLACE
 from ..plan import ALL_GROUPS
 from .chain import chain_stepped_ids
 from .ghost_rigid import rigid_points
-from .ghost_steps import MjGhostSteps
+from .ghost_steps import MjGhostSteps, com_velocities
 from .objects import MjBody
 
 _SLEEP_BIT = int(getattr(mujoco.mjtEnableBit, "mjENBL_SLEEP", 0))
@@ -88,9 +88,12 @@ class AmbfGhosts:
             r, k = rows[mine], ks[mine]
             order = np.lexsort((r, k))  # the candidates in turn, each against the ghost's geoms
             points: dict[int, list] = {}
+            boxes = self._geom_is_box
             for a, c, kk in zip(gg[r[order]].tolist(), cg[k[order]].tolist(), k[order].tolist()):
                 pair = (min(a, c), max(a, c))
                 n = min(max(made.get(pair, 0) or self._rigid_made.get(pair, 0), 1), MANIFOLD_POINTS)
+                if not (boxes[a] and boxes[c]):  # Bullet's GJK: one point a pass (ghost_rigid.py)
+                    n = 1
                 sb = self._cand_geom_body[kk]
                 points.setdefault(id(sb), [sb, 0])[1] += n
             answers[i] = [(sb, n) for sb, n in points.values()]
@@ -147,6 +150,7 @@ class AmbfGhosts:
                 if mujoco.mj_geomDistance(m, d, int(gg[r]), int(cg[k]), 0.0, None) < 0.0
             ]
             self._rigid_hits = tuple(np.array([p[i] for p in pairs], dtype=int) for i in (0, 1))
+            self._geom_is_box = np.asarray(m.geom_type) == mujoco.mjtGeom.mjGEOM_BOX
             self._rigid_made = rigid_points(m, d, [(int(gg[r]), int(cg[k])) for r, k in pairs])  # ghost_rigid.py
             self._is_ghost_geom = np.zeros(m.ngeom, dtype=bool)
             self._is_ghost_geom[gg] = True
@@ -356,7 +360,7 @@ class AmbfGhosts:
         mujoco.mj_comPos(m, d)
         mujoco.mj_comVel(m, d)
         n = len(plan.ids)
-        vel = _com_velocities(d, m, plan.both)
+        vel = com_velocities(d, m, plan.both)
         w, v = vel[:n, :3], vel[:n, 3:]
         v_par = np.where(plan.has_parent, vel[n:, 3:], 0.0)
         mag = np.sqrt(np.einsum("ij,ij->i", v_par, v_par))
@@ -386,15 +390,3 @@ class AmbfGhosts:
                 wrench[np.isin(plan.jointed_ids, stepped)] = 0.0
             np.add.at(d.xfrc_applied, plan.jointed_ids, wrench)  # in order: a body in two ghosts
             self._xfrc_dirty = True
-
-
-def _com_velocities(d, m, ids: np.ndarray) -> np.ndarray:
-    """[ω, v] of bodies ``ids`` at their centres of mass in the world frame (mj_objectVelocity's,
-    from cvel: mj_comVel must have run)."""
-    cvel = d.cvel[ids]
-    om = cvel[:, :3]
-    r = d.xipos[ids] - d.subtree_com[m.body_rootid[ids]]
-    cvel[:, 3] += om[:, 1] * r[:, 2] - om[:, 2] * r[:, 1]
-    cvel[:, 4] += om[:, 2] * r[:, 0] - om[:, 0] * r[:, 2]
-    cvel[:, 5] += om[:, 0] * r[:, 1] - om[:, 1] * r[:, 0]
-    return cvel
