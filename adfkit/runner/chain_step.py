@@ -163,24 +163,26 @@ def gyroscopic(w: np.ndarray, rot: np.ndarray, diag: np.ndarray, dt: float) -> n
     btRigidBodies take before the solver's rows (btRigidBody's default flag
     BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY, computeGyroscopicImpulseImplicit_Body): one
     Newton step of I·(ω' − ω) + dt·ω'×(I·ω') = 0 in the body's principal frame (``rot``, its
-    principal inertias ``diag``)."""
-    wb = rot.T @ w
-    ib = diag * wb
-    f = dt * cross3(wb, ib)
-    x, y, z = wb.tolist()
-    a, b, c = ib.tolist()
-    # the Jacobian I + (skew(ω)·I − skew(I·ω))·dt
+    principal inertias ``diag``), on Python floats (numpy's 3x3 solve cost five times as much)."""
+    x, y, z = (rot.T @ w).tolist()
     i0, i1, i2 = diag.tolist()
-    jac = np.array(
-        [
-            [i0, (-z * i1 + c) * dt, (y * i2 - b) * dt],
-            [(z * i0 - c) * dt, i1, (-x * i2 + a) * dt],
-            [(-y * i0 + b) * dt, (x * i1 - a) * dt, i2],
-        ]
-    )
-    if not np.any(f) or abs(np.linalg.det(jac)) <= 1.1920929e-07:  # btMatrix3x3::solve33's tiny step
+    a, b, c = i0 * x, i1 * y, i2 * z
+    # the residual dt·ω×(I·ω) and the Jacobian I + (skew(ω)·I − skew(I·ω))·dt
+    f0, f1, f2 = dt * (y * c - z * b), dt * (z * a - x * c), dt * (x * b - y * a)
+    if f0 == 0.0 and f1 == 0.0 and f2 == 0.0:
         return w
-    return rot @ (wb - np.linalg.solve(jac, f))
+    m00, m01, m02 = i0, (c - z * i1) * dt, (y * i2 - b) * dt
+    m10, m11, m12 = (z * i0 - c) * dt, i1, (a - x * i2) * dt
+    m20, m21, m22 = (b - y * i0) * dt, (x * i1 - a) * dt, i2
+    c0, c1, c2 = m11 * m22 - m12 * m21, m12 * m20 - m10 * m22, m10 * m21 - m11 * m20  # cofactors of row 0
+    det = m00 * c0 + m01 * c1 + m02 * c2
+    if abs(det) <= 1.1920929e-07:  # btMatrix3x3::solve33 leaves so small a step as good as none
+        return w
+    # Cramer's rule, as solve33
+    d0 = (f0 * c0 + m01 * (m12 * f2 - f1 * m22) + m02 * (f1 * m21 - m11 * f2)) / det
+    d1 = (m00 * (f1 * m22 - m12 * f2) + f0 * c1 + m02 * (m10 * f2 - f1 * m20)) / det
+    d2 = (m00 * (m11 * f2 - f1 * m21) + m01 * (f1 * m20 - m10 * f2) + f0 * c2) / det
+    return rot @ np.array([x - d0, y - d1, z - d2])
 
 
 def _erp(joint) -> float:
