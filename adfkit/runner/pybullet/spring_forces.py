@@ -329,15 +329,13 @@ class SpringSet:
         mass alone, where the pivot is off its centre of mass, overshot: a pendulum bob pushed
         sideways at its pivot 0.1 m above its centre turned 20x as far as the push meant, and a
         bob resting on the floor so flew apart."""
-        total = np.zeros(axes.shape[0:1] + (3,))
+        k = len(pivot)
+        total = np.zeros((k, 3))
+        cols = axes.transpose(0, 2, 1).reshape(-1, 3)  # the three axes of each joint, one per row
         for ends in (self.fl_ip, self.fl_ic):
-            r = pivot - pos[ends]  # (k, 3)
-            inv_i = self.inv_i_shared[ends]  # (k, 3), principal, in the body's frame
-            rt = rot[ends].transpose(0, 2, 1)
-            for j in range(3):
-                a = axes[:, :, j]
-                rxa = (rt @ _cross(r, a)[:, :, None])[..., 0]  # in the principal frame
-                total[:, j] += self.inv_m_shared[ends] + (rxa * rxa * inv_i).sum(1)
+            r = np.repeat(pivot - pos[ends], 3, axis=0)  # (3k, 3): each arm once per axis
+            rxa = (_cross(r, cols).reshape(k, 3, 3)) @ rot[ends]  # rows r×a in the principal frame
+            total += self.inv_m_shared[ends][:, None] + (rxa * rxa * self.inv_i_shared[ends][:, None, :]).sum(2)
         return 1.0 / np.maximum(total, 1e-12)
 
     @staticmethod
