@@ -86,7 +86,7 @@ ambf: $(STAMP)
 	@if [ -x "$(AMBF_CACHE)/ambf/bin/lin-x86_64/ambf_simulator" ] && [ -f "$(AMBF_CACHE)/ambf/build/AMBFConfig.cmake" ]; then \
 		echo "AMBF is built: $(AMBF_CACHE)/ambf"; \
 	elif [ -f "$(AMBF_KIT)/build_ambf_headless.sh" ]; then \
-		bash "$(AMBF_KIT)/build_ambf_headless.sh" "$(AMBF_KIT)/ambf-2.0-src.tar.gz" "$(AMBF_CACHE)" 2; \
+		bash "$(AMBF_KIT)/build_ambf_headless.sh" "$(abspath $(AMBF_KIT))/ambf-2.0-src.tar.gz" "$(AMBF_CACHE)" 2; \
 	else \
 		echo "no AMBF kit at $(AMBF_KIT) (AMBF_KIT=DIR names one) and no build in $(AMBF_CACHE)"; exit 1; \
 	fi
