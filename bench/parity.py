@@ -201,16 +201,23 @@ def corpus_at_rest() -> list[Scene]:
 
 
 def main(argv: list[str]) -> int:
+    import argparse
+
     from adfkit.parity import ambf, session
 
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], prog="bench/parity.py")
+    ap.add_argument("--plots", type=Path, metavar="DIR", help="draw each scene's gaps over time there")
+    ap.add_argument("--json", type=Path, metavar="OUT", help="write the rows as JSON there too")
+    ap.add_argument("--only", nargs="+", default=[], metavar="NAME", help="the scenes whose names hold one of these")
+    ap.add_argument("--suture", action="store_true", help="only the suture replayed in AMBF (tens of minutes)")
+    ap.add_argument("--corpus-at-rest", action="store_true", help="more corpus files AMBF loads, at rest for 1 s")
+    args = ap.parse_args(argv)
     build, why = ambf.available()
     if build is None:
         print(f"skipped: {why}")
         return 0
-    plots = Path(argv[argv.index("--plots") + 1]) if "--plots" in argv else None
-    out_json = Path(argv[argv.index("--json") + 1]) if "--json" in argv else None
-    only = argv[argv.index("--only") + 1 :] if "--only" in argv else []
-    if "--suture" in argv:
+    plots, out_json, only = args.plots, args.json, args.only
+    if args.suture:
         print(
             "| scene | pair | adfkit | AMBF following | AMBF set-points | AMBF paced | tip gap following "
             "| tip gap set-points | tip gap paced | adfkit stepping (episode) | AMBF following | AMBF | AMBF paced |"
@@ -223,7 +230,7 @@ def main(argv: list[str]) -> int:
     with tempfile.TemporaryDirectory(prefix="adfkit-parity-bench-") as tmp:
         folder = Path(tmp)
         scenes = own_scenes(folder / "own") + sample_scenes() + corpus_scenes(build, folder)
-        if "--corpus-at-rest" in argv:
+        if args.corpus_at_rest:
             scenes += corpus_at_rest()
         for sc in scenes:
             if only and not any(o.lower() in sc.name.lower() for o in only):
