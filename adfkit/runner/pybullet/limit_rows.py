@@ -81,6 +81,15 @@ def spring_row_velocity(q: float, v: float, limits: tuple[float, float], erp: fl
     return None
 
 
+def _pulled(q: float, limits: tuple[float, float], force: float) -> bool:
+    """Whether a row's motor, last step, pulled its joint toward the nearer limit (``force``, the
+    motor's applied joint force or torque) where AMBF's limit row, whose impulse is clamped to push
+    the joint away from its limit, would have let it go: PyBullet's velocity motor holds both ways."""
+    lo, hi = limits
+    inward = 1.0 if q - lo < hi - q else -1.0
+    return force * inward < 0.0
+
+
 class LimitRows:
     def __init__(self, world) -> None:
         self.world = world
@@ -143,6 +152,8 @@ class LimitRows:
                     pb.changeDynamics(art.uid, n, jointLowerLimit=lo, jointUpperLimit=hi, physicsClientId=cid)
                     (self.widened.add if outside else self.widened.discard)(key)
                 back = row(q, v, lim, dt=self.dt)
+                if back is not None and key in self.engaged and _pulled(q, lim, s[3]):
+                    back = None  # AMBF's row only pushes: let go of a joint its motor held back
                 if back is not None:
                     pb.setJointMotorControl2(
                         art.uid, n, pb.VELOCITY_CONTROL, targetVelocity=back, force=LIMIT_FORCE, physicsClientId=cid
