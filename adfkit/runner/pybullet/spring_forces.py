@@ -208,10 +208,17 @@ class SpringSet:
 
     @staticmethod
     def _spring(gains, x, v):
-        """The spring-damper's force or torque -(K·x + C·v) / D, ``gains`` (K, C, D) (_gains; D None: 1)."""
+        """The spring-damper's force or torque -(K·x + C·v) / D, ``gains`` (K, C, D) (_gains).
+        D None is AMBF's row (get_limit_motor_info2): its impulse is bounded by the spring-damper's
+        and the damper's alone and driven to the bound on the side of their sum, so where the damper
+        opposes the spring and outweighs it the damper acts alone (a spring released toward its
+        equilibrium is braked by the whole of -C·v, not by what the spring leaves of it)."""
         k, c, den = gains
-        out = -(k * x + c * v)
-        return out if den is None else out / den
+        spring, damper = -k * x, -c * v
+        out = spring + damper
+        if den is None:
+            return np.where((spring * damper < 0.0) & (np.abs(damper) > np.abs(spring)), damper, out)
+        return out / den
 
     @property
     def pq(self) -> dict[tuple, tuple]:
@@ -282,7 +289,15 @@ class SpringSet:
         i_eff = self.i_eff_col
         tau = self._spring(self._ang, ang - self.eq_ang, w_rel)
         tau += self._limit(
-            ang, lambda: w_rel + tau * dt / i_eff, self.ang_low, self.ang_high, i_eff, dt, erp, self.ang_active
+            ang,
+            lambda: w_rel + tau * dt / i_eff,
+            self.ang_low,
+            self.ang_high,
+            i_eff,
+            dt,
+            erp,
+            self.ang_active,
+            self.form == "ambf",
         )
         torque = self.net @ (ra @ tau[:, :, None])[..., 0]
         force = None
@@ -296,7 +311,12 @@ class SpringSet:
             pa, pbw = pivots[:k], pivots[k:]
             raft = rat[fl]
             d = (raft @ (pbw - pa)[:, :, None])[..., 0]
-            v_rel = (raft @ (lv[fc] - lv[fp])[:, :, None])[..., 0]
+            if self.form == "ambf":  # Bullet's: the pivots' own velocities, each body's turning too
+                arms = pivots - pos[ends]
+                vp = lv[ends] + _cross(av[ends], arms)
+                v_rel = (raft @ (vp[k:] - vp[:k])[:, :, None])[..., 0]
+            else:
+                v_rel = (raft @ (lv[fc] - lv[fp])[:, :, None])[..., 0]
             m_eff = self._pivot_mass(pos, rot, pbw, ra[fl]) if self.form == "ambf" else self.fl_m
             f = self._spring(self._fl, d - self.fl_eq, v_rel)
             # the limits see the velocity gravity adds over the step too: held for the whole step,
@@ -305,7 +325,15 @@ class SpringSet:
             # that far below AMBF's, which solves them as constraint rows)
             g_rel = (raft @ self.fl_g_rel[:, :, None])[..., 0]
             f += self._limit(
-                d, v_rel + (f / m_eff + g_rel) * dt, self.fl_low, self.fl_high, m_eff, dt, erp, self.fl_active
+                d,
+                v_rel + (f / m_eff + g_rel) * dt,
+                self.fl_low,
+                self.fl_high,
+                m_eff,
+                dt,
+                erp,
+                self.fl_active,
+                self.form == "ambf",
             )
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
             force = self.fl_net @ f_w
@@ -339,18 +367,30 @@ class SpringSet:
         return 1.0 / np.maximum(total, 1e-12)
 
     @staticmethod
-    def _limit(x, v, low, high, inertia, dt, erp, active=None):
+    def _limit(x, v, low, high, inertia, dt, erp, active=None, rows=False):
         """Velocity-correcting force that keeps x within [low, high] (low > high: free, Bullet):
         it drives a violation back at -erp·err/dt and only ever pushes, never pulls. ``v`` may be
-        a callable giving it, called only where a limit is crossed."""
+        a callable giving it, called only where it is needed. ``rows``: AMBF's limit rows
+        (btGeneric6DofSpring2Constraint's, there whenever low < high, not only past a limit,
+        limit_rows.spring_row_velocity): inside, a joint moves toward a limit at a gap g at most
+        erp·g/dt, and not at all where it would cross it within the step."""
         if active is None:
             active = low <= high
         over = active & (x > high)
         under = active & (x < low)
+        ranged = active & (low < high) if rows else None
         if not (np.count_nonzero(over) or np.count_nonzero(under)):  # a third of .any()'s cost
-            return 0.0
+            if ranged is None or not np.count_nonzero(ranged):
+                return 0.0
         if callable(v):
             v = v()
         err = np.where(over, x - high, np.where(under, x - low, 0.0))
         f = inertia * (-erp * err / dt - v) / dt
-        return np.where(over, np.minimum(f, 0.0), np.where(under, np.maximum(f, 0.0), 0.0))
+        out = np.where(over, np.minimum(f, 0.0), np.where(under, np.maximum(f, 0.0), 0.0))
+        if ranged is None:
+            return out
+        gap_lo, gap_hi = x - low, high - x
+        slowest = np.where((gap_lo > 0.0) & (-v * dt > gap_lo), 0.0, -erp * gap_lo / dt)
+        fastest = np.where((gap_hi > 0.0) & (v * dt > gap_hi), 0.0, erp * gap_hi / dt)
+        pushes = np.maximum(inertia * (slowest - v) / dt, 0.0) + np.minimum(inertia * (fastest - v) / dt, 0.0)
+        return np.where(ranged, pushes, out)
