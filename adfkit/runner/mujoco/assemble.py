@@ -15,7 +15,7 @@ from ..collisions import HULL_OVERLAP, hull_overlaps, one_hull
 from ..plan import ALL_GROUPS
 from ..rotations import pose_to_matrix
 from .build import GHOST_GROUP, build_plan
-from .contacts import ground_pairs, set_contacts
+from .contacts import bullet_pairs, ground_pairs, set_contacts
 from .damping import BodyDamping
 from .drives import DriveLimits, drive_limit
 from .integrator import integrator_for
@@ -81,6 +81,8 @@ class Assembly:
         self.model.opt.integrator = integrator_for(self.model)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
+        bullet = self.opt.bodies == "ambf" and self.soft is None  # Bullet's frictions (contacts.py)
+        own = bullet_pairs(spec, self.model, self.model.geom_group == GHOST_GROUP) if bullet else []
         self.ground_z = None
         if ground and (plan.bodies or (self.soft is not None and self.soft.items)):
             self.ground_z = self._lowest_point() - 1e-3 if self.opt.ground_z is None else self.opt.ground_z
@@ -94,11 +96,23 @@ class Assembly:
                 contype=ALL_GROUPS,
                 conaffinity=ALL_GROUPS,
             )
-            if self.opt.bodies == "ambf" and self.soft is None:  # Bullet's friction on it (contacts.py)
+            if bullet:
                 ground_pairs(spec, floor, self.model, ALL_GROUPS)
+            for g, fr in own:
+                g.friction = fr
             self.model = compile_spec(self, spec)
             if ghost_gravity:
                 self.model.body_gravcomp[:] = 0.0
+            self.data = mujoco.MjData(self.model)
+            mujoco.mj_forward(self.model, self.data)
+        elif own:  # the frictions and pairs compiled in, the algebra and integrator chosen as above
+            for g, fr in own:
+                g.friction = fr
+            self.model = compile_spec(self, spec)
+            if ghost_gravity:
+                self.model.body_gravcomp[:] = 0.0
+            self.model.opt.jacobian = jacobian_for(self.model)
+            self.model.opt.integrator = integrator_for(self.model)
             self.data = mujoco.MjData(self.model)
             mujoco.mj_forward(self.model, self.data)
         self._plan = plan

@@ -14,6 +14,9 @@ from .collision import EXCLUDE_SPARE
 from .ghosts import AmbfGhosts
 from .objects import MjActuator, MjBody, MjGhost, MjSensor
 
+#: an explicit pair's margin while its bodies are kept apart: MuJoCo's bounding test never passes
+PAIR_OFF = -1e9
+
 
 class Interaction(AmbfGhosts):
     def _sense(self, s: MjSensor) -> None:
@@ -139,6 +142,10 @@ class Interaction(AmbfGhosts):
             sigs[free[0]] = sig
             self._runtime_excludes.add(sig)
         m.exclude_signature[: m.nexclude] = np.sort(sigs)
+        if m.npair:  # explicit pairs (the floor's, Bullet's frictions) heed no exclusion: kept out of reach
+            b1, b2 = m.geom_bodyid[m.pair_geom1], m.geom_bodyid[m.pair_geom2]
+            hit = ((b1 == lo) & (b2 == hi)) | ((b1 == hi) & (b2 == lo))
+            m.pair_margin[hit] = self._pair_margins[hit] if enabled else PAIR_OFF
 
     def wake(self, sb: MjBody) -> None:
         """Wake the sleeping tree of ``sb`` (MuJoCo wakes a tree a force is applied to: a

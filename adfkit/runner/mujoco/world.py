@@ -57,6 +57,7 @@ class MujocoWorld(Assembly, Interaction, World):
         self._ghost_steps = None  # longer control steps: a moving free body's physics steps (ghost_steps.py)
         self.camera_problem = ""
         self._build()
+        self._pair_margins = np.array(self.model.pair_margin)  # set_collision gives them back
 
     def joint_state(self, art, idxs) -> tuple[np.ndarray, np.ndarray]:
         """Positions and velocities of joints ``idxs`` (record indices) of an articulation."""
