@@ -210,3 +210,57 @@ def test_a_scene_without_a_suture_is_a_setup_error_not_a_traceback(tmp_path, cap
     err = capsys.readouterr().err
     assert "error[suture-setup]: no unique body matches 'Needle'" in err and "Traceback" not in err
     assert "the scene needs a Needle" in err
+
+
+def _velocities(run, name: str) -> np.ndarray:
+    """A body's linear velocity at each sample (the plugin's ADFKIT_PARITY_VELOCITIES record)."""
+    i = run.body_names().index(name)
+    return np.array([s["velocities"][i] for s in run.samples], float)
+
+
+@needs_ambf
+def test_ambfs_hole_ghosts_give_the_static_phantom_a_velocity_its_hole_bodies_take(monkeypatch):
+    """AMBF's ghost sets the velocity of every rigid body it senses, the static phantom too (its
+    hull reaches into the hole ghosts): Bullet never moves a static body, but the six-dof springs
+    that hang the hole bodies on it damp them towards that velocity, and the ghosts give the
+    phantom their hole bodies' velocities back. At rest, 1 s (the corpus phantom and its ghosts
+    alone): the phantom 5.9e-5 m/s, Entry1 5.1e-5 m/s, measured. Control: the plugin's
+    ADFKIT_PARITY_STILL_STATIC puts every static body at rest after each step, and nothing moves."""
+    from conftest import CORPUS, require_corpus
+
+    require_corpus()
+    stage = ambf.Stage(CORPUS / "src/launch.yaml", [10, 11])
+    monkeypatch.setenv("ADFKIT_PARITY_VELOCITIES", "1")
+    monkeypatch.delenv("ADFKIT_PARITY_STILL_STATIC", raising=False)
+    run = ambf.run(BUILD, stage, 1.0, 0.1)
+    phantom, entry = "/ambf/env/phantom/Phantom", "/ambf/env/phantom/Entry1"
+    assert run.created["bodies"][run.body_names().index(phantom)]["mass"] == 0.0
+    assert np.abs(_velocities(run, phantom)).max() > 1e-5
+    assert np.linalg.norm(_velocities(run, entry), axis=1).max() > 1e-5
+    monkeypatch.setenv("ADFKIT_PARITY_STILL_STATIC", "1")
+    still = ambf.run(BUILD, stage, 1.0, 0.1)
+    assert np.abs(_velocities(still, phantom)).max() == 0.0
+    assert np.linalg.norm(_velocities(still, entry), axis=1).max() < 1e-9
+
+
+@needs_ambf
+def test_undoing_what_ambfs_ghost_did_to_a_cube_lets_it_fall_through_the_slab(tmp_path, monkeypatch):
+    """The plugin's ADFKIT_PARITY_UNGHOST ("NAME PARTS") gives the bodies named back, after each
+    step, the velocities Bullet's step left them and the world's gravity, undoing AMBF's ghosts:
+    the parity scene's cube, which AMBF's ghost slab stops (z 0.20-0.25 m), falls through it to
+    the floor as its twin beside the slab does. Control: without the knob it stops in the slab."""
+    from adfkit.scenes.parity import write_parity
+
+    stage = ambf.Stage(write_parity(tmp_path), [3])
+    cube, twin = "/ambf/env/ghost/cube", "/ambf/env/ghost/twin"
+
+    def heights() -> tuple[float, float]:
+        tr = from_ambf(ambf.run(BUILD, stage, 0.6, 0.3))
+        return tuple(float(tr.poses[-1, tr.body_names.index(n), 2]) for n in (cube, twin))
+
+    monkeypatch.delenv("ADFKIT_PARITY_UNGHOST", raising=False)
+    z_cube, z_twin = heights()
+    assert 0.2 < z_cube < 0.25 and z_twin < 0.1
+    monkeypatch.setenv("ADFKIT_PARITY_UNGHOST", "ghost/cube linear angular gravity")
+    z_cube, z_twin_again = heights()
+    assert z_cube == pytest.approx(z_twin, abs=1e-3) and z_twin_again == pytest.approx(z_twin, abs=1e-6)

@@ -43,6 +43,15 @@
 //   ADFKIT_PARITY_CONTACTS  "1": each sample also lists the contact manifolds of the last physics step
 //                           that hold points, [A, B, points, least distance, summed normal impulse]
 //                           (A and B: a rigid body's or ghost's qualified name, "?" for anything else)
+//   ADFKIT_PARITY_VELOCITIES "1": each sample also lists every rigid body's linear velocity (m/s, the
+//                           created record's order), as Bullet holds it after AMBF's ghosts acted
+//   Measurement knobs, which change what AMBF does (for finding out what a behaviour comes from):
+//   ADFKIT_PARITY_STILL_STATIC "1": every static body (mass 0) is put back at rest after each step
+//                           (AMBF's ghosts set the velocity of every body they sense, a static one too)
+//   ADFKIT_PARITY_UNGHOST   "SUBSTRING PARTS": the rigid bodies whose qualified names hold SUBSTRING get
+//                           back, after each step, what AMBF's ghosts changed of them: PARTS names any of
+//                           linear and angular (the velocities Bullet's step left, read at its internal
+//                           tick callback) and gravity (the world's)
 //
 // Records: {"kind":"created",...} once, {"kind":"sample",...} per sample (its "clock": the command
 // clock, the simulated time "t" when unpaced), {"kind":"end",...} last (a paced replay's "pace":
@@ -180,6 +189,25 @@ public:
         m_contacts = contacts && string(contacts) == "1";
         const char* ghosts = getenv("ADFKIT_PARITY_GHOSTS");
         m_followGhosts = !(ghosts && string(ghosts) == "headless");
+        const char* velocities = getenv("ADFKIT_PARITY_VELOCITIES");
+        m_velocities = velocities && string(velocities) == "1";
+        const char* still = getenv("ADFKIT_PARITY_STILL_STATIC");
+        m_stillStatic = still && string(still) == "1";
+        // a measurement's knob: "SUBSTRING PARTS" undoes what AMBF's ghosts did after each step to
+        // the rigid bodies whose qualified names hold SUBSTRING, PARTS of linear, angular, gravity
+        const char* unghost = getenv("ADFKIT_PARITY_UNGHOST");
+        if (unghost && *unghost) {
+            istringstream us(unghost);
+            string parts;
+            us >> m_unghostName >> parts;
+            m_unghostLinear = parts.find("linear") != string::npos;
+            m_unghostAngular = parts.find("angular") != string::npos;
+            m_unghostGravity = parts.find("gravity") != string::npos;
+            for (afRigidBodyPtr rb : m_world->getRigidBodies())
+                if (rb->getQualifiedName().find(m_unghostName) != string::npos) m_unghosted.push_back(rb->m_bulletRigidBody);
+            m_unghostBefore.resize(m_unghosted.size() * 2);
+            m_world->m_bulletWorld->setInternalTickCallback(&AdfkitParity::after_tick, this, false);
+        }
         // a measurement's knob: Bullet's solver iterations (AMBF leaves them at Bullet's 10)
         int iterations = (int)env_double("ADFKIT_PARITY_SOLVER_ITERATIONS", 0.0);
         if (iterations > 0) m_world->m_bulletWorld->getSolverInfo().m_numIterations = iterations;
@@ -205,6 +233,8 @@ public:
 
     virtual void physicsUpdate(double dt) {
         m_steps++;
+        if (m_stillStatic) still_static();
+        if (!m_unghosted.empty()) unghost();
         update_global_poses();
         double t = m_world->getSimulationTime();
         if (!m_paced) m_cmdClock = t;
@@ -225,6 +255,35 @@ public:
     virtual bool close() { return 0; }
 
 private:
+    // Bullet's step ended (before AMBF's ghosts act): the velocities the ghosts will change
+    static void after_tick(btDynamicsWorld* w, btScalar) {
+        AdfkitParity* self = static_cast<AdfkitParity*>(w->getWorldUserInfo());
+        for (size_t i = 0; i < self->m_unghosted.size(); i++) {
+            self->m_unghostBefore[2 * i] = self->m_unghosted[i]->getLinearVelocity();
+            self->m_unghostBefore[2 * i + 1] = self->m_unghosted[i]->getAngularVelocity();
+        }
+    }
+
+    void unghost() {
+        btVector3 g = m_world->m_bulletWorld->getGravity();
+        for (size_t i = 0; i < m_unghosted.size(); i++) {
+            btRigidBody* b = m_unghosted[i];
+            if (m_unghostLinear) b->setLinearVelocity(m_unghostBefore[2 * i]);
+            if (m_unghostAngular) b->setAngularVelocity(m_unghostBefore[2 * i + 1]);
+            if (m_unghostGravity) b->setGravity(g);
+        }
+    }
+
+    // a static body (mass 0) at rest again after AMBF's ghosts set its velocity: a measurement's knob
+    void still_static() {
+        for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
+            btRigidBody* b = rb->m_bulletRigidBody;
+            if (!b->isStaticObject()) continue;
+            b->setLinearVelocity(btVector3(0, 0, 0));
+            b->setAngularVelocity(btVector3(0, 0, 0));
+        }
+    }
+
     // what AMBF's graphics loop does (afWorld::updateSceneObjects) for the poses physics reads:
     // a ghost object places itself at its global pose at each step
     void update_global_poses() {
@@ -406,6 +465,15 @@ private:
         }
         s += "]";
         if (m_contacts) s += ",\"contacts\":" + contacts();
+        if (m_velocities) {
+            s += ",\"velocities\":[";
+            bool firstV = true;
+            for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
+                s += (firstV ? "" : ",") + vec(rb->m_bulletRigidBody->getLinearVelocity());
+                firstV = false;
+            }
+            s += "]";
+        }
         s += "}\n";
         fputs(s.c_str(), m_out);
         fflush(m_out);
@@ -643,6 +711,11 @@ private:
     long m_steps = 0;
     bool m_followGhosts = true;
     bool m_contacts = false;
+    bool m_velocities = false, m_stillStatic = false;
+    string m_unghostName;
+    bool m_unghostLinear = false, m_unghostAngular = false, m_unghostGravity = false;
+    vector<btRigidBody*> m_unghosted;
+    vector<btVector3> m_unghostBefore;
     vector<Command> m_commands;
     size_t m_nextCommand = 0;
     map<string, Command> m_drives;
