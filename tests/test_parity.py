@@ -1204,3 +1204,80 @@ def test_a_sliders_reading_before_ambfs_first_step_is_unknown():
     tr = from_ambf(SimpleNamespace(created=created, samples=samples, wall_s=0.0))
     assert np.isnan(tr.joints[0, 0]) and tr.joints[1, 0] == 0.01
     assert tr.joints[0, 1] == 0.2
+
+
+INERT_JOINT = """\
+bodies: [BODY base, BODY arm]
+joints: [JOINT hinge, JOINT typo, JOINT stray]
+namespace: /ambf/env/inert/
+BODY base:
+  name: base
+  mass: 0.0
+  collision shape: BOX
+  collision geometry: {x: 0.1, y: 0.1, z: 0.1}
+  location: {position: {x: 0.0, y: 0.0, z: 0.3}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+BODY arm:
+  name: arm
+  mass: 0.2
+  collision shape: BOX
+  collision geometry: {x: 0.1, y: 0.02, z: 0.02}
+  location: {position: {x: 0.1, y: 0.0, z: 0.3}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+JOINT hinge:
+  name: hinge
+  parent: BODY base
+  child: BODY arm
+  type: revolute
+  parent pivot: {x: 0.05, y: 0.0, z: 0.0}
+  child pivot: {x: -0.05, y: 0.0, z: 0.0}
+  parent axis: {x: 0.0, y: 1.0, z: 0.0}
+  child axis: {x: 0.0, y: 1.0, z: 0.0}
+JOINT typo:
+  name: typo
+  parent: BODY base
+  child: BODY arm
+  type: Revolute
+  parent pivot: {x: 0.05, y: 0.0, z: 0.0}
+  child pivot: {x: -0.05, y: 0.0, z: 0.0}
+  parent axis: {x: 0.0, y: 1.0, z: 0.0}
+  child axis: {x: 0.0, y: 1.0, z: 0.0}
+JOINT stray:
+  name: stray
+  parent: BODY base
+  child: BODY nowhere
+  type: Revolute
+  parent pivot: {x: 0.0, y: 0.0, z: 0.0}
+  child pivot: {x: 0.0, y: 0.0, z: 0.0}
+  parent axis: {x: 0.0, y: 1.0, z: 0.0}
+  child axis: {x: 0.0, y: 1.0, z: 0.0}
+"""
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_joint_of_an_unknown_type_is_listed_as_ambf_keeps_it(tmp_path, engine):
+    """AMBF keeps a joint whose `type` it does not know (`Revolute`), between two bodies it finds,
+    without a constraint, and lists it among its joints; one whose child it cannot find it skips.
+    adfkit lists the same (it made nothing of either): `adfkit parity` said "only in AMBF" of it."""
+    from adfkit.adf import load_scene
+    from adfkit.parity.traces import AdfkitPlayer, made_by
+    from adfkit.runner import Options, open_world
+
+    path = tmp_path / "inert.yaml"
+    path.write_text(INERT_JOINT)
+    world = open_world(load_scene(path), Options(visuals=False), engine=engine)
+    try:
+        assert made_by(world)["joint"] == ["/ambf/env/inert/hinge", "/ambf/env/inert/typo"]
+        trace = AdfkitPlayer(world).play(0.02, 0.004)
+        assert np.isnan(trace.joints[:, 1]).all() and np.isfinite(trace.joints[:, 0]).all()
+    finally:
+        world.close()
+
+
+@needs_ambf
+def test_ambf_and_adfkit_list_a_joint_of_an_unknown_type_alike(tmp_path, capsys):
+    path = tmp_path / "inert.yaml"
+    path.write_text(INERT_JOINT)
+    main(["parity", str(path), "--seconds", "0.2", "--engine", "both", "--json"])
+    docs = json.loads(capsys.readouterr().out)
+    assert [d["engine"] for d in docs] == ["pybullet", "mujoco"]
+    for doc in docs:
+        assert doc["only_in_ambf"] == doc["only_in_adfkit"] == [], doc

@@ -53,7 +53,7 @@ def made_by(world) -> dict[str, list[str]]:
         "body": [ambf_name(sb.key, sb.body) for sb in rigid_bodies(world)],
         "soft body": [ambf_name(s.key, s.soft) for s in (soft.items if soft is not None else [])],
         "ghost": [ambf_name(g.key, g.ghost) for g in world.ghosts],
-        "joint": [ambf_name(joint_key(world, j), j) for j, _p, _c in world.joints_made],
+        "joint": [ambf_name(joint_key(world, j), j) for j, _p, _c in world.joints_made + world.inert_joints()],
         "sensor": [ambf_name(s.key, s.sensor) for s in world.sensors],
         "actuator": [ambf_name(a.key, a.actuator) for a in world.actuators],
     }
@@ -145,7 +145,7 @@ class AdfkitPlayer:
         self.world = world
         self.made = made_by(world)
         self.bodies = rigid_bodies(world)
-        self.joints = list(world.joints_made)
+        self.joints = list(world.joints_made) + world.inert_joints()  # the inert last: no value
         self.by_name = {
             "joint": {n: (j, c) for n, (j, _p, c) in zip(self.made["joint"], self.joints)},
             "actuator": dict(zip(self.made["actuator"], world.actuators)),

@@ -69,6 +69,30 @@ class World:
         self._chain_stepped: dict[int, int] = {}  # per articulation, the physics step chain_velocities played
         self._ghosts_passed = False  # the ghosts have had their first collision pass (before the first step)
 
+    def inert_joints(self) -> list[tuple]:
+        """(ADF joint, parent body, child body) of each joint AMBF keeps without a constraint: an
+        unknown `type` (adf-format.md §8, `JOINT TYPE NOT UNDERSTOOD`) between two bodies it finds
+        (one it cannot find is skipped, as every joint is). The runner makes nothing of them; AMBF
+        lists them among its joints."""
+        from ..model.semantics import joint_kind
+        from .plan import joint_ends
+
+        out = []
+        for m in self.scene.all_models():
+            if all(joint_kind(j.type) is not None for j in m.joints):
+                continue
+            local = Registry()
+            for sb in self.bodies:
+                if getattr(sb, "model", None) is m:
+                    local.items[sb.key] = sb
+            ns = m.namespace or ""
+            for j in m.joints:
+                if joint_kind(j.type) is None:
+                    parent, child = joint_ends(self.registry, local, ns, j)
+                    if parent is not None and child is not None:
+                        out.append((j, parent, child))
+        return out
+
     def chain_velocities(self, art, motors: dict, efforts: dict) -> np.ndarray | None:
         """The joints' velocities (by record index) one physics step of AMBF's solver leaves them
         at: the articulation as AMBF's btRigidBodies, its hinges' and sliders' locking, motor
