@@ -3,9 +3,10 @@ AMBF's chain of btRigidBodies (each link and the base a body at its centre of ma
 velocities, damped over the step as Bullet damps them and given the step's gravity and the last
 step's contact forces), its hinges and sliders and the joints closing its loops solved as
 runner/chain_rows.py solves them, and the joints' velocities read back out. What AMBF's bodies
-carry apart from the joints' motion, which a reduced-coordinate articulation cannot (their
-velocities and their displacement off where the joints put them, left by ten iterations that
-did not settle), is carried from step to step here. The engines read their own state into it
+carry that a reduced-coordinate articulation cannot is carried from step to step here: their
+velocities as the last step left them, in the world's frame (the articulation's are turned with
+its links as its joints carry them), and their displacement off where the joints put them, left
+by ten iterations that did not settle. The engines read their own state into it
 (runner/pybullet/chain.py, runner/mujoco/chain.py)."""
 
 from __future__ import annotations
@@ -65,8 +66,9 @@ class ChainStep:
         self.joints = [(parent, kind, limits_of(j), _erp(j)) for parent, kind, j in joints]
         self.added = added
         n = len(bodies)
-        self.apart = np.zeros((n, 6))
         self.drift = np.zeros((n, 6))
+        # the bodies' velocities the last step left (n, 6: linear, angular, in the world's frame)
+        self.carried: np.ndarray | None = None
         self.step = -2  # the physics step it was last played at: a step missed, nothing is carried
 
     def velocities(
@@ -82,18 +84,23 @@ class ChainStep:
         ``efforts`` (joint index -> N·m or N) pushing their two bodies apart; ``loops(bodies,
         coms, rots, drift)`` gives the joints closing the chain's loops."""
         if step != self.step + 1:
-            self.apart[:] = 0.0
+            self.carried = None
             self.drift[:] = 0.0
         self.step = step
         rots, coms = state.rots, state.coms
-        # the carried state is kept in each body's own frame: it turns with the body
-        apart, drift = _turned(rots, self.apart), _turned(rots, self.drift)
+        # the drift is kept in each body's own frame: it turns with the body
+        drift = _turned(rots, self.drift)
+        # AMBF's bodies start the step at the velocities the last one left them, in the world's
+        # frame: the articulation's, read where its joints have since carried the bodies, are
+        # turned with them (a body on a turning joint: its velocity across its arm), which AMBF's
+        # rows take out in the step, unsettled in ten iterations
+        start = np.concatenate([state.v, state.w], axis=1) if self.carried is None else self.carried
         bodies = []
         for k in range(len(coms)):
             rot = rots[k]
             dv, dw = self.decay[k]
             moving = self.inv_mass[k] > 0.0
-            v, w, g = state.v[k] + apart[k, :3], state.w[k] + apart[k, 3:], self.gravity[k]
+            v, w, g = start[k, :3], start[k, 3:], self.gravity[k]
             for points, v_parent in state.ghosted.get(k, ()):  # AMBF's ghosts, after the last step
                 v, w = ghost_velocity(v, w, v_parent, points)
                 g = 0.0
@@ -147,14 +154,15 @@ class ChainStep:
                         bd.v = bd.v + sign * effort * self.dt * bd.inv_mass * jt.axis
         after = solve(bodies, joints, self.dt, self.added)
         # read as the articulation's joints, which carry the bodies where their joints put them
-        # (what is apart is measured from there: the next step starts from the same velocities)
+        # (what is apart is measured from there)
         at = [Body(c, bd.inv_mass, bd.inv_inertia, bd.v, bd.w, bd.inertia) for c, bd in zip(coms, bodies)]
         qd, together = joint_velocities(at, fk, after)
         apart = after - together
         apart[[k for k in range(len(coms)) if self.inv_mass[k] <= 0.0]] = 0.0
         drift += apart * self.dt
-        back = rots.transpose(0, 2, 1)
-        self.apart, self.drift = _turned(back, apart), _turned(back, drift)
+        self.drift = _turned(rots.transpose(0, 2, 1), drift)
+        self.carried = after
+        self.carried[[k for k in range(len(coms)) if self.inv_mass[k] <= 0.0]] = 0.0
         return qd
 
 
