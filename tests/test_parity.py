@@ -616,7 +616,7 @@ def test_a_psm_in_its_finger_ghosts_follows_ambfs_under_a_velocity_program(tmp_p
     """The challenge's PSM (LND 400006) with its finger ghosts and actuator (the corpus launch
     file, -l 6,7): its jaws and pitch end link lie in the ghosts throughout, and AMBF's ghost
     acts on them inside the step of AMBF's solver that adfkit plays on the driven chain. Measured
-    (PyBullet, 1 s): the insertion link 0.84 mm from AMBF's, the jaws 0.13 mm (48.2 and 0.97 mm
+    (PyBullet, 1 s): the insertion link 0.78 mm from AMBF's, the jaws 0.13 mm (50.1 and 1.01 mm
     when the ghosts' pushes were left out of that step)."""
     from conftest import require_corpus
 
