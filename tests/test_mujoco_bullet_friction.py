@@ -79,24 +79,30 @@ def test_contacts_on_the_ramp_carry_bullets_combined_frictions(tmp_path):
     assert own and all(s[2] in (0.5, 1.0) and s[2] != s[4] for s in own), own
 
 
+def _touching(world, a, b) -> bool:
+    mujoco.mj_forward(world.model, world.data)
+    return any({x, y} == {a.key, b.key} for x, y, *_ in _now(world))
+
+
 def test_set_collision_turns_an_explicit_pair_off_and_on(tmp_path):
-    """The ball without rolling friction meets the ramp by an explicit pair (MuJoCo's rule would
-    give it the ramp's rolling friction): turned off, the pair makes no contact and the ball falls
-    through the ramp; turned on again, it has its margin back."""
+    """On the ramp the ball without rolling friction meets the floor by an explicit pair (the
+    ramp's classes decide the rest: the floor's friction 0.8 with the ball's rolling 0 is no
+    class's combination). Put into the floor, the ball touches it; turned off, the pair makes no
+    contact; turned on again, it has its margin back and touches."""
     world = _ramp(tmp_path, "ambf")
     try:
-        m = world.model
-        ramp, ball = world.body("BODY ramp"), world.body("BODY rolling")
+        m, d = world.model, world.data
+        floor, ball = world.body("BODY Floor"), world.body("BODY rolling")
         b1, b2 = m.geom_bodyid[m.pair_geom1], m.geom_bodyid[m.pair_geom2]
-        theirs = ((b1 == ramp.id) & (b2 == ball.id)) | ((b1 == ball.id) & (b2 == ramp.id))
-        assert theirs.any()
+        assert (((b1 == floor.id) & (b2 == ball.id)) | ((b1 == ball.id) & (b2 == floor.id))).any()
         margins = np.array(m.pair_margin)
-        assert any({a, b} == {ramp.key, ball.key} for a, b, *_ in _contacts(world, 0.1))
-        world.set_collision(ball, ramp, False)
-        z0 = ball.com_position()[2]
-        assert not any({a, b} == {ramp.key, ball.key} for a, b, *_ in _contacts(world, 0.1))
-        assert ball.com_position()[2] < z0 - 0.03  # through the 2 cm ramp
-        world.set_collision(ball, ramp, True)
+        adr = m.jnt_qposadr[m.body_jntadr[ball.id]]
+        d.qpos[adr : adr + 3] = [0.5, 0.75, 0.02]  # 1 cm into the floor, clear of the ramp
+        assert _touching(world, ball, floor)
+        world.set_collision(ball, floor, False)
+        assert not _touching(world, ball, floor)
+        world.set_collision(ball, floor, True)
         assert np.array_equal(np.array(m.pair_margin), margins)
+        assert _touching(world, ball, floor)
     finally:
         world.close()

@@ -98,16 +98,16 @@ class Assembly:
             )
             if bullet:
                 ground_pairs(spec, floor, self.model, ALL_GROUPS)
-            for g, fr in own:
-                g.friction = fr
+            for g, fr, prio in own:
+                g.friction, g.priority = fr, prio
             self.model = compile_spec(self, spec)
             if ghost_gravity:
                 self.model.body_gravcomp[:] = 0.0
             self.data = mujoco.MjData(self.model)
             mujoco.mj_forward(self.model, self.data)
         elif own:  # the frictions and pairs compiled in, the algebra and integrator chosen as above
-            for g, fr in own:
-                g.friction = fr
+            for g, fr, prio in own:
+                g.friction, g.priority = fr, prio
             self.model = compile_spec(self, spec)
             if ghost_gravity:
                 self.model.body_gravcomp[:] = 0.0
@@ -119,7 +119,7 @@ class Assembly:
         if self.soft is not None:
             self.soft.bind(spec)
         m, d = self.model, self.data
-        set_contacts(m, self.dt)  # rigid, frictions combined as Bullet does (contacts.py)
+        set_contacts(m, self.dt, ranked=bool(own))  # rigid, frictions combined as Bullet does (contacts.py)
         self.bodies: list[MjBody] = []
         by_plan = {}
         for bp in plan.bodies:

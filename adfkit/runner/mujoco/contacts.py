@@ -26,12 +26,14 @@ the two bodies' frictions combined so that a frictionless body is frictionless t
   it slide and the arm fall 47° as AMBF's does. A scene with soft bodies keeps MuJoCo's rule on
   the floor (their nodes collide with it by its contact bits, which the pairs turn off).
   There every other two bodies meet with Bullet's combination too (bullet_pairs): the product
-  of the frictions and r1·f2 + r2·f1 of the rolling frictions, through each geom's friction
-  made its combination with itself (a scene of one friction: every pair by MuJoCo's own rule)
-  and an explicit pair wherever MuJoCo's rule on those gives another. With the lower of the two,
-  the parity ramp's balls met it with 0.5 for AMBF's 0.25 and rolled. The corpus suturing set
-  needs 823 explicit pairs (6,250 with a pair for every two geoms that may touch: its MuJoCo
-  runs 1.8x the CPU time; with 823, 1.18x, the same poses to the bit).
+  of the frictions and r1·f2 + r2·f1 of the rolling frictions. Each class of geoms (one friction,
+  one rolling friction) gets a priority and a friction that gives most of its pairs with the
+  classes below it Bullet's combination (a default body on a floor of 0.8: 0.4 and 0.013), and
+  a pair MuJoCo's rule then gets wrong is an explicit pair. With the lower of the two, the parity
+  ramp's balls met it with 0.5 for AMBF's 0.25 and rolled. The corpus suturing set needs 2
+  explicit pairs (6,250 with a pair for every two geoms that may touch, its MuJoCo 1.8x the CPU
+  time; 823 with each class given its combination with itself, 1.18x; now 1.04-1.08x, the same
+  poses to the bit in all three).
 """
 
 from __future__ import annotations
@@ -48,10 +50,13 @@ CONTACT_TIMECONST_STEPS = 2
 GROUND_FRICTION = 0.5
 
 
-def set_contacts(model, dt: float) -> None:
-    """Every geom's contact time constant and its friction priority (see the module docstring)."""
+def set_contacts(model, dt: float, ranked: bool = False) -> None:
+    """Every geom's contact time constant and its friction priority (see the module docstring);
+    ``ranked``: the priorities bullet_pairs gave kept."""
     model.geom_solref[:, 0] = CONTACT_TIMECONST_STEPS * dt
     model.pair_solref[:, 0] = CONTACT_TIMECONST_STEPS * dt
+    if ranked:
+        return
     mu = np.round(model.geom_friction[:, 0], 9)
     levels = np.unique(mu)  # ascending
     model.geom_priority[:] = len(levels) - 1 - np.searchsorted(levels, mu)
@@ -117,37 +122,68 @@ def touching_pairs(model, skip) -> list[tuple[int, int]]:
     return list(zip(ids[rows].tolist(), ids[cols].tolist(), strict=True))
 
 
+def _bullet(a: tuple, b: tuple) -> tuple:
+    """Bullet's combination of two (friction, rolling friction): btManifoldResult's."""
+    return (
+        round(min(a[0] * b[0], BULLET_MAX_FRICTION), 9),
+        round(min(a[1] * b[0] + b[1] * a[0], BULLET_MAX_FRICTION), 9),
+    )
+
+
+def _ranked(counts: dict) -> list[tuple]:
+    """Geom classes (friction, rolling) from the top priority down, each with the friction MuJoCo
+    gives it: a class above the rest decides its pairs with them (and, at one priority, with its
+    own), so each is given the combination most of those pairs have in Bullet, and the class that
+    leaves the fewest of them to explicit pairs goes first (ties: the one deciding most)."""
+    rest = sorted({k for pair in counts for k in pair})
+    out = []
+    while rest:
+        best = None
+        for g in rest:
+            votes: dict[tuple, int] = {}
+            for (a, b), n in counts.items():
+                if (a == g and b in rest) or (b == g and a in rest):
+                    v = _bullet(a, b)
+                    votes[v] = votes.get(v, 0) + n
+            v, n = max(votes.items(), key=lambda kv: (kv[1], kv[0])) if votes else (_bullet(g, g), 0)
+            rank = (sum(votes.values()) - n, -n)
+            if best is None or rank < best[0]:
+                best = (rank, g, v)
+        assert best is not None
+        out.append((best[1], best[2]))
+        rest.remove(best[1])
+    return out
+
+
 def bullet_pairs(spec, model, skip) -> list:
     """Bullet's combined frictions (btManifoldResult: the product of the two bodies' frictions,
     rolling r1·f2 + r2·f1, each clamped to 10) on every geom pair MuJoCo's own pass may collide
-    (touching_pairs). A geom's own friction becomes its combination with itself (f², 2·r·f); where
-    MuJoCo's rule on those (the lower friction's geom, set_contacts' priority, else the larger of
-    each) gives another combination, the pair is made an explicit one with Bullet's, MuJoCo's
-    mixing of the rest kept (the larger margin, gap and condim): a scene of one friction needs
-    none. Returns the (spec geom, friction) to set once nothing reads the files' frictions from
-    ``spec`` any more (ground_pairs); a geom in a pair without a name is given one."""
+    (touching_pairs). MuJoCo cannot multiply: where two geoms' priorities differ it takes the
+    higher one's friction, else the larger of each. So each class of geoms (one friction, one
+    rolling friction) gets a priority of its own and a friction (_ranked) that gives most of its
+    pairs Bullet's combination; each pair MuJoCo's rule then gets wrong is made an explicit pair
+    with Bullet's, MuJoCo's mixing of the rest kept (the larger margin, gap and condim). Returns
+    the (spec geom, friction, priority) to set once nothing reads the files' frictions from
+    ``spec`` any more (ground_pairs); a geom in an explicit pair without a name is given one."""
     pairs = touching_pairs(model, skip)
     if not pairs:
         return []
     f, mg, gp, cd = model.geom_friction, model.geom_margin, model.geom_gap, model.geom_condim
-    slide, roll = f[:, 0], f[:, 2]
-    own = np.stack(
-        [np.minimum(slide * slide, BULLET_MAX_FRICTION), np.minimum(2 * roll * slide, BULLET_MAX_FRICTION)], 1
-    )
-    rank = np.round(slide, 9)  # set_contacts' priority: the lower friction wins
-    geoms = {g.id: g for g in spec.geoms}  # by the compiled model's ids
-    used = set()
+    cls = {n: (round(float(f[n, 0]), 9), round(float(f[n, 2]), 9)) for pair in pairs for n in pair}
+    counts: dict[tuple, int] = {}
     for i, j in pairs:
-        want = (
-            min(slide[i] * slide[j], BULLET_MAX_FRICTION),
-            min(roll[i] * slide[j] + roll[j] * slide[i], BULLET_MAX_FRICTION),
-        )
-        if rank[i] != rank[j]:
-            got = own[i] if rank[i] < rank[j] else own[j]
-        else:
-            got = np.maximum(own[i], own[j])
-        used.update((i, j))
-        if abs(got[0] - want[0]) <= 1e-12 and abs(got[1] - want[1]) <= 1e-12:
+        key = tuple(sorted((cls[i], cls[j])))
+        counts[key] = counts.get(key, 0) + 1
+    ranked = _ranked(counts)
+    top = len(ranked)
+    prio = {c: top - k for k, (c, _v) in enumerate(ranked)}
+    given = dict(ranked)
+    geoms = {g.id: g for g in spec.geoms}  # by the compiled model's ids
+    for i, j in pairs:
+        a, b = cls[i], cls[j]
+        got = given[a] if prio[a] >= prio[b] else given[b]  # one class, one friction: either
+        want = _bullet(a, b)
+        if got == want:
             continue
         for n in (i, j):
             if not geoms[n].name:
@@ -160,4 +196,4 @@ def bullet_pairs(spec, model, skip) -> list:
             margin=float(max(mg[i], mg[j])),
             gap=float(max(gp[i], gp[j])),
         )
-    return [(geoms[n], [float(own[n, 0]), float(f[n, 1]), float(own[n, 1])]) for n in sorted(used)]
+    return [(geoms[n], [given[c][0], float(f[n, 1]), given[c][1]], prio[c]) for n, c in sorted(cls.items())]
