@@ -1,6 +1,6 @@
 """An ADF scene as one MuJoCo model: every model file through the project's MJCF writer
 (bodies, joints, loops as equalities, lights), attached under its own prefix, plus what the
-runner adds (docs/mujoco.md):
+runner adds (docs/mujoco.md): joints to another model's bodies (cross_joints.py);
 
 - six-dof-family joints (the thread, the phantom's hole bodies) join the kinematic tree and
   get one slide per free linear axis and one hinge per free angular axis, with the ADF
@@ -26,19 +26,11 @@ from ...converters.mjcf_write import LOOP_KINDS, to_mjcf
 from ...model.semantics import JointKind, ShapeKind, body_joint_frames, collision_primitives, pose_or_identity
 from ...model.tree import ONE_DOF
 from .. import plan as scene_rules
-from ..plan import (
-    SPRING_KINDS,
-    is_hole,
-    key_of,
-    loaded_so_far,
-    not_played,
-    played_actuators,
-    played_sensors,
-    resolve_parent,
-)
+from ..plan import SPRING_KINDS, is_hole, key_of, loaded_so_far, not_played, played_actuators, played_sensors
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
 from .collision import GHOST_CONTYPE, GHOST_GROUP, collision_filters, warn_losses
+from .cross_joints import cross_model_joints
 from .drives import add_drive, drive_limit
 from .inertia import ambf_inertia
 from .spec import _parse_spec, _resolve_meshes
@@ -265,6 +257,7 @@ def build_plan(world) -> Plan:
                     f"{j.identifier}: a {kind.value} joint closing a loop is not played by the MuJoCo engine; skipped",
                     j,
                 )
+    loops += cross_model_joints(world, spec, plans_by_model, BodyPlan)  # a joint to another model's body
     ambf_inertia(opt, spec, bodies)
     if world.soft is not None:
         world.soft.attach(spec, scene.all_models(), {bp.key: bp for bp in bodies})
@@ -277,7 +270,7 @@ def build_plan(world) -> Plan:
         known = loaded_so_far(known, mine.values())
         ns = m.namespace or ""
         for gh in m.ghost_objects:
-            parent = resolve_parent(world, gh.parent, ns, gh, BodyPlan) if gh.parent else None
+            parent = scene_rules.resolve_parent(world, gh.parent, ns, gh, BodyPlan) if gh.parent else None
             loc = location = pose_to_matrix(pose_or_identity(gh.location))
             if parent is not None:
                 loc = np.linalg.inv(pose_to_matrix(parent.link.frame_in_body)) @ loc

@@ -1,0 +1,62 @@
+"""Joints between bodies of different model files. AMBF looks a joint's parent and child up in its
+own model, then in every body loaded before it (adf-format.md §12.2), so a model can hang a body
+on another model's; the MJCF writer builds each model's tree alone and leaves such a joint out.
+Here each is closed the way a joint closing a loop is: a weld for a `fixed` joint, a connect at
+its pivot for the other kinds MJCF can close (LOOP_KINDS; a hinge's or slider's axis is then not
+held, as for a loop). The others are warned about and not played."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ...converters.mjcf_write import LOOP_KINDS
+from ...model.semantics import JointKind, body_joint_frames, joint_kind
+from ..names import Registry
+from ..plan import joint_ends
+
+
+def cross_model_joints(world, spec, plans_by_model, body_type) -> list[tuple]:
+    """The joints of ``plans_by_model`` ([(model, {identifier: BodyPlan}, tree | None)]) whose two
+    ends AMBF finds in different models, each added to ``spec`` as an equality: [(joint, kind,
+    parent plan, child plan, pivot A in the parent's MJCF body, pivot B in the child's)]."""
+    out = []
+    for m, mine, tree in plans_by_model:
+        made = set() if tree is None else {id(lk.joint) for lk in tree.ordered() if lk.parent is not None}
+        made |= set() if tree is None else {id(r[0]) for r in tree.loops}
+        local = Registry()
+        for bp in mine.values():
+            local.items[bp.key] = bp
+        for j in m.joints:
+            kind = joint_kind(j.type)
+            if kind is None or id(j) in made:
+                continue
+            parent, child = joint_ends(world.registry, local, m.namespace or "", j)
+            if not (isinstance(parent, body_type) and isinstance(child, body_type)) or parent is child:
+                continue
+            if parent.model is child.model:
+                continue  # within one model: its tree had its reasons
+            if kind not in LOOP_KINDS:
+                world._warn(
+                    "runner-loop",
+                    f"{j.identifier}: a {kind.value} joint to another model's body is not played by the MuJoCo "
+                    "engine; skipped",
+                    j,
+                )
+                continue
+            a, b = body_joint_frames(j, parent.body, child.body)
+            pa = np.array(parent.link.in_link(a).position, float)
+            pb = np.array(child.link.in_link(b).position, float)
+            fixed = kind is JointKind.FIXED
+            eq = spec.add_equality(
+                type=mujoco.mjtEq.mjEQ_WELD if fixed else mujoco.mjtEq.mjEQ_CONNECT,
+                name=f"cross:{parent.key}->{child.key}:{j.identifier}",
+                name1=parent.mjname,
+                name2=child.mjname,
+                objtype=mujoco.mjtObj.mjOBJ_BODY,
+            )
+            # a connect's anchor is in body1's frame; a weld's in body2's, at its origin as MJCF's
+            # default (MjSpec's puts it 1 m along y), keeping the two bodies' poses at qpos0
+            eq.data[:3] = np.zeros(3) if fixed else pa
+            out.append((j, kind, parent, child, pa, pb))
+    return out
