@@ -130,6 +130,7 @@ class SpringSet:
         self.m_eff = 1.0 / np.maximum(inv_m[self.ip] + inv_m[self.ic], 1e-12)
         self.i_eff = 1.0 / np.maximum(inv_i[self.ip] + inv_i[self.ic], 1e-12)
         self.ang_active = self.ang_low <= self.ang_high
+        self.ang_ranged = self.ang_low < self.ang_high if form == "ambf" else None  # AMBF's rows inside (_limit)
         fl = self.free_lin
         # the free-linear joints' constant blocks, sliced once (the same values every step)
         self.fl_ip, self.fl_ic = self.ip[fl], self.ic[fl]
@@ -140,6 +141,7 @@ class SpringSet:
         self.fl_arms = np.concatenate((self.fl_ic, self.fl_ip))
         self.fl_eq, self.fl_low, self.fl_high = self.eq_lin[fl], self.lin_low[fl], self.lin_high[fl]
         self.fl_active = self.fl_low <= self.fl_high
+        self.fl_ranged = self.fl_low < self.fl_high if form == "ambf" else None
         self.fl_m = self.m_eff[fl][:, None]
         # each body's 1/m and principal 1/I, shared as m_eff's are, for the pivots' mass (_pivot_mass)
         self.inv_m_shared = inv_m
@@ -297,7 +299,7 @@ class SpringSet:
             dt,
             erp,
             self.ang_active,
-            self.form == "ambf",
+            self.ang_ranged,
         )
         torque = self.net @ (ra @ tau[:, :, None])[..., 0]
         force = None
@@ -333,7 +335,7 @@ class SpringSet:
                 dt,
                 erp,
                 self.fl_active,
-                self.form == "ambf",
+                self.fl_ranged,
             )
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
             force = self.fl_net @ f_w
@@ -367,21 +369,23 @@ class SpringSet:
         return 1.0 / np.maximum(total, 1e-12)
 
     @staticmethod
-    def _limit(x, v, low, high, inertia, dt, erp, active=None, rows=False):
+    def _limit(x, v, low, high, inertia, dt, erp, active=None, ranged=None):
         """Velocity-correcting force that keeps x within [low, high] (low > high: free, Bullet):
         it drives a violation back at -erp·err/dt and only ever pushes, never pulls. ``v`` may be
-        a callable giving it, called only where it is needed. ``rows``: AMBF's limit rows
-        (btGeneric6DofSpring2Constraint's, there whenever low < high, not only past a limit,
-        limit_rows.spring_row_velocity): inside, a joint moves toward a limit at a gap g at most
-        erp·g/dt, and not at all where it would cross it within the step."""
-        if active is None:
-            active = low <= high
+        a callable giving it, called only where it is needed. ``ranged`` (the axes whose range is
+        open, or None): AMBF's limit rows there (btGeneric6DofSpring2Constraint's, there whenever
+        low < high, limit_rows.spring_row_velocity): inside, a joint moves toward a limit at a gap g
+        at most erp·g/dt, and not at all where it would cross it within the step."""
+        active = low <= high if active is None else active
         over = active & (x > high)
         under = active & (x < low)
-        ranged = active & (low < high) if rows else None
-        if not (np.count_nonzero(over) or np.count_nonzero(under)):  # a third of .any()'s cost
-            if ranged is None or not np.count_nonzero(ranged):
-                return 0.0
+        if ranged is not None:  # the rows act only where x + v·dt/erp would leave the range
+            v = v() if callable(v) else v
+            ahead = x + v * (dt / erp)
+            if not np.count_nonzero(ranged & ((ahead < low) | (ahead > high))):
+                ranged = None
+        if not (np.count_nonzero(over) or np.count_nonzero(under)) and ranged is None:  # a third of .any()'s
+            return 0.0
         if callable(v):
             v = v()
         err = np.where(over, x - high, np.where(under, x - low, 0.0))
@@ -393,4 +397,4 @@ class SpringSet:
         slowest = np.where((gap_lo > 0.0) & (-v * dt > gap_lo), 0.0, -erp * gap_lo / dt)
         fastest = np.where((gap_hi > 0.0) & (v * dt > gap_hi), 0.0, erp * gap_hi / dt)
         pushes = np.maximum(inertia * (slowest - v) / dt, 0.0) + np.minimum(inertia * (fastest - v) / dt, 0.0)
-        return np.where(ranged, pushes, out)
+        return np.where(ranged & active, pushes, out)
