@@ -253,22 +253,55 @@ def played_sensors(world, m, body_type=None, known=None) -> list[SensorRays]:
     ns = m.namespace or ""
     out = []
     for s in m.sensors:
-        if SENSOR_TYPES.get(s.type) != "proximity" or not s.array:
+        rays = None
+        if SENSOR_TYPES.get(s.type) == "proximity":
+            rays = array_rays(s) if s.array else parametric_rays(s) if s.parametric else None
+        if rays is None:
             world._warn(
                 "runner-sensor",
-                f"{s.identifier}: only proximity sensors with an `array` of rays are played; skipped",
+                f"{s.identifier}: only proximity sensors with an `array` or a `parametric` fan of rays "
+                "are played; skipped",
                 s,
             )
             continue
         parent = resolve_parent(world, s.parent, ns, s, body_type, known)
         if parent is None:
             continue
-        rng = s.range if s.range is not None else DEFAULT_SENSOR_RANGE
-        starts = np.array([r.offset or (0, 0, 0) for r in s.array], dtype=float)
-        dirs = np.array([r.direction or (1, 0, 0) for r in s.array], dtype=float)
         loc = pose_to_matrix(pose_or_identity(s.location))
-        out.append(SensorRays(key_of(ns, s), s, parent, loc, starts, starts + dirs * rng))
+        out.append(SensorRays(key_of(ns, s), s, parent, loc, *rays))
     return out
+
+
+def array_rays(s) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and ends, in the sensor frame, of an `array` of rays (§11.1)."""
+    rng = s.range if s.range is not None else DEFAULT_SENSOR_RANGE
+    starts = np.array([r.offset or (0, 0, 0) for r in s.array], dtype=float)
+    dirs = np.array([r.direction or (1, 0, 0) for r in s.array], dtype=float)
+    return starts, starts + dirs * rng
+
+
+def parametric_rays(s) -> tuple[np.ndarray, np.ndarray] | None:
+    """Starts and ends of a `parametric` fan as AMBF's loader makes them
+    (ADFLoader_1_0::loadRayTracerSensorAttribs): resolution² rays around +X, ray (i, j) turned by
+    Rz(h_i)·Ry(v_j), h and v spanning the horizontal and vertical angles, starting `start offset`
+    along it; AMBF puts them through the sensor's `location` already and places the sensor at its
+    location again, so the rays are returned in the location's frame (the location twice, as
+    AMBF has it). None where AMBF refuses the fan (a key missing, resolution below 2)."""
+    p = s.parametric
+    keys = (p.resolution, p.horizontal_angle, p.vertical_angle, p.start_offset)
+    if any(k is None for k in keys) or p.resolution < 2:
+        return None
+    n, hs, vs, off = int(p.resolution), float(p.horizontal_angle), float(p.vertical_angle), float(p.start_offset)
+    rng = s.range if s.range is not None else DEFAULT_SENSOR_RANGE
+    loc = pose_to_matrix(pose_or_identity(s.location))
+    h = -hs / 2 + np.arange(n) * hs / (n - 1)
+    v = -vs / 2 + np.arange(n) * vs / (n - 1)
+    hh, vv = np.meshgrid(h, v, indexing="ij")  # ray index n·i + j: h_i, v_j
+    turned = np.stack([np.cos(hh) * np.cos(vv), np.sin(hh) * np.cos(vv), -np.sin(vv)], axis=-1).reshape(-1, 3)
+    starts = turned * off @ loc[:3, :3].T + loc[:3, 3]
+    dirs = turned @ loc[:3, :3].T
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    return starts, starts + dirs * rng
 
 
 def played_actuators(world, m, body_type=None, known=None) -> list[Grasper]:
