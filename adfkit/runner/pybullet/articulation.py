@@ -182,6 +182,10 @@ def build(root, records, shapes_for, dt: float, cid: int, self_collision: bool) 
     world = root.body_world_matrix
     bpos, born = matrix_to_pq(world @ root.ref_in_body)
     flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT if self_collision else 0
+    if self_collision and any(r[0].ignore_inter_collision is False for r in records):
+        # a joint whose bodies AMBF lets collide (`ignore inter-collision: false`): links meet
+        # their parents, and every other joint's pair is filtered out (assemble._collision_filters)
+        flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_INCLUDE_PARENT
     uid = pb.createMultiBody(
         root.mass,
         bcol,
