@@ -281,7 +281,7 @@ class JointCommands:
         chain's bodies (``chain_velocities``) and these rows drive every joint of it, the impulses
         that take the joints where its ten iterations leave them; otherwise settled together
         (``soft_row_impulses``). Each joint is pushed with its impulse over the control step,
-        within its motor's force."""
+        within its motor's force where the rows are settled here."""
         w = self.world
         art = rows[0][0].art
         idx = [dj.index for dj, _ in rows]
@@ -303,8 +303,11 @@ class JointCommands:
                 mobility, [dj.row_mass for dj, _ in rows], [dj.cfm for dj, _ in rows], [t for _, t in rows], free
             )
         cdt = w.dt * w.opt.control_substeps
-        cap = np.array([dj.max_force * cdt for dj, _ in rows])  # the motor's `max motor impulse`
-        impulse = np.clip(impulse, -cap, cap)
+        if after is None:  # the rows settled here: each within its motor's `max motor impulse`
+            cap = np.array([dj.max_force * cdt for dj, _ in rows])
+            impulse = np.clip(impulse, -cap, cap)
+        # (the chain step's rows hold each motor within it already; the push that carries the
+        # articulation where its bodies went carries what the chain's other rows gave them too)
         for (dj, _t), lam in zip(rows, impulse):
             w.joint_effort(art, dj.index, float(lam) / cdt)
         self._rows[id(art)] = (idx, mobility, impulse, v)
