@@ -1169,22 +1169,22 @@ def test_the_psms_tool_turns_under_efforts_as_in_ambf(tmp_path, monkeypatch):
 
 @pytest.mark.slow
 @needs_ambf
-def test_a_chains_motor_rows_settle_as_ambfs_do_given_iterations(tmp_path, monkeypatch):
-    """The KUKA's and the PSM's velocity programs against AMBF with 100 solver iterations, where
-    its rows settle: the runner's rows, settled together, are within 0.1 mm of it (measured
-    0.08 and 0.05 mm; one row at a time the KUKA was 15 mm off, its shoulder 0.268 rad/s where
-    AMBF's is 0.246, its elbow 0.235 against 0.249). Control: AMBF as it plays, at 10
-    iterations, which leave the KUKA's rows unsettled (3.5 mm)."""
+def test_a_chains_motor_rows_are_left_unsettled_as_ambfs_ten_iterations_leave_them(tmp_path, monkeypatch):
+    """The KUKA's and the PSM's velocity programs against AMBF as it plays, its ten solver
+    iterations leaving the chain's motor, locking and limit rows unsettled: the runner's chain
+    step plays the same ten iterations and is within 0.5 mm of it (measured 0.14 and 0.09 mm).
+    Control: AMBF with 100 iterations, where its rows settle, is 3.5 and 7.8 mm from the same run:
+    the iterations are what the runner plays, not settled rows."""
     from conftest import CORPUS, require_corpus
 
     require_corpus()
     kuka = CORPUS / "ambf/ambf_models/descriptions/multi-bodies/robots/blender-kuka.yaml"
     psm = CORPUS / "src/ADF/PSMs/LND_400006_SIMPLE/psm1.yaml"
-    worst, _ = _program_gaps(kuka, "velocity", tmp_path, monkeypatch)
-    assert 2e-3 < worst < 5e-3
-    monkeypatch.setenv("ADFKIT_PARITY_SOLVER_ITERATIONS", "100")
     assert _program_gaps(kuka, "velocity", tmp_path, monkeypatch)[0] < 0.5e-3
     assert _program_gaps(psm, "velocity", tmp_path, monkeypatch)[0] < 0.5e-3
+    monkeypatch.setenv("ADFKIT_PARITY_SOLVER_ITERATIONS", "100")
+    assert _program_gaps(kuka, "velocity", tmp_path, monkeypatch)[0] > 2e-3
+    assert _program_gaps(psm, "velocity", tmp_path, monkeypatch)[0] > 2e-3
 
 
 @needs_ambf
