@@ -74,13 +74,7 @@ class Assembly:
             # model counts the bodies that may have it when compiled, so every body is one, then 0
             for b in spec.bodies[1:]:
                 b.gravcomp = 1.0
-        self.model = compile_spec(self, spec)
-        if ghost_gravity:
-            self.model.body_gravcomp[:] = 0.0
-        self.model.opt.jacobian = jacobian_for(self.model)
-        self.model.opt.integrator = integrator_for(self.model)
-        self.data = mujoco.MjData(self.model)
-        mujoco.mj_forward(self.model, self.data)
+        self._compile(spec, ghost_gravity)
         bullet = self.opt.bodies == "ambf" and self.soft is None  # Bullet's frictions (contacts.py)
         own = bullet_pairs(spec, self.model, self.model.geom_group == GHOST_GROUP) if bullet else []
         self.ground_z = None
@@ -98,23 +92,10 @@ class Assembly:
             )
             if bullet:
                 ground_pairs(spec, floor, self.model, ALL_GROUPS)
+        if self.ground_z is not None or own:  # the floor, the frictions and pairs compiled in
             for g, fr, prio in own:
                 g.friction, g.priority = fr, prio
-            self.model = compile_spec(self, spec)
-            if ghost_gravity:
-                self.model.body_gravcomp[:] = 0.0
-            self.data = mujoco.MjData(self.model)
-            mujoco.mj_forward(self.model, self.data)
-        elif own:  # the frictions and pairs compiled in, the algebra and integrator chosen as above
-            for g, fr, prio in own:
-                g.friction, g.priority = fr, prio
-            self.model = compile_spec(self, spec)
-            if ghost_gravity:
-                self.model.body_gravcomp[:] = 0.0
-            self.model.opt.jacobian = jacobian_for(self.model)
-            self.model.opt.integrator = integrator_for(self.model)
-            self.data = mujoco.MjData(self.model)
-            mujoco.mj_forward(self.model, self.data)
+            self._compile(spec, ghost_gravity)
         self._plan = plan
         if self.soft is not None:
             self.soft.bind(spec)
@@ -242,6 +223,18 @@ class Assembly:
             hull, other = (a, b) if mesh[0] and (not mesh[1] or b.static) else (b, a)
             pairs[(hull, other)] = max(pairs.get((hull, other), 0.0), -float(c.dist))
         hull_overlaps(self, pairs, "MuJoCo")
+
+    def _compile(self, spec, ghost_gravity: bool) -> None:
+        """``spec`` compiled into the world's model and data: the gravity compensation the ghosts
+        may switch on back to 0 (see above), the algebra and the integrator chosen for the model
+        (jacobian_for, integrator_for), the poses worked out."""
+        self.model = compile_spec(self, spec)
+        if ghost_gravity:
+            self.model.body_gravcomp[:] = 0.0
+        self.model.opt.jacobian = jacobian_for(self.model)
+        self.model.opt.integrator = integrator_for(self.model)
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
 
     def _lowest_point(self) -> float:
         m = self.model
