@@ -6,6 +6,8 @@ Bullet plays them (Options.springs="ambf"), explicit with Bullet's caps at every
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import numpy as np
 import pytest
 
@@ -267,18 +269,27 @@ JOINT anchor-bob:
 """
 
 
-def _bob_after(tmp_path, seconds: float) -> np.ndarray:
+@contextmanager
+def _ambf_world(tmp_path, text: str, ground: bool):
+    """A world of the model ``text`` under the options `adfkit run` and `adfkit parity` play
+    (AMBF's springs, bodies and link shapes), closed after."""
     from adfkit.adf import load_scene
     from adfkit.runner import Options, open_world
 
-    (tmp_path / "bob.yaml").write_text(BOB_ON_A_SPRING)
-    opt = Options(visuals=False, springs="ambf", bodies="ambf", link_shapes="body", ground=True)
-    w = open_world(load_scene(tmp_path / "bob.yaml"), opt)
+    path = tmp_path / "model.yaml"
+    path.write_text(text)
+    opt = Options(visuals=False, springs="ambf", bodies="ambf", link_shapes="body", ground=ground)
+    w = open_world(load_scene(path), opt)
     try:
-        w.run(seconds)
-        return np.asarray(w.body("bob").com_position())
+        yield w
     finally:
         w.close()
+
+
+def _bob_after(tmp_path, seconds: float) -> np.ndarray:
+    with _ambf_world(tmp_path, BOB_ON_A_SPRING, ground=True) as w:
+        w.run(seconds)
+        return np.asarray(w.body("bob").com_position())
 
 
 def test_a_bob_on_a_six_dof_spring_rests_on_the_floor_under_it(tmp_path, monkeypatch):
@@ -354,22 +365,14 @@ def test_a_swinging_bobs_pivot_stays_on_its_slide(tmp_path):
     mass instead, the rows took the swing's motion for the pivot's and let the pivot wander 2.0 mm
     sideways in the first second, the bob 1.7 mm and 0.9° from AMBF's; now 0.18 mm (adfkit parity
     on the parity scene's pendulums: 0.17 mm and 0.10°)."""
-    from adfkit.adf import load_scene
-    from adfkit.runner import Options, open_world
-
-    (tmp_path / "swing.yaml").write_text(SWING_ON_A_SLIDE)
-    opt = Options(visuals=False, springs="ambf", bodies="ambf", link_shapes="body", ground=False)
-    w = open_world(load_scene(tmp_path / "swing.yaml"), opt)
-    try:
-        sideways, lowest = 0.0, 1.0
+    sideways, lowest = 0.0, 1.0
+    with _ambf_world(tmp_path, SWING_ON_A_SLIDE, ground=False) as w:
         for _ in range(250):
             w.step(1)
             m = w.body("bob").world_matrix()
             pivot = m[:3, :3] @ np.array([0.0, 0.0, 0.1]) + m[:3, 3]
             sideways = max(sideways, float(np.hypot(pivot[0], pivot[1])))
             lowest = min(lowest, float(pivot[2]))
-    finally:
-        w.close()
     assert lowest == pytest.approx(0.98, abs=2e-4)  # it swings down onto its slide's lower limit
     assert sideways < 3e-4
 
@@ -413,15 +416,7 @@ def test_a_linear_spring_lifts_its_block_off_the_limit_it_fell_onto(tmp_path):
     joint away from its limit; the runner plays it with the joint's velocity motor, which holds
     both ways, so it now lets go of a joint it held back the step before. Control: held, the block
     stayed on the limit (0.87 mm from AMBF's at the end)."""
-    from adfkit.adf import load_scene
-    from adfkit.runner import Options, open_world
-
-    (tmp_path / "spring.yaml").write_text(SPRING_ON_ITS_LIMIT)
-    opt = Options(visuals=False, springs="ambf", bodies="ambf", link_shapes="body", ground=False)
-    w = open_world(load_scene(tmp_path / "spring.yaml"), opt)
-    try:
+    with _ambf_world(tmp_path, SPRING_ON_ITS_LIMIT, ground=False) as w:
         w.run(3.0)
         z = w.body("block").world_matrix()[2, 3]
-    finally:
-        w.close()
     assert z == pytest.approx(0.5 - 0.2 * 9.81 / 40.0, abs=1e-4)
