@@ -420,3 +420,18 @@ def test_a_linear_spring_lifts_its_block_off_the_limit_it_fell_onto(tmp_path):
         w.run(3.0)
         z = w.body("block").world_matrix()[2, 3]
     assert z == pytest.approx(0.5 - 0.2 * 9.81 / 40.0, abs=1e-4)
+
+
+def test_a_bob_pulled_hard_falls_onto_its_springs_limit_and_stays(tmp_path):
+    """A 1 g bob on a six-dof spring (AMBF's default ±1.2 m on every axis) pulled down by 10^11 g:
+    AMBF's limit rows let it fall to its -1.2 m limit (at each step at most 0.2 of the gap, the
+    crossing tested with the velocity before the step's pull) and hold it there: 0.003 mm from
+    AMBF over 0.3 s (adfkit parity). Tested with the velocity after the pull, the rows stopped it
+    where it hung (1.2 m from AMBF's); without rows inside the range it was flung (8e7 m/s)."""
+    import test_stability
+
+    text = test_stability.SCENE.replace("GZ", "-1.0e12")
+    with _ambf_world(tmp_path, text, ground=False) as w:
+        w.run(0.1)
+        z = w.body("bob").world_matrix()[2, 3]
+    assert z == pytest.approx(0.5 - 1.2, abs=1e-4)

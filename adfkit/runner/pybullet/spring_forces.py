@@ -299,7 +299,7 @@ class SpringSet:
             dt,
             erp,
             self.ang_active,
-            self.ang_ranged,
+            (self.ang_ranged, w_rel),
         )
         torque = self.net @ (ra @ tau[:, :, None])[..., 0]
         force = None
@@ -335,7 +335,7 @@ class SpringSet:
                 dt,
                 erp,
                 self.fl_active,
-                self.fl_ranged,
+                (self.fl_ranged, v_rel),
             )
             f_w = (ra[fl] @ f[:, :, None])[..., 0]
             force = self.fl_net @ f_w
@@ -370,31 +370,30 @@ class SpringSet:
 
     @staticmethod
     def _limit(x, v, low, high, inertia, dt, erp, active=None, ranged=None):
-        """Velocity-correcting force that keeps x within [low, high] (low > high: free, Bullet):
-        it drives a violation back at -erp·err/dt and only ever pushes, never pulls. ``v`` may be
-        a callable giving it, called only where it is needed. ``ranged`` (the axes whose range is
-        open, or None): AMBF's limit rows there (btGeneric6DofSpring2Constraint's, there whenever
-        low < high, limit_rows.spring_row_velocity): inside, a joint moves toward a limit at a gap g
-        at most erp·g/dt, and not at all where it would cross it within the step."""
+        """Velocity-correcting force that keeps x within [low, high] (low > high: free, Bullet): it
+        drives a violation back at -erp·err/dt and only ever pushes. ``v`` (the velocity at the end
+        of the step, the step's forces in) may be a callable giving it. ``ranged``: (the axes whose
+        range is open, the velocity before the step) or None: AMBF's limit rows there (there while
+        low < high: limit_rows.spring_row_velocity): a joint moves toward a limit at a gap g at most
+        erp·g/dt, and not at all where it came in fast enough to cross it within the step."""
         active = low <= high if active is None else active
-        over = active & (x > high)
-        under = active & (x < low)
-        if ranged is not None:  # the rows act only where x + v·dt/erp would leave the range
+        over, under, rows = active & (x > high), active & (x < low), None
+        if ranged is not None and ranged[0] is not None:  # rows act where x + v·dt/erp leaves the range
+            rows, v0 = ranged
             v = v() if callable(v) else v
             ahead = x + v * (dt / erp)
-            if not np.count_nonzero(ranged & ((ahead < low) | (ahead > high))):
-                ranged = None
-        if not (np.count_nonzero(over) or np.count_nonzero(under)) and ranged is None:  # a third of .any()'s
+            rows = rows if np.count_nonzero(rows & ((ahead < low) | (ahead > high))) else None
+        if not (np.count_nonzero(over) or np.count_nonzero(under)) and rows is None:  # a third of .any()'s
             return 0.0
         if callable(v):
             v = v()
         err = np.where(over, x - high, np.where(under, x - low, 0.0))
         f = inertia * (-erp * err / dt - v) / dt
         out = np.where(over, np.minimum(f, 0.0), np.where(under, np.maximum(f, 0.0), 0.0))
-        if ranged is None:
+        if rows is None:
             return out
-        gap_lo, gap_hi = x - low, high - x
-        slowest = np.where((gap_lo > 0.0) & (-v * dt > gap_lo), 0.0, -erp * gap_lo / dt)
-        fastest = np.where((gap_hi > 0.0) & (v * dt > gap_hi), 0.0, erp * gap_hi / dt)
+        gap_lo, gap_hi = x - low, high - x  # Bullet tests the crossing with the velocity before the step
+        slowest = np.where((gap_lo > 0.0) & (-v0 * dt > gap_lo), 0.0, -erp * gap_lo / dt)
+        fastest = np.where((gap_hi > 0.0) & (v0 * dt > gap_hi), 0.0, erp * gap_hi / dt)
         pushes = np.maximum(inertia * (slowest - v) / dt, 0.0) + np.minimum(inertia * (fastest - v) / dt, 0.0)
-        return np.where(ranged & active, pushes, out)
+        return np.where(rows & active, pushes, out)
