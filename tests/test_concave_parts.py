@@ -174,3 +174,17 @@ def test_both_engines_and_both_writers_make_the_same_parts(tmp_path):
                 assert len(pb.getCollisionShapeData(uid, -1, physicsClientId=cid)) == n
             finally:
                 pb.disconnect(cid)
+
+
+def test_parts_files_are_their_own_when_an_id_comes_back(monkeypatch):
+    """The OBJ of a body's convex parts is remembered by the parts' id: an id Python hands out
+    again to new parts once the old ones are gone (the tests that swap _DONE out free theirs)
+    gives the new parts a file of their own, not the old parts' (which a PyBullet world took as the
+    body's collision shape). Stood in by an entry under the new parts' id."""
+    box = trimesh.creation.box((0.01, 0.01, 0.01))
+    ball = trimesh.creation.icosphere(radius=0.02)
+    old = concave.ConvexParts([box], 1.0, 0, 0.0)
+    new = concave.ConvexParts([ball], 1.0, 0, 0.0)
+    monkeypatch.setattr(concave, "_FILES", {id(new): (old, concave.parts_obj(old))})
+    mine = trimesh.load(concave.parts_obj(new), force="mesh")
+    assert mine.extents == pytest.approx([0.04, 0.04, 0.04], rel=0.05)  # the ball's, not the box's 0.01

@@ -187,7 +187,9 @@ def _within(parts: list[trimesh.Trimesh], hull: trimesh.Trimesh) -> list[trimesh
     return out
 
 
-_FILES: dict[int, Path] = {}
+# by the parts' id, each kept with its parts: a dead object's id, reused by a new one, found
+# the other's file (the tests that swap _DONE out free theirs)
+_FILES: dict[int, tuple[ConvexParts, Path]] = {}
 
 
 def parts_obj(parts: ConvexParts) -> Path:
@@ -195,13 +197,15 @@ def parts_obj(parts: ConvexParts) -> Path:
     hull of each OBJ object; the MJCF and URDF writers split it into a file per part)."""
     from .decompose import hulls_obj_text
 
-    made = _FILES.get(id(parts))
+    kept = _FILES.get(id(parts))
+    made = kept[1] if kept is not None and kept[0] is parts else None
     if made is None or not made.exists():
         text, _ = hulls_obj_text(parts.hulls, "", prefix="part")
         fd, name = tempfile.mkstemp(prefix="parts_", suffix=".obj", dir=scratch.scratch_dir())
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write("\n".join(ln for ln in text.splitlines() if not ln.startswith(("mtllib", "usemtl"))) + "\n")
-        made = _FILES[id(parts)] = Path(name)
+        made = Path(name)
+        _FILES[id(parts)] = (parts, made)
     return made
 
 
