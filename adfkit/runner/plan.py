@@ -40,7 +40,7 @@ ALL_GROUPS = (1 << 31) - 1
 
 #: sections of a model each engine does not play (each is warned about and listed in the report)
 NOT_PLAYED = {
-    "pybullet": (("vehicle", "vehicles"),),
+    "pybullet": (),
     "mujoco": (("vehicle", "vehicles"),),
 }
 

@@ -40,6 +40,7 @@ from .loops import close_loops
 from .meshfiles import pybullet_reads_quietly
 from .shapes import collision_parts, create_collision, create_visual
 from .spring_forces import SpringSet
+from .vehicles import PyBulletVehicles
 from .volumes import build_volumes
 
 
@@ -155,6 +156,7 @@ class Assembly:
             self._build_ghosts(m)
             self._build_actuators(m, known)
             self._build_sensors(m, known)
+        self.vehicles = PyBulletVehicles(self, models)
         self.cameras = build_cameras(self)
         self._floor_z = self._floor()
         self.ground_z = None

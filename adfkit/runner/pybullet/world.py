@@ -87,7 +87,8 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         self._ghost_steps = GhostSteps(self) if acting else None
         if self._ghost_steps is not None and not self._ghost_steps.free:
             self._ghost_steps = None
-        if self._springs_every_step or self._ghost_steps is not None:
+        self._each_step = self._springs_every_step or self._ghost_steps is not None or bool(self.vehicles)
+        if self._each_step:
             pb.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSubSteps=1, physicsClientId=self.cid)
             held.record(self.cid)
 
@@ -212,18 +213,27 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
         t0 = time.perf_counter()
         sub = self.opt.control_substeps
+        veh = self.vehicles or None  # AMBF's vehicles act after each physics step (vehicles.py)
         for _ in range(n):
             self.control()
+            if veh is not None:
+                veh.push()
             pb.stepSimulation(physicsClientId=self.cid)
+            if veh is not None:
+                veh.update(self.dt)
             fine = self._ghost_steps is not None and self._ghost_steps.fine
-            if self._springs_every_step or self._ghost_steps is not None:
-                for _ in range(sub - 1):  # the springs and ghosts again at each physics step, the rest held
+            if self._each_step:
+                for _ in range(sub - 1):  # the springs, ghosts, vehicles again at each physics step, the rest held
                     held.replay(self.cid)
                     if fine:
                         self._ghost_steps.between()
                     if self._springs_every_step:
                         self.springs.apply(self.dt)
+                    if veh is not None:
+                        veh.push()
                     pb.stepSimulation(physicsClientId=self.cid)
+                    if veh is not None:
+                        veh.update(self.dt)
                 held.clear(self.cid)
         self.steps += n * sub
         self.sim_time = self.steps * self.dt
