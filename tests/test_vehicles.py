@@ -1,7 +1,7 @@
-"""AMBF's vehicles (adf-format.md §11.3): Bullet's raycast vehicle, played by the PyBullet runner
+"""AMBF's vehicles (adf-format.md §11.3): Bullet's raycast vehicle, played by both engines
 (runner/vehicles.py). Before, the runner skipped them: a 10 kg chassis on four raycast wheels
 fell onto the floor where AMBF's stood on its suspension (`adfkit parity` on a hand-made car:
-379 mm apart; now 0.006 mm)."""
+379 mm apart; now 0.006 mm in PyBullet, 0.013 mm in MuJoCo)."""
 
 from __future__ import annotations
 
@@ -103,11 +103,11 @@ def _scene(tmp_path, friction=10.0, slope_r=0.0, slope_p=0.0, same_file=False):
     return launch
 
 
-def _play(launch, seconds):
+def _play(launch, seconds, engine="pybullet"):
     from adfkit.adf import load_scene
     from adfkit.runner import Options, open_world
 
-    world = open_world(load_scene(launch), Options(visuals=False), engine="pybullet")
+    world = open_world(load_scene(launch), Options(visuals=False), engine=engine)
     try:
         start = {b.name: np.array(b.world_matrix()) for b in world.bodies}
         world.run(seconds)
@@ -119,21 +119,23 @@ def _play(launch, seconds):
     return start, end, made, said
 
 
-def test_a_car_stands_on_its_suspension_and_its_wheel_bodies_are_static(tmp_path):
-    start, end, made, _ = _play(_scene(tmp_path), 2.0)
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_car_stands_on_its_suspension_and_its_wheel_bodies_are_static(tmp_path, engine):
+    start, end, made, _ = _play(_scene(tmp_path), 2.0, engine)
     assert made == 1
     assert end["Chassis"][2, 3] == pytest.approx(SETTLED_Z, abs=5e-4)  # 0.4774 m
     for i in range(1, 5):  # AMBF makes each wheel's body static where it stands
         assert np.array_equal(end[f"Wheel{i}"], start[f"Wheel{i}"])
 
 
-def test_the_wheels_grip_sideways_and_roll_forward(tmp_path):
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_the_wheels_grip_sideways_and_roll_forward(tmp_path, engine):
     """On a floor tilted 0.1 rad about the car's forward axis the wheels' side friction holds the
     car; with no grip (friction 0) it slides downhill. Tilted about its sideways axis it rolls
     downhill: a wheel without a brake rolls freely (Bullet's rolling impulse is 0)."""
-    sideways = _play(_scene(tmp_path / "a", slope_r=0.1), 1.0)[1]["Chassis"][:3, 3]
-    slipping = _play(_scene(tmp_path / "b", friction=0.0, slope_r=0.1), 1.0)[1]["Chassis"][:3, 3]
-    rolling = _play(_scene(tmp_path / "c", slope_p=0.1), 1.0)[1]["Chassis"][:3, 3]
+    sideways = _play(_scene(tmp_path / "a", slope_r=0.1), 1.0, engine)[1]["Chassis"][:3, 3]
+    slipping = _play(_scene(tmp_path / "b", friction=0.0, slope_r=0.1), 1.0, engine)[1]["Chassis"][:3, 3]
+    rolling = _play(_scene(tmp_path / "c", slope_p=0.1), 1.0, engine)[1]["Chassis"][:3, 3]
     assert abs(sideways[1]) < 0.01  # held: about 3 mm of creep as it lands
     assert slipping[1] < -0.1  # downhill is -y for a roll of +0.1
     assert rolling[0] > 0.1  # downhill is +x for a pitch of +0.1
@@ -153,8 +155,7 @@ def test_a_vehicle_in_its_chassis_s_own_file_is_not_made(tmp_path):
 def test_a_car_lands_on_its_suspension_as_in_ambf(tmp_path, capsys, slope):
     launch = _scene(tmp_path, slope_r=slope)
     capsys.readouterr()
-    main(["parity", str(launch), "--seconds", "2.0", "--engine", "pybullet", "--json"])
-    doc = json.loads(capsys.readouterr().out)
-    doc = doc[0] if isinstance(doc, list) else doc
-    chassis = next(b for b in doc["bodies"] if b["name"].endswith("/Chassis"))
-    assert chassis["max_position_gap_m"] < 1e-4 and chassis["max_angle_gap_deg"] < 0.01
+    main(["parity", str(launch), "--seconds", "2.0", "--engine", "both", "--json"])
+    for doc in json.loads(capsys.readouterr().out):
+        chassis = next(b for b in doc["bodies"] if b["name"].endswith("/Chassis"))
+        assert chassis["max_position_gap_m"] < 1e-4 and chassis["max_angle_gap_deg"] < 0.01, doc["engine"]

@@ -39,10 +39,7 @@ SPRING_KINDS = (
 ALL_GROUPS = (1 << 31) - 1
 
 #: sections of a model each engine does not play (each is warned about and listed in the report)
-NOT_PLAYED = {
-    "pybullet": (),
-    "mujoco": (("vehicle", "vehicles"),),
-}
+NOT_PLAYED: dict[str, tuple] = {"pybullet": (), "mujoco": ()}
 
 
 def world_gravity(scene, opt) -> np.ndarray:

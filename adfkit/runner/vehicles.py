@@ -87,17 +87,18 @@ class RaycastVehicle:
         for w in wheels:
             w.suspension_length = w.rest_length
 
-    def update(self, dt: float, pos, quat, v, w, cast) -> tuple[np.ndarray, np.ndarray] | None:
+    def update(self, dt: float, pos, quat, v, w, cast, inv_i=None) -> tuple[np.ndarray, np.ndarray] | None:
         """btRaycastVehicle::updateVehicle after a physics step of ``dt``: the chassis COM at
         ``pos`` turned by ``quat`` (x, y, z, w) moving at ``v``, ``w``; ``cast(froms, tos)`` gives a
-        RayHit or None per ray (the closest body with contact response). Returns the force and the
+        RayHit or None per ray (the closest body with contact response); ``inv_i``, the chassis's
+        inverse inertia in the world (default: the principal one turned by ``quat``). Returns the force and the
         torque about the COM that give the chassis the step's impulses over the next physics step,
         or None when the chassis cannot take impulses (static)."""
         if self.inv_mass == 0.0 or not self.wheels:
             return None
         com = np.asarray(pos, dtype=float)
         rot = quat_to_matrix(quat)
-        inv_i = rot @ np.diag(self.inv_inertia) @ rot.T
+        inv_i = rot @ np.diag(self.inv_inertia) @ rot.T if inv_i is None else inv_i
         lin, ang = np.array(v, dtype=float), np.array(w, dtype=float)
         total_j, total_t = np.zeros(3), np.zeros(3)
 
@@ -216,7 +217,7 @@ def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
     return v * math.cos(angle) + cross3(k, v) * math.sin(angle) + k * float(k @ v) * (1 - math.cos(angle))
 
 
-def planned(world, models) -> list[tuple]:
+def planned(world, models, bodies_of, warn: bool = True) -> list[tuple]:
     """Each vehicle AMBF makes, as ``(key, vehicle, chassis, wheel bodies, RaycastWheels)``: its
     chassis and its wheels' bodies found by AMBF's lookup among the bodies of the models loaded
     before its own (adf-format.md §12.2: a vehicle cannot use bodies of its own file), with a
@@ -228,6 +229,7 @@ def planned(world, models) -> list[tuple]:
 
     known = None
     out = []
+    say = world._warn if warn else (lambda *a, **k: None)
     for m in models:
         ns = m.namespace or ""
         for veh in m.vehicles:
@@ -235,20 +237,19 @@ def planned(world, models) -> list[tuple]:
             found = (known.find(veh.chassis) if known is not None else (None, []))[0]
             chassis = known.items[found] if found is not None else None
             if chassis is None:
-                world._warn(
+                say(
                     "runner-vehicle",
                     f"{veh.identifier}: chassis {veh.chassis!r} is not a body of a model loaded before this one; "
                     "AMBF makes no vehicle",
                     veh,
                     "list the chassis's model before the vehicle's in the launch file",
                 )
-                world.not_played.append(
-                    {"object": veh.identifier, "what": "vehicle", "why": "its chassis is not found"}
-                )
+                if warn:
+                    world.not_played.append({"object": veh.identifier, "what": "vehicle", "why": "no chassis"})
                 continue
             bodies, wheels = [], []
             for i, wd in enumerate(veh.wheels or []):
-                wheel = _wheel(world, veh, i, wd, chassis.com_in_body)
+                wheel = _wheel(say, veh, i, wd, _com_in_body(chassis))
                 if wheel is None:
                     continue
                 body = None
@@ -256,7 +257,7 @@ def planned(world, models) -> list[tuple]:
                     hit = known.find(wd.body)[0]
                     body = known.items[hit] if hit is not None else None
                     if body is None:
-                        world._warn(
+                        say(
                             "runner-vehicle-wheel",
                             f"{veh.identifier}: wheel {i + 1}'s body {wd.body!r} is not found; its ray is kept",
                             veh,
@@ -264,15 +265,24 @@ def planned(world, models) -> list[tuple]:
                 bodies.append(body)
                 wheels.append(wheel)
             out.append((key, veh, chassis, bodies, wheels))
-        known = loaded_so_far(known, world._model_bodies.get(id(m), []))
+        known = loaded_so_far(known, bodies_of(m))
     return out
 
 
-def _wheel(world, veh, i: int, wd, com_in_body: np.ndarray) -> RaycastWheel | None:
+def _com_in_body(body) -> np.ndarray:
+    """An engine body's COM frame in its body frame (a MuJoCo plan's body: its file's, §7.2)."""
+    com = getattr(body, "com_in_body", None)
+    if com is not None:
+        return com
+    from ..model.semantics import inertial_offset
+    from .rotations import pose_to_matrix
+
+    return pose_to_matrix(inertial_offset(body.body))
+
+
+def _wheel(say, veh, i: int, wd, com_in_body: np.ndarray) -> RaycastWheel | None:
     if wd.body is None and wd.mesh is None:
-        world._warn(
-            "runner-vehicle-wheel", f"{veh.identifier}: wheel {i + 1} has neither body nor mesh; AMBF skips it", veh
-        )
+        say("runner-vehicle-wheel", f"{veh.identifier}: wheel {i + 1} has neither body nor mesh; AMBF skips it", veh)
         return None
     s = wd.suspension
     need = {
@@ -286,7 +296,7 @@ def _wheel(world, veh, i: int, wd, com_in_body: np.ndarray) -> RaycastWheel | No
     }
     missing = [k for k, v in need.items() if v is None]
     if missing:
-        world._warn(
+        say(
             "runner-vehicle-wheel",
             f"{veh.identifier}: wheel {i + 1} lacks {', '.join(missing)} (AMBF reads it unset); the wheel is left out",
             veh,

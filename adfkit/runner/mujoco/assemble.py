@@ -23,6 +23,7 @@ from .limits import ambf_limits
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
 from .start import six_dof_start
+from .vehicles import MujocoVehicles, weld_wheels
 
 SOLVER_TOLERANCE = 1e-6
 WAKE_FORCE = 1e-12  # N
@@ -35,6 +36,7 @@ SPRING_LIMIT = 0.25  # k ≤ SPRING_LIMIT·M_ii/dt²: the PyBullet runner's clam
 class Assembly:
     def _build(self) -> None:
         plan = build_plan(self)
+        weld_wheels(self, plan)  # AMBF's vehicles' wheel bodies are static (vehicles.py)
         spec = plan.spec
         spec.option.timestep = self.dt
         spec.option.gravity = self.gravity
@@ -172,6 +174,7 @@ class Assembly:
         self._ray_groups = np.array([1, 0, 1, 1, 0, 0], dtype=np.uint8)
         self._ray_hit = np.zeros(1, dtype=np.int32)
         self._body_of_id = {sb.id: sb for sb in self.bodies}
+        self.vehicles = MujocoVehicles(self)
         self.constraints = [
             (j.identifier, None, by_plan[id(p)], by_plan[id(c)], pa, pb_, None) for j, kind, p, c, pa, pb_ in plan.loops
         ]

@@ -234,16 +234,26 @@ class MujocoWorld(Assembly, Interaction, World):
         kinematics = mujoco.mj_kinematics
         pending = mj_stability.pending_messages()
         limits = self.drive_limits.check
+        veh = self.vehicles or None  # AMBF's vehicles act after each physics step (vehicles.py)
         for k in range(n):
             control()
             fine = self._ghost_steps
-            if fine is not None and fine.ghosts:  # AMBF's ghosts at every physics step (ghost_steps.py)
+            fine = fine if fine is not None and fine.ghosts else None  # AMBF's ghosts at every physics step
+            if fine is not None or veh is not None:
                 for i in range(sub):
+                    if veh is not None:
+                        veh.push()
                     step(m, d, 1)
-                    if i < sub - 1:
+                    if veh is not None:
+                        veh.pull()
                         kinematics(m, d)
+                        veh.update(self.dt)
+                    if i < sub - 1 and fine is not None:
+                        if veh is None:
+                            kinematics(m, d)
                         fine.between()
-                fine.end()
+                if fine is not None:
+                    fine.end()
             else:
                 step(m, d, sub)
             # mj_step computes the poses (xpos, xquat, geom_xpos) before it integrates: without

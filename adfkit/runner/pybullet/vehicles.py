@@ -18,7 +18,7 @@ class PyBulletVehicles:
         self.cid = world.cid
         self.vehicles: list[RaycastVehicle] = []
         self._pending: list[tuple] = []
-        for key, veh, chassis, bodies, wheels in planned(world, models):
+        for key, veh, chassis, bodies, wheels in planned(world, models, lambda m: world._model_bodies.get(id(m), [])):
             for b in bodies:
                 if b is None or b.static:
                     continue
