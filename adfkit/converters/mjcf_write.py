@@ -59,6 +59,8 @@ MAX_BODY_DEPTH = 496
 # Moving bodies need mass and inertia above MuJoCo's mjMINVAL; massless ADF links get this.
 MIN_MASS = 1e-6
 MIN_INERTIA = 1e-9
+#: m along a hinge's axis to the second point of the two connects that close it to a static body
+HINGE_LEVER = 0.1
 #: joints closing a loop that MJCF can write: an equality (a weld, or a connect at the pivot)
 LOOP_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P, JointKind.TORSION_SPRING)
 
@@ -399,7 +401,7 @@ def to_mjcf(
     model = usable_scales(model, losses)
     # a loop is closed at a point (connect) or welded: a slide closing one would be locked
     kinds = tree_kinds if tree_kinds is not None else (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)
-    tree = build_tree(model, kinds, True, breadth_first)
+    tree = build_tree(model, kinds, True, breadth_first, static_roots=True)
     has_volume = volumes and any(v.defined for v in model.volumes)
     if not tree.roots and not any(sb.defined for sb in model.soft_bodies) and not has_volume:
         raise AdfError(
@@ -463,6 +465,19 @@ def to_mjcf(
             )
             if tag == "connect":
                 e.set("anchor", _vec(anchor))
+            if kind is JointKind.REVOLUTE and (effective_mass(parent) == 0.0 or effective_mass(child) == 0.0):
+                # a hinge to a static body (one the tree keeps a root: static_roots): a second point
+                # on its axis makes the two connects a hinge
+                axis_point = pl.in_link(a).transform(Vec3(0.0, 0.0, HINGE_LEVER))
+                e2 = ET.SubElement(
+                    eq,
+                    "connect",
+                    name=_unique(_joint_name(j) + "_axis", used["equality"]),
+                    body1=names[id(pl)],
+                    body2=names[id(by_body[child.identifier])],
+                )
+                e2.set("anchor", _vec(axis_point))
+                continue
             if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.TORSION_SPRING):
                 spring = "; its limits and spring are not written" if kind is JointKind.TORSION_SPRING else ""
                 losses.append(

@@ -124,6 +124,7 @@ def build_tree(
     tree_kinds=(JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED),
     slides_first: bool = False,
     breadth_first: bool = False,
+    static_roots: bool = False,
 ) -> KinematicTree:
     """Spanning tree over the joints whose kind is in ``tree_kinds``.
 
@@ -134,7 +135,10 @@ def build_tree(
     the tree before a revolute one into it (left_for_last), for a format that closes a loop only
     at a point (MJCF's connect, which would lock a slide). ``breadth_first``: bodies reached
     nearest the root first (the PyBullet runner's multibodies: a loop is closed at the same joint
-    in both engines), else depth first."""
+    in both engines), else depth first. ``static_roots``: a static body is a root even where a
+    joint names it as its child (a format whose tree moves every body under its root: MJCF, where
+    the body would be carried by its dynamic parent; the joint then closes a loop to it, as the
+    PyBullet runner's constraint does)."""
     records, unresolved = [], []
     for j in model.joints:
         kind = joint_kind(j.type)
@@ -153,7 +157,10 @@ def build_tree(
     for r in records:
         if r[1] in tree_kinds:
             into[id(r[3])].append(r)
-    order = sorted(model.bodies, key=lambda b: (id(b) in is_child, effective_mass(b) != 0.0))
+    if static_roots:
+        order = sorted(model.bodies, key=lambda b: (effective_mass(b) != 0.0, id(b) in is_child))
+    else:
+        order = sorted(model.bodies, key=lambda b: (id(b) in is_child, effective_mass(b) != 0.0))
     links: dict[str, Link] = {}
     roots: list[Link] = []
     used: set[int] = set()

@@ -30,7 +30,7 @@ from ..plan import SPRING_KINDS, is_hole, key_of, loaded_so_far, not_played, pla
 from ..rotations import matrix_to_quat, pose_to_matrix
 from ..volumes import volume_surfaces
 from .collision import GHOST_CONTYPE, GHOST_GROUP, collision_filters, warn_losses
-from .cross_joints import cross_model_joints
+from .cross_joints import cross_model_joints, stiff_static_hinges
 from .drives import add_drive, drive_limit
 from .inertia import ambf_inertia
 from .spec import _parse_spec, _resolve_meshes
@@ -257,6 +257,7 @@ def build_plan(world) -> Plan:
                     f"{j.identifier}: a {kind.value} joint closing a loop is not played by the MuJoCo engine; skipped",
                     j,
                 )
+    stiff_static_hinges(spec, loops, world.dt, WELD_TIMECONST_STEPS, WELD_DAMPING_RATIO)
     loops += cross_model_joints(world, spec, plans_by_model, BodyPlan)  # a joint to another model's body
     ambf_inertia(opt, spec, bodies)
     if world.soft is not None:
