@@ -551,6 +551,44 @@ BODY box:
         world.close()
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("d", [1.0, 1.5])
+def test_a_damping_of_one_or_more_stops_a_body_as_bullet_clamps_it(tmp_path, engine, d):
+    """Bullet clamps a damping to [0, 1] and at 1 zeroes the velocities every physics step: a box
+    sent off at 1 m/s with `damping: {linear: 1.0}` (or more) stops within one control step. The
+    MuJoCo engine played no damping at all there (the rate -ln(1 - d) undefined), so it flew on."""
+    scene = _model(
+        tmp_path,
+        f"""
+bodies: [BODY box]
+BODY box:
+  name: box
+  mass: 0.2
+  inertia: {{ix: 1.0e-4, iy: 2.0e-4, iz: 3.0e-4}}
+  location: {_pose(z=1.0)}
+  collision shape: BOX
+  collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
+  damping: {{linear: {d}, angular: {d}}}
+""",
+    )
+    world = engine(scene, Options(gravity=(0, 0, 0), visuals=False, ground=False))
+    try:
+        box = world.body("box")
+        if engine is MujocoWorld:
+            world.data.qvel[:6] = [1.0, 0.0, 0.0, 0.0, 0.0, 3.0]
+            mujoco.mj_forward(world.model, world.data)
+        else:
+            import pybullet as pb
+
+            pb.resetBaseVelocity(box.uid, [1.0, 0.0, 0.0], [0.0, 0.0, 3.0], physicsClientId=world.cid)
+        world.run(0.1)
+        p, _, v, om = box.state()
+        assert abs(p[0]) < 0.003  # at most one control step's decay (4 ms from 1 m/s)
+        assert np.abs(v).max() < 1e-6 and np.abs(om).max() < 1e-6
+    finally:
+        world.close()
+
+
 SENSOR = f"""
 bodies: [BODY eye, BODY near, BODY far]
 sensors: [SENSOR ray]

@@ -15,8 +15,12 @@ from ..model.semantics import DEFAULT_ANGULAR_DAMPING, DEFAULT_LINEAR_DAMPING
 
 
 def _rate(d: float | None, default: float) -> float:
+    """Bullet clamps a damping to [0, 1] (btRigidBody::setDamping); at 1 it zeroes the velocity
+    each physics step: an infinite rate, which stops the body within the step it is applied over."""
     d = default if d is None else float(d)
-    return -math.log(1.0 - d) if 0.0 < d < 1.0 else 0.0
+    if d >= 1.0:
+        return math.inf
+    return -math.log(1.0 - d) if d > 0.0 else 0.0
 
 
 def decay_rates(body) -> tuple[float, float]:
