@@ -77,6 +77,25 @@ def _primitive_half(prim, margin: float) -> tuple[np.ndarray, np.ndarray] | None
     return None
 
 
+#: kg·m², a principal moment standing for an infinite one (a body that cannot turn about that axis)
+FROZEN_INERTIA = 1.0e4
+
+
+def frozen_inertia(body) -> tuple[float, float, float] | None:
+    """The file's `inertia` of a moving body as AMBF's Bullet plays it where a moment is 0: Bullet
+    inverts only the moments that are not 0 (btRigidBody::setMassProps), so the body cannot turn
+    about that axis at all, where an engine given 0 (or the floor it raises it to) turns it
+    freely. Each 0 becomes FROZEN_INERTIA; None where no moment is 0, one is negative or missing,
+    or the body has no mass."""
+    given = body.inertia
+    if given is None or None in (given.ix, given.iy, given.iz) or not body.mass or body.mass <= 0:
+        return None
+    moments = (float(given.ix), float(given.iy), float(given.iz))
+    if min(moments) < 0 or min(moments) > 0:
+        return None
+    return tuple(m if m > 0 else FROZEN_INERTIA for m in moments)  # type: ignore[return-value]
+
+
 def estimated_inertia(model, body, com_in_body: np.ndarray) -> tuple[float, float, float] | None:
     """The principal inertia AMBF estimates for ``body`` about its inertial frame ``com_in_body``
     (a 4x4 pose in the body frame): the box of its collision shape's bounds there, as Bullet's

@@ -7,7 +7,7 @@ import numpy as np
 
 from ...converters.mjcf_write import MIN_INERTIA
 from ...model.semantics import inertial_offset
-from ..ambf_bodies import estimated_inertia
+from ..ambf_bodies import estimated_inertia, frozen_inertia
 from ..rotations import pose_to_matrix
 
 
@@ -22,6 +22,10 @@ def ambf_inertia(opt, spec, bodies) -> None:
         return
     for bp in bodies:
         if bp.mjname == "world":
+            continue
+        frozen = frozen_inertia(bp.body)  # a moment of 0: AMBF's body never turns about that axis
+        if frozen is not None:
+            spec.body(bp.mjname).inertia = frozen
             continue
         est = estimated_inertia(bp.model, bp.body, pose_to_matrix(inertial_offset(bp.body)))
         if est is not None:
