@@ -273,7 +273,7 @@ def test_mujoco_keeps_a_slide_in_the_tree_and_closes_the_loop_at_a_hinge(tmp_pat
     for rule in (True, False):
         if not rule:
             monkeypatch.setattr(
-                mjcf_write, "build_tree", lambda m, kinds=None, _s=False, _b=False: build_tree(m, kinds)
+                mjcf_write, "build_tree", lambda m, kinds=None, _s=False, _b=False, **_kw: build_tree(m, kinds)
             )
         world = open_world(load_scene(path), Options(visuals=False, ground=False), engine="mujoco")
         try:

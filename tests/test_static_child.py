@@ -1,9 +1,9 @@
 """A joint whose child is a static body (mass 0): AMBF hinges the dynamic parent to it wherever the
 file puts it. The MJCF writer's tree hung the static body under its dynamic parent, so in the
 MuJoCo engine the post fell with the arm (`adfkit parity` on a hand-made model, 1.5 s: 1005.6 mm
-from AMBF). A static body is now a root of its own and the hinge closes a loop to it with two
-connects on its axis, held as stiffly as a grasp's weld: 0.59 mm (PyBullet, which made the joint
-a constraint to the static body already: 0.17 mm)."""
+from AMBF). A static body is now the tree's root and the arm hangs from it by the hinge taken from
+the child's side (ReversedJoint): 0.47 mm (PyBullet, which made the joint a constraint to the
+static body already: 0.17 mm)."""
 
 from __future__ import annotations
 
@@ -72,7 +72,10 @@ def test_an_arm_swings_from_the_static_post_its_joint_names_as_child(tmp_path, e
     assert lowest < 1.0 - 0.16  # the arm swung down through its lowest point, 0.17 m below
 
 
-def test_the_mjcf_writer_keeps_a_static_child_a_root_and_closes_its_hinge(tmp_path):
+def test_the_mjcf_writer_hangs_the_arm_from_its_static_child_by_the_joint_reversed(tmp_path):
+    """The static post is the tree's root and the arm hangs from it by the file's hinge taken
+    from the child's side (ReversedJoint): MJCF's joint value is the file's, sign included (the
+    post turns +q about y relative to the arm, so the arm turns -q relative to the post)."""
     import xml.etree.ElementTree as ET
 
     import mujoco
@@ -84,16 +87,19 @@ def test_the_mjcf_writer_keeps_a_static_child_a_root_and_closes_its_hinge(tmp_pa
     path.write_text(ARM_ON_POST)
     out = tmp_path / "post.xml"
     write(load(path), out)
-    mujoco.MjModel.from_xml_path(str(out))  # MuJoCo takes it
     root = ET.parse(out).getroot()
-    world = root.find("worldbody")
-    tops = {b.get("name"): b for b in world.findall("body")}
-    assert set(tops) == {"post", "arm"}  # both at the top: the post is nobody's child
-    assert tops["post"].find("joint") is None and tops["post"].find("freejoint") is None
-    connects = root.findall("equality/connect")
-    assert len(connects) == 2  # the pivot and a point 0.1 m along the hinge's axis
-    anchors = sorted(tuple(float(x) for x in c.get("anchor").split()) for c in connects)
-    assert np.allclose(np.subtract(anchors[1], anchors[0]), [0.0, 0.1, 0.0])
+    tops = root.find("worldbody").findall("body")
+    assert [b.get("name") for b in tops] == ["post"]  # the static post is the root, nobody's child
+    assert root.find("equality") is None  # no loop to close
+    m = mujoco.MjModel.from_xml_path(str(out))
+    d = mujoco.MjData(m)
+    assert m.njnt == 1 and m.jnt_type[0] == mujoco.mjtJoint.mjJNT_HINGE
+    d.qpos[0] = 0.3
+    mujoco.mj_kinematics(m, d)
+    arm = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "arm")
+    pivot = np.array([0.0, 0.0, 1.0])  # the post's centre
+    turn = np.array([[np.cos(-0.3), 0.0, np.sin(-0.3)], [0.0, 1.0, 0.0], [-np.sin(-0.3), 0.0, np.cos(-0.3)]])
+    assert np.allclose(d.xipos[arm], pivot + turn @ np.array([0.17, 0.0, 0.0]), atol=1e-9)  # 51 mm up
 
 
 @needs_ambf

@@ -401,7 +401,7 @@ def to_mjcf(
     model = usable_scales(model, losses)
     # a loop is closed at a point (connect) or welded: a slide closing one would be locked
     kinds = tree_kinds if tree_kinds is not None else (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED)
-    tree = build_tree(model, kinds, True, breadth_first, static_roots=True)
+    tree = build_tree(model, kinds, True, breadth_first, static_roots=True, reversible=True)
     has_volume = volumes and any(v.defined for v in model.volumes)
     if not tree.roots and not any(sb.defined for sb in model.soft_bodies) and not has_volume:
         raise AdfError(

@@ -319,9 +319,42 @@ def inertial_rotation(body) -> Quat:
     return inertial_offset(body).orientation
 
 
+class ReversedJoint:
+    """A joint a kinematic tree takes from its child's side (the file's child reached first, its
+    parent hanging on it): the two bodies swapped, everything else the file's. Its frames
+    (body_joint_frames) are the file's swapped and turned half a turn across the joint's axis, so
+    that its value, limits and motor are the file's joint's, sign included."""
+
+    def __init__(self, joint) -> None:
+        self.joint = joint
+
+    def __getattr__(self, name: str):
+        return getattr(self.joint, name)
+
+    @property
+    def parent(self):
+        return self.joint.child
+
+    @property
+    def child(self):
+        return self.joint.parent
+
+
+#: half a turn about z (a slide along x reverses) and about x (a turn about z reverses)
+_HALF_TURN_Z = Pose(Vec3(), Quat(0.0, 0.0, 1.0, 0.0))
+_HALF_TURN_X = Pose(Vec3(), Quat(1.0, 0.0, 0.0, 0.0))
+
+
 def body_joint_frames(joint, parent, child) -> tuple[Pose, Pose]:
     """:func:`joint_frames` of ``joint`` between the ADF bodies ``parent`` and ``child`` (their
-    scales and inertial frames)."""
+    scales and inertial frames). A ReversedJoint's are its file joint's (between ``child`` and
+    ``parent``) swapped, each turned by the same half turn across the joint's axis: the child
+    frame then moves about (along) the parent's as the file's child moved about its parent's,
+    by the same value."""
+    if isinstance(joint, ReversedJoint):
+        a, b = body_joint_frames(joint.joint, child, parent)
+        turn = _HALF_TURN_Z if joint_kind(joint.type) is JointKind.PRISMATIC else _HALF_TURN_X
+        return b * turn, a * turn
     ps = getattr(parent, "scale", None) or 1.0
     cs = getattr(child, "scale", None) or 1.0
     return joint_frames(joint, ps, cs, inertial_rotation(parent), inertial_rotation(child))

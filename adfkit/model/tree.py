@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from .files import ModelFile
 from .objects import Body, Joint
 from .pose import Pose, Quat, Vec3
-from .semantics import JointKind, body_joint_frames, effective_mass, joint_kind, reference_axis
+from .semantics import JointKind, ReversedJoint, body_joint_frames, effective_mass, joint_kind, reference_axis
 
 ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
 #: the joints whose `joint limits` bound one axis: the one-DOF joints and the torsion and linear
@@ -125,6 +125,7 @@ def build_tree(
     slides_first: bool = False,
     breadth_first: bool = False,
     static_roots: bool = False,
+    reversible: bool = False,
 ) -> KinematicTree:
     """Spanning tree over the joints whose kind is in ``tree_kinds``.
 
@@ -138,7 +139,10 @@ def build_tree(
     in both engines), else depth first. ``static_roots``: a static body is a root even where a
     joint names it as its child (a format whose tree moves every body under its root: MJCF, where
     the body would be carried by its dynamic parent; the joint then closes a loop to it, as the
-    PyBullet runner's constraint does)."""
+    PyBullet runner's constraint does). ``reversible``: a joint whose child the tree reaches
+    first takes its dynamic parent, one no tree joint has as its child, into the tree through the
+    joint reversed (ReversedJoint), as the PyBullet runner's multibodies do, where it would
+    otherwise close a loop to a root of its own."""
     records, unresolved = [], []
     for j in model.joints:
         kind = joint_kind(j.type)
@@ -148,11 +152,15 @@ def build_tree(
             continue
         records.append((j, kind, parent, child))
     edges = defaultdict(list)
+    back = defaultdict(list)  # the tree joints into each body, taken from the child's side (reversible)
     is_child = set()
     for r in records:
         if r[1] in tree_kinds:
             edges[id(r[2])].append(r)
             is_child.add(id(r[3]))
+    for r in records:  # a dynamic parent no tree joint reaches (else it closes a loop, as before)
+        if reversible and r[1] in tree_kinds and effective_mass(r[2]) != 0.0 and id(r[2]) not in is_child:
+            back[id(r[3])].append(r)
     into = defaultdict(list)
     for r in records:
         if r[1] in tree_kinds:
@@ -165,9 +173,9 @@ def build_tree(
     roots: list[Link] = []
     used: set[int] = set()
 
-    def attach(link: Link, r) -> Link:
+    def attach(link: Link, r, file_record=None) -> Link:
         j, kind, parent, child = r
-        used.add(id(r))
+        used.add(id(file_record if file_record is not None else r))
         a, b = body_joint_frames(j, parent, child)
         node = Link(child, parent=link, joint=j, kind=kind, frame_in_body=b, origin=link.in_link(a))
         node.q0 = _initial_value(link, node)
@@ -197,6 +205,9 @@ def build_tree(
                     later.append((link, r))
                     continue
                 stack.append(attach(link, r))
+            for r in back[id(link.body)]:
+                if id(r) not in used and r[2].identifier not in links:
+                    stack.append(attach(link, (ReversedJoint(r[0]), r[1], r[3], r[2]), r))
     loops = [r for r in records if id(r) not in used]
     return KinematicTree(roots, links, loops, unresolved)
 

@@ -14,7 +14,7 @@ from collections import defaultdict, deque
 import numpy as np
 import pybullet as pb
 
-from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, body_joint_frames
+from ...model.semantics import DEFAULT_JOINT_MAX_MOTOR_IMPULSE, JointKind, ReversedJoint, body_joint_frames
 from ...model.tree import left_for_last
 from ..rotations import invert, matrix_to_pq, pose_matrix
 
@@ -80,7 +80,19 @@ def components(joints):
                 continue
             b = queue.popleft()
             for rec in adj[id(b)] + [x for x in joints if x[1] is JointKind.FIXED and x[2] is b]:
-                if id(rec) in used or rec[2] is not b or id(rec[3]) in seen_bodies:
+                if id(rec) in used:
+                    continue
+                free_parent = id(rec[2]) not in seen_bodies and id(rec[2]) not in children and not rec[2].static
+                if rec[3] is b and free_parent and rec[2] is not b:
+                    # the file's child reached first and its parent no tree joint's child: the parent
+                    # hangs on it by the joint reversed (a free body jointed into a tree, written
+                    # from the free body's side), where it was a root of its own and the joint a loop
+                    used.add(id(rec))
+                    seen_bodies.add(id(rec[2]))
+                    order.append((ReversedJoint(rec[0]), rec[1], b, rec[2]))
+                    queue.append(rec[2])
+                    continue
+                if rec[2] is not b or id(rec[3]) in seen_bodies:
                     continue
                 if rec[3].static:
                     continue
