@@ -24,7 +24,8 @@ class Options:
     # Euler over the control step (stable at any gain; the default here, which the tasks were built and
     # accepted on); "ambf", as AMBF's btGeneric6DofSpring2Constraint: explicit k·x + c·v at every
     # physics step, k and c capped at m/(16·dt²) and m/dt (m the joint's inertia about the axis or its
-    # mass). `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: unused
+    # mass). `adfkit run` and `adfkit parity` play AMBF's unless asked otherwise. MuJoCo: "ambf" plays the
+    # dampers of the springs Bullet does not cap explicitly, bounded as Bullet's rows (mujoco/spring_rows.py)
     springs: str = "implicit"
     # where the PyBullet runner puts a multibody link's collision shapes: "body", where the file puts
     # them on the body (AMBF's; the link's frame is its joint's frame, the shapes are made in it);

@@ -22,6 +22,7 @@ from .integrator import integrator_for
 from .limits import ambf_limits
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
+from .spring_rows import SpringRows, capped_joints
 from .start import six_dof_start
 from .vehicles import MujocoVehicles, weld_wheels
 
@@ -136,11 +137,17 @@ class Assembly:
         self.joint_names = [j.identifier for j, *_ in plan.joints] + [j.identifier for j, *_ in plan.loops]
         self.joints_made = [(j, by_plan[id(p)], by_plan[id(c)]) for j, _k, p, c, *_ in plan.joints + plan.loops]
         self._build_articulations(plan, by_plan)
+        # AMBF's springs (Options.springs "ambf"): Bullet's spring rows at every physics step where
+        # a damper acts, but on the springs Bullet caps (spring_rows.py)
+        capped = capped_joints(m, self.data, plan.joints, self.dt)  # (the file's gains, before the clamp)
         self._drive_limits_and_springs()
+        self.spring_rows = SpringRows(self, plan.joints, capped) if self.opt.springs == "ambf" else None
+        if self.spring_rows is not None and not np.any(self.spring_rows.c):
+            self.spring_rows = None
         if self.opt.bodies == "ambf" and six_dof_start(m, self.data, plan.joints):
             mujoco.mj_forward(m, self.data)
         if self.opt.bodies == "ambf":
-            ambf_limits(m, plan.joints, self.dt)
+            ambf_limits(m, plan.joints, self.dt, capped)
         self._gravity_overrides()
         self._base_xfrc = np.array(d.xfrc_applied)
         # every writer of xfrc_applied beyond this base (damping, hole ghosts, wake, a body's

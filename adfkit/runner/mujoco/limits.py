@@ -22,6 +22,9 @@ import mujoco
 
 from ...model.semantics import DEFAULT_JOINT_ERP, HINGE_LIMIT_BIAS, ONE_AXIS_SPRINGS, SLIDER_LIMIT_ERP, JointKind
 
+#: btGeneric6DofSpring2Constraint's stop ERP, which AMBF leaves at Bullet's default on a six dof spring
+SIX_DOF_SPRING_STOP_ERP = 0.2
+
 
 def limit_rate(joint, kind) -> float | None:
     """c·dt of Bullet's limit row on ``joint``, None where MuJoCo's default is kept."""
@@ -30,18 +33,23 @@ def limit_rate(joint, kind) -> float | None:
         return HINGE_LIMIT_BIAS * erp
     if kind in ONE_AXIS_SPRINGS:
         return erp
+    if kind is JointKind.SIX_DOF_SPRING:
+        return SIX_DOF_SPRING_STOP_ERP
     if kind is JointKind.PRISMATIC:
         return SLIDER_LIMIT_ERP
     return None
 
 
-def ambf_limits(model, joints, dt: float) -> None:
-    """The limited MuJoCo joints of ``joints`` (build.Plan.joints) given Bullet's limit rows."""
+def ambf_limits(model, joints, dt: float, skip=frozenset()) -> None:
+    """The limited MuJoCo joints of ``joints`` (build.Plan.joints) given Bullet's limit rows, but
+    those named in ``skip`` (spring_rows.capped_joints: springs Bullet caps keep MuJoCo's own)."""
     for j, kind, _parent, _child, names in joints:
         rate = limit_rate(j, kind)
         if rate is None:
             continue
         for name in names:
+            if name in skip:
+                continue
             jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
             if jid >= 0 and model.jnt_limited[jid]:
                 model.jnt_solref[jid] = [-rate / dt**2, -1.0 / dt]

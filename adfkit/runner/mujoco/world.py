@@ -233,14 +233,17 @@ class MujocoWorld(Assembly, Interaction, World):
         base, xfrc, control, step = self._base_xfrc, d.xfrc_applied, self.control, mujoco.mj_step
         kinematics = mujoco.mj_kinematics
         pending = mj_stability.pending_messages()
-        limits = self.drive_limits.check
+        limits, rows = self.drive_limits.check, self.spring_rows
         veh = self.vehicles or None  # AMBF's vehicles act after each physics step (vehicles.py)
         for k in range(n):
             control()
             fine = self._ghost_steps
             fine = fine if fine is not None and fine.ghosts else None  # AMBF's ghosts at every physics step
-            if fine is not None or veh is not None:
+            springs = rows is not None and rows.apply(sub * self.dt)  # spring_rows.py; False: sprung trees at rest
+            if fine is not None or veh is not None or springs:
                 for i in range(sub):
+                    if springs and i:
+                        rows.apply()
                     if veh is not None:
                         veh.push()
                     step(m, d, 1)
