@@ -95,21 +95,24 @@ SPRING_MODEL = (
       name: spring
       parent: BODY free
       child: BODY link
-      type: torsion spring
+      type: six dof spring
       parent pivot: {x: 0, y: 0, z: -0.25}
       parent axis: {x: 0, y: 0, z: 1}
       child pivot: {x: 0, y: 0, z: 0.25}
       child axis: {x: 0, y: 0, z: 1}
-      joint limits: {low: -0.5, high: 0.5}
-      stiffness: 1.0
-      damping: 0.01
+      joint limits:
+        linear: {low: {x: 0, y: 0, z: 0}, high: {x: 0, y: 0, z: 0}}
+        angular: {low: {x: 0, y: 0, z: -0.5}, high: {x: 0, y: 0, z: 0.5}}
+      stiffness: {linear: {x: 0, y: 0, z: 0}, angular: {x: 0, y: 0, z: 1.0}}
+      damping: {linear: {x: 0, y: 0, z: 0}, angular: {x: 0, y: 0, z: 0.01}}
     """)
 )
 
 
 def test_spring_from_a_free_body_to_a_multibody_link_is_built(tmp_path):
     """The class behind `createConstraint failed` on the springy PSM/ECM/MTM models: PyBullet
-    joins a multibody link and a maximal-coordinate body only with the link as body A."""
+    joins a multibody link and a maximal-coordinate body only with the link as body A. (A six-dof
+    spring: a limited torsion spring from the free body now joins the multibody, reversed.)"""
     from adfkit.adf.scene import load_scene
     from adfkit.runner import Options, open_world
 
