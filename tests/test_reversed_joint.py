@@ -125,3 +125,28 @@ def test_a_bob_slides_on_the_arm_its_joint_names_as_child_as_in_ambf(tmp_path, c
     for doc in json.loads(capsys.readouterr().out):
         bob = next(b for b in doc["bodies"] if b["name"].endswith("/bob"))
         assert bob["max_position_gap_m"] < 2e-3 and bob["max_angle_gap_deg"] < 0.5, doc["engine"]
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_reversed_joint_follows_a_velocity_command_in_the_file_s_sign(tmp_path, engine):
+    """Without gravity, the slider commanded at +0.05 m/s moves the file's child (the arm's
+    pivot) +0.02 m along the file's parent's (the bob's) axis in 0.4 s, as AMBF's slider would."""
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+    from adfkit.runner.joint_commands import JointCommands
+
+    path = tmp_path / "bob.yaml"
+    path.write_text(BOB_ON_ARM)
+    opt = Options(visuals=False, ground=False, bodies="ambf", gravity=(0.0, 0.0, 0.0), control_substeps=1)
+    world = open_world(load_scene(path), opt, engine=engine)
+    try:
+        joint, _parent, child = next(r for r in world.joints_made if r[0].identifier == "JOINT bob-arm")
+        commands = JointCommands(world)
+        commands.command(joint, child, "velocity", 0.05)
+        for _ in range(400):
+            commands.apply(world.sim_time)
+            world.step(1)
+        bob, arm = world.body("bob"), world.body("arm")
+        assert _slide(np.array(bob.world_matrix()), np.array(arm.world_matrix())) == pytest.approx(0.02, abs=2e-3)
+    finally:
+        world.close()

@@ -151,6 +151,9 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
     for (_, where), c in zip(read, commands):
         if c.kind not in commandfile.JOINT_KINDS:
             continue
+        first = players[0].by_name["joint"][c.target][0]
+        if joint_kind(first.type) in (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING) and c.kind != "effort":
+            continue  # AMBF moves a spring by effort only; a position or velocity command does nothing there
         for player in players:
             joint, child = player.by_name["joint"][c.target]
             if player.commands.drivable(joint, child) is None:
@@ -161,8 +164,14 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
         if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
             why = "it closes a kinematic loop, which adfkit plays as a constraint without a motor"
             hint = "drive the loop's other joints (those of its tree), or leave this one out"
+        elif kind in (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING):
+            if player.world.engine == "mujoco":
+                why = "the MuJoCo engine does not push springs by effort (the PyBullet runner does)"
+            else:
+                why = "adfkit pushes a spring of a kinematic tree only (one with both limits), and this one is not"
+            hint = "play it with --engine pybullet, or leave this joint out of the command file"
         else:
-            why = f"adfkit drives revolute and prismatic joints only, and this one is {joint.type!r}"
+            why = f"adfkit drives revolute, prismatic and spring joints only, and this one is {joint.type!r}"
             hint = "leave this joint out of the command file"
         engine = f" in {player.world.engine}" if len(players) > 1 else ""
         diags.append(error("command-target", f"adfkit cannot drive joint {c.target!r}{engine}: {why}", where, hint))

@@ -50,6 +50,16 @@ AMBF_SLIDER_DT = 0.001
 #: the shortest time between two controller updates AMBF divides by (afJointController.m_min_dt)
 MIN_DT = 1e-5
 KINDS = ("position", "velocity", "effort")
+#: the joints AMBF pushes with an effort and does not move by position or velocity
+SPRINGS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
+#: the joints a command drives: AMBF's hinges and sliders, and its limited springs (by effort)
+DRIVEN_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, *SPRINGS)
+
+
+def _file_parent(joint, child, world):
+    """The engine body of ``joint``'s file parent (whose articulation holds a reversed joint)."""
+    made = getattr(world, "joints_made", ())
+    return next((p for j, p, c in made if j is joint), None)
 
 
 def motor_enabled(joint) -> bool:
@@ -200,17 +210,23 @@ class JointCommands:
 
     def drivable(self, joint, child) -> DrivenJoint | None:
         """The joint (an ADF joint, its engine child body) as a driven joint, or None when the
-        engine did not make it a revolute/prismatic joint of an articulation."""
+        engine did not make it a joint of an articulation: a revolute or prismatic joint, or a
+        limited torsion or linear spring (which AMBF pushes with an effort and does not move by
+        position or velocity: ``effort_only``). A joint the articulation took reversed (its file
+        parent hangs on its file child) is found by its file joint."""
         kind = joint_kind(joint.type)
         art = getattr(child, "articulation", None)
-        if kind not in (JointKind.REVOLUTE, JointKind.PRISMATIC) or art is None:
+        if art is None:
+            art = getattr(_file_parent(joint, child, self.world), "articulation", None)
+        if kind not in DRIVEN_KINDS or art is None:
             return None
-        idx = next((i for i, r in enumerate(art.records) if r[0] is joint), None)
-        if idx is None:
+        file_joint = getattr(joint, "joint", joint)
+        idx = next((i for i, r in enumerate(art.records) if getattr(r[0], "joint", r[0]) is file_joint), None)
+        if idx is None or art.kinds[idx] not in DRIVEN_KINDS:
             return None
         (p, i, d), out = controller_of(joint)
         imp = joint.max_motor_impulse if joint.max_motor_impulse is not None else DEFAULT_JOINT_MAX_MOTOR_IMPULSE
-        dt = AMBF_SLIDER_DT if kind is JointKind.PRISMATIC else self.world.dt
+        dt = AMBF_SLIDER_DT if kind in (JointKind.PRISMATIC, JointKind.LINEAR_SPRING) else self.world.dt
         w = self.world
         soft = hasattr(w, "joint_row_mass") and hasattr(w, "joint_mobility")
         return DrivenJoint(
@@ -235,8 +251,10 @@ class JointCommands:
         dj = self.joints.get(id(joint))
         if dj is None:
             dj = self.drivable(joint, child)
+            if dj is None and joint_kind(joint.type) in SPRINGS and kind != "effort":
+                return  # AMBF moves a spring by effort only: a position or velocity command does nothing
             if dj is None:
-                raise ValueError(f"{joint.identifier}: not a revolute or prismatic joint of an articulation")
+                raise ValueError(f"{joint.identifier}: not a revolute, prismatic or spring joint of an articulation")
             self.joints[id(joint)] = dj
             rows = getattr(self.world, "limit_rows", None)  # the engine's own hold past a limit
             if rows is not None:
@@ -318,6 +336,8 @@ class JointCommands:
         soft: dict[int, list] = {}  # an articulation's soft motor rows, settled together below
         for dj in self.joints.values():
             kind, value = dj.command
+            if dj.kind in SPRINGS and kind != "effort":
+                continue  # AMBF moves a spring by effort only (afJoint::commandPosition, commandVelocity)
             if kind == "velocity":
                 self._motor(dj, value, soft)
             elif kind == "effort":

@@ -9,7 +9,7 @@ import math
 import mujoco
 import numpy as np
 
-from ...model.semantics import JointKind, effective_mass, inertial_offset
+from ...model.semantics import JointKind, ReversedJoint, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
 from ..collisions import HULL_OVERLAP, hull_overlaps, one_hull
 from ..plan import ALL_GROUPS
@@ -135,7 +135,9 @@ class Assembly:
             self.volumes.append(vs.report)
         self._by_plan = by_plan
         self.joint_names = [j.identifier for j, *_ in plan.joints] + [j.identifier for j, *_ in plan.loops]
-        self.joints_made = [(j, by_plan[id(p)], by_plan[id(c)]) for j, _k, p, c, *_ in plan.joints + plan.loops]
+        made = [(j, by_plan[id(p)], by_plan[id(c)]) for j, _k, p, c, *_ in plan.joints + plan.loops]
+        # as the file has them: a joint the tree took reversed (ReversedJoint) listed by its file joint
+        self.joints_made = [(j.joint, c, p) if isinstance(j, ReversedJoint) else (j, p, c) for j, p, c in made]
         self._build_articulations(plan, by_plan)
         # AMBF's springs (Options.springs "ambf"): Bullet's spring rows at every physics step where
         # a damper acts, but on the springs Bullet caps (spring_rows.py)
