@@ -245,7 +245,8 @@ class Assembly:
                 m, b, frame_in_body, b.scale or 1.0, sb.static, self.diagnostics, self.soft is not None
             )
             sb._parts_frame = frame_in_body
-        col = create_collision(sb._parts, self.cid, b, self.diagnostics) if sb._parts is not None else -1
+        ambf = self.opt.bodies == "ambf"  # AMBF's compound shapes (shapes.create_collision)
+        col = create_collision(sb._parts, self.cid, b, self.diagnostics, ambf) if sb._parts is not None else -1
         vis = create_visual(m, b, frame_in_body, b.scale or 1.0, self.cid, self.diagnostics) if self.opt.visuals else -1
         return col, self._plane_visual(sb._parts, col, vis)
 

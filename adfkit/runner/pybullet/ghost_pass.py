@@ -58,7 +58,7 @@ class GhostPass:
         """The collision shape of ``parts`` in this world; -1 where PyBullet refuses it now (a
         mesh file gone since the world was built)."""
         try:
-            return create_collision(parts, self._connect())
+            return create_collision(parts, self._connect(), compound=self.world.opt.bodies == "ambf")
         except pb.error:
             return -1
 

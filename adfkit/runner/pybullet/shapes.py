@@ -221,13 +221,17 @@ def collision_parts(
     return parts
 
 
-def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnostic] | None = None) -> int:
+def create_collision(
+    parts: ShapeParts, cid: int, obj=None, diags: list[Diagnostic] | None = None, compound: bool = False
+) -> int:
     """Create the PyBullet collision shape, its children given the file's margin; -1 for an
     empty one, or (with a warning located at ``obj``) for one PyBullet refuses. A collision
-    mesh does not need its textures: PyBullet's words about missing ones are not printed."""
+    mesh does not need its textures: PyBullet's words about missing ones are not printed.
+    ``compound``: a single shape too is a compound of it, as AMBF makes every body's
+    (``_create_collision``)."""
     try:
         with reads_quietly([kw["fileName"] for kw in parts.kwargs if "fileName" in kw]):
-            col = _create_collision(parts, cid)
+            col = _create_collision(parts, cid, compound)
             give_margin(col, parts.margin, cid)  # (a probe body: PyBullet reads the files there)
         return col
     except pb.error as exc:
@@ -245,7 +249,12 @@ def create_collision(parts: ShapeParts, cid: int, obj=None, diags: list[Diagnost
         return -1
 
 
-def _create_collision(parts: ShapeParts, cid: int) -> int:
+#: m, the frame offset that has PyBullet wrap a single shape in a compound (it makes a bare
+#: shape of one whose frame is the identity)
+COMPOUND_NUDGE = 1e-12
+
+
+def _create_collision(parts: ShapeParts, cid: int, compound: bool = False) -> int:
     if parts.plane is not None and not parts.types:
         n, off = parts.plane
         return pb.createCollisionShape(
@@ -254,7 +263,15 @@ def _create_collision(parts: ShapeParts, cid: int) -> int:
     if not parts.types:
         return -1
     if len(parts.types) == 1:
-        return pb.createCollisionShape(parts.types[0], physicsClientId=cid, **parts.kwargs[0])
+        kw = parts.kwargs[0]
+        if compound:
+            # AMBF puts every shape in a btCompoundShape, whose child a pair meets only where the
+            # two bounding boxes overlap: a ball falling onto a floor makes its contact only once
+            # it is in the floor, where PyBullet's bare sphere made it 3 µm above (its second
+            # bounce 125 mm from AMBF's; 0.000 mm as a compound)
+            x, y, z = kw.get("collisionFramePosition", (0.0, 0.0, 0.0))
+            kw = {**kw, "collisionFramePosition": [x, y, z + COMPOUND_NUDGE]}
+        return pb.createCollisionShape(parts.types[0], physicsClientId=cid, **kw)
     arrays: dict[str, list] = {
         k: []
         for k in (
