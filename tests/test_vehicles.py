@@ -159,3 +159,20 @@ def test_a_car_lands_on_its_suspension_as_in_ambf(tmp_path, capsys, slope):
     for doc in json.loads(capsys.readouterr().out):
         chassis = next(b for b in doc["bodies"] if b["name"].endswith("/Chassis"))
         assert chassis["max_position_gap_m"] < 1e-4 and chassis["max_angle_gap_deg"] < 0.01, doc["engine"]
+
+
+def test_validate_says_a_vehicle_must_follow_its_bodies_file(tmp_path, capsys):
+    """`adfkit validate` of the launch: a vehicle in its chassis's own file names bodies AMBF does
+    not find (it searches the models loaded before the vehicle's only), with the fix as the hint."""
+    launch = _scene(tmp_path, same_file=True)
+    capsys.readouterr()
+    main(["validate", str(launch)])
+    err = capsys.readouterr()
+    text = err.out + err.err
+    assert (
+        "'chassis' of 'VEHICLE Car' is 'BODY Chassis', which names no body in the models loaded before this one" in text
+    )
+    assert "move the vehicle to a file listed after its bodies' file" in text
+    capsys.readouterr()
+    main(["validate", str(_scene(tmp_path / "ok"))])
+    assert "dangling-reference" not in "".join(capsys.readouterr())

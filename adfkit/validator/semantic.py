@@ -279,10 +279,10 @@ class Checker:
         for obj in [*m.ghost_objects, *m.cameras, *m.lights, *m.volumes]:
             self.reference(m, obj, "parent", own, earlier, immediate=False, cameras=cameras)
         for v in m.vehicles:
-            self.reference(m, v, "chassis", Registry(), earlier, immediate=True, world_only=True)
+            self.reference(m, v, "chassis", own, earlier, immediate=True, world_only=True)
             for w in v.wheels or []:
                 if w.body is not None:
-                    self.reference(m, w, "body", Registry(), earlier, immediate=True, world_only=True, owner=v)
+                    self.reference(m, w, "body", own, earlier, immediate=True, world_only=True, owner=v)
         for light in m.lights:
             self.light(light)
         for c in m.cameras:
@@ -656,12 +656,19 @@ class Checker:
                 return None
         if self.context or (immediate and not world_only):
             where = "this file or the models loaded before it" if self.context else "this file"
-            self.emit(
-                "dangling-reference",
-                f"'{key}' of '{label}' is {text!r}, which names no body in {where}",
-                loc,
+            hint = (
                 "check the spelling; AMBF skips the object. If the body lives in another model, "
-                "validate the launch file so the models loaded earlier are searched",
+                "validate the launch file so the models loaded earlier are searched"
+            )
+            if world_only:
+                where = "the models loaded before this one"
+                if own.lookup(text, None)[0] == "found":
+                    hint = (
+                        "AMBF finds a vehicle's bodies only among the models loaded before the vehicle's: "
+                        "move the vehicle to a file listed after its bodies' file"
+                    )
+            self.emit(
+                "dangling-reference", f"'{key}' of '{label}' is {text!r}, which names no body in {where}", loc, hint
             )
         else:
             self.emit(
