@@ -637,6 +637,20 @@ def test_proximity_sensor_rays_see_what_is_in_range(tmp_path):
         world.close()
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_proximity_sensor_of_range_0_senses_nothing(tmp_path, engine):
+    """Rays of no length: MuJoCo's mj_ray refuses them (a fatal error that ended the process);
+    both engines sense nothing."""
+    world = engine(
+        _model(tmp_path, SENSOR.replace("range: 0.1", "range: 0.0")), Options(gravity=(0, 0, 0), ground=False)
+    )
+    try:
+        world.step(2)
+        assert world.sensors[0].sensed == []
+    finally:
+        world.close()
+
+
 # ---- cameras and CLI -------------------------------------------------------------------------
 def test_mujoco_camera_depth_segmentation_rgb(tmp_path):
     from adfkit.runner.mujoco.render import CameraUnavailable

@@ -176,3 +176,16 @@ def test_validate_says_a_vehicle_must_follow_its_bodies_file(tmp_path, capsys):
     capsys.readouterr()
     main(["validate", str(_scene(tmp_path / "ok"))])
     assert "dangling-reference" not in "".join(capsys.readouterr())
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_wheel_pointing_nowhere_meets_nothing(tmp_path, engine):
+    """A `down direction` of zero length: a ray of no length, which meets nothing (MuJoCo's mj_ray
+    refused it with a fatal error); the chassis falls onto the floor."""
+    launch = _scene(tmp_path)
+    car = tmp_path / "car.yaml"
+    car.write_text(
+        car.read_text().replace("down direction: {x: 0.0, y: 0.0, z: -1.0}", "down direction: {x: 0.0, y: 0.0, z: 0.0}")
+    )
+    _start, end, made, _said = _play(launch, 1.0, engine)
+    assert made == 1 and end["Chassis"][2, 3] < 0.15

@@ -26,6 +26,9 @@ class Interaction(AmbfGhosts):
         b = s.ends @ t[:3, :3].T + t[:3, 3]
         s.sensed, s.rays = [], []
         for p, q in zip(a, b):
+            if not float(np.dot(q - p, q - p)) > 1e-24:  # a sensor of range 0 senses nothing (mj_ray refuses it)
+                s.rays.append((None, 1.0))
+                continue
             x = mujoco.mj_ray(m, d, p, q - p, self._ray_groups, 1, s.parent.id, self._ray_hit)
             sb = None
             if 0.0 <= x <= 1.0 and self._ray_hit[0] >= 0:

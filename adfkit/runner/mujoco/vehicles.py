@@ -64,6 +64,9 @@ class MujocoVehicles:
         def cast(froms: np.ndarray, tos: np.ndarray) -> list:
             out = []
             for a, b in zip(froms, tos):
+                if not float(np.dot(b - a, b - a)) > 1e-24:  # a ray of no length meets nothing (mj_ray refuses it)
+                    out.append(None)
+                    continue
                 x = mujoco.mj_ray(m, d, a, b - a, w._ray_groups, 1, exclude, self._hit, self._normal)
                 hit = None
                 if 0.0 <= x <= 1.0 and self._hit[0] >= 0:
