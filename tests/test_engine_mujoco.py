@@ -1014,3 +1014,32 @@ def test_a_hinge_named_with_a_hash_is_not_read_as_a_six_dof_axis(tmp_path):
         assert z < -0.01 and math.hypot(x, z) == pytest.approx(0.1, abs=1e-3)
     finally:
         world.close()
+
+
+def test_a_primitive_of_size_0_is_refused_at_its_body_s_geometry(tmp_path):
+    """MuJoCo refuses a geom of size 0; the error names the geom, and is located at its ADF body's
+    `collision geometry` (it was put at the scene's first model, here the only one, line 1)."""
+    from adfkit.diagnostics import AdfError
+
+    scene = _model(
+        tmp_path,
+        f"""
+bodies: [BODY a, BODY flat]
+BODY a:
+  name: a
+  mass: 0.1
+  location: {_pose(z=1.0)}
+  collision shape: SPHERE
+  collision geometry: {{radius: 0.01}}
+BODY flat:
+  name: flat
+  mass: 0.1
+  location: {_pose(z=0.5)}
+  collision shape: BOX
+  collision geometry: {{x: 0.0, y: 0.02, z: 0.02}}
+""",
+    )
+    with pytest.raises(AdfError) as e:
+        MujocoWorld(scene, Options(visuals=False, ground=False))
+    d = e.value.diagnostics[0]
+    assert d.rule == "mujoco-refused" and d.location.line == 14  # (the text starts with a blank line)

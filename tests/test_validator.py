@@ -159,6 +159,13 @@ EXAMPLES = {
         "warning",
     ),
     "collision-groups": (CLEAN.replace("BODY b:\n", "BODY b:\n  collision groups: [1000]\n"), 8, "warning"),
+    "geometry-size": (
+        CLEAN.replace(
+            "BODY b:\n", "BODY b:\n  collision shape: Capsule\n  collision geometry: {radius: 0.05, height: 0.02}\n"
+        ),
+        9,
+        "warning",
+    ),
     "name-collision": (CLEAN.replace("name: b\n", "name: a\n"), 8, "warning"),
     "name-spaces": (CLEAN.replace("name: b\n", "name: b b\n"), 8, "info"),
     "namespace-slash": ("namespace: /ambf/env\n" + CLEAN, 1, "info"),

@@ -212,6 +212,13 @@ _RULES = [
     ),
     Rule("geometry-axis", W, "Primitive axis is not x/y/z; AMBF uses z", "`axis: w`"),
     Rule(
+        "geometry-size",
+        W,
+        "A collision primitive of size 0 or less, or a capsule shorter than its two caps (AMBF gives "
+        "Bullet a negative length; MuJoCo refuses both)",
+        "`collision geometry: {radius: 0.05, height: 0.02}` on a capsule",
+    ),
+    Rule(
         "sensor-type",
         W,
         "A sensor/actuator type unknown to AMBF 2.0 (it crashes on it; newer versions and "

@@ -426,6 +426,11 @@ class Checker:
                     g.where("axis"),
                     "write x, y or z",
                 )
+        prims = [(obj.collision_shape, obj.collision_geometry)] + [
+            (e.shape, e.geometry) for e in (obj.compound_collision_shape or [])
+        ]
+        for shape, g in prims:
+            self.geometry_size(obj, shape, g)
         for grp in getattr(obj, "collision_groups", None) or []:
             if not 0 <= grp <= 999:
                 self.emit(
@@ -434,6 +439,33 @@ class Checker:
                     obj.where("collision groups"),
                     "use groups 0–999",
                 )
+
+    def geometry_size(self, obj, shape, g) -> None:
+        """A collision primitive's sizes (adf-format.md §7.5): each > 0, and a capsule's height,
+        caps included, at least its diameter."""
+        kind = (shape or "").lower()
+        if g is None or kind not in ("box", "sphere", "cylinder", "capsule", "cone"):
+            return
+        keys = ("x", "y", "z") if kind == "box" else ("radius",) if kind == "sphere" else ("radius", "height")
+        for k in keys:
+            v = getattr(g, k, None)
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and v <= 0:
+                self.emit(
+                    "geometry-size",
+                    f"collision {kind} of '{obj.identifier}' has {k} {v:g}",
+                    g.where(k),
+                    "give every size a positive value",
+                )
+                return
+        r, h = getattr(g, "radius", None), getattr(g, "height", None)
+        if kind == "capsule" and isinstance(r, (int, float)) and isinstance(h, (int, float)) and h < 2 * r:
+            self.emit(
+                "geometry-size",
+                f"collision capsule of '{obj.identifier}' is {h:g} m long with caps of radius {r:g}: AMBF "
+                f"gives Bullet a cylinder part {h - 2 * r:g} m long",
+                g.where("height"),
+                "`height` is the capsule's whole length, caps included: at least twice the radius",
+            )
 
     def joint(self, m: ModelFile, j, own: Registry, earlier: Registry) -> None:
         if "enable motor" in j.key_sources and "enable feedback" not in j.key_sources:

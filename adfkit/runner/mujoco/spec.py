@@ -104,7 +104,17 @@ def _adf_bodies(world, spec, geoms) -> list:
 def _where(world, spec, text: str):
     """Where the element MuJoCo's error names comes from: its ADF body, else the scene's first model."""
     hit = re.search(r"Element name '([^']*)'", text)
-    el = spec.body(hit.group(1)) if hit is not None and hit.group(1) else None
+    name = hit.group(1) if hit is not None else ""
+    el = spec.body(name) if name else None
+    geom = spec.geom(name) if name and el is None else None
+    if geom is not None:  # a geom MuJoCo refuses (a primitive of size 0): its body's shape
+        bodies = _adf_bodies(world, spec, [geom])
+        if bodies:
+            b = bodies[0]
+            for key in ("collision geometry", "compound collision shape", "collision mesh", "mesh"):
+                if getattr(b, key.replace(" ", "_"), None) is not None:
+                    return b.where(key) or b.source
+            return b.source
     bodies = _adf_bodies(world, spec, [g for g in spec.geoms if el is not None and g.parent.name == el.name])
     if bodies:
         return bodies[0].source
