@@ -35,7 +35,13 @@ class PyBulletVehicles:
                 b.mass, b.inertia = 0.0, (0.0, 0.0, 0.0)
             if chassis.static:
                 inv_mass, inv_inertia = 0.0, np.zeros(3)
-            else:
+            else:  # AMBF keeps the chassis awake (DISABLE_DEACTIVATION)
+                pb.changeDynamics(
+                    chassis.uid,
+                    chassis.link,
+                    activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
+                    physicsClientId=self.cid,
+                )
                 inv_mass = 1.0 / chassis.mass
                 inv_inertia = [1.0 / i if i > 0 else 0.0 for i in chassis.inertia]
             self.vehicles.append(RaycastVehicle(key, chassis, wheels, inv_mass, inv_inertia))
