@@ -515,11 +515,9 @@ BODY bead:
         world.close()
 
 
-@pytest.mark.parametrize("engine", ENGINES)
-def test_body_velocity_damping_as_bullet_applies_it(tmp_path, engine):
-    """ADF body damping (0.9 linear, 0.5 angular) decays a free body's velocities as Bullet
-    does, (1 - d) per second: from 1 m/s and 3 rad/s to 0.1 m/s and 1.5 rad/s after 1 s (1 %),
-    in both engines (MuJoCo has no body damping of its own; damping.py)."""
+def _box_sent_off(tmp_path, engine, linear: float, angular: float):
+    """A free 0.2 kg box with `damping: {linear, angular}`, no gravity, sent off at 1 m/s along x
+    turning at 3 rad/s about z: (world, box)."""
     scene = _model(
         tmp_path,
         f"""
@@ -531,19 +529,28 @@ BODY box:
   location: {_pose(z=1.0)}
   collision shape: BOX
   collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
-  damping: {{linear: 0.9, angular: 0.5}}
+  damping: {{linear: {linear}, angular: {angular}}}
 """,
     )
     world = engine(scene, Options(gravity=(0, 0, 0), visuals=False, ground=False))
-    try:
-        box = world.body("box")
-        if engine is MujocoWorld:
-            world.data.qvel[:6] = [1.0, 0.0, 0.0, 0.0, 0.0, 3.0]
-            mujoco.mj_forward(world.model, world.data)
-        else:
-            import pybullet as pb
+    box = world.body("box")
+    if engine is MujocoWorld:
+        world.data.qvel[:6] = [1.0, 0.0, 0.0, 0.0, 0.0, 3.0]
+        mujoco.mj_forward(world.model, world.data)
+    else:
+        import pybullet as pb
 
-            pb.resetBaseVelocity(box.uid, [1.0, 0.0, 0.0], [0.0, 0.0, 3.0], physicsClientId=world.cid)
+        pb.resetBaseVelocity(box.uid, [1.0, 0.0, 0.0], [0.0, 0.0, 3.0], physicsClientId=world.cid)
+    return world, box
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_body_velocity_damping_as_bullet_applies_it(tmp_path, engine):
+    """ADF body damping (0.9 linear, 0.5 angular) decays a free body's velocities as Bullet
+    does, (1 - d) per second: from 1 m/s and 3 rad/s to 0.1 m/s and 1.5 rad/s after 1 s (1 %),
+    in both engines (MuJoCo has no body damping of its own; damping.py)."""
+    world, box = _box_sent_off(tmp_path, engine, 0.9, 0.5)
+    try:
         world.run(1.0)
         _, _, v, om = box.state()
         assert v[0] == pytest.approx(0.1, rel=0.01) and om[2] == pytest.approx(1.5, rel=0.01)
@@ -557,30 +564,8 @@ def test_a_damping_of_one_or_more_stops_a_body_as_bullet_clamps_it(tmp_path, eng
     """Bullet clamps a damping to [0, 1] and at 1 zeroes the velocities every physics step: a box
     sent off at 1 m/s with `damping: {linear: 1.0}` (or more) stops within one control step. The
     MuJoCo engine played no damping at all there (the rate -ln(1 - d) undefined), so it flew on."""
-    scene = _model(
-        tmp_path,
-        f"""
-bodies: [BODY box]
-BODY box:
-  name: box
-  mass: 0.2
-  inertia: {{ix: 1.0e-4, iy: 2.0e-4, iz: 3.0e-4}}
-  location: {_pose(z=1.0)}
-  collision shape: BOX
-  collision geometry: {{x: 0.02, y: 0.02, z: 0.02}}
-  damping: {{linear: {d}, angular: {d}}}
-""",
-    )
-    world = engine(scene, Options(gravity=(0, 0, 0), visuals=False, ground=False))
+    world, box = _box_sent_off(tmp_path, engine, d, d)
     try:
-        box = world.body("box")
-        if engine is MujocoWorld:
-            world.data.qvel[:6] = [1.0, 0.0, 0.0, 0.0, 0.0, 3.0]
-            mujoco.mj_forward(world.model, world.data)
-        else:
-            import pybullet as pb
-
-            pb.resetBaseVelocity(box.uid, [1.0, 0.0, 0.0], [0.0, 0.0, 3.0], physicsClientId=world.cid)
         world.run(0.1)
         p, _, v, om = box.state()
         assert abs(p[0]) < 0.003  # at most one control step's decay (4 ms from 1 m/s)

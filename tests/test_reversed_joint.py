@@ -7,12 +7,10 @@ reversed (model.semantics.ReversedJoint), its value the file's: 1.13 and 1.16 mm
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
+from parity_scene import body, launch_with, parity
 
-from adfkit.cli import main
 from adfkit.model.semantics import ReversedJoint, body_joint_frames
 from adfkit.parity import ambf
 
@@ -113,17 +111,8 @@ def test_a_bob_slides_on_the_arm_its_joint_names_as_child(tmp_path, engine):
 
 @needs_ambf
 def test_a_bob_slides_on_the_arm_its_joint_names_as_child_as_in_ambf(tmp_path, capsys):
-    main(["build-scene", "parity", str(tmp_path)])
-    (tmp_path / "bob.yaml").write_text(BOB_ON_ARM)
-    launch = tmp_path / "bob_launch.yaml"
-    launch.write_text(
-        "world config: world.yaml\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
-        "multibody configs:\n- bob.yaml\n"
-    )
-    capsys.readouterr()
-    main(["parity", str(launch), "--seconds", "1.5", "--engine", "both", "--json"])
-    for doc in json.loads(capsys.readouterr().out):
-        bob = next(b for b in doc["bodies"] if b["name"].endswith("/bob"))
+    for doc in parity(capsys, launch_with(tmp_path, {"bob.yaml": BOB_ON_ARM}), 1.5):
+        bob = body(doc, "bob")
         assert bob["max_position_gap_m"] < 2e-3 and bob["max_angle_gap_deg"] < 0.5, doc["engine"]
 
 

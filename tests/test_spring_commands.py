@@ -9,13 +9,12 @@ AMBF over 0.5 s, as at rest; under an effort 2 N·m on its base spring 0.004° a
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 import pytest
+from parity_scene import body, launch_with, parity
 
-from adfkit.cli import main
 from adfkit.parity import ambf
 
 BUILD, WHY = ambf.available()
@@ -94,29 +93,8 @@ def test_a_position_or_velocity_command_leaves_a_spring_as_ambf_does(tmp_path, e
     "program", ["0.0, effort, post-arm, 0.01\n0.2, effort, post-arm, -0.02\n", "0.0, position, post-arm, 1.0\n"]
 )
 def test_commands_to_a_spring_play_as_in_ambf(tmp_path, capsys, program):
-    main(["build-scene", "parity", str(tmp_path)])
-    (tmp_path / "turntable.yaml").write_text(TURNTABLE)
-    launch = tmp_path / "turntable_launch.yaml"
-    launch.write_text(
-        "world config: world.yaml\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
-        "multibody configs:\n- turntable.yaml\n"
-    )
+    launch = launch_with(tmp_path, {"turntable.yaml": TURNTABLE})
     (tmp_path / "commands.txt").write_text(program)
-    capsys.readouterr()
-    main(
-        [
-            "parity",
-            str(launch),
-            "--seconds",
-            "0.5",
-            "--engine",
-            "pybullet",
-            "--commands",
-            str(tmp_path / "commands.txt"),
-            "--json",
-        ]
-    )
-    doc = json.loads(capsys.readouterr().out)
-    doc = doc[0] if isinstance(doc, list) else doc
-    arm = next(b for b in doc["bodies"] if b["name"].endswith("/arm"))
+    (doc,) = parity(capsys, launch, 0.5, "pybullet", "--commands", str(tmp_path / "commands.txt"))
+    arm = body(doc, "arm")
     assert arm["max_position_gap_m"] < 5e-4 and arm["max_angle_gap_deg"] < 0.5

@@ -7,12 +7,10 @@ static body already: 0.17 mm)."""
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
+from parity_scene import body, launch_with, parity
 
-from adfkit.cli import main
 from adfkit.parity import ambf
 
 BUILD, WHY = ambf.available()
@@ -104,17 +102,7 @@ def test_the_mjcf_writer_hangs_the_arm_from_its_static_child_by_the_joint_revers
 
 @needs_ambf
 def test_an_arm_swings_from_a_static_child_as_in_ambf(tmp_path, capsys):
-    main(["build-scene", "parity", str(tmp_path)])
-    (tmp_path / "post.yaml").write_text(ARM_ON_POST)
-    launch = tmp_path / "post_launch.yaml"
-    launch.write_text(
-        "world config: world.yaml\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
-        "multibody configs:\n- post.yaml\n"
-    )
-    capsys.readouterr()
-    main(["parity", str(launch), "--seconds", "1.5", "--engine", "both", "--json"])
-    for doc in json.loads(capsys.readouterr().out):
-        arm = next(b for b in doc["bodies"] if b["name"].endswith("/arm"))
-        post = next(b for b in doc["bodies"] if b["name"].endswith("/post"))
+    for doc in parity(capsys, launch_with(tmp_path, {"post.yaml": ARM_ON_POST}), 1.5):
+        arm, post = body(doc, "arm"), body(doc, "post")
         assert arm["max_position_gap_m"] < 1e-3 and arm["max_angle_gap_deg"] < 0.5, doc["engine"]
         assert post["max_position_gap_m"] == 0.0, doc["engine"]

@@ -5,10 +5,9 @@ fell onto the floor where AMBF's stood on its suspension (`adfkit parity` on a h
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
+from parity_scene import body, launch_with, parity
 
 from adfkit.cli import main
 from adfkit.parity import ambf
@@ -82,24 +81,14 @@ for _i, (_x, _y) in enumerate([(0.4, 0.35), (0.4, -0.35), (-0.4, 0.35), (-0.4, -
 def _scene(tmp_path, friction=10.0, slope_r=0.0, slope_p=0.0, same_file=False):
     """A launch file: world and floor, the car's bodies, then its vehicle (its own file, loaded
     after the bodies, as AMBF needs; ``same_file`` puts it in the bodies' file)."""
-    main(["build-scene", "parity", str(tmp_path)])  # world, colours, input devices
-    floor = FLOOR.replace("SLOPE_R", str(slope_r)).replace("SLOPE_P", str(slope_p))
-    (tmp_path / "floor.yaml").write_text(floor)
     parts = PARTS.replace("SLOPE_R", str(slope_r)).replace("SLOPE_P", str(slope_p))
     car = CAR.replace("FRICTION", str(friction))
-    models = ["parts.yaml"]
+    models = {"parts.yaml": parts, "car.yaml": car}
     if same_file:
         parts = parts.replace("namespace: /ambf/env/\n", "vehicles: [VEHICLE Car]\nnamespace: /ambf/env/\n", 1)
-        parts += car.split("namespace: /ambf/env/\n", 1)[1]
-    else:
-        (tmp_path / "car.yaml").write_text(car)
-        models.append("car.yaml")
-    (tmp_path / "parts.yaml").write_text(parts)
-    launch = tmp_path / "car_launch.yaml"
-    launch.write_text(
-        "world config: world.yaml\ncolor config: colors.yaml\ninput devices config: input_devices.yaml\n"
-        "multibody configs:\n" + "".join(f"- {m}\n" for m in models)
-    )
+        models = {"parts.yaml": parts + car.split("namespace: /ambf/env/\n", 1)[1]}
+    launch = launch_with(tmp_path, models, "car_launch.yaml")
+    (tmp_path / "floor.yaml").write_text(FLOOR.replace("SLOPE_R", str(slope_r)).replace("SLOPE_P", str(slope_p)))
     return launch
 
 
@@ -153,11 +142,8 @@ def test_a_vehicle_in_its_chassis_s_own_file_is_not_made(tmp_path):
 @needs_ambf
 @pytest.mark.parametrize("slope", [0.0, 0.1])
 def test_a_car_lands_on_its_suspension_as_in_ambf(tmp_path, capsys, slope):
-    launch = _scene(tmp_path, slope_r=slope)
-    capsys.readouterr()
-    main(["parity", str(launch), "--seconds", "2.0", "--engine", "both", "--json"])
-    for doc in json.loads(capsys.readouterr().out):
-        chassis = next(b for b in doc["bodies"] if b["name"].endswith("/Chassis"))
+    for doc in parity(capsys, _scene(tmp_path, slope_r=slope), 2.0):
+        chassis = body(doc, "Chassis")
         assert chassis["max_position_gap_m"] < 1e-4 and chassis["max_angle_gap_deg"] < 0.01, doc["engine"]
 
 
