@@ -136,7 +136,9 @@ def test_a_vehicle_in_its_chassis_s_own_file_is_not_made(tmp_path):
     _start, end, made, said = _play(_scene(tmp_path, same_file=True), 1.0)
     assert made == 0
     assert end["Chassis"][2, 3] < 0.2
-    assert any("chassis 'BODY Chassis' is not a body of a model loaded before this one" in d for d in said)
+    assert any(
+        "chassis 'BODY Chassis' is not among the bodies made by the models loaded before this one" in d for d in said
+    )
 
 
 @needs_ambf

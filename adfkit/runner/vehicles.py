@@ -239,7 +239,7 @@ def planned(world, models, bodies_of, warn: bool = True) -> list[tuple]:
             if chassis is None:
                 say(
                     "runner-vehicle",
-                    f"{veh.identifier}: chassis {veh.chassis!r} is not a body of a model loaded before this one; "
+                    f"{veh.identifier}: chassis {veh.chassis!r} is not among the bodies made by the models loaded before this one; "
                     "AMBF makes no vehicle",
                     veh,
                     "list the chassis's model before the vehicle's in the launch file",
