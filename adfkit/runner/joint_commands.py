@@ -56,12 +56,6 @@ SPRINGS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
 DRIVEN_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, *SPRINGS)
 
 
-def _file_parent(joint, child, world):
-    """The engine body of ``joint``'s file parent (whose articulation holds a reversed joint)."""
-    made = getattr(world, "joints_made", ())
-    return next((p for j, p, c in made if j is joint), None)
-
-
 def motor_enabled(joint) -> bool:
     """AMBF's `enable motor`: on by default; when the key is there, AMBF reads `enable
     feedback`'s value instead (its loader's slip)."""
@@ -212,16 +206,13 @@ class JointCommands:
         """The joint (an ADF joint, its engine child body) as a driven joint, or None when the
         engine did not make it a joint of an articulation: a revolute or prismatic joint, or a
         limited torsion or linear spring (which AMBF pushes with an effort and does not move by
-        position or velocity: ``effort_only``). A joint the articulation took reversed (its file
-        parent hangs on its file child) is found by its file joint."""
+        position or velocity: SPRINGS). A joint the articulation took reversed (its file parent
+        hangs on its file child, which the articulation holds) is found by its file joint."""
         kind = joint_kind(joint.type)
         art = getattr(child, "articulation", None)
-        if art is None:
-            art = getattr(_file_parent(joint, child, self.world), "articulation", None)
         if kind not in DRIVEN_KINDS or art is None:
             return None
-        file_joint = getattr(joint, "joint", joint)
-        idx = next((i for i, r in enumerate(art.records) if getattr(r[0], "joint", r[0]) is file_joint), None)
+        idx = next((i for i, r in enumerate(art.records) if getattr(r[0], "joint", r[0]) is joint), None)
         if idx is None or art.kinds[idx] not in DRIVEN_KINDS:
             return None
         (p, i, d), out = controller_of(joint)

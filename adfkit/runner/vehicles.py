@@ -9,7 +9,7 @@ is used as written. The chassis is held up by a spring-damper along each wheel's
 sideways by a friction impulse, both applied to the chassis alone after each physics step
 (``btDiscreteDynamicsWorld::updateActions``, after the bodies moved). The coordinate system is
 AMBF's (right y, up z, forward x). Nothing commands the wheels here (no engine force, brake or
-steering), so a wheel rolls freely: Bullet's rolling friction without a brake is 0.
+steering), so a wheel rolls freely: Bullet's rolling impulse without a brake is 0.
 
 The engine hands ``RaycastVehicle.update`` the chassis's COM state and a ray caster; it returns
 the impulse's force and torque about the COM spread over the next physics step (an impulse
@@ -18,7 +18,6 @@ end, damping and gravity included)."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,7 +32,7 @@ DEFAULT_FRICTION_SLIP = 10.5
 DEFAULT_ROLL_INFLUENCE = 0.1
 #: resolveSingleBilateral's contact damping (btContactConstraint.cpp)
 SIDE_DAMPING = 0.2
-RIGHT, UP, FORWARD = 1, 2, 0  # afVehicle: m_vehicle->setCoordinateSystem(1, 2, 0)
+UP = 2  # afVehicle: m_vehicle->setCoordinateSystem(1, 2, 0), the chassis frame's up axis z
 
 
 @dataclass
@@ -48,13 +47,9 @@ class RaycastWheel:
     compression: float  # the file's suspension `compression`
     friction_slip: float = DEFAULT_FRICTION_SLIP
     roll_influence: float = DEFAULT_ROLL_INFLUENCE
-    steering: float = 0.0
-    brake: float = 0.0
-    engine_force: float = 0.0
     # state kept from one update to the next (btWheelInfo)
     suspension_length: float = 0.0
     in_contact: bool = False
-    rotation: float = 0.0
 
 
 @dataclass
@@ -151,70 +146,36 @@ class RaycastVehicle:
             suspension.append(max(force / self.inv_mass, 0.0))
         for s, n, p in zip(suspension, normal, contact):
             apply(n * min(s, MAX_SUSPENSION_FORCE) * dt, p - com)
-        self._friction(dt, com, rot, inv_i, contact, normal, axle, down, suspension, apply, point_velocity)
+        self._friction(com, rot, inv_i, contact, normal, axle, suspension, dt, apply, point_velocity)
         return total_j / dt, total_t / dt
 
-    def _friction(self, dt, com, rot, inv_i, contact, normal, axle, down, suspension, apply, point_velocity) -> None:
+    def _friction(self, com, rot, inv_i, contact, normal, axle, suspension, dt, apply, point_velocity) -> None:
         """btRaycastVehicle::updateFriction: each grounded wheel's sideways impulse (Bullet's
-        resolveSingleBilateral against a fixed body), its rolling impulse (brake-bounded: 0
-        without a brake), both scaled down together where they exceed the wheel's grip."""
-        on_ground = [wh.in_contact for wh in self.wheels]
-        if not any(on_ground):
-            return
-        n_ground = sum(on_ground)
-        side, fwd, axles, forwards = [0.0] * len(self.wheels), [0.0] * len(self.wheels), [], []
-        for i, wh in enumerate(self.wheels):
-            a = axle[i]
-            if wh.steering:
-                a = _rotate(a, -down[i], wh.steering)
-            a = _norm(a - normal[i] * float(a @ normal[i]))
-            f = _norm(cross3(normal[i], a))
-            axles.append(a)
-            forwards.append(f)
-            if not wh.in_contact:
-                continue
-            rel = contact[i] - com
-            side[i] = -SIDE_DAMPING * float(a @ point_velocity(rel)) / _denominator(self.inv_mass, inv_i, rel, a)
-        sliding = False
-        skid = [1.0] * len(self.wheels)
-        for i, wh in enumerate(self.wheels):
-            if not wh.in_contact:
-                continue
-            if wh.engine_force != 0.0:
-                fwd[i] = wh.engine_force * dt
-            else:
-                rel = contact[i] - com
-                j = -float(forwards[i] @ point_velocity(rel)) / _denominator(self.inv_mass, inv_i, rel, forwards[i])
-                fwd[i] = min(max(j / n_ground, -wh.brake), wh.brake)
-            grip = suspension[i] * dt * wh.friction_slip
-            x, y = fwd[i] * 0.5, side[i]
-            if x * x + y * y > grip * grip:
-                sliding = True
-                skid[i] = grip / math.sqrt(x * x + y * y)
-        if sliding:
-            for i in range(len(self.wheels)):
-                if side[i] != 0.0 and skid[i] < 1.0:
-                    fwd[i] *= skid[i]
-                    side[i] *= skid[i]
+        resolveSingleBilateral against a fixed body), scaled down where it exceeds the wheel's
+        grip. Its rolling impulse is bounded by the brake, and nothing commands a brake, an
+        engine force or a steering angle here: it is 0, and the axle the file's."""
         up = rot[:, UP]
-        for i, wh in enumerate(self.wheels):
-            rel = contact[i] - com
-            if fwd[i] != 0.0:
-                apply(forwards[i] * fwd[i], rel)
-            if side[i] != 0.0:
-                rel = rel - up * (float(up @ rel) * (1.0 - wh.roll_influence))  # ROLLING_INFLUENCE_FIX
-                apply(axles[i] * side[i], rel)
+        pushes = []  # every wheel's impulse from the velocities before any of them (as Bullet's)
+        for wh, a, n, p, s in zip(self.wheels, axle, normal, contact, suspension):
+            if not wh.in_contact:
+                continue
+            a = _norm(a - n * float(a @ n))
+            rel = p - com
+            side = -SIDE_DAMPING * float(a @ point_velocity(rel)) / _denominator(self.inv_mass, inv_i, rel, a)
+            grip = s * dt * wh.friction_slip
+            side = max(min(side, grip), -grip)  # the skid
+            if side != 0.0:
+                pushes.append(
+                    (a * side, rel - up * (float(up @ rel) * (1.0 - wh.roll_influence)))
+                )  # ROLLING_INFLUENCE_FIX
+        for impulse, rel in pushes:
+            apply(impulse, rel)
 
 
 def _denominator(inv_mass: float, inv_i: np.ndarray, rel: np.ndarray, direction: np.ndarray) -> float:
     """btRigidBody::computeImpulseDenominator (the fixed ground adds nothing)."""
     c = cross3(rel, direction)
     return inv_mass + float(direction @ cross3(inv_i @ c, rel))
-
-
-def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
-    k = _norm(axis)
-    return v * math.cos(angle) + cross3(k, v) * math.sin(angle) + k * float(k @ v) * (1 - math.cos(angle))
 
 
 def planned(world, models, bodies_of, warn: bool = True) -> list[tuple]:

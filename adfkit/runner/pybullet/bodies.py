@@ -125,6 +125,7 @@ def set_dynamics(sb: SimBody, ambf_dt: float | None = None) -> None:
         if b.damping is not None and b.damping.angular is not None
         else DEFAULT_ANGULAR_DAMPING,
     )
+    frozen = ambf_bodies.frozen_inertia(b) if ambf_dt is not None and not sb.static else None
     if (
         not sb.static
         and b.mass is not None
@@ -134,8 +135,8 @@ def set_dynamics(sb: SimBody, ambf_dt: float | None = None) -> None:
     ):
         kw["localInertiaDiagonal"] = [b.inertia.ix, b.inertia.iy, b.inertia.iz]
         kw["mass"] = sb.mass  # PyBullet zeroes a maximal body's mass when only the inertia is given
-    elif ambf_dt is not None and not sb.static and ambf_bodies.frozen_inertia(b) is not None:
-        kw["localInertiaDiagonal"] = list(ambf_bodies.frozen_inertia(b))  # a moment of 0: AMBF's never turns
+    elif frozen is not None:
+        kw["localInertiaDiagonal"] = list(frozen)  # a moment of 0: AMBF's body never turns about it
         kw["mass"] = sb.mass
     elif ambf_dt is not None and not sb.static and sb.mass > 0:
         estimate = ambf_bodies.estimated_inertia(sb.model, b, sb.com_in_body)

@@ -44,7 +44,9 @@ class PyBulletVehicles:
                 )
                 inv_mass = 1.0 / chassis.mass
                 inv_inertia = [1.0 / i if i > 0 else 0.0 for i in chassis.inertia]
-            self.vehicles.append(RaycastVehicle(key, chassis, wheels, inv_mass, inv_inertia))
+            v = RaycastVehicle(key, chassis, wheels, inv_mass, inv_inertia)
+            v.com_in_ref = invert(chassis.ref_in_body) @ chassis.com_in_body  # AMBF's COM in PyBullet's frame
+            self.vehicles.append(v)
 
     def __bool__(self) -> bool:
         return bool(self.vehicles)
@@ -62,7 +64,7 @@ class PyBulletVehicles:
             sb = v.chassis
             p, q, lin, ang = sb.state()
             ref = pose_matrix(p, q)  # PyBullet's frame of the chassis
-            com = ref @ invert(sb.ref_in_body) @ sb.com_in_body  # AMBF's COM frame
+            com = ref @ v.com_in_ref  # AMBF's COM frame
             pos, quat = matrix_to_pq(com)
             lin_com = np.array(lin) + cross3(ang, com[:3, 3] - ref[:3, 3])
             made = v.update(dt, pos, quat, lin_com, ang, self._cast)
