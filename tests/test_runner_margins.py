@@ -28,8 +28,9 @@ PLATES = _boxes_obj(
 )
 
 
-def _rest_gap(tmp_path, plates_margin: str, floor: str) -> float:
-    """How far, m, the plates' underside comes to rest above the floor's top (z = 0)."""
+def _rest_gap(tmp_path, plates_margin: str, floor: str, engine: str = "pybullet") -> float:
+    """How far, m, the plates' underside comes to rest above the floor's top (z = 0); MuJoCo
+    with AMBF's bodies (`adfkit run`'s), the only ones it gives a hull's margin."""
     from adfkit.adf import load_scene
     from adfkit.runner import Options, open_world
 
@@ -51,7 +52,8 @@ BODY plates:
   location: {{position: {{x: 0.0, y: 0.0, z: 0.003}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
 """
     )
-    world = open_world(load_scene(tmp_path / "model.yaml", None, []), Options(ground=False, visuals=False))
+    opt = Options(ground=False, visuals=False, bodies="ambf" if engine == "mujoco" else "pybullet")
+    world = open_world(load_scene(tmp_path / "model.yaml", None, []), opt, engine=engine)
     try:
         world.run(0.5)
         return world.body("BODY plates").world_matrix()[2, 3] - 0.0004
@@ -82,3 +84,15 @@ def test_static_hulls_take_the_files_margin(tmp_path):
     assert _rest_gap(tmp_path, "  collision margin: 0.0001", hull_floor) == pytest.approx(2e-4, abs=5e-5)
     hull_floor_default = "  collision mesh: slabs.obj\n  collision mesh type: CONVEX_HULL"
     assert _rest_gap(tmp_path, "  collision margin: 0.0001", hull_floor_default) == pytest.approx(1.1e-3, abs=1e-4)
+
+
+def test_mujoco_hulls_take_the_files_margin(tmp_path):
+    """MuJoCo's geoms have no margin of their own; under AMBF's bodies a mesh geom gets the
+    body's `collision margin` (AMBF's 1 mm without the key) as its contact margin, where MuJoCo's
+    contacts come to rest, so a hull rests as far from a box as in Bullet: 0.1 mm, 1 mm, 10 mm
+    (`adfkit parity` on a 3 cm icosphere of margin 0.01 dropped on the floor: 11.1 mm from AMBF
+    before, 0.004 mm at the end)."""
+    pytest.importorskip("mujoco")
+    assert _rest_gap(tmp_path, "  collision margin: 0.0001", BOX_FLOOR, "mujoco") == pytest.approx(1e-4, abs=5e-5)
+    assert _rest_gap(tmp_path, "", BOX_FLOOR, "mujoco") == pytest.approx(1e-3, abs=1e-4)
+    assert _rest_gap(tmp_path, "  collision margin: 0.01", BOX_FLOOR, "mujoco") == pytest.approx(1e-2, abs=2e-4)

@@ -5,9 +5,12 @@ collision shape the writer could not give MuJoCo."""
 
 from __future__ import annotations
 
+import mujoco
+
 from ...converters.urdf import _material
 from ...diagnostics import warning
 from ...model.semantics import ShapeKind
+from ..ambf_bodies import AMBF_MARGIN
 from ..collisions import collision_masks, convex_parts_note
 from .contacts import ambf_surface
 
@@ -59,6 +62,17 @@ def _shape_left_out(world, m, loss) -> None:
     world.not_played.append({"object": loss.element, "what": loss.feature, "why": loss.reason})
 
 
+def hull_margin(body) -> float:
+    """A mesh geom's contact margin under AMBF's bodies: the body's `collision margin` (AMBF's
+    1 mm without it). Bullet collides a hull (and AMBF's other mesh shapes) grown by its margin;
+    MuJoCo's contacts come to rest at the pair's margin, so the geom keeps the same distance. A
+    box's, cylinder's and capsule's margins lie inside them in Bullet and a sphere's is its radius:
+    MuJoCo's primitives keep none. Between two meshes MuJoCo takes the larger margin, where Bullet
+    adds the two."""
+    m = body.collision_margin
+    return float(m) if m is not None and m >= 0 else AMBF_MARGIN
+
+
 def collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
     """ADF collision groups as contype/conaffinity bits (bodies collide when they share a
     group, as in the PyBullet runner); joints (the tree's and those closing loops) and models
@@ -81,6 +95,8 @@ def collision_filters(world, spec, bodies, joints, plans_by_model) -> None:
             g.contype = g.conaffinity = mask
             if world.opt.bodies == "ambf":  # AMBF's surfaces (contacts.ambf_surface)
                 ambf_surface(g, fr)
+                if g.type == mujoco.mjtGeom.mjGEOM_MESH:
+                    g.margin = hull_margin(bp.body)
             elif fr is not None and fr.static is not None:
                 g.friction = [fr.static, g.friction[1], fr.rolling if fr.rolling is not None else g.friction[2]]
     pairs = set()
