@@ -26,6 +26,7 @@ from ..model.semantics import (
     JointKind,
     ShapeKind,
     body_joint_frames,
+    collision_mesh_pose,
     collision_primitives,
     cone_vertices,
     effective_mass,
@@ -288,6 +289,7 @@ def _write_geoms(
             g.set("rgba", _vec(rgba))
     prims = collision_primitives(body)
     if prims is None:
+        to_mesh = to_link * collision_mesh_pose(body)
         cmesh = collision_mesh_path(model, body)
         flat = None
         if cmesh is not None:
@@ -297,7 +299,7 @@ def _write_geoms(
             g = ET.SubElement(
                 el, "geom", name=_unique(f"{name}_collision", used["geom"]), type="box", size=_vec(sizes / 2), group="3"
             )
-            _place(g, to_link * Pose(Vec3(*centre), Quat.from_matrix(rot.tolist())))
+            _place(g, to_mesh * Pose(Vec3(*centre), Quat.from_matrix(rot.tolist())))
             losses.append(
                 Loss(
                     who,
@@ -321,7 +323,7 @@ def _write_geoms(
                     mesh=assets.mesh(part, scale),
                     group="3",
                 )
-                _place(g, to_link)
+                _place(g, to_mesh)
             if not stand_in:
                 losses.append(
                     Loss(

@@ -200,10 +200,31 @@ def pose_or_identity(p: Pose | None) -> Pose:
 
 
 def inertial_offset(body) -> Pose:
-    """The COM frame in the body frame (identity unless written and mass is written)."""
+    """The COM frame in the body frame (identity unless written and mass is written), or AMBF's
+    estimate from the collision mesh where the runner gave the body one (runner/ambf_bodies.py
+    attach_com_estimates, geometry/chai3d_com.py)."""
+    est = getattr(body, "ambf_com", None)
+    if est is not None:
+        return Pose(Vec3(*est))
     if body.mass is None:
         return Pose()
     return pose_or_identity(body.inertial_offset)
+
+
+def com_estimated(body) -> bool:
+    """AMBF estimates the body's centre of mass from its collision mesh (adf-format.md §7.2):
+    the body collides with a mesh and its file gives no `inertial offset`, or no `mass` (then
+    none of its inertial keys is read)."""
+    if body.mass is not None and body.inertial_offset is not None:
+        return False
+    return collision_primitives(body) is None
+
+
+def collision_mesh_pose(body) -> Pose:
+    """Pose of the collision mesh in the body frame: the body frame itself, or AMBF's estimated
+    inertial frame where the runner gave the body one (AMBF builds the mesh's shape in it)."""
+    est = getattr(body, "ambf_com", None)
+    return Pose(Vec3(*est)) if est is not None else Pose()
 
 
 def collision_offset(body) -> Pose:

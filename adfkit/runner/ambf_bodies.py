@@ -37,7 +37,7 @@ import numpy as np
 
 from ..adf.paths import collision_mesh_path
 from ..diagnostics import AdfError
-from ..model.semantics import collision_primitives
+from ..model.semantics import collision_primitives, effective_mass
 
 #: AMBF's `collision margin` when a body gives none (afCollisionAttributes.m_margin), m
 AMBF_MARGIN = 0.001
@@ -106,9 +106,10 @@ def estimated_inertia(model, body, com_in_body: np.ndarray) -> tuple[float, floa
     from ..model.semantics import CollisionMeshType, collision_mesh_type
 
     given = body.inertia
-    if given is not None and None not in (given.ix, given.iy, given.iz):
+    if body.mass is not None and given is not None and None not in (given.ix, given.iy, given.iz):
         return None
-    if not body.mass or body.mass <= 0:
+    mass = effective_mass(body)  # without `mass` AMBF takes 1 kg and reads no `inertia` (§7.2)
+    if not mass or mass <= 0:
         return None
     margin = body.collision_margin
     if isinstance(margin, bool) or not isinstance(margin, (int, float)) or not margin >= 0:
@@ -145,4 +146,22 @@ def estimated_inertia(model, body, com_in_body: np.ndarray) -> tuple[float, floa
         h = np.abs(to_com[:3, :3] @ rot) @ half
         lows.append(c - h)
         highs.append(c + h)
-    return box_inertia(float(body.mass), np.max(highs, axis=0) - np.min(lows, axis=0))
+    return box_inertia(float(mass), np.max(highs, axis=0) - np.min(lows, axis=0))
+
+
+def attach_com_estimates(scene, on: bool) -> None:
+    """Give every body of ``scene`` AMBF's estimated centre of mass (geometry/chai3d_com.py) as
+    ``ambf_com`` where ``on`` (AMBF's bodies asked for: Options.bodies "ambf") and AMBF estimates
+    it (model.semantics.com_estimated), else None: model.semantics.inertial_offset and
+    collision_mesh_pose read it, so the engines put the centre of mass and the collision mesh
+    where AMBF does."""
+    from ..geometry.chai3d_com import mesh_com
+    from ..model.semantics import com_estimated
+
+    for m in scene.all_models():
+        for b in m.bodies:
+            est = None
+            if on and com_estimated(b) and (path := collision_mesh_path(m, b)) is not None:
+                scale = b.scale if isinstance(b.scale, (int, float)) and not isinstance(b.scale, bool) else 1.0
+                est = mesh_com(path, float(scale))
+            b.ambf_com = est

@@ -41,6 +41,9 @@ def _deforms(world) -> bool:
 def open_world(scene, options: Options | None = None, gui: bool = False, engine: str = "pybullet", **kw):
     """The scene built in ``engine`` ("pybullet", the reference runner, or "mujoco"), ready to step.
     ``kw``: the engine's own options (MuJoCo: ``sleep``)."""
+    from .ambf_bodies import attach_com_estimates
+
+    attach_com_estimates(scene, options is not None and options.bodies == "ambf")
     if engine == "pybullet":
         from .pybullet.world import PyBulletWorld
 

@@ -7,6 +7,8 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
+
 from .. import inputs
 from ..adf.paths import collision_mesh_path, relative_to_file, shader_paths, uses_collision_mesh, visual_mesh_path
 from ..diagnostics import AdfError, Diagnostic, SourceLocation
@@ -69,12 +71,46 @@ def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:
     ]
 
 
+#: the rules after which a body's mesh is not read for its estimated centre of mass
+MESH_TROUBLE = ("mesh-format", "missing-mesh", "mesh-unreadable", "input-refused", "obj-faces-crash-ambf")
+#: m, the estimated centre of mass off the body frame below which AMBF's estimate is not worth a word
+COM_ESTIMATE_NOTED = 1e-4
+
+
+def _com_estimated(m: ModelFile, body: Body) -> list[Diagnostic]:
+    """`inertial-offset-estimated`: AMBF puts the centre of mass of a mesh body without
+    `inertial offset` (or without `mass`) at its estimate from the collision mesh, and builds
+    the collision shape there, that far off the visual (geometry/chai3d_com.py)."""
+    from ..geometry.chai3d_com import mesh_com
+    from ..model.semantics import com_estimated
+
+    if not com_estimated(body) or (path := collision_mesh_path(m, body)) is None or not _present(path):
+        return []
+    scale = body.scale if isinstance(body.scale, (int, float)) and not isinstance(body.scale, bool) else 1.0
+    est = mesh_com(path, float(scale))
+    if est is None or float(np.linalg.norm(est)) < COM_ESTIMATE_NOTED:
+        return []
+    mm = ", ".join(f"{1e3 * float(x):.1f}" for x in est)
+    why = "no `mass`" if body.mass is None else "no `inertial offset`"
+    return [
+        _d(
+            "inertial-offset-estimated",
+            f"'{body.identifier}' has {why}: AMBF puts its centre of mass at ({mm}) mm in the body frame, "
+            f"its estimate from {path.name}'s vertices, and builds its collision shape there, "
+            f"{1e3 * float(np.linalg.norm(est)):.1f} mm off its visual mesh",
+            body.where("mass") or body.source,
+            "give the body `inertial offset` (and `mass`); `adfkit inertia MESH --mass M` computes one",
+        )
+    ]
+
+
 def model_paths(m: ModelFile) -> list[Diagnostic]:
     out: list[Diagnostic] = []
     objs: list[Body | SoftBody | Ghost] = [*m.bodies, *m.soft_bodies, *m.ghost_objects]
     for obj in objs:
         if not obj.defined:
             continue
+        start = len(out)
         seen = set()
         checks = []
         if not obj.shape and not obj.compound_shape:
@@ -136,6 +172,8 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
                             "textures come from the mesh's own material (MTL) file",
                         )
                     )
+        if isinstance(obj, Body) and not any(d.rule in MESH_TROUBLE for d in out[start:]):
+            out += _com_estimated(m, obj)
         out += _shaders(m.path, getattr(obj, "shaders", None), f"'{obj.identifier}'", obj.where("shaders"))
     for s in m.sensors:
         if s.mesh and not _exists(str(m.directory / s.mesh)):

@@ -212,6 +212,14 @@ _RULES = [
     ),
     Rule("geometry-axis", W, "Primitive axis is not x/y/z; AMBF uses z", "`axis: w`"),
     Rule(
+        "inertial-offset-estimated",
+        W,
+        "A body colliding with a mesh has no `inertial offset` (or no `mass`): AMBF puts its centre of mass at the "
+        "mean of the collision mesh's vertices (of its first sub-mesh, once per sub-mesh) and builds its collision "
+        "shape there, off its visual; the finding says by how much",
+        "a link's STL written from its joint, without `inertial offset`",
+    ),
+    Rule(
         "geometry-size",
         W,
         "A collision primitive of size 0 or less, or a capsule shorter than its two caps (AMBF gives "

@@ -24,6 +24,7 @@ from ...model.semantics import (
     CollisionMeshType,
     Primitive,
     ShapeKind,
+    collision_mesh_pose,
     collision_mesh_type,
     collision_primitives,
     cone_vertices,
@@ -198,7 +199,7 @@ def collision_parts(
         )
         return parts
     kind, _ = collision_mesh_type(obj.collision_mesh_type)
-    pos, orn = matrix_to_pq(body_to_com)
+    pos, orn = matrix_to_pq(body_to_com @ pose_to_matrix(collision_mesh_pose(obj)))
     kw = dict(fileName=str(path), meshScale=[scale] * 3, collisionFramePosition=pos, collisionFrameOrientation=orn)
     if kind is CollisionMeshType.CONCAVE_MESH and static and deformable:
         if not is_convex(path):
