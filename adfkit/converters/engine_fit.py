@@ -54,8 +54,8 @@ def usable_scales(model, losses: list[Loss]):
 
 
 def joint_range(joint, losses: list[Loss]) -> tuple[float, float] | None:
-    """The joint's (low, high) when both are set, finite and ordered; else None (with a loss
-    for limits that are set but unusable)."""
+    """The joint's (low, high) when both are set, finite and ordered (equal ones a hair apart);
+    else None (with a loss for limits that are set but unusable)."""
     lim = joint.joint_limits
     if lim is None or lim.low is None or lim.high is None:
         return None
@@ -72,7 +72,20 @@ def joint_range(joint, losses: list[Loss]) -> tuple[float, float] | None:
             )
         )
         return None
+    if low == high:  # Bullet holds the joint there; MuJoCo refuses a range that is not low < high
+        losses.append(
+            Loss(
+                joint.identifier,
+                "joint limits",
+                f"low = high = {low!r} (the joint held there): written {LOCKED_RANGE:g} wide about it",
+            )
+        )
+        return low - LOCKED_RANGE / 2, high + LOCKED_RANGE / 2
     return low, high
+
+
+#: rad or m, the width of the range written for a joint whose limits are equal (MuJoCo needs low < high)
+LOCKED_RANGE = 1e-6
 
 
 class MeshFiles:
