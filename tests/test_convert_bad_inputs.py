@@ -341,3 +341,19 @@ def test_flat_box_of_a_point_or_a_line_is_its_bounds(points):
     assert np.allclose(centre, [span / 2, 0, 0], atol=1e-9)
     assert sorted(np.round(sizes[:2], 9).tolist()) == [0.0, span]
     assert sizes[2] == pytest.approx(FLAT_THICKNESS * max(span, 1e-6))
+
+
+def test_mjcf_output_of_an_inertia_breaking_the_triangle_inequality_loads_in_mujoco(tmp_path):
+    """Bullet (so AMBF) plays principal moments (0.01, 0.001, 0.001); MuJoCo refuses them ("inertia
+    must satisfy A + B >= C"), and the MuJoCo engine refused the whole scene. Written with the
+    largest lowered to the sum of the other two, and a loss that says so."""
+    mujoco = pytest.importorskip("mujoco")
+    (tmp_path / "m.yaml").write_text(
+        "bodies: [BODY odd]\nBODY odd:\n  name: odd\n  mass: 0.2\n  inertia: {ix: 0.01, iy: 0.001, iz: 0.001}\n"
+        "  collision shape: BOX\n  collision geometry: {x: 0.05, y: 0.05, z: 0.05}\n"
+        "  location: {position: {x: 0, y: 0, z: 0.3}, orientation: {r: 0, p: 0, y: 0}}\n"
+    )
+    losses = write(read(tmp_path / "m.yaml")[0], tmp_path / "m.xml")
+    assert ("BODY odd", "inertia") in set(loss_keys(losses))
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "m.xml"))
+    assert sorted(m.body("odd").inertia) == pytest.approx([0.001, 0.001, 0.002])

@@ -17,6 +17,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from ..adf.paths import collision_mesh_path, visual_mesh_path
 from ..adf.writer import atomic_write_text
 from ..diagnostics import AdfError, error
@@ -218,6 +220,16 @@ def _write_body(
                 )
             )
             mass, ix, iy, iz = max(mass, MIN_MASS), max(ix, MIN_INERTIA), max(iy, MIN_INERTIA), max(iz, MIN_INERTIA)
+        if inertia_math.physical_problem((ix, iy, iz)) == "break the triangle inequality":
+            ix, iy, iz = _triangle(ix, iy, iz)
+            losses.append(
+                Loss(
+                    who,
+                    "inertia",
+                    "breaks the triangle inequality (Bullet, so AMBF, plays it; MuJoCo refuses it): "
+                    f"written with its largest moment lowered to the sum of the other two, {_vec((ix, iy, iz))}",
+                )
+            )
         com = link.in_link(inertial_offset(body))
         inertial = ET.SubElement(el, "inertial", pos=_vec(com.position))
         _place(inertial, Pose(Vec3(), com.orientation))
@@ -234,6 +246,14 @@ def _write_body(
     if body.damping is not None:
         losses.append(Loss(who, "damping", "MuJoCo has no body velocity damping"))
     return el
+
+
+def _triangle(ix: float, iy: float, iz: float) -> tuple[float, float, float]:
+    """Principal moments with the one larger than the sum of the other two lowered to that sum."""
+    m = [ix, iy, iz]
+    k = int(np.argmax(m))
+    m[k] = m[(k + 1) % 3] + m[(k + 2) % 3]
+    return m[0], m[1], m[2]
 
 
 def _is_world(link: Link) -> bool:
