@@ -16,6 +16,7 @@ from ..plan import ALL_GROUPS
 from ..rotations import pose_to_matrix
 from .build import GHOST_GROUP, build_plan
 from .contacts import bullet_pairs, ground_pairs, set_contacts
+from .cross_joints import file_anchors
 from .damping import BodyDamping
 from .drives import DriveLimits, drive_limit
 from .integrator import integrator_for
@@ -184,6 +185,7 @@ class Assembly:
         self._ray_hit = np.zeros(1, dtype=np.int32)
         self._body_of_id = {sb.id: sb for sb in self.bodies}
         self.vehicles = MujocoVehicles(self)
+        file_anchors(m, plan.loops)
         self.constraints = [
             (j.identifier, None, by_plan[id(p)], by_plan[id(c)], pa, pb_, None) for j, kind, p, c, pa, pb_ in plan.loops
         ]

@@ -74,3 +74,29 @@ def stiff_static_hinges(spec, loops, dt: float, timeconst_steps: float, damping_
         for eq in spec.equalities:
             if eq.type == mujoco.mjtEq.mjEQ_CONNECT and {eq.name1, eq.name2} == {parent.mjname, child.mjname}:
                 eq.solref = [timeconst_steps * dt, damping_ratio]
+
+
+def file_anchors(m, loops) -> None:
+    """Each connect that closes a joint of ``loops`` holds the child's pivot the file gives, as
+    AMBF's btPoint2PointConstraint and btHingeConstraint hold both pivots: MuJoCo computes a
+    connect's second anchor from where the bodies start, so where a file places a child off its
+    joint MuJoCo held the two pivots that far apart for good (a p2p from a free box to a static
+    one, the child's pivot 100 mm off: 100.4 mm open after 1 s, AMBF's 0.010 mm). The second
+    connect of a hinge to a static body (a point on its axis) moves with it."""
+    connects = [e for e in range(m.neq) if m.eq_type[e] == mujoco.mjtEq.mjEQ_CONNECT]
+    for _j, kind, parent, child, pa, pb in loops:
+        if kind is JointKind.FIXED:
+            continue
+        ids = (
+            mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, parent.mjname),
+            mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, child.mjname),
+        )
+        pair = [e for e in connects if (int(m.eq_obj1id[e]), int(m.eq_obj2id[e])) == ids]
+        pivot = [e for e in pair if np.linalg.norm(m.eq_data[e, :3] - pa) < 1e-9]
+        if len(pivot) != 1:
+            continue
+        shift = np.asarray(pb, float) - m.eq_data[pivot[0], 3:6]
+        if np.linalg.norm(shift) <= 1e-9:  # the file's placement sits on the joint: kept bit for bit
+            continue
+        for e in pair:
+            m.eq_data[e, 3:6] += shift
