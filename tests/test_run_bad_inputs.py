@@ -233,3 +233,26 @@ def test_the_floor_under_a_model_played_alone_meets_bodies_of_every_collision_gr
             assert z == pytest.approx(floor + 0.05, abs=2e-3), (n, z, floor)  # the 5 cm spheres rest on it
     finally:
         world.close()
+
+
+def test_a_joint_between_two_static_bodies_reports_no_constraint_error(tmp_path):
+    """A `fixed` joint between two static boxes 0.2 m apart holds nothing (nor does AMBF's): the
+    report's constraint error was their 223.6 mm (pivots at each centre, 0.1 m up on the child)."""
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+
+    bodies = BODY.format(name="a", mass=0.0, x=0.0, z=0.3, shape=SPHERE) + BODY.format(
+        name="b", mass=0.0, x=0.2, z=0.3, shape=SPHERE
+    )
+    joint = (
+        "JOINT j:\n  name: j\n  parent: BODY a\n  child: BODY b\n  type: fixed\n"
+        "  parent pivot: {x: 0, y: 0, z: 0}\n  child pivot: {x: 0, y: 0, z: 0.1}\n"
+        "  parent axis: {x: 0, y: 0, z: 1}\n  child axis: {x: 0, y: 0, z: 1}\n"
+    )
+    (tmp_path / "m.yaml").write_text("bodies: [BODY a, BODY b]\njoints: [JOINT j]\n" + bodies + joint)
+    world = open_world(load_scene(tmp_path / "m.yaml", None, []), Options(visuals=False, ground=False))
+    try:
+        world.run(0.1)
+        assert world.constraint_error() == 0.0
+    finally:
+        world.close()

@@ -257,8 +257,9 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
 
     def constraint_error(self) -> float:
         """Largest distance, m, between the two pivots of any joint (constraints and springs
-        with a locked linear range); multibody joints are exact."""
-        rows = self.constraints
+        with a locked linear range); multibody joints are exact, and a joint between two static
+        bodies holds nothing (AMBF's constraint between them does nothing either)."""
+        rows = [r for r in self.constraints if not (r[2].static and r[3].static)]
         if not rows:
             return 0.0
         key = tuple(id(r) for r in rows)
