@@ -12,9 +12,7 @@ import pytest
 from parity_scene import body, launch_with, parity
 
 from adfkit.adf import load_scene
-from adfkit.adf.paths import collision_mesh_path
-from adfkit.geometry.chai3d_com import mesh_com
-from adfkit.model.semantics import com_estimated
+from adfkit.geometry.chai3d_com import body_com, mesh_com
 from adfkit.parity import ambf
 from adfkit.runner import Options, open_world
 
@@ -51,7 +49,7 @@ L_BOXES = [(-0.04, 0.04, -0.01, 0.01, -0.01, 0.01), (0.03 - 0.01, 0.03 + 0.01, -
 
 def com_estimate(m, b):
     """The estimate the runner attaches to body ``b`` of model ``m`` (None where AMBF takes the file's)."""
-    return mesh_com(collision_mesh_path(m, b), b.scale or 1.0) if com_estimated(b) else None
+    return body_com(m, b)
 
 
 def _model(tmp_path, text: str, extra: str = "") -> tuple:

@@ -35,6 +35,18 @@ import numpy as np
 from .meshcheck import is_ascii_stl
 
 
+def body_com(model, body) -> np.ndarray | None:
+    """AMBF's estimated centre of mass of ``body`` (of ``model``) in its body frame, or None
+    where AMBF takes the file's (model.semantics.com_estimated) or the mesh cannot be read."""
+    from ..adf.paths import collision_mesh_path
+    from ..model.semantics import com_estimated
+
+    if not com_estimated(body) or (path := collision_mesh_path(model, body)) is None or not path.is_file():
+        return None
+    scale = body.scale if isinstance(body.scale, (int, float)) and not isinstance(body.scale, bool) else 1.0
+    return mesh_com(path, float(scale))
+
+
 def mesh_com(path: Path, scale: float = 1.0) -> np.ndarray | None:
     """AMBF's estimated centre of mass, in the body frame, of a body whose collision mesh is the
     OBJ or STL file at ``path`` (module docstring); None for a file that cannot be read here."""

@@ -155,13 +155,8 @@ def attach_com_estimates(scene, on: bool) -> None:
     it (model.semantics.com_estimated), else None: model.semantics.inertial_offset and
     collision_mesh_pose read it, so the engines put the centre of mass and the collision mesh
     where AMBF does."""
-    from ..geometry.chai3d_com import mesh_com
-    from ..model.semantics import com_estimated
+    from ..geometry.chai3d_com import body_com
 
     for m in scene.all_models():
         for b in m.bodies:
-            est = None
-            if on and com_estimated(b) and (path := collision_mesh_path(m, b)) is not None:
-                scale = b.scale if isinstance(b.scale, (int, float)) and not isinstance(b.scale, bool) else 1.0
-                est = mesh_com(path, float(scale))
-            b.ambf_com = est
+            b.ambf_com = body_com(m, b) if on else None

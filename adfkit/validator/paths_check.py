@@ -81,22 +81,20 @@ def _com_estimated(m: ModelFile, body: Body) -> list[Diagnostic]:
     """`inertial-offset-estimated`: AMBF puts the centre of mass of a mesh body without
     `inertial offset` (or without `mass`) at its estimate from the collision mesh, and builds
     the collision shape there, that far off the visual (geometry/chai3d_com.py)."""
-    from ..geometry.chai3d_com import mesh_com
-    from ..model.semantics import com_estimated
+    from ..geometry.chai3d_com import body_com
 
-    if not com_estimated(body) or (path := collision_mesh_path(m, body)) is None or not _present(path):
-        return []
-    scale = body.scale if isinstance(body.scale, (int, float)) and not isinstance(body.scale, bool) else 1.0
-    est = mesh_com(path, float(scale))
+    est = body_com(m, body)
     if est is None or float(np.linalg.norm(est)) < COM_ESTIMATE_NOTED:
         return []
+    path = collision_mesh_path(m, body)
+    name = path.name if path is not None else "its collision mesh"
     mm = ", ".join(f"{1e3 * float(x):.1f}" for x in est)
     why = "no `mass`" if body.mass is None else "no `inertial offset`"
     return [
         _d(
             "inertial-offset-estimated",
             f"'{body.identifier}' has {why}: AMBF puts its centre of mass at ({mm}) mm in the body frame, "
-            f"its estimate from {path.name}'s vertices, and builds its collision shape there, "
+            f"its estimate from {name}'s vertices, and builds its collision shape there, "
             f"{1e3 * float(np.linalg.norm(est)):.1f} mm off its visual mesh",
             body.where("mass") or body.source,
             "give the body `inertial offset` (and `mass`); `adfkit inertia MESH --mass M` computes one",
