@@ -32,6 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import inputs
+from ..diagnostics import AdfError
 from .meshcheck import is_ascii_stl
 
 
@@ -52,11 +54,17 @@ def mesh_com(path: Path, scale: float = 1.0) -> np.ndarray | None:
     OBJ or STL file at ``path`` (module docstring); None for a file that cannot be read here."""
     try:
         meshes, corners = _first_submesh(path)
-    except (OSError, ValueError, IndexError, struct.error):
+    except (AdfError, OSError, ValueError, IndexError, struct.error):
         return None
     if not len(corners):
         return None
     return meshes * _welded(corners * float(scale)).mean(axis=0)
+
+
+def _text(path: Path) -> str:
+    """A mesh or material file's text, read under the input policy (adfkit.inputs: its size cap,
+    no devices or pipes)."""
+    return inputs.read_bytes(path, "mesh", what="mesh file").decode("utf-8", errors="replace")
 
 
 def _first_submesh(path: Path) -> tuple[int, np.ndarray]:
@@ -67,11 +75,9 @@ def _first_submesh(path: Path) -> tuple[int, np.ndarray]:
     if suffix != ".stl":
         raise ValueError("not an OBJ or STL file")
     if is_ascii_stl(path):
-        rows = [
-            ln.split()[1:4] for ln in path.read_text(errors="replace").splitlines() if ln.strip().startswith("vertex")
-        ]
+        rows = [ln.split()[1:4] for ln in _text(path).splitlines() if ln.strip().startswith("vertex")]
         return 1, np.asarray(rows, dtype=np.float32).astype(float).reshape(-1, 3)
-    data = path.read_bytes()
+    data = inputs.read_bytes(path, "mesh", what="mesh file")
     (n,) = struct.unpack_from("<I", data, 80)
     tris = np.frombuffer(
         data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]), count=n, offset=84
@@ -80,7 +86,7 @@ def _first_submesh(path: Path) -> tuple[int, np.ndarray]:
 
 
 def _obj_first_submesh(path: Path) -> tuple[int, np.ndarray]:
-    text = path.read_text(errors="replace")
+    text = _text(path)
     materials: list[str] = []
     objects = 0
     for line in text.splitlines():
@@ -90,7 +96,7 @@ def _obj_first_submesh(path: Path) -> tuple[int, np.ndarray]:
             if lib.is_file():
                 materials += [
                     ln.split(None, 1)[1].strip() if len(ln.split(None, 1)) > 1 else ""
-                    for ln in lib.read_text(errors="replace").splitlines()
+                    for ln in _text(lib).splitlines()
                     if ln.strip().startswith("newmtl")
                 ]
         elif head == "o":
