@@ -6,7 +6,11 @@ and only pushes: a joint started outside is kicked in and coasts on; a joint res
 is held there. c is 0.3·erp/dt for a revolute joint (btHingeConstraint: setLimit's bias factor
 0.3 times the joint's `joint erp`, 0.1 unless the file says otherwise) and erp/dt for the axes of
 a `torsion spring` or `linear spring` (btGeneric6DofSpring2Constraint's stop ERP), 0.2/dt for a
-prismatic joint (btSliderConstraint's rows at the world's ERP, not the joint's). Measured in
+prismatic joint (btSliderConstraint's rows at the world's ERP, not the joint's), 0.2/dt for the
+angular axes of a `six dof` joint (btGeneric6DofConstraint's stop ERP) and 0.3/dt for a `cone
+twist` (btConeTwistConstraint's bias factor): with MuJoCo's default a rod hinged at its end by
+either, released level into its stop, sank 11-35 mm past where AMBF's stops (0.02-3.2 mm now).
+Measured in
 AMBF: a 0.5 kg arm on a hinge about z started 0.2 rad past its lower limit turns in at 6.0 rad/s
 (0.3·0.1·0.2/1 ms) from the first step; on a torsion spring at 17.6 rad/s over the first 4 ms
 (20 by the formula). MuJoCo's default (a 20 ms time constant, damping ratio 1) eased the hinge
@@ -22,8 +26,11 @@ import mujoco
 
 from ...model.semantics import DEFAULT_JOINT_ERP, HINGE_LIMIT_BIAS, ONE_AXIS_SPRINGS, SLIDER_LIMIT_ERP, JointKind
 
-#: btGeneric6DofSpring2Constraint's stop ERP, which AMBF leaves at Bullet's default on a six dof spring
+#: btGeneric6DofSpring2Constraint's stop ERP, which AMBF leaves at Bullet's default on a six dof spring;
+#: btGeneric6DofConstraint's rotational limits (btRotationalLimitMotor::m_stopERP) have the same
 SIX_DOF_SPRING_STOP_ERP = 0.2
+#: btConeTwistConstraint's bias factor, which AMBF's setLimit leaves at Bullet's default
+CONE_TWIST_BIAS = 0.3
 
 
 def limit_rate(joint, kind) -> float | None:
@@ -33,8 +40,10 @@ def limit_rate(joint, kind) -> float | None:
         return HINGE_LIMIT_BIAS * erp
     if kind in ONE_AXIS_SPRINGS:
         return erp
-    if kind is JointKind.SIX_DOF_SPRING:
+    if kind in (JointKind.SIX_DOF_SPRING, JointKind.SIX_DOF):
         return SIX_DOF_SPRING_STOP_ERP
+    if kind is JointKind.CONE_TWIST:
+        return CONE_TWIST_BIAS
     if kind is JointKind.PRISMATIC:
         return SLIDER_LIMIT_ERP
     return None

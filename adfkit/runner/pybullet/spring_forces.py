@@ -20,6 +20,7 @@ import pybullet as pb
 
 from ..rotations import euler_xyz, quat_to_matrix
 from ..springs import SpringJoint
+from .joint_inertia import PivotInertia, bullet_spring_masses
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -30,30 +31,6 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
     out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     return out
-
-
-def bullet_spring_masses(bodies, ip, ic, frame_a, frame_b):
-    """The inertia (n, 3) and mass (n, 3) Bullet's btGeneric6DofSpring2Constraint caps each joint's
-    spring and damper with, per axis of joint frame A: each dynamic body's inertia about the axis
-    (1/|I⁻¹·a|, the axis in its principal frame; the child's at the joint's zero angle) plus its
-    mass times the squared distance from its centre of mass to the joint frame, and each body's
-    mass; the two in series (mA·mB/(mA + mB)), one body's alone when the other is static."""
-    mass = np.array([0.0 if b.static else b.mass for b in bodies])
-    inertia = np.array([np.maximum(np.asarray(b.inertia, float), 1e-12) for b in bodies])
-
-    def about(i, frame):  # (n, 3): body i's inertia about each axis of its joint frame
-        axes = frame[:, :3, :3]  # columns: the joint frame's axes in the body's principal frame
-        own = 1.0 / np.linalg.norm(axes / inertia[i][:, :, None], axis=1)
-        return mass[i][:, None] * (frame[:, :3, 3] ** 2).sum(1)[:, None] + own
-
-    def series(a, b, ma, mb):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            both = a * b / (a + b)
-        return np.where((ma == 0)[:, None], b, np.where((mb == 0)[:, None], a, both))
-
-    ma, mb = mass[ip], mass[ic]
-    lin = series(np.repeat(ma[:, None], 3, 1), np.repeat(mb[:, None], 3, 1), ma, mb)
-    return series(about(ip, frame_a), about(ic, frame_b), ma, mb), lin
 
 
 class SpringSet:
@@ -161,6 +138,8 @@ class SpringSet:
         )
         self.fl_g_rel = (acc[self.ic] - acc[self.ip])[fl] if n else np.zeros((0, 3))
         self.i_eff_col = self.i_eff[:, None]
+        held = PivotInertia.held(bodies, self.ip, self.ic, deg, fl)  # a body alone on a static one
+        self.pivots = (PivotInertia(bodies, self.ip, self.ic, deg, self.pb_in_c), held) if form == "ambf" else None
         # Bullet's m, but never past the joint's share of its bodies' inertia (and mass) that the
         # implicit form uses: Bullet's counts mass·r² even about an axis through both centres of
         # mass, and the forces here act all at once (a Jacobi step), where Bullet solves rows one
@@ -289,6 +268,8 @@ class SpringSet:
         w_rel = (rat @ (av[ic] - av[ip])[:, :, None])[..., 0]
         # angular springs and limits, in joint frame A, turned into the world
         i_eff = self.i_eff_col
+        if self.pivots is not None:
+            i_eff = np.where(self.pivots[1], self.pivots[0].about_pivots(pos, rot, ra), i_eff)
         tau = self._spring(self._ang, ang - self.eq_ang, w_rel)
         tau += self._limit(
             ang,
