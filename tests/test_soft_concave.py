@@ -40,6 +40,7 @@ def _scene(tmp, tray: trimesh.Trimesh) -> str:
           mass: 0.0
           mesh: tray.obj
           color rgba: {{r: 0.3, g: 0.3, b: 0.3, a: 1.0}}
+          inertial offset: {{position: {{x: 0.0, y: 0.0, z: 0.0}}}}
         SOFT Pad:
           name: Pad
           mass: 0.04

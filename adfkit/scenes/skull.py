@@ -207,6 +207,7 @@ def write_skull(out_dir: str | Path, p: SkullParams | None = None) -> Path:
             name="2mm",
             mesh="2mm.OBJ",
             mass=0.0,
+            inertial_offset=Pose(),  # else AMBF moves its collision shape to its vertices' mean, 8.2 mm
             location=Pose.from_rpy((0.2 * half, 0.1 * half, half + 0.004), (0.0, -1.2, 0.0)),
         )
     )
