@@ -86,6 +86,28 @@ def _first_submesh(path: Path) -> tuple[int, np.ndarray]:
 
 
 def _obj_first_submesh(path: Path) -> tuple[int, np.ndarray]:
+    meshes, faces, corners = _obj_submeshes(path)
+    return meshes, corners
+
+
+def empty_submeshes(path: Path) -> tuple[int, int] | None:
+    """(sub-meshes CHAI3D makes of the OBJ at ``path``, how many of them have no face), or None
+    for a file that is not an OBJ or cannot be read. AMBF 2.0 crashes (a segfault, measured)
+    building a concave collision shape (GImpact) of one with an empty sub-mesh: an OBJ with more
+    objects than materials, or a material library with a material no face uses."""
+    if path.suffix.lower() != ".obj":
+        return None
+    try:
+        meshes, faces, _ = _obj_submeshes(path)
+    except (AdfError, OSError, ValueError, IndexError):
+        return None
+    return meshes, meshes - len(faces)
+
+
+def _obj_submeshes(path: Path) -> tuple[int, set[int], np.ndarray]:
+    """(how many sub-meshes CHAI3D makes, the indices of those with a face, the first one's
+    triangle corners in order): one per material of the `mtllib` (or per object where there are
+    more objects), each face in the sub-mesh of the `usemtl` before it (module docstring)."""
     text = _text(path)
     materials: list[str] = []
     objects = 0
@@ -103,6 +125,7 @@ def _obj_first_submesh(path: Path) -> tuple[int, np.ndarray]:
             objects += 1
     verts: list[list[float]] = []
     corners: list[list[float]] = []
+    used: set[int] = set()
     current = 0
     for line in text.splitlines():
         head, _, rest = line.strip().partition(" ")
@@ -112,14 +135,17 @@ def _obj_first_submesh(path: Path) -> tuple[int, np.ndarray]:
             name = rest.strip()
             if name in materials:
                 current = materials.index(name)
-        elif head == "f" and current == 0:
+        elif head == "f":
+            used.add(current)
+            if current:
+                continue
             idx = []
             for tok in rest.split():
                 i = int(tok.split("/")[0])
                 idx.append(i - 1 if i > 0 else len(verts) + i)
             for k in range(2, len(idx)):
                 corners += [verts[idx[0]], verts[idx[k - 1]], verts[idx[k]]]
-    return max(len(materials), objects, 1), np.asarray(corners, dtype=float).reshape(-1, 3)
+    return max(len(materials), objects, 1), used, np.asarray(corners, dtype=float).reshape(-1, 3)
 
 
 def _welded(corners: np.ndarray) -> np.ndarray:

@@ -15,6 +15,7 @@ from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..geometry.meshcheck import mesh_problem, obj_faces_crash_ambf, obj_material_problems
 from ..model import InputDevices, Launch, ModelFile, World
 from ..model.objects import Body, Ghost, SoftBody
+from ..model.semantics import collision_primitives
 from . import softbody_rules, volume_rules
 from .rules import RULES
 
@@ -102,6 +103,37 @@ def _com_estimated(m: ModelFile, body: Body) -> list[Diagnostic]:
     ]
 
 
+def _empty_submeshes(m: ModelFile, body: Body) -> list[Diagnostic]:
+    """`obj-empty-submesh`: AMBF 2.0 segfaults building a concave collision shape of an OBJ one
+    of whose CHAI3D sub-meshes has no face (measured: static or moving; a hull or a convex mesh
+    of it loads)."""
+    from ..geometry.chai3d_com import empty_submeshes
+    from ..model.semantics import CollisionMeshType, collision_mesh_type
+
+    if collision_primitives(body) is not None or collision_mesh_type(body.collision_mesh_type)[0] is not (
+        CollisionMeshType.CONCAVE_MESH
+    ):
+        return []
+    path = collision_mesh_path(m, body)
+    if path is None or not _present(path):
+        return []
+    found = empty_submeshes(path)
+    if not found or not found[1]:
+        return []
+    meshes, empty = found
+    key = "collision mesh" if body.collision_mesh is not None else "mesh"
+    return [
+        _d(
+            "obj-empty-submesh",
+            f"'{body.identifier}': AMBF 2.0 crashes building the concave collision shape of {path.name}: "
+            f"its materials and objects make {meshes} sub-meshes, {empty} of them without a face",
+            body.where(key) or body.source,
+            "remove the materials no face uses from its .mtl (and objects without faces), or set "
+            "`collision mesh type: CONVEX_HULL`",
+        )
+    ]
+
+
 def model_paths(m: ModelFile) -> list[Diagnostic]:
     out: list[Diagnostic] = []
     objs: list[Body | SoftBody | Ghost] = [*m.bodies, *m.soft_bodies, *m.ghost_objects]
@@ -171,7 +203,7 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
                         )
                     )
         if isinstance(obj, Body) and not any(d.rule in MESH_TROUBLE for d in out[start:]):
-            out += _com_estimated(m, obj)
+            out += _com_estimated(m, obj) + _empty_submeshes(m, obj)
         out += _shaders(m.path, getattr(obj, "shaders", None), f"'{obj.identifier}'", obj.where("shaders"))
     for s in m.sensors:
         if s.mesh and not _exists(str(m.directory / s.mesh)):

@@ -212,6 +212,13 @@ _RULES = [
     ),
     Rule("geometry-axis", W, "Primitive axis is not x/y/z; AMBF uses z", "`axis: w`"),
     Rule(
+        "obj-empty-submesh",
+        E,
+        "A concave collision mesh (AMBF's default type) whose OBJ makes a sub-mesh without faces: a material "
+        "of its library no face uses, or more objects than materials. AMBF 2.0 crashes building it",
+        "`two.mtl` with a material `unused`, the mesh's `collision mesh type` left out",
+    ),
+    Rule(
         "inertial-offset-estimated",
         W,
         "A body colliding with a mesh has no `inertial offset` (or no `mass`): AMBF puts its centre of mass at the "
