@@ -56,7 +56,7 @@ class PivotInertia:
 
     @staticmethod
     def held(bodies, ip: np.ndarray, ic: np.ndarray, deg: np.ndarray, free_lin: np.ndarray) -> np.ndarray:
-        """(n, 1): the joints whose limits turn a body about their pivot: one body static, the
+        """(n,) bool: the joints whose limits turn a body about their pivot: one body static, the
         other on no other force-driven joint, the linear axes locked. In a chain (a thread's
         light elements between two joints each) the joints act at once, and limits sized for
         the inertia about each pivot threw the corpus-like thread falling from a held needle
@@ -64,7 +64,7 @@ class PivotInertia:
         static = np.array([b.static for b in bodies])
         alone = (static[ip] & (deg[ic] == 1)) | (static[ic] & (deg[ip] == 1))
         alone[free_lin] = False
-        return alone[:, None]
+        return alone
 
     def about_pivots(self, pos: np.ndarray, rot: np.ndarray, axes: np.ndarray) -> np.ndarray:
         """(n, 3): each joint's effective inertia about each axis of its frame A (``axes``: the

@@ -138,8 +138,10 @@ class SpringSet:
         )
         self.fl_g_rel = (acc[self.ic] - acc[self.ip])[fl] if n else np.zeros((0, 3))
         self.i_eff_col = self.i_eff[:, None]
-        held = PivotInertia.held(bodies, self.ip, self.ic, deg, fl)  # a body alone on a static one
-        self.pivots = (PivotInertia(bodies, self.ip, self.ic, deg, self.pb_in_c), held) if form == "ambf" else None
+        held = np.flatnonzero(PivotInertia.held(bodies, self.ip, self.ic, deg, fl))  # alone on a static body
+        self.pivots = None
+        if form == "ambf" and held.size:
+            self.pivots = (PivotInertia(bodies, self.ip[held], self.ic[held], deg, self.pb_in_c[held]), held)
         # Bullet's m, but never past the joint's share of its bodies' inertia (and mass) that the
         # implicit form uses: Bullet's counts mass·r² even about an axis through both centres of
         # mass, and the forces here act all at once (a Jacobi step), where Bullet solves rows one
@@ -269,7 +271,9 @@ class SpringSet:
         # angular springs and limits, in joint frame A, turned into the world
         i_eff = self.i_eff_col
         if self.pivots is not None:
-            i_eff = np.where(self.pivots[1], self.pivots[0].about_pivots(pos, rot, ra), i_eff)
+            held = self.pivots[1]
+            i_eff = np.repeat(i_eff, 3, axis=1)
+            i_eff[held] = self.pivots[0].about_pivots(pos, rot, ra[held])
         tau = self._spring(self._ang, ang - self.eq_ang, w_rel)
         tau += self._limit(
             ang,
