@@ -156,7 +156,8 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
             continue  # AMBF moves a spring by effort only; a position or velocity command does nothing there
         for player in players:
             joint, child = player.by_name["joint"][c.target]
-            if player.commands.drivable(joint, child) is None:
+            pushed = c.kind == "effort" and getattr(player.world, "pushes_spring", lambda _j: False)(joint)
+            if player.commands.drivable(joint, child) is None and not pushed:
                 break
         else:
             continue
@@ -166,7 +167,7 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
             hint = "drive the loop's other joints (those of its tree), or leave this one out"
         elif kind in (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING):
             if player.world.engine == "mujoco":
-                why = "the MuJoCo engine does not push springs by effort (the PyBullet runner does)"
+                why = "the MuJoCo engine pushes a spring with both limits only, and this one is not"
             else:
                 why = "adfkit pushes a spring of a kinematic tree only (one with both limits), and this one is not"
             hint = "play it with --engine pybullet, or leave this joint out of the command file"

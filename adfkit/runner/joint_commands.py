@@ -56,6 +56,13 @@ SPRINGS = (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING)
 DRIVEN_KINDS = (JointKind.REVOLUTE, JointKind.PRISMATIC, *SPRINGS)
 
 
+def spring_pushed(world, joint, effort: float) -> bool:
+    """Whether ``world`` pushes spring ``joint`` by ``effort`` itself (an engine whose springs are
+    not joints of its articulations: the MuJoCo engine's ``spring_effort``)."""
+    push = getattr(world, "spring_effort", None)
+    return push is not None and joint_kind(joint.type) in SPRINGS and bool(push(joint, effort))
+
+
 def motor_enabled(joint) -> bool:
     """AMBF's `enable motor`: on by default; when the key is there, AMBF reads `enable
     feedback`'s value instead (its loader's slip)."""
@@ -244,6 +251,8 @@ class JointCommands:
             dj = self.drivable(joint, child)
             if dj is None and joint_kind(joint.type) in SPRINGS and kind != "effort":
                 return  # AMBF moves a spring by effort only: a position or velocity command does nothing
+            if dj is None and kind == "effort" and spring_pushed(self.world, joint, value):
+                return  # the engine pushes the spring itself (the MuJoCo engine: MujocoWorld.spring_effort)
             if dj is None:
                 raise ValueError(f"{joint.identifier}: not a revolute, prismatic or spring joint of an articulation")
             self.joints[id(joint)] = dj

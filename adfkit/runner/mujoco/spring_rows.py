@@ -123,6 +123,7 @@ class SpringRows:
         )
         self.starts = np.concatenate([[0], np.cumsum(m.tree_dofnum[self.trees])[:-1]]).astype(int)
         self.slow = SLOW * float(getattr(m.opt, "sleep_tolerance", 0.0)) if world.sleep else None
+        self.efforts = np.zeros(len(self.dofs))  # each axis's effort command (MujocoWorld.spring_effort)
         self._qacc, self._awake = d.qacc, d.tree_awake
 
     def __len__(self) -> int:
@@ -139,10 +140,14 @@ class SpringRows:
         damper = -self.c * v
         if self.slow is not None:
             speed = np.abs(self._qvel[self.tree_dofs])
-            if ahead and not np.count_nonzero(
-                self._awake[self.trees]
-                * np.maximum.reduceat(speed + np.abs(self._qacc[self.tree_dofs]) * ahead, self.starts)
-                >= self.slow
+            if (
+                ahead
+                and not np.count_nonzero(
+                    self._awake[self.trees]
+                    * np.maximum.reduceat(speed + np.abs(self._qacc[self.tree_dofs]) * ahead, self.starts)
+                    >= self.slow
+                )
+                and not np.count_nonzero(self.efforts)
             ):  # (a sleeping tree's qacc is the last it had awake)
                 self._qfrc[self.dofs] = 0.0
                 return False
@@ -150,5 +155,5 @@ class SpringRows:
             damper = np.where(moving[self.tree_of], damper, 0.0)
         spring = -self.k * (self._qpos[self.qadr] - self.eq)
         alone = (spring * damper < 0.0) & (np.abs(damper) > np.abs(spring))
-        self._qfrc[self.dofs] = np.where(alone, -spring, 0.0) + damper + 0.0  # + 0.0: no -0.0
+        self._qfrc[self.dofs] = np.where(alone, -spring, 0.0) + damper + self.efforts + 0.0  # + 0.0: no -0.0
         return True

@@ -107,6 +107,25 @@ class MujocoWorld(Assembly, Interaction, World):
         if a >= 0:
             d.qfrc_applied[a] = float(effort)
 
+    def pushes_spring(self, joint) -> bool:
+        """Whether ``spring_effort`` can push ``joint`` (a limited torsion or linear spring here)."""
+        return id(joint) in self._spring_dofs
+
+    def spring_effort(self, joint, effort: float) -> bool:
+        """A limited torsion or linear spring (the file's ``joint``) pushed by ``effort`` (N·m or N)
+        about or along its axis until the next command, as AMBF's commandEffort pushes it; False
+        for a joint that is not such a spring of this world."""
+        dof = self._spring_dofs.get(id(joint))
+        if dof is None:
+            return False
+        rows = self.spring_rows
+        at = np.flatnonzero(rows.dofs == dof) if rows is not None else []
+        if len(at):
+            rows.efforts[at[0]] = float(effort)  # its row sets the dof's force each physics step
+        else:
+            self.data.qfrc_applied[dof] = float(effort)
+        return True
+
     def set_body_velocity(self, sb, linear, angular) -> bool:
         """Set a free body's COM velocity (world frame); False for a body that is not free."""
         m, d = self.model, self.data
