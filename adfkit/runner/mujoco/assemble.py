@@ -9,7 +9,7 @@ import math
 import mujoco
 import numpy as np
 
-from ...model.semantics import ONE_AXIS_SPRINGS, JointKind, ReversedJoint, effective_mass, inertial_offset
+from ...model.semantics import JointKind, ReversedJoint, effective_mass, inertial_offset
 from ...model.tree import ONE_DOF
 from ..collisions import HULL_OVERLAP, hull_overlaps, one_hull
 from ..plan import ALL_GROUPS
@@ -23,7 +23,7 @@ from .integrator import integrator_for
 from .limits import ambf_limits
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
 from .spec import compile_spec
-from .spring_rows import SpringRows, capped_joints
+from .spring_rows import SpringRows, capped_joints, spring_dofs
 from .start import six_dof_start
 from .vehicles import MujocoVehicles, weld_wheels
 
@@ -145,11 +145,7 @@ class Assembly:
         capped = capped_joints(m, self.data, plan.joints, self.dt)  # (the file's gains, before the clamp)
         self._drive_limits_and_springs()
         self.spring_rows = SpringRows(self, plan.joints, capped) if self.opt.springs == "ambf" else None
-        self._spring_dofs = {  # a limited torsion or linear spring's one free axis (spring_effort)
-            id(getattr(j, "joint", j)): int(m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, names[0])])
-            for j, kind, _p, _c, names in plan.joints
-            if kind in ONE_AXIS_SPRINGS and len(names) == 1
-        }
+        self._spring_dofs = spring_dofs(m, plan.joints)  # a limited spring's free axis (spring_effort)
         if self.spring_rows is not None and not np.any(self.spring_rows.c):
             self.spring_rows = None
         if self.opt.bodies == "ambf" and six_dof_start(m, self.data, plan.joints):

@@ -27,7 +27,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from ...model.semantics import JointKind
+from ...model.semantics import ONE_AXIS_SPRINGS, JointKind
 from .damping import SLOW
 
 #: the joints AMBF makes btGeneric6DofSpring2Constraints (afJoint::createFromAttribs)
@@ -68,6 +68,17 @@ def _axes(model, joints):
         pid = 0 if parent.mjname == "world" else mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, parent.mjname)
         ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in names]
         yield names, [(j, int(m.jnt_dofadr[j]), pid) for j in ids if j >= 0]
+
+
+def spring_dofs(model, joints) -> dict[int, int]:
+    """{id(the file's joint): its dof} of each limited torsion or linear spring of ``joints``
+    (build.Plan.joints), whose one free axis is a MuJoCo hinge or slide (MujocoWorld.spring_effort)."""
+    m = model
+    return {
+        id(getattr(j, "joint", j)): int(m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, names[0])])
+        for j, kind, _p, _c, names in joints
+        if kind in ONE_AXIS_SPRINGS and len(names) == 1
+    }
 
 
 def capped_joints(model, data, joints, dt: float) -> frozenset:
