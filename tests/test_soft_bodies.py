@@ -246,7 +246,10 @@ def _findings(tmp_path, mesh="sq.3ds", mass="0.1", klst="0.5", pit="4", bend="2"
 
 
 def test_clean_soft_body_has_no_findings(tmp_path):
-    assert _findings(tmp_path) == []
+    """Only the note every soft body gets: in AMBF rigid bodies pass through it (measured: a
+    capsule needle and an 8 mm sphere dropped on the soft_phantom sample's skin fell through it
+    onto the tray beneath, with the file's collision flags and with CL_RS and 32 clusters)."""
+    assert _findings(tmp_path) == [("rigid-through-soft-body", 3, "info")]
 
 
 @pytest.mark.parametrize(

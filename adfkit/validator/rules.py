@@ -304,6 +304,14 @@ _RULES = [
         "`randomize constraints: false`",
     ),
     Rule(
+        "rigid-through-soft-body",
+        I,
+        "Every soft body: in AMBF 2.0 rigid bodies pass through it, because Bullet 2.88's soft-body collision sees "
+        "convex shapes only and AMBF wraps every body's shape in a compound (a lone PLANE aside); adfkit's engines "
+        "collide it with every rigid body",
+        "a needle dropped on a soft skin falls through it onto the tray beneath in AMBF",
+    ),
+    Rule(
         "soft-body-mesh",
         W,
         "A soft body without a mesh (AMBF skips it) or with a collision primitive it does not use",

@@ -49,6 +49,17 @@ def check(m: ModelFile) -> list[Diagnostic]:
         if not sb.defined:
             continue
         who = f"soft body '{sb.identifier}'"
+        out.append(
+            _d(
+                "rigid-through-soft-body",
+                f"{who}: in AMBF 2.0 rigid bodies pass through it: Bullet 2.88's soft-body collision (its sparse "
+                "distance field) sees convex shapes only, and AMBF wraps every body's shape in a compound (a lone "
+                "PLANE aside); adfkit's engines collide it with every rigid body",
+                sb.where(),
+                file,
+                "in AMBF, hold it up with `fixed nodes` and do not rely on it to stop a rigid body",
+            )
+        )
         if not sb.mesh:
             out.append(
                 _d(
