@@ -25,6 +25,7 @@ from .assemble import Assembly
 from .chain import ChainModel, chain_ghosts
 from .interact import Interaction
 from .objects import MjBody
+from .restitution import Restitution
 from .soft import MjSoftBodies
 
 
@@ -58,6 +59,7 @@ class MujocoWorld(Assembly, Interaction, World):
         self.camera_problem = ""
         self._build()
         self._pair_margins = np.array(self.model.pair_margin)  # set_collision gives them back
+        self.restitution = Restitution.make(self) if self.opt.bodies == "ambf" else None  # restitution.py
 
     def joint_state(self, art, idxs) -> tuple[np.ndarray, np.ndarray]:
         """Positions and velocities of joints ``idxs`` (record indices) of an articulation."""
@@ -254,18 +256,23 @@ class MujocoWorld(Assembly, Interaction, World):
         pending = mj_stability.pending_messages()
         limits, rows = self.drive_limits.check, self.spring_rows
         veh = self.vehicles or None  # AMBF's vehicles act after each physics step (vehicles.py)
+        rest = self.restitution  # Bullet's restitution after each physics step (restitution.py)
         for k in range(n):
             control()
             fine = self._ghost_steps
             fine = fine if fine is not None and fine.ghosts else None  # AMBF's ghosts at every physics step
             springs = rows is not None and rows.apply(sub * self.dt)  # spring_rows.py; False: sprung trees at rest
-            if fine is not None or veh is not None or springs:
+            if fine is not None or veh is not None or springs or rest is not None:
                 for i in range(sub):
                     if springs and i:
                         rows.apply()
                     if veh is not None:
                         veh.push()
+                    if rest is not None:
+                        rest.before()
                     step(m, d, 1)
+                    if rest is not None:
+                        rest.after()
                     if veh is not None:
                         veh.pull()
                         kinematics(m, d)
