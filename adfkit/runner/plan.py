@@ -234,6 +234,10 @@ class SensorRays:
     starts: np.ndarray  # (n, 3) ray starts in the sensor frame
     ends: np.ndarray
 
+    @property
+    def resistance(self) -> bool:
+        return SENSOR_TYPES.get(self.sensor.type) == "resistance"
+
 
 @dataclass
 class Grasper:
@@ -244,20 +248,22 @@ class Grasper:
     max_impulse: float
 
 
-def played_sensors(world, m, body_type=None, known=None) -> list[SensorRays]:
-    """The model's proximity sensors with rays, parents resolved among ``known``, the bodies of
-    the models loaded so far (``loaded_so_far``); the others warned about."""
+def played_sensors(world, m, body_type=None, known=None, resistance: bool = False) -> list[SensorRays]:
+    """The model's proximity and resistance sensors with rays, parents resolved among ``known``,
+    the bodies of the models loaded so far (``loaded_so_far``); the others warned about (a
+    resistance sensor's forces: resistance.py), resistance sensors only where ``resistance``
+    (PyBullet under AMBF's bodies)."""
     ns = m.namespace or ""
     out = []
     for s in m.sensors:
         rays = None
-        if SENSOR_TYPES.get(s.type) == "proximity":
+        if SENSOR_TYPES.get(s.type) == "proximity" or (resistance and SENSOR_TYPES.get(s.type) == "resistance"):
             rays = array_rays(s) if s.array else parametric_rays(s) if s.parametric else None
         if rays is None:
             world._warn(
                 "runner-sensor",
-                f"{s.identifier}: only proximity sensors with an `array` or a `parametric` fan of rays "
-                "are played; skipped",
+                f"{s.identifier}: only proximity sensors (and, in PyBullet under AMBF's bodies, resistance "
+                "sensors) with an `array` or a `parametric` fan of rays are played; skipped",
                 s,
             )
             continue

@@ -27,6 +27,7 @@ from ..plan import (
     played_sensors,
     resolve_parent,
 )
+from ..resistance import RayState, ResistanceParams
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from ..springs import spring_alone
 from . import articulation, egl
@@ -326,8 +327,11 @@ class Assembly:
             self.actuators.append(SimActuator(g.key, g.actuator, g.parent, g.location, g.max_impulse / self.dt))
 
     def _build_sensors(self, m, known) -> None:
-        for r in played_sensors(self, m, known=known):
-            self.sensors.append(SimSensor(r.key, r.sensor, r.parent, r.location, r.starts, r.ends))
+        for r in played_sensors(self, m, known=known, resistance=self.opt.bodies == "ambf"):
+            s = SimSensor(r.key, r.sensor, r.parent, r.location, r.starts, r.ends)
+            if r.resistance:  # AMBF's resistance forces (resistance.py)
+                s.resist, s.states = ResistanceParams.of(r.sensor), [RayState() for _ in r.starts]
+            self.sensors.append(s)
 
     def _floor(self) -> float:
         zs = []

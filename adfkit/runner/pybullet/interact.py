@@ -65,6 +65,8 @@ class SimSensor:
     ends: np.ndarray
     sensed: list = field(default_factory=list)
     rays: list = field(default_factory=list)  # per ray: (body hit or None, fraction of the range)
+    resist: object = None  # a resistance sensor's ResistanceParams (played under AMBF's bodies)
+    states: list = field(default_factory=list)  # and its rays' RayStates (resistance.py)
 
 
 class Interaction:

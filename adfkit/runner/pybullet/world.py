@@ -31,6 +31,7 @@ from .cameras import choose_renderer, render
 from .chain import ChainModel
 from .ghost_steps import GhostSteps
 from .interact import Interaction
+from .resist import PyBulletResistance
 from .softbodies import SoftBodies, enable_deformable_world
 from .solver_info import AMBF_SOLVER_INFO
 from .state import WorldState
@@ -87,7 +88,9 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         self._ghost_steps = GhostSteps(self) if acting else None
         if self._ghost_steps is not None and not self._ghost_steps.free:
             self._ghost_steps = None
-        self._each_step = self._springs_every_step or self._ghost_steps is not None or bool(self.vehicles)
+        self.resistance = PyBulletResistance(self, [s for s in self.sensors if s.resist is not None])
+        self._after_steps = [a for a in (self.vehicles, self.resistance) if a]
+        self._each_step = self._springs_every_step or self._ghost_steps is not None or bool(self._after_steps)
         if self._each_step:
             pb.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSubSteps=1, physicsClientId=self.cid)
             held.record(self.cid)
@@ -213,14 +216,17 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         """Advance n control steps (n·control_substeps physics steps of 1/physics_hz)."""
         t0 = time.perf_counter()
         sub = self.opt.control_substeps
-        veh = self.vehicles or None  # AMBF's vehicles act after each physics step (vehicles.py)
+        # AMBF's vehicles and resistance sensors act after each physics step (vehicles.py, resist.py)
+        veh = self._after_steps or None
         for _ in range(n):
             self.control()
             if veh is not None:
-                veh.push()
+                for v in veh:
+                    v.push()
             pb.stepSimulation(physicsClientId=self.cid)
             if veh is not None:
-                veh.update(self.dt)
+                for v in veh:
+                    v.update(self.dt)
             fine = self._ghost_steps is not None and self._ghost_steps.fine
             if self._each_step:
                 for _ in range(sub - 1):  # the springs, ghosts, vehicles again at each physics step, the rest held
@@ -230,10 +236,12 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
                     if self._springs_every_step:
                         self.springs.apply(self.dt)
                     if veh is not None:
-                        veh.push()
+                        for v in veh:
+                            v.push()
                     pb.stepSimulation(physicsClientId=self.cid)
                     if veh is not None:
-                        veh.update(self.dt)
+                        for v in veh:
+                            v.update(self.dt)
                 held.clear(self.cid)
         self.steps += n * sub
         self.sim_time = self.steps * self.dt
