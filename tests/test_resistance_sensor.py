@@ -2,7 +2,8 @@
 PyBullet runner under AMBF's bodies (runner/resistance.py, runner/pybullet/resist.py). Before,
 the runner skipped them: a 0.1 kg tip whose 50 mm ray reaches 39 mm into a block, contact
 stiffness 3, was thrown up by AMBF (168.6 mm at 0.14 s) and lay on the block in adfkit (47 mm
-apart at 0.14 s); now 0.008 mm at 24 ms and 1.7 mm over 0.3 s (`adfkit parity`, PyBullet)."""
+apart at 0.14 s); now 0.09 mm over 0.3 s (thrown and landed) and 0.82 mm / 0.8° over 0.6 s
+(`adfkit parity`, PyBullet)."""
 
 from __future__ import annotations
 
@@ -118,7 +119,7 @@ def test_the_tip_is_pushed_off_the_block_as_ambf_pushes_it(tmp_path):
 @needs_ambf
 def test_the_tip_leaves_the_block_as_in_ambf(tmp_path, capsys):
     launch = launch_with(tmp_path, {"tip.yaml": TIP})
-    (doc,) = parity(capsys, launch, 0.3, "pybullet")
+    (doc,) = parity(capsys, launch, 0.6, "pybullet")
     tip = body(doc, "tip")
-    assert tip["max_position_gap_m"] < 2.5e-3 and tip["max_angle_gap_deg"] < 1.0
+    assert tip["max_position_gap_m"] < 1e-3 and tip["max_angle_gap_deg"] < 1.0
     assert not doc["only_in_ambf"]
