@@ -11,7 +11,7 @@ import pybullet as pb
 
 from ...model.semantics import DEFAULT_SENSOR_RANGE
 from ..resistance import Body, missed, ray_force
-from ..rotations import invert
+from ..rotations import invert, rotation_exp
 
 MAX_HITS = 8  # hits looked through past the parent
 
@@ -78,19 +78,9 @@ def _motion_state(sb, dt: float) -> np.ndarray:
     step's velocities; the parity plugin's sample() says the same of AMBF's published poses)."""
     p, q, v, w = sb.state()
     m = np.eye(4)
-    m[:3, :3] = _turn(-np.array(w) * dt) @ np.array(pb.getMatrixFromQuaternion(q)).reshape(3, 3)
+    m[:3, :3] = rotation_exp(-np.array(w) * dt) @ np.array(pb.getMatrixFromQuaternion(q)).reshape(3, 3)
     m[:3, 3] = np.array(p) - np.array(v) * dt
     return m
-
-
-def _turn(r: np.ndarray) -> np.ndarray:
-    """The rotation by the rotation vector ``r`` (Rodrigues)."""
-    a = float(np.linalg.norm(r))
-    if a < 1e-12:
-        return np.eye(3)
-    k = r / a
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(a) * kx + (1 - np.cos(a)) * kx @ kx
 
 
 def _body(sb) -> Body:
