@@ -72,8 +72,6 @@ def _shaders(doc_path, shaders, owner: str, loc) -> list[Diagnostic]:
     ]
 
 
-#: the rules after which a body's mesh is not read for its estimated centre of mass
-MESH_TROUBLE = ("mesh-format", "missing-mesh", "mesh-unreadable", "input-refused", "obj-faces-crash-ambf")
 #: m, the estimated centre of mass off the body frame below which AMBF's estimate is not worth a word
 COM_ESTIMATE_NOTED = 1e-4
 
@@ -202,7 +200,8 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
                             "textures come from the mesh's own material (MTL) file",
                         )
                     )
-        if isinstance(obj, Body) and not any(d.rule in MESH_TROUBLE for d in out[start:]):
+        # a mesh found missing, refused or unreadable above is not read again (a missing texture is fine)
+        if isinstance(obj, Body) and all(d.rule == "missing-texture" for d in out[start:]):
             out += _com_estimated(m, obj) + _empty_submeshes(m, obj)
         out += _shaders(m.path, getattr(obj, "shaders", None), f"'{obj.identifier}'", obj.where("shaders"))
     for s in m.sensors:
