@@ -1,9 +1,12 @@
-"""AMBF's `resistance` sensors (adf-format.md §11.1; afResistanceSensor::update), played by the
-PyBullet runner under AMBF's bodies (runner/resistance.py, runner/pybullet/resist.py). Before,
+"""AMBF's `resistance` sensors (adf-format.md §11.1; afResistanceSensor::update), played by both
+engines under AMBF's bodies (runner/resistance.py, runner/pybullet/resist.py,
+runner/mujoco/resist.py). Before,
 the runner skipped them: a 0.1 kg tip whose 50 mm ray reaches 39 mm into a block, contact
 stiffness 3, was thrown up by AMBF (168.6 mm at 0.14 s) and lay on the block in adfkit (47 mm
 apart at 0.14 s); now 0.09 mm over 0.3 s (thrown and landed) and 0.82 mm / 0.8° over 0.6 s
-(`adfkit parity`, PyBullet)."""
+(`adfkit parity`, PyBullet); MuJoCo 0.17 mm over 0.3 s (it lands the tip level, where Bullet's
+contact solver tilts it 0.11°: 4.4 mm / 12.8° by 0.6 s, thrown again). A ray 15 mm off the axis
+turns the tip over within 0.013 mm / 0.06° of AMBF over 0.1 s in both engines."""
 
 from __future__ import annotations
 
@@ -100,26 +103,74 @@ def test_the_sensor_keys_and_ambf_s_defaults():
     assert (p.area, p.stiffness, p.normal_damping) == (0.1, 3.0, 0.0)
 
 
-def test_the_tip_is_pushed_off_the_block_as_ambf_pushes_it(tmp_path):
+#: the sensor 15 mm off the tip's axis and the tip 20 mm over the block: the ray turns it over
+#: before it touches the block (lands on its side at 0.11 s)
+OFF_AXIS = TIP.replace("position: {x: 0.0, y: 0.0, z: -0.01}", "position: {x: 0.015, y: 0.0, z: -0.01}").replace(
+    "z: 0.121}", "z: 0.14}"
+)
+
+
+def _tip_after(tmp_path, engine: str, seconds: float, text: str = TIP, bodies: str = "ambf"):
+    """The tip's pose (4×4) after ``seconds`` and the world's diagnostics' rules."""
     from adfkit.adf import load_scene
     from adfkit.runner import Options, open_world
 
-    launch = launch_with(tmp_path, {"tip.yaml": TIP})
-    world = open_world(load_scene(launch), Options(visuals=False, bodies="ambf"), engine="pybullet")
+    launch = launch_with(tmp_path, {"tip.yaml": text})
+    world = open_world(load_scene(launch), Options(visuals=False, bodies=bodies), engine=engine)
     try:
         tip = next(b for b in world.bodies if b.name.endswith("tip"))
-        world.run(0.02)
-        z = tip.world_matrix()[2, 3]
+        world.run(seconds)
+        return tip.world_matrix(), [d.rule for d in world.diagnostics]
     finally:
         world.close()
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_the_tip_is_pushed_off_the_block_as_ambf_pushes_it(tmp_path, engine):
+    t, rules = _tip_after(tmp_path, engine, 0.02)
     # AMBF: 123.353 mm at 20 ms (from 121 mm; without the sensor the tip falls 1 mm onto the block)
-    assert z == pytest.approx(0.123353, abs=2e-5)
+    assert t[2, 3] == pytest.approx(0.123353, abs=2e-5)
+    assert "runner-sensor" not in rules
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_only_ambf_s_bodies_play_the_sensor(tmp_path, engine):
+    t, rules = _tip_after(tmp_path, engine, 0.02, bodies="pybullet")
+    assert "runner-sensor" in rules  # skipped, and said so
+    assert t[2, 3] == pytest.approx(0.12, abs=2e-4)  # fallen onto the block
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_ray_off_the_axis_turns_its_parent_as_in_ambf(tmp_path, engine):
+    """-F at the hit point, 15 mm off the COM: a torque (MuJoCo: xfrc_applied about its COM)."""
+    t, _ = _tip_after(tmp_path, engine, 0.06, OFF_AXIS)
+    tilt = np.degrees(np.arccos(np.clip(t[2, 2], -1.0, 1.0)))
+    # AMBF at 60 ms: 34.634° turned, 4.476 mm along -x (both engines: 34.63°, 4.478 mm)
+    assert tilt == pytest.approx(34.634, abs=0.03)
+    assert t[0, 3] == pytest.approx(-4.4761e-3, abs=1e-5)
 
 
 @needs_ambf
-def test_the_tip_leaves_the_block_as_in_ambf(tmp_path, capsys):
+@pytest.mark.parametrize(
+    "engine,seconds,within_m",
+    [
+        ("pybullet", 0.6, 1e-3),
+        # MuJoCo lands the tip level (0.11° tilted in AMBF by Bullet's contact solver): 0.3 s
+        ("mujoco", 0.3, 0.5e-3),
+    ],
+)
+def test_the_tip_leaves_the_block_as_in_ambf(tmp_path, capsys, engine, seconds, within_m):
     launch = launch_with(tmp_path, {"tip.yaml": TIP})
-    (doc,) = parity(capsys, launch, 0.6, "pybullet")
+    (doc,) = parity(capsys, launch, seconds, engine)
     tip = body(doc, "tip")
-    assert tip["max_position_gap_m"] < 1e-3 and tip["max_angle_gap_deg"] < 1.0
+    assert tip["max_position_gap_m"] < within_m and tip["max_angle_gap_deg"] < 1.0
     assert not doc["only_in_ambf"]
+
+
+@needs_ambf
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_ray_off_the_axis_turns_the_tip_as_in_ambf(tmp_path, capsys, engine):
+    launch = launch_with(tmp_path, {"tip.yaml": OFF_AXIS})
+    (doc,) = parity(capsys, launch, 0.1, engine)
+    tip = body(doc, "tip")
+    assert tip["max_position_gap_m"] < 0.05e-3 and tip["max_angle_gap_deg"] < 0.2

@@ -252,7 +252,7 @@ def played_sensors(world, m, body_type=None, known=None, resistance: bool = Fals
     """The model's proximity and resistance sensors with rays, parents resolved among ``known``,
     the bodies of the models loaded so far (``loaded_so_far``); the others warned about (a
     resistance sensor's forces: resistance.py), resistance sensors only where ``resistance``
-    (PyBullet under AMBF's bodies)."""
+    (under AMBF's bodies)."""
     ns = m.namespace or ""
     out = []
     for s in m.sensors:
@@ -262,8 +262,8 @@ def played_sensors(world, m, body_type=None, known=None, resistance: bool = Fals
         if rays is None:
             world._warn(
                 "runner-sensor",
-                f"{s.identifier}: only proximity sensors (and, in PyBullet under AMBF's bodies, resistance "
-                "sensors) with an `array` or a `parametric` fan of rays are played; skipped",
+                f"{s.identifier}: only proximity sensors (and, under AMBF's bodies, resistance sensors) "
+                "with an `array` or a `parametric` fan of rays are played; skipped",
                 s,
             )
             continue

@@ -22,6 +22,7 @@ from .drives import DriveLimits, drive_limit
 from .integrator import integrator_for
 from .limits import ambf_limits
 from .objects import MjActuator, MjArticulation, MjBody, MjGhost, MjSensor
+from .resist import MujocoResistance
 from .spec import compile_spec
 from .spring_rows import SpringRows, capped_joints, spring_dofs
 from .start import six_dof_start
@@ -186,6 +187,7 @@ class Assembly:
         self._ray_hit = np.zeros(1, dtype=np.int32)
         self._body_of_id = {sb.id: sb for sb in self.bodies}
         self.vehicles = MujocoVehicles(self)
+        self.resistance = MujocoResistance(self)  # AMBF's resistance sensors' forces (resist.py)
         file_anchors(m, plan.loops)
         self.constraints = [
             (j.identifier, None, by_plan[id(p)], by_plan[id(c)], pa, pb_, None) for j, kind, p, c, pa, pb_ in plan.loops

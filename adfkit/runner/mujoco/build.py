@@ -287,7 +287,7 @@ def build_plan(world) -> Plan:
             )
             if gp.geoms:
                 ghosts.append(gp)
-        sensors += played_sensors(world, m, BodyPlan, known)
+        sensors += played_sensors(world, m, BodyPlan, known, resistance=opt.bodies == "ambf")
         for g in played_actuators(world, m, BodyPlan, known):
             parent, key = g.parent, g.key
             weld = f"grasp:{key}"

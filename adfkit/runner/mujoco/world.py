@@ -255,7 +255,8 @@ class MujocoWorld(Assembly, Interaction, World):
         kinematics = mujoco.mj_kinematics
         pending = mj_stability.pending_messages()
         limits, rows = self.drive_limits.check, self.spring_rows
-        veh = self.vehicles or None  # AMBF's vehicles act after each physics step (vehicles.py)
+        # AMBF's vehicles and resistance sensors act after each physics step (vehicles.py, resist.py)
+        veh = [a for a in (self.vehicles, self.resistance) if a] or None
         rest = self.restitution  # Bullet's restitution after each physics step (restitution.py)
         for k in range(n):
             control()
@@ -267,16 +268,19 @@ class MujocoWorld(Assembly, Interaction, World):
                     if springs and i:
                         rows.apply()
                     if veh is not None:
-                        veh.push()
+                        for v in veh:
+                            v.push()
                     if rest is not None:
                         rest.before()
                     step(m, d, 1)
                     if rest is not None:
                         rest.after()
                     if veh is not None:
-                        veh.pull()
+                        for v in veh:
+                            v.pull()
                         kinematics(m, d)
-                        veh.update(self.dt)
+                        for v in veh:
+                            v.update(self.dt)
                     if i < sub - 1 and fine is not None:
                         if veh is None:
                             kinematics(m, d)
