@@ -15,7 +15,7 @@ from ..diagnostics import AdfError, Diagnostic, SourceLocation
 from ..geometry.meshcheck import mesh_problem, obj_faces_crash_ambf, obj_material_problems
 from ..model import InputDevices, Launch, ModelFile, World
 from ..model.objects import Body, Ghost, SoftBody
-from ..model.semantics import collision_primitives
+from ..model.semantics import SENSOR_TYPES, collision_primitives
 from . import softbody_rules, volume_rules
 from .rules import RULES
 
@@ -132,6 +132,27 @@ def _empty_submeshes(m: ModelFile, body: Body) -> list[Diagnostic]:
     ]
 
 
+def _sensor_mesh(s) -> list[Diagnostic]:
+    """`sensor-mesh`: AMBF 2.0 reads a found sensor mesh's rays (triangle centroids along their
+    normals) but never sets the sensor's ray count (afRayTracerSensor::createFromAttribs sets it for
+    an `array` or a `parametric` fan only): measured, a proximity sensor segfaults (exit -11) at its
+    first update and a resistance sensor throws std::bad_alloc (exit -6) sizing its contacts. An
+    `array` beside it wins in AMBF's loader; a type AMBF does not know is `sensor-type`'s."""
+    if s.array is not None or SENSOR_TYPES.get(s.type or "") not in ("proximity", "resistance"):
+        return []
+    if Path(s.mesh).suffix.lower() not in AMBF_MESH_SUFFIXES:
+        return []  # CHAI3D cannot read it: AMBF says so and skips the sensor
+    return [
+        _d(
+            "sensor-mesh",
+            f"'{s.identifier}': AMBF 2.0 crashes on a {SENSOR_TYPES[s.type]} sensor whose rays come from "
+            f"mesh {s.mesh} (it never sets the sensor's ray count)",
+            s.where("mesh"),
+            "give the rays as an `array` (an offset and a direction each, in the sensor frame)",
+        )
+    ]
+
+
 def model_paths(m: ModelFile) -> list[Diagnostic]:
     out: list[Diagnostic] = []
     objs: list[Body | SoftBody | Ghost] = [*m.bodies, *m.soft_bodies, *m.ghost_objects]
@@ -214,6 +235,8 @@ def model_paths(m: ModelFile) -> list[Diagnostic]:
                     "sensor meshes resolve against the model directory only",
                 )
             )
+        elif s.mesh:
+            out += _sensor_mesh(s)
     for v in m.volumes:
         out += _shaders(m.path, v.shaders, f"'{v.identifier}'", v.where("shaders"))
     for c in m.cameras:

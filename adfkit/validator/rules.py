@@ -243,6 +243,13 @@ _RULES = [
     Rule("missing-parent", W, "A sensor or actuator without `parent` (AMBF skips it)", "a sensor with no parent"),
     Rule("missing-type", W, "Sensor or actuator without `type` (skipped)", "a sensor with no type"),
     Rule(
+        "sensor-mesh",
+        E,
+        "A proximity or resistance sensor whose rays come from a `mesh` AMBF finds and reads: AMBF 2.0 "
+        "crashes on it (afRayTracerSensor leaves its ray count unset for a mesh)",
+        "`mesh: patch.STL` beside the model file, no `array`",
+    ),
+    Rule(
         "sensor-rays",
         W,
         "A sensor without exactly one of array/mesh/parametric, resolution < 2 or range < 0",
