@@ -5,7 +5,9 @@ runner/mujoco/resist.py). Before, the runner skipped them: a 0.1 kg tip whose 50
 block in adfkit (47 mm apart at 0.14 s). Now (`adfkit parity`) over 0.3 s, thrown, landed and thrown
 again: PyBullet 0.015 mm, MuJoCo 0.14 mm (it lands the tip level, where Bullet's contact solver
 tilts it 0.11°: 4.1 mm / 12.8° by 0.6 s, PyBullet 1.05 mm / 0.75°). A ray 15 mm off the axis turns
-the tip over, 60° in 0.1 s: PyBullet 0.0000 mm / 0.000°, MuJoCo 0.0024 mm / 0.002° from AMBF."""
+the tip over, 60° in 0.1 s: PyBullet 0.0000 mm / 0.000°, MuJoCo 0.0024 mm / 0.002° from AMBF; a
+free block under a free tip, 10 mm off its axis, pushed down and turned over 0.2 s: PyBullet 0.0000
+mm, MuJoCo 0.014 mm / 0.000°."""
 
 from __future__ import annotations
 
@@ -111,6 +113,14 @@ OFF_AXIS = TIP.replace("position: {x: 0.0, y: 0.0, z: -0.01}", "position: {x: 0.
     "z: 0.121}", "z: 0.14}"
 )
 
+#: the block free too (0.3 kg), 10 mm off the tip's axis, both falling from 0.5 m: the ray pushes
+#: the block down and the tip up, and turns both (the hit 10 mm off the block's COM)
+PAIR = TIP.replace(
+    "location: {position: {x: 0.0, y: 0.0, z: 0.05}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n  mass: 0.0",
+    "location: {position: {x: 0.01, y: 0.0, z: 0.45}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n  mass: 0.3\n"
+    "  inertia: {ix: 0.0025, iy: 0.0025, iz: 0.0045}",
+).replace("z: 0.121}", "z: 0.521}")
+
 
 def _tip_after(tmp_path, engine: str, seconds: float, text: str = TIP, bodies: str = "ambf"):
     """The tip's pose (4×4) after ``seconds`` and the world's diagnostics' rules."""
@@ -160,6 +170,26 @@ def test_a_ray_off_the_axis_turns_its_parent_as_in_ambf(tmp_path, engine):
     assert t[0, 3] == pytest.approx(-4.4761e-3, abs=1e-6)
 
 
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_the_body_hit_is_pushed_back_as_in_ambf(tmp_path, engine):
+    """+F on the body hit, at the hit point: AMBF's block at 80 ms 401.8237 mm high (falling freely
+    it would be 418.6 mm), 0.0287 mm along +x, turned 1.120°; PyBullet the same, MuJoCo 2.6 µm lower."""
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+
+    launch = launch_with(tmp_path, {"tip.yaml": PAIR})
+    world = open_world(load_scene(launch), Options(visuals=False, bodies="ambf"), engine=engine)
+    try:
+        block = next(b for b in world.bodies if b.name.endswith("block"))
+        world.run(0.08)
+        t = block.world_matrix()
+    finally:
+        world.close()
+    assert t[2, 3] == pytest.approx(0.4018237, abs=5e-6)
+    assert t[0, 3] == pytest.approx(0.0100287, abs=1e-6)
+    assert np.degrees(np.arccos(np.clip(t[2, 2], -1.0, 1.0))) == pytest.approx(1.120, abs=0.005)
+
+
 @needs_ambf
 @pytest.mark.parametrize(
     "engine,seconds,within_m",
@@ -183,3 +213,13 @@ def test_a_ray_off_the_axis_turns_the_tip_as_in_ambf(tmp_path, capsys, engine):
     (doc,) = parity(capsys, launch, 0.1, engine)
     tip = body(doc, "tip")
     assert tip["max_position_gap_m"] < 0.01e-3 and tip["max_angle_gap_deg"] < 0.01
+
+
+@needs_ambf
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_the_body_hit_moves_as_in_ambf(tmp_path, capsys, engine):
+    launch = launch_with(tmp_path, {"tip.yaml": PAIR})
+    (doc,) = parity(capsys, launch, 0.2, engine)
+    for name in ("tip", "block"):
+        row = body(doc, name)
+        assert row["max_position_gap_m"] < 0.05e-3 and row["max_angle_gap_deg"] < 0.01, row
