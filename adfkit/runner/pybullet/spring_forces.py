@@ -345,13 +345,23 @@ class SpringSet:
         sideways at its pivot 0.1 m above its centre turned 20x as far as the push meant, and a
         bob resting on the floor so flew apart."""
         k = len(pivot)
-        total = np.zeros((k, 3))
+        ends, inv_m, inv_i = self._pivot_ends()
         cols = axes.transpose(0, 2, 1).reshape(-1, 3)  # the three axes of each joint, one per row
-        for ends in (self.fl_ip, self.fl_ic):
-            r = np.repeat(pivot - pos[ends], 3, axis=0)  # (3k, 3): each arm once per axis
-            rxa = (_cross(r, cols).reshape(k, 3, 3)) @ rot[ends]  # rows r×a in the principal frame
-            total += self.inv_m_shared[ends][:, None] + (rxa * rxa * self.inv_i_shared[ends][:, None, :]).sum(2)
+        # both ends at once (the parents', then the children's rows): each row's products as they were
+        r = np.repeat(np.concatenate((pivot, pivot)) - pos[ends], 3, axis=0)  # (6k, 3): each arm once per axis
+        rxa = _cross(r, np.concatenate((cols, cols))).reshape(2 * k, 3, 3) @ rot[ends]  # r×a, principal frame
+        terms = inv_m + (rxa * rxa * inv_i).sum(2)
+        total = terms[:k] + terms[k:]  # the parent's, then the child's (0 + the parent's is the parent's)
         return 1.0 / np.maximum(total, 1e-12)
+
+    def _pivot_ends(self):
+        """_pivot_mass's constants: the free-linear joints' parents then children, their shared 1/m
+        (a column) and principal 1/I (one row per end), sliced once."""
+        c = getattr(self, "_pivot_consts", None)
+        if c is None:
+            ends = np.concatenate((self.fl_ip, self.fl_ic))
+            c = self._pivot_consts = (ends, self.inv_m_shared[ends][:, None], self.inv_i_shared[ends][:, None, :])
+        return c
 
     @staticmethod
     def _limit(x, v, low, high, inertia, dt, erp, active=None, ranged=None):
