@@ -209,9 +209,10 @@ class Interaction:
         while both stay exactly where they were (and no collision pair or grasp has changed).
         ``g.points`` gets each body found with its penetrating contact points (distance < 0): from
         ``manifolds`` (_manifold_points) where given, else the closest-point query's (one a pair).
-        Given ``manifolds`` (AMBF's rule, which acts on their points alone), a body without a
-        penetrating point in the ghost's pass is not asked about (on the corpus suturing set three
-        queries in four, none of them inside)."""
+        Given ``manifolds`` (AMBF's rule, which acts on their points alone, as afGhostObject reads
+        its manifolds), a body is inside where the ghost's pass made a penetrating point with it and
+        nowhere else: no closest-point query (on the corpus suturing set, 3 s, each of its 12,138
+        queries had found the body inside)."""
         cid = self.cid
         keys = self._near_keys.get(g.uid) if manifolds is not None and self._near_keys else None  # _manifold_points'
         keys = pb.getOverlappingObjects(*pb.getAABB(g.uid, -1, cid), cid) or () if keys is None else keys
@@ -224,6 +225,10 @@ class Interaction:
             sb = dynamic.get(key)
             if sb is None or (sb is parent and not with_parent) or (counts is not None and not counts.get(key)):
                 continue
+            if counts is not None:  # a penetrating point of the pass: inside, as AMBF's ghost reads it
+                found.append(sb)
+                points.append((sb, counts[key]))
+                continue
             pose = poses.get(key) if poses else None
             was = known.get(key) if pose is not None else None
             if was is not None and was[0] == at and was[1] == pose:
@@ -235,7 +240,7 @@ class Interaction:
                     known[key] = (at, pose, inside, deep)
             if inside:
                 found.append(sb)
-                points.append((sb, deep if counts is None else counts[key]))
+                points.append((sb, deep))
         g.overlapping = found
         g.points = points
         return found
