@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.semantics import DEFAULT_SIX_DOF_LIMIT, DEFAULT_SIX_DOF_SPRING, JointKind
+from .cone_twist import spans
 
 
 @dataclass
@@ -29,6 +30,7 @@ class SpringJoint:
     eq_ang: np.ndarray = field(default_factory=lambda: np.zeros(3))
     linear_constrained: bool = True  # a p2p holds the pivots together
     in_multibody: bool = False  # a multibody's joint plays its limits and locked axes (spring_alone)
+    cone: np.ndarray | None = None  # a cone twist's (swing span 1, swing span 2, twist span): cone_twist.spans
 
 
 def _vec(v, default: float) -> np.ndarray:
@@ -67,6 +69,8 @@ def spring_joint(joint, kind: JointKind, parent, child, frame_a, frame_b) -> Spr
                 ang_low, ang_high = np.array([0, 0, lim.low]), np.array([0, 0, lim.high])
     sj = SpringJoint(joint.identifier, parent, child, frame_a, frame_b, lin_low, lin_high, ang_low, ang_high)
     sj.linear_constrained = bool(np.all(lin_low == 0) and np.all(lin_high == 0))
+    if kind is JointKind.CONE_TWIST:
+        sj.cone = spans(lim)
     if kind is JointKind.SIX_DOF_SPRING:
         for attr, key in (
             ("stiffness", "stiffness"),

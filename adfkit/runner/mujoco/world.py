@@ -23,6 +23,7 @@ from . import motor_rows
 from . import stability as mj_stability
 from .assemble import Assembly
 from .chain import ChainModel, chain_ghosts
+from .cone_rows import ConeRows
 from .interact import Interaction
 from .objects import MjBody
 from .restitution import Restitution
@@ -60,6 +61,7 @@ class MujocoWorld(Assembly, Interaction, World):
         self._build()
         self._pair_margins = np.array(self.model.pair_margin)  # set_collision gives them back
         self.restitution = Restitution.make(self) if self.opt.bodies == "ambf" else None  # restitution.py
+        self.cone_rows = ConeRows.make(self) if self.opt.bodies == "ambf" else None  # cone_rows.py
 
     def joint_state(self, art, idxs) -> tuple[np.ndarray, np.ndarray]:
         """Positions and velocities of joints ``idxs`` (record indices) of an articulation."""
@@ -258,15 +260,18 @@ class MujocoWorld(Assembly, Interaction, World):
         # AMBF's vehicles and resistance sensors act after each physics step (vehicles.py, resist.py)
         veh = [a for a in (self.vehicles, self.resistance) if a] or None
         rest = self.restitution  # Bullet's restitution after each physics step (restitution.py)
+        cones = self.cone_rows  # Bullet's cone-twist rows before each physics step (cone_rows.py)
         for k in range(n):
             control()
             fine = self._ghost_steps
             fine = fine if fine is not None and fine.ghosts else None  # AMBF's ghosts at every physics step
             springs = rows is not None and rows.apply(sub * self.dt)  # spring_rows.py; False: sprung trees at rest
-            if fine is not None or veh is not None or springs or rest is not None:
+            if fine is not None or veh is not None or springs or rest is not None or cones is not None:
                 for i in range(sub):
                     if springs and i:
                         rows.apply()
+                    if cones is not None:
+                        cones.apply()
                     if veh is not None:
                         for v in veh:
                             v.push()

@@ -20,6 +20,7 @@ import pybullet as pb
 
 from ..rotations import euler_xyz, quat_to_matrix
 from ..springs import SpringJoint
+from .cone_limits import ConeLimits
 from .joint_inertia import PivotInertia, bullet_spring_masses
 
 
@@ -106,6 +107,8 @@ class SpringSet:
         inv_i = np.array([0.0 if b.static else 1.0 / max(min(b.inertia), 1e-12) for b in bodies]) * deg
         self.m_eff = 1.0 / np.maximum(inv_m[self.ip] + inv_m[self.ic], 1e-12)
         self.i_eff = 1.0 / np.maximum(inv_i[self.ip] + inv_i[self.ic], 1e-12)
+        cones = ConeLimits.among(joints) if form == "ambf" else np.zeros(0, int)
+        self.ang_low[cones], self.ang_high[cones] = 1.0, -1.0  # Bullet's cone and twist instead (cone_limits.py)
         self.ang_active = self.ang_low <= self.ang_high
         self.ang_ranged = self.ang_low < self.ang_high if form == "ambf" else None  # AMBF's rows inside (_limit)
         fl = self.free_lin
@@ -158,6 +161,7 @@ class SpringSet:
         self.i_implicit = np.where(exact, m_ang, self.i_eff[:, None])  # what the implicit form integrates
         self.m_implicit = np.where(exact, m_lin, self.m_eff[:, None])
         self._gains_dt = None
+        self.cones = ConeLimits(self, cones, held, acc) if len(cones) else None
 
     def _gains(self, dt: float) -> None:
         """Per-joint constants of the spring-damper -(K·x + C·v) / D at this step (_spring).
@@ -286,6 +290,8 @@ class SpringSet:
             self.ang_active,
             (self.ang_ranged, w_rel),
         )
+        if self.cones is not None:  # Bullet's swing and twist rows (cone_limits.py)
+            tau[self.cones.index] += self.cones.in_frame_a(pos, rot, lv, av, ra, frames[n:], dt)
         torque = self.net @ (ra @ tau[:, :, None])[..., 0]
         force = None
         fl = self.free_lin

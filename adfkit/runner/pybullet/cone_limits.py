@@ -1,0 +1,74 @@
+"""The limits of `cone twist` joints in the PyBullet runner as AMBF's Bullet plays them (runner/
+cone_twist.py: an elliptic swing cone and a twist limit apart), where AMBF's springs are asked for
+(``Options.springs`` "ambf": ``adfkit run``, ``adfkit parity``); otherwise SpringSet limits each
+Euler angle of the joint.
+
+PyBullet's point constraint holds the pivots; the swing and twist rows are a torque pair at every
+physics step (SpringSet.apply). Where the joint holds a body alone on a static one, the rows'
+impulses are those Bullet's solver leaves: the joint's three pivot rows and two angular rows
+solved one after another, ten sweeps, each body with its inertia about its centre of mass
+(cone_twist.sequential_impulses). Sized instead to leave the joint turning back at exactly
+Bullet's rate about the pivot, a rod falling diagonally into a cone of 0.3 x 0.8 rad was 0.95 mm
+from AMBF, one into 0.2 x 1.2 rad 16 mm, 5 mm into 0.8 x 0.3 (0.83, 14 and 1.2 mm now; `adfkit
+parity`, 2 s). In a chain the joints' rows act at once, each sized for SpringSet's share of its
+bodies' least inertia (as its Euler limits are)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..cone_twist import CONE_TWIST_BIAS, cone_rows, elliptic, row_impulses, sequential_impulses
+
+
+class ConeLimits:
+    """The cone twists among SpringSet's joints whose swing Bullet limits with an ellipse."""
+
+    @staticmethod
+    def among(joints) -> np.ndarray:
+        """Indices of the joints (SpringJoint) these limits play."""
+        return np.flatnonzero([j.cone is not None and elliptic(j.cone) for j in joints])
+
+    def __init__(self, springs, index, held, gravity) -> None:
+        """The joints ``index`` of SpringSet ``springs``; ``held``: the indices of its joints that
+        hold a body alone on a static one (PivotInertia.held); ``gravity``: each body's."""
+        bodies = springs.bodies
+        self.index = index
+        self.span = np.stack([springs.joints[i].cone for i in index])
+        self.ip, self.ic = springs.ip[index], springs.ic[index]
+        self.held = np.isin(index, held)
+        self.shared = np.eye(3) / springs.i_eff[index][:, None, None]
+        # each body's 1/m, principal 1/I and gravity (static: none), for Bullet's solve (cone_twist.py)
+        self.inv_mass = np.array([0.0 if b.static else 1.0 / float(b.mass) for b in bodies])
+        self.inv_principal = np.array([np.zeros(3) if b.static else 1.0 / np.asarray(b.inertia, float) for b in bodies])
+        self.gravity = np.where(self.inv_mass[:, None] > 0.0, gravity, 0.0)
+        self.pa_in_p, self.pb_in_c = (p[index][:, :, None] for p in (springs.pa_in_p, springs.pb_in_c))
+
+    def torques(self, pos, rot, lv, av, r_a, r_b, dt: float) -> np.ndarray:
+        """(k, 3): the torque on each joint's child in the world (its parent takes the opposite),
+        ``r_a``, ``r_b`` the joint frames in the world, ``pos``, ``rot``, ``lv``, ``av`` every body's
+        centre-of-mass pose and velocity (SpringSet.states), for all the joints these play."""
+        axes, err = cone_rows(r_a, r_b, self.span)
+        active = err > 0.0
+        if not active.any():
+            return np.zeros((len(self.index), 3))
+        ip, ic = self.ip, self.ic
+        w_rel = av[ic] - av[ip]
+        inv = self.shared
+        rate = (axes @ w_rel[:, :, None])[..., 0]
+        lam = row_impulses(axes @ inv @ axes.transpose(0, 2, 1), rate, CONE_TWIST_BIAS * err / dt, active)
+        h = self.held
+        if h.any():  # a body held alone: Bullet's solve of the joint's rows
+            pivots = [pos[i] + (rot[i] @ p)[..., 0] for i, p in ((ip, self.pa_in_p), (ic, self.pb_in_c))]
+            sides = []
+            for i, pivot in zip((ip[h], ic[h]), pivots):
+                r = rot[i]
+                inv_i = (r * self.inv_principal[i][:, None, :]) @ r.transpose(0, 2, 1)
+                v = lv[i] + self.gravity[i] * dt
+                sides.append((self.inv_mass[i], inv_i, v, av[i], pivot[h] - pos[i]))
+            lam[h] = sequential_impulses(sides, (pivots[1] - pivots[0])[h], axes[h], err[h], dt)
+        return (axes * lam[:, :, None]).sum(1) / dt
+
+    def in_frame_a(self, pos, rot, lv, av, r_a, r_b, dt: float) -> np.ndarray:
+        """torques() of the joints these play in their frames A, ``r_a`` and ``r_b`` every joint's."""
+        c = self.index
+        return (r_a[c].transpose(0, 2, 1) @ self.torques(pos, rot, lv, av, r_a[c], r_b[c], dt)[:, :, None])[..., 0]
