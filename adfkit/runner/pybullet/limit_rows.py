@@ -122,9 +122,9 @@ class LimitRows:
     def leave(self, art, index: int) -> None:
         """Joint ``index`` of ``art`` is under a joint command from now on: not this row's."""
         self.commanded.add((art.uid, index))
-        self._release(art, index)
+        self.release(art, index)
 
-    def _release(self, art, index: int) -> None:
+    def release(self, art, index: int) -> None:
         """The joint's own limits back in PyBullet; its motor no longer this row's."""
         key = (art.uid, index)
         self.engaged.discard(key)
@@ -135,10 +135,13 @@ class LimitRows:
 
     def apply(self) -> None:
         cid = self.world.cid
+        chains = getattr(self.world, "limit_chains", None)
         for art, rows in self.joints:
+            if chains is not None and chains.playing(art):  # AMBF's solver step plays its stops (limit_chains.py)
+                continue
             if art.held:  # its position motors drive every joint
                 for n, _l, _r in rows:
-                    self._release(art, n)
+                    self.release(art, n)
                 continue
             states = pb.getJointStates(art.uid, [n for n, _l, _r in rows], physicsClientId=cid)
             for (n, lim, row), s in zip(rows, states):

@@ -31,6 +31,7 @@ from .cameras import choose_renderer, render
 from .chain import ChainModel
 from .ghost_steps import GhostSteps
 from .interact import Interaction
+from .limit_chains import LimitChains
 from .resist import PyBulletResistance
 from .softbodies import SoftBodies, enable_deformable_world
 from .solver_info import AMBF_SOLVER_INFO
@@ -90,7 +91,11 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             self._ghost_steps = None
         self.resistance = PyBulletResistance(self, [s for s in self.sensors if s.resist is not None])
         self._after_steps = [a for a in (self.vehicles, self.resistance) if a]
-        self._each_step = self._springs_every_step or self._ghost_steps is not None or bool(self._after_steps)
+        # free multibodies' stops through AMBF's solver step, at every physics step (limit_chains.py)
+        self.limit_chains = LimitChains(self)
+        self._stops = self.limit_chains.before_step if self.limit_chains else None
+        each = self._springs_every_step or self._ghost_steps is not None or bool(self._after_steps)
+        self._each_step = each or self._stops is not None
         if self._each_step:
             pb.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSubSteps=1, physicsClientId=self.cid)
             held.record(self.cid)
@@ -218,11 +223,14 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         sub = self.opt.control_substeps
         # AMBF's vehicles and resistance sensors act after each physics step (vehicles.py, resist.py)
         veh = self._after_steps or None
+        stops = self._stops
         for _ in range(n):
             self.control()
             if veh is not None:
                 for v in veh:
                     v.push()
+            if stops is not None:
+                stops()
             pb.stepSimulation(physicsClientId=self.cid)
             if veh is not None:
                 for v in veh:
@@ -238,6 +246,8 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
                     if veh is not None:
                         for v in veh:
                             v.push()
+                    if stops is not None:
+                        stops()
                     pb.stepSimulation(physicsClientId=self.cid)
                     if veh is not None:
                         for v in veh:

@@ -1,0 +1,115 @@
+"""A free multibody's stops played through AMBF's own solver step (runner/pybullet/limit_chains.py).
+
+The scene: a 0.2 kg, 0.2 m rod hinged at one end on a static post, released level, falling
+into its +1 rad stop at 10.8 rad/s. Measured with `adfkit parity` on AMBF 2.0 (1 ms samples):
+AMBF's rod comes back off the stop to 0.99415 rad (its centre of mass about the pivot), 5.9 mrad
+inside the stop, 18 ms after it, then rests on it. The joint's own row (limit_rows.py: the
+hinge's limit row on the joint alone, 0.3 of the speed back) threw it back to 0.864 rad (136 mrad;
+the rod 14.6 mm from AMBF's at most). The slow test plays the scene against AMBF."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from adfkit.adf import load_scene
+from adfkit.parity import ambf
+from adfkit.runner import Options, open_world
+
+ROD = """bodies: [BODY post, BODY rod]
+joints: [JOINT hinge]
+namespace: /ambf/env/
+BODY post:
+  name: post
+  mass: 0.0
+  collision shape: Box
+  collision geometry: {x: 0.02, y: 0.02, z: 0.02}
+  location: {position: {x: 0.0, y: 0.0, z: 0.5}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+BODY rod:
+  name: rod
+  mass: 0.2
+  collision shape: Box
+  collision geometry: {x: 0.2, y: 0.01, z: 0.01}
+  location: {position: {x: 0.11, y: 0.0, z: 0.5}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+JOINT hinge:
+  name: hinge
+  parent: BODY post
+  child: BODY rod
+  type: revolute
+  parent pivot: {x: 0.0, y: 0.0, z: 0.0}
+  child pivot: {x: -0.11, y: 0.0, z: 0.0}
+  parent axis: {x: 0.0, y: 1.0, z: 0.0}
+  child axis: {x: 0.0, y: 1.0, z: 0.0}
+  joint limits: {low: -1.0, high: 1.0}
+"""
+BUILD, WHY = ambf.available()
+needs_ambf = pytest.mark.skipif(BUILD is None, reason=WHY)
+
+#: AMBF's rod: where it turns back to after the stop (rad), measured
+AMBF_TURNS_BACK_TO = 0.99415
+
+
+def _world(tmp_path: Path, bodies: str = "ambf"):
+    path = tmp_path / "rod.yaml"
+    path.write_text(ROD)
+    opt = Options(visuals=False, ground=False, renderer="tiny")  # adfkit run's 4 ms control step
+    opt.bodies, opt.springs, opt.ghosts, opt.link_shapes = bodies, "ambf", "ambf", "body"
+    return open_world(load_scene(path), opt)
+
+
+def _swing(world, seconds: float) -> list[float]:
+    """The hinge's angle after each control step."""
+    (_j, _parent, child) = world.joints_made[0]
+    out = []
+    for _ in range(int(round(seconds / (world.dt * world.opt.control_substeps)))):
+        world.step(1)
+        out.append(float(world.joint_state(child.articulation, [child.link])[0][0]))
+    return out
+
+
+def test_a_rod_falling_into_its_stop_turns_back_as_far_as_ambf_s(tmp_path):
+    world = _world(tmp_path)
+    try:
+        assert world.limit_chains  # a free multibody with a limited hinge, under AMBF's bodies
+        q = _swing(world, 0.4)
+        hit = next(k for k, x in enumerate(q) if x >= 1.0)
+        back = min(q[hit:])
+        # 0.99346 here (4 ms control steps), AMBF's 0.99415 (the joint's own row: 0.864)
+        assert back == pytest.approx(AMBF_TURNS_BACK_TO, abs=1e-3)
+        assert q[-1] == pytest.approx(1.0, abs=0.5e-3)  # resting on the stop
+        assert not world.limit_chains.engaged  # at rest: the stop is the joint's own row's again
+    finally:
+        world.close()
+
+
+def test_without_ambf_s_bodies_the_joint_s_own_row_stops_it(tmp_path):
+    """Control: PyBullet's bodies (Options' default) leave the stop to PyBullet's limit and the
+    joint's own row, nothing handed to the chain step."""
+    world = _world(tmp_path, bodies="pybullet")
+    try:
+        assert not world.limit_chains
+        q = _swing(world, 0.4)
+        hit = next(k for k, x in enumerate(q) if x >= 1.0 - 1e-3)
+        assert min(q[hit:]) < 0.9  # 0.864
+    finally:
+        world.close()
+
+
+@pytest.mark.slow
+@needs_ambf
+def test_the_rod_against_ambf(tmp_path):
+    """`adfkit parity` on the rod (PyBullet, 4 ms, 1 s): within 0.1 mm and 0.1° of AMBF's
+    (measured 0.066 mm, 0.09°; the joint's own row 14.6 mm, 7.6°)."""
+    from adfkit.parity import session
+    from adfkit.scenes.parity import write_parity
+
+    write_parity(tmp_path)  # world, colours, input devices
+    (tmp_path / "rod.yaml").write_text(ROD)
+    launch = tmp_path / "launch.yaml"
+    text = launch.read_text()
+    launch.write_text(text[: text.index("multibody configs:")] + "multibody configs:\n- rod.yaml\n")
+    req = session.Request(launch, None, BUILD, seconds=1.0, every=0.02, engines=("pybullet",))
+    (c,) = session.run(req, progress=False).comparisons
+    rod = next(g for g in c.bodies if g.name.endswith("/rod"))
+    assert rod.max_position < 1e-4 and rod.max_angle < 0.1, (rod.max_position, rod.max_angle)
