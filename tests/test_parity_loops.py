@@ -56,6 +56,33 @@ def test_a_gripper_resting_on_the_floor_stays_as_in_ambf():
     assert _largest_gaps(path, link_shapes="com")["pybullet"] > 0.02
 
 
+@pytest.mark.slow
+@needs_ambf
+def test_gripper3_s_jaw_loop_keeps_what_its_file_leaves_open_in_mujoco(monkeypatch):
+    """Corpus gripper 3: two jaws hinged on a base, their tips joined by a slider, the loop 0.37 mm
+    open where the file places them, across its plane, where no joint of MuJoCo's tree can close
+    it. MuJoCo's connect closing it keeps that opening: 7.98 mm from AMBF at most over 1 s
+    (measured). Control: the connect held at the file's pivot (cross_joints.file_anchors without
+    its same-tree exception), which twisted the jaws: 19.6 mm."""
+    from adfkit.runner.mujoco import assemble
+
+    require_corpus()
+    path = CORPUS / MODELS / "grippers/resistive/gripper3/gripper.yaml"
+    assert _largest_gaps(path, ("mujoco",))["mujoco"] < 0.010
+    real = assemble.file_anchors
+
+    def everywhere(m, loops):
+        roots = m.body_rootid.copy()
+        m.body_rootid[:] = range(m.nbody)  # every body a root of its own: no loop within one tree
+        try:
+            real(m, loops)
+        finally:
+            m.body_rootid[:] = roots
+
+    monkeypatch.setattr(assemble, "file_anchors", everywhere)
+    assert _largest_gaps(path, ("mujoco",))["mujoco"] > 0.015
+
+
 def test_a_command_on_a_joint_closing_a_loop_is_a_located_error(tmp_path):
     """AMBF drives every hinge's motor; adfkit plays the joint that closes a loop as a
     constraint without one. A command file that drives it is a located error before anything is

@@ -82,7 +82,12 @@ def file_anchors(m, loops) -> None:
     connect's second anchor from where the bodies start, so where a file places a child off its
     joint MuJoCo held the two pivots that far apart for good (a p2p from a free box to a static
     one, the child's pivot 100 mm off: 100.4 mm open after 1 s, AMBF's 0.010 mm). The second
-    connect of a hinge to a static body (a point on its axis) moves with it."""
+    connect of a hinge to a static body (a point on its axis) moves with it. Not a loop within
+    one tree (a joint between two links of one multibody): its bodies start where the file puts
+    them, and what the file leaves open across a planar loop no joint of the tree can close, so
+    the connect keeps it, as the PyBullet runner anchors it (pybullet/loops.py). Held at the
+    file's pivot, corpus gripper 3's jaw loop (0.37 mm open) twisted the jaws 19.6 mm from AMBF's
+    (7.98 mm kept open; the parallel structure 9.97 and 9.26 mm)."""
     connects = [e for e in range(m.neq) if m.eq_type[e] == mujoco.mjtEq.mjEQ_CONNECT]
     for _j, kind, parent, child, pa, pb in loops:
         if kind is JointKind.FIXED:
@@ -91,6 +96,8 @@ def file_anchors(m, loops) -> None:
             mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, parent.mjname),
             mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, child.mjname),
         )
+        if m.body_rootid[ids[0]] == m.body_rootid[ids[1]] != 0:  # a loop within one tree: see above
+            continue
         pair = [e for e in connects if (int(m.eq_obj1id[e]), int(m.eq_obj2id[e])) == ids]
         pivot = [e for e in pair if np.linalg.norm(m.eq_data[e, :3] - pa) < 1e-9]
         if len(pivot) != 1:
