@@ -15,19 +15,18 @@ from ...model.semantics import DEFAULT_SENSOR_RANGE
 from ..plan import SENSOR_TYPES
 from ..resistance import Body, RayState, ResistanceParams, missed, ray_force
 from ..rotations import invert, rotation_exp
+from .after_step import AfterStep
 
 
-class MujocoResistance:
+class MujocoResistance(AfterStep):
     def __init__(self, world) -> None:
         """The world's played resistance sensors (played_sensors keeps them under AMBF's bodies)."""
-        self.world = world
+        super().__init__(world)
         self.sensors = [
             (s, ResistanceParams.of(s.sensor), [RayState() for _ in s.starts])
             for s in world.sensors
             if SENSOR_TYPES.get(s.sensor.type) == "resistance"
         ]
-        self._pending: list[tuple] = []  # (MuJoCo body id, wrench about its COM), world frame
-        self._saved: list[tuple] = []
         self._hit = np.zeros(1, dtype=np.int32)
         self._normal = np.zeros(3)
         self._vel = np.zeros(6)
@@ -79,20 +78,6 @@ class MujocoResistance:
         mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, sb.id, self._vel, 0)
         ang = self._vel[:3].copy()
         return Body(t[:3, 3], t[:3, :3], self._vel[3:] + np.cross(ang, t[:3, 3] - d.xipos[sb.id]), ang)
-
-    def push(self) -> None:
-        """Before a physics step: the forces the last one left, on top of the step's forces."""
-        xf = self.world.data.xfrc_applied
-        self._saved = [(bid, xf[bid].copy()) for bid, _ in self._pending]
-        for bid, wrench in self._pending:
-            xf[bid] += wrench
-
-    def pull(self) -> None:
-        """After the physics step: the forces as they were before push."""
-        xf = self.world.data.xfrc_applied
-        for bid, row in self._saved:
-            xf[bid] = row
-        self._saved = []
 
 
 def _motion_state(a: Body, dt: float) -> np.ndarray:

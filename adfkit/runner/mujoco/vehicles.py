@@ -11,6 +11,7 @@ import numpy as np
 
 from ..rotations import matrix_to_quat
 from ..vehicles import RaycastVehicle, RayHit, planned
+from .after_step import AfterStep
 
 
 def weld_wheels(world, plan) -> None:
@@ -37,9 +38,9 @@ def weld_wheels(world, plan) -> None:
                 )
 
 
-class MujocoVehicles:
+class MujocoVehicles(AfterStep):
     def __init__(self, world) -> None:
-        self.world = world
+        super().__init__(world)
         m = world.model
         models = world.scene.all_models()
         self.vehicles: list[RaycastVehicle] = []
@@ -50,8 +51,6 @@ class MujocoVehicles:
             inertia = m.body_inertia[chassis.id]
             inv_inertia = [1.0 / i if i > 0 else 0.0 for i in inertia]
             self.vehicles.append(RaycastVehicle(key, chassis, wheels, 1.0 / mass if mass > 0 else 0.0, inv_inertia))
-        self._pending: list[tuple] = []
-        self._saved: list[tuple] = []
         self._hit = np.zeros(1, dtype=np.int32)
         self._normal = np.zeros(3)
 
@@ -97,17 +96,3 @@ class MujocoVehicles:
                 force, torque = made
                 torque = torque + np.cross(t[:3, 3] - d.xipos[bid], force)  # about MuJoCo's COM
                 self._pending.append((bid, np.concatenate([force, torque])))
-
-    def push(self) -> None:
-        """Before a physics step: the impulses the last one left, on top of the step's forces."""
-        xf = self.world.data.xfrc_applied
-        self._saved = [(bid, xf[bid].copy()) for bid, _ in self._pending]
-        for bid, wrench in self._pending:
-            xf[bid] += wrench
-
-    def pull(self) -> None:
-        """After the physics step: the forces as they were before push."""
-        xf = self.world.data.xfrc_applied
-        for bid, row in self._saved:
-            xf[bid] = row
-        self._saved = []
