@@ -96,6 +96,62 @@ def test_without_ambf_s_bodies_the_joint_s_own_row_stops_it(tmp_path):
         world.close()
 
 
+TWO_LINKS = (
+    ROD.replace("bodies: [BODY post, BODY rod]", "bodies: [BODY post, BODY rod, BODY tip]").replace(
+        "joints: [JOINT hinge]", "joints: [JOINT hinge, JOINT wrist]"
+    )
+    + """BODY tip:
+  name: tip
+  mass: 0.1
+  collision shape: Box
+  collision geometry: {x: 0.1, y: 0.01, z: 0.01}
+  location: {position: {x: 0.27, y: 0.03, z: 0.5}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+JOINT wrist:
+  name: wrist
+  parent: BODY rod
+  child: BODY tip
+  type: revolute
+  parent pivot: {x: 0.11, y: 0.03, z: 0.0}
+  child pivot: {x: -0.05, y: 0.0, z: 0.0}
+  parent axis: {x: 0.0, y: 1.0, z: 0.0}
+  child axis: {x: 0.0, y: 1.0, z: 0.0}
+"""
+)
+
+
+def test_a_command_mid_bounce_leaves_the_other_joints_free(tmp_path):
+    """A command on the hinge while the chain step plays the bounce: the chain step gives the
+    multibody back and the wrist, which nothing commands, swings on under gravity, not held at
+    the velocity the chain step last gave its motor."""
+    from adfkit.runner.joint_commands import JointCommands
+
+    path = tmp_path / "two.yaml"
+    path.write_text(TWO_LINKS)
+    opt = Options(visuals=False, ground=False, renderer="tiny")
+    opt.bodies, opt.springs, opt.ghosts, opt.link_shapes = "ambf", "ambf", "ambf", "body"
+    world = open_world(load_scene(path), opt)
+    try:
+        (hinge, _p, rod), (_w, _r, tip) = world.joints_made
+        art = rod.articulation
+        for _ in range(200):
+            world.step(1)
+            if world.limit_chains.engaged:
+                break
+        assert world.limit_chains.engaged  # the rod came into its stop
+        drives = JointCommands(world)
+        drives.command(hinge, rod, "position", 0.9)
+        speeds = []
+        for _ in range(50):
+            drives.apply(world.sim_time)
+            world.step(1)
+            speeds.append(float(world.joint_state(art, [tip.link])[1][0]))
+        assert not world.limit_chains.engaged
+        # the wrist's speed changes from step to step (gravity, the rod's motion): no motor holds it
+        assert max(abs(b - a) for a, b in zip(speeds, speeds[1:])) > 1e-3
+    finally:
+        world.close()
+
+
 @pytest.mark.slow
 @needs_ambf
 def test_the_rod_against_ambf(tmp_path):

@@ -61,9 +61,15 @@ class LimitChains:
     def __bool__(self) -> bool:
         return bool(self.arts)
 
-    def _free(self, art) -> bool:
+    def _commanded(self, art) -> set[int]:
+        """The joints of ``art`` a command or a holding position motor drives."""
+        if art.held:
+            return set(range(len(art.records)))
         commanded = self.world.limit_rows.commanded
-        return not art.held and not any((art.uid, n) in commanded for n in range(len(art.records)))
+        return {n for n in range(len(art.records)) if (art.uid, n) in commanded}
+
+    def _free(self, art) -> bool:
+        return not self._commanded(art)
 
     def playing(self, art) -> bool:
         """Whether the chain step plays ``art``'s joints now (limit_rows.py leaves them alone)."""
@@ -77,8 +83,8 @@ class LimitChains:
         for art, limited in self.arts:
             key = id(art)
             if not self._free(art):
-                if key in self.engaged:  # its joints' motors are the commands' now
-                    self._give_back(art, limited, motors=False)
+                if key in self.engaged:  # the commanded joints' motors are the commands' now
+                    self._give_back(art, limited, keep=self._commanded(art))
                 continue
             idx = list(range(len(art.records)))
             states = pb.getJointStates(art.uid, idx, physicsClientId=cid)
@@ -124,12 +130,14 @@ class LimitChains:
             )
         self.engaged[id(art)] = self.step
 
-    def _give_back(self, art, limited, motors: bool = True) -> None:
+    def _give_back(self, art, limited, keep: set[int] | None = None) -> None:
+        """The joints' own limits back, and their motors off but those of ``keep`` (driven by
+        commands since)."""
         cid = self.world.cid
         for n, (lo, hi) in limited:
             pb.changeDynamics(art.uid, n, jointLowerLimit=lo, jointUpperLimit=hi, physicsClientId=cid)
-        if motors:
-            idx = list(range(len(art.records)))
+        idx = [n for n in range(len(art.records)) if keep is None or n not in keep]
+        if idx:
             pb.setJointMotorControlArray(
                 art.uid, idx, pb.VELOCITY_CONTROL, forces=[0.0] * len(idx), physicsClientId=cid
             )
