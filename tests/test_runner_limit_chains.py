@@ -152,6 +152,22 @@ def test_a_command_mid_bounce_leaves_the_other_joints_free(tmp_path):
         world.close()
 
 
+def test_a_snapshot_restored_mid_bounce_plays_the_fall_again(tmp_path):
+    """Restored to its start while the chain step plays a bounce, the rod falls and bounces as it
+    did the first time (the chain step's motors and opened limits are the motion's it left)."""
+    world = _world(tmp_path)
+    try:
+        snap = world.save_state()
+        first = _swing(world, 0.2)
+        while not world.limit_chains.engaged:
+            world.step(1)
+        world.restore_state(snap)
+        again = _swing(world, 0.2)
+        assert max(abs(a - b) for a, b in zip(first, again)) < 1e-6
+    finally:
+        world.close()
+
+
 @pytest.mark.slow
 @needs_ambf
 def test_the_rod_against_ambf(tmp_path):

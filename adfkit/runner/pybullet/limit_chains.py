@@ -120,6 +120,14 @@ class LimitChains:
                 physicsClientId=cid,
             )
 
+    def reset(self) -> None:
+        """The world put back to a snapshot: every multibody given back, what the chain step
+        carried from step to step dropped (its next step is not this one's successor)."""
+        for art, limited in self.arts:
+            if id(art) in self.engaged:
+                self._give_back(art, limited)
+        self.step += 2
+
     def _take(self, art, limited) -> None:
         rows = self.world.limit_rows
         for n in range(len(art.records)):

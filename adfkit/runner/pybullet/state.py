@@ -80,6 +80,7 @@ class WorldState:
         for g in self.ghosts:  # a restore puts the ghosts back too: the next control step places them
             g.placed_at = None
         self._pairs_epoch += 1
+        self.limit_chains.reset()  # its motors and opened limits belong to the motion left behind
         if snap.world() is self:
             self._restore_own(snap)
         else:
