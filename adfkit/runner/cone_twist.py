@@ -20,6 +20,7 @@ getInfo2NonVirtual's other branch): those joints keep the runner's per-axis limi
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import solve_triangular
 
 #: btConeTwistConstraint's bias factor, which AMBF's setLimit leaves at Bullet's default
 CONE_TWIST_BIAS = 0.3
@@ -154,3 +155,67 @@ def sequential_impulses(bodies, gap, axes, err, dt: float, erp: float = 0.2, ite
             wa += (ia @ (ang_a * d)[:, :, None])[..., 0]
             wb += (ib @ (ang_b * d)[:, :, None])[..., 0]
     return lam[3:].T
+
+
+def chain_impulses(bodies, joints, axes, err, dt: float, erp: float = 0.2, iterations: int = 10):
+    """sequential_impulses for joints that share bodies (a chain of cone twists): every joint's
+    three pivot rows and its rows past a limit, joint after joint in their order, ``iterations``
+    sweeps. ``bodies``: (1/m (B,), I⁻¹ in the world (B, 3, 3), velocity with the step's gravity in
+    (B, 3), angular velocity (B, 3)); ``joints``: (parent index (n,), child index (n,), arm from
+    the parent's centre of mass to its pivot (n, 3), the child's (n, 3), the child's pivot less
+    the parent's (n, 3)). Returns the (n, 2) impulses of the swing and twist rows.
+
+    A sweep of Bullet's solver is projected Gauss-Seidel on the rows' J·M⁻¹·Jᵀ: triangular solves,
+    one more after each row that only pushes and would pull (held at 0). Row by row in Python, a
+    12-element rope stepped 50x slower than with the Euler angles' limits.)"""
+    inv_m, inv_i, v, w = bodies
+    ia, ib, arm_a, arm_b, gap = joints
+    n, nb = len(ia), len(inv_m)
+    # the rows, joint after joint: its three pivot rows (x, y, z), then its swing and twist rows
+    # that act; on body A the linear part and an angular one, on body B minus the linear part
+    jj, rr = np.nonzero(err > 0.0)
+    owner = np.concatenate([np.repeat(np.arange(n), 3), jj])
+    slot = np.concatenate([np.tile(np.arange(3), n), 3 + rr])
+    order = np.lexsort((slot, owner))
+    owner, slot = owner[order], slot[order]
+    pivot = slot < 3
+    k = np.where(pivot, slot, 0)
+    r = np.where(pivot, 0, slot - 3)
+    lin = np.where(pivot[:, None], np.eye(3)[k], 0.0)
+    # a × e_k is column k of a's cross-product matrix
+    ang_a = np.where(pivot[:, None], _skew(arm_a[owner])[np.arange(len(k)), :, k], -axes[owner, r])
+    ang_b = np.where(pivot[:, None], -_skew(arm_b[owner])[np.arange(len(k)), :, k], axes[owner, r])
+    target = np.where(pivot, erp / dt * gap[owner, k], CONE_TWIST_BIAS / dt * err[owner, r])
+    low_a = np.where(pivot, -np.inf, 0.0)
+    rows, o = len(owner), owner
+    j_lin, j_ang = np.zeros((rows, nb, 3)), np.zeros((rows, nb, 3))
+    at = np.arange(rows)
+    j_lin[at, ia[o]] += lin
+    j_lin[at, ib[o]] -= lin
+    j_ang[at, ia[o]] += ang_a
+    j_ang[at, ib[o]] += ang_b
+    moved_ang = np.einsum("bij,rbj->rbi", inv_i, j_ang)
+    delassus = np.einsum("rbi,sbi->rs", j_lin * inv_m[None, :, None], j_lin) + np.einsum(
+        "rbi,sbi->rs", moved_ang, j_ang
+    )
+    rhs = target - np.einsum("rbi,bi->r", j_lin, v) - np.einsum("rbi,bi->r", j_ang, w)
+    diag = np.maximum(np.diag(delassus), 1e-300)
+    lower = np.tril(delassus, -1) + np.diag(diag)
+    upper = np.triu(delassus, 1)
+    lam = np.zeros(rows)
+    for _ in range(iterations):
+        start = 0  # the rows before it have their impulses of this sweep
+        while start < rows:
+            b = rhs[start:] - delassus[start:, :start] @ lam[:start] - upper[start:, start:] @ lam[start:]
+            free = solve_triangular(lower[start:, start:], b, lower=True, check_finite=False)
+            pulls = np.flatnonzero(free < low_a[start:])
+            if not pulls.size:
+                lam[start:] = free
+                break
+            q = start + int(pulls[0])  # a row that only pushes would pull: held at 0, the rest after it
+            lam[start:q] = free[: q - start]
+            lam[q] = low_a[q]
+            start = q + 1
+    out = np.zeros((n, 2))
+    out[owner[~pivot], r[~pivot]] = lam[~pivot]
+    return out
