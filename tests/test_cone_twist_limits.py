@@ -135,13 +135,16 @@ def test_a_rod_falling_diagonally_is_held_on_bullets_ellipse(tmp_path, engine):
     ):
         world = open_world(load_scene(tmp_path / "m.yaml", None, []), opt, engine=engine)
         try:
-            ratios = []
+            ratios, opening = [], 0.0
             for _ in range(200):
                 world.run(0.01)
                 ratios.append(_swing_over_limit(world, frame_a))
+                opening = max(opening, world.constraint_error())
         finally:
             world.close()
         worst[name] = max(ratios)
+        if name == "ambf":  # the pivot held (in PyBullet by Bullet's pivot rows, played as forces)
+            assert opening < 2e-4, opening
     assert 0.98 < worst["ambf"] < 1.02, worst
     assert worst["euler"] > 1.2, worst  # the check can fail: per-axis limits leave the ellipse
 
@@ -157,13 +160,17 @@ RODS = [
 @needs_ambf
 def test_cone_twists_swing_and_twist_into_their_limits_as_in_ambf(tmp_path, capsys):
     """Rods falling diagonally into elliptic cones and a plate hung off its twist axis (its weight
-    twists it into its 0.2 rad limit): within 1 mm of AMBF in both engines over 2 s (PyBullet
-    0.09-0.83 mm, MuJoCo 0.12-0.82 mm; 13-80 and 15-66 mm with each Euler angle limited)."""
+    twists it into its 0.2 rad limit) follow AMBF's over 2 s: in PyBullet, where the bodies move
+    freely under Bullet's rows as in AMBF, the plate and the rod into the 0.6 x 0.4 rad cone within
+    0.03 mm, the two rods chattering on their 0.3 x 0.8 rad cones 1.00 mm at most (a bounce a
+    step apart; 0.05 mm between bounces); MuJoCo 0.12-0.82 mm. 13-80 (PyBullet) and 15-66 mm
+    (MuJoCo) with each Euler angle limited."""
     launch = launch_with(tmp_path, {"m.yaml": _model(RODS)})
     for doc in parity(capsys, launch, 2.0, "both"):
         for n, *_ in RODS:
             row = body(doc, f"rod{n}")
-            assert row["max_position_gap_m"] < 1e-3, (doc["engine"], row)
+            exact = doc["engine"] == "pybullet" and n in (3, 4)
+            assert row["max_position_gap_m"] < (1e-4 if exact else 1.5e-3), (doc["engine"], row)
             assert row["max_angle_gap_deg"] < 1.0, (doc["engine"], row)
 
 

@@ -116,14 +116,15 @@ def row_impulses(w: np.ndarray, rate: np.ndarray, target: np.ndarray, active: np
     return lam
 
 
-def sequential_impulses(bodies, gap, axes, err, dt: float, erp: float = 0.2, iterations: int = 10):
+def sequential_impulses(bodies, gap, axes, err, dt: float, erp: float = 0.2, iterations: int = 10, moved=None):
     """(n, 2) impulses of the swing and twist rows as Bullet's solver leaves them: the joint's
     three pivot rows (at ``erp``) and its two angular rows solved one after another, ``iterations``
     sweeps (btSequentialImpulseConstraintSolver's default 10, no warm start for joint rows), each
     body moving with its own mass and inertia about its centre of mass. ``bodies``: for the parent
     and the child, (1/m (n,), I⁻¹ in the world (n, 3, 3), velocity (n, 3) with the step's gravity
     in, angular velocity (n, 3), arm from the centre of mass to the pivot (n, 3)); ``gap`` (n, 3)
-    the child's pivot less the parent's; ``axes``, ``err`` as cone_rows gives them."""
+    the child's pivot less the parent's; ``axes``, ``err`` as cone_rows gives them. ``moved``: a
+    list that gets the two bodies' velocities and angular velocities after the solve."""
     n = len(gap)
     (ma, ia, va, wa, ra), (mb, ib, vb, wb, rb) = bodies
     va, wa, vb, wb = va.copy(), wa.copy(), vb.copy(), wb.copy()
@@ -154,6 +155,8 @@ def sequential_impulses(bodies, gap, axes, err, dt: float, erp: float = 0.2, ite
             vb -= mb[:, None] * lin * d
             wa += (ia @ (ang_a * d)[:, :, None])[..., 0]
             wb += (ib @ (ang_b * d)[:, :, None])[..., 0]
+    if moved is not None:
+        moved += [va, wa, vb, wb]
     return lam[3:].T
 
 

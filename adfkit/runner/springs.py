@@ -31,6 +31,7 @@ class SpringJoint:
     linear_constrained: bool = True  # a p2p holds the pivots together
     in_multibody: bool = False  # a multibody's joint plays its limits and locked axes (spring_alone)
     cone: np.ndarray | None = None  # a cone twist's (swing span 1, swing span 2, twist span): cone_twist.spans
+    free_pivot: bool = False  # no engine constraint: the springs play Bullet's pivot rows (pybullet/cone_limits.py)
 
 
 def _vec(v, default: float) -> np.ndarray:

@@ -32,6 +32,7 @@ from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from ..springs import spring_alone
 from . import articulation, egl
 from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
+from .cone_limits import ConeLimits
 from .damping import LinkDamping
 from .ghost_pass import GhostPass
 from .interact import SimActuator, SimGhost, SimSensor
@@ -122,6 +123,10 @@ class Assembly:
             if kind in SPRING_KINDS:
                 sj = spring_joint(j, kind, parent, child, fa, fb)
                 springs.append(sj)
+                sj.free_pivot = self.opt.springs == "ambf" and ConeLimits.frees_pivot(sj, leftover)
+                if sj.free_pivot:  # Bullet's pivot rows played by the springs (cone_limits.py)
+                    self.constraints.append((j.identifier, None, parent, child, fa[:3, 3], fb[:3, 3], None))
+                    continue
                 if not sj.linear_constrained:
                     continue
                 kind_c = JointKind.P2P
