@@ -69,6 +69,7 @@ def own_scenes(folder: Path) -> list[Scene]:
     out.append(Scene("ball, cylinder, capsule and cone dropped tilted on the floor", launch, [7], 1.0, both))
     out.append(Scene("balls and a cylinder sliding down a 25° ramp", launch, [8], 1.0, both))
     out.append(Scene("two boxes on a fixed joint dropped onto an edge", launch, [9], 1.0, both))
+    out.append(Scene("a rod, a slider and two links falling into their stops", launch, [10], 1.5, both))
     out.append(
         Scene(
             "arm with a turned inertial frame, position commands",

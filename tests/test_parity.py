@@ -48,9 +48,10 @@ def test_the_parity_scenes_are_valid_and_play(scenes, capsys):
         bodies, joints = bodies + int(counts[1]) - 1, joints + int(counts[2])
     # the floor; slab and box; post and arm; three boxes; post, cube and twin; the needle's stand-in
     # and 40 thread elements; post and block; rail and four bobs; ball, cylinder, capsule and cone;
-    # the ramp, two balls and a cylinder; two boxes; the arm's joint, the thread's 40, the slider,
-    # the pendulums' 4 and the boxes' fixed joint
-    assert (bodies, joints) == (69, 47)
+    # the ramp, two balls and a cylinder; two boxes; the stops' post, rod, rail, bob, base and two
+    # links; the arm's joint, the thread's 40, the slider, the pendulums' 4, the boxes' fixed joint
+    # and the stops' 4
+    assert (bodies, joints) == (76, 51)
 
 
 def test_efforts_hold_the_slider_on_its_limits(scenes):

@@ -4,7 +4,7 @@ joint driven by position, velocity and effort commands (a command file for each)
 settling in a stack, a cube falling into a ghost object, the suture thread falling from a held
 needle, a slider pushed onto its limits by efforts (a command file), four pendulums on p2p,
 cone-twist, six-dof and six-dof-spring joints, a ball, a cylinder, a capsule and a cone dropped
-tilted on the floor. They need nothing but themselves: no corpus, no meshes. The launch file
+tilted on the floor, free joints running into their stops. They need nothing but themselves: no corpus, no meshes. The launch file
 lists one model per scene on the same world (a floor); ``-l`` picks one. Beside them, outside
 the launch file, ``turned_arm.yaml``: the arm with its inertial frame turned about the joint's
 axis (its inertia turned with it), which AMBF reads with the joint's zero turned
@@ -42,7 +42,9 @@ GREY = RGBA(r=0.6, g=0.6, b=0.65, a=1.0)
 ORANGE = RGBA(r=0.9, g=0.5, b=0.1, a=1.0)
 
 #: the launch file's models, in order (-l INDEX)
-SCENES = ("drop", "arm", "stack", "ghost", "thread", "slider", "pendulums", "primitives", "ramp", "fixed_pair")
+SCENES = (
+    "drop", "arm", "stack", "ghost", "thread", "slider", "pendulums", "primitives", "ramp", "fixed_pair", "stops"
+)  # fmt: skip
 
 #: command files beside the scenes: (file, scene, lines)
 COMMANDS = {
@@ -379,6 +381,57 @@ def build_fixed_pair() -> ModelFile:
     return m
 
 
+def build_stops() -> ModelFile:
+    """Free joints running into their stops, nothing commanding them: a 0.2 kg, 20 cm rod hinged
+    at one end on a static post, released level into its 1 rad stop (at 10.8 rad/s: AMBF's rod
+    comes back off it to 0.994 rad and rests on it); a 0.3 kg bob sliding down a prismatic rail
+    tilted 37° into its stop 10 cm down; two links (0.3 and 0.2 kg) hinged one on the other,
+    falling into their stops at 0.8 and 0.6 rad: how a stop turns back what comes into it."""
+    m = ModelFile(namespace="/ambf/env/stops/")
+    y = Vec3(0.0, 1.0, 0.0)
+
+    def hinge(parent: str, child: str, pivot: Vec3, child_pivot: Vec3, limit: float) -> Joint:
+        return Joint(
+            identifier=f"JOINT {parent}-{child}",
+            name=f"{parent}-{child}",
+            parent=f"BODY {parent}",
+            child=f"BODY {child}",
+            type="revolute",
+            parent_pivot=pivot,
+            parent_axis=y,
+            child_pivot=child_pivot,
+            child_axis=y,
+            joint_limits=JointLimits(low=-limit, high=limit),
+        )
+
+    m.bodies.append(_box("post", (0.02, 0.02, 0.02), (0.0, -0.4, 0.5)))
+    m.bodies.append(_box("rod", (0.2, 0.01, 0.01), (0.11, -0.4, 0.5), mass=0.2, color=ORANGE))
+    m.joints.append(hinge("post", "rod", Vec3(0.0, 0.0, 0.0), Vec3(-0.11, 0.0, 0.0), 1.0))
+    m.bodies.append(_box("rail", (0.02, 0.02, 0.02), (0.0, 0.0, 0.5)))
+    m.bodies.append(_box("bob", (0.04, 0.04, 0.04), (0.1, 0.0, 0.5), mass=0.3, color=ORANGE))
+    tilted = Vec3(0.0, 0.6, 0.8)
+    m.joints.append(
+        Joint(
+            identifier="JOINT rail-bob",
+            name="rail-bob",
+            parent="BODY rail",
+            child="BODY bob",
+            type="prismatic",
+            parent_pivot=Vec3(0.1, 0.0, 0.0),
+            parent_axis=tilted,
+            child_pivot=Vec3(0.0, 0.0, 0.0),
+            child_axis=tilted,
+            joint_limits=JointLimits(low=-0.1, high=0.1),
+        )
+    )
+    m.bodies.append(_box("base", (0.02, 0.02, 0.02), (0.0, 0.4, 0.6)))
+    m.bodies.append(_box("upper", (0.2, 0.02, 0.02), (0.11, 0.4, 0.6), mass=0.3, color=ORANGE))
+    m.bodies.append(_box("lower", (0.15, 0.015, 0.015), (0.305, 0.45, 0.6), mass=0.2, color=ORANGE))
+    m.joints.append(hinge("base", "upper", Vec3(0.0, 0.0, 0.0), Vec3(-0.11, 0.0, 0.0), 0.8))
+    m.joints.append(hinge("upper", "lower", Vec3(0.11, 0.05, 0.0), Vec3(-0.085, 0.0, 0.0), 0.6))
+    return m
+
+
 BUILD = {
     "drop": build_drop,
     "arm": build_arm,
@@ -390,6 +443,7 @@ BUILD = {
     "primitives": build_primitives,
     "ramp": build_ramp,
     "fixed_pair": build_fixed_pair,
+    "stops": build_stops,
 }
 
 
