@@ -1337,3 +1337,26 @@ def test_ambf_and_adfkit_list_a_joint_of_an_unknown_type_alike(tmp_path, capsys)
     assert [d["engine"] for d in docs] == ["pybullet", "mujoco"]
     for doc in docs:
         assert doc["only_in_ambf"] == doc["only_in_adfkit"] == [], doc
+
+
+def test_an_unstable_adfkit_world_is_said_and_fails_the_comparison():
+    """A comparison whose adfkit world met an instability (a MuJoCo state reset) fails, prints
+    the event and lists it in the JSON, even where every body happens to lie within tolerance."""
+    import io
+    from types import SimpleNamespace
+
+    from adfkit.parity.compare import compare
+    from adfkit.parity.session import Outcome, print_text
+
+    ambf = _replay_trace([(0.0, 0.0, 0.05 - 0.001 * k) for k in range(5)])
+    mine = replace(ambf, side="mujoco")
+    c = compare(ambf, mine, 1e-3, 1.0)
+    assert c.failures() == []
+    c.unstable = ["t = 0.212 s (/ambf/env/BODY b2): MuJoCo met NaN ... and reset the whole state"]
+    assert c.failures() == ["adfkit mujoco unstable: " + c.unstable[0]]
+    assert c.as_json()["adfkit_unstable"] == c.unstable and c.as_json()["agree"] is False
+    req = SimpleNamespace(path="scene.yaml", control_substeps=4)
+    text = io.StringIO()
+    print_text(Outcome([c], req, [], 0.1, ""), text)
+    assert "adfkit mujoco unstable: t = 0.212 s" in text.getvalue()
+    assert "differ: 1 past" in text.getvalue()

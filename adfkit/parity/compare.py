@@ -43,6 +43,9 @@ class Comparison:
     tips: list[str] = field(default_factory=list)  # the tool tips' names (traces.tool_tips)
     # each side's joints standing open (openings.py), by side: "ambf" and the engine's
     opening: dict = field(default_factory=dict)
+    # what the adfkit world met on the way (runner/stability.py: a MuJoCo state reset, NaN, a flung
+    # body), each with its time: its poses from then on are not the physics' answer
+    unstable: list[str] = field(default_factory=list)
 
     @property
     def tip_gaps(self) -> list[Gap]:
@@ -65,6 +68,7 @@ class Comparison:
         ]
         out += [f"only in AMBF: {d['kind']} {d['name']}" for d in self.only_in_ambf]
         out += [f"only in adfkit: {d['kind']} {d['name']}" for d in self.only_in_adfkit]
+        out += [f"adfkit {self.adfkit.side} unstable: {u}" for u in self.unstable]
         return out
 
     def as_json(self) -> dict:
@@ -98,6 +102,7 @@ class Comparison:
             "only_in_adfkit": self.only_in_adfkit,
             "wall_s": {"ambf": self.ambf.wall_s, self.adfkit.side: self.adfkit.wall_s},
             "notes": self.notes,
+            "adfkit_unstable": self.unstable,
             "joint_opening": {side: o.as_json() for side, o in self.opening.items()},
         }
 

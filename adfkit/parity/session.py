@@ -126,6 +126,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
             trace = p.play(req.seconds, req.every, commands, bar)
             bar.close()
             c = compare(ambf_trace, trace, req.tolerance_m, req.tolerance_deg)
+            c.unstable = [str(e) for e in p.world.watch.events]
             if any(cmd.kind in commandfile.JOINT_KINDS for cmd, _ in commands_read):  # driven: its tips
                 c.tips = tool_tips(list(zip(p.made["body"], p.bodies)), p.joints)
             pivots = shut_pivots(p.world, p.made)
@@ -230,6 +231,8 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
         for label, items in (("only in AMBF", c.only_in_ambf), ("only in adfkit", c.only_in_adfkit)):
             for d in items:
                 print(f"  {label}: {d['kind']} {d['name']}", file=stream)
+        for u in c.unstable:
+            print(f"  adfkit {eng} unstable: {u}", file=stream)
         print(
             f"  stepping: AMBF {c.ambf.wall_s:.2f} s, adfkit {eng} {c.adfkit.wall_s:.2f} s "
             f"(AMBF's whole process {out.ambf_process_s:.2f} s)",
