@@ -50,9 +50,9 @@ needs_ambf = pytest.mark.skipif(BUILD is None, reason=WHY)
 AMBF_TURNS_BACK_TO = 0.99415
 
 
-def _world(tmp_path: Path, bodies: str = "ambf"):
+def _world(tmp_path: Path, bodies: str = "ambf", text: str = ROD):
     path = tmp_path / "rod.yaml"
-    path.write_text(ROD)
+    path.write_text(text)
     opt = Options(visuals=False, ground=False, renderer="tiny")  # adfkit run's 4 ms control step
     opt.bodies, opt.springs, opt.ghosts, opt.link_shapes = bodies, "ambf", "ambf", "body"
     return open_world(load_scene(path), opt)
@@ -125,11 +125,7 @@ def test_a_command_mid_bounce_leaves_the_other_joints_free(tmp_path):
     the velocity the chain step last gave its motor."""
     from adfkit.runner.joint_commands import JointCommands
 
-    path = tmp_path / "two.yaml"
-    path.write_text(TWO_LINKS)
-    opt = Options(visuals=False, ground=False, renderer="tiny")
-    opt.bodies, opt.springs, opt.ghosts, opt.link_shapes = "ambf", "ambf", "ambf", "body"
-    world = open_world(load_scene(path), opt)
+    world = _world(tmp_path, text=TWO_LINKS)
     try:
         (hinge, _p, rod), (_w, _r, tip) = world.joints_made
         art = rod.articulation
