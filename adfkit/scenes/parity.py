@@ -390,45 +390,32 @@ def build_stops() -> ModelFile:
     m = ModelFile(namespace="/ambf/env/stops/")
     y = Vec3(0.0, 1.0, 0.0)
 
-    def hinge(parent: str, child: str, pivot: Vec3, child_pivot: Vec3, limit: float) -> Joint:
+    def joint(kind: str, parent: str, child: str, pivot: Vec3, child_pivot: Vec3, axis: Vec3, limit: float) -> Joint:
         return Joint(
             identifier=f"JOINT {parent}-{child}",
             name=f"{parent}-{child}",
             parent=f"BODY {parent}",
             child=f"BODY {child}",
-            type="revolute",
+            type=kind,
             parent_pivot=pivot,
-            parent_axis=y,
+            parent_axis=axis,
             child_pivot=child_pivot,
-            child_axis=y,
+            child_axis=axis,
             joint_limits=JointLimits(low=-limit, high=limit),
         )
 
+    zero = Vec3(0.0, 0.0, 0.0)
     m.bodies.append(_box("post", (0.02, 0.02, 0.02), (0.0, -0.4, 0.5)))
     m.bodies.append(_box("rod", (0.2, 0.01, 0.01), (0.11, -0.4, 0.5), mass=0.2, color=ORANGE))
-    m.joints.append(hinge("post", "rod", Vec3(0.0, 0.0, 0.0), Vec3(-0.11, 0.0, 0.0), 1.0))
+    m.joints.append(joint("revolute", "post", "rod", zero, Vec3(-0.11, 0.0, 0.0), y, 1.0))
     m.bodies.append(_box("rail", (0.02, 0.02, 0.02), (0.0, 0.0, 0.5)))
     m.bodies.append(_box("bob", (0.04, 0.04, 0.04), (0.1, 0.0, 0.5), mass=0.3, color=ORANGE))
-    tilted = Vec3(0.0, 0.6, 0.8)
-    m.joints.append(
-        Joint(
-            identifier="JOINT rail-bob",
-            name="rail-bob",
-            parent="BODY rail",
-            child="BODY bob",
-            type="prismatic",
-            parent_pivot=Vec3(0.1, 0.0, 0.0),
-            parent_axis=tilted,
-            child_pivot=Vec3(0.0, 0.0, 0.0),
-            child_axis=tilted,
-            joint_limits=JointLimits(low=-0.1, high=0.1),
-        )
-    )
+    m.joints.append(joint("prismatic", "rail", "bob", Vec3(0.1, 0.0, 0.0), zero, Vec3(0.0, 0.6, 0.8), 0.1))
     m.bodies.append(_box("base", (0.02, 0.02, 0.02), (0.0, 0.4, 0.6)))
     m.bodies.append(_box("upper", (0.2, 0.02, 0.02), (0.11, 0.4, 0.6), mass=0.3, color=ORANGE))
     m.bodies.append(_box("lower", (0.15, 0.015, 0.015), (0.305, 0.45, 0.6), mass=0.2, color=ORANGE))
-    m.joints.append(hinge("base", "upper", Vec3(0.0, 0.0, 0.0), Vec3(-0.11, 0.0, 0.0), 0.8))
-    m.joints.append(hinge("upper", "lower", Vec3(0.11, 0.05, 0.0), Vec3(-0.085, 0.0, 0.0), 0.6))
+    m.joints.append(joint("revolute", "base", "upper", zero, Vec3(-0.11, 0.0, 0.0), y, 0.8))
+    m.joints.append(joint("revolute", "upper", "lower", Vec3(0.11, 0.05, 0.0), Vec3(-0.085, 0.0, 0.0), y, 0.6))
     return m
 
 
