@@ -10,16 +10,16 @@ back, about 0.15 of it, where the joint's own row, limit_rows.py, turns it back 
 So, under AMBF's bodies (Options.bodies "ambf"), a multibody whose joints are all hinges and
 sliders, at least one of them limited, with nothing commanding its joints and no position motor
 holding it, is handed to the chain step (runner/chain_step.py, the rows of runner/chain_rows.py)
-from the physics step before one of its limited joints would cross its limit until the joint is
-back inside, its bodies have met their joints again and the joints are clear of their limits:
-at each physics step every joint's motor is driven at the velocity AMBF's solver leaves it at
-(its PyBullet limits opened meanwhile). The world steps physics steps one by one when there is
+from the physics step before one of its limited joints would cross its limit, coming in at
+REST_SPEED or faster, until SETTLE physics steps after the last such step (a joint resting on
+its stop is left to limit_rows.py): at each physics step every joint's motor is driven at the
+velocity AMBF's solver leaves it at (its PyBullet limits opened meanwhile). The world steps physics steps one by one when there is
 such a multibody (world.py), as it does for AMBF's springs.
 
 Not for a multibody with a loop the chain step would close (a hinge or point joining two of its
 links): the corpus parallel structure, a four-bar swinging down onto a stop, went 7.9 -> 10.7 mm
-from AMBF's (0.84 -> 3.1 mm at the end), its loop held shut by PyBullet while the chain step's
-joint velocities left it open. Nor do AMBF's ghosts act on its links in the chain step while it
+from AMBF's (0.84 -> 3.1 mm at the end; not explained: driving only its limited joints at the
+chain step's velocities, its loop left to PyBullet, gave the same). Nor do AMBF's ghosts act on its links in the chain step while it
 plays them (the links' ghost forces are the control step's, which the motors override)."""
 
 from __future__ import annotations
