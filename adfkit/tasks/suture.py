@@ -321,6 +321,7 @@ class SutureTask(GraspChoice, Motions):
         if not hasattr(self, "sweep"):
             self.check_sweep()
         self.drive_grasps, self.pull_grasps, self.handbacks, self.tail_clears = [], [], [], []
+        self.handback_about_tail: list[bool] = []  # per hand-back: carried with the tail on a line
         self.pulls: list[tuple[float, list, tuple]] = []  # per pair: the grasp's angle, the poses, where clear
         for k, p in enumerate(self.pairs):
             b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
@@ -417,11 +418,28 @@ class SutureTask(GraspChoice, Motions):
             except SutureError:
                 continue
             self.handbacks.append(h)
+            self.handback_about_tail.append(self._tail_path_reached(k, h, puller, prev))
             return g
         raise SutureError(
             f"{self.driver}/{self.puller}: no pose over pair {self.pairs[k].index} where both "
             "arms can hand the needle over"
         )
+
+    def about_tail(self, a: np.ndarray, b: np.ndarray):
+        """Needle poses path(s), s in [0, 1], from a to b: the tail (where the thread is tied) on
+        the straight line between, the needle turning about it."""
+        t = np.eye(4)
+        t[:3, 3] = self.geom.tail
+        ta, tb = a @ t, b @ t
+        return lambda s: interpolate(ta, tb, smooth(s)) @ invert(t)
+
+    def _tail_path_reached(self, k: int, h: np.ndarray, puller: PSM, prev: Grasp) -> bool:
+        """Whether the puller, holding the needle by ``prev``, reaches every pose of the path
+        about the tail (about_tail) from where pull k-1 leaves the needle to the hand-back ``h``."""
+        b, psi_x, _, _, _ = self.frames[self.pairs[k - 1].index]
+        high = self.lifted(self.needle_at(b, psi_x + self.geom.span + self.tail_clears[k - 1]), 2 * LIFT)
+        path = self.about_tail(high, h)
+        return all(self._margin(puller, path(s) @ prev.ee_in_needle) > 0 for s in np.linspace(0.0, 1.0, 13))
 
     def tissue(self) -> list:
         """Every tissue body (roles.py)."""
@@ -523,7 +541,10 @@ class SutureTask(GraspChoice, Motions):
             yield from self.wait(0.2)
             if k + 1 < len(self.pairs):
                 self._set_phase(f"hand back {pair.index}")
-                yield from self.carry_to(self.handbacks[k], HAND_BACK_S)
+                if self.handback_about_tail[k]:
+                    yield from self.carry(self.about_tail(self.needle_pose(), self.handbacks[k]), HAND_BACK_S)
+                else:
+                    yield from self.carry_to(self.handbacks[k], HAND_BACK_S)
                 yield from self.wait(0.2)
                 yield from self.take(self.driver, self.drive_grasps[k + 1])
                 yield from self.let_go(self.puller, holder=self.driver)
