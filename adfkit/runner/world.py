@@ -101,15 +101,23 @@ class World:
         (runner/chain_step.py; runner/joint_commands.py). None where AMBF's bodies are not asked for
         (Options.bodies), the control step is more than one physics step, or the engine's
         chain_model cannot read the articulation."""
-        if self.chain_model is None or self.opt.bodies != "ambf" or self.opt.control_substeps != 1:
+        if self.opt.control_substeps != 1:
+            return None
+        model = self.chain_of(art)
+        if model is None:
+            return None
+        self._chain_stepped[id(art)] = self.steps  # AMBF's ghosts act on its links in the chain's step
+        return model.velocities(motors, efforts, self.steps, self.chain_ghosts(art))
+
+    def chain_of(self, art):
+        """The engine's chain_model of ``art`` (made once), None where AMBF's bodies are not asked
+        for (Options.bodies) or it cannot read the articulation."""
+        if self.chain_model is None or self.opt.bodies != "ambf":
             return None
         model = self._chains.get(id(art))
         if model is None:
             model = self._chains[id(art)] = self.chain_model(self, art)
-        if not model.ok:
-            return None
-        self._chain_stepped[id(art)] = self.steps  # AMBF's ghosts act on its links in the chain's step
-        return model.velocities(motors, efforts, self.steps, self.chain_ghosts(art))
+        return model if model.ok else None
 
     def chain_ghosts(self, art) -> dict:
         """The bodies of ``art`` (chain index: the base 0, link k at k + 1) AMBF's ghosts act on

@@ -45,7 +45,7 @@ class LimitChains:
         self.arts: list[tuple] = []  # (articulation, [(record index, limits)] of its limited joints)
         self.engaged: dict[int, int] = {}  # id(art) -> the physics step it last came in fast at
         self.step = 0  # physics steps played, for the chain step's own count
-        if world.opt.bodies != "ambf" or getattr(world, "chain_model", None) is None:
+        if world.opt.bodies != "ambf" or world.chain_model is None:
             return
         for art in world.articulations:
             if not all(k in (JointKind.REVOLUTE, JointKind.PRISMATIC) for k in art.kinds):
@@ -98,10 +98,8 @@ class LimitChains:
             if key not in self.engaged:
                 if not near:
                     continue
-                model = w._chains.get(key)
-                if model is None:
-                    model = w._chains[key] = w.chain_model(w, art)
-                if not model.ok or model.loops:  # a loop the chain step closes: measured worse (above)
+                model = w.chain_of(art)
+                if model is None or model.loops:  # a loop the chain step closes: measured worse (above)
                     self.arts = [(a, lim) for a, lim in self.arts if a is not art]
                     continue
                 self._take(art, limited)
@@ -110,7 +108,7 @@ class LimitChains:
             if self.step - self.engaged[key] > SETTLE:
                 self._give_back(art, limited)
                 continue
-            qd = w._chains[key].velocities({}, {}, self.step)
+            qd = w.chain_of(art).velocities({}, {}, self.step)
             pb.setJointMotorControlArray(
                 art.uid,
                 idx,
