@@ -74,3 +74,30 @@ def test_the_solid_phantom_in_its_own_file_fails_at_the_entry(tmp_path, engine):
 def test_filled_holes_fail_at_their_entry_in_mujoco(tmp_path):
     p, _ = _pair_1(fill_holes(tmp_path, (1,)), "mujoco")
     assert not p["passed"] and p["rule"] == "blocked-at-entry", p
+
+
+def test_the_hand_back_path_carries_the_tail_on_a_straight_line():
+    """SutureTask.about_tail: from pose a to pose b the needle's tail (where the thread is tied)
+    runs on the straight line between its two places while the needle turns about it, and the
+    path starts at a and ends at b."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from adfkit.runner.rotations import rotation_exp
+    from adfkit.tasks.suture import SutureTask
+
+    tail = np.array([0.01, -0.004, 0.0])
+    a, b = np.eye(4), np.eye(4)
+    a[:3, 3] = [0.02, 0.01, 0.05]
+    b[:3, :3], b[:3, 3] = rotation_exp(np.array([0.2, -1.1, 2.0])), [-0.03, 0.04, 0.08]
+    path = SutureTask.about_tail(SimpleNamespace(geom=SimpleNamespace(tail=tail)), a, b)
+    assert np.allclose(path(0.0), a, atol=1e-12) and np.allclose(path(1.0), b, atol=1e-12)
+    ta, tb = (p[:3, :3] @ tail + p[:3, 3] for p in (a, b))
+    for s in np.linspace(0.05, 0.95, 7):
+        p = path(s)
+        at = p[:3, :3] @ tail + p[:3, 3]
+        off = (at - ta) - np.dot(at - ta, tb - ta) / np.dot(tb - ta, tb - ta) * (tb - ta)
+        assert np.linalg.norm(off) < 1e-12  # on the line
+    mid = path(0.5)  # the needle's centre does not go straight: it turns about the tail
+    assert np.linalg.norm(mid[:3, 3] - (a[:3, 3] + b[:3, 3]) / 2) > 1e-3
