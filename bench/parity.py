@@ -62,6 +62,7 @@ def own_scenes(folder: Path) -> list[Scene]:
     out.append(Scene("cube into a ghost (AMBF's rule, the default)", launch, [3], 0.6, both))
     out.append(Scene("cube into a ghost (--ghosts hole-friction)", launch, [3], 0.6, ghosts="hole-friction"))
     out.append(Scene("thread falling from a held needle", launch, [4], 2.0, both))
+    out.append(Scene("thread falling, its elements at the challenge phantom's inertia", launch, [11], 2.0, both))
     out.append(
         Scene("slider pushed onto its limits by efforts", launch, [5], 1.0, both, commands=folder / "slider_effort.txt")
     )

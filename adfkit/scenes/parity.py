@@ -4,7 +4,9 @@ joint driven by position, velocity and effort commands (a command file for each)
 settling in a stack, a cube falling into a ghost object, the suture thread falling from a held
 needle, a slider pushed onto its limits by efforts (a command file), four pendulums on p2p,
 cone-twist, six-dof and six-dof-spring joints, a ball, a cylinder, a capsule and a cone dropped
-tilted on the floor, free joints running into their stops. They need nothing but themselves: no corpus, no meshes. The launch file
+tilted on the floor, free joints running into their stops, and the thread again with its
+elements at the challenge phantom's inertia (5e-5 kg·m², at which AMBF's thread settles; at
+its capsules' own it writhes). They need nothing but themselves: no corpus, no meshes. The launch file
 lists one model per scene on the same world (a floor); ``-l`` picks one. Beside them, outside
 the launch file, ``turned_arm.yaml``: the arm with its inertial frame turned about the joint's
 axis (its inertia turned with it), which AMBF reads with the joint's zero turned
@@ -43,7 +45,8 @@ ORANGE = RGBA(r=0.9, g=0.5, b=0.1, a=1.0)
 
 #: the launch file's models, in order (-l INDEX)
 SCENES = (
-    "drop", "arm", "stack", "ghost", "thread", "slider", "pendulums", "primitives", "ramp", "fixed_pair", "stops"
+    "drop", "arm", "stack", "ghost", "thread", "slider", "pendulums", "primitives", "ramp", "fixed_pair", "stops",
+    "challenge_thread",
 )  # fmt: skip
 
 #: command files beside the scenes: (file, scene, lines)
@@ -238,10 +241,15 @@ def build_ghost() -> ModelFile:
     return m
 
 
-def build_thread() -> ModelFile:
+#: the inertia of each thread element in the challenge's phantom (its file's), kg·m² about each axis
+CHALLENGE_THREAD_INERTIA = 5.0e-5
+
+
+def build_thread(inertia: float | None = None) -> ModelFile:
     """The suture thread of the sample scene (40 capsules on six-dof springs, the published
     settings) held at one end by a static stand-in for the needle 0.2 m up, lying level at the
-    start: it falls and swings down until it hangs."""
+    start: it falls and swings down until it hangs. ``inertia`` (kg·m² about each axis) replaces
+    the elements' own, their capsules' (the challenge phantom's elements carry 5e-5)."""
     from .suturing import layout as L
     from .suturing.thread import thread_bodies_and_joints
 
@@ -256,6 +264,8 @@ def build_thread() -> ModelFile:
     for b in bodies:
         p = b.location.position
         b.location = Pose(Vec3(p.x, p.y, round(p.z + lift, 9)), b.location.orientation)
+        if inertia is not None:
+            b.inertia = Inertia(ix=inertia, iy=inertia, iz=inertia)
         m.bodies.append(b)
     m.joints.extend(joints)
     return m
@@ -431,6 +441,7 @@ BUILD = {
     "ramp": build_ramp,
     "fixed_pair": build_fixed_pair,
     "stops": build_stops,
+    "challenge_thread": lambda: build_thread(CHALLENGE_THREAD_INERTIA),
 }
 
 
@@ -470,6 +481,7 @@ __all__ = [
     "build_stack",
     "build_ghost",
     "build_thread",
+    "CHALLENGE_THREAD_INERTIA",
     "build_slider",
     "build_pendulums",
     "build_primitives",
