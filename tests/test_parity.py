@@ -164,6 +164,33 @@ def test_bodies_of_one_name_are_paired_by_where_they_start():
     assert sorted(pairs) == [(0, 1), (1, 0)]
 
 
+def test_an_angle_read_across_pi_is_no_joint_gap():
+    """AMBF reads a revolute joint in (-π, π] where adfkit's keeps turning (the LND PSM's unlimited
+    tool roll under an effort: -3.27 rad against AMBF's +3.01, 0.04 rad apart, was reported 6.24
+    apart); a slider's values are lengths and are not wrapped."""
+    from types import SimpleNamespace
+
+    from adfkit.parity.traces import Trace, from_ambf
+
+    created = {
+        "bodies": [],
+        "soft_bodies": [],
+        "ghosts": [],
+        "sensors": [],
+        "actuators": [],
+        "joints": [{"qname": "/m/roll", "type": "revolute"}, {"qname": "/m/slide", "type": "prismatic"}],
+    }
+    samples = [{"t": t, "bodies": [], "joints": [v, v]} for t, v in ((0.02, 3.0127), (0.04, 0.8252))]
+    a = from_ambf(SimpleNamespace(created=created, samples=samples, wall_s=0.0))
+    assert a.angular_joints == {"/m/roll"}
+    names = ["/m/roll", "/m/slide"]
+    b = Trace("pybullet", {"body": [], "joint": names}, [], a.times, np.zeros((2, 0, 7)), names,
+              np.array([[-3.2705, -3.2705], [-5.2308, -5.2308]]), 0.0)  # fmt: skip
+    gaps = {g.name: g.max_position for g in compare.compare(a, b).joints}
+    assert gaps["/m/roll"] == pytest.approx(0.2272, abs=1e-4)  # 2π - 6.0560 at 0.04 s
+    assert gaps["/m/slide"] == pytest.approx(6.2832, abs=1e-4)
+
+
 def test_plugin_record_errors_are_reported():
     with pytest.raises(AdfError, match="no joint /x"):
         ambf._record([{"kind": "error", "message": "command line 1: no joint /x"}], 3, 0.1, "", 1.0)

@@ -179,7 +179,10 @@ def compare(ambf: Trace, adfkit: Trace, tolerance_m: float = 1e-3, tolerance_deg
         va, vb = ambf.joints[ia, i], adfkit.joints[ib, j]
         if np.all(np.isnan(va)) or np.all(np.isnan(vb)):
             continue
-        joints.append(Gap(ambf.joint_names[i], np.abs(va - vb), np.zeros(len(common))))
+        gap = va - vb
+        if ambf.joint_names[i] in ambf.angular_joints:  # AMBF reads an angle in (-π, π]: 2π apart is no gap
+            gap = (gap + np.pi) % (2.0 * np.pi) - np.pi
+        joints.append(Gap(ambf.joint_names[i], np.abs(gap), np.zeros(len(common))))
     bodies.sort(key=lambda g: -g.max_position)
     joints.sort(key=lambda g: -g.max_position)
     return Comparison(

@@ -28,6 +28,7 @@ class Trace:
     wall_s: float  # stepping alone
     notes: list[str] = field(default_factory=list)
     clock: np.ndarray | None = None  # (S,) a paced AMBF replay's command clock at each sample
+    angular_joints: frozenset[str] = frozenset()  # the joints whose values are angles (AMBF's in (-π, π])
 
 
 def ambf_name(key: str, obj) -> str:
@@ -94,7 +95,21 @@ def from_ambf(rec, staged: tuple[str, ...] = ()) -> Trace:
     if sliders and times.size and times[0] == 0.0:
         joints[0, sliders] = np.nan
     clock = np.array([x.get("clock", x["t"]) for x in s])
-    return Trace("ambf", made, made["body"], times, poses[:, keep], made["joint"], joints, rec.wall_s, clock=clock)
+    angular = frozenset(
+        n for n, j in zip(made["joint"], rec.created["joints"]) if j.get("type") in ("revolute", "torsion spring")
+    )
+    return Trace(
+        "ambf",
+        made,
+        made["body"],
+        times,
+        poses[:, keep],
+        made["joint"],
+        joints,
+        rec.wall_s,
+        clock=clock,
+        angular_joints=angular,
+    )
 
 
 def _pose(sb) -> list[float]:
