@@ -1,11 +1,13 @@
-"""A free multibody's stops played through AMBF's own solver step (runner/pybullet/limit_chains.py).
+"""A free multibody's stops played through AMBF's own solver step (runner/free_stops.py, played
+by runner/pybullet/limit_chains.py and runner/mujoco/limit_chains.py).
 
 The scene: a 0.2 kg, 0.2 m rod hinged at one end on a static post, released level, falling
 into its +1 rad stop at 10.8 rad/s. Measured with `adfkit parity` on AMBF 2.0 (1 ms samples):
 AMBF's rod comes back off the stop to 0.99415 rad (its centre of mass about the pivot), 5.9 mrad
 inside the stop, 18 ms after it, then rests on it. The joint's own row (limit_rows.py: the
 hinge's limit row on the joint alone, 0.3 of the speed back) threw it back to 0.864 rad (136 mrad;
-the rod 14.6 mm from AMBF's at most). The slow test plays the scene against AMBF."""
+the rod 14.6 mm from AMBF's at most); MuJoCo's limit (at Bullet's rate, mujoco/limits.py) stopped
+it dead on the stop (1.00014 rad, no turn back). The slow test plays the scene against AMBF."""
 
 from __future__ import annotations
 
@@ -50,32 +52,44 @@ needs_ambf = pytest.mark.skipif(BUILD is None, reason=WHY)
 AMBF_TURNS_BACK_TO = 0.99415
 
 
-def _world(tmp_path: Path, bodies: str = "ambf", text: str = ROD):
+def _world(tmp_path: Path, bodies: str = "ambf", text: str = ROD, engine: str = "pybullet"):
     path = tmp_path / "rod.yaml"
     path.write_text(text)
     opt = Options(visuals=False, ground=False, renderer="tiny")  # adfkit run's 4 ms control step
     opt.bodies, opt.springs, opt.ghosts, opt.link_shapes = bodies, "ambf", "ambf", "body"
-    return open_world(load_scene(path), opt)
+    return open_world(load_scene(path), opt, engine=engine)
 
 
 def _swing(world, seconds: float) -> list[float]:
     """The hinge's angle after each control step."""
     (_j, _parent, child) = world.joints_made[0]
+    art = child.articulation
+    n = _index(art, child)
     out = []
     for _ in range(int(round(seconds / (world.dt * world.opt.control_substeps)))):
         world.step(1)
-        out.append(float(world.joint_state(child.articulation, [child.link])[0][0]))
+        out.append(float(world.joint_state(art, [n])[0][0]))
     return out
 
 
-def test_a_rod_falling_into_its_stop_turns_back_as_far_as_ambf_s(tmp_path):
-    world = _world(tmp_path)
+def _index(art, child) -> int:
+    """The record index of the joint ``child`` hangs from in ``art`` (either engine)."""
+    return next(n for n, rec in enumerate(art.records) if rec[3] is child)
+
+
+ENGINES = ("pybullet", "mujoco")
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_rod_falling_into_its_stop_turns_back_as_far_as_ambf_s(tmp_path, engine):
+    world = _world(tmp_path, engine=engine)
     try:
         assert world.limit_chains  # a free multibody with a limited hinge, under AMBF's bodies
         q = _swing(world, 0.4)
         hit = next(k for k, x in enumerate(q) if x >= 1.0)
         back = min(q[hit:])
-        # 0.99346 here (4 ms control steps), AMBF's 0.99415 (the joint's own row: 0.864)
+        # 0.99346 in PyBullet, 0.99351 in MuJoCo (4 ms control steps), AMBF's 0.99415 (the
+        # joint's own row in PyBullet: 0.864; MuJoCo's limit: 1.00014, no turn back)
         assert back == pytest.approx(AMBF_TURNS_BACK_TO, abs=1e-3)
         assert q[-1] == pytest.approx(1.0, abs=0.5e-3)  # resting on the stop
         assert not world.limit_chains.engaged  # at rest: the stop is the joint's own row's again
@@ -94,6 +108,44 @@ def test_without_ambf_s_bodies_the_joint_s_own_row_stops_it(tmp_path):
         assert min(q[hit:]) < 0.9  # 0.864
     finally:
         world.close()
+
+
+def test_in_mujoco_without_ambf_s_bodies_its_own_limit_stops_it(tmp_path):
+    """Control: MuJoCo's bodies (Options' default) leave the stop to MuJoCo's soft limit, which
+    stops the rod dead on it, nothing handed to the chain step."""
+    world = _world(tmp_path, bodies="pybullet", engine="mujoco")
+    try:
+        assert not world.limit_chains
+        q = _swing(world, 0.4)
+        hit = next(k for k, x in enumerate(q) if x >= 1.0 - 1e-3)
+        assert min(q[hit:]) > 0.999  # 1.0008: no turn back
+    finally:
+        world.close()
+
+
+@pytest.mark.parametrize("bodies", ["rod", "tip"])
+def test_both_engines_play_the_two_links_bounce_alike(tmp_path, bodies):
+    """The same chain step in both engines: the rod falling into its stop with a free link
+    hinged on its end, each engine's joint angles over the first 0.6 s (the bounce and the
+    swing after it) within a few mrad of the other's (measured: 0.23 mrad the rod's, 1.3 mrad
+    the free link's; under each engine's own bodies and limits 0.37 and 6.9 rad)."""
+    qs = []
+    for engine in ENGINES:
+        (tmp_path / engine).mkdir()
+        world = _world(tmp_path / engine, text=TWO_LINKS, engine=engine)
+        try:
+            (_h, _p, rod), (_w, _r, tip) = world.joints_made
+            art = rod.articulation
+            n = _index(art, rod if bodies == "rod" else tip)
+            q = []
+            for _ in range(150):
+                world.step(1)
+                q.append(float(world.joint_state(art, [n])[0][0]))
+            qs.append(q)
+        finally:
+            world.close()
+    gap = max(abs(a - b) for a, b in zip(*qs))
+    assert gap < 5e-3, gap
 
 
 TWO_LINKS = (
@@ -119,13 +171,14 @@ JOINT wrist:
 )
 
 
-def test_a_command_mid_bounce_leaves_the_other_joints_free(tmp_path):
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_command_mid_bounce_leaves_the_other_joints_free(tmp_path, engine):
     """A command on the hinge while the chain step plays the bounce: the chain step gives the
     multibody back and the wrist, which nothing commands, swings on under gravity, not held at
-    the velocity the chain step last gave its motor."""
+    the velocity the chain step last gave it."""
     from adfkit.runner.joint_commands import JointCommands
 
-    world = _world(tmp_path, text=TWO_LINKS)
+    world = _world(tmp_path, text=TWO_LINKS, engine=engine)
     try:
         (hinge, _p, rod), (_w, _r, tip) = world.joints_made
         art = rod.articulation
@@ -140,7 +193,7 @@ def test_a_command_mid_bounce_leaves_the_other_joints_free(tmp_path):
         for _ in range(50):
             drives.apply(world.sim_time)
             world.step(1)
-            speeds.append(float(world.joint_state(art, [tip.link])[1][0]))
+            speeds.append(float(world.joint_state(art, [_index(art, tip)])[1][0]))
         assert not world.limit_chains.engaged
         # the wrist's speed changes from step to step (gravity, the rod's motion): no motor holds it
         assert max(abs(b - a) for a, b in zip(speeds, speeds[1:])) > 1e-3
@@ -166,9 +219,11 @@ def test_a_snapshot_restored_mid_bounce_plays_the_fall_again(tmp_path):
 
 @pytest.mark.slow
 @needs_ambf
-def test_the_rod_against_ambf(tmp_path):
-    """`adfkit parity` on the rod (PyBullet, 4 ms, 1 s): within 0.1 mm and 0.1° of AMBF's
-    (measured 0.066 mm, 0.09°; the joint's own row 14.6 mm, 7.6°)."""
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_rod_against_ambf(tmp_path, engine):
+    """`adfkit parity` on the rod (4 ms, 1 s): within 0.1 mm and 0.1° of AMBF's (measured
+    PyBullet 0.066 mm, 0.09°, the joint's own row 14.6 mm, 7.6°; MuJoCo 0.069 mm, 0.09°, its
+    own limit 0.54 mm, 0.34°)."""
     from adfkit.parity import session
     from adfkit.scenes.parity import write_parity
 
@@ -177,7 +232,7 @@ def test_the_rod_against_ambf(tmp_path):
     launch = tmp_path / "launch.yaml"
     text = launch.read_text()
     launch.write_text(text[: text.index("multibody configs:")] + "multibody configs:\n- rod.yaml\n")
-    req = session.Request(launch, None, BUILD, seconds=1.0, every=0.02, engines=("pybullet",))
+    req = session.Request(launch, None, BUILD, seconds=1.0, every=0.02, engines=(engine,))
     (c,) = session.run(req, progress=False).comparisons
     rod = next(g for g in c.bodies if g.name.endswith("/rod"))
     assert rod.max_position < 1e-4 and rod.max_angle < 0.1, (rod.max_position, rod.max_angle)

@@ -256,9 +256,10 @@ class JointCommands:
             if dj is None:
                 raise ValueError(f"{joint.identifier}: not a revolute, prismatic or spring joint of an articulation")
             self.joints[id(joint)] = dj
-            rows = getattr(self.world, "limit_rows", None)  # the engine's own hold past a limit
-            if rows is not None:
-                rows.leave(dj.art, dj.index)
+            # the engine's own hold past a limit, and the free stops' chain step (free_stops.py)
+            for hold in (getattr(self.world, "limit_rows", None), getattr(self.world, "limit_chains", None)):
+                if hold is not None:
+                    hold.leave(dj.art, dj.index)
         dj.command = (kind, float(value))
 
     def _effort(self, dj: DrivenJoint, effort: float) -> None:

@@ -89,6 +89,11 @@ class MjArticulation:
     def joint_values(self) -> list[float]:
         return [float(self.world.data.qpos[a]) if a >= 0 else 0.0 for a in self.qadr]
 
+    @property
+    def held(self) -> bool:
+        """Whether a drive holds one of its joints (``drive``, or a joint's motor command)."""
+        return bool(np.any(self.world.data.eq_active[self._eq]))
+
     def retarget(self) -> None:
         """The drives' targets from ``targets`` (a drive switched off stays off)."""
         t = np.asarray(self.targets, dtype=float)[self._driven]

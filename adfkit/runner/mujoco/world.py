@@ -25,6 +25,7 @@ from .assemble import Assembly
 from .chain import ChainModel, chain_ghosts
 from .cone_rows import ConeRows
 from .interact import Interaction
+from .limit_chains import LimitChains
 from .objects import MjBody
 from .restitution import Restitution
 from .soft import MjSoftBodies
@@ -62,6 +63,7 @@ class MujocoWorld(Assembly, Interaction, World):
         self._pair_margins = np.array(self.model.pair_margin)  # set_collision gives them back
         self.restitution = Restitution.make(self) if self.opt.bodies == "ambf" else None  # restitution.py
         self.cone_rows = ConeRows.make(self) if self.opt.bodies == "ambf" else None  # cone_rows.py
+        self.limit_chains = LimitChains(self)  # free multibodies' stops through AMBF's solver step
 
     def joint_state(self, art, idxs) -> tuple[np.ndarray, np.ndarray]:
         """Positions and velocities of joints ``idxs`` (record indices) of an articulation."""
@@ -261,12 +263,14 @@ class MujocoWorld(Assembly, Interaction, World):
         veh = [a for a in (self.vehicles, self.resistance) if a] or None
         rest = self.restitution  # Bullet's restitution after each physics step (restitution.py)
         cones = self.cone_rows  # Bullet's cone-twist rows before each physics step (cone_rows.py)
+        stops = self.limit_chains if self.limit_chains else None  # AMBF's solver around a stop (limit_chains.py)
         for k in range(n):
             control()
             fine = self._ghost_steps
             fine = fine if fine is not None and fine.ghosts else None  # AMBF's ghosts at every physics step
             springs = rows is not None and rows.apply(sub * self.dt)  # spring_rows.py; False: sprung trees at rest
-            if fine is not None or veh is not None or springs or rest is not None or cones is not None:
+            each = fine is not None or veh is not None or springs or rest is not None or cones is not None
+            if each or stops is not None:
                 for i in range(sub):
                     if springs and i:
                         rows.apply()
@@ -277,7 +281,11 @@ class MujocoWorld(Assembly, Interaction, World):
                             v.push()
                     if rest is not None:
                         rest.before()
+                    if stops is not None:
+                        stops.before()
                     step(m, d, 1)
+                    if stops is not None:
+                        stops.after()
                     if rest is not None:
                         rest.after()
                     if veh is not None:

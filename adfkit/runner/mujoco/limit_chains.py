@@ -1,0 +1,49 @@
+"""AMBF's hinge and slider stops on a free multibody in MuJoCo (which and when: runner/
+free_stops.py). Before each physics step the chain step (mujoco/chain.py) is read on MuJoCo's
+state at the step's start; after MuJoCo's step the multibody's joints are taken to the velocities
+it left them at by one impulse along the joints (M⁻¹ over them, the model's other dofs free:
+motor_rows.joint_mobility), and every dof the impulse moved is carried on by it for the step
+(semi-implicit, as Bullet integrates): the joints end the step where AMBF's solver leaves them,
+q + dt·q̇, whatever MuJoCo's own limit and forces did within it, as the PyBullet runner's motors
+at joint_commands.LIMIT_FORCE take them there. A joint resting on its stop is left to MuJoCo's
+limit with Bullet's rate (limits.py). The world steps physics steps one by one when there is
+such a multibody (world.py)."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ..free_stops import FreeStops
+
+
+class LimitChains(FreeStops):
+    def __init__(self, world) -> None:
+        super().__init__(world)
+        self._played: list[tuple] = []  # (articulation, velocities) the chain step gave this step
+
+    def before(self) -> None:
+        """Before each physics step: the velocities of the multibodies the chain step plays."""
+        self._played = self.velocities()
+
+    def after(self) -> None:
+        """After the physics step: their joints at those velocities, by an impulse along them."""
+        if not self._played:
+            return
+        w = self.world
+        m, d = w.model, w.data
+        for art, qd in self._played:
+            dofs = np.asarray(art.vadr, dtype=int)
+            unit = np.zeros((len(dofs), m.nv))
+            unit[np.arange(len(dofs)), dofs] = 1.0
+            moved = np.zeros_like(unit)
+            mujoco.mj_solveM(m, d, moved, unit)  # M⁻¹ of the step's start, a row per joint
+            impulse = np.linalg.solve(moved[:, dofs], qd - d.qvel[dofs])
+            dv = moved.T @ impulse
+            d.qvel[:] += dv
+            mujoco.mj_integratePos(m, d.qpos, dv, w.dt)
+        self._played = []
+
+    def _state_now(self) -> None:
+        # the poses the last physics step left (MuJoCo computes them before it integrates)
+        mujoco.mj_kinematics(self.world.model, self.world.data)
