@@ -51,6 +51,7 @@ class FreeStops:
         self.engaged: dict[int, int] = {}  # id(art) -> the physics step it last came in fast at
         self.commanded: set[tuple[int, int]] = set()  # (id(art), record index) under a joint command
         self.step = 0  # physics steps played, for the chain step's own count
+        self.free: list[tuple] = []  # the multibodies of ``arts`` nothing drives, as ``watching`` found them
         if world.opt.bodies != "ambf" or world.chain_model is None:
             return
         for art in world.articulations:
@@ -77,6 +78,21 @@ class FreeStops:
         if art.held:
             return set(range(len(art.records)))
         return {n for n in range(len(art.records)) if (id(art), n) in self.commanded}
+
+    def watching(self) -> bool:
+        """Whether a multibody may be handed to the chain step or is played now (one free or one
+        engaged): an engine that steps physics steps together otherwise steps them one by one."""
+        cmd = self.commanded
+        self.free = [
+            (art, limited)
+            for art, limited in self.arts
+            if not art.held and not (cmd and any((id(art), n) in cmd for n in range(len(art.records))))
+        ]
+        return bool(self.engaged) or bool(self.free)
+
+    def idle(self, steps: int) -> None:
+        """``steps`` physics steps played without a look (``watching`` said no)."""
+        self.step += steps
 
     def playing(self, art) -> bool:
         """Whether the chain step plays ``art``'s joints now (the engine's own limit leaves them)."""

@@ -270,7 +270,10 @@ class MujocoWorld(Assembly, Interaction, World):
             fine = fine if fine is not None and fine.ghosts else None  # AMBF's ghosts at every physics step
             springs = rows is not None and rows.apply(sub * self.dt)  # spring_rows.py; False: sprung trees at rest
             each = fine is not None or veh is not None or springs or rest is not None or cones is not None
-            if each or stops is not None:
+            watch = stops is not None and stops.watching()  # else nothing free to bounce: no look
+            if stops is not None and not watch:
+                stops.idle(sub)
+            if each or watch:
                 for i in range(sub):
                     if springs and i:
                         rows.apply()
@@ -281,10 +284,10 @@ class MujocoWorld(Assembly, Interaction, World):
                             v.push()
                     if rest is not None:
                         rest.before()
-                    if stops is not None:
+                    if watch:
                         stops.before()
                     step(m, d, 1)
-                    if stops is not None:
+                    if watch:
                         stops.after()
                     if rest is not None:
                         rest.after()
