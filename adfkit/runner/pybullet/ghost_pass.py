@@ -29,6 +29,7 @@ import pybullet as pb
 
 from ..ghost_rules import in_same_place
 from ..rotations import invert, matrix_to_pq
+from . import bullet_globals
 from .shapes import create_collision
 
 # the copies' collision bits: a ghost meets bodies, a body meets ghosts, never another body
@@ -49,9 +50,6 @@ class GhostPass:
     def _connect(self) -> int:
         if self.cid is None:
             self.cid = pb.connect(pb.DIRECT)
-            threshold = self.world.opt.contact_threshold
-            if threshold is not None:
-                pb.setPhysicsEngineParameter(contactBreakingThreshold=threshold, physicsClientId=self.cid)
         return self.cid
 
     def _shape(self, parts) -> int:
@@ -132,6 +130,7 @@ class GhostPass:
             reset(uid, p, q, cid)
             pb.setCollisionFilterGroupMask(uid, -1, GHOST_BIT, BODY_BIT, physicsClientId=cid)
             on.append((g, uid, keys))
+        bullet_globals.use(self.world.contact_threshold, cid)  # the dynamics world's (one per process)
         pb.performCollisionDetection(physicsClientId=cid)
         for g, uid, keys in on:
             counts = out[g.uid] = {}

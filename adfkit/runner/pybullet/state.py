@@ -24,6 +24,7 @@ import pybullet as pb
 
 from ... import scratch
 from ..rotations import matrix_to_pq
+from . import bullet_globals
 
 
 @dataclass(eq=False)
@@ -81,6 +82,7 @@ class WorldState:
             g.placed_at = None
         self._pairs_epoch += 1
         self.limit_chains.reset()  # its motors and opened limits belong to the motion left behind
+        bullet_globals.use(self.contact_threshold, self.cid)  # the restore detects contacts (one per process)
         if snap.world() is self:
             self._restore_own(snap)
         else:

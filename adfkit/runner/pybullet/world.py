@@ -22,7 +22,7 @@ from ..soft import in_scene as soft_in_scene
 from ..soft import soft_health
 from ..stability import CHECK_EVERY_S
 from ..world import World
-from . import egl, held
+from . import bullet_globals, egl, held
 from . import stability as pb_stability
 from .articulation import AXIS, ROTARY, TREE_KINDS
 from .assemble import Assembly
@@ -67,10 +67,10 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         params = dict(fixedTimeStep=self.dt * self.opt.control_substeps, numSubSteps=self.opt.control_substeps)
         if self.opt.solver_iterations:
             params["numSolverIterations"] = self.opt.solver_iterations
-        if self.opt.contact_threshold is not None:
-            # AABBs grow by it and contact points are made within (a size-scaled share of) it;
-            # a millimetre-sized scene plays ~1.4x faster at 0.001 (bench/run_suturing.py)
-            params["contactBreakingThreshold"] = self.opt.contact_threshold
+        # AABBs grow by it and contact points are made within (a size-scaled share of) it; a
+        # millimetre-sized scene plays ~1.4x faster at 0.001 (bench/run_suturing.py). One value for
+        # the whole process: put in force again before each step (bullet_globals.py)
+        self.contact_threshold = params["contactBreakingThreshold"] = bullet_globals.threshold(self.opt)
         if self.opt.bodies == "ambf":
             params.update(AMBF_SOLVER_INFO)  # AMBF's contact solver settings (solver_info.py)
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
@@ -224,6 +224,7 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         # AMBF's vehicles and resistance sensors act after each physics step (vehicles.py, resist.py)
         veh = self._after_steps or None
         stops = self._stops
+        bullet_globals.use(self.contact_threshold, self.cid)  # another world may have set its own
         for _ in range(n):
             self.control()
             if veh is not None:
