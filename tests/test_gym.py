@@ -154,6 +154,27 @@ def test_the_same_seed_and_actions_give_the_same_observations_bit_for_bit(kw):
         assert np.array_equal(first[0]["needle_pose"], other[0]["needle_pose"])
 
 
+def test_a_world_made_between_two_replays_leaves_them_bit_for_bit():
+    """Another world of the process made and stepped between two seeded replays, with its own
+    contact threshold (which Bullet holds once for the process: runner/pybullet/bullet_globals.py),
+    changes nothing of them; before each world put its own in force, the replays parted at the
+    first step."""
+    from adfkit.runner import Options, open_world
+
+    env = make("adfkit/NeedleReach-v0")
+    actions = _actions(env, 4)
+    a = _play(env, 5, actions)
+    other = open_world(env.unwrapped._model, Options(visuals=False, contact_threshold=0.001))
+    try:
+        other.step(2)
+        b = _play(env, 5, actions)
+    finally:
+        other.close()
+    for i, (x, y) in enumerate(zip(a, b)):
+        for k in x:
+            assert np.array_equal(x[k], y[k]), (i, k)
+
+
 def test_a_grasp_and_lift_replay_bit_for_bit():
     """The expert's actions (grasp, lift) replayed after the same seeded reset: the grasp's
     constraint and collision filters are gone with the world, nothing of them stays."""
