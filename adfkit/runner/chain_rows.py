@@ -26,11 +26,9 @@ from itertools import chain
 
 import numpy as np
 
-#: btContactSolverInfo's m_erp, which a slider's limit row uses (AMBF's setParam(BT_CONSTRAINT_ERP)
-#: is not one a slider reads)
-GLOBAL_ERP = 0.2
-#: btHingeConstraint::setLimit's default bias factor, which AMBF's hinges keep
-HINGE_LIMIT_BIAS = 0.3
+from ..model.semantics import HINGE_LIMIT_BIAS
+from ..model.semantics import SLIDER_LIMIT_ERP as GLOBAL_ERP  # a slider's limit row: the world's erp
+
 #: btContactSolverInfo's m_numIterations, which AMBF keeps
 AMBF_ITERATIONS = 10
 _EPS = 1.1920929e-07  # SIMD_EPSILON (float)

@@ -39,6 +39,7 @@ from ..model.semantics import (
     DEFAULT_JOINT_CFM,
     DEFAULT_JOINT_ERP,
     DEFAULT_JOINT_MAX_MOTOR_IMPULSE,
+    SLIDER_LIMIT_ERP,
     JointKind,
     joint_kind,
 )
@@ -197,6 +198,7 @@ class DrivenJoint:
     cfm: float = 0.0
     erp: float = AMBF_JOINT_ERP
     row_mass: float = math.inf
+    limit_erp: float = AMBF_JOINT_ERP  # the share of an overshoot its limit row takes back a physics step
     command: tuple[str, float] | None = None
 
 
@@ -223,6 +225,7 @@ class JointCommands:
         if idx is None or art.kinds[idx] not in DRIVEN_KINDS:
             return None
         (p, i, d), out = controller_of(joint)
+        erp = joint.joint_erp if joint.joint_erp is not None else AMBF_JOINT_ERP
         imp = joint.max_motor_impulse if joint.max_motor_impulse is not None else DEFAULT_JOINT_MAX_MOTOR_IMPULSE
         dt = AMBF_SLIDER_DT if kind in (JointKind.PRISMATIC, JointKind.LINEAR_SPRING) else self.world.dt
         w = self.world
@@ -238,8 +241,10 @@ class JointCommands:
             imp / dt,
             motor_enabled(joint),
             cfm=joint.joint_cfm if joint.joint_cfm is not None else DEFAULT_JOINT_CFM,
-            erp=joint.joint_erp if joint.joint_erp is not None else AMBF_JOINT_ERP,
+            erp=erp,
             row_mass=w.joint_row_mass(art, idx) if soft else math.inf,
+            # a slider's limit row takes the world's erp (AMBF's joint erp goes where it does not read)
+            limit_erp=SLIDER_LIMIT_ERP if kind is JointKind.PRISMATIC else erp,
         )
 
     def command(self, joint, child, kind: str, value: float) -> None:
@@ -263,22 +268,30 @@ class JointCommands:
         dj.command = (kind, float(value))
 
     def _effort(self, dj: DrivenJoint, effort: float) -> None:
-        """An effort, held at the joint's limits as AMBF's hinge and slider hold them (hard rows):
-        past a limit, the joint is driven back at erp·error per step instead, whatever took it
-        there (PyBullet drops a multibody link's limits while others of it are driven; the LND
-        PSM's jaw, pushed on its stop, turned 141° past it; the KUKA flailing under its
-        controllers' efforts, its base joint 5.3 rad where AMBF's stay within their ±2.09).
-        A limit row only pushes: a joint already leaving its limit faster than that is left to
-        the effort (the PSM's effort program: a jaw pushed shut, its yaw link kicked by the
-        other jaw's stop, opened 0.52 rad in AMBF and stayed shut under a motor that held it both
-        ways)."""
+        """An effort, held at the joint's limits as AMBF's limit rows hold them, where the
+        engine's own limits do not (World.hold_limits_under_efforts: PyBullet drops a multibody
+        link's limits while others of it are driven; the LND PSM's jaw, pushed on its stop,
+        turned 141° past it; the KUKA flailing under its controllers' efforts, its base joint
+        5.3 rad where AMBF's stay within their ±2.09): past a limit, the joint is driven back at
+        erp·error per step instead, whatever took it there, erp the joint's (a slider's the
+        world's, 0.2, as AMBF's btSliderConstraint reads it: the parity slider pushed onto its
+        stops 0.41 -> 0.00 mm from AMBF's). A limit row only pushes: a joint the effort takes back
+        in faster than that (its velocity after the step's effort, by the joint's row mass where
+        the engine tells it) or already leaving its limit faster is left to the effort (the PSM's
+        effort program: a jaw pushed shut, its yaw link kicked by the other jaw's stop, opened
+        0.52 rad in AMBF and stayed shut under a motor that held it both ways). The MuJoCo
+        engine's limits are AMBF's rows at their rates (mujoco/limits.py) and act under an
+        effort: it is not held (the parity slider 0.61 -> 0.29 mm from AMBF's, the MTM's effort
+        program 11.4 -> 1.7 mm, where a hold at the slider's rate kept the MuJoCo block a
+        micrometre past its soft limit once the effort turned)."""
         w = self.world
-        if dj.limits is not None:
+        if dj.limits is not None and w.hold_limits_under_efforts:
             q, v = (float(x[0]) for x in w.joint_state(dj.art, [dj.index]))
             lo, hi = dj.limits
             err = q - hi if q > hi else (q - lo if q < lo else 0.0)
-            back = -dj.erp * err / w.dt
-            if err != 0.0 and (v - back) * err > 0.0:
+            back = -dj.limit_erp * err / w.dt
+            after = v + effort * w.dt / dj.row_mass  # the effort's share of the step (none untold)
+            if err != 0.0 and (after - back) * err > 0.0 and (v - back) * err > 0.0:
                 w.joint_motor(dj.art, dj.index, back, LIMIT_FORCE)
                 return
         w.joint_effort(dj.art, dj.index, effort)

@@ -37,6 +37,10 @@ class World:
     # the engine's reading of an articulation for AMBF's solver step (its chain.py's ChainModel:
     # ``ok``, ``velocities(motors, efforts, step)``), or None
     chain_model: type | None = None
+    # whether an effort-driven joint past its limits must be driven back by the runner
+    # (joint_commands.JointCommands._effort): PyBullet's multibody drops a link's limits while
+    # others of it are driven; MuJoCo's limits, given AMBF's rows' rates (mujoco/limits.py), hold
+    hold_limits_under_efforts = True
 
     def _setup(self, scene, options: Options | None, gui: bool) -> None:
         """What every world holds before its engine builds the scene."""

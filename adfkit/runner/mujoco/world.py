@@ -35,6 +35,7 @@ class MujocoWorld(Assembly, Interaction, World):
     engine = "mujoco"
     body_type = MjBody
     chain_model = ChainModel  # AMBF's solver step on an articulation (chain.py)
+    hold_limits_under_efforts = False  # its limit rows hold an effort-driven joint as AMBF's (limits.py)
 
     def chain_ghosts(self, art) -> dict:
         return chain_ghosts(self, art)
