@@ -116,7 +116,9 @@ class FreeStops:
             near = False
             for n, (lo, hi) in limited:
                 ahead = q[n] + 2.0 * v[n] * dt  # where it is a step after the next: the solver sees it past
-                if abs(v[n]) >= REST_SPEED and not (lo <= q[n] <= hi and lo <= ahead <= hi):
+                # heading out across a limit (a joint coming back in is the limit row's: a hinge
+                # started past its limit is kicked in at 0.3·erp·error/dt and coasts, as in AMBF)
+                if abs(v[n]) >= REST_SPEED and ((ahead > hi and v[n] > 0.0) or (ahead < lo and v[n] < 0.0)):
                     near = True
                     break
             if key not in self.engaged:

@@ -51,8 +51,8 @@ class LimitChains(FreeStops):
                 return
             q = d.qpos[qa]
             ahead = q + 2.0 * v * dt
-            inside = (lo <= q) & (q <= hi) & (lo <= ahead) & (ahead <= hi)
-            if not np.any(fast & ~inside):
+            out = ((ahead > hi) & (v > 0.0)) | ((ahead < lo) & (v < 0.0))  # heading out across a limit
+            if not np.any(fast & out):
                 self.step += 1
                 return
         self._played = self.velocities()
