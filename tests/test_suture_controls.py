@@ -101,3 +101,27 @@ def test_the_hand_back_path_carries_the_tail_on_a_straight_line():
         assert np.linalg.norm(off) < 1e-12  # on the line
     mid = path(0.5)  # the needle's centre does not go straight: it turns about the tail
     assert np.linalg.norm(mid[:3, 3] - (a[:3, 3] + b[:3, 3]) / 2) > 1e-3
+
+
+def test_a_take_reaims_where_its_grasp_moved_past_the_jaws_room():
+    """motions._apart, what Motions.take compares with REAIM: a grasp pose shifted or turned
+    (a turn counts as the arc it sweeps at the jaws' depth) is that far from where it was aimed;
+    1.7 mm and 6 degrees (the springy-holes copy's seed 1 at hand back 3) re-aim, the 0.5-0.6 mm
+    a needle settling on the tissue moves it at the pick-up does not."""
+    import numpy as np
+
+    from adfkit.runner.rotations import rotation_exp
+    from adfkit.tasks.grasping import JAW_DEPTH
+    from adfkit.tasks.motions import REAIM, _apart
+
+    a = np.eye(4)
+    a[:3, 3] = [0.01, 0.02, 0.03]
+    shifted, turned = a.copy(), a.copy()
+    shifted[:3, 3] += [0.0003, -0.0004, 0.0]
+    turned[:3, :3] = rotation_exp(np.array([0.0, 0.0, 0.3]))
+    assert abs(_apart(a, shifted) - 0.0005) < 1e-12 and abs(_apart(a, turned) - 0.3 * JAW_DEPTH) < 1e-12
+    assert _apart(a, a) == 0.0 and _apart(a, shifted) < REAIM
+    seed_1 = a.copy()
+    seed_1[:3, :3] = rotation_exp(np.radians([0.0, 6.0, 0.0]))
+    seed_1[:3, 3] += [0.0, -0.0017, 0.0]
+    assert _apart(a, seed_1) > REAIM

@@ -457,6 +457,7 @@ class SutureObserver:
             **self._constraint_errors(rep),
             "control_steps": self.n,
             "clipped_setpoints": self.task.clipped,
+            "reaimed_takes": self.task.reaimed,
             "plan": self._plan(),
         }
 

@@ -9,7 +9,7 @@ import numpy as np
 from ..runner.psm import PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
-from .grasping import BACK_OFF, JAW_APPROACH, ROLL, Grasp, SutureError
+from .grasping import BACK_OFF, JAW_APPROACH, JAW_DEPTH, ROLL, Grasp, SutureError
 
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
 GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
@@ -18,6 +18,28 @@ GUARD_BACK = 0.0005  # m ... and draws back this far the way it came
 #: they open (0.05 rad a finger, 0.4 mm at its middle: at 0.02 the finger stayed on the boundary
 #: with 50-60 N for 24 ms while the jaws closed a step at a time)
 GUARD_JAW_BACK = 0.1
+#: m: where the grasp on the needle has moved farther than this while a tool came over it (the
+#: needle turning in the other arm's grasp), the tool is brought over the grasp where it is now,
+#: in REAIM_S, before it comes down. The jaws, JAW_APPROACH apart, leave the wire 1.35 mm either
+#: side; a needle settling on the tissue moves its grasp 0.5-0.6 mm while the arm comes (the
+#: springy-holes copy's pick-up), a needle turning in the puller's jaws 3.4 mm (its seed 1, hand
+#: back 3, where the driver's jaws came down on the wire and missed the grasp by 6 mm)
+REAIM = 0.001
+REAIM_S = 0.3
+
+
+def _backed_off(ee: np.ndarray) -> np.ndarray:
+    """The end-effector pose BACK_OFF back along its jaw axis."""
+    out = ee.copy()
+    out[:3, 3] -= BACK_OFF * ee[:3, 2]
+    return out
+
+
+def _apart(a: np.ndarray, b: np.ndarray) -> float:
+    """How far pose b is from pose a: metres, or the turn between them as the arc it sweeps at
+    the jaws' depth (m)."""
+    turn = float(np.linalg.norm(rotation_log(a[:3, :3].T @ b[:3, :3])))
+    return max(float(np.linalg.norm(b[:3, 3] - a[:3, 3])), turn * JAW_DEPTH)
 
 
 def interpolate(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
@@ -128,10 +150,14 @@ class Motions:
         grasp (on the needle where it is now) and holds the needle."""
         psm = self.psms[name]
         goal = self.needle_pose() @ grasp.ee_in_needle
-        above = goal.copy()
-        above[:3, 3] -= BACK_OFF * goal[:3, 2]
+        above = _backed_off(goal)
         psm.servo_jaw(opening)
         yield from self.move(psm, above, 0.8)
+        now = self.needle_pose() @ grasp.ee_in_needle
+        if _apart(goal, now) > REAIM:  # the needle moved (in the other arm's grasp) while this one came
+            goal, above = now, _backed_off(now)
+            self.reaimed += 1
+            yield from self.move(psm, above, REAIM_S, settle=0.0)
         yield from self.line(psm, above, goal, 0.5, guarded=True)  # along the jaw axis, as the plan checked it
         yield from self.wait(0.2)
         ee = psm.base_in_world() @ psm.measured_cp()

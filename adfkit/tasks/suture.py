@@ -60,6 +60,10 @@ HAND_BACK_S = 3.0
 #: rad/s the needle turns about its centre as the puller draws it out (at 0.6 the thread, through
 #: three pairs, dragged the needle 2.0 mm in the grasp during pull 4 on 1 of 10 seeds)
 PULL_RATE = 0.4
+#: m the pull ends with the needle lifted over where its tail cleared the exit
+PULL_LIFT = 2 * LIFT
+#: m over the next pair's start of the arc at which the puller hands the needle back
+HAND_BACK_LIFT = 2 * LIFT
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
 
@@ -177,6 +181,7 @@ class SutureTask(GraspChoice, Motions):
         self.roles = body_roles(world, self.needle, self.psms, not_tissue)
         self.phase = "start"
         self.clipped = 0  # set-points clipped to the joint limits
+        self.reaimed = 0  # takes brought over the needle again where it moved as the tool came (Motions.take)
         self.phase_log: list[tuple[str, float]] = []  # (phase, simulated start time)
         self.holder: str | None = None  # the PSM holding the needle
         self.held_ee_in_needle: np.ndarray | None = None
@@ -354,7 +359,7 @@ class SutureTask(GraspChoice, Motions):
         best = None
         for tail in TAIL_CLEARS:
             done = psi_x + self.geom.span + tail
-            out = self.lifted(self.needle_at(b, done), 2 * LIFT)
+            out = self.lifted(self.needle_at(b, done), PULL_LIFT)
             pull = [self.needle_at(b, psi) for psi in np.linspace(psi_end, done, 7)] + [out]
             clear = (*self.along_arc(b, psi_end, done), out)
             try:
@@ -404,7 +409,7 @@ class SutureTask(GraspChoice, Motions):
         prev = self.pull_grasps[k - 1]
         along = self.along_arc(b, -self.approach, psi_x + beyond)
         for psi in np.radians(np.arange(-15, 250, 15)) - self.approach:
-            h = self.lifted(self.needle_at(b, psi), 2 * LIFT)
+            h = self.lifted(self.needle_at(b, psi), HAND_BACK_LIFT)
             if self._margin(puller, h @ prev.ee_in_needle) <= 0:
                 continue
             try:
@@ -437,7 +442,7 @@ class SutureTask(GraspChoice, Motions):
         """Whether the puller, holding the needle by ``prev``, reaches every pose of the path
         about the tail (about_tail) from where pull k-1 leaves the needle to the hand-back ``h``."""
         b, psi_x, _, _, _ = self.frames[self.pairs[k - 1].index]
-        high = self.lifted(self.needle_at(b, psi_x + self.geom.span + self.tail_clears[k - 1]), 2 * LIFT)
+        high = self.lifted(self.needle_at(b, psi_x + self.geom.span + self.tail_clears[k - 1]), PULL_LIFT)
         path = self.about_tail(high, h)
         return all(self._margin(puller, path(s) @ prev.ee_in_needle) > 0 for s in np.linspace(0.0, 1.0, 13))
 
@@ -536,7 +541,7 @@ class SutureTask(GraspChoice, Motions):
                 lambda s: self.needle_at(b_now, psi_end + (done - psi_end) * s), (done - psi_end) / PULL_RATE
             )
             out = self.needle_at(b_now, done)
-            high = self.lifted(out, 2 * LIFT)
+            high = self.lifted(out, PULL_LIFT)
             yield from self.carry(lambda s: interpolate(out, high, smooth(s)), 1.0)
             yield from self.wait(0.2)
             if k + 1 < len(self.pairs):
