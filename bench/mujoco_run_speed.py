@@ -17,7 +17,7 @@ temporary directory) in the same minutes: each round plays both, each in a fresh
 order alternating, and prints both trees' medians, their ratio and whether their poses' digests
 agree (the same poses to the last bit), with the ratio of the least rounds (load only ever adds).
 
-The suturing set is the corpus's (launch indices 6-11) when ``../shared/corpus`` is there, else
+The suturing set is the corpus's (launch indices 6-11) when ``$ADFKIT_CORPUS`` (else ``../shared/corpus``) is there, else
 the project's bundled suturing scene. Asserts nothing; prints figures.
 """
 

@@ -26,7 +26,7 @@ ghosts' collision pass (``interact._manifold_points``, wherever it runs the pass
 springs (``SpringSet.apply``, at every physics step under AMBF's springs), the forces applied
 again before each physics step (``held.replay``) and the rest of the control step. cProfile adds
 its cost to every Python call, so the Python shares are upper bounds. The suturing set is the
-corpus's (launch indices 6-11) when ``../shared/corpus`` is there, else the bundled suturing scene.
+corpus's (launch indices 6-11) when ``$ADFKIT_CORPUS`` (else ``../shared/corpus``) is there, else the bundled suturing scene.
 Prints figures, asserts nothing.
 """
 

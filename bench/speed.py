@@ -14,13 +14,14 @@
 - ``adfkit validate`` of the whole corpus (``-j`` default and ``-j 1``) alternated with its
   floor (libyaml alone), and ``adfkit --help``: fresh processes, start-up included, medians of 5.
 
-The suturing set is the corpus's (launch indices 6-11) when ``../shared/corpus`` is there, else
+The suturing set is the corpus's (launch indices 6-11) when ``$ADFKIT_CORPUS`` (else ``../shared/corpus``) is there, else
 the project's bundled suturing scene. Asserts nothing; prints figures.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
@@ -28,7 +29,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-CORPUS = ROOT.parent / "shared" / "corpus"
+CORPUS = Path(os.environ.get("ADFKIT_CORPUS", ROOT.parent / "shared" / "corpus"))
 
 
 def scene_and_label():
