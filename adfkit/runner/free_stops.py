@@ -82,12 +82,7 @@ class FreeStops:
     def watching(self) -> bool:
         """Whether a multibody may be handed to the chain step or is played now (one free or one
         engaged): an engine that steps physics steps together otherwise steps them one by one."""
-        cmd = self.commanded
-        self.free = [
-            (art, limited)
-            for art, limited in self.arts
-            if not art.held and not (cmd and any((id(art), n) in cmd for n in range(len(art.records))))
-        ]
+        self.free = [(art, limited) for art, limited in self.arts if not self._commanded(art)]
         return bool(self.engaged) or bool(self.free)
 
     def idle(self, steps: int) -> None:

@@ -275,9 +275,9 @@ class JointCommands:
         5.3 rad where AMBF's stay within their ±2.09): past a limit, the joint is driven back at
         erp·error per step instead, whatever took it there, erp the joint's (a slider's the
         world's, 0.2, as AMBF's btSliderConstraint reads it: the parity slider pushed onto its
-        stops 0.41 -> 0.00 mm from AMBF's). A limit row only pushes: a joint the effort takes back
-        in faster than that (its velocity after the step's effort, by the joint's row mass where
-        the engine tells it) or already leaving its limit faster is left to the effort (the PSM's
+        stops 0.41 -> 0.00 mm from AMBF's). A limit row only pushes: a joint leaving its limit faster
+        than that once the step's effort has acted (by the joint's row mass where the engine tells
+        it) is left to the effort (the PSM's
         effort program: a jaw pushed shut, its yaw link kicked by the other jaw's stop, opened
         0.52 rad in AMBF and stayed shut under a motor that held it both ways). The MuJoCo
         engine's limits are AMBF's rows at their rates (mujoco/limits.py) and act under an
@@ -290,8 +290,8 @@ class JointCommands:
             lo, hi = dj.limits
             err = q - hi if q > hi else (q - lo if q < lo else 0.0)
             back = -dj.limit_erp * err / w.dt
-            after = v + effort * w.dt / dj.row_mass  # the effort's share of the step (none untold)
-            if err != 0.0 and (after - back) * err > 0.0 and (v - back) * err > 0.0:
+            after = v + effort * w.dt / dj.row_mass  # what the row meets: the step's effort added (none untold)
+            if err != 0.0 and (after - back) * err > 0.0:
                 w.joint_motor(dj.art, dj.index, back, LIMIT_FORCE)
                 return
         w.joint_effort(dj.art, dj.index, effort)
