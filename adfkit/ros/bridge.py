@@ -23,10 +23,10 @@ import numpy as np
 from ..runner.joint_commands import JointCommands
 from ..runner.rotations import invert, matrix_to_quat, pose_matrix
 from .env import publisher
+from .guard import TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY, body_cmd_fault, pose_fault
 from .objects import RosObject, ros_objects, topic_of, world_namespace
 
 WATCHDOG_S = 0.5  # ambf_comm's time out for every object (ObjectCommPlugin, WorldCommPlugin)
-TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY = 0, 1, 2
 POSITION_GAINS = (10.0, 1.0)  # AMBF's default Cartesian controller (P, D), output velocity
 
 
@@ -77,8 +77,16 @@ class Handler:
         self.obj = obj
 
     def _on_cmd(self, msg) -> None:
+        why = self.fault(msg)
+        if why:  # guard.py: never into the physics; the last good command holds
+            self.bridge.note(f"{self.obj.topic}/Command ignored: {why} (not a finite number)")
+            return
         self.cmd = msg
         self.heard = time.monotonic()
+
+    def fault(self, msg) -> str | None:
+        """Why ``msg`` must not be applied (guard.py), or None."""
+        return None
 
     def live(self, now: float) -> bool:
         """A command arrived within the watchdog's time out."""
@@ -126,6 +134,9 @@ class BodyHandler(Handler):
                 self.groups.setdefault(id(j.art), (j.art, []))[1].append((k, j.index))
 
     # ---- commands ------------------------------------------------------------------------
+    def fault(self, msg) -> str | None:
+        return body_cmd_fault(msg, len(self.obj.joints))
+
     def apply(self, now: float) -> None:
         cmd = self.cmd
         if cmd is None:
@@ -153,7 +164,11 @@ class BodyHandler(Handler):
             self._velocity(w, cmd.twist)
         jc, driven = self.bridge.joints, {}
         for entry, value, kind in zip(self.obj.joints, joint_cmds, types):
-            if kind not in (TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY):  # AMBF: "COMMAND TYPE NOT UNDERSTOOD"
+            if kind not in (TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY):
+                self.bridge.note(
+                    f'WARNING! FOR JOINT "{entry.name}" COMMAND TYPE {kind} NOT UNDERSTOOD, SUPPORTED TYPES ARE'
+                    " 0 -> FORCE, 1 -> POSITION, 2 -> VELOCITY"
+                )  # AMBF's words (ObjectCommPlugin.cpp), said once
                 continue
             if entry.art is None:
                 self.bridge.note(
@@ -238,6 +253,16 @@ class BodyHandler(Handler):
             st.joint_positions, st.joint_velocities, st.joint_efforts = [], [], []
 
 
+def _not_found(name: str, hits) -> str:
+    """AMBF's warning for a body name that names no body or several (getBaseObject)."""
+    if len(hits) > 1:
+        shown = ", ".join(hits[:8]) + (", ..." if len(hits) > 8 else "")
+        return f'MULTIPLE OBJECTS WITH SUB-STRING: "{name}" FOUND. PLEASE SPECIFY FURTHER ({shown})'
+    if hits:
+        return f'"{name}" ({hits[0]}) is not a rigid body; ignored'
+    return f'CAN\'T FIND ANY OBJECTS NAMED: "{name}"; ignored'
+
+
 def _angle(a: np.ndarray, b: np.ndarray) -> float:
     c = (np.trace(a[:3, :3].T @ b[:3, :3]) - 1.0) / 2.0
     return float(math.acos(max(-1.0, min(1.0, c))))
@@ -294,12 +319,20 @@ class ActuatorHandler(Handler):
             return
         body = None
         if cmd.use_sensor_data:
-            key, s = self.bridge.find_sensor(cmd.sensor_identifier.data)
+            name = cmd.sensor_identifier.data
+            key, s = self.bridge.find_sensor(name)
             if s is not None:
                 body = next((b for b, _ in (s.rays or []) if b is not None), None)
+            else:  # AMBF's words (actuatorFetchCommand), said once
+                self.bridge.note(
+                    f"ERROR! IN ACTUATOR CALLBACK {self.obj.name}, REQUESTED SENSOR NAME {name} NOT FOUND. IGNORING!"
+                )
         else:
-            key, hit = w.registry.find(cmd.body_name.data)
+            name = cmd.body_name.data
+            key, hit = w.registry.find(name)
             body = hit if key is not None and isinstance(hit, w.body_type) else None
+            if body is None:
+                self.bridge.note(f"{self.obj.topic}: actuate: {_not_found(name, hit if key is None else [key])}")
         if body is not None and body is not self.a.parent:
             w.actuate(self.a, body)
 
@@ -313,6 +346,9 @@ class CameraHandler(Handler):
     def rebind(self, obj: RosObject) -> None:
         self.obj, self.cams = obj, obj.target
         self.state.parent_name.data = self.cams[0].camera.parent or ""
+
+    def fault(self, msg) -> str | None:
+        return pose_fault(msg.pose) if msg.enable_position_controller else None
 
     def apply(self, now: float) -> None:
         cmd = self.cmd

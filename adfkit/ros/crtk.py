@@ -22,6 +22,7 @@ import numpy as np
 
 from ..runner.rotations import matrix_to_quat, pose_matrix
 from .env import publisher
+from .guard import pose_fault, values_fault
 from .objects import ambf_name
 
 NAMESPACE = "/CRTK"
@@ -43,6 +44,16 @@ def msg_matrix(pose) -> np.ndarray:
     q = np.array([pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w], float)
     n = np.linalg.norm(q)
     return pose_matrix([pose.position.x, pose.position.y, pose.position.z], q / n if n > 0 else [0, 0, 0, 1])
+
+
+def _fault(topic: str, msg) -> str | None:
+    """Why a PSM's CRTK command cannot be carried out (guard.py), or None: a joint command
+    needs the six arm joints (the jaw one value), every value a finite number."""
+    if topic in ("servo_cp", "move_cp"):
+        return pose_fault(msg.pose)
+    if topic == "servo_jv":
+        return values_fault(msg.velocity, "velocity", 6)
+    return values_fault(msg.position, "position", 1 if topic == "jaw/servo_jp" else 6)
 
 
 class PsmCrtk:
@@ -75,6 +86,10 @@ class PsmCrtk:
         self.grasped = False
 
     def _hold(self, topic: str, msg) -> None:
+        why = _fault(topic, msg)
+        if why:  # guard.py: never into the physics or the IK
+            self.crtk.bridge.note(f"{NAMESPACE}/{self.name}/{topic} ignored: {why}")
+            return
         self.pending[topic] = msg
 
     def _clamp(self, q) -> np.ndarray:
@@ -94,7 +109,7 @@ class PsmCrtk:
         if pending:
             self.crtk.bridge.yield_body(psm.base)
         for topic, msg in pending.items():
-            if topic == "servo_jp" and len(msg.position) >= 6:
+            if topic == "servo_jp":
                 self.move = self.velocity = None
                 psm.servo_jp(self._clamp(msg.position))
             elif topic == "servo_cp":
@@ -103,14 +118,14 @@ class PsmCrtk:
                     self.move = self.velocity = None
                     psm.servo_jp(q)
             elif topic in ("move_jp", "move_cp"):
-                q = self._clamp(msg.position) if topic == "move_jp" and len(msg.position) >= 6 else None
+                q = self._clamp(msg.position) if topic == "move_jp" else None
                 q = self._ik(msg) if topic == "move_cp" else q
                 if q is not None:
                     self.velocity = None
                     self.move = (psm.measured_jp(), q, w.sim_time)
-            elif topic == "servo_jv" and len(msg.velocity) >= 6:
+            elif topic == "servo_jv":
                 self.move, self.velocity = None, [float(v) for v in msg.velocity[:6]]
-            elif topic == "jaw/servo_jp" and len(msg.position) >= 1:
+            elif topic == "jaw/servo_jp":
                 self._jaw(float(msg.position[0]))
         if self.move is not None:
             q0, q1, t0 = self.move
@@ -166,6 +181,10 @@ class EcmCrtk:
         self.pending = None
 
     def _hold(self, msg) -> None:
+        why = pose_fault(msg.pose)
+        if why:
+            self.crtk.bridge.note(f"{NAMESPACE}/ecm/servo_cp ignored: {why}")
+            return
         self.pending = msg
 
     def apply(self) -> None:

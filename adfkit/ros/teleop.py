@@ -20,6 +20,7 @@ import numpy as np
 from ..diagnostics import AdfError, error
 from ..runner.rotations import rotation_exp
 from .crtk import msg_matrix
+from .guard import pose_fault
 
 GEOMAGIC_SCALE = 0.0002  # the challenge's: device mm to 0.2 mm of tool motion
 JOY_SPEED = 0.02  # m/s at full deflection
@@ -93,6 +94,10 @@ class GeomagicTeleop(Teleop):
         ]
 
     def _on_pose(self, msg) -> None:
+        why = pose_fault(msg.pose)
+        if why:  # guard.py: the target is never NaN
+            self.crtk.bridge.note(f"teleop {self.arm.name}: a device pose ignored: {why}")
+            return
         t = msg_matrix(msg.pose)
         t[:3, 3] *= GEOMAGIC_SCALE
         self.pose = t
@@ -127,7 +132,7 @@ class JoyTeleop(Teleop):
     def _on_joy(self, msg) -> None:
         a = np.zeros(6)
         n = min(6, len(msg.axes))
-        a[:n] = np.clip(np.asarray(msg.axes[:n], float), -1.0, 1.0)
+        a[:n] = np.clip(np.nan_to_num(np.asarray(msg.axes[:n], float), nan=0.0), -1.0, 1.0)  # NaN: at rest
         self.axes = a
         self.button = bool(msg.buttons[0]) if len(msg.buttons) else False
 
