@@ -27,7 +27,12 @@ from .guard import TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY, body_cmd_fault, pos
 from .objects import RosObject, ros_objects, topic_of, world_namespace
 
 WATCHDOG_S = 0.5  # ambf_comm's time out for every object (ObjectCommPlugin, WorldCommPlugin)
-POSITION_GAINS = (10.0, 1.0)  # AMBF's default Cartesian controller (P, D), output velocity
+#: AMBF's default Cartesian controller without a `controller` block: P 10 (D 1), output a velocity.
+#: Its D term is left out: on a velocity output, D 1 makes v_k = P·e_k − v_(k−1), a loop with an
+#: eigenvalue of −1/(1 − P·dt) (−1.005 at 1 kHz), so a free body under a pose command swings ever
+#: wider (a 1 kg box told to move 0.2 m was 2.4e5 m away 4 s later); P alone closes the error by
+#: P·dt a step (0.1 s time constant), as AMBF's does between its swings.
+POSITION_GAIN = 10.0
 
 
 def _set_pose(msg_pose, t: np.ndarray) -> None:
@@ -194,14 +199,13 @@ class BodyHandler(Handler):
                 elif hasattr(w, "move_base"):
                     w.move_base(sb, target)
             return
-        p, d = POSITION_GAINS
+        p = POSITION_GAIN
         cur = sb.world_matrix() @ sb.com_in_body
         goal = target @ sb.com_in_body
-        _, _, v, om = sb.state()
-        lin = p * (goal[:3, 3] - cur[:3, 3]) - d * np.asarray(v)
+        lin = p * (goal[:3, 3] - cur[:3, 3])
         from ..runner.rotations import rotation_log
 
-        ang = p * (cur[:3, :3] @ rotation_log(cur[:3, :3].T @ goal[:3, :3])) - d * np.asarray(om)
+        ang = p * (cur[:3, :3] @ rotation_log(cur[:3, :3].T @ goal[:3, :3]))
         self._set_velocity(w, lin, ang)
 
     def _velocity(self, w, twist) -> None:
