@@ -18,7 +18,7 @@ from adfkit.runner.pybullet.spring_forces import SpringSet  # noqa: E402
 
 def _after(k, c, x, v, inertia, dt):
     den = 1.0 + (c * dt + k * dt**2) / inertia
-    tau = SpringSet._spring((k, c + k * dt, den), x, v)
+    tau = SpringSet._spring((-k, -(c + k * dt), den), x, v)  # (-K, -C, D), as SpringSet._gains makes them
     return tau, v + tau * dt / inertia
 
 

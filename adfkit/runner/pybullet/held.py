@@ -11,9 +11,14 @@ push() and twist(); a world that records registers its client here."""
 
 from __future__ import annotations
 
+from collections import deque
+from itertools import starmap
+from operator import call
+
 import pybullet as pb
 
-_recording: dict[int, list[tuple]] = {}  # physics client id -> (call, args) applied since its last control step
+# physics client id -> (call, *args) of each force applied since its last control step, in order
+_recording: dict[int, list[tuple]] = {}
 
 
 def push(uid: int, link: int, force, at, cid: int) -> None:
@@ -21,7 +26,7 @@ def push(uid: int, link: int, force, at, cid: int) -> None:
     pb.applyExternalForce(uid, link, force, at, pb.WORLD_FRAME, cid)
     held = _recording.get(cid)
     if held is not None:
-        held.append((pb.applyExternalForce, (uid, link, force, at, pb.WORLD_FRAME, cid)))
+        held.append((pb.applyExternalForce, uid, link, force, at, pb.WORLD_FRAME, cid))
 
 
 def twist(uid: int, link: int, torque, cid: int) -> None:
@@ -29,7 +34,7 @@ def twist(uid: int, link: int, torque, cid: int) -> None:
     pb.applyExternalTorque(uid, link, torque, pb.WORLD_FRAME, cid)
     held = _recording.get(cid)
     if held is not None:
-        held.append((pb.applyExternalTorque, (uid, link, torque, pb.WORLD_FRAME, cid)))
+        held.append((pb.applyExternalTorque, uid, link, torque, pb.WORLD_FRAME, cid))
 
 
 def record(cid: int) -> None:
@@ -41,9 +46,9 @@ def forget(cid: int) -> None:
 
 
 def replay(cid: int) -> None:
-    """Apply again what was applied since the control step began (PyBullet cleared it)."""
-    for call, args in _recording.get(cid, ()):
-        call(*args)
+    """Apply again what was applied since the control step began (PyBullet cleared it), in the
+    order it was applied (the calls looped in C)."""
+    deque(starmap(call, _recording.get(cid, ())), 0)
 
 
 def clear(cid: int) -> None:

@@ -18,20 +18,11 @@ from itertools import chain, repeat
 import numpy as np
 import pybullet as pb
 
+from ..rotations import cross_rows as _cross
 from ..rotations import euler_xyz, quat_to_matrix
 from ..springs import SpringJoint
 from .cone_limits import ConeLimits
 from .joint_inertia import PivotInertia, bullet_spring_masses
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross product of (n, 3) arrays: np.cross's products in np.cross's order,
-    without its axis bookkeeping (a third of the cost at this size)."""
-    out = np.empty_like(a)
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
 
 
 class SpringSet:
@@ -109,7 +100,8 @@ class SpringSet:
         self.i_eff = 1.0 / np.maximum(inv_i[self.ip] + inv_i[self.ic], 1e-12)
         cones = ConeLimits.among(joints) if form == "ambf" else np.zeros(0, int)
         self.ang_low[cones], self.ang_high[cones] = 1.0, -1.0  # Bullet's cone and twist instead (cone_limits.py)
-        self.ang_active = self.ang_low <= self.ang_high
+        active = self.ang_low <= self.ang_high
+        self.ang_active = True if active.all() else active  # True: _limit skips its &s
         self.ang_ranged = self.ang_low < self.ang_high if form == "ambf" else None  # AMBF's rows inside (_limit)
         fl = self.free_lin
         # the free-linear joints' constant blocks, sliced once (the same values every step)
@@ -120,7 +112,7 @@ class SpringSet:
         self.fl_p_ends = np.concatenate((self.pa_in_p[fl], self.pb_in_c[fl]))[:, :, None]
         self.fl_arms = np.concatenate((self.fl_ic, self.fl_ip))
         self.fl_eq, self.fl_low, self.fl_high = self.eq_lin[fl], self.lin_low[fl], self.lin_high[fl]
-        self.fl_active = self.fl_low <= self.fl_high
+        self.fl_active = True if (self.fl_low <= self.fl_high).all() else self.fl_low <= self.fl_high
         self.fl_ranged = self.fl_low < self.fl_high if form == "ambf" else None
         self.fl_m = self.m_eff[fl][:, None]
         # each body's 1/m and principal 1/I, shared as m_eff's are, for the pivots' mass (_pivot_mass)
@@ -172,22 +164,22 @@ class SpringSet:
         get_limit_motor_info2): K = min(k, m/(16·dt²)), C = min(c, m/dt), D = 1 (None: not divided by)."""
         if self._gains_dt == dt:
             return
-        if self.form == "ambf":
+        if self.form == "ambf":  # (_spring takes -K and -C: negated once here, not at every step)
             self._ang = (
-                np.minimum(self.k_ang, self.m_ang / (16 * dt * dt)),
-                np.minimum(self.c_ang, self.m_ang / dt),
+                -np.minimum(self.k_ang, self.m_ang / (16 * dt * dt)),
+                -np.minimum(self.c_ang, self.m_ang / dt),
                 None,
             )
             self._lin = (
-                np.minimum(self.k_lin, self.m_lin / (16 * dt * dt)),
-                np.minimum(self.c_lin, self.m_lin / dt),
+                -np.minimum(self.k_lin, self.m_lin / (16 * dt * dt)),
+                -np.minimum(self.c_lin, self.m_lin / dt),
                 None,
             )
         else:
             den_ang = 1.0 + (self.c_ang * dt + self.k_ang * dt**2) / self.i_implicit
             den_lin = 1.0 + (self.c_lin * dt + self.k_lin * dt**2) / self.m_implicit
-            self._ang = (self.k_ang, self.c_ang + self.k_ang * dt, den_ang)
-            self._lin = (self.k_lin, self.c_lin + self.k_lin * dt, den_lin)
+            self._ang = (-self.k_ang, -(self.c_ang + self.k_ang * dt), den_ang)
+            self._lin = (-self.k_lin, -(self.c_lin + self.k_lin * dt), den_lin)
         k, c, den = self._lin
         fl = self.free_lin
         self._fl = (k[fl], c[fl], den if den is None else den[fl])
@@ -195,13 +187,14 @@ class SpringSet:
 
     @staticmethod
     def _spring(gains, x, v):
-        """The spring-damper's force or torque -(K·x + C·v) / D, ``gains`` (K, C, D) (_gains).
+        """The spring-damper's force or torque -(K·x + C·v) / D, ``gains`` (-K, -C, D) (_gains: the
+        same products as (-K)·x and (-C)·v, the negations made once).
         D None is AMBF's row (get_limit_motor_info2): its impulse is bounded by the spring-damper's
         and the damper's alone and driven to the bound on the side of their sum, so where the damper
         opposes the spring and outweighs it the damper acts alone (a spring released toward its
         equilibrium is braked by the whole of -C·v, not by what the spring leaves of it)."""
-        k, c, den = gains
-        spring, damper = -k * x, -c * v
+        neg_k, neg_c, den = gains
+        spring, damper = neg_k * x, neg_c * v
         out = spring + damper
         if den is None:
             return np.where((spring * damper < 0.0) & (np.abs(damper) > np.abs(spring)), damper, out)
@@ -378,7 +371,10 @@ class SpringSet:
         low < high: limit_rows.spring_row_velocity): a joint moves toward a limit at a gap g at most
         erp·g/dt, and not at all where it came in fast enough to cross it within the step."""
         active = low <= high if active is None else active
-        over, under, rows = active & (x > high), active & (x < low), None
+        if active is True:  # every axis limited: the same masks without the &
+            over, under, rows = x > high, x < low, None
+        else:
+            over, under, rows = active & (x > high), active & (x < low), None
         if ranged is not None and ranged[0] is not None:  # rows act where x + v·dt/erp leaves the range
             rows, v0 = ranged
             v = v() if callable(v) else v
@@ -388,13 +384,15 @@ class SpringSet:
             return 0.0
         if callable(v):
             v = v()
-        err = np.where(over, x - high, np.where(under, x - low, 0.0))
+        gap_lo = x - low
+        err = np.where(over, x - high, np.where(under, gap_lo, 0.0))
         f = inertia * (-erp * err / dt - v) / dt
         out = np.where(over, np.minimum(f, 0.0), np.where(under, np.maximum(f, 0.0), 0.0))
         if rows is None:
             return out
-        gap_lo, gap_hi = x - low, high - x  # Bullet tests the crossing with the velocity before the step
-        slowest = np.where((gap_lo > 0.0) & (-v0 * dt > gap_lo), 0.0, -erp * gap_lo / dt)
-        fastest = np.where((gap_hi > 0.0) & (v0 * dt > gap_hi), 0.0, erp * gap_hi / dt)
+        gap_hi = high - x  # Bullet tests the crossing with the velocity before the step
+        v0_dt = v0 * dt  # (-v0·dt is -(v0·dt) to the bit: rounding is symmetric)
+        slowest = np.where((gap_lo > 0.0) & (-v0_dt > gap_lo), 0.0, -erp * gap_lo / dt)
+        fastest = np.where((gap_hi > 0.0) & (v0_dt > gap_hi), 0.0, erp * gap_hi / dt)
         pushes = np.maximum(inertia * (slowest - v) / dt, 0.0) + np.minimum(inertia * (fastest - v) / dt, 0.0)
-        return np.where(rows & active, pushes, out)
+        return np.where(rows if active is True else rows & active, pushes, out)
