@@ -77,6 +77,8 @@ class FreeStops:
         """The joints of ``art`` a command or a holding position motor drives."""
         if art.held:
             return set(range(len(art.records)))
+        if not self.commanded:  # no joint commanded yet (asked before every physics step)
+            return set()
         return {n for n in range(len(art.records)) if (id(art), n) in self.commanded}
 
     def watching(self) -> bool:
@@ -107,8 +109,8 @@ class FreeStops:
                 if key in self.engaged:  # the commanded joints' motors are the commands' now
                     self._give_back(art, limited, keep=commanded)
                 continue
-            q, v = w.joint_state(art, list(range(len(art.records))))
-            near = False
+            q, v = (x.tolist() for x in w.joint_state(art, list(range(len(art.records)))))
+            near = False  # (floats: numpy's scalars gave the same sums at five times the cost)
             for n, (lo, hi) in limited:
                 ahead = q[n] + 2.0 * v[n] * dt  # where it is a step after the next: the solver sees it past
                 # heading out across a limit (a joint coming back in is the limit row's: a hinge
