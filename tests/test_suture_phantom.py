@@ -6,6 +6,7 @@ before the run; what a file it cannot use says. Slow: a generated family of good
 
 from __future__ import annotations
 
+import copy
 import math
 import re
 
@@ -125,6 +126,97 @@ def test_a_file_it_cannot_use_is_told_why(tmp_path, capsys):
     assert main(["suture", "--phantom", str(tmp_path / "none.yaml")]) == 2
     err = capsys.readouterr().err
     assert "--phantom puts your phantom into the bundled scene" in err and "none.yaml does not exist" in err
+
+
+def _renamed(path, body, ghost):
+    """The phantom's hole bodies and ghosts renamed: ``body(kind, k)``, ``ghost(kind, k)``."""
+    doc, _ = read_file(path, "model")
+    ref = {}
+    for b in doc.bodies:
+        m = re.fullmatch(r"(Entry|Exit)(\d+)", b.name)
+        if m:
+            new = body(m.group(1), int(m.group(2)))
+            ref[b.identifier] = f"BODY {new}"
+            b.name, b.identifier = new, f"BODY {new}"
+    for g in doc.ghost_objects:
+        m = re.fullmatch(r"ghost(Entry|Exit)(\d+)", g.name)
+        new = ghost(m.group(1), int(m.group(2)))
+        g.name, g.identifier, g.parent = new, f"GHOST {new}", ref[g.parent]
+    write_file(doc, path)
+    return path
+
+
+@pytest.mark.parametrize(
+    "body, ghost",
+    [
+        (lambda k, i: f"{k} {i}", lambda k, i: f"ghost {k} {i}"),  # "Entry 1" (the last word of the key was "1")
+        (lambda k, i: f"{k.lower()}_{i}", lambda k, i: f"{k.lower()}_{i}_ghost"),  # the number not at the end
+    ],
+    ids=["spaces", "suffix"],
+)
+def test_holes_spelt_as_a_modeller_spells_them_are_found(tmp_path, body, ghost):
+    """Hole bodies and ghosts named "Entry 1" / "ghost Entry 1" (the ghosts' parents were looked up
+    by the last word of their key, "1", and both holes of a pair fell on one body: "the phantom's
+    entry and exit holes lie on top of each other") or "entry_1" / "entry_1_ghost" ("no hole
+    pair") are the pairs they name, each on its own hole body."""
+    path = _renamed(phantom_file(tmp_path, pairs=2, spacing=0.012), body, ghost)
+    h = phantom_holes(read_file(path, "model")[0])
+    assert h.pairs() == [1, 2] and h.names[2] == {"entry": body("Entry", 2), "exit": body("Exit", 2)}
+    assert h.frames[1]["exit"][0, 3] - h.frames[1]["entry"][0, 3] == pytest.approx(2 * L.HOLE_HALF_GAP)
+    c = _compose(path)
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.suture import hole_pairs
+
+    world = open_world(c.scene, Options(renderer="tiny", visuals=False))
+    try:
+        assert [(p.index, p.entry_name, p.exit_name) for p in hole_pairs(world)] == [
+            (k, ghost("Entry", k), ghost("Exit", k)) for k in (1, 2)
+        ]
+    finally:
+        world.close()
+
+
+def test_a_broken_set_of_holes_is_refused_with_what_to_fix(tmp_path, capsys):
+    """Exit 2 and the reason, never a suture of what is left: hole bodies without ghosts; a pair
+    with one hole (Entry3 without Exit3 was dropped and pairs 1-2 passed, exit 0); two ghosts on
+    one hole; a file in millimetres (positions 1000 times too large: it failed as `reach`, "entry
+    and exit of pair 1 are 13996.6 mm apart")."""
+    from adfkit.cli import main
+
+    def broken(name, fn, pairs=3):
+        path = phantom_file(tmp_path / name, pairs=pairs, spacing=0.012)
+        doc, _ = read_file(path, "model")
+        fn(doc)
+        write_file(doc, path)
+        return path
+
+    def refused(path, *said):
+        with pytest.raises(PhantomError) as exc:
+            _compose(path)
+        for s in said:
+            assert s in str(exc.value)
+        return str(exc.value)
+
+    bodies_only = broken("bodies", lambda d: setattr(d, "ghost_objects", []))
+    refused(bodies_only, "no hole pair", "it has hole bodies (Entry1, Entry2, Entry3, Exit1, ...) but no hole ghosts")
+    lone = broken("lone", lambda d: setattr(d, "ghost_objects", [g for g in d.ghost_objects if g.name != "ghostExit3"]))
+    refused(lone, "pair 3 has only its entry hole (ghostEntry3), no Exit3 hole ghost (its whole pairs: 1, 2)")
+    assert main(["suture", "--phantom", str(lone), "--pairs", "all", "--out", str(tmp_path / "o")]) == 2
+    assert "pair 3 has only its entry hole" in capsys.readouterr().err
+
+    def twice(d):
+        extra = copy.deepcopy(next(g for g in d.ghost_objects if g.name == "ghostExit2"))
+        extra.name, extra.identifier = "Exit2_ghost", "GHOST Exit2_ghost"
+        d.ghost_objects.append(extra)
+
+    refused(broken("twice", twice), "pair 2's exit hole has 2 ghosts (ghostExit2, Exit2_ghost)")
+
+    def millimetres(d):
+        for b in d.bodies:
+            p = b.location.position
+            b.location = type(b.location)(type(p)(p.x * 1000, p.y * 1000, p.z * 1000), b.location.orientation)
+
+    refused(broken("mm", millimetres), "Entry1 and Exit1 are 14.0 m apart", "is the file in millimetres (14.0 mm)?")
 
 
 # ---- the good family, played (slow) ----------------------------------------------------------

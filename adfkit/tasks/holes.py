@@ -8,12 +8,23 @@ tested on exact numbers as well as on a simulation.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
+#: a hole's name: "entry" or "exit" and its pair's number, however a modeller spells it
+#: (ghostEntry1, Entry 1, entry_1, Entry1_ghost)
+HOLE_NAME = re.compile(r"(entry|exit)\D*?(\d+)", re.IGNORECASE)
+
 #: opening half-width used when a hole body has no capsule boundary (m)
 DEFAULT_HALF_OPENING = 0.0024
+
+
+def hole_name(name: str) -> tuple[str, int] | None:
+    """("entry" or "exit", pair k) of a hole's name, or None."""
+    m = HOLE_NAME.search(name or "")
+    return (m.group(1).lower(), int(m.group(2))) if m else None
 
 
 def has_boundary(body) -> bool:

@@ -20,7 +20,6 @@ a Gymnasium env, an expert policy).
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,7 +37,7 @@ from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError 
     GraspChoice,
     SutureError,
 )
-from .holes import ghost_box, hole_frame
+from .holes import ghost_box, hole_frame, hole_name
 from .motions import Motions, interpolate, smooth
 from .needle import fit_needle, obj_vertices, wire_radius
 from .roles import body_roles
@@ -95,10 +94,9 @@ def hole_ghosts(world) -> dict[int, dict]:
     ghost, "exit": ghost}}, either missing where the scene lacks it."""
     found: dict[int, dict] = {}
     for g in world.ghosts:
-        name = (g.ghost.name or g.ghost.identifier).lower()
-        m = re.search(r"(entry|exit)\D*(\d+)\s*$", name)
-        if m and g.friction:
-            found.setdefault(int(m.group(2)), {})[m.group(1)] = g
+        hole = hole_name(g.ghost.name or g.ghost.identifier)
+        if hole and g.friction:
+            found.setdefault(hole[1], {})[hole[0]] = g
     return found
 
 

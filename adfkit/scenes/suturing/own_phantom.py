@@ -43,12 +43,15 @@ import numpy as np
 from ...model import Body, Friction, Geometry, ModelFile, Pose, Scene, ShapeEntry, Vec3
 from ...model.semantics import collision_primitives
 from ...runner.rotations import pose_to_matrix
+from ...tasks.holes import HOLE_NAME, hole_name
 from . import layout as L
 from .frames import pose, rot_z, translation
 
 #: the bundled phantom's bodies the modeller's phantom replaces (the needle's file keeps the rest)
 BUNDLED_TISSUE = re.compile(r"^(Phantom|Entry\d+|Exit\d+)$")
-HOLE_NAME = re.compile(r"(entry|exit)\D*(\d+)\s*$", re.IGNORECASE)
+#: m from entry to exit beyond which a pair is not a suture's bite but a file in other units
+#: (this needle bites at most 14.5 mm; a phantom written in millimetres has its holes 14000 apart)
+UNITS_APART = 0.1
 TRAY = "SutureTray"
 #: m: the tray's thickness, the depth of its slot: room for the jaws' fingers around the wire
 #: (the bundled slab's slot is 8 mm deep; a tray raised 8 mm onto a phantom's slab stood 2 mm
@@ -73,25 +76,38 @@ def _has_capsules(body: Body) -> bool:
 @dataclass
 class Holes:
     """The phantom's hole pairs: {k: {"entry": 4x4, "exit": 4x4}} in the world (the hole body's
-    frame where it is framed by capsules, else the ghost's), and the names."""
+    frame where it is framed by capsules, else the ghost's), the names, and the ghosts each
+    hole was found by ({k: {kind: [ghost names]}}: more than one is a file to fix)."""
 
     frames: dict[int, dict[str, np.ndarray]] = field(default_factory=dict)
     names: dict[int, dict[str, str]] = field(default_factory=dict)
+    ghosts: dict[int, dict[str, list[str]]] = field(default_factory=dict)
 
     def pairs(self) -> list[int]:
         return sorted(k for k, d in self.frames.items() if "entry" in d and "exit" in d)
 
+    def lone(self) -> dict[int, str]:
+        """{k: "entry" or "exit"} of the pairs that have one hole only."""
+        return {k: next(iter(d)) for k, d in self.frames.items() if len(d) == 1}
+
+
+def _ref(text: str | None) -> str:
+    """A body's reference as a file spells it (``BODY Entry 1``, ``Entry 1``, with or without a
+    namespace) reduced to the body's own name: ``Entry 1``."""
+    s = (text or "").rsplit("/", 1)[-1].strip()
+    return s[5:].strip() if s.upper().startswith("BODY ") else s
+
 
 def phantom_holes(model: ModelFile) -> Holes:
     """The hole ghosts of a phantom file, by pair, with where each hole is."""
-    bodies = {(b.identifier or "").split()[-1]: b for b in model.bodies}
+    bodies = {_ref(b.identifier): b for b in model.bodies}
     out = Holes()
     for g in model.ghost_objects:
-        m = HOLE_NAME.search(g.name or g.identifier or "")
-        if not m:
+        hole = hole_name(g.name or g.identifier or "")
+        if hole is None:
             continue
-        k, kind = int(m.group(2)), m.group(1).lower()
-        parent = bodies.get((g.parent or "").split()[-1]) if g.parent else None
+        kind, k = hole
+        parent = bodies.get(_ref(g.parent)) if g.parent else None
         at = _matrix(parent.location) if parent is not None else np.eye(4)
         if parent is not None and _has_capsules(parent):
             frame, name = at, parent.name or parent.identifier
@@ -99,7 +115,56 @@ def phantom_holes(model: ModelFile) -> Holes:
             frame, name = at @ _matrix(g.location), g.name or g.identifier
         out.frames.setdefault(k, {})[kind] = frame
         out.names.setdefault(k, {})[kind] = name
+        out.ghosts.setdefault(k, {}).setdefault(kind, []).append(g.name or g.identifier)
     return out
+
+
+def check_holes(holes: Holes, model: ModelFile) -> None:
+    """Refuse, saying why, a phantom whose holes cannot be sutured as they stand: none at all
+    (or hole bodies without their ghosts), a hole without its pair's other one, two ghosts for
+    one hole, a pair so far apart that the file is in other units than metres."""
+    if not holes.frames:
+        named = sorted(b.name or b.identifier for b in model.bodies if hole_name(b.name or b.identifier or ""))
+        raise PhantomError(
+            "no hole pair: the phantom has no ghosts named Entry k and Exit k (ghostEntry1, ghostExit1, ...)"
+            + (
+                f"; it has hole bodies ({', '.join(named[:4])}{', ...' if len(named) > 4 else ''}) but no hole "
+                "ghosts: give each a ghost (GHOST ghostEntry1 with parent: BODY Entry1), as the add-on's "
+                "Add hole pair does"
+                if named
+                else ""
+            )
+        )
+    lone = holes.lone()
+    if lone:
+        said = "; ".join(
+            f"pair {k} has only its {kind} hole ({holes.ghosts[k][kind][0]}), no "
+            f"{'Exit' if kind == 'entry' else 'Entry'}{k} hole ghost"
+            for k, kind in sorted(lone.items())
+        )
+        whole = holes.pairs()
+        raise PhantomError(
+            ("no hole pair: the phantom has no whole pair of Entry k and Exit k hole ghosts; " if not whole else "")
+            + said
+            + (f" (its whole pairs: {', '.join(map(str, whole))}): name both holes of every pair" if whole else "")
+        )
+    twice = [(k, kind, g) for k, d in sorted(holes.ghosts.items()) for kind, g in sorted(d.items()) if len(g) > 1]
+    if twice:
+        k, kind, g = twice[0]
+        raise PhantomError(f"pair {k}'s {kind} hole has {len(g)} ghosts ({', '.join(g)}): keep one for each hole")
+    for k in holes.pairs():
+        d = float(np.linalg.norm(holes.frames[k]["exit"][:3, 3] - holes.frames[k]["entry"][:3, 3]))
+        if d > UNITS_APART:
+            n = holes.names[k]
+            raise PhantomError(
+                f"{n['entry']} and {n['exit']} are {d:.1f} m apart, where this needle drives a pair at most "
+                "14.5 mm apart: "
+                + (
+                    f"is the file in millimetres ({d:.1f} mm)? ADF lengths are in metres"
+                    if d > 5.0
+                    else f"bring Exit{k} next to Entry{k}"
+                )
+            )
 
 
 def _up() -> np.ndarray:
@@ -227,12 +292,7 @@ def compose(bundled: Scene, phantom: ModelFile) -> Composed:
             f"the phantom file has its own {own[0]}: --phantom puts a phantom beside the bundled needle "
             "and thread; export the phantom's bodies alone, or play your whole scene (adfkit suture SCENE)"
         )
-    if not holes.pairs():
-        lone = {k: d for k, d in holes.frames.items() if len(d) == 1}
-        raise PhantomError(
-            "no hole pair: the phantom has no ghosts named Entry k and Exit k (ghostEntry1, ghostExit1, ...)"
-            + (f"; pair {min(lone)} has only its {next(iter(lone[min(lone)]))} hole" if lone else "")
-        )
+    check_holes(holes, phantom)
     t = placement(holes)
     scene = copy.deepcopy(bundled)
     needle_file = None
