@@ -254,6 +254,31 @@ def test_forcing_and_a_tool_on_the_tissue_are_judged_before_reach_the_earlier_fi
     assert pair_verdict(obs, pair)["rule"] == "tool-hit-tissue"
 
 
+def test_a_planner_stopped_while_carrying_is_blocked_only_by_what_the_carried_needle_met():
+    """Stopped in carry 1 (a joint limit on the way): blocked at the entry when the carried
+    needle came to press on the tissue and still did when it stopped; `reach` when the only
+    touch was the bed it was lifted from (begun before the carry; a phantom's tray, 4.7 N, made
+    it "blocked at Entry1") or a bump it had left behind."""
+    obs, pair = _record(None, None)
+    obs.task.phase_log = [("settle", 0.0), ("pick up", 0.75), ("carry 1", 2.48)]
+    obs.needle_contacts = {"carry 1": {"SutureTray": 4.7}}
+    obs.tip_path = [[4.27, 0.0, 0.0, 0.02]]
+    stop = "carry 1: joint values outside the PSM's limits: outer_wrist_yaw = 1.396 (limits -1.396…1.396)"
+    bed = {"t_start": 0.02, "t_end": 2.51, "phase": "settle", "part": "body", "tissue": "SutureTray"}
+    obs.needle_events = [bed | {"max_force_n": 5.8, "sustained_force_n": 4.3}]
+    v = pair_verdict(obs, pair, stop, "carry 1")
+    assert v["rule"] == "reach" and v["reason"] == stop
+    bump = {"t_start": 3.0, "t_end": 3.5, "phase": "carry 1", "part": "tip", "tissue": "Phantom"}
+    obs.needle_events.append(bump | {"max_force_n": 6.0, "sustained_force_n": 5.0})
+    assert pair_verdict(obs, pair, stop, "carry 1")["rule"] == "reach"  # left behind 0.8 s before the stop
+    obs.needle_events[-1]["t_end"] = 4.27
+    v = pair_verdict(obs, pair, stop, "carry 1")
+    assert v["rule"] == "blocked-at-entry" and "pressed on Phantom (6.0 N)" in v["reason"]
+    assert "SutureTray" not in v["reason"] and v["reason"].endswith(
+        f"before the insertion (the planner stopped: {stop})"
+    )
+
+
 def test_a_tool_pressing_on_the_tissue_fails_its_pair_and_a_touch_does_not():
     from adfkit.tasks.verdicts import TOOL_HIT_N
 

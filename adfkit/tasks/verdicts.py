@@ -44,6 +44,7 @@ ON_ARC = 0.004
 SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
 SLIP_SETTLE_S = 0.25  # s a grasp is given to settle after the other arm let go
 BLOCK_N = 1.0  # N: a carried needle pressing on the tissue this hard on its way to a hole is blocked there
+STILL_TOUCHING_S = 0.1  # s: a touch that ended this near the episode's stop was still on when it stopped
 RULES = (
     "not-tried",
     "blocked-at-entry",
@@ -107,14 +108,15 @@ def _narrower_than_wire(obs, hole) -> str:
     return f"{_label(hole)}'s opening ({_mm(width)}) is narrower than the needle's wire ({_mm(2 * obs.wire_radius)})"
 
 
-def _blocked_reason(obs, k: int, entry, phase: str = "") -> tuple[str, str]:
+def _blocked_reason(obs, k: int, entry, phase: str = "", forces=None) -> tuple[str, str]:
     """What stopped the tip at entry k: the bodies the tip pressed on (else the needle) in
-    ``phase`` (the insertion), with their contact forces, and a boundary narrower than the wire."""
+    ``phase`` (the insertion), with their contact forces (``forces`` where the caller chose
+    them), and a boundary narrower than the wire."""
     phase = phase or f"insert {k}"
     label = _label(entry)
     narrow = _narrower_than_wire(obs, entry).replace(f"{label}'s opening", "; its opening", 1)
-    at_tip = getattr(obs, "tip_contacts", {}).get(phase, {})
-    forces = at_tip or obs.needle_contacts.get(phase, {})
+    at_tip = {} if forces is not None else getattr(obs, "tip_contacts", {}).get(phase, {})
+    forces = forces if forces is not None else (at_tip or obs.needle_contacts.get(phase, {}))
     if forces:
         who = "the tip" if at_tip else "the needle"
         hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forces.items(), key=lambda kv: -kv[1]) if f >= 0.05)
@@ -123,6 +125,24 @@ def _blocked_reason(obs, k: int, entry, phase: str = "") -> tuple[str, str]:
             f"nearer than {_mm(entry.closest)} to the opening{narrow}"
         )
     return "entry-missed", f"the tip never went through {label} (nearest {_mm(entry.closest)} from its opening){narrow}"
+
+
+def _met_while_carried(obs, phase: str) -> dict[str, float]:
+    """{tissue body: largest N} the carried needle (not the thread) came to press on, BLOCK_N or
+    more, in ``phase``, still touching it when the episode stopped: not the bed it was lifted
+    from (a touch that began before the carry), nor a bump it left behind. (A phantom's tray,
+    pressed with 4.7 N as the needle left it, made a joint limit reached on the way
+    "blocked at Entry1".)"""
+    path = getattr(obs, "tip_path", None)
+    stop = path[-1][0] if path else math.inf
+    out: dict[str, float] = {}
+    for e in getattr(obs, "needle_events", None) or []:
+        if e.get("part") == "thread" or e["phase"] != phase or e["max_force_n"] < BLOCK_N:
+            continue
+        if stop - e["t_end"] > STILL_TOUCHING_S:
+            continue
+        out[e["tissue"]] = max(out.get(e["tissue"], 0.0), e["max_force_n"])
+    return out
 
 
 def _crossing_fault(c: dict, hole, side: str) -> tuple[str, str] | None:
@@ -309,13 +329,10 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         return rule, reason + (f"; then the planner stopped: {failure}" if failed_here else "")
     if not ins:
         approach = f"carry {k}"
-        if (
-            failed_here
-            and failure_phase == approach
-            and any(f >= BLOCK_N for f in obs.needle_contacts.get(approach, {}).values())
-        ):
+        met = _met_while_carried(obs, approach) if failed_here and failure_phase == approach else {}
+        if met:
             # stopped on the way to the hole with the needle pressing on the tissue: what is there blocks it
-            rule, reason = _blocked_reason(obs, k, entry, approach)
+            rule, reason = _blocked_reason(obs, k, entry, approach, met)
             return rule, f"{reason}, before the insertion (the planner stopped: {failure})"
         if failed_here and not (failure_phase or "").startswith(("insert", "regrasp")):
             return "reach", failure
