@@ -41,16 +41,16 @@ def boundary_body(ghost):
 
 
 def ghost_box(ghost) -> tuple[float, float, float] | None:
-    """A hole ghost's box (x, y, z sizes, m, scaled): its shape's geometry, else its collision
+    """A hole ghost's box (x, y, z sizes, m): its shape's geometry, else its collision
     geometry, else a box of its compound collision shape (the Blender add-on writes a ghost's
-    box so); None for another shape."""
+    box so); None for another shape. AMBF 2.x does not scale primitive collision shapes by the
+    object's ``scale`` (adf-format.md §12.3), nor does the runner: neither does this."""
     g = ghost.ghost
     found = [(g.shape, g.geometry), (g.collision_shape, g.collision_geometry)]
     found += [(e.shape, e.geometry) for e in g.compound_collision_shape or []]
     for shape, geo in found:
         if geo is not None and (shape or "box").lower() == "box" and None not in (geo.x, geo.y, geo.z):
-            s = g.scale or 1.0
-            return (geo.x * s, geo.y * s, geo.z * s)
+            return (geo.x, geo.y, geo.z)
     return None
 
 
@@ -70,9 +70,10 @@ def hole_frame(world, ghost) -> np.ndarray:
 def opening_half_extents(body) -> np.ndarray:
     """Half-widths (x, y), m, of the free opening inside a hole body's boundary: per in-plane
     axis, the nearest capsule lying across that axis, less its radius. A body without
-    capsules gets DEFAULT_HALF_OPENING on both axes."""
+    capsules gets DEFAULT_HALF_OPENING on both axes. The body's ``scale`` leaves its capsules
+    as they are (AMBF 2.x scales meshes only, adf-format.md §12.3, and so does the runner: a
+    hole scaled 0.2 was read as a 1.0 mm opening that its unscaled 4.8 mm capsules do not make)."""
     half = [np.inf, np.inf]
-    scale = getattr(body, "scale", None) or 1.0
     for s in getattr(body, "compound_collision_shape", None) or []:
         if (s.shape or "").lower() != "capsule" or s.geometry is None:
             continue
@@ -85,8 +86,7 @@ def opening_half_extents(body) -> np.ndarray:
             half[1] = min(half[1], abs(off.y) - r)
         elif axis == "y":
             half[0] = min(half[0], abs(off.x) - r)
-    out = np.array([h if np.isfinite(h) else DEFAULT_HALF_OPENING for h in half]) * scale
-    return out
+    return np.array([h if np.isfinite(h) else DEFAULT_HALF_OPENING for h in half])
 
 
 @dataclass
