@@ -27,6 +27,21 @@ def test_opening_is_the_free_square_inside_the_boundary_capsules():
     assert opening_half_extents(entry1) == pytest.approx([0.0024, 0.0024], abs=1e-9)
 
 
+def test_a_holes_scale_leaves_its_capsules_and_its_ghost_as_they_collide():
+    """AMBF 2.x scales a body's meshes, never its primitive collision shapes (adf-format.md
+    §12.3), and the runner builds them so: a hole body and its ghost at scale 0.2 keep their
+    4.8 mm opening and 5 mm box (read before as 1.0 mm, "narrower than the wire", and 1 mm)."""
+    import dataclasses
+
+    from adfkit.scenes.suturing.phantom import hole_ghost
+    from adfkit.tasks.holes import ghost_box
+
+    entry1 = next(b for b in build_phantom().bodies if b.name == "Entry1")
+    assert opening_half_extents(dataclasses.replace(entry1, scale=0.2)) == pytest.approx([0.0024, 0.0024], abs=1e-9)
+    ghost = dataclasses.replace(hole_ghost("Entry", 1), scale=0.2)
+    assert ghost_box(SimpleNamespace(ghost=ghost)) == pytest.approx((0.005, 0.005, 0.00045))
+
+
 def test_a_crossing_outside_the_opening_is_measured_and_backwards_is_not_tip_first():
     half = np.array([0.0024, 0.0024])
     at, outside = plane_crossing(np.array([0.001, 0.0, 0.001]), np.array([0.001, 0.0, -0.001]), half)
@@ -115,6 +130,33 @@ def test_verdict_rules_on_exact_records():
         *_record(_c(5.0, True), _c(8.0, False), slips=[{"phase": "pull 1", "t": 10.0, "arm": "psm2", "slip_m": 0.005}])
     )
     assert v["rule"] == "slip" and "5.0 mm" in v["reason"] and "pull 1" in v["reason"]
+
+
+def test_a_ghost_smaller_than_its_hole_is_aimed_past_and_said_so():
+    """The planner aims through a hole's opening (as far in as its ghost reaches, or its
+    capsules' opening where that is wider: a 1 mm ghost had it bite 14 mm at the holes' centres
+    and the wrist reached its limit in carry 1); the tip that then passes beside the small ghost
+    fails with the ghost's size against the opening, not "0.0 mm off the hole"."""
+    from adfkit.model import Geometry, Ghost
+    from adfkit.scenes.suturing.phantom import hole_ghost
+    from adfkit.tasks.suture import _in_plane_room
+
+    entry1 = next(b for b in build_phantom().bodies if b.name == "Entry1")
+    on = lambda g: SimpleNamespace(ghost=g, parent=SimpleNamespace(body=entry1))  # noqa: E731
+    assert _in_plane_room(on(hole_ghost("Entry", 1)), None) == pytest.approx(0.0025)  # the bundled 5 mm ghost
+    small = Ghost(
+        identifier="GHOST ghostEntry1", name="ghostEntry1", shape="Box", geometry=Geometry(x=0.001, y=0.001, z=0.0002)
+    )
+    assert _in_plane_room(on(small), None) == pytest.approx(0.0024)  # the opening: 4.8 mm
+    assert _in_plane_room(SimpleNamespace(ghost=small, parent=None), None) == pytest.approx(0.0005)  # no capsules
+    obs, pair = _record(dict(_c(5.0, True, ghost=False), at_mm=[1.6, 0.0]), _c(8.0, False))
+    obs.holes[0].ghost = SimpleNamespace(ghost=small)
+    v = pair_verdict(obs, pair)
+    assert v["rule"] == "entry-ghost-off-hole"
+    assert v["reason"].startswith("the tip went through ghostEntry1's opening 1.6 mm from its centre but not through")
+    assert "the ghost (1.0 × 1.0 mm) covers less than the opening (4.8 × 4.8 mm)" in v["reason"]
+    obs.holes[0].ghost_offset = 0.005  # a ghost of any size moved off its hole: where it is
+    assert "whose centre is 5.0 mm off the hole" in pair_verdict(obs, pair)["reason"]
 
 
 def test_a_tip_pushed_back_out_of_the_entry_is_blocked_or_has_left_the_boundary():

@@ -37,7 +37,7 @@ from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError 
     GraspChoice,
     SutureError,
 )
-from .holes import ghost_box, hole_frame, hole_name
+from .holes import boundary_body, ghost_box, hole_frame, hole_name, opening_half_extents
 from .motions import Motions, interpolate, smooth
 from .needle import fit_needle, obj_vertices, wire_radius
 from .roles import body_roles
@@ -84,9 +84,14 @@ def _rot_z(a: float) -> np.ndarray:
 
 
 def _in_plane_room(ghost, direction) -> float:
-    """How far from its centre a hole ghost reaches along ``direction`` (in its plane)."""
+    """How far from its centre the tip may go through a hole: as far as its ghost reaches in its
+    plane, or its boundary's opening where that is wider (a ghost smaller than the opening made
+    the planner bite 14 mm at the holes' centres, and the wrist reached its limit on the way;
+    the verdict then says the tip missed the ghost)."""
     box = ghost_box(ghost)
-    return min(box[0], box[1]) / 2 if box is not None else 0.0
+    room = min(box[0], box[1]) / 2 if box is not None else 0.0
+    b = boundary_body(ghost)
+    return max(room, float(min(opening_half_extents(b.body)))) if b is not None else room
 
 
 def hole_ghosts(world) -> dict[int, dict]:

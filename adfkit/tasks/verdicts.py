@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 
+from .holes import ghost_box
+
 #: N: a tool pressing on the tissue at least this hard, held over 20 ms (a touch's
 #: sustained_force_n: the mean of five control steps less the largest), fails the pair. Every
 #: touch is recorded (metrics' tool_tissue_events, each pair's tool_tissue_max_n); a jaw brushing
@@ -145,6 +147,14 @@ def _met_while_carried(obs, phase: str) -> dict[str, float]:
     return out
 
 
+def _ghost_box(ghost) -> tuple[float, float, float] | None:
+    """A hole ghost's box (holes.ghost_box), None where it has none or is not a scene's ghost."""
+    try:
+        return ghost_box(ghost)
+    except AttributeError:
+        return None
+
+
 def _crossing_fault(c: dict, hole, side: str) -> tuple[str, str] | None:
     if c["outside_opening_m"] > 0:
         return f"{side}-outside-opening", (
@@ -155,6 +165,16 @@ def _crossing_fault(c: dict, hole, side: str) -> tuple[str, str] | None:
         return f"{side}-not-tip-first", f"the needle went through {_label(hole)} backwards (tail first)"
     if not c["ghost_overlap"]:
         g = hole.ghost.ghost
+        box = _ghost_box(hole.ghost)
+        half = getattr(hole, "half", None)
+        if box is not None and half is not None and min(box[:2]) < 2 * float(min(half)) and hole.ghost_offset < 5e-4:
+            return f"{side}-ghost-off-hole", (
+                f"the tip went through {_label(hole)}'s opening {math.hypot(*c['at_mm']):.1f} mm from its centre "
+                f"but not through its ghost {g.name or g.identifier}: the ghost ({box[0] * 1000:.1f} × "
+                f"{box[1] * 1000:.1f} mm) covers less than the opening ({2 * half[0] * 1000:.1f} × "
+                f"{2 * half[1] * 1000:.1f} mm), and no friction holds the needle beside it; make the ghost "
+                "as large as the opening"
+            )
         return f"{side}-ghost-off-hole", (
             f"the tip went through {_label(hole)}'s opening but not through its ghost "
             f"{g.name or g.identifier}, whose centre is {_mm(hole.ghost_offset)} off "
