@@ -241,6 +241,70 @@ def test_a_good_phantom_passes_every_pair(tmp_path, name):
     assert len(m["pairs"]) == FAMILY[name]["pairs"] and m["swept_arc_check"] == {}
 
 
+def _solid(doc):
+    """The ridge's gaps filled: holes drilled into nothing."""
+    from suture_phantoms import _box
+
+    phantom = next(b for b in doc.bodies if b.name == "Phantom")
+    phantom.compound_collision_shape.append(
+        _box((-L.RIDGE_HALF_X, -0.03, L.SLAB[2]), (L.RIDGE_HALF_X, 0.03, L.RIDGE_TOP))
+    )
+
+
+def _mesh_collision(doc):
+    """No collision primitives: the body collides as its mesh, a concave triangle mesh for a
+    static body (AMBF's default collision mesh type; the runner plays it as its triangles)."""
+    next(b for b in doc.bodies if b.name == "Phantom").compound_collision_shape = None
+
+
+def _small_ghosts(doc):
+    from adfkit.model import Geometry
+
+    for g in doc.ghost_objects:
+        g.geometry = g.collision_geometry = Geometry(x=0.001, y=0.001, z=0.0002)
+
+
+def _scaled_holes(doc):
+    for obj in [b for b in doc.bodies if b.name.startswith(("Entry", "Exit"))] + list(doc.ghost_objects):
+        obj.scale = 0.2
+
+
+#: a modeller's phantom, changed one way, and pair 1's verdict and what its reason says (seed 0)
+ODD = {
+    # the driver's jaws, closing round the wire on the tray, held 56 N on it: tool-hit-tissue on
+    # SutureTray in the pick-up, before the needle met the filled channel
+    "holes into solid tissue": (_solid, "blocked-at-entry", "blocked at Entry1"),
+    # the same 56 N on the tray failed it; its channels are free in its triangles
+    "tissue colliding as its mesh": (_mesh_collision, None, None),
+    # aimed at the ghosts' centres, a 14 mm bite: the wrist reached its limit in carry 1
+    "1 mm ghosts": (_small_ghosts, "entry-ghost-off-hole", "the ghost (1.0 × 1.0 mm) covers less than the opening"),
+    # read as 1.0 mm openings and 1 mm ghosts: the same 14 mm bite, `reach` in carry 1
+    "holes scaled 0.2": (_scaled_holes, None, None),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(ODD))
+def test_a_phantom_made_another_way_gets_the_verdict_its_physics_earns(tmp_path, name):
+    from adfkit.tasks.episode import run_episode
+
+    change, rule, said = ODD[name]
+    path = phantom_file(tmp_path, pairs=2, spacing=0.012)
+    doc, _ = read_file(path, "model")
+    change(doc)
+    write_file(doc, path)
+    m = run_episode(BUNDLED / "launch.yaml", pairs=[1], seed=0, progress=False, gif=False, phantom=path)
+    (p,) = m["pairs"]
+    assert p["rule"] == rule and p["passed"] == (rule is None), (p["rule"], p["reason"])
+    assert said is None or said in p["reason"]
+    assert not [e for e in m["tool_tissue_events"] if e["phase"] == "pick up" and e["sustained_force_n"] >= 20.0]
+    if change is _mesh_collision:  # the check before the run reads the mesh as its hull, and says so
+        assert (
+            "(read as the convex hull of Phantom's collision mesh, which AMBF and PyBullet collide as its triangles"
+            in (m["swept_arc_check"]["1"] if "1" in m["swept_arc_check"] else m["swept_arc_check"][1])
+        )
+
+
 def test_a_pair_out_of_the_arms_reach_is_named_with_how_far(tmp_path):
     """Two pairs 170 mm apart: the arms, placed for their centre, reach neither; the plan says
     which hole, which joint and by how much, before anything moves."""

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..runner.psm import PSM
+from ..runner.psm import JAW_OPEN, PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
 from .grasping import BACK_OFF, JAW_APPROACH, JAW_DEPTH, ROLL, Grasp, SutureError
@@ -172,7 +172,7 @@ class Motions:
         self.holder = name
         self.held_ee_in_needle = invert(self.needle_pose()) @ ee
         psm.servo_jaw(0.0)
-        yield from self.wait(0.15)
+        yield from self.closing(psm, 0.15)
 
     def _touch(self, psm: PSM) -> tuple[list, set[int]]:
         """What a guard watches: the arm's links and the tissue (roles.py) they may press on."""
@@ -195,6 +195,18 @@ class Motions:
             if self._pressing(*touch):  # the finger that got least far decides where both stop
                 fingers = self.world.joint_state(psm.art, psm.jaws)[0]
                 psm.servo_jaw(max(0.0, 2 * float(min(fingers)) - GUARD_JAW_BACK))
+
+    def closing(self, psm: PSM, seconds: float):
+        """Wait ``seconds`` while the jaws close on the held needle; while they press on the
+        tissue with GUARD_N they open back to GUARD_JAW_BACK more than the finger that got least
+        far, as the opening does (the actuator holds the needle either way). On a phantom's tray
+        the driver's fingers, closing round the wire in its slot, pressed on it with 56 N held."""
+        touch = self._touch(psm)
+        for _ in range(self._steps(seconds)):
+            yield self.phase
+            if self._pressing(*touch):
+                fingers = self.world.joint_state(psm.art, psm.jaws)[0]
+                psm.servo_jaw(min(JAW_OPEN, 2 * float(max(fingers)) + GUARD_JAW_BACK))
 
     def let_go(self, name: str, holder: str | None = None):
         """``name`` releases the needle and backs off. ``holder``, the arm that keeps it, is then

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.semantics import concave_mesh
 from .clearance import Tissue
 from .grasping import SutureError
 from .holes import boundary_body, hole_frame, hole_label, opening_half_extents
@@ -75,6 +76,8 @@ class Block:
     width_m: float | None  # the channel's width across the needle's plane where narrowest, when the centre line is free
     wire_m: float  # the wire's thickness
     opening_m: float | None = None  # the body's opening, when it is one of the pair's holes
+    #: the body collides as a concave triangle mesh, read here as the convex hull of each piece
+    hulled_mesh: bool = False
 
     def text(self, entry: str, exit_: str) -> str:
         a, b = self.start_m * 1000, self.end_m * 1000
@@ -102,11 +105,23 @@ class Block:
             if inside > 0
             else f"{self.depth_m * 1000:.1f} mm into the {self.wire_m * 1000:.2f} mm wire"
         )
-        return f"{self.body} lies in the needle's path between {entry} and {exit_} ({span}): {how}"
+        said = f"{self.body} lies in the needle's path between {entry} and {exit_} ({span}): {how}"
+        if self.hulled_mesh:  # a static mesh AMBF and PyBullet collide as its triangles
+            said += (
+                f" (read as the convex hull of {self.body}'s collision mesh, which AMBF and PyBullet collide as "
+                "its triangles, and MuJoCo as its hull: give it collision primitives to be checked as it collides)"
+            )
+        return said
 
 
 def _per_body(task) -> list[tuple[str, Tissue]]:
     return [(sb.name, Tissue([sb])) for sb in task.roles.tissue]
+
+
+def _hulled(task) -> set[str]:
+    """The tissue bodies read as hulls of a mesh the engines keep concave (static: AMBF's
+    default collision mesh type)."""
+    return {sb.name for sb in task.roles.tissue if sb.static and concave_mesh(sb.body)}
 
 
 def arc_blocks(task, pair, wire_r: float, bodies: list[tuple[str, Tissue]]) -> list[Block]:
@@ -167,6 +182,7 @@ def check(task, wire_r: float) -> dict[int, str]:
     """Per pair, what the swept arc and the surface at its holes show, in words (pairs with
     nothing to say are absent)."""
     bodies = _per_body(task)
+    hulled = _hulled(task)
     hole_bodies = {id(boundary_body(g) or g.parent) for p in task.pairs for g in (p.entry, p.exit)}
     surface = Tissue([sb for sb in task.roles.tissue if id(sb) not in hole_bodies])
     out: dict[int, str] = {}
@@ -188,6 +204,7 @@ def check(task, wire_r: float) -> dict[int, str]:
             hole = next((b for g in (pair.entry, pair.exit) if (b := boundary_body(g)) and b.name == blk.body), None)
             if hole is not None:
                 blk.opening_m = 2 * float(min(opening_half_extents(hole.body)))
+            blk.hulled_mesh = blk.body in hulled
         notes += [blk.text(entry, exit_) for blk in blocks]
         if notes:
             out[pair.index] = "; ".join(dict.fromkeys(notes))
