@@ -54,9 +54,9 @@ class LinkDamping:
             local = np.einsum("nji,nj->ni", rot, ang)
             torque = np.einsum("nij,nj->ni", rot, k_ang * local)
             force = k_lin[:, None] * lin
-            for n, link in enumerate(links):
-                push(uid, link, force[n].tolist(), pos[n].tolist(), cid)
-                twist(uid, link, torque[n].tolist(), cid)
+            for link, f, at, t in zip(links, force.tolist(), pos.tolist(), torque.tolist()):  # each row's floats
+                push(uid, link, f, at, cid)
+                twist(uid, link, t, cid)
 
 
 def _states(uid: int, links: list[int], cid: int, read: dict):
