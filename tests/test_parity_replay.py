@@ -264,3 +264,73 @@ def test_undoing_what_ambfs_ghost_did_to_a_cube_lets_it_fall_through_the_slab(tm
     monkeypatch.setenv("ADFKIT_PARITY_UNGHOST", "ghost/cube linear angular gravity")
     z_cube, z_twin_again = heights()
     assert z_cube == pytest.approx(z_twin, abs=1e-3) and z_twin_again == pytest.approx(z_twin, abs=1e-6)
+
+
+def _parity_args(*extra: str):
+    from adfkit.cli import build_parser
+
+    return build_parser().parse_args(["parity", "--suture", *extra])
+
+
+def test_the_suture_is_recorded_under_the_options_the_user_names():
+    """`adfkit parity --suture` records under the suture's own Options (those `adfkit suture`
+    plays: implicit springs, PyBullet's bodies, hole friction, shapes about the links' centres of
+    mass, a 4 ms control step, 50 solver iterations) unless the user names others; what they name
+    and nothing else changes."""
+    from adfkit.commands.parity import recording_options
+    from adfkit.runner import Options
+    from adfkit.tasks.episode import SOLVER_ITERATIONS
+
+    own = suture.record_options(recording_options(_parity_args()))
+    plain = Options()
+    assert [getattr(own, k) for k in suture.RECORD_OPTIONS] == [getattr(plain, k) for k in suture.RECORD_OPTIONS]
+    assert own.solver_iterations == SOLVER_ITERATIONS
+    named = suture.record_options(recording_options(_parity_args("--springs", "ambf", "--link-shapes", "body")))
+    assert (named.springs, named.link_shapes) == ("ambf", "body")
+    assert (named.bodies, named.ghosts, named.control_substeps) == (plain.bodies, plain.ghosts, plain.control_substeps)
+    every = recording_options(
+        _parity_args("--bodies", "ambf", "--ghosts", "ambf", "--control-substeps", "1", "--springs", "implicit")
+    )
+    assert every == {
+        "springs": "implicit",
+        "bodies": "ambf",
+        "ghosts": "ambf",
+        "link_shapes": None,
+        "control_substeps": 1,
+    }
+    with pytest.raises(ValueError, match="not solver_iterations"):
+        suture.record_options({"solver_iterations": 10})
+
+
+def _needle_after(world, seconds: float) -> tuple[float, float]:
+    """How far (m) and through what angle (deg) the needle has moved from where it started."""
+    needle = next(sb for sb in world.bodies if sb.key.endswith("Needle"))
+    m0 = needle.world_matrix().copy()
+    while world.sim_time < seconds - 1e-9:
+        world.step(1)
+    m = needle.world_matrix()
+    turn = np.clip((np.trace(m0[:3, :3].T @ m[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)
+    return float(np.linalg.norm(m[:3, 3] - m0[:3, 3])), float(np.degrees(np.arccos(turn)))
+
+
+def test_the_recording_world_plays_the_springs_the_user_names(tmp_path):
+    """The springy-holes copy lays its thread's first joint bent 15.4°: in the suture's own world
+    (implicit springs over the 4 ms control step) the joint straightens within 20 ms and throws the
+    needle 2.3 mm and 8°; recorded under AMBF's springs (explicit at every 1 ms step) the needle
+    moves 0.4 mm (AMBF's: 0.73 mm, turned 1.4°). The world the recording is made in is the one
+    that plays what was named."""
+    import subprocess
+    import sys
+
+    subprocess.run([sys.executable, str(ROOT / "bench" / "springy_holes.py"), str(tmp_path)], check=True)
+    launch = tmp_path / "launch.yaml"
+    moved = {}
+    for springs in ("implicit", "ambf"):
+        world = suture.recording_world(launch, None, {"springs": springs})
+        try:
+            assert world.opt.springs == springs and world.opt.solver_iterations == 50
+            moved[springs] = _needle_after(world, 0.02)
+        finally:
+            world.close()
+    assert moved["implicit"][0] > 0.002 and moved["implicit"][1] > 7.0
+    assert moved["ambf"][0] < 0.001 and moved["ambf"][1] < 7.0

@@ -44,31 +44,36 @@ def add_arguments(p) -> None:
         "--control-substeps",
         type=int,
         help="adfkit's physics steps per control step (default 4, as adfkit run; 1 with a command file "
-        "that drives joints: AMBF applies joint commands at every 1 ms step)",
+        "that drives joints: AMBF applies joint commands at every 1 ms step; --suture: the suture's 4)",
     )
     p.add_argument(
         "--ghosts",
         choices=("ambf", "hole-friction"),
-        default="ambf",
         help="what adfkit's ghosts do (default ambf: AMBF's own ghost objects, gravity off and 10 %% of "
         "the velocity taken per contact point and step; hole-friction: the suture's rule, the paper's "
-        "F = -K·v in hole ghosts)",
+        "F = -K·v in hole ghosts, the default with --suture)",
     )
     p.add_argument(
         "--springs",
         choices=("ambf", "implicit"),
-        default="ambf",
         help="how adfkit's PyBullet runner plays six-dof springs (default ambf: as AMBF's Bullet, explicit "
-        "at every physics step with its caps; implicit: backward Euler over the control step, the suture's)",
+        "at every physics step with its caps; implicit: backward Euler over the control step, the suture's "
+        "and the default with --suture)",
     )
     p.add_argument(
         "--bodies",
         choices=("ambf", "pybullet"),
-        default="ambf",
         help="what adfkit's PyBullet bodies are: ambf (default; AMBF's btRigidBodies: AMBF's estimated inertia, "
         "the box of the collision shape's bounds, where the file gives none, and joints as fast as "
         "AMBF's bodies may turn, π/4 a physics step) or pybullet (PyBullet's estimate and its "
-        "multibody's 100 rad/s joint cap: the suture's)",
+        "multibody's 100 rad/s joint cap: the suture's, and the default with --suture)",
+    )
+    p.add_argument(
+        "--link-shapes",
+        choices=("body", "com"),
+        help="where adfkit's PyBullet runner puts a multibody link's collision shapes: body (default; where "
+        "the file puts them, as AMBF) or com (about the link's centre of mass: the suture's, and the default "
+        "with --suture)",
     )
     p.add_argument("--no-ground", action="store_true", help="a model file: no floor under it on either side")
     p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")
@@ -127,9 +132,10 @@ def run(args) -> int:
         commands=Path(args.commands) if args.commands else None,
         control_substeps=args.control_substeps,  # None: session.Request decides
         ground=not args.no_ground,
-        ghosts=args.ghosts,
-        springs=args.springs,
-        bodies=args.bodies,
+        ghosts=args.ghosts or "ambf",
+        springs=args.springs or "ambf",
+        bodies=args.bodies or "ambf",
+        link_shapes=args.link_shapes or "body",
         tolerance_m=args.tolerance_mm / 1e3,
         tolerance_deg=args.tolerance_deg,
     )
@@ -183,6 +189,8 @@ def _suture(args) -> int:
         progress=not args.json,
         paces=paces,
         follow=follow,
+        # what the user names; the rest the suture's own, which its acceptance was run on
+        options=recording_options(args),
     )
     if args.json:
         print(dumps(out, indent=1))
@@ -193,6 +201,7 @@ def _suture(args) -> int:
             f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF {how} "
             f"({out['commands']} commands)"
         )
+        print("  recorded with " + ", ".join(f"{k} {v}" for k, v in out["recorded_with"].items()))
         for p in out["pairs"]:
             gap = p["tip_path_gap_m"]
             print(
@@ -225,3 +234,15 @@ def _suture(args) -> int:
         w = out["wall_s"]
         print(f"  stepping: adfkit {w['adfkit']:.1f} s (the whole episode), AMBF {w['ambf']:.1f} s")
     return 0 if out["same_verdicts"] else 1
+
+
+def recording_options(args) -> dict:
+    """The Options ``--suture`` records adfkit's suture under, as the user named them
+    (``--springs``, ``--bodies``, ``--ghosts``, ``--link-shapes``, ``--control-substeps``)."""
+    return {
+        "springs": args.springs,
+        "bodies": args.bodies,
+        "ghosts": args.ghosts,
+        "link_shapes": args.link_shapes,
+        "control_substeps": args.control_substeps,
+    }

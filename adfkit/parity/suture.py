@@ -85,6 +85,7 @@ class Recording:
     grasps: list[tuple[float, str, str | None]] = field(default_factory=list)  # (t, arm, body or None)
     tools: dict[str, str] = field(default_factory=dict)  # arm -> the AMBF name of the body its actuator is on
     wall_s: float = 0.0
+    options: dict = field(default_factory=dict)  # the Options adfkit's suture was recorded under (RECORD_OPTIONS)
 
     def commands_for(self, follow: str) -> list[ambf.Command]:
         """The commands a replay plays: ``commands``, the set-points (no ``follow`` lines);
@@ -210,18 +211,51 @@ def _name(obj) -> str:
     return ambf_name(obj.key, inner)
 
 
-def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False, measured: bool = False) -> Recording:
+#: the Options a recording may be made under (``record``'s ``options``); what it is not given is the
+#: suture's own (``Options()``'s, which ``adfkit suture`` plays and was accepted on)
+RECORD_OPTIONS = ("springs", "bodies", "ghosts", "link_shapes", "control_substeps")
+
+
+def record_options(options: dict | None = None):
+    """The runner's Options a suture is recorded under: the suture's own (``adfkit suture``'s:
+    50 solver iterations, the rest ``Options()``'s), with ``options`` (keys of ``RECORD_OPTIONS``,
+    None values left out) in their place."""
+    from ..runner import Options
+    from ..tasks.episode import SOLVER_ITERATIONS
+
+    given = {k: v for k, v in (options or {}).items() if v is not None}
+    unknown = sorted(set(given) - set(RECORD_OPTIONS))
+    if unknown:
+        raise ValueError(f"a suture is recorded under {', '.join(RECORD_OPTIONS)}, not {', '.join(unknown)}")
+    return Options(renderer="tiny", visuals=False, solver_iterations=SOLVER_ITERATIONS, **given)
+
+
+def recording_world(launch: Path, indices, options: dict | None = None):
+    """The PyBullet world a suture is recorded in: the scene under ``record_options(options)``."""
+    from ..adf import load_scene
+    from ..runner import open_world
+
+    return open_world(load_scene(Path(launch), indices), record_options(options))
+
+
+def record(
+    launch: Path,
+    indices,
+    pairs,
+    seed: int = 0,
+    progress: bool = False,
+    measured: bool = False,
+    options: dict | None = None,
+) -> Recording:
     """Play adfkit's scripted suture (PyBullet) and record it for AMBF (with ``measured``, its
-    PSM joints' measured paths too)."""
+    PSM joints' measured paths too), under the suture's own Options or, where ``options`` names
+    them, those (``record_options``)."""
     import time
 
-    from ..adf import load_scene
-    from ..runner import Options, open_world
-    from ..tasks.episode import SOLVER_ITERATIONS, play_task
+    from ..tasks.episode import play_task
     from ..tasks.suture import SutureError, SutureTask
 
-    scene = load_scene(Path(launch), indices)
-    world = open_world(scene, Options(renderer="tiny", visuals=False, solver_iterations=SOLVER_ITERATIONS))
+    world = recording_world(launch, indices, options)
     try:
         try:
             task = SutureTask(world, list(pairs), seed=seed)
@@ -273,6 +307,7 @@ def record(launch: Path, indices, pairs, seed: int = 0, progress: bool = False, 
             grasps=rec.grasps,
             tools=tools,
             wall_s=wall,
+            options={k: getattr(world.opt, k) for k in RECORD_OPTIONS},
         )
     finally:
         world.close()
@@ -599,11 +634,14 @@ def compare_suture(
     progress: bool = False,
     paces: tuple[Pace | None, ...] = (None,),
     follow: str = "measured",
+    options: dict | None = None,
 ) -> dict:
-    """The suture in adfkit and replayed in AMBF (as ``replay_modes(paces, follow)`` lists, the
-    first judged against adfkit's verdicts), judged alike: the issue's JSON."""
+    """The suture in adfkit, recorded under ``options`` (``record``), and replayed in AMBF (as
+    ``replay_modes(paces, follow)`` lists, the first judged against adfkit's verdicts), judged
+    alike: the issue's JSON."""
     modes = replay_modes(paces, follow)
-    rec = record(launch, indices, pairs, seed, progress, measured=any(f == "measured" for _, f in modes))
+    measured = any(f == "measured" for _, f in modes)
+    rec = record(launch, indices, pairs, seed, progress, measured=measured, options=options)
     return compare_recorded(rec, launch, indices, build, modes) | {"scene": str(launch), "seed": seed}
 
 
@@ -634,6 +672,7 @@ def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuil
         out.append(row)
     return {
         "seconds": rec.seconds,
+        "recorded_with": dict(rec.options),
         "commands": len(rec.commands_for(first.follow)),
         "follow": first.follow,
         "pairs": out,
