@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from ..runner.rotations import invert, matrix_to_quat
+from .contact_forces import contacts_among
 from .holes import (
     DEFAULT_HALF_OPENING,
     boundary_body,
@@ -210,7 +211,7 @@ class SutureObserver:
         to_arc = None
         per_touch: dict[tuple, list] = {}  # key -> [summed force, strongest contact's force, its point, element]
         needle_per_body: dict[str, float] = {}
-        for tb, other, f, at in self.world.contacts_among(self.tissue):
+        for tb, other, f, at in contacts_among(self.world, self.tissue):
             who = self._whom.get(id(other))
             if who is None:
                 continue

@@ -9,6 +9,7 @@ import numpy as np
 from ..runner.psm import JAW_OPEN, PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
+from .contact_forces import contacts_among
 from .grasping import BACK_OFF, JAW_APPROACH, JAW_DEPTH, ROLL, Grasp, SutureError
 
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
@@ -180,7 +181,7 @@ class Motions:
 
     def _pressing(self, links: list, tissue: set[int]) -> bool:
         """One of ``links`` presses on the tissue with GUARD_N or more (after the last step)."""
-        return any(f >= GUARD_N for _, o, f, _ in self.world.contacts_among(links) if id(o) in tissue)
+        return any(f >= GUARD_N for _, o, f, _ in contacts_among(self.world, links) if id(o) in tissue)
 
     def opening(self, psm: PSM, seconds: float):
         """Wait ``seconds`` while the jaws open; while they press on the tissue with GUARD_N they
