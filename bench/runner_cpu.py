@@ -192,13 +192,22 @@ def _name(key) -> str:
 
 def profile(scene, rules: dict, seconds: float) -> None:
     from adfkit.runner import open_world
+    from adfkit.runner.pybullet import held
 
     world = open_world(scene, options(rules), engine="pybullet")
+    replay, replayed = held.replay, [0]
+
+    def counted(cid: int) -> None:  # held.replay's calls go through starmap, which cProfile does not see
+        replayed[0] += len(held._recording.get(cid, ()))
+        replay(cid)
+
+    held.replay = counted
     try:
         n = int(round(seconds / (world.dt * world.opt.control_substeps)))
         prof = cProfile.Profile(time.process_time)  # CPU time: a loaded machine's waits left out
         prof.runcall(world.step, n)
     finally:
+        held.replay = replay
         world.close()
     st = pstats.Stats(prof)
     total = sum(v[3] for k, v in st.stats.items() if _name(k).endswith("world.py:step"))
@@ -214,6 +223,7 @@ def profile(scene, rules: dict, seconds: float) -> None:
     if springs.joints:
         hidden = len(springs._twisted[0]) + (len(springs._pushed[1]) if springs.free_lin.size else 0)
     calls += hidden * sum(v[1] for k, v in st.stats.items() if _name(k).endswith("spring_forces.py:apply"))
+    calls += replayed[0]
     print(f"    PyBullet calls: {calls} ({calls / n:.0f} a control step)")
 
 
