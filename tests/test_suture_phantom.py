@@ -180,7 +180,8 @@ def test_a_broken_set_of_holes_is_refused_with_what_to_fix(tmp_path, capsys):
     """Exit 2 and the reason, never a suture of what is left: hole bodies without ghosts; a pair
     with one hole (Entry3 without Exit3 was dropped and pairs 1-2 passed, exit 0); two ghosts on
     one hole; a file in millimetres (positions 1000 times too large: it failed as `reach`, "entry
-    and exit of pair 1 are 13996.6 mm apart")."""
+    and exit of pair 1 are 13996.6 mm apart"); a body named as one the bundled scene keeps (its
+    own CameraFrame: the stereo camera found no parent and stayed where the bundled scene has it)."""
     from adfkit.cli import main
 
     def broken(name, fn, pairs=3):
@@ -217,6 +218,13 @@ def test_a_broken_set_of_holes_is_refused_with_what_to_fix(tmp_path, capsys):
             b.location = type(b.location)(type(p)(p.x * 1000, p.y * 1000, p.z * 1000), b.location.orientation)
 
     refused(broken("mm", millimetres), "Entry1 and Exit1 are 14.0 m apart", "is the file in millimetres (14.0 mm)?")
+
+    def camera_frame(d):  # as the challenge's phantom files carry one: the cameras lost their parent
+        from adfkit.model import Body, Pose
+
+        d.bodies.append(Body(identifier="BODY CameraFrame", name="CameraFrame", mass=0.0, location=Pose()))
+
+    refused(broken("camera", camera_frame), "has a body named CameraFrame", "the stereo camera hangs from it")
 
 
 # ---- the good family, played (slow) ----------------------------------------------------------

@@ -292,6 +292,16 @@ def compose(bundled: Scene, phantom: ModelFile) -> Composed:
             f"the phantom file has its own {own[0]}: --phantom puts a phantom beside the bundled needle "
             "and thread; export the phantom's bodies alone, or play your whole scene (adfkit suture SCENE)"
         )
+    kept = {b.name for m in bundled.models for b in m.bodies if not BUNDLED_TISSUE.match(b.name or "")}
+    clash = sorted({b.name for b in phantom.bodies if b.name in kept})
+    if clash:
+        # the bundled scene's cameras hang from its CameraFrame: beside a second one they found no
+        # parent and stayed where the bundled scene has them, whatever the placement
+        raise PhantomError(
+            f"the phantom file has a body named {clash[0]}, as a body of the bundled scene that --phantom keeps "
+            f"({'the stereo camera hangs from it' if clash[0] == 'CameraFrame' else 'the arms, the needle or the camera'}): "
+            "export the phantom's tissue and hole bodies alone, or rename it"
+        )
     check_holes(holes, phantom)
     t = placement(holes)
     scene = copy.deepcopy(bundled)
