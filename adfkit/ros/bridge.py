@@ -20,13 +20,15 @@ import time
 
 import numpy as np
 
-from ..runner.joint_commands import JointCommands
+from ..model.semantics import JointKind
+from ..runner.joint_commands import DRIVEN_KINDS, JointCommands
 from ..runner.rotations import invert, matrix_to_quat, pose_matrix
 from .env import publisher
 from .guard import TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY, body_cmd_fault, pose_fault
 from .objects import RosObject, ros_objects, topic_of, world_namespace
 
 WATCHDOG_S = 0.5  # ambf_comm's time out for every object (ObjectCommPlugin, WorldCommPlugin)
+MOTORS = (JointKind.REVOLUTE, JointKind.PRISMATIC)  # the joints a position or velocity command moves
 #: AMBF's default Cartesian controller without a `controller` block: P 10 (D 1), output a velocity.
 #: Its D term is left out: on a velocity output, D 1 makes v_k = P·e_k − v_(k−1), a loop with an
 #: eigenvalue of −1/(1 − P·dt) (−1.005 at 1 kHz), so a free body under a pose command swings ever
@@ -174,6 +176,16 @@ class BodyHandler(Handler):
                     f'WARNING! FOR JOINT "{entry.name}" COMMAND TYPE {kind} NOT UNDERSTOOD, SUPPORTED TYPES ARE'
                     " 0 -> FORCE, 1 -> POSITION, 2 -> VELOCITY"
                 )  # AMBF's words (ObjectCommPlugin.cpp), said once
+                continue
+            if entry.kind not in (MOTORS if kind != TYPE_FORCE else DRIVEN_KINDS):
+                # afJoint::commandPosition/Velocity move a hinge or a slider, commandEffort also a
+                # spring; any other joint (fixed, p2p, cone twist, six dof) AMBF leaves as it is
+                if value != 0.0 or kind != TYPE_FORCE:  # the zero efforts ambf_client pads with: silent
+                    what = {TYPE_FORCE: "effort", TYPE_POSITION: "position", TYPE_VELOCITY: "velocity"}[kind]
+                    self.bridge.note(
+                        f"{self.obj.topic}: joint {entry.name} is a {entry.kind.value} joint, which AMBF moves"
+                        f" by no {what} command; ignored"
+                    )
                 continue
             if entry.art is None:
                 self.bridge.note(

@@ -1,0 +1,103 @@
+"""A body whose joint list (AMBF's, by index) holds a fixed joint inside the multibody, as the
+corpus's puzzle2 does: a command on that index (an ambf_client script that sets every joint,
+or the zero efforts ambf_client pads the list with before the index it sets) is one AMBF leaves
+alone. Before, `adfkit ros` stopped on it (ValueError: not a revolute, prismatic or spring joint
+of an articulation); now it is ignored, said once, and the hinge beside it still moves."""
+
+from __future__ import annotations
+
+import pytest
+import ros_support as rs
+
+pytest.importorskip("pybullet")
+
+MODEL = """namespace: /ambf/env/
+bodies: [BODY base, BODY arm, BODY tip]
+joints: [JOINT base-arm, JOINT arm-tip]
+BODY base:
+  name: base
+  mass: 0.0
+  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.1, y: 0.1, z: 0.1}
+  shape: BOX
+  geometry: {x: 0.1, y: 0.1, z: 0.1}
+BODY arm:
+  name: arm
+  mass: 1.0
+  inertia: {ix: 1.0e-3, iy: 1.0e-3, iz: 1.0e-3}
+  location: {position: {x: 0.1, y: 0.0, z: 0.2}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.2, y: 0.05, z: 0.05}
+  shape: BOX
+  geometry: {x: 0.2, y: 0.05, z: 0.05}
+BODY tip:
+  name: tip
+  mass: 0.1
+  inertia: {ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}
+  location: {position: {x: 0.25, y: 0.0, z: 0.2}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.05, y: 0.05, z: 0.05}
+  shape: BOX
+  geometry: {x: 0.05, y: 0.05, z: 0.05}
+JOINT base-arm:
+  name: base-arm
+  parent: BODY base
+  child: BODY arm
+  parent axis: {x: 0.0, y: 0.0, z: 1.0}
+  parent pivot: {x: 0.0, y: 0.0, z: 0.2}
+  child axis: {x: 0.0, y: 0.0, z: 1.0}
+  child pivot: {x: -0.1, y: 0.0, z: 0.0}
+  joint limits: {low: -1.5, high: 1.5}
+  type: revolute
+JOINT arm-tip:
+  name: arm-tip
+  parent: BODY arm
+  child: BODY tip
+  parent axis: {x: 0.0, y: 0.0, z: 1.0}
+  parent pivot: {x: 0.15, y: 0.0, z: 0.0}
+  child axis: {x: 0.0, y: 0.0, z: 1.0}
+  child pivot: {x: 0.0, y: 0.0, z: 0.0}
+  type: fixed
+"""
+
+
+def test_commands_on_a_fixed_joint_are_ignored_and_the_hinge_still_moves(tmp_path):
+    rs.require_client()
+    paths = rs.ambf_client(tmp_path / "ambf")
+    model = tmp_path / "arm.yaml"
+    model.write_text(MODEL)
+    master = rs.Master()
+    try:
+        server = rs.Server(master, model)
+        try:
+            out = rs.run_client(
+                master,
+                paths,
+                """
+                import json, time
+                from ambf_client import Client
+                c = Client("t_fixed"); c.connect(); time.sleep(0.3)
+                base = c.get_obj_handle("/ambf/env/base"); time.sleep(0.5)
+                names = list(base.get_joint_names())
+                for k in range(len(names)):  # every joint of the list, the fixed one too
+                    base.set_joint_vel(k, 0.2)
+                time.sleep(0.5)
+                base.set_joint_effort(1, 0.5); time.sleep(0.3)
+                base.set_joint_pos(0, 0.4)
+                t = time.time()
+                while time.time() - t < 10 and abs(base.get_joint_pos(0) - 0.4) > 2e-3:
+                    time.sleep(0.05)
+                print(json.dumps({"names": names, "q": base.get_all_joint_pos()}))
+                """,
+            )
+            alive = server.proc.poll() is None
+        finally:
+            err = server.close()
+    finally:
+        master.close()
+    assert alive and "Traceback" not in err, err
+    assert out["names"] == ["base-arm", "arm-tip"]
+    assert abs(out["q"][0] - 0.4) < 5e-3
+    assert "joint arm-tip is a fixed joint, which AMBF moves by no velocity command; ignored" in err
+    assert "joint arm-tip is a fixed joint, which AMBF moves by no effort command; ignored" in err
