@@ -101,3 +101,48 @@ def test_commands_on_a_fixed_joint_are_ignored_and_the_hinge_still_moves(tmp_pat
     assert abs(out["q"][0] - 0.4) < 5e-3
     assert "joint arm-tip is a fixed joint, which AMBF moves by no velocity command; ignored" in err
     assert "joint arm-tip is a fixed joint, which AMBF moves by no effort command; ignored" in err
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_twist_moves_a_static_multibody_root_with_its_links(tmp_path, engine):
+    """AMBF moves a static body by a twist command, v·dt a step (its COM frame), whatever hangs
+    from it following through the joints. Before, the root of a multibody (the arm's base here,
+    a PSM's base in the suturing scene) did not move in the MuJoCo engine, which said that a
+    twist moves free bodies only (PyBullet moved it by the base's velocity)."""
+    pytest.importorskip(engine)
+    rs.require_client()
+    paths = rs.ambf_client(tmp_path / "ambf")
+    model = tmp_path / "arm.yaml"
+    model.write_text(MODEL)
+    master = rs.Master()
+    try:
+        server = rs.Server(master, model, "--engine", engine)
+        try:
+            out = rs.run_client(
+                master,
+                paths,
+                """
+                import json, time
+                from ambf_client import Client
+                c = Client("t_twist"); c.connect(); time.sleep(0.3)
+                base = c.get_obj_handle("/ambf/env/base"); tip = c.get_obj_handle("/ambf/env/tip")
+                w = c.get_world_handle(); time.sleep(0.5)
+                def pos(h):
+                    p = h.get_pos(); return [p.x, p.y, p.z]
+                b0, t0, s0 = pos(base), pos(tip), w._state.sim_step
+                while w._state.sim_step - s0 < 1000:  # 1 s of simulated time at 0.05 m/s along y
+                    base.set_linear_vel(0.0, 0.05, 0.0); time.sleep(0.02)
+                base.set_linear_vel(0.0, 0.0, 0.0); time.sleep(0.3)
+                print(json.dumps({"b0": b0, "t0": t0, "b1": pos(base), "t1": pos(tip),
+                                  "steps": w._state.sim_step - s0}))
+                """,
+            )
+        finally:
+            err = server.close()
+    finally:
+        master.close()
+    assert "Traceback" not in err, err
+    moved = out["b1"][1] - out["b0"][1]
+    assert 0.045 < moved < 0.07, out  # 0.05 m/s for the ~1 s of steps the commands held
+    assert abs(out["b1"][0] - out["b0"][0]) < 1e-3 and abs(out["b1"][2] - out["b0"][2]) < 1e-3
+    assert abs((out["t1"][1] - out["t0"][1]) - moved) < 5e-3  # the arm came along

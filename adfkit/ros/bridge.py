@@ -224,15 +224,20 @@ class BodyHandler(Handler):
         lin = np.array([twist.linear.x, twist.linear.y, twist.linear.z])
         ang = np.array([twist.angular.x, twist.angular.y, twist.angular.z])
         sb = self.sb
-        if sb.static and hasattr(w, "place_body") and sb.articulation is None:
+        if sb.static:  # AMBF moves a static body's COM frame by the twist each step (a multibody's root too)
             from ..runner.rotations import rotation_exp
 
-            t = sb.world_matrix()
+            c = sb.world_matrix() @ sb.com_in_body
             cdt = w.dt * w.opt.control_substeps
-            t[:3, 3] += lin * cdt
-            t[:3, :3] = rotation_exp(ang * cdt) @ t[:3, :3]
-            w.place_body(sb, t)
-            return
+            c[:3, 3] += lin * cdt
+            c[:3, :3] = rotation_exp(ang * cdt) @ c[:3, :3]
+            t = c @ invert(sb.com_in_body)
+            if hasattr(w, "place_body") and sb.articulation is None:
+                w.place_body(sb, t)
+                return
+            if sb.articulation is not None and hasattr(w, "move_base"):
+                w.move_base(sb, t)
+                return
         self._set_velocity(w, lin, ang)
 
     def _set_velocity(self, w, lin, ang) -> None:
