@@ -337,13 +337,10 @@ def test_the_recording_world_plays_the_springs_the_user_names(tmp_path):
 
 
 def test_the_suture_reads_contact_forces_alike_however_the_world_steps():
-    """The bundled needle at rest on the phantom: where the control step is one stepSimulation of
-    four physics steps (the suture's own world) PyBullet reports a quarter of the force (1.34 N of
-    the needle's 4.9 N weight, the rest on its thread); stepped one by one (AMBF's springs) the
-    whole (5.35 N). The suture's rules and guards read both as the first, on which its limits
-    were set (a tool pressing 20 N, the needle 40 N)."""
-    from adfkit.tasks import contact_forces
-
+    """The bundled needle at rest on the phantom presses on it with the same newtons (5.3 N of
+    its 4.9 N weight and its thread's share) whether a control step is one stepSimulation of
+    four physics steps (the suture's own world, where PyBullet reports a quarter of the force,
+    multiplied back by physics_steps_a_call) or they are stepped one by one (AMBF's springs)."""
     read = {}
     for springs in ("implicit", "ambf"):
         world = suture.recording_world(ROOT / "sample_scenes" / "suturing" / "launch.yaml", None, {"springs": springs})
@@ -351,13 +348,9 @@ def test_the_suture_reads_contact_forces_alike_however_the_world_steps():
             needle = next(sb for sb in world.bodies if sb.key.endswith("Needle"))
             while world.sim_time < 0.2 - 1e-9:
                 world.step(1)
-            raw = sum(f for _, _, f, _ in world.contacts_among([needle]))
-            found = contact_forces.contacts_among(world, [needle])
-            read[springs] = (world.contact_force_scale, raw, sum(f for _, _, f, _ in found))
+            read[springs] = (world.physics_steps_a_call, sum(f for _, _, f, _ in world.contacts_among([needle])))
         finally:
             world.close()
-    assert read["implicit"][0] == 1.0 and read["implicit"][1] == read["implicit"][2]
-    assert read["ambf"][0] == 0.25
-    assert read["ambf"][1] == pytest.approx(4 * read["implicit"][1], rel=0.05)
-    assert read["ambf"][2] == pytest.approx(read["implicit"][2], rel=0.05)
-    assert read["implicit"][2] > 1.0  # the needle lies on the phantom: a test of forces, not of zeros
+    assert read["implicit"][0] == 4 and read["ambf"][0] == 1
+    assert read["ambf"][1] == pytest.approx(read["implicit"][1], rel=0.05)
+    assert read["implicit"][1] > 4.0  # the needle lies on the phantom: a test of forces, not of zeros

@@ -212,19 +212,20 @@ def test_corpus_set_hole_bodies_are_tissue_to_the_observer():
 
 def _corpus_through(pairs: list[int], seed: int) -> dict:
     """A corpus-set episode, checked: every pair passed from the physics, the needle never
-    pressed on the tissue from the first insertion on (it used to, with up to 128 N, through
-    PyBullet's 1 mm hull margins), no tool pressed on it, nothing slipped."""
+    pressed on the tissue from the first insertion on (it used to, with up to 512 N, through
+    PyBullet's 1 mm hull margins), no tool pressed on it, nothing slipped (PyBullet's newtons:
+    its limits are 4x MuJoCo's, tasks/contact_forces.py)."""
     from adfkit.tasks.episode import run_episode
 
     m = run_episode(CORPUS / "src" / "launch.yaml", "6-11", pairs, seed=seed, out=None, progress=False, gif=False)
     assert m["failure"] is None, m["failure"]
     assert [p["passed"] for p in m["pairs"]] == [True] * len(pairs), [(p["pair"], p["reason"]) for p in m["pairs"]]
     inside = [ph for ph in m["needle_tissue_contact_n"] if ph.split()[0] in ("insert", "regrasp", "pull", "hand")]
-    assert max((f for ph in inside for f in m["needle_tissue_contact_n"][ph].values()), default=0.0) < 5.0
+    assert max((f for ph in inside for f in m["needle_tissue_contact_n"][ph].values()), default=0.0) < 20.0
     assert (
-        m["tip_tissue_contact_n"] == {} or max(f for d in m["tip_tissue_contact_n"].values() for f in d.values()) < 5.0
+        m["tip_tissue_contact_n"] == {} or max(f for d in m["tip_tissue_contact_n"].values() for f in d.values()) < 20.0
     )
-    assert max((e["max_force_n"] for e in m["tool_tissue_events"]), default=0.0) < 5.0  # a touch at most
+    assert max((e["max_force_n"] for e in m["tool_tissue_events"]), default=0.0) < 20.0  # a touch at most
     assert m["slips"] == []
     assert m["max_constraint_error_m"] < 1e-3
     return m

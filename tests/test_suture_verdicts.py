@@ -212,9 +212,11 @@ def test_the_needle_or_thread_forced_on_the_tissue_fails_where_it_was_forced():
     """Any part of the needle, or the thread, pressing on a tissue body with FORCED_N held, in
     any phase of the pair, fails it; the rule and the reason say where along the needle's arc
     (at the entry, in the channel, at the exit, or elsewhere), with what and how hard."""
-    from adfkit.tasks.verdicts import FORCED_N
+    from adfkit.tasks.verdicts import FORCED_N, THREAD_FORCED_N, force_limits
 
-    assert FORCED_N == 40.0
+    # MuJoCo's limits; PyBullet's records carry theirs, 4x in newtons (tasks/contact_forces.py)
+    assert (FORCED_N, THREAD_FORCED_N) == (40.0, 1000.0)
+    assert (force_limits(4.0)["forced_n"], force_limits(4.0)["thread_forced_n"]) == (160.0, 4000.0)
     obs, pair = _record(_c(5.0, True), _c(8.0, False))
     arc = {"past_entry_m": 0.0063, "before_exit_m": 0.005, "off_arc_m": 0.0004, "from_tip_m": 0.0086}
     obs.needle_events = [dict(_pressed(**arc), over_limit=None)]  # touched, never held FORCED_N
@@ -322,9 +324,11 @@ def test_a_planner_stopped_while_carrying_is_blocked_only_by_what_the_carried_ne
 
 
 def test_a_tool_pressing_on_the_tissue_fails_its_pair_and_a_touch_does_not():
-    from adfkit.tasks.verdicts import TOOL_HIT_N
+    """A tool holding TOOL_HIT_N on the tissue fails its pair: 50 N in MuJoCo (and in a record
+    that carries no limits), 200 N in PyBullet's newtons (its records carry force_limits)."""
+    from adfkit.tasks.verdicts import TOOL_HIT_N, force_limits
 
-    assert TOOL_HIT_N == 50.0
+    assert TOOL_HIT_N == 50.0 and force_limits(4.0)["tool_hit_n"] == 200.0
     touch = {"phase": "regrasp 1", "arm": "psm1", "link": "tool gripper1 simple", "tissue": "Exit1", "t_start": 10.7}
     obs, pair = _record(_c(5.0, True), _c(8.0, False))
     obs.tool_events = [dict(touch, max_force_n=20.3, sustained_force_n=4.1)]
@@ -332,6 +336,13 @@ def test_a_tool_pressing_on_the_tissue_fails_its_pair_and_a_touch_does_not():
     # a one-step spike as a guarded approach stops is a touch; the same force held is a hit
     obs.tool_events = [dict(touch, max_force_n=57.7, sustained_force_n=11.5)]
     assert pair_verdict(obs, pair)["passed"]
+    obs.tool_events = [dict(touch, max_force_n=150.0, sustained_force_n=120.0)]
+    assert pair_verdict(obs, pair)["rule"] == "tool-hit-tissue"  # no limits recorded: 50 N
+    obs.force_limits = force_limits(4.0)  # PyBullet's record: 200 N
+    assert pair_verdict(obs, pair)["passed"]
+    obs.tool_events = [dict(touch, max_force_n=250.0, sustained_force_n=200.0)]
+    assert pair_verdict(obs, pair)["rule"] == "tool-hit-tissue"
+    del obs.force_limits
     held = dict(touch, max_force_n=15943.9, sustained_force_n=12011.0, link="tool pitch link simple", tissue="Phantom")
     obs.tool_events = [held]
     v = pair_verdict(obs, pair)

@@ -1,20 +1,21 @@
-"""The contact forces the suture reads (its force rules, tasks/metrics.py, and its guards,
-tasks/motions.py), in the reading its limits were set and accepted on: PyBullet's where a control
-step is one stepSimulation of four 1 ms physics steps, which reports the last physics step's
-impulse over the whole 4 ms, a quarter of the force (``contact_force_scale`` of the PyBullet
-world). A world that steps its physics steps one by one (AMBF's springs, ghosts or bodies, the
-Options ``adfkit parity --suture`` may record under) reports the whole force; read as it is, the
-needle lying on the corpus phantom pressed with 5.3 N there against 1.3 N, and the pick-up's
-grasp with 45-67 N against 11-17 N, past the suture's 40 N (``pressed-on-tissue``). MuJoCo
-reports the force as it is and is read so."""
+"""The suture's force limits in the newtons of the engine it runs in.
+
+Every world reports a contact's normal force in newtons (``contacts``, ``contacts_among``;
+PyBullet's reading multiplied back by the physics steps a stepSimulation split into,
+``PyBulletWorld.physics_steps_a_call``). The suture's limits (``verdicts.force_limits``,
+``motions.GUARD_N``) were set on each engine's measured runs: MuJoCo's in newtons, PyBullet's on
+its reading at the default ``control_substeps`` (4), a quarter of the force. In newtons
+PyBullet's are therefore 4x the figures written there (a tool pressing 200 N fails a pair, the
+needle 160 N). The factor is a power of two, so the scaled forces and limits compare exactly as
+the readings and the written figures did."""
 
 from __future__ import annotations
 
+#: the suture's limits in an engine's newtons, as a multiple of the figures written in verdicts.py
+#: and motions.py (an engine not named: 1)
+LIMIT_SCALE = {"pybullet": 4.0}
 
-def contacts_among(world, bodies) -> list:
-    """``world.contacts_among(bodies)``, each force in the suture's reading."""
-    found = world.contacts_among(bodies)
-    scale = getattr(world, "contact_force_scale", 1.0)
-    if scale == 1.0:
-        return found
-    return [(sb, other, f * scale, at) for sb, other, f, at in found]
+
+def limit_scale(world) -> float:
+    """What the suture's written force limits are multiplied by in ``world``'s newtons."""
+    return LIMIT_SCALE.get(getattr(world, "engine", "") or "", 1.0)

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..runner.rotations import invert, matrix_to_quat
-from .contact_forces import contacts_among
+from .contact_forces import limit_scale
 from .holes import (
     DEFAULT_HALF_OPENING,
     boundary_body,
@@ -25,10 +25,11 @@ from .holes import (
 )
 from .needle import wire_radius
 from .roles import task_roles
-from .verdicts import FORCED_N, SLIP_LIMIT, SLIP_SETTLE_S, THREAD_FORCED_N, TOOL_HIT_N, pair_verdict, phase_pair
+from .verdicts import SLIP_LIMIT, SLIP_SETTLE_S, force_limits, pair_verdict, phase_pair
 
-TOOL_TOUCH_N = 0.05  # N: a tool-tissue contact at least this strong is recorded as an event
-NEEDLE_EVENT_N = 1.0  # N: a needle's or thread's touch this strong at its peak is written in the metrics
+#: N: a needle's or thread's touch this strong at its peak is written in the metrics (times the
+#: engine's limit scale, contact_forces.py, as the verdicts' limits: force_limits_n in the metrics)
+NEEDLE_EVENT_N = 1.0
 SUSTAIN_STEPS = 5  # control steps (20 ms at 250 Hz) over which a touch's force is held (sustained_force_n)
 NEAR_HOLE = 0.005  # m: a crossing of a hole's plane farther than this beside its opening is not an attempt at it
 TIP_CONTACT = 0.002  # m: a contact this near the tip is the tip's
@@ -74,6 +75,10 @@ class SutureObserver:
     def __init__(self, task, error_every: int = 10, drift_every: int = 5) -> None:
         self.task, self.world = task, task.world
         self.error_every, self.drift_every = error_every, drift_every
+        # the force limits in this engine's newtons (contact_forces.py), which the verdicts read here
+        scale = limit_scale(self.world)
+        self.force_limits = force_limits(scale)
+        self.needle_event_n = NEEDLE_EVENT_N * scale
         self.n = 0
         self.tip_path: list[list[float]] = []  # [t, x, y, z]
         self.max_constraint_error = 0.0
@@ -211,7 +216,7 @@ class SutureObserver:
         to_arc = None
         per_touch: dict[tuple, list] = {}  # key -> [summed force, strongest contact's force, its point, element]
         needle_per_body: dict[str, float] = {}
-        for tb, other, f, at in contacts_among(self.world, self.tissue):
+        for tb, other, f, at in self.world.contacts_among(self.tissue):
             who = self._whom.get(id(other))
             if who is None:
                 continue
@@ -242,8 +247,9 @@ class SutureObserver:
                 d = self.thread_contacts.setdefault(phase, {})
                 d[n] = max(d.get(n, 0.0), f)
         touching = set()
+        touch = self.force_limits["touch_n"]
         for key, (f, _, at, what) in per_touch.items():
-            if f < TOOL_TOUCH_N:
+            if f < touch:
                 continue
             touching.add(key)
             self._touch(key, t, phase, f, at, what, needle_pose)
@@ -276,7 +282,8 @@ class SutureObserver:
                 ev["at_peak"] = self._where(key, phase, at, what, needle_pose)
         held = self._held(key, f)
         ev["sustained_force_n"] = max(ev["sustained_force_n"], held)
-        limit = {"tool": TOOL_HIT_N, "thread": THREAD_FORCED_N}.get(key[0], FORCED_N)
+        lim = self.force_limits
+        limit = {"tool": lim["tool_hit_n"], "thread": lim["thread_forced_n"]}.get(key[0], lim["forced_n"])
         if limit is not None and held >= limit and "over_limit" not in ev:
             ev["over_limit"] = {"t": t, "phase": phase, "force_n": held}
             if key[0] != "tool":
@@ -433,14 +440,16 @@ class SutureObserver:
             "grasp_drift_by_phase_m": self.drift_by_phase,
             "grasp_drift_one_arm_by_phase_m": self.one_arm_drift_by_phase,
             "slip_limit_m": SLIP_LIMIT,
+            # the force limits the touches were recorded and judged by, in this engine's newtons
+            "force_limits_n": {**self.force_limits, "needle_event_n": self.needle_event_n},
             "switched_off": list(getattr(self.task, "switched_off", [])),
             "slips": self.slips,
             "tool_tissue_events": self.tool_events,
             "needle_tissue_contact_n": self.needle_contacts,
             "tip_tissue_contact_n": self.tip_contacts,
             "thread_tissue_contact_n": self.thread_contacts,
-            # the needle's and the thread's touches of 1 N or more (lighter ones: lying on the tissue)
-            "needle_tissue_events": [e for e in self.needle_events if e["max_force_n"] >= NEEDLE_EVENT_N],
+            # the needle's and the thread's touches of needle_event_n or more (lighter ones: lying on the tissue)
+            "needle_tissue_events": [e for e in self.needle_events if e["max_force_n"] >= self.needle_event_n],
             "joint_angle_error_by_phase_deg": {k: float(np.degrees(a)) for k, a in self.angle_by_phase.items()},
             "needle_wire_radius_m": self.wire_radius,
             # what the check of the needle's swept arc before the run found, per pair (sweep.py)

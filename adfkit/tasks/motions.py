@@ -9,11 +9,13 @@ import numpy as np
 from ..runner.psm import JAW_OPEN, PSM
 from ..runner.psm_kinematics import JointLimitError
 from ..runner.rotations import invert, rotation_exp, rotation_log
-from .contact_forces import contacts_among
+from .contact_forces import limit_scale
 from .grasping import BACK_OFF, JAW_APPROACH, JAW_DEPTH, ROLL, Grasp, SutureError
 
 CLIP_TOLERANCE = 0.15  # rad (m for the insertion) a set-point may pass a limit and be clipped
-GUARD_N = 20.0  # N: a tool coming onto the needle stops where it presses on the tissue this hard ...
+#: N (times the engine's limit scale, contact_forces.py): a tool coming onto the needle stops
+#: where it presses on the tissue this hard ...
+GUARD_N = 20.0
 GUARD_BACK = 0.0005  # m ... and draws back this far the way it came
 #: rad the jaws close back from the finger that got least far, while they press on the tissue as
 #: they open (0.05 rad a finger, 0.4 mm at its middle: at 0.02 the finger stayed on the boundary
@@ -181,7 +183,8 @@ class Motions:
 
     def _pressing(self, links: list, tissue: set[int]) -> bool:
         """One of ``links`` presses on the tissue with GUARD_N or more (after the last step)."""
-        return any(f >= GUARD_N for _, o, f, _ in contacts_among(self.world, links) if id(o) in tissue)
+        guard = GUARD_N * limit_scale(self.world)
+        return any(f >= guard for _, o, f, _ in self.world.contacts_among(links) if id(o) in tissue)
 
     def opening(self, psm: PSM, seconds: float):
         """Wait ``seconds`` while the jaws open; while they press on the tissue with GUARD_N they

@@ -11,6 +11,9 @@ reached every pose of the pair. The first rule broken is the verdict's ``rule`` 
 
 The verdict reads only what the observer recorded (contacts of the needle, the thread and the
 tools with the tissue bodies, with forces and points, and the needle's poses), never an engine.
+The forces are in the newtons of the engine that took the record, and the limits they are held
+to are the record's own (``force_limits``: those its observer held it to, per engine,
+tasks/contact_forces.py); a record without them is read with the figures below.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ ON_ARC = 0.004
 SLIP_LIMIT = 0.002  # m the needle may move in the grasp while one arm holds it
 SLIP_SETTLE_S = 0.25  # s a grasp is given to settle after the other arm let go
 BLOCK_N = 1.0  # N: a carried needle pressing on the tissue this hard on its way to a hole is blocked there
+TOUCH_N = 0.05  # N: a contact at least this strong is a touch (recorded as an event, named in a reason)
 STILL_TOUCHING_S = 0.1  # s: a touch that ended this near the episode's stop was still on when it stopped
 RULES = (
     "not-tried",
@@ -68,6 +72,23 @@ RULES = (
     "thread-not-through",
     "slip",
 )
+
+
+def force_limits(scale: float = 1.0) -> dict[str, float | None]:
+    """The force limits above, in N, each times ``scale`` (an engine's, contact_forces.limit_scale)."""
+    written = {
+        "tool_hit_n": TOOL_HIT_N,
+        "forced_n": FORCED_N,
+        "thread_forced_n": THREAD_FORCED_N,
+        "block_n": BLOCK_N,
+        "touch_n": TOUCH_N,
+    }
+    return {k: None if v is None else v * scale for k, v in written.items()}
+
+
+def limits_of(obs) -> dict[str, float | None]:
+    """The force limits ``obs`` was taken with (its ``force_limits``), else the figures above."""
+    return getattr(obs, "force_limits", None) or force_limits()
 
 
 def _mm(m: float) -> str:
@@ -121,7 +142,8 @@ def _blocked_reason(obs, k: int, entry, phase: str = "", forces=None) -> tuple[s
     forces = forces if forces is not None else (at_tip or obs.needle_contacts.get(phase, {}))
     if forces:
         who = "the tip" if at_tip else "the needle"
-        hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forces.items(), key=lambda kv: -kv[1]) if f >= 0.05)
+        touch = limits_of(obs)["touch_n"]
+        hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(forces.items(), key=lambda kv: -kv[1]) if f >= touch)
         return "blocked-at-entry", (
             f"blocked at {label}: {who} pressed on {hits or 'the tissue'} and came no "
             f"nearer than {_mm(entry.closest)} to the opening{narrow}"
@@ -137,9 +159,10 @@ def _met_while_carried(obs, phase: str) -> dict[str, float]:
     "blocked at Entry1".)"""
     path = getattr(obs, "tip_path", None)
     stop = path[-1][0] if path else math.inf
+    block = limits_of(obs)["block_n"]
     out: dict[str, float] = {}
     for e in getattr(obs, "needle_events", None) or []:
-        if e.get("part") == "thread" or e["phase"] != phase or e["max_force_n"] < BLOCK_N:
+        if e.get("part") == "thread" or e["phase"] != phase or e["max_force_n"] < block:
             continue
         if stop - e["t_end"] > STILL_TOUCHING_S:
             continue
@@ -303,13 +326,14 @@ def _forced(obs, k: int, first: bool, entry, exit_) -> tuple[float, str, str] | 
 
 def _tool_hit(obs, k: int, first: bool) -> tuple[float, str, str] | None:
     """The first touch of a tool in pair k's phases that held TOOL_HIT_N or more on the tissue."""
-    if TOOL_HIT_N is None:
+    limit = limits_of(obs)["tool_hit_n"]
+    if limit is None:
         return None
     hits = []
     for e in obs.tool_events:
         over = e.get("over_limit")
         pressed = e.get("sustained_force_n", e["max_force_n"])
-        if over is None and pressed >= TOOL_HIT_N:  # recorded without the moment (older records)
+        if over is None and pressed >= limit:  # recorded without the moment (older records)
             over = {"t": e["t_start"], "phase": e["phase"], "force_n": pressed}
         if over is not None and in_pair(over["phase"], k, first):
             hits.append((over["t"], e, over))
@@ -372,7 +396,8 @@ def _judge(obs, pair, failure: str | None, failure_phase: str | None, first: boo
         return fault
     outs = [c for c in outs_all if c["t"] > c_in["t"]]
     back = _back_out(entry.crossings, c_in["t"], outs[0]["t"] if outs else math.inf)
-    at_tip = {b: f for b, f in getattr(obs, "tip_contacts", {}).get(f"insert {k}", {}).items() if f >= 0.05}
+    touch = limits_of(obs)["touch_n"]
+    at_tip = {b: f for b, f in getattr(obs, "tip_contacts", {}).get(f"insert {k}", {}).items() if f >= touch}
     if back and at_tip:
         # in through the opening and pushed back out by what the tip ran into: the channel is closed
         hits = ", ".join(f"{b} ({f:.1f} N)" for b, f in sorted(at_tip.items(), key=lambda kv: -kv[1]))

@@ -346,6 +346,7 @@ class Interaction:
 
     def contacts_among(self, bodies) -> list:
         """As World.contacts_among, one getContactPoints a multibody (all its links at once)."""
+        per_call = float(self.physics_steps_a_call)  # the force in newtons (physics_steps_a_call)
         wanted: dict[int, dict[int, SimBody]] = {}
         for sb in bodies:
             for link in sb.links:
@@ -361,11 +362,13 @@ class Interaction:
                 sb = links.get(c[3])
                 other = lookup.get((c[2], c[4]))
                 if sb is not None and other is not None and other is not sb:
-                    out.append((sb, other, float(c[9]), c[5]))
+                    out.append((sb, other, float(c[9]) * per_call, c[5]))
         return out
 
     def contacts(self, sb: SimBody) -> list:
-        """[(other SimBody, normal force N, world point)] of the contacts ``sb`` has after the last step."""
+        """[(other SimBody, normal force N, world point)] of the contacts ``sb`` has after the last
+        step: PyBullet's reading times the physics steps the step split into (physics_steps_a_call)."""
+        per_call = float(self.physics_steps_a_call)
         out = []
         query = {"bodyA": sb.uid, "physicsClientId": self.cid}
         if not sb.piece_links:
@@ -375,5 +378,5 @@ class Interaction:
                 continue
             other = self._lookup.get((c[2], c[4]))
             if other is not None and other is not sb:
-                out.append((other, float(c[9]), c[5]))
+                out.append((other, float(c[9]) * per_call, c[5]))
         return out

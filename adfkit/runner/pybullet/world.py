@@ -211,14 +211,13 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
             self.parting()
 
     @property
-    def contact_force_scale(self) -> float:
-        """What a contact's normal force read after a step (``contacts``) is multiplied by to read
-        as where the control step is one stepSimulation of ``control_substeps`` physics steps (the
-        default): PyBullet reports the last physics step's impulse over the stepSimulation's
-        time, the whole control step there (a quarter of the force at 4 substeps: a 1 kg box at
-        rest reads 2.45 N) and one physics step where the world steps them one by one (AMBF's
-        springs, ghosts or stops: 9.81 N)."""
-        return 1.0 / self.opt.control_substeps if self._each_step else 1.0
+    def physics_steps_a_call(self) -> int:
+        """The physics steps each stepSimulation splits into: ``control_substeps`` where a control
+        step is one call (the default), 1 where the world steps them one by one (AMBF's springs,
+        ghosts or stops). PyBullet reports a contact's normal force as the last physics step's
+        impulse over the call's whole time, a 1/``physics_steps_a_call`` share of it (a 1 kg box
+        at rest reads 2.45 N at 4 substeps): ``contacts`` multiplies it back to newtons."""
+        return 1 if self._each_step else self.opt.control_substeps
 
     def _state_now(self, sb) -> tuple:
         """SimBody.state() of ``sb`` as this control step read it (the springs' free bodies, the damped
