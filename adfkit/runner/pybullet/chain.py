@@ -99,7 +99,10 @@ class ChainModel:
 
 def _contact_pushes(uid: int, cid: int) -> list[tuple[int, np.ndarray, np.ndarray]]:
     """(body index, force, point) of every contact on the multibody ``uid`` in the last step:
-    the normal force and both friction forces, on each of its links a contact touches."""
+    the normal force and both friction forces, on each of its links a contact touches. The chain
+    steps only where each stepSimulation is one physics step (control_substeps 1, or the stops
+    stepping them one by one), where PyBullet's reading is the force in newtons
+    (``PyBulletWorld.physics_steps_a_call`` is 1 there)."""
     out = []
     for c in pb.getContactPoints(bodyA=uid, physicsClientId=cid):
         force = c[9] * np.asarray(c[7]) + c[10] * np.asarray(c[11]) + c[12] * np.asarray(c[13])
