@@ -38,7 +38,8 @@ def add_arguments(p) -> None:
         "--commands",
         metavar="FILE",
         help="drive both sides: lines `TIME, KIND, TARGET[, VALUE]`, KIND position|velocity|effort "
-        "(a joint) or grasp|release (a constraint actuator; grasp names the body)",
+        "(a joint), grasp|release (a constraint actuator; grasp names the body) or pose (a free body, "
+        "VALUE `x y z roll pitch yaw` or `x y z qx qy qz qw`)",
     )
     p.add_argument(
         "--control-substeps",

@@ -144,7 +144,7 @@ def plugin_library(build: AmbfBuild) -> Path:
 @dataclass
 class Command:
     """One line of the plugin's command file: at ``t`` seconds, ``kind`` (position, velocity,
-    effort, grasp, release, place, force, collide; follow: a point of a joint's path) on
+    effort, grasp, release, place, force, pose, collide; follow: a point of a joint's path) on
     ``target`` (a joint's, an actuator's or a body's AMBF name) with ``value`` (a joint
     command's, a path point's position; a collide's 0 or 1), ``body`` (a grasp's or a collide's
     other body) or ``numbers``."""
@@ -154,10 +154,10 @@ class Command:
     target: str
     value: float = 0.0
     body: str = ""
-    numbers: tuple = ()  # place: the body frame (x y z qx qy qz qw); force: (fx fy fz px py pz) in the world
+    numbers: tuple = ()  # place, pose: the body frame (x y z qx qy qz qw); force: (fx fy fz px py pz) in the world
 
     def line(self) -> str:
-        if self.kind in ("place", "force"):
+        if self.kind in ("place", "force", "pose"):
             arg = " ".join(repr(float(v)) for v in self.numbers)
         elif self.kind == "collide":
             arg = f"{self.body} {int(self.value)}"

@@ -6,19 +6,24 @@ TIME in simulated seconds; KIND ``position``, ``velocity`` or ``effort`` (TARGET
 the command: rad, rad/s, N·m, or m, m/s, N for a prismatic joint), ``grasp`` (TARGET a constraint
 actuator, VALUE the body it fixes) or ``release`` (TARGET an actuator). Names are AMBF's (namespace
 and `name`, spaces removed) or any unique end of one (``psm1/baselink-yawlink``, ``base link-yaw
-link`` when only one model has it). ``#`` starts a comment. A joint command holds until the
-joint's next command, as AMBF holds the last command it received."""
+link`` when only one model has it), or ``pose`` (TARGET a free body, VALUE ``x y z`` and a
+quaternion ``qx qy qz qw`` or ``roll pitch yaw``, space-separated: its body frame's pose, steered
+there each step as AMBF's ROS plugin steers a body under a pose command). ``#`` starts a
+comment. A joint's or a body's command holds until its next command, as AMBF holds the last
+command it received."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from .. import inputs
 from ..diagnostics import AdfError, SourceLocation, error
+from ..model.pose import Quat, rpy_to_quat
 from .ambf import Command
 
 JOINT_KINDS = ("position", "velocity", "effort")
-KINDS = JOINT_KINDS + ("grasp", "release")
+KINDS = JOINT_KINDS + ("grasp", "release", "pose")
 
 
 def read(path: str | Path) -> list[tuple[Command, SourceLocation]]:
@@ -59,8 +64,26 @@ def read(path: str | Path) -> list[tuple[Command, SourceLocation]]:
                 raise AdfError(error("command-syntax", f"value {fields[3]} is not finite", where, hint))
         elif kind == "grasp":
             cmd.body = fields[3]
+        elif kind == "pose":
+            cmd.numbers = _pose(fields[3], where)
         out.append((cmd, where))
     return out
+
+
+def _pose(text: str, where: SourceLocation) -> tuple:
+    """A pose command's body frame, (x, y, z, qx, qy, qz, qw), from x y z and a quaternion or
+    roll pitch yaw (fixed-axis X-Y-Z, as ADF's ``rpy``)."""
+    hint = "e.g. `0.0, pose, Box, 0.2 0 1 0.1 0 0.3` (x y z roll pitch yaw) or `... 0.2 0 1 0 0 0 1` (qx qy qz qw)"
+    try:
+        n = [float(v) for v in text.split()]
+    except ValueError:
+        raise AdfError(error("command-syntax", f"pose {text!r} is not numbers", where, hint)) from None
+    if len(n) not in (6, 7) or not all(math.isfinite(v) for v in n):
+        raise AdfError(error("command-syntax", f"a pose is 6 or 7 finite numbers, not {text!r}", where, hint))
+    q = rpy_to_quat(*n[3:]) if len(n) == 6 else Quat(*n[3:])
+    if abs(math.hypot(*q) - 1.0) > 1e-3:
+        raise AdfError(error("command-syntax", f"the quaternion of {text!r} is not of unit length", where, hint))
+    return (*n[:3], *q)
 
 
 def resolve(text: str, names: list[str], what: str, where: SourceLocation | None) -> str:
@@ -92,8 +115,8 @@ def resolved(commands: list[tuple[Command, SourceLocation]], made: dict[str, lis
     """The commands with their targets as AMBF names of what adfkit built (``made``)."""
     out = []
     for c, where in commands:
-        kind = "joint" if c.kind in JOINT_KINDS else "actuator"
-        r = Command(c.t, c.kind, resolve(c.target, made[kind], kind, where), c.value)
+        kind = "joint" if c.kind in JOINT_KINDS else "body" if c.kind == "pose" else "actuator"
+        r = Command(c.t, c.kind, resolve(c.target, made[kind], kind, where), c.value, numbers=c.numbers)
         if c.kind == "grasp":
             r.body = resolve(c.body, made["body"], "body", where)
         out.append(r)

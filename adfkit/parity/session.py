@@ -91,7 +91,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
     check(req)
     commands_read = commandfile.read(req.commands) if req.commands is not None else []
     if req.control_substeps is None:
-        drives = any(c.kind in commandfile.JOINT_KINDS for c, _ in commands_read)
+        drives = any(c.kind in commandfile.JOINT_KINDS + ("pose",) for c, _ in commands_read)
         req = replace(req, control_substeps=1 if drives else 4)
         check(req)
     diags: list[Diagnostic] = []

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..runner.names import merge_namespace
+from ..runner.rotations import AMBF_CARTESIAN_P, pose_matrix, steer_velocity
 
 #: what each side lists as created, in this order
 KINDS = ("body", "soft body", "ghost", "joint", "sensor", "actuator")
@@ -152,7 +153,9 @@ class AdfkitPlayer:
     """A scene played in an adfkit world, sampled as the AMBF plugin samples it, driven by the
     same commands: each takes effect at the first control step at or after its time (AMBF: the
     first 1 ms physics step), joint commands through runner.joint_commands as AMBF applies
-    them, grasp and release through the world's constraint actuators."""
+    them, grasp and release through the world's constraint actuators, a pose command as
+    ``adfkit ros`` steers a free body under one (AMBF's Cartesian P as a velocity, without its D:
+    docs/ros.md)."""
 
     def __init__(self, world) -> None:
         from ..runner.joint_commands import JointCommands
@@ -168,6 +171,7 @@ class AdfkitPlayer:
         }
         self.commands = JointCommands(world)
         self.per = world.dt * world.opt.control_substeps
+        self.poses: dict[str, np.ndarray] = {}  # a body's pose command, its body frame (4x4)
 
     def _activate(self, cmds, t: float) -> None:
         w = self.world
@@ -178,9 +182,17 @@ class AdfkitPlayer:
                 w.actuate(act, self.by_name["body"][c.body])
             elif c.kind == "release":
                 w.release(self.by_name["actuator"][c.target])
+            elif c.kind == "pose":
+                self.poses[c.target] = pose_matrix(c.numbers[:3], c.numbers[3:])
             else:
                 j, child = self.by_name["joint"][c.target]
                 self.commands.command(j, child, c.kind, c.value)
+
+    def _steer(self) -> None:
+        for name, goal in self.poses.items():
+            sb = self.by_name["body"][name]
+            lin, ang = steer_velocity(sb.world_matrix() @ sb.com_in_body, goal @ sb.com_in_body, AMBF_CARTESIAN_P)
+            self.world.set_body_velocity(sb, lin, ang)
 
     def _joint_values(self) -> list[float]:
         out = []
@@ -208,6 +220,7 @@ class AdfkitPlayer:
                 pending = pending[len(due) :]
                 self._activate(due, t)
             self.commands.apply(t)
+            self._steer()
             wall += time.perf_counter() - t0
             if k % k_every == 0 or k == n:
                 times.append(t)

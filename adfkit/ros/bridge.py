@@ -22,7 +22,7 @@ import numpy as np
 
 from ..model.semantics import JointKind
 from ..runner.joint_commands import DRIVEN_KINDS, JointCommands
-from ..runner.rotations import invert, matrix_to_quat, pose_matrix
+from ..runner.rotations import AMBF_CARTESIAN_P, invert, matrix_to_quat, pose_matrix, steer_velocity
 from .env import publisher
 from .guard import TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY, body_cmd_fault, pose_fault
 from .objects import RosObject, ros_objects, topic_of, world_namespace
@@ -30,11 +30,11 @@ from .objects import RosObject, ros_objects, topic_of, world_namespace
 WATCHDOG_S = 0.5  # ambf_comm's time out for every object (ObjectCommPlugin, WorldCommPlugin)
 MOTORS = (JointKind.REVOLUTE, JointKind.PRISMATIC)  # the joints a position or velocity command moves
 #: AMBF's default Cartesian controller without a `controller` block: P 10 (D 1), output a velocity.
-#: Its D term is left out: on a velocity output, D 1 makes v_k = P·e_k − v_(k−1), a loop with an
-#: eigenvalue of −1/(1 − P·dt) (−1.005 at 1 kHz), so a free body under a pose command swings ever
-#: wider (a 1 kg box told to move 0.2 m was 2.4e5 m away 4 s later); P alone closes the error by
-#: P·dt a step (0.1 s time constant), as AMBF's does between its swings.
-POSITION_GAIN = 10.0
+#: Its D term is left out: on a velocity output, with the pose AMBF reads one step behind (its motion
+#: state), D 1 makes a loop whose roots ring at 249.6 Hz and grow by 0.25 % a step at 1 kHz; measured
+#: in AMBF (`tests/test_parity_pose.py`), a 1 kg box told to move 0.23 m was 1.9 m away after 1 s and
+#: 113 m after 3 s. P alone closes the error by P·dt a step (0.1 s time constant).
+POSITION_GAIN = AMBF_CARTESIAN_P
 
 
 def _set_pose(msg_pose, t: np.ndarray) -> None:
@@ -211,13 +211,7 @@ class BodyHandler(Handler):
                 elif hasattr(w, "move_base"):
                     w.move_base(sb, target)
             return
-        p = POSITION_GAIN
-        cur = sb.world_matrix() @ sb.com_in_body
-        goal = target @ sb.com_in_body
-        lin = p * (goal[:3, 3] - cur[:3, 3])
-        from ..runner.rotations import rotation_log
-
-        ang = p * (cur[:3, :3] @ rotation_log(cur[:3, :3].T @ goal[:3, :3]))
+        lin, ang = steer_velocity(sb.world_matrix() @ sb.com_in_body, target @ sb.com_in_body, POSITION_GAIN)
         self._set_velocity(w, lin, ang)
 
     def _velocity(self, w, twist) -> None:

@@ -113,3 +113,18 @@ def rotation_exp(v: np.ndarray) -> np.ndarray:
     k = v / a
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     return np.eye(3) + np.sin(a) * kx + (1 - np.cos(a)) * kx @ kx
+
+
+#: AMBF's default Cartesian controller's P (afCartesianControllerAttributes), which a pose command
+#: steers a free body with in `adfkit ros` and `adfkit parity` (its D is left out: docs/ros.md)
+AMBF_CARTESIAN_P = 10.0
+
+
+def steer_velocity(cur: np.ndarray, goal: np.ndarray, gain: float) -> tuple[np.ndarray, np.ndarray]:
+    """The linear and angular velocity (world frame) that close a body's pose ``cur`` (4x4) on
+    ``goal`` by ``gain`` times the error, the proportional part of AMBF's Cartesian controller on
+    a velocity output (afCartesianController::computeOutput, the rotation error as the body
+    frame's rotation vector turned into the world)."""
+    lin = gain * (goal[:3, 3] - cur[:3, 3])
+    ang = gain * (cur[:3, :3] @ rotation_log(cur[:3, :3].T @ goal[:3, :3]))
+    return lin, ang

@@ -19,6 +19,12 @@
 //                           place (TARGET a rigid body, ARG its body frame "x y z qx qy qz qw": set
 //                           there at rest), force (TARGET a rigid body, ARG "fx fy fz px py pz": a
 //                           force at a world point, every step until its next force command);
+//                           pose (TARGET a dynamic rigid body, ARG "x y z qx qy qz qw": every step
+//                           until its next pose command, what AMBF's ROS plugin does with a
+//                           RigidBodyCmd TYPE_POSITION for a dynamic body, ObjectCommPlugin's
+//                           rigidBodyFetchCommand: the body's Cartesian controller's output for
+//                           its COM position and rotation with the step's dt, set as its velocity,
+//                           or applied as a force and torque if the controller outputs a force);
 //                           collide (TARGET a rigid body, ARG "BODY 0|1": 0 lets the two pass through each
 //                           other, as a task's set_collision does; 1 undoes that),
 //                           follow (TARGET a revolute or prismatic joint, ARG a position: a point
@@ -241,7 +247,7 @@ public:
         else if (joints_arrived(t)) m_cmdClock += dt;
         else m_heldSteps++;
         activate(m_cmdClock);
-        drive();
+        drive(dt);
         double c = m_cmdClock;
         bool last = c + 1e-9 >= m_seconds || (m_paced && t + 1e-9 >= m_paceMax);
         if (last || c + 1e-9 >= m_nextSample) {
@@ -574,11 +580,14 @@ private:
                     fail(where + "collide needs a body and 0 or 1");
                 if (!find_body(c.target)) fail(where + "no rigid body " + c.target);
                 if (!find_body(c.arg)) fail(where + "no rigid body " + c.arg);
-            } else if (c.kind == "place" || c.kind == "force") {
-                if (!find_body(c.target)) fail(where + "no rigid body " + c.target);
+            } else if (c.kind == "place" || c.kind == "force" || c.kind == "pose") {
+                afRigidBodyPtr rb = find_body(c.target);
+                if (!rb) fail(where + "no rigid body " + c.target);
+                if (c.kind == "pose" && rb->m_bulletRigidBody->isStaticOrKinematicObject())
+                    fail(where + "pose drives a dynamic body only: " + c.target);
                 double v;
                 while (ls >> v) c.numbers.push_back(v);
-                size_t want = c.kind == "place" ? 7 : 6;
+                size_t want = c.kind == "force" ? 6 : 7;
                 if (c.numbers.size() != want) fail(where + c.kind + " needs " + to_string(want) + " numbers");
             } else {
                 fail(where + "unknown kind " + c.kind);
@@ -607,6 +616,9 @@ private:
             } else if (c.kind == "force") {
                 m_forces[c.target] = c;
                 m_forceBodies[c.target] = find_body(c.target);
+            } else if (c.kind == "pose") {
+                m_poses[c.target] = c;
+                m_poseBodies[c.target] = find_body(c.target);
             } else {
                 afJointPtr j = find_joint(c.target);
                 m_drives[c.target] = c;
@@ -658,7 +670,8 @@ private:
 
     // every joint command again each physics step, as AMBF's own ROS plugin applies the last
     // command it received (position: the joint's controller; effort: a torque for the next step)
-    void drive() {
+    void drive(double dt) {
+        for (auto& kv : m_poses) pose(m_poseBodies[kv.first], kv.second.numbers, dt);
         for (auto& kv : m_forces) {
             const vector<double>& n = kv.second.numbers;
             btRigidBody* b = m_forceBodies[kv.first]->m_bulletRigidBody;
@@ -674,6 +687,25 @@ private:
             else j->commandEffort(v);
         }
         follow(m_cmdClock);
+    }
+
+    // ObjectCommPlugin::rigidBodyFetchCommand's TYPE_POSITION branch for a dynamic body, as is
+    void pose(afRigidBodyPtr rb, const vector<double>& n, double dt) {
+        btRigidBody* b = rb->m_bulletRigidBody;
+        btTransform com = rb->getCOMTransform();
+        btMatrix3x3 cur_rot, cmd_rot;
+        cur_rot.setRotation(com.getRotation());
+        cmd_rot.setRotation(btQuaternion(n[3], n[4], n[5], n[6]));
+        btVector3 cmd_pos(n[0], n[1], n[2]);
+        btVector3 p = rb->m_controller.computeOutput<btVector3>(com.getOrigin(), cmd_pos, dt);
+        btVector3 r = rb->m_controller.computeOutput<btVector3>(cur_rot, cmd_rot, dt);
+        if (rb->m_controller.m_positionOutputType == afControlType::FORCE) {
+            b->applyCentralForce(p);
+            b->applyTorque(r);
+        } else {
+            b->setLinearVelocity(p);
+            b->setAngularVelocity(r);
+        }
     }
 
     bool following(const string& joint) {
@@ -725,6 +757,8 @@ private:
     double m_followGain = 100.0;
     map<string, Command> m_forces;
     map<string, afRigidBodyPtr> m_forceBodies;
+    map<string, Command> m_poses;
+    map<string, afRigidBodyPtr> m_poseBodies;
     set<pair<btRigidBody*, btRigidBody*>> m_passing;  // pairs a collide command let pass
     bool m_paced = false;
     double m_paceRad = 0.0, m_paceM = 0.0, m_paceWait = 0.0, m_paceMax = 0.0;
