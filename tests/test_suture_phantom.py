@@ -277,6 +277,16 @@ def _scaled_holes(doc):
         obj.scale = 0.2
 
 
+def _turned_over_holes(doc):
+    """Each hole body turned half a turn about its x: its z into the tissue."""
+    from adfkit.runner.rotations import pose_to_matrix
+    from adfkit.scenes.suturing.frames import pose, rot_x
+
+    for b in doc.bodies:
+        if b.name.startswith(("Entry", "Exit")):
+            b.location = pose(pose_to_matrix(b.location) @ rot_x(math.pi))
+
+
 #: a modeller's phantom, changed one way, and pair 1's verdict and what its reason says (seed 0)
 ODD = {
     # the driver's jaws, closing round the wire on the tray, held 56 N on it: tool-hit-tissue on
@@ -288,6 +298,8 @@ ODD = {
     "1 mm ghosts": (_small_ghosts, "entry-ghost-off-hole", "the ghost (1.0 × 1.0 mm) covers less than the opening"),
     # read as 1.0 mm openings and 1 mm ghosts: the same 14 mm bite, `reach` in carry 1
     "holes scaled 0.2": (_scaled_holes, None, None),
+    # the needle went through; its crossings were read the wrong way: entry-missed, "0.0 mm"
+    "holes turned over": (_turned_over_holes, None, None),
 }
 
 

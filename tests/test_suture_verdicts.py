@@ -42,6 +42,23 @@ def test_a_holes_scale_leaves_its_capsules_and_its_ghost_as_they_collide():
     assert ghost_box(SimpleNamespace(ghost=ghost)) == pytest.approx((0.005, 0.005, 0.00045))
 
 
+def test_a_hole_whose_z_points_into_the_tissue_is_read_turned_over():
+    """A hole body's z is out of the tissue (against gravity); one turned over (a normal flipped
+    in Blender) is read turned half a turn about its x, so that the needle going in crosses it
+    inward: read as it was, a pair the needle went through was "entry-missed" ("nearest 0.0 mm
+    from its opening")."""
+    from adfkit.scenes.suturing.frames import rot_x, rot_y, translation
+    from adfkit.tasks.holes import hole_frame
+
+    entry1 = next(b for b in build_phantom().bodies if b.name == "Entry1")
+    up = translation(0.01, 0.02, 0.03) @ rot_y(-0.73)
+    for pose, want in ((up, up), (up @ rot_x(np.pi), up @ rot_x(np.pi) @ rot_x(np.pi))):
+        ghost = SimpleNamespace(parent=SimpleNamespace(body=entry1, world_matrix=lambda p=pose: p))
+        got = hole_frame(SimpleNamespace(gravity=np.array([0.0, 0.0, -9.81])), ghost)
+        assert got == pytest.approx(want, abs=1e-12)
+        assert got[2, 2] > 0 and got[:3, 0] == pytest.approx(pose[:3, 0])
+
+
 def test_a_crossing_outside_the_opening_is_measured_and_backwards_is_not_tip_first():
     half = np.array([0.0024, 0.0024])
     at, outside = plane_crossing(np.array([0.001, 0.0, 0.001]), np.array([0.001, 0.0, -0.001]), half)

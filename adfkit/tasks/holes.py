@@ -62,9 +62,18 @@ def hole_label(ghost) -> str:
 
 def hole_frame(world, ghost) -> np.ndarray:
     """World pose of a hole: its boundary body's frame where it has one (the ghost may sit
-    off the hole: the needle must go through the hole), else the ghost's."""
+    off the hole: the needle must go through the hole), else the ghost's; its z out of the
+    tissue (against gravity): a hole whose z points into the tissue (a normal flipped in
+    Blender) is read turned half a turn about its x, so that the needle going in crosses it
+    inward (read as it was, such a pair that the needle went through was "entry-missed")."""
     b = boundary_body(ghost)
-    return b.world_matrix() if b is not None else world.ghost_pose(ghost)
+    f = b.world_matrix() if b is not None else world.ghost_pose(ghost)
+    g = getattr(world, "gravity", None)
+    g = np.asarray((0.0, 0.0, -9.81) if g is None else g, dtype=float)
+    if float(f[:3, 2] @ g) > 0.0:  # z along gravity: into the tissue
+        f = f.copy()
+        f[:3, 1:3] *= -1.0
+    return f
 
 
 def opening_half_extents(body) -> np.ndarray:

@@ -19,6 +19,7 @@ from .holes import (
     DEFAULT_HALF_OPENING,
     boundary_body,
     chain_crossing,
+    hole_frame,
     opening_half_extents,
     plane_crossing,
     tip_leading,
@@ -62,7 +63,7 @@ class _Hole:
             self.ghost_offset = float(np.linalg.norm(g[:3, 3]))
 
     def frame(self) -> np.ndarray:
-        return self.body.world_matrix() if self.body is not None else self.world.ghost_pose(self.ghost)
+        return hole_frame(self.world, self.ghost)  # z out of the tissue, as the planner reads the hole
 
     def inverse_frame(self) -> np.ndarray:
         """The world-to-hole transform (read once where the hole cannot move: a static body)."""
