@@ -928,6 +928,7 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
         "pace": None,
         "ambf_not_finite_from_s": None,
         "wall_s": {"adfkit": 544.7, "ambf": 107.1},
+        "recorded_with": {"springs": "implicit", "control_substeps": 4},
         "same_verdicts": False,
         "replays": [
             {"pace": None, "follow": "measured", "tracking": {"/psm1/yaw": {"median": 0.00064, "max": 0.0316}}},
@@ -947,8 +948,8 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     }
     seen = {}
 
-    def fake(launch, indices, pairs, build, seed, progress, paces, follow):
-        seen["paces"], seen["follow"] = paces, follow
+    def fake(launch, indices, pairs, build, seed, progress, paces, follow, options):
+        seen["paces"], seen["follow"], seen["options"] = paces, follow, options
         return out
 
     monkeypatch.setattr(suture, "compare_suture", fake)
@@ -957,9 +958,13 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     text = capsys.readouterr().out
     assert seen["paces"] == (None, suture.PACE) and seen["follow"] == "commands"
     assert "pair 1: adfkit passed, AMBF failed (entry-missed" in text and "47.8 mm" in text
+    assert "recorded with springs implicit, control_substeps 4" in text
     assert "; paced: AMBF failed" in text and "432.4 s" in text and "1119 wait(s) given up" in text
     assert "measured: AMBF's PSM joints a median 0.00064 at most (/psm1/yaw) from adfkit's, 0.0316 at worst" in text
     assert main(["parity", "--suture", "--pairs", "1"]) == 1 and seen["paces"] == (None,)
+    assert seen["options"]["springs"] is None  # unnamed: the suture's own, its acceptance's
+    assert main(["parity", "--suture", "--pairs", "1", "--springs", "ambf", "--control-substeps", "1"]) == 1
+    assert seen["options"]["springs"] == "ambf" and seen["options"]["control_substeps"] == 1
     assert seen["follow"] == "measured"  # the default without a pace: following adfkit's measured joints
     assert main(["parity", "--suture", "--pairs", "1", "--pace", "on"]) == 1 and seen["follow"] == "commands"
     assert main(["parity", "--suture", "--pairs", "1", "--follow", "both", "--pace", "both"]) == 1
