@@ -121,6 +121,22 @@ class Server:
         return err
 
 
+def served(scene: Path, client, *args: str):
+    """Start a rosmaster and `adfkit ros SCENE ARGS`, call ``client(master)`` and close both:
+    (what the client returned, whether the server still served when it returned, its stderr)."""
+    master = Master()
+    try:
+        server = Server(master, scene, *args)
+        try:
+            out = client(master)
+            alive = server.proc.poll() is None
+        finally:
+            err = server.close()
+    finally:
+        master.close()
+    return out, alive, err
+
+
 def run_client(master: Master, paths: list[Path], body: str, timeout: float = 60) -> dict:
     """Run ``body`` (Python, which ends by printing one JSON line) as a ROS client through
     ``python -m adfkit.ros.pyrun`` with ``paths`` first on sys.path; the JSON, parsed."""

@@ -53,16 +53,7 @@ def test_guard_names_the_first_value_that_is_not_finite():
 def test_bad_commands_are_refused_and_the_server_keeps_serving(tmp_path):
     rs.require_client()
     paths = rs.ambf_client(tmp_path)
-    master = rs.Master()
-    try:
-        server = rs.Server(master, rs.SAMPLE)
-        try:
-            out = _drive(master, paths)
-            alive = server.proc.poll() is None
-        finally:
-            err = server.close()
-    finally:
-        master.close()
+    out, alive, err = rs.served(rs.SAMPLE, lambda master: _drive(master, paths))
     assert alive and "Traceback" not in err, err
     assert all(map(math.isfinite, out["q_bad"])) and abs(out["q_bad"][0] - 0.2) < 0.01  # the last good one held
     assert all(map(math.isfinite, out["needle"]))

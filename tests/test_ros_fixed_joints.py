@@ -67,35 +67,29 @@ def test_commands_on_a_fixed_joint_are_ignored_and_the_hinge_still_moves(tmp_pat
     paths = rs.ambf_client(tmp_path / "ambf")
     model = tmp_path / "arm.yaml"
     model.write_text(MODEL)
-    master = rs.Master()
-    try:
-        server = rs.Server(master, model)
-        try:
-            out = rs.run_client(
-                master,
-                paths,
-                """
-                import json, time
-                from ambf_client import Client
-                c = Client("t_fixed"); c.connect(); time.sleep(0.3)
-                base = c.get_obj_handle("/ambf/env/base"); time.sleep(0.5)
-                names = list(base.get_joint_names())
-                for k in range(len(names)):  # every joint of the list, the fixed one too
-                    base.set_joint_vel(k, 0.2)
-                time.sleep(0.5)
-                base.set_joint_effort(1, 0.5); time.sleep(0.3)
-                base.set_joint_pos(0, 0.4)
-                t = time.time()
-                while time.time() - t < 10 and abs(base.get_joint_pos(0) - 0.4) > 2e-3:
-                    time.sleep(0.05)
-                print(json.dumps({"names": names, "q": base.get_all_joint_pos()}))
-                """,
-            )
-            alive = server.proc.poll() is None
-        finally:
-            err = server.close()
-    finally:
-        master.close()
+    out, alive, err = rs.served(
+        model,
+        lambda master: rs.run_client(
+            master,
+            paths,
+            """
+            import json, time
+            from ambf_client import Client
+            c = Client("t_fixed"); c.connect(); time.sleep(0.3)
+            base = c.get_obj_handle("/ambf/env/base"); time.sleep(0.5)
+            names = list(base.get_joint_names())
+            for k in range(len(names)):  # every joint of the list, the fixed one too
+                base.set_joint_vel(k, 0.2)
+            time.sleep(0.5)
+            base.set_joint_effort(1, 0.5); time.sleep(0.3)
+            base.set_joint_pos(0, 0.4)
+            t = time.time()
+            while time.time() - t < 10 and abs(base.get_joint_pos(0) - 0.4) > 2e-3:
+                time.sleep(0.05)
+            print(json.dumps({"names": names, "q": base.get_all_joint_pos()}))
+            """,
+        ),
+    )
     assert alive and "Traceback" not in err, err
     assert out["names"] == ["base-arm", "arm-tip"]
     assert abs(out["q"][0] - 0.4) < 5e-3
@@ -114,33 +108,30 @@ def test_a_twist_moves_a_static_multibody_root_with_its_links(tmp_path, engine):
     paths = rs.ambf_client(tmp_path / "ambf")
     model = tmp_path / "arm.yaml"
     model.write_text(MODEL)
-    master = rs.Master()
-    try:
-        server = rs.Server(master, model, "--engine", engine)
-        try:
-            out = rs.run_client(
-                master,
-                paths,
-                """
-                import json, time
-                from ambf_client import Client
-                c = Client("t_twist"); c.connect(); time.sleep(0.3)
-                base = c.get_obj_handle("/ambf/env/base"); tip = c.get_obj_handle("/ambf/env/tip")
-                w = c.get_world_handle(); time.sleep(0.5)
-                def pos(h):
-                    p = h.get_pos(); return [p.x, p.y, p.z]
-                b0, t0, s0 = pos(base), pos(tip), w._state.sim_step
-                while w._state.sim_step - s0 < 1000:  # 1 s of simulated time at 0.05 m/s along y
-                    base.set_linear_vel(0.0, 0.05, 0.0); time.sleep(0.02)
-                base.set_linear_vel(0.0, 0.0, 0.0); time.sleep(0.3)
-                print(json.dumps({"b0": b0, "t0": t0, "b1": pos(base), "t1": pos(tip),
-                                  "steps": w._state.sim_step - s0}))
-                """,
-            )
-        finally:
-            err = server.close()
-    finally:
-        master.close()
+    out, _, err = rs.served(
+        model,
+        lambda master: rs.run_client(
+            master,
+            paths,
+            """
+            import json, time
+            from ambf_client import Client
+            c = Client("t_twist"); c.connect(); time.sleep(0.3)
+            base = c.get_obj_handle("/ambf/env/base"); tip = c.get_obj_handle("/ambf/env/tip")
+            w = c.get_world_handle(); time.sleep(0.5)
+            def pos(h):
+                p = h.get_pos(); return [p.x, p.y, p.z]
+            b0, t0, s0 = pos(base), pos(tip), w._state.sim_step
+            while w._state.sim_step - s0 < 1000:  # 1 s of simulated time at 0.05 m/s along y
+                base.set_linear_vel(0.0, 0.05, 0.0); time.sleep(0.02)
+            base.set_linear_vel(0.0, 0.0, 0.0); time.sleep(0.3)
+            print(json.dumps({"b0": b0, "t0": t0, "b1": pos(base), "t1": pos(tip),
+                              "steps": w._state.sim_step - s0}))
+            """,
+        ),
+        "--engine",
+        engine,
+    )
     assert "Traceback" not in err, err
     moved = out["b1"][1] - out["b0"][1]
     assert 0.045 < moved < 0.07, out  # 0.05 m/s for the ~1 s of steps the commands held

@@ -17,33 +17,28 @@ def test_set_pos_and_set_rpy_bring_a_free_box_there_and_hold_it(tmp_path):
     paths = rs.ambf_client(tmp_path / "ambf")
     model = tmp_path / "box.yaml"
     model.write_text("namespace: /ambf/env/\n" + box_camera_model(mass=1.0, z=1.0))  # no floor: it would fall
-    master = rs.Master()
-    try:
-        server = rs.Server(master, model)
-        try:
-            out = rs.run_client(
-                master,
-                paths,
-                """
-                import json, time
-                from ambf_client import Client
-                c = Client("t_free"); c.connect(); time.sleep(0.3)
-                box = c.get_obj_handle("box"); time.sleep(0.3)
-                w = c.get_world_handle()
-                track = []
-                s0 = w._state.sim_step
-                while w._state.sim_step - s0 < 3000:  # 3 s of simulated time, however slow the box
-                    box.set_pos(0.1, -0.05, 1.2); box.set_rpy(0.3, -0.2, 1.0)
-                    p = box.get_pos(); track.append([p.x, p.y, p.z])
-                    time.sleep(0.02)
-                print(json.dumps({"track": track, "rpy": list(box.get_rpy())}))
-                """,
-                timeout=120,
-            )
-        finally:
-            err = server.close()
-    finally:
-        master.close()
+    out, _, err = rs.served(
+        model,
+        lambda master: rs.run_client(
+            master,
+            paths,
+            """
+            import json, time
+            from ambf_client import Client
+            c = Client("t_free"); c.connect(); time.sleep(0.3)
+            box = c.get_obj_handle("box"); time.sleep(0.3)
+            w = c.get_world_handle()
+            track = []
+            s0 = w._state.sim_step
+            while w._state.sim_step - s0 < 3000:  # 3 s of simulated time, however slow the box
+                box.set_pos(0.1, -0.05, 1.2); box.set_rpy(0.3, -0.2, 1.0)
+                p = box.get_pos(); track.append([p.x, p.y, p.z])
+                time.sleep(0.02)
+            print(json.dumps({"track": track, "rpy": list(box.get_rpy())}))
+            """,
+            timeout=120,
+        ),
+    )
     assert "Traceback" not in err, err
     track = out["track"]
     far = max(max(abs(a - b) for a, b in zip(p, (0.1, -0.05, 1.2))) for p in track)
