@@ -31,7 +31,7 @@ from ..resistance import RayState, ResistanceParams
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
 from ..springs import spring_alone
 from . import articulation, egl
-from .bodies import SimBody, body_gravity, make_sim_body, set_dynamics
+from .bodies import SimBody, body_gravity, make_sim_body, refresh_inertia, set_dynamics
 from .cone_limits import ConeLimits
 from .damping import LinkDamping
 from .ghost_pass import GhostPass
@@ -183,6 +183,8 @@ class Assembly:
         self._acting_ghosts = self.ghosts if self.opt.ghosts == "ambf" else self._friction_ghosts
         self._manifold_place, self._manifold_made = None, {}  # interact._manifold_points' last pass
         self._ghost_pass = GhostPass(self)  # where that pass is run (ghost_pass.py)
+        if self._ambf_dt is not None and self.soft is None:  # AMBF's bodies turn by their inertia from the start
+            refresh_inertia(self.cid)
 
     def _group_gravity_overrides(self):
         """Bodies whose gravity differs from the world's, grouped per multibody so each control

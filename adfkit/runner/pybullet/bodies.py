@@ -146,3 +146,25 @@ def set_dynamics(sb: SimBody, ambf_dt: float | None = None) -> None:
     pb.changeDynamics(sb.uid, sb.link, physicsClientId=sb.cid, **kw)
     info = pb.getDynamicsInfo(sb.uid, sb.link, physicsClientId=sb.cid)
     sb.inertia = tuple(info[2]) if not sb.static else (0.0, 0.0, 0.0)
+
+
+def refresh_inertia(cid: int) -> None:
+    """Have Bullet take every body's inertia as changeDynamics set it before the first physics step.
+
+    A maximal-coordinate body (a btRigidBody) turns by the world-frame inverse inertia Bullet last
+    computed, which it recomputes only when it integrates the body: an inertia set through
+    changeDynamics (localInertiaDiagonal) reaches the first physics step as the collision shape's
+    own. A thread element given 5e-5 kg·m², turned by its joint's 0.054 N·m spring, spun at
+    1720 rad/s after 1 ms, as its 3e-8 kg·m² capsule would, where 1.08 rad/s is its own. AMBF makes
+    its bodies with their inertia. One physics step of a nanosecond makes Bullet recompute it, and
+    the world's state from before that step is put back (saveState / restoreState): every body
+    starts where and as it was. (Not with soft bodies, whose state PyBullet does not save.)"""
+    state = pb.saveState(physicsClientId=cid)
+    params = pb.getPhysicsEngineParameters(physicsClientId=cid)
+    pb.setPhysicsEngineParameter(fixedTimeStep=1e-9, numSubSteps=1, physicsClientId=cid)
+    pb.stepSimulation(physicsClientId=cid)
+    pb.setPhysicsEngineParameter(
+        fixedTimeStep=params["fixedTimeStep"], numSubSteps=params["numSubSteps"], physicsClientId=cid
+    )
+    pb.restoreState(state, physicsClientId=cid)
+    pb.removeState(state, physicsClientId=cid)
