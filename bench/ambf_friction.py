@@ -84,6 +84,7 @@ def scene_text(world, seconds: float) -> str:
     from adfkit.model.semantics import (
         DEFAULT_ANGULAR_DAMPING,
         DEFAULT_LINEAR_DAMPING,
+        DEFAULT_RESTITUTION,
         JointKind,
         ShapeKind,
         collision_primitives,
@@ -108,7 +109,8 @@ def scene_text(world, seconds: float) -> str:
         ang = d.angular if d is not None and d.angular is not None else DEFAULT_ANGULAR_DAMPING
         p, q = matrix_to_pq(sb.body_world_matrix @ sb.com_in_body)
         mass = 0.0 if sb.static else sb.mass
-        lines.append(_line("body", mass, *sb.inertia, *p, *q, info[1], info[6], info[5], lin, ang, str(len(prims))))
+        restitution = b.restitution if b.restitution is not None else DEFAULT_RESTITUTION
+        lines.append(_line("body", mass, *sb.inertia, *p, *q, info[1], info[6], restitution, lin, ang, str(len(prims))))
         margin = b.collision_margin if b.collision_margin is not None else 0.001
         for prim in prims:
             g = prim.geometry
