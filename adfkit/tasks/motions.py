@@ -193,24 +193,23 @@ class Motions:
         overstate the room by 0.6 mm: at pair 1 of the bundled scene the driver's jaws, opened
         to let go, came 0.15 mm into Entry1's boundary and, in MuJoCo's rigid contacts, pressed
         on it with 130-260 N."""
-        touch = self._touch(psm)
-        for _ in range(self._steps(seconds)):
-            yield self.phase
-            if self._pressing(*touch):  # the finger that got least far decides where both stop
-                fingers = self.world.joint_state(psm.art, psm.jaws)[0]
-                psm.servo_jaw(max(0.0, 2 * float(min(fingers)) - GUARD_JAW_BACK))
+        yield from self._guarded_jaws(psm, seconds, lambda f: max(0.0, 2 * float(min(f)) - GUARD_JAW_BACK))
 
     def closing(self, psm: PSM, seconds: float):
         """Wait ``seconds`` while the jaws close on the held needle; while they press on the
         tissue with GUARD_N they open back to GUARD_JAW_BACK more than the finger that got least
         far, as the opening does (the actuator holds the needle either way). On a phantom's tray
         the driver's fingers, closing round the wire in its slot, pressed on it with 56 N held."""
+        yield from self._guarded_jaws(psm, seconds, lambda f: min(JAW_OPEN, 2 * float(max(f)) + GUARD_JAW_BACK))
+
+    def _guarded_jaws(self, psm: PSM, seconds: float, back):
+        """Wait ``seconds``; after each step where the jaws press on the tissue with GUARD_N,
+        command them to ``back(fingers)`` (the finger that got least far decides where both stop)."""
         touch = self._touch(psm)
         for _ in range(self._steps(seconds)):
             yield self.phase
             if self._pressing(*touch):
-                fingers = self.world.joint_state(psm.art, psm.jaws)[0]
-                psm.servo_jaw(min(JAW_OPEN, 2 * float(max(fingers)) + GUARD_JAW_BACK))
+                psm.servo_jaw(back(self.world.joint_state(psm.art, psm.jaws)[0]))
 
     def let_go(self, name: str, holder: str | None = None):
         """``name`` releases the needle and backs off. ``holder``, the arm that keeps it, is then
@@ -225,8 +224,6 @@ class Motions:
         if holder is not None:
             keep = self.psms[holder]
             yield from self.line(keep, self.setpoint_world(keep), self.needle_pose() @ self.held_ee_in_needle, 0.2)
-        here = self.setpoint_world(psm)
-        back = here.copy()
-        back[:3, 3] -= BACK_OFF * here[:3, 2]
+        back = _backed_off(self.setpoint_world(psm))
         back[2, 3] += 0.01
         yield from self.move(psm, back, 0.5, settle=0.0)
