@@ -3,9 +3,11 @@
 The planner asks this before it commits to a grasp, so that the jaws and the wrist stay off the
 phantom while the tools collide with it (nothing is switched off to make the plan work). It is
 answered from the scene's own collision shapes, not from the engine: primitives of the tissue
-bodies (boxes, capsules, spheres, cylinders, planes) and the convex pieces of their collision
-meshes (one hull per sub-mesh of an OBJ file, as the engines build them), against points sampled
-on the tool's collision primitives near its end effector.
+bodies (boxes, capsules, spheres, cylinders, planes), the triangles of a static body's concave
+collision mesh (AMBF's default mesh type, as AMBF and PyBullet collide it: ``mesh_distance``) and
+the convex pieces of the other collision meshes (one hull per sub-mesh of an OBJ file, as the
+engines build them; MuJoCo collides every mesh so), against points sampled on the tool's
+collision primitives near its end effector.
 """
 
 from __future__ import annotations
@@ -16,8 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from ..adf.paths import collision_mesh_path
-from ..model.semantics import ShapeKind, axis_vector, collision_primitives
+from ..model.semantics import ShapeKind, axis_vector, collision_primitives, concave_mesh
 from ..runner.rotations import invert, pose_to_matrix
+from .mesh_distance import TriangleMeshes, obj_triangles
 
 FIELD_HALF = 0.045  # m: a distance field reaches this far each way from its centre ...
 FIELD_STEP = 0.0015  # m ... on a grid this fine (exact at its nodes, trilinear between them)
@@ -100,13 +103,17 @@ class _Field:
 class Tissue:
     """The collision shapes of the static tissue bodies, in the world, for distance queries."""
 
-    def __init__(self, bodies, centres=()) -> None:
+    def __init__(self, bodies, centres=(), triangles: bool = True) -> None:
         """``centres``: where the queries will be (a distance field is made around each, the
-        first time a query is nearest to it); without any, around each query's own centimetre."""
+        first time a query is nearest to it); without any, around each query's own centimetre.
+        ``triangles``: a static body's concave collision mesh read as its triangles, as AMBF and
+        PyBullet collide it (False: as the hulls of its pieces, as MuJoCo collides it)."""
+        self.triangles = triangles
         self.boxes: list[tuple[np.ndarray, np.ndarray]] = []  # (world-from-box 4x4, half extents)
         self.segments: list[tuple[np.ndarray, np.ndarray, float]] = []  # capsules, spheres, cylinders
         self.planes: list[tuple[np.ndarray, float]] = []  # (normal, offset): n·x <= offset is inside
         self.hulls: list[tuple[np.ndarray, np.ndarray]] = []
+        self.meshes: list[TriangleMeshes] = []  # static concave collision meshes, as their triangles
         self.unknown: list[str] = []  # bodies whose shapes could not be read (left out, named)
         for sb in bodies:
             self._add(sb)
@@ -124,6 +131,13 @@ class Tissue:
                 self.unknown.append(sb.name)
                 return
             s = _num(body.scale, 1.0)
+            if self.triangles and sb.static and concave_mesh(body):
+                mesh = obj_triangles(path, s, t)
+                if mesh is None:
+                    self.unknown.append(sb.name)
+                else:
+                    self.meshes.append(mesh)
+                return
             for v in _obj_groups(path):
                 v = (t[:3, :3] @ (v * s).T).T + t[:3, 3]
                 planes = _hull_planes(v)
@@ -187,6 +201,8 @@ class Tissue:
             best = np.minimum(best, (pts @ self._plane_n.T - self._plane_d).min(axis=1))
         for normals, offsets in self.hulls:
             best = np.minimum(best, (pts @ normals.T + offsets).max(axis=1))
+        for mesh in self.meshes:
+            best = np.minimum(best, mesh.exact(pts, near, radius))
         return best
 
     def field(self, near: np.ndarray) -> _Field:

@@ -321,7 +321,7 @@ class SutureTask(GraspChoice, Motions):
         centres = [
             (hole_frame(self.world, p.entry)[:3, 3] + hole_frame(self.world, p.exit)[:3, 3]) / 2 for p in self.pairs
         ]
-        self.tissue_shapes = Tissue(self.roles.tissue, centres)
+        self.tissue_shapes = Tissue(self.roles.tissue, centres, triangles=sweep.triangles(self.world))
         self.tools = {n: ToolShape(self.world, psm) for n, psm in self.psms.items()}
         if not hasattr(self, "tools_wide"):  # planned without steps(): the jaws as they are
             self.tools_wide = self.tools

@@ -6,8 +6,9 @@ pair fails on what the needle and the thread pressed on, never on this).
 The needle turns about its circle's centre from the insertion's start to the end of the pull,
 so its wire sweeps the circle through entry k and exit k (the hole figure draws it). At points
 SAMPLE apart along that circle, the signed distance to each tissue body's collision shapes
-(primitives and the convex pieces of meshes, as the planner's clearance reads them,
-``clearance.Tissue``) says whether the wire fits there: the centre line at least a wire radius
+(primitives, a static body's concave mesh as its triangles and other meshes as the convex
+pieces the engine collides, as the planner's clearance reads them, ``clearance.Tissue``) says
+whether the wire fits there: the centre line at least a wire radius
 from every body. Where it does not, the finding says which body, from where to where along the
 arc (mm past entry k), and either how wide the channel is across the needle's plane, where the
 centre line is free but the channel narrower than the wire, or how far the body reaches into
@@ -76,7 +77,8 @@ class Block:
     width_m: float | None  # the channel's width across the needle's plane where narrowest, when the centre line is free
     wire_m: float  # the wire's thickness
     opening_m: float | None = None  # the body's opening, when it is one of the pair's holes
-    #: the body collides as a concave triangle mesh, read here as the convex hull of each piece
+    #: the body is a static concave triangle mesh, which the engine (MuJoCo) collides as the
+    #: convex hull of each piece, and so it is read here
     hulled_mesh: bool = False
 
     def text(self, entry: str, exit_: str) -> str:
@@ -108,19 +110,27 @@ class Block:
         said = f"{self.body} lies in the needle's path between {entry} and {exit_} ({span}): {how}"
         if self.hulled_mesh:  # a static mesh AMBF and PyBullet collide as its triangles
             said += (
-                f" (read as the convex hull of {self.body}'s collision mesh, which AMBF and PyBullet collide as "
-                "its triangles, and MuJoCo as its hull: give it collision primitives to be checked as it collides)"
+                f" (the convex hull of {self.body}'s collision mesh, as MuJoCo collides it; AMBF and PyBullet "
+                "collide its triangles: give it collision primitives to be played alike everywhere)"
             )
         return said
 
 
+def triangles(world) -> bool:
+    """Whether the engine collides a static concave mesh as its triangles (AMBF does, PyBullet
+    does; MuJoCo collides every mesh as the convex hull of each piece)."""
+    return getattr(world, "engine", "") != "mujoco"
+
+
 def _per_body(task) -> list[tuple[str, Tissue]]:
-    return [(sb.name, Tissue([sb])) for sb in task.roles.tissue]
+    return [(sb.name, Tissue([sb], triangles=triangles(task.world))) for sb in task.roles.tissue]
 
 
 def _hulled(task) -> set[str]:
-    """The tissue bodies read as hulls of a mesh the engines keep concave (static: AMBF's
-    default collision mesh type)."""
+    """The tissue bodies read as hulls of a mesh AMBF keeps concave (static: AMBF's default
+    collision mesh type), in an engine that collides it so."""
+    if triangles(task.world):
+        return set()
     return {sb.name for sb in task.roles.tissue if sb.static and concave_mesh(sb.body)}
 
 
@@ -184,7 +194,7 @@ def check(task, wire_r: float) -> dict[int, str]:
     bodies = _per_body(task)
     hulled = _hulled(task)
     hole_bodies = {id(boundary_body(g) or g.parent) for p in task.pairs for g in (p.entry, p.exit)}
-    surface = Tissue([sb for sb in task.roles.tissue if id(sb) not in hole_bodies])
+    surface = Tissue([sb for sb in task.roles.tissue if id(sb) not in hole_bodies], triangles=triangles(task.world))
     out: dict[int, str] = {}
     for pair in task.pairs:
         notes = []

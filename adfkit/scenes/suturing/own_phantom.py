@@ -202,20 +202,22 @@ class _Placed:
         self.body, self.model = body, model
         self.name = body.name or body.identifier
         self._t = _matrix(body.location)
+        self.static = (body.mass or 0.0) == 0.0
 
     def world_matrix(self) -> np.ndarray:
         return self._t
 
 
-def tissue_top(model: ModelFile, points: np.ndarray, below: float = 0.03) -> np.ndarray:
+def tissue_top(model: ModelFile, points: np.ndarray, below: float = 0.03, triangles: bool = True) -> np.ndarray:
     """For each world point (N, 3), the height of the phantom's collision surface under it (the
     first it meets looking down from ``below`` above the point); -inf where there is none within
-    2 * ``below``."""
+    2 * ``below``. ``triangles``: a concave collision mesh read as the engine collides it
+    (clearance.Tissue): as its triangles (AMBF, PyBullet), else as hulls (MuJoCo)."""
     from ...tasks.clearance import Tissue
     from ...tasks.sweep import march
 
     bodies = [_Placed(b, model) for b in model.bodies if collision_primitives(b) != [] and (b.mass or 0.0) == 0.0]
-    shapes = Tissue(bodies)
+    shapes = Tissue(bodies, triangles=triangles)
     t = march(shapes, points + below * _up(), -_up(), far=2 * below)
     return np.where(np.isfinite(t), points[:, 2] + below - t, -np.inf)
 
@@ -282,9 +284,10 @@ def _moved(body: Body, t: np.ndarray) -> None:
     body.location = pose(t @ _matrix(body.location))
 
 
-def compose(bundled: Scene, phantom: ModelFile) -> Composed:
+def compose(bundled: Scene, phantom: ModelFile, triangles: bool = True) -> Composed:
     """The bundled scene with ``phantom`` in place of its phantom, the rest placed for its holes
-    (the module docstring)."""
+    (the module docstring); ``triangles``: whether the engine collides a static concave mesh as
+    its triangles (tissue_top)."""
     holes = phantom_holes(phantom)
     own = [b.name or b.identifier for b in phantom.bodies if NEEDLE_PARTS.match(b.name or "")]
     if own:
@@ -338,7 +341,7 @@ def compose(bundled: Scene, phantom: ModelFile) -> Composed:
     grid = [(x, y, bed - TRAY_DEPTH) for x in np.linspace(sx0, sx1, 9) for y in np.linspace(sy0, sy1, 5)]
     under = np.array(grid + [(p[0], p[1], bed) for p in wire])
     placed = np.c_[under, np.ones(len(under))] @ needle_t.T
-    top = tissue_top(phantom, placed[:, :3])
+    top = tissue_top(phantom, placed[:, :3], triangles=triangles)
     lift = max(0.0, float(np.max(top - placed[:, 2]))) if np.isfinite(top).any() else 0.0
     if lift > 0:
         up = translation(0.0, 0.0, lift)
