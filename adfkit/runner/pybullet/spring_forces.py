@@ -12,20 +12,17 @@ spring leaves; they can do no more than stop the joint's relative motion within 
 
 from __future__ import annotations
 
-from collections import deque
-from itertools import chain, repeat
-
 import numpy as np
-import pybullet as pb
 
 from ..rotations import cross_rows as _cross
-from ..rotations import euler_xyz, quat_to_matrix
+from ..rotations import euler_xyz
 from ..springs import SpringJoint
 from .cone_limits import ConeLimits
 from .joint_inertia import PivotInertia, bullet_spring_masses
+from .spring_reads import SpringReads
 
 
-class SpringSet:
+class SpringSet(SpringReads):
     """All force-driven joints, evaluated together with numpy each control step.
 
     The per-step cost is mostly PyBullet's: one getBasePositionAndOrientation and one
@@ -43,6 +40,8 @@ class SpringSet:
         self.world_gravity = np.asarray(gravity, dtype=float)
         self._poses: list = []  # each free body's (position, quaternion) as last read, in _base_keys' order
         self._vels: list = []  # and its (linear, angular) velocity
+        self._read_c = None  # the free bodies' states read in one C call (state_calls.py), else None
+        self._bases_read = None  # the (n, 13) rows it read last
         self._base_index: dict[tuple[int, int], int] = {}  # (uid, -1) -> its place in those
         self._order = None
         n = len(joints)
@@ -200,59 +199,6 @@ class SpringSet:
             return np.where((spring * damper < 0.0) & (np.abs(damper) > np.abs(spring)), damper, out)
         return out / den
 
-    @property
-    def pq(self) -> dict[tuple, tuple]:
-        """{(uid, -1): (position, quaternion)} of each free body as last read (states()); made when
-        asked (the ghosts ask once a control step, the springs read at every physics step)."""
-        return dict(zip(self._base_keys, self._poses)) if self._poses else {}
-
-    def last_state(self, key: tuple[int, int]) -> tuple | None:
-        """(position, quaternion, linear velocity, angular velocity) of free body ``key`` (uid, -1) as
-        states() last read it, as SimBody.state() gives them; None for a body it does not read."""
-        i = self._base_index.get(key)
-        return None if i is None or not self._poses else self._poses[i] + self._vels[i]
-
-    def _read_plan(self):
-        """How to read every body's COM state with the fewest PyBullet calls: free bodies and
-        multibody bases one by one (PyBullet has no batch call for them), the links of each
-        multibody with one getLinkStates. Built on first use (bodies have their uids then)."""
-        bases, links = [], {}
-        for i, b in enumerate(self.bodies):
-            if b.link < 0:
-                bases.append((i, b.uid))
-            else:
-                links.setdefault(b.uid, []).append((i, b.link))
-        order = [i for i, _ in bases] + [i for group in links.values() for i, _ in group]
-        self._bases = [uid for _, uid in bases]
-        self._base_keys = [(uid, -1) for uid in self._bases]
-        self._base_index = {key: i for i, key in enumerate(self._base_keys)}
-        self._links = [(uid, [k for _, k in group]) for uid, group in links.items()]
-        self._order = np.argsort(np.array(order, dtype=int))  # read order -> body order
-        self._in_order = bool(np.array_equal(self._order, np.arange(len(order))))
-        # the dynamic bodies' uids and links (each gets a torque), and the pushed ones' (a force too)
-        dyn, pushed = [self.bodies[i] for i in self.dynamic], self.dynamic[self.pushed[self.dynamic]]
-        self._twisted = ([b.uid for b in dyn], [b.link for b in dyn])
-        self._pushed = (pushed, [self.bodies[i].uid for i in pushed], [self.bodies[i].link for i in pushed])
-
-    def states(self):
-        """(positions, rotation matrices, linear and angular velocities) of every body's COM;
-        the free bodies' (position, quaternion) stay for ``pq`` until the next read."""
-        if self._order is None:
-            self._read_plan()
-        cid = self.cid
-        bases = self._bases
-        get_pose, get_vel, get_links = pb.getBasePositionAndOrientation, pb.getBaseVelocity, pb.getLinkStates
-        poses = [get_pose(uid, cid) for uid in bases]
-        vels = [get_vel(uid, cid) for uid in bases]
-        rows = [p + q + v + w for (p, q), (v, w) in zip(poses, vels)]
-        self._poses, self._vels = poses, vels
-        for uid, ks in self._links:  # computeLinkVelocity, computeForwardKinematics
-            rows += [s[0] + s[1] + s[6] + s[7] for s in get_links(uid, ks, 1, 1, cid)]
-        a = np.fromiter(chain.from_iterable(rows), float, 13 * len(rows)).reshape(-1, 13)
-        if not self._in_order:
-            a = a[self._order]
-        return (a[:, 0:3], quat_to_matrix(a[:, 3:7]), a[:, 7:10], a[:, 10:13])
-
     def apply(self, dt: float, erp: float = 0.2) -> None:
         if not self.joints:
             return
@@ -326,15 +272,7 @@ class SpringSet:
             # the force's moments about the child's, then the parent's, centre of mass
             moments = _cross(np.concatenate((pbw, pbw)) - pos[self.fl_arms], np.concatenate((f_w, f_w)))
             torque += self.fl_child_t @ moments[:k] - self.fl_parent_t @ moments[k:]
-        # each body's torque, then each pushed body's force at its centre of mass (whose moment
-        # PyBullet adds to the torque after it, as one body's calls in turn did), looped in C
-        cid, frame = self.cid, pb.WORLD_FRAME
-        uids, links = self._twisted
-        deque(map(pb.applyExternalTorque, uids, links, torque[self.dynamic].tolist(), repeat(frame), repeat(cid)), 0)
-        if force is not None:
-            at, uids, links = self._pushed
-            forces, coms = force[at].tolist(), pos[at].tolist()
-            deque(map(pb.applyExternalForce, uids, links, forces, coms, repeat(frame), repeat(cid)), 0)
+        self._push(torque, force, pos)
 
     def _pivot_mass(self, pos, rot, pivot, axes) -> np.ndarray:
         """(k, 3): the mass each free-linear joint's pivot B has along each axis of its frame A
