@@ -5,9 +5,10 @@
 shape). A mesh body's shape is a btCompoundShape of one child a sub-mesh (a btGImpactMeshShape,
 btConvexTriangleMeshShape or btConvexHullShape, each with the body's `collision margin`) placed in
 the inertial frame, and the compound's inertia is the box of its bounds: the sub-meshes' bounds
-grown by the margin on every side, mass/12·(ly² + lz², ...); a btConvexHullShape's bounds are
-grown by Bullet's default margin (0.04 m, CONVEX_DISTANCE_MARGIN) besides: the hull caches its
-bounds when it is made, with the margin it is made with, and AMBF sets the file's margin after
+grown by the margin on every side, mass/12·(ly² + lz², ...); a btConvexHullShape's or
+btConvexTriangleMeshShape's bounds (`CONVEX_HULL`, `CONVEX_MESH`) are grown by Bullet's default
+margin (0.04 m, CONVEX_DISTANCE_MARGIN) besides: each caches its bounds when it is made, with the
+margin it is made with, and AMBF sets the file's margin after
 (btPolyhedralConvexAabbCachingShape::recalcLocalAabb; getAabb adds the margin of the moment). The
 corpus suturing set's needle (nine hulls within 1.7 x 1.0 x 0.1 cm, 0.5 kg) has 6.140e-4, 6.649e-4,
 7.293e-4 kg·m² in AMBF, the box of its bounds grown by 4.01 cm on every side; grown by the margin
@@ -132,8 +133,11 @@ def estimated_inertia(model, body, com_in_body: np.ndarray) -> tuple[float, floa
         except (AdfError, ValueError):
             return None
         grow = float(margin)
-        if collision_mesh_type(body.collision_mesh_type)[0] is CollisionMeshType.CONVEX_HULL:
-            grow += BULLET_DEFAULT_MARGIN  # each hull's bounds as it cached them (module docstring)
+        if collision_mesh_type(body.collision_mesh_type)[0] in (
+            CollisionMeshType.CONVEX_HULL,
+            CollisionMeshType.CONVEX_MESH,
+        ):
+            grow += BULLET_DEFAULT_MARGIN  # the bounds each convex shape cached (module docstring)
         lo, hi = mesh.bounds[0] - grow, mesh.bounds[1] + grow
         boxes.append(((lo + hi) / 2.0, (hi - lo) / 2.0, np.eye(3)))
     if not boxes:
