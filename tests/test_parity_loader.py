@@ -246,3 +246,38 @@ def test_ambf_crashes_on_texture_faces_without_normals_and_loads_the_sample_scen
     rec = ambf.run(BUILD, ambf.Stage(launch, list(range(6))), 0.0, 0.0)
     counts = {k: len(v) for k, v in rec.created.items() if isinstance(v, list)}
     assert counts == {"bodies": 70, "soft_bodies": 0, "ghosts": 12, "joints": 56, "sensors": 2, "actuators": 2}
+
+
+NULL_AND_ABSENT = """\
+namespace: /ambf/env/
+bodies: [BODY a, BODY null, BODY absent]
+BODY a:
+  name: a
+  mass: 0.1
+  BOX_SHAPES
+BODY null:
+"""
+
+
+def test_a_body_listed_with_an_empty_mapping_is_not_made_and_one_without_a_mapping_is(tmp_path):
+    # AMBF's loader skips an object whose node is null ("RIGID BODY ~ NODE IS NULL") and builds
+    # one from an empty node for a listed key the file does not map (measured, below)
+    from adfkit.adf import load_scene
+    from adfkit.diagnostics import Severity
+    from adfkit.runner import Options, open_world
+    from adfkit.validator.engine import validate_file
+
+    path = _write(tmp_path, "m.yaml", NULL_AND_ABSENT)
+    res = validate_file(path)
+    said = [d.message for d in res.diagnostics if d.rule == "undefined-object" and d.severity == Severity.WARNING]
+    assert any("'BODY null'" in m and "mapping is empty; AMBF skips it" in m for m in said), said
+    assert any("'BODY absent'" in m and "has no mapping" in m for m in said), said
+    world = open_world(load_scene(path), Options(visuals=False, ground=False))
+    try:
+        assert sorted(b.key for b in world.bodies) == ["/ambf/env/BODY a", "/ambf/env/BODY absent"]
+    finally:
+        world.close()
+    if BUILD is not None:
+        r = loader.check_file(path, BUILD)
+        assert r.ambf == "loads" and r.agree, r.as_json()
+        assert r.ambf_counts["body"] == r.adfkit_counts["body"] == 2

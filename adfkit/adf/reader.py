@@ -385,6 +385,19 @@ def _read_with_objects(reader: Reader, cls, root: yaml.MappingNode) -> AdfFile:
             if isinstance(mapping, yaml.MappingNode):
                 reader.fill(item, mapping)
                 consumed.add(ident)
+            elif mapping is not None and _is_null(mapping):
+                # `BODY x:` with nothing under it: AMBF's loader skips the object (its node is
+                # null: "RIGID BODY ... NODE IS NULL", and alike for every kind), where a listed
+                # key with no mapping at all gets an object built from an empty node
+                reader.diagnostics.append(
+                    warning(
+                        "undefined-object",
+                        f"'{ident}' is listed in '{list_key}' but its mapping is empty; AMBF skips it",
+                        reader.loc(mapping),
+                        f"give '{ident}:' its keys or remove it from the list",
+                    )
+                )
+                continue
             else:
                 item.defined = False
                 item.source = reader.loc(entry)

@@ -79,7 +79,10 @@ _RULES = [
         "`location: {x: 1, y: 0, z: 0}`",
     ),
     Rule(
-        "undefined-object", W, "A listed identifier has no mapping in the file", "`bodies: [BODY a]` without `BODY a:`"
+        "undefined-object",
+        W,
+        "A listed identifier has no mapping in the file, or an empty one (AMBF skips that object)",
+        "`bodies: [BODY a]` without `BODY a:`",
     ),
     Rule(
         "unknown-key",
