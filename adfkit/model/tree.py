@@ -99,24 +99,40 @@ def motion(kind: JointKind | None, value: float) -> Pose:
     return Pose()
 
 
-def find_body(model: ModelFile, ref: str | None) -> Body | None:
-    """A joint's `parent`/`child` as AMBF resolves it in one file: the identifier, else the
-    body whose name or identifier contains the text uniquely (§12.1)."""
+def _merge_namespace(parent: str | None, child: str | None) -> str:
+    """§12.1: a child namespace starting with '/' replaces the parent; else the two are joined."""
+    parent, child = parent or "", child or ""
+    out = child if child.startswith("/") else parent + child
+    while "//" in out:
+        out = out.replace("//", "/")
+    return out
+
+
+def find_body(model: ModelFile, ref: str | None, joint=None) -> Body | None:
+    """A `parent`/`child` (of ``joint``, whose namespace then counts) as AMBF resolves it in one
+    file (§12.1, §12.2): among the bodies' keys (namespace + identifier, not their `name`s), the
+    key equal to the text, else the one key containing it; then the same with the joint's
+    namespace before the text. An ambiguous text (`Entry1` beside `Entry10`) finds nothing."""
     if not ref:
         return None
-    for b in model.bodies:
-        if b.identifier == ref:
-            return b
-    for b in model.bodies:
-        if b.name == ref or b.identifier == "BODY " + ref:
-            return b
-    hits = [b for b in model.bodies if ref in b.identifier]
-    return hits[0] if len(hits) == 1 else None
+    ns = model.namespace or ""
+    keys = [(_merge_namespace(ns, b.namespace) + b.identifier, b) for b in model.bodies]
+    texts = [ref]
+    if joint is not None:
+        texts.append(_merge_namespace(ns, getattr(joint, "namespace", None)) + ref)
+    for text in texts:
+        exact = [b for k, b in keys if k == text]
+        if exact:
+            return exact[0]
+        hits = [b for k, b in keys if text in k]
+        if len(hits) == 1:
+            return hits[0]
+    return None
 
 
 def joint_ends(model: ModelFile, joint) -> set[str | None]:
     """The identifiers of the bodies a joint's `parent` and `child` name (None for one not found)."""
-    return {getattr(find_body(model, ref), "identifier", None) for ref in (joint.parent, joint.child)}
+    return {getattr(find_body(model, ref, joint), "identifier", None) for ref in (joint.parent, joint.child)}
 
 
 def build_tree(
@@ -146,7 +162,7 @@ def build_tree(
     records, unresolved = [], []
     for j in model.joints:
         kind = joint_kind(j.type)
-        parent, child = find_body(model, j.parent), find_body(model, j.child)
+        parent, child = find_body(model, j.parent, j), find_body(model, j.child, j)
         if kind is None or parent is None or child is None or parent is child:
             unresolved.append(j)
             continue
