@@ -255,9 +255,29 @@ def test_joint_pose_reports_children_off_their_joint_and_outside_limits(tmp_path
     assert _pose_case(tmp_path, 0, -1.0, "  joint limits: {low: 5.0, high: 5.5}\n") == []
 
 
+@pytest.mark.parametrize("kind", ["p2p", "cone twist", "fixed", "torsion spring"])
+def test_joint_pose_reports_pivots_held_together_standing_apart(tmp_path, kind):
+    # pivots (0, 0, 0) in a and b: b 5 cm from a puts them 50 mm apart (AMBF's joint pulls them
+    # together over its first steps; the MuJoCo engine starts b on the joint)
+    def case(x_b):
+        text = CLEAN.replace("BODY a:\n", "BODY a:\n" + LOC.format(x=0, yaw=0)).replace(
+            "BODY b:\n", "BODY b:\n" + LOC.format(x=x_b, yaw=0.3)
+        )
+        f = tmp_path / "pivots.yaml"
+        f.write_text(text.replace("type: revolute", f"type: {kind}"), encoding="utf-8")
+        return [d for d in validate_file(f).diagnostics if d.rule == "joint-pose"]
+
+    assert case(0.0015) == []  # within the add-on's rounding
+    (apart,) = case(0.05)
+    assert apart.location.line == 9 and f"pivots of {kind} joint 'JOINT j' 50.0 mm apart" in apart.message, (
+        apart.message
+    )
+
+
 @pytest.mark.parametrize(
     "rel, expected",
     [
+        (MB + "robots/urdf-neuro-robot.yaml", 18),  # 17 links off their joints, a fixed joint's pivots apart
         (MB + "robots/blender-psm.yaml", 0),
         (MB + "robots/blender-kuka.yaml", 0),
         (MB + "robots/blender-kuka-lbr-med.yaml", 1),
@@ -273,6 +293,8 @@ def test_joint_pose_on_the_corpus(corpus, rel, expected):
         assert "1000.0 mm" in hits[0].message  # Link1 a metre from where base-Link1 puts it
     if "gripper3" in rel:
         assert all("-0.676 rad, outside its limits -1.2…-0.8" in d.message for d in hits)
+    if "neuro" in rel:
+        assert sum("pivots of fixed joint 'JOINT cannula_fixed_joint' 49.5 mm apart" in d.message for d in hits) == 1
 
 
 def test_primitive_geometry_keys_are_required_per_shape(tmp_path):

@@ -52,6 +52,8 @@ def adf_keys(node: object) -> frozenset:
 SPRINGS = {JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING}
 ONE_DOF = {JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.LINEAR_SPRING, JointKind.TORSION_SPRING}
 TREE_ONE_DOF = (JointKind.REVOLUTE, JointKind.PRISMATIC)
+#: the joints whose two pivots always stand together (pivots_apart)
+PIVOTS_HELD = (JointKind.FIXED, JointKind.P2P, JointKind.CONE_TWIST, JointKind.TORSION_SPRING)
 POSE_TOLERANCE = 2e-3  # m, and rad for limits: beyond the add-on's 3-decimal rounding of locations and pivots
 POSE_ANGLE_TOLERANCE = math.radians(1.0)
 ABSURD = 1e6
@@ -605,7 +607,9 @@ class Checker:
     def joint_poses(self, m: ModelFile) -> None:
         """Where the file's `location`s put each revolute/prismatic joint of the kinematic
         tree: within its limits, and with the child on the joint (its pose reproduced by the
-        parent's location and one joint value)."""
+        parent's location and one joint value); and each fixed, p2p, cone-twist or torsion-spring
+        joint's two pivots together."""
+        self.pivots_apart(m)
         if not any(joint_kind(j.type) in TREE_ONE_DOF for j in m.joints):
             return
         from ..model.tree import build_tree, motion
@@ -652,6 +656,35 @@ class Checker:
                     link.body.where("location"),
                     "fix the body's location or the joint's pivots and axes "
                     "(the Blender add-on writes both from the scene)",
+                )
+
+    def pivots_apart(self, m: ModelFile) -> None:
+        """A joint that holds its pivots together (fixed, p2p, cone twist, torsion spring) whose
+        bodies' `location`s put its pivots apart: AMBF starts the bodies there and its constraint
+        pulls them together over the first steps (the MuJoCo engine starts the child on the joint)."""
+        from ..model.tree import find_body
+
+        for j in m.joints:
+            if not j.defined or joint_kind(j.type) not in PIVOTS_HELD:
+                continue
+            parent, child = find_body(m, j.parent, j), find_body(m, j.child, j)
+            if parent is None or child is None or parent is child:
+                continue
+            if parent.location is None or child.location is None:
+                continue
+            try:
+                a, b = body_joint_frames(j, parent, child)
+            except (TypeError, ValueError, ZeroDivisionError):
+                continue  # incomplete pivots or axes: the schema says so
+            gap = ((parent.location * a).position - (child.location * b).position).norm()
+            if gap > POSE_TOLERANCE:
+                self.emit(
+                    "joint-pose",
+                    f"the locations of '{parent.identifier}' and '{child.identifier}' put the pivots of "
+                    f"{j.type} joint '{j.identifier}' {gap * 1000:.1f} mm apart; AMBF starts them there "
+                    "and its joint pulls them together over the first steps",
+                    child.where("location"),
+                    "fix the child's location or the joint's pivots (the Blender add-on writes both from the scene)",
                 )
 
     def reference(
