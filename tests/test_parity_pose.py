@@ -71,3 +71,65 @@ def test_ambfs_pose_controller_swings_a_free_box_ever_wider(tmp_path):
     hz = np.count_nonzero(np.diff(np.sign(z))) / 2.0  # over 1 s
     assert 240 < hz < 260
     assert err["pybullet"][1000:].max() < 1.5e-3
+
+
+CONTROLLED = """bodies: [BODY box, BODY vel]
+BODY box:
+  name: box
+  mass: 1.0
+  inertia: {ix: 1.0e-3, iy: 2.0e-3, iz: 1.5e-3}
+  location: {position: {x: 0.0, y: 0.0, z: 1.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.2, y: 0.2, z: 0.2}
+  controller:
+    linear: {P: 50, I: 3, D: 5}
+    angular: {P: 2, D: 0.2}
+BODY vel:
+  name: vel
+  mass: 0.5
+  inertia: {ix: 1.0e-3, iy: 1.0e-3, iz: 1.0e-3}
+  location: {position: {x: 1.0, y: 0.0, z: 1.0}}
+  collision shape: BOX
+  collision geometry: {x: 0.1, y: 0.1, z: 0.1}
+  controller:
+    linear: {P: 20, D: 0.01}
+    angular: {P: 5, D: 0.01}
+  controller output type: VELOCITY
+"""
+
+
+def test_a_bodys_controller_block_sets_its_pose_controllers_gains_and_output(tmp_path):
+    from adfkit.adf import load_scene
+    from adfkit.runner.cartesian import PoseSteer
+
+    (tmp_path / "c.yaml").write_text(CONTROLLED)
+    (model,) = load_scene(tmp_path / "c.yaml").all_models()
+    box, vel = (PoseSteer.of(b) for b in model.bodies)
+    assert (box.force, box.p_lin, box.d_lin, box.p_ang, box.d_ang) == (True, 50.0, 5.0, 2.0, 0.2)
+    assert (vel.force, vel.p_lin, vel.p_ang) == (False, 20.0, 5.0)
+    assert not PoseSteer.of(model.bodies[0].__class__()).force  # no block: P 10 as a velocity
+    cur, goal = np.eye(4), np.eye(4)
+    goal[:3, 3] = (0.1, 0.0, 0.0)
+    f, _ = box.step(cur, goal, 0.001)  # P·e + D·(e - 0)/dt at the first step, as AMBF's
+    assert f == pytest.approx((50 * 0.1 + 5 * 0.1 / 0.001, 0.0, 0.0))
+
+
+@needs_ambf
+def test_a_pose_command_under_a_controller_block_follows_ambf(tmp_path):
+    """With a `controller` block AMBF steers by its PD as a force and a torque (sagging mg/P under
+    gravity); adfkit played it by P 10 as a velocity, 221 mm from AMBF's box. Now it takes the
+    block's gains and output, and the pose a physics step behind as AMBF reads it."""
+    (tmp_path / "c.yaml").write_text(CONTROLLED)
+    (tmp_path / "pose.txt").write_text(
+        "0.0, pose, box, 0.1 -0.05 1.2 0.3 -0.2 1.0\n0.0, pose, vel, 1.1 0.05 1.1 0.2 0.1 -0.3\n"
+    )
+    req = session.Request(
+        tmp_path / "c.yaml", None, BUILD, seconds=1.0, every=0.01, commands=Path(tmp_path / "pose.txt"), ground=False
+    )
+    c = session.run(req, progress=False).comparisons[0]
+    gaps = {g.name: g for g in c.bodies}
+    assert gaps["box"].max_position < 1e-5 and gaps["box"].max_angle < 0.01
+    sag = GOAL[2] - c.ambf.poses[-1, c.ambf.body_names.index("box"), 2]
+    assert sag == pytest.approx(9.8 / 50, rel=0.02)  # AMBF's force output sags mg/P: so does adfkit's
+    # the block's P as a velocity: AMBF's D 0.01 kicks it 1 m/s at its first step (1.1 mm), then P rules
+    assert gaps["vel"].max_position < 1.5e-3 and gaps["vel"].position[-1] < 1e-5

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..runner.names import merge_namespace
-from ..runner.rotations import AMBF_CARTESIAN_P, pose_matrix, steer_velocity
+from ..runner.rotations import pose_matrix
 
 #: what each side lists as created, in this order
 KINDS = ("body", "soft body", "ghost", "joint", "sensor", "actuator")
@@ -154,8 +154,8 @@ class AdfkitPlayer:
     same commands: each takes effect at the first control step at or after its time (AMBF: the
     first 1 ms physics step), joint commands through runner.joint_commands as AMBF applies
     them, grasp and release through the world's constraint actuators, a pose command as
-    ``adfkit ros`` steers a free body under one (AMBF's Cartesian P as a velocity, without its D:
-    docs/ros.md)."""
+    ``adfkit ros`` steers a free body under one (the body's Cartesian controller,
+    runner/cartesian.py: AMBF's P as a velocity without its D, or its PD as a force)."""
 
     def __init__(self, world) -> None:
         from ..runner.joint_commands import JointCommands
@@ -172,6 +172,7 @@ class AdfkitPlayer:
         self.commands = JointCommands(world)
         self.per = world.dt * world.opt.control_substeps
         self.poses: dict[str, np.ndarray] = {}  # a body's pose command, its body frame (4x4)
+        self.steers: dict = {}  # a body's Cartesian controller under its pose commands (runner/cartesian.py)
 
     def _activate(self, cmds, t: float) -> None:
         w = self.world
@@ -189,10 +190,18 @@ class AdfkitPlayer:
                 self.commands.command(j, child, c.kind, c.value)
 
     def _steer(self) -> None:
+        from ..runner.cartesian import PoseSteer
+
         for name, goal in self.poses.items():
             sb = self.by_name["body"][name]
-            lin, ang = steer_velocity(sb.world_matrix() @ sb.com_in_body, goal @ sb.com_in_body, AMBF_CARTESIAN_P)
-            self.world.set_body_velocity(sb, lin, ang)
+            steer = self.steers.setdefault(name, PoseSteer.of(sb.body))
+            cur = sb.world_matrix() @ sb.com_in_body
+            lin, ang = steer.step(cur, goal @ sb.com_in_body, self.per, self.world.opt.control_substeps == 1)
+            if steer.force:  # the body's own `controller`: a force and a torque, as AMBF's
+                sb.force(lin, sb.com_position())
+                sb.torque(ang)
+            else:
+                self.world.set_body_velocity(sb, lin, ang)
 
     def _joint_values(self) -> list[float]:
         out = []

@@ -21,20 +21,21 @@ import time
 import numpy as np
 
 from ..model.semantics import JointKind
+from ..runner.cartesian import PoseSteer
 from ..runner.joint_commands import DRIVEN_KINDS, JointCommands
-from ..runner.rotations import AMBF_CARTESIAN_P, invert, matrix_to_quat, pose_matrix, steer_velocity
+from ..runner.rotations import invert, matrix_to_quat, pose_matrix
 from .env import publisher
 from .guard import TYPE_FORCE, TYPE_POSITION, TYPE_VELOCITY, body_cmd_fault, pose_fault
 from .objects import RosObject, ros_objects, topic_of, world_namespace
 
 WATCHDOG_S = 0.5  # ambf_comm's time out for every object (ObjectCommPlugin, WorldCommPlugin)
 MOTORS = (JointKind.REVOLUTE, JointKind.PRISMATIC)  # the joints a position or velocity command moves
-#: AMBF's default Cartesian controller without a `controller` block: P 10 (D 1), output a velocity.
-#: Its D term is left out: on a velocity output, with the pose AMBF reads one step behind (its motion
-#: state), D 1 makes a loop whose roots ring at 249.6 Hz and grow by 0.25 % a step at 1 kHz; measured
-#: in AMBF (`tests/test_parity_pose.py`), a 1 kg box told to move 0.23 m was 1.9 m away after 1 s and
-#: 113 m after 3 s. P alone closes the error by P·dt a step (0.1 s time constant).
-POSITION_GAIN = AMBF_CARTESIAN_P
+# A pose command steers a free body by its Cartesian controller (runner/cartesian.py): without a
+# `controller` block AMBF's P 10 (D 1) as a velocity, its D term left out: on a velocity output,
+# with the pose AMBF reads one step behind (its motion state), D 1 makes a loop whose roots ring at
+# 249.6 Hz and grow by 0.25 % a step at 1 kHz; measured in AMBF (`tests/test_parity_pose.py`), a 1 kg
+# box told to move 0.23 m was 1.9 m away after 1 s and 113 m after 3 s. P alone closes the error by
+# P·dt a step (0.1 s time constant). With a block, its gains, and its PD as a force where AMBF's is.
 
 
 def _set_pose(msg_pose, t: np.ndarray) -> None:
@@ -129,6 +130,7 @@ class BodyHandler(Handler):
 
     def rebind(self, obj: RosObject) -> None:
         self.obj, self.sb = obj, obj.target
+        self.steer: PoseSteer | None = None
         st = self.state
         st.mass = float(self.sb.mass)
         inertia = getattr(self.sb, "inertia", (0.0, 0.0, 0.0))
@@ -211,8 +213,16 @@ class BodyHandler(Handler):
                 elif hasattr(w, "move_base"):
                     w.move_base(sb, target)
             return
-        lin, ang = steer_velocity(sb.world_matrix() @ sb.com_in_body, target @ sb.com_in_body, POSITION_GAIN)
-        self._set_velocity(w, lin, ang)
+        if self.steer is None:  # the body's own Cartesian controller, kept from command to command
+            self.steer = PoseSteer.of(sb.body)
+        cur = sb.world_matrix() @ sb.com_in_body
+        cdt = w.dt * w.opt.control_substeps
+        lin, ang = self.steer.step(cur, target @ sb.com_in_body, cdt, w.opt.control_substeps == 1)
+        if self.steer.force:  # a `controller` block: AMBF's force and torque, held over the control step
+            sb.force(lin, sb.com_position())
+            sb.torque(ang)
+        else:
+            self._set_velocity(w, lin, ang)
 
     def _velocity(self, w, twist) -> None:
         lin = np.array([twist.linear.x, twist.linear.y, twist.linear.z])
