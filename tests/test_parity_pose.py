@@ -189,7 +189,7 @@ JOINT upper-lower:
 def test_a_pose_command_pushes_a_link_by_its_controller_block_as_ambf(tmp_path):
     """A link of an arm (a multibody link in adfkit) told a pose under its `controller` block:
     AMBF pushes its btRigidBody by the block's PD as a force and the arm follows; adfkit left
-    every link alone (the link 237 mm from AMBF's). The same force on the link: within 5 mm on
+    every link alone (the link 356 mm from AMBF's). The same force on the link: within 5 mm on
     the way, 0.5 mm at the end (measured 3.1 and 0.1 mm)."""
     (tmp_path / "arm.yaml").write_text(ARM)
     (tmp_path / "pose.txt").write_text("0.0, pose, lower, 0.35 0.25 0.5 0 0 1.2\n")
