@@ -274,6 +274,39 @@ def test_joint_pose_reports_pivots_held_together_standing_apart(tmp_path, kind):
     )
 
 
+def test_joint_pose_reports_a_joint_to_an_earlier_file_off_its_pivot(tmp_path):
+    # a.yaml's top, b.yaml's link hinged to it: its tree is not this file's, so only the pivots
+    # are read; the link 53.9 mm off (found only by `adfkit parity` before)
+    (tmp_path / "floor.yaml").write_text("bodies: []\n")
+    (tmp_path / "world.yaml").write_text("environment: floor.yaml\n")
+    (tmp_path / "input.yaml").write_text("input devices: []\n")
+    (tmp_path / "colors.yaml").write_text("red: {r: 1, g: 0, b: 0, a: 1}\n")
+    (tmp_path / "launch.yaml").write_text(
+        "world config: world.yaml\ncolor config: colors.yaml\ninput devices config: input.yaml\n"
+        "multibody configs: [a.yaml, b.yaml]\n"
+    )
+    box = "  mass: 0.5\n  collision shape: BOX\n  collision geometry: {x: 0.1, y: 0.1, z: 0.1}\n"
+    (tmp_path / "a.yaml").write_text(
+        "bodies: [BODY top]\nBODY top:\n  name: top\n" + box + "  location: {position: {x: 0.1, y: 0, z: 0.52}}\n"
+    )
+
+    def b_at(x, z):
+        (tmp_path / "b.yaml").write_text(
+            "bodies: [BODY link]\njoints: [JOINT top-link]\nBODY link:\n  name: link\n"
+            + box
+            + f"  location: {{position: {{x: {x}, y: 0, z: {z}}}}}\n"
+            "JOINT top-link:\n  name: top-link\n  parent: BODY top\n  child: BODY link\n  type: revolute\n"
+            "  parent pivot: {x: 0.15, y: 0, z: 0}\n  child pivot: {x: -0.1, y: 0, z: 0}\n"
+            "  parent axis: {x: 0, y: 1, z: 0}\n  child axis: {x: 0, y: 1, z: 0}\n"
+        )
+        results, _ = validate_paths([tmp_path / "launch.yaml"])
+        return [d for r in results for d in r.diagnostics if d.rule == "joint-pose"]
+
+    assert b_at(0.35, 0.52) == []
+    (off,) = b_at(0.4, 0.5)
+    assert "pivots of revolute joint 'JOINT top-link' 53.9 mm apart" in off.message, off.message
+
+
 @pytest.mark.parametrize(
     "rel, expected",
     [

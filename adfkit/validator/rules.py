@@ -129,7 +129,7 @@ _RULES = [
         W,
         "The bodies' `location`s put a revolute/prismatic joint outside its limits, or "
         "the child off the joint, or a fixed, p2p, cone-twist or torsion-spring joint's pivots apart "
-        "(AMBF moves it on the first steps)",
+        "(a revolute joint's too, to a body of an earlier file; AMBF moves it on the first steps)",
         "a child body 5 cm from its parent's pivot",
     ),
     Rule(

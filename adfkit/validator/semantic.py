@@ -277,7 +277,7 @@ class Checker:
         earlier = body_registry(self.context)
         for j in m.joints:
             self.joint(m, j, own, earlier)
-        self.joint_poses(m)
+        self.joint_poses(m, earlier)
         for s in [*m.sensors, *m.actuators]:
             self.sensor(s)
             self.reference(m, s, "parent", own, earlier, immediate=True)
@@ -604,12 +604,13 @@ class Checker:
             severity=severity,
         )
 
-    def joint_poses(self, m: ModelFile) -> None:
+    def joint_poses(self, m: ModelFile, earlier: Registry | None = None) -> None:
         """Where the file's `location`s put each revolute/prismatic joint of the kinematic
         tree: within its limits, and with the child on the joint (its pose reproduced by the
         parent's location and one joint value); and each fixed, p2p, cone-twist or torsion-spring
-        joint's two pivots together."""
-        self.pivots_apart(m)
+        joint's two pivots together (a revolute joint's too where it joins a body of an earlier
+        file, ``earlier``, which the tree of this file does not hold)."""
+        self.pivots_apart(m, earlier)
         if not any(joint_kind(j.type) in TREE_ONE_DOF for j in m.joints):
             return
         from ..model.tree import build_tree, motion
@@ -658,16 +659,32 @@ class Checker:
                     "(the Blender add-on writes both from the scene)",
                 )
 
-    def pivots_apart(self, m: ModelFile) -> None:
-        """A joint that holds its pivots together (fixed, p2p, cone twist, torsion spring) whose
-        bodies' `location`s put its pivots apart: AMBF starts the bodies there and its constraint
-        pulls them together over the first steps (the MuJoCo engine starts the child on the joint)."""
+    def pivots_apart(self, m: ModelFile, earlier: Registry | None = None) -> None:
+        """A joint that holds its pivots together (fixed, p2p, cone twist, torsion spring; a
+        revolute joint to a body of an earlier file) whose bodies' `location`s put its pivots
+        apart: AMBF starts the bodies there and its constraint pulls them together over the first
+        steps (the MuJoCo engine starts the child on the joint)."""
         from ..model.tree import find_body
 
         for j in m.joints:
-            if not j.defined or joint_kind(j.type) not in PIVOTS_HELD:
+            kind = joint_kind(j.type)
+            if not j.defined or kind not in (*PIVOTS_HELD, JointKind.REVOLUTE):
                 continue
-            parent, child = find_body(m, j.parent, j), find_body(m, j.child, j)
+            parent: Any = find_body(m, j.parent, j)
+            child: Any = find_body(m, j.child, j)
+            crossing = False
+            if earlier is not None and (parent is None or child is None):
+                jns = merge_namespace(m.namespace, j.namespace)
+                found: list[Any] = []
+                for ref, mine in ((j.parent, parent), (j.child, child)):
+                    if mine is None and ref:
+                        verdict, keys = earlier.lookup(ref, jns + ref)
+                        if verdict == "found":
+                            mine, crossing = earlier.keys[keys[0]], True
+                    found.append(mine)
+                parent, child = found
+            if kind not in PIVOTS_HELD and not crossing:
+                continue  # a revolute joint within this file: joint_poses reads it through the tree
             if parent is None or child is None or parent is child:
                 continue
             if parent.location is None or child.location is None:
