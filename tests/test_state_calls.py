@@ -47,8 +47,9 @@ def test_the_c_reads_are_pybullet_s_reads():
 
 
 def test_the_c_calls_play_the_python_calls_trajectory():
-    """The bundled suturing scene under adfkit run's options, 150 control steps, once with the C calls
-    and once with the Python calls: every body's state the same to the bit after every 10."""
+    """The bundled suturing scene under adfkit run's options, the springs evaluated in numpy, 150
+    control steps, once with the reads and pushes in C and once with the Python calls: every body's
+    state the same to the bit after every 10."""
     _c_or_skip()
     a = open_world(load_scene(BUNDLED, None), Options(**AMBF))
     b = open_world(load_scene(BUNDLED, None), Options(**AMBF))
@@ -56,7 +57,8 @@ def test_the_c_calls_play_the_python_calls_trajectory():
         a.step(1)
         b.step(1)
         assert a.springs._read_c is not None and b.springs._read_c is not None
-        b.springs._read_c = None  # the Python calls from here on
+        a.springs._c_springs = b.springs._c_springs = None  # numpy's evaluation on both
+        b.springs._read_c = None  # and the Python calls on one
         for _ in range(15):
             a.step(10)
             b.step(10)
@@ -75,6 +77,50 @@ def test_without_the_library_the_python_calls_play(monkeypatch):
     try:
         assert state_calls.for_client(w.cid) is None
         w.step(2)
-        assert w.springs._read_c is None and w.springs.pq
+        assert w.springs._read_c is None and w.springs._c_springs is None and w.springs.pq
+    finally:
+        w.close()
+
+
+def test_the_springs_in_c_give_numpy_s_torques_and_forces():
+    """The bundled suturing scene under adfkit run's options: the springs evaluated in C (spring_c.py)
+    give every body numpy's torque and force to round-off, after 100 control steps (the thread
+    resting on the phantom, its joints bent) and with a thread element spun (its limits act).
+    Control: with the C joints' rest angles moved they differ."""
+    _c_or_skip()
+    w = open_world(load_scene(BUNDLED, None), Options(**AMBF))
+    try:
+        w.step(100)
+        s = w.springs
+        cs = s._c_springs
+        assert cs is not None
+
+        def both():
+            state = pb.saveState(physicsClientId=w.cid)
+            cs.apply(s._c_read(), w.dt, 0.2)
+            in_c = cs.torque.copy(), cs.force.copy()
+            pb.restoreState(state, physicsClientId=w.cid)
+            got = {}
+            s._c_springs, s._push = None, lambda t, f, p: got.update(t=t.copy(), f=f)
+            try:
+                s.apply(w.dt)
+            finally:
+                s._c_springs = cs
+                del s._push
+            pb.restoreState(state, physicsClientId=w.cid)
+            force = got["f"] if got["f"] is not None else 0.0 * in_c[1]
+            return in_c, (got["t"], force)
+
+        def close(c, n):
+            scale = max(abs(n[0]).max(), abs(n[1]).max())
+            return max(abs(c[0] - n[0]).max(), abs(c[1] - n[1]).max()) <= 1e-9 * scale
+
+        assert close(*both())
+        thread = next(sb for sb in s.bodies if sb.name.startswith("Thread") and not sb.static)
+        pb.resetBaseVelocity(thread.uid, [0, 0, 0], [0.0, 40.0, 0.0], physicsClientId=w.cid)
+        assert close(*both())
+        moved = cs._keep["eq"] + 0.05  # the C's own rest angles (the set's stay)
+        cs.struct.eq = moved.ctypes.data
+        assert not close(*both())
     finally:
         w.close()

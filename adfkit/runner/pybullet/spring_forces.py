@@ -153,6 +153,7 @@ class SpringSet(SpringReads):
         self.m_implicit = np.where(exact, m_lin, self.m_eff[:, None])
         self._gains_dt = None
         self.cones = ConeLimits(self, cones, held, acc) if len(cones) else None
+        self._c_springs = None  # the whole evaluation in C, where it can be (spring_c.py; _read_plan)
 
     def _gains(self, dt: float) -> None:
         """Per-joint constants of the spring-damper -(K·x + C·v) / D at this step (_spring).
@@ -201,6 +202,11 @@ class SpringSet(SpringReads):
 
     def apply(self, dt: float, erp: float = 0.2) -> None:
         if not self.joints:
+            return
+        if self._order is None:
+            self._read_plan()
+        if self._c_springs is not None:  # read, evaluated and pushed in C (spring_c.py)
+            self._c_springs.apply(self._c_read(), dt, erp)
             return
         self._gains(dt)
         pos, rot, lv, av = self.states()

@@ -12,6 +12,7 @@ import numpy as np
 import pybullet as pb
 
 from ..rotations import quat_to_matrix
+from . import spring_c
 from .state_calls import for_client as state_calls_for
 
 
@@ -69,6 +70,13 @@ class SpringReads:
         if calls is not None:
             self._read_c = calls.reader(self._bases)
             self._apply_c = calls.applier(*self._twisted, *self._pushed[1:])
+            if spring_c.playable(self):
+                self._c_springs = spring_c.CSprings(calls.lib, calls.client, self)
+
+    def _c_read(self):
+        """The free bodies' states read in C (spring_c.py's path), kept for ``pq`` and last_state."""
+        a = self._bases_read = self._read_c()
+        return a
 
     def states(self):
         """(positions, rotation matrices, linear and angular velocities) of every body's COM;

@@ -5,7 +5,8 @@ PyBullet has no batched call for separate bodies: under AMBF's springs (Options.
 spring set reads each of the corpus suturing set's 49 free bodies twice and pushes 56 of them at
 every physics step, ~150 Python calls of ~1 µs. The C file makes the same requests of the same
 physics server through PyBullet's own C API, one request a body, so every number read or applied
-is the one PyBullet's Python calls give: the trajectory stays the same to the bit.
+is the one PyBullet's Python calls give: the trajectory stays the same to the bit. The same file
+evaluates AMBF's springs whole (spring_c.py), which is not numpy's rounding.
 
 Where no C compiler is found, the build fails, PyBullet refuses the plugin or ``ADFKIT_NO_C`` is
 set, ``for_client`` answers None and the runner makes the Python calls (the same numbers, slower).
@@ -49,7 +50,7 @@ def _build(path: Path) -> bool:
     os.close(fd)
     try:
         done = subprocess.run(
-            [cc, "-O2", "-shared", "-fPIC", "-o", tmp, str(SOURCE), "-ldl"], capture_output=True, timeout=120
+            [cc, "-O2", "-shared", "-fPIC", "-o", tmp, str(SOURCE), "-ldl", "-lm"], capture_output=True, timeout=120
         )
         if done.returncode != 0:
             return False
@@ -83,6 +84,9 @@ def _load() -> ctypes.CDLL | None:
     lib.adfkit_read_bases.restype = i
     lib.adfkit_apply.argtypes = (vp, i, ptr, ptr, ptr, i, ptr, ptr, ptr, ptr)
     lib.adfkit_apply.restype = None
+    d = ctypes.c_double
+    lib.adfkit_springs_apply.argtypes = (vp, ptr, ptr, d, d, ptr, ptr)
+    lib.adfkit_springs_apply.restype = i
     lib.path = str(path)
     _lib = lib
     return lib
