@@ -46,6 +46,9 @@ class Comparison:
     # what the adfkit world met on the way (runner/stability.py: a MuJoCo state reset, NaN, a flung
     # body), each with its time: its poses from then on are not the physics' answer
     unstable: list[str] = field(default_factory=list)
+    # a matched body whose pose stops being a number on one side (AMBF's world blowing up, as under
+    # a zero joint axis or a zero moment of inertia in contact): side, name, the first such time
+    not_a_number: list[dict] = field(default_factory=list)
 
     @property
     def tip_gaps(self) -> list[Gap]:
@@ -69,6 +72,10 @@ class Comparison:
         out += [f"only in AMBF: {d['kind']} {d['name']}" for d in self.only_in_ambf]
         out += [f"only in adfkit: {d['kind']} {d['name']}" for d in self.only_in_adfkit]
         out += [f"adfkit {self.adfkit.side} unstable: {u}" for u in self.unstable]
+        out += [
+            f"{'AMBF' if d['side'] == 'ambf' else 'adfkit ' + d['side']}'s {d['name']} is not a number from {d['from_s']:.3f} s"
+            for d in self.not_a_number
+        ]
         return out
 
     def as_json(self) -> dict:
@@ -103,6 +110,7 @@ class Comparison:
             "wall_s": {"ambf": self.ambf.wall_s, self.adfkit.side: self.adfkit.wall_s},
             "notes": self.notes,
             "adfkit_unstable": self.unstable,
+            "not_a_number": self.not_a_number,
             "joint_opening": {side: o.as_json() for side, o in self.opening.items()},
         }
 
@@ -162,13 +170,17 @@ def compare(ambf: Trace, adfkit: Trace, tolerance_m: float = 1e-3, tolerance_deg
     common = np.intersect1d(ta, tb)
     ia = np.searchsorted(ta, common)
     ib = np.searchsorted(tb, common)
-    bodies = []
+    bodies, nan = [], []
     if ambf.poses.size and adfkit.poses.size:
         for i, j in match(ambf.body_names, adfkit.body_names, ambf.poses[0, :, :3], adfkit.poses[0, :, :3]):
             pa, pb = ambf.poses[ia, i], adfkit.poses[ib, j]
             bodies.append(
                 Gap(ambf.body_names[i], np.linalg.norm(pa[:, :3] - pb[:, :3], axis=1), angle_deg(pa[:, 3:], pb[:, 3:]))
             )
+            for side, p in ((ambf.side, pa), (adfkit.side, pb)):
+                bad = ~np.isfinite(p).all(axis=1)
+                if bad.any():
+                    nan.append({"side": side, "name": ambf.body_names[i], "from_s": float(common[np.argmax(bad)])})
     joints = []
     for i, j in match(
         ambf.joint_names,
@@ -195,4 +207,5 @@ def compare(ambf: Trace, adfkit: Trace, tolerance_m: float = 1e-3, tolerance_deg
         _only(adfkit.made, ambf.made),
         tolerance_m,
         tolerance_deg,
+        not_a_number=nan,
     )

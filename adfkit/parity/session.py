@@ -233,6 +233,9 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
                 print(f"  {label}: {d['kind']} {d['name']}", file=stream)
         for u in c.unstable:
             print(f"  adfkit {eng} unstable: {u}", file=stream)
+        for d in c.not_a_number:
+            who = "AMBF" if d["side"] == "ambf" else f"adfkit {d['side']}"
+            print(f"  {who}'s {d['name']} is not a number from {d['from_s']:.3f} s", file=stream)
         print(
             f"  stepping: AMBF {c.ambf.wall_s:.2f} s, adfkit {eng} {c.adfkit.wall_s:.2f} s "
             f"(AMBF's whole process {out.ambf_process_s:.2f} s)",
