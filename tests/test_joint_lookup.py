@@ -110,3 +110,43 @@ def test_both_engines_make_the_joints_ambf_makes(tmp_path, engine):
     if BUILD is not None:
         r = loader.check_file(path, BUILD)
         assert r.ambf_counts["joint"] == 1 and r.agree, r.as_json()
+
+
+SELF_JOINT = f"""\
+namespace: /ambf/env/
+bodies: [BODY a]
+joints: [JOINT aa]
+BODY a:
+  name: a
+  mass: 1.0
+  {SPHERE}
+  location: {{position: {{x: 0, y: 0, z: 0.2}}}}
+JOINT aa:
+  name: aa
+  parent: BODY a
+  child: BODY a
+  type: revolute
+  parent pivot: {{x: 0, y: 0, z: 0}}
+  child pivot: {{x: 0, y: 0, z: 0}}
+  parent axis: {{x: 0, y: 0, z: 1}}
+  child axis: {{x: 0, y: 0, z: 1}}
+"""
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_joint_of_a_body_to_itself_is_listed_as_ambf_lists_it_and_moves_nothing(tmp_path, engine):
+    # AMBF makes it (its joint list has it) and it moves nothing; both engines left it out and
+    # `adfkit parity` said "only in AMBF: joint" (PyBullet printed its own createConstraint failure)
+    path = tmp_path / "self.yaml"
+    path.write_text(SELF_JOINT)
+    opt = Options(visuals=False, ground=False)
+    opt.bodies = "ambf"
+    world = open_world(load_scene(path), opt, engine=engine)
+    try:
+        assert made_by(world)["joint"] == ["/ambf/env/aa"]
+        assert world.joints_made == []  # nothing built for it
+    finally:
+        world.close()
+    if BUILD is not None:
+        r = loader.check_file(path, BUILD)
+        assert r.ambf_counts["joint"] == 1 and r.agree, r.as_json()

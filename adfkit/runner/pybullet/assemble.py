@@ -84,6 +84,9 @@ class Assembly:
                 if None in ends:
                     self._warn("runner-joint-body", f"{j.identifier}: parent or child body not found; skipped", j)
                     continue
+                if ends[0] is ends[1]:  # AMBF keeps it, and it moves nothing (World.inert_joints)
+                    self._warn("runner-joint-body", f"{j.identifier}: joins a body to itself; nothing made", j)
+                    continue
                 records.append((j, kind, ends[0], ends[1]))
         self.joints_made = [(j, parent, child) for j, _kind, parent, child in records]
         trees, leftover = articulation.components(records)
