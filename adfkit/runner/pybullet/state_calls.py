@@ -8,8 +8,9 @@ physics server through PyBullet's own C API, one request a body, so every number
 is the one PyBullet's Python calls give: the trajectory stays the same to the bit. The same file
 evaluates AMBF's springs whole (spring_c.py), which is not numpy's rounding.
 
-Where no C compiler is found, the build fails, PyBullet refuses the plugin or ``ADFKIT_NO_C`` is
-set, ``for_client`` answers None and the runner makes the Python calls (the same numbers, slower).
+Where no C compiler is found, the build fails, PyBullet refuses the plugin, the client is not a
+DIRECT one (a GUI server runs in a thread of its own) or ``ADFKIT_NO_C`` is set, ``for_client``
+answers None and the runner makes the Python calls (the same numbers, slower; numpy's springs).
 """
 
 from __future__ import annotations
@@ -139,6 +140,8 @@ class StateCalls:
 def for_client(cid: int) -> StateCalls | None:
     """The C calls for PyBullet client ``cid`` (its plugin loaded into its server), or None where
     they cannot be had (see the module)."""
+    if pb.getConnectionInfo(cid).get("connectionMethod") != pb.DIRECT:
+        return None  # a GUI or shared-memory server steps in a thread of its own: its client's calls alone
     lib = _load()
     if lib is None:
         return None
