@@ -379,7 +379,8 @@ class Checker:
                         "inertia",
                         f"body '{b.identifier}' has a non-positive moment of inertia ({ix:g}, {iy:g}, {iz:g})",
                         b.where("inertia"),
-                        "moments of a dynamic body are > 0 (AMBF cannot turn a body about an axis whose moment is 0)",
+                        "moments of a dynamic body are > 0 (AMBF cannot turn a body about an axis whose moment is 0, "
+                        "and its pose turns NaN once a contact turns it)",
                     )
                 elif any(a + c < e * (1 - 1e-6) for a, c, e in ((ix, iy, iz), (iy, iz, ix), (iz, ix, iy))):
                     self.emit(
