@@ -69,12 +69,12 @@ int main(int argc, char** argv) {
             q.setValue(qx, qy, qz, qw);
         };
         if (word == "body") {
-            double m, ix, iy, iz, fr, rf, rest, ld, ad;
+            double m, ix, iy, iz, fr, rf, rest, ld, ad, gx, gy, gz;
             int n;
             std::cin >> m >> ix >> iy >> iz;
             pose();
             btTransform at(q, p);
-            std::cin >> fr >> rf >> rest >> ld >> ad >> n;
+            std::cin >> fr >> rf >> rest >> ld >> ad >> gx >> gy >> gz >> n;
             btCollisionShape* col = nullptr;
             auto* compound = new btCompoundShape();
             for (int i = 0; i < n; i++) {
@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
             body->setActivationState(DISABLE_DEACTIVATION);  // afRigidBody, every body
             body->setSleepingThresholds(0, 0);
             world->addRigidBody(body);
+            body->setGravity(btVector3(gx, gy, gz));  // the world's, or the body's or model's `gravity` (afRigidBody)
             bodies.push_back(body);
         } else if (word == "fixed") {
             int a, b;

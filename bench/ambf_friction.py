@@ -110,7 +110,10 @@ def scene_text(world, seconds: float) -> str:
         p, q = matrix_to_pq(sb.body_world_matrix @ sb.com_in_body)
         mass = 0.0 if sb.static else sb.mass
         restitution = b.restitution if b.restitution is not None else DEFAULT_RESTITUTION
-        lines.append(_line("body", mass, *sb.inertia, *p, *q, info[1], info[6], restitution, lin, ang, str(len(prims))))
+        g = sb.gravity if sb.gravity is not None else world.gravity  # a body's or its model's `gravity`
+        lines.append(
+            _line("body", mass, *sb.inertia, *p, *q, info[1], info[6], restitution, lin, ang, *g, str(len(prims)))
+        )
         margin = b.collision_margin if b.collision_margin is not None else 0.001
         for prim in prims:
             g = prim.geometry

@@ -63,3 +63,66 @@ def test_ambfs_bullet_plays_the_cone_as_ambf_and_with_two_friction_directions_as
     # ... to within a millimetre of PyBullet's (measured 0.8 mm; AMBF's is 59.6 mm from it)
     assert _gaps(compare(two, pybullet))["cone"] < 2.0
     assert _gaps(compare(real, pybullet))["cone"] > 40.0
+
+
+SLIDING = """\
+bodies: [BODY ground, BODY grav, BODY brick]
+BODY ground:
+  name: ground
+  mass: 0.0
+  collision shape: Box
+  collision geometry: {x: 3, y: 3, z: 0.05}
+  location: {position: {x: 0.0, y: 0.0, z: -0.025}}
+BODY grav:
+  name: grav
+  mass: 0.2
+  gravity: {x: 0.0, y: 2.0, z: -5.0}
+  collision shape: CYLINDER
+  collision geometry: {radius: 0.03, height: 0.05, axis: Z}
+  location: {position: {x: 0.4, y: 0.0, z: 0.03}}
+BODY brick:
+  name: brick
+  mass: 0.2
+  gravity: {x: 1.5, y: 1.0, z: -5.0}
+  collision shape: BOX
+  collision geometry: {x: 0.06, y: 0.04, z: 0.03}
+  location: {position: {x: -0.4, y: 0.0, z: 0.02}}
+"""
+
+
+def test_bodies_sliding_flat_under_their_own_gravity_part_by_ambfs_friction_rows(bench, tmp_path):
+    # a cylinder and a brick sliding on their faces under sideways `gravity` of their own (a
+    # hand-made scene): AMBF's turn and drift where adfkit's slide straight (57 mm over 2 s). The
+    # program, given each body's gravity, plays them as AMBF does; with two friction directions
+    # started from zero, as adfkit's PyBullet does: AMBF's friction rows are the whole gap
+    from adfkit.adf import load_scene
+    from adfkit.parity.compare import compare
+    from adfkit.parity.traces import AdfkitPlayer, from_ambf
+    from adfkit.runner import Options, open_world
+
+    (tmp_path / "slide.yaml").write_text(SLIDING)
+    for name, text in {
+        "world.yaml": "environment: floor.yaml\n",
+        "floor.yaml": "bodies: []\n",
+        "input.yaml": "input devices: []\n",
+        "colors.yaml": "red: {r: 1, g: 0, b: 0, a: 1}\n",
+        "launch.yaml": "world config: world.yaml\ncolor config: colors.yaml\ninput devices config: input.yaml\n"
+        "multibody configs: [slide.yaml]\n",
+    }.items():
+        (tmp_path / name).write_text(text)
+    launch = tmp_path / "launch.yaml"
+    opt = Options(control_substeps=4, visuals=False, renderer="tiny", ground=False)
+    opt.ghosts, opt.springs, opt.link_shapes, opt.bodies = "ambf", "ambf", "body", "ambf"
+    world = open_world(load_scene(launch, [0], []), opt, engine="pybullet")
+    try:
+        text = bench.scene_text(world, 1.0)
+        exe = bench.program(BUILD)
+        one, both = bench.lab_trace(exe, text, world), bench.lab_trace(exe, text, world, "two", "fresh")
+        pybullet = AdfkitPlayer(world).play(1.0, 0.02)
+    finally:
+        world.close()
+    stage = ambf.Stage(launch, [0])
+    real = from_ambf(ambf.run(BUILD, stage, 1.0, 0.02), stage.staged_bodies)
+    assert max(_gaps(compare(real, one)).values()) < 1.0  # measured 0.26 mm
+    assert max(_gaps(compare(both, pybullet)).values()) < 1.0  # measured 0.38 mm
+    assert max(_gaps(compare(real, pybullet)).values()) > 10.0  # measured 29.3 mm
