@@ -125,3 +125,35 @@ def test_a_take_reaims_where_its_grasp_moved_past_the_jaws_room():
     seed_1[:3, :3] = rotation_exp(np.radians([0.0, 6.0, 0.0]))
     seed_1[:3, 3] += [0.0, -0.0017, 0.0]
     assert _apart(a, seed_1) > REAIM
+
+
+def test_a_joint_move_onto_a_limit_stays_within_it():
+    """Motions.move_jp from a wrist yaw of -0.5207 rad to its upper limit (a goal ``move``
+    clipped there): the line q0 + (q1 - q0) * s rounds to one ulp past the limit at its end,
+    which servo_jp refuses (a phantom's carry 1 stopped so, its plan good); the move ends on the
+    limit, every set-point on the way within it."""
+
+    from suture_phantoms import BUNDLED
+
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.suture import SutureTask
+
+    world = open_world(load_scene(BUNDLED / "launch.yaml"), Options(renderer="tiny", visuals=False))
+    try:
+        task = SutureTask(world, [1], seed=0)
+        task.phase = "test"
+        psm = next(iter(task.psms.values()))
+        hi = float(psm.kin.upper_limits[5])
+        q0 = psm.setpoint_jp().copy()
+        q0[5] = -0.520749
+        assert q0[5] + (hi - q0[5]) * 1.0 > hi  # the straight line's end, as floats add it
+        psm.servo_jp(q0)
+        q1 = q0.copy()
+        q1[5] = hi
+        seen = []
+        for _ in task.move_jp(psm, q1, 0.05, settle=0.0):
+            seen.append(psm.setpoint_jp()[5])
+        assert seen[-1] == hi and max(seen) <= hi and len(seen) > 2
+    finally:
+        world.close()

@@ -106,11 +106,19 @@ class Motions:
         yield from self.move_jp(psm, q, seconds, settle)
 
     def move_jp(self, psm: PSM, q1, seconds: float, settle: float = 0.15):
+        """From the set-point to q1, each joint along a straight line in joint space. A joint
+        whose ends are both within its limits stays within them on the way: q0 + (q1 - q0) * s
+        can round one ulp past q1, and a goal clipped onto a limit (``move``) was then refused
+        by servo_jp (a phantom's carry 1 stopped there, "outer_wrist_yaw = 1.396 (limits
+        -1.396…1.396)", its plan good); the values within the limits are those of the line."""
         q0 = psm.setpoint_jp()
         q1 = np.asarray(q1, dtype=float)
+        lo, hi = psm.kin.lower_limits[: len(q1)], psm.kin.upper_limits[: len(q1)]
+        kept = (q0 >= lo) & (q0 <= hi) & (q1 >= lo) & (q1 <= hi)
         n = self._steps(seconds)
         for i in range(1, n + 1):
-            psm.servo_jp(q0 + (q1 - q0) * smooth(i / n))
+            q = q0 + (q1 - q0) * smooth(i / n)
+            psm.servo_jp(np.where(kept, np.clip(q, lo, hi), q))
             yield self.phase
         yield from self.wait(settle)
 
