@@ -375,5 +375,9 @@ def test_a_pair_out_of_the_arms_reach_is_named_with_how_far(tmp_path):
         assert re.search(
             r"'s outer_\w+ \d+\.\d(°| mm) past its limit with the needle's tip \d+\.\d mm from (Entry|Exit)1", msg
         )
+        # the pairs' centre, for which the arms stand, is 85 mm from each: said, with each pair's distance
+        assert msg.endswith(
+            "; the pairs lie up to 85.0 mm from their centre, for which the arms are set up (pair 1 85.0 mm, pair 2 85.0 mm)"
+        )
     finally:
         world.close()

@@ -65,6 +65,9 @@ PULL_LIFT = 2 * LIFT
 HAND_BACK_LIFT = 2 * LIFT
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
+#: m from the pairs' centre (where the arms are set up, and a --phantom's placed) beyond which an
+#: arm that reaches no grasp is told how far each pair lies (the bundled pairs lie within 36 mm)
+SPREAD_NOTE = 0.04
 
 
 @dataclass
@@ -332,26 +335,49 @@ class SutureTask(GraspChoice, Motions):
         self.handback_about_tail: list[bool] = []  # per hand-back: carried with the tail on a line
         self.pulls: list[tuple[float, list, tuple]] = []  # per pair: the grasp's angle, the poses, where clear
         for k, p in enumerate(self.pairs):
-            b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
-            psi_end = psi_x + beyond
-            insertion = [self.lifted(self.needle_at(b, -self.approach), LIFT)]
-            insertion += [self.needle_at(b, psi) for psi in np.linspace(-self.approach, psi_end, 7)]
-            along = self.along_arc(b, -self.approach, psi_end)
-            if k == 0:
-                self.drive_grasps.append(
-                    self.choose_grasp(
-                        self.psms[self.driver],
-                        -self.geom.span + g_tail,
-                        [n0, self.lifted(n0, LIFT)] + insertion,
-                        down_at=n0,
-                        what=f"pair {p.index}, driving",
-                        clear_at=(n0, insertion[0], *along),
-                        joint_moves=(2,),  # carry_to: from over the pick-up to over the entry
-                    )
+            try:
+                self._plan_pair(k, p, n0)
+            except SutureError as exc:
+                raise SutureError(f"{exc}{self._spread(centres)}") from exc
+
+    def _spread(self, centres: list) -> str:
+        """ "; the pairs lie ... from their centre" where one lies more than SPREAD_NOTE from it:
+        a pair far from the others takes the arms' reach from all (a phantom's pair 2 moved
+        200 mm away left pair 1 out of reach, and the message named pair 1 alone)."""
+        if len(centres) < 2:
+            return ""
+        mid = np.mean(centres, axis=0)
+        away = [float(np.linalg.norm(c - mid)) for c in centres]
+        if max(away) <= SPREAD_NOTE:
+            return ""
+        each = ", ".join(f"pair {p.index} {a * 1000:.1f} mm" for p, a in zip(self.pairs, away))
+        return (
+            f"; the pairs lie up to {max(away) * 1000:.1f} mm from their centre, for which the arms are set up ({each})"
+        )
+
+    def _plan_pair(self, k: int, p: HolePair, n0: np.ndarray) -> None:
+        """The driver's grasp (the pick-up's, or the hand-back's) and the puller's for pair p,
+        the k-th visited."""
+        b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
+        psi_end = psi_x + beyond
+        insertion = [self.lifted(self.needle_at(b, -self.approach), LIFT)]
+        insertion += [self.needle_at(b, psi) for psi in np.linspace(-self.approach, psi_end, 7)]
+        along = self.along_arc(b, -self.approach, psi_end)
+        if k == 0:
+            self.drive_grasps.append(
+                self.choose_grasp(
+                    self.psms[self.driver],
+                    -self.geom.span + g_tail,
+                    [n0, self.lifted(n0, LIFT)] + insertion,
+                    down_at=n0,
+                    what=f"pair {p.index}, driving",
+                    clear_at=(n0, insertion[0], *along),
+                    joint_moves=(2,),  # carry_to: from over the pick-up to over the entry
                 )
-            else:
-                self.drive_grasps.append(self.hand_back(k, g_tail, insertion))
-            self.plan_pull(p, b, psi_x, psi_end, g_tip)
+            )
+        else:
+            self.drive_grasps.append(self.hand_back(k, g_tail, insertion))
+        self.plan_pull(p, b, psi_x, psi_end, g_tip)
 
     def plan_pull(self, p: HolePair, b: np.ndarray, psi_x: float, psi_end: float, g_tip: float) -> None:
         """The puller's grasp for pair p and how far its pull turns the needle: the tail
