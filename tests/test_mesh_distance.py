@@ -5,6 +5,8 @@ convex hull (as MuJoCo collides it) fills the channels."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from suture_phantoms import phantom_file
@@ -94,3 +96,34 @@ def test_an_open_sheet_has_no_inside():
     assert (d >= 0).all() and (closed < 0).any()
     # two faces fewer: no point nearer, most as near as to the closed surface
     assert (d >= np.abs(closed) - 1e-12).all() and (np.abs(d - np.abs(closed)) < 1e-12).mean() > 0.5
+
+
+def test_a_cylinder_of_tissue_is_read_as_a_cylinder_not_its_capsule():
+    """A cylinder primitive (12 mm radius, 20 mm long along y): the signed distance is the
+    cylinder's, 12 mm past its ends too, where the capsule of its radius it was read as reached."""
+    from types import SimpleNamespace
+
+    from adfkit.model import Body, Geometry, Pose, Vec3
+
+    body = Body(
+        identifier="BODY Ridge",
+        name="Ridge",
+        mass=0.0,
+        location=Pose(Vec3(0.01, 0.02, 0.0)),
+        collision_shape="Cylinder",
+        collision_geometry=Geometry(radius=0.012, height=0.02, axis="y"),
+    )
+    sb = SimpleNamespace(body=body, model=None, name="Ridge", static=True, world_matrix=lambda: np.eye(4))
+    sb.world_matrix = lambda: np.array([[1, 0, 0, 0.01], [0, 1, 0, 0.02], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+    t = Tissue([sb])
+    local = np.array(
+        [
+            [0.0, 0.0, 0.0],  # the centre: 10 mm inside (the ends are nearer than the side)
+            [0.0, 0.0, 0.015],  # 3 mm off the side
+            [0.0, 0.013, 0.0],  # 3 mm past an end, on the axis (the capsule: 9 mm inside)
+            [0.0, 0.013, 0.015],  # 3 mm past the end and 3 mm off the side: the rim 4.24 mm away
+            [0.005, -0.004, 0.0],  # 7 mm in from the side, 6 mm in from the end
+        ]
+    )
+    got = t.exact(local + [0.01, 0.02, 0.0], np.array([0.01, 0.02, 0.0]), 0.1)
+    assert got == pytest.approx([-0.010, 0.003, 0.003, math.hypot(0.003, 0.003), -0.006], abs=1e-12)

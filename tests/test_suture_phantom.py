@@ -358,6 +358,68 @@ def test_a_phantom_colliding_as_its_mesh_is_read_as_the_engine_collides_it(tmp_p
     )
 
 
+def _curved_ridge(doc, radius=0.012):
+    """The ridge a horizontal cylinder along the line of pairs (a gap at each pair), its top where
+    the ridge's was; the holes on its curved surface, each turned to its normal there."""
+    from adfkit.model import Geometry, Pose, ShapeEntry, Vec3
+    from adfkit.scenes.suturing.frames import pose, rot_y, translation
+
+    phantom = next(b for b in doc.bodies if b.name == "Phantom")
+    zc = L.RIDGE_TOP - radius
+    ys = sorted({b.location.position.y for b in doc.bodies if b.name.startswith("Entry")})
+    edges = [-max(abs(y) for y in ys) - 0.014]
+    for y in ys:
+        edges += [y - L.RIDGE_GAP / 2, y + L.RIDGE_GAP / 2]
+    edges.append(-edges[0])
+    phantom.compound_collision_shape = phantom.compound_collision_shape[:1] + [
+        ShapeEntry(
+            shape="Cylinder",
+            geometry=Geometry(radius=radius, height=b - a, axis="y"),
+            offset=Pose(Vec3(0.0, (a + b) / 2, zc)),
+        )
+        for a, b in zip(edges[0::2], edges[1::2])
+    ]
+    x = L.HOLE_HALF_GAP
+    for b in doc.bodies:
+        for kind, sign in (("Entry", -1.0), ("Exit", 1.0)):
+            if b.name.startswith(kind):
+                z = zc + math.sqrt(radius**2 - x * x)
+                b.location = pose(translation(sign * x, b.location.position.y, z) @ rot_y(sign * math.asin(x / radius)))
+
+
+def _tilted(doc, deg=30.0):
+    """The whole phantom turned ``deg`` about x: the line of pairs runs uphill."""
+    from adfkit.runner.rotations import pose_to_matrix
+    from adfkit.scenes.suturing.frames import pose, rot_x
+
+    for b in doc.bodies:
+        b.location = pose(rot_x(math.radians(deg)) @ pose_to_matrix(b.location))
+
+
+@pytest.mark.parametrize("change", [_curved_ridge, _tilted])
+def test_holes_on_a_curved_or_sloping_surface_are_read_as_lying_on_it(tmp_path, change):
+    """Holes on a ridge of 12 mm radius (each turned to the surface's normal) and on a phantom
+    tilted 30 degrees: the check before the run finds the arcs clear (the ridge's cylinders read
+    as capsules filled the channels: "Phantom lies in the needle's path ... 3.4 mm inside it")
+    and the holes on the surface (the highest ray of the ring stood 1.8 and 2.9 mm above them)."""
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.needle import wire_radius
+    from adfkit.tasks.suture import SutureTask
+    from adfkit.tasks.sweep import check
+
+    path = phantom_file(tmp_path, pairs=2, spacing=0.012)
+    doc, _ = read_file(path, "model")
+    change(doc)
+    write_file(doc, path)
+    c = _compose(path)
+    world = open_world(c.scene, Options(renderer="tiny", visuals=False))
+    try:
+        task = SutureTask(world, c.pairs, seed=0)
+        assert check(task, wire_radius(task)) == {}
+    finally:
+        world.close()
+
+
 def test_a_pair_out_of_the_arms_reach_is_named_with_how_far(tmp_path):
     """Two pairs 170 mm apart: the arms, placed for their centre, reach neither; the plan says
     which hole, which joint and by how much, before anything moves."""

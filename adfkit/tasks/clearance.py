@@ -110,7 +110,8 @@ class Tissue:
         PyBullet collide it (False: as the hulls of its pieces, as MuJoCo collides it)."""
         self.triangles = triangles
         self.boxes: list[tuple[np.ndarray, np.ndarray]] = []  # (world-from-box 4x4, half extents)
-        self.segments: list[tuple[np.ndarray, np.ndarray, float]] = []  # capsules, spheres, cylinders
+        self.segments: list[tuple[np.ndarray, np.ndarray, float]] = []  # capsules, spheres, cones
+        self.cylinders: list[tuple[np.ndarray, np.ndarray, float, float]] = []  # (centre, axis, half height, radius)
         self.planes: list[tuple[np.ndarray, float]] = []  # (normal, offset): n·x <= offset is inside
         self.hulls: list[tuple[np.ndarray, np.ndarray]] = []
         self.meshes: list[TriangleMeshes] = []  # static concave collision meshes, as their triangles
@@ -156,9 +157,13 @@ class Tissue:
                 a = axis_vector(g.axis)
                 u = m[:3, :3] @ np.array([a.x, a.y, a.z], dtype=float)
                 h = _num(g.height) / 2
+                if p.kind is ShapeKind.CYLINDER:  # exact: as a capsule its caps filled the channels
+                    # beside a curved ridge of 12 mm radius (a phantom's), 12 mm past each end
+                    self.cylinders.append((c, u, h, _num(g.radius)))
+                    continue
                 if p.kind is ShapeKind.CAPSULE:  # its height includes the caps (adf-format.md §7.5)
                     h = max(h - _num(g.radius), 0.0)
-                # a cylinder or cone lies inside the capsule of its radius along its axis
+                # a cone lies inside the capsule of its base radius along its axis
                 self.segments.append((c - h * u, c + h * u, _num(g.radius)))
             elif p.kind is ShapeKind.PLANE and g.normal is not None:
                 n = m[:3, :3] @ np.array([_num(g.normal.x), _num(g.normal.y), _num(g.normal.z)], dtype=float)
@@ -174,6 +179,11 @@ class Tissue:
         self._seg_a = np.array([a for a, _, _ in self.segments]).reshape(-1, 3)
         self._seg_ab = np.array([b - a for a, b, _ in self.segments]).reshape(-1, 3)
         self._seg_r = np.array([r for _, _, r in self.segments])
+        self._cyl_c = np.array([c for c, _, _, _ in self.cylinders]).reshape(-1, 3)
+        self._cyl_u = np.array([u for _, u, _, _ in self.cylinders]).reshape(-1, 3)
+        self._cyl_h = np.array([h for _, _, h, _ in self.cylinders])
+        self._cyl_r = np.array([r for _, _, _, r in self.cylinders])
+        self._cyl_reach = np.hypot(self._cyl_h, self._cyl_r)
         self._plane_n = np.array([n for n, _ in self.planes]).reshape(-1, 3)
         self._plane_d = np.array([d for _, d in self.planes])
         self._box_reach = np.linalg.norm(self._box_h, axis=1)
@@ -196,6 +206,15 @@ class Tissue:
             ab = self._seg_ab[segs, None, :]
             t = np.clip((ap * ab).sum(axis=2) / np.maximum((ab * ab).sum(axis=2), 1e-18), 0.0, 1.0)
             d = np.sqrt(((ap - t[:, :, None] * ab) ** 2).sum(axis=2)) - self._seg_r[segs, None]
+            best = np.minimum(best, d.min(axis=0))
+        cyls = np.flatnonzero(np.linalg.norm(self._cyl_c - near, axis=1) < radius + self._cyl_reach)
+        if len(cyls):
+            cp = pts[None, :, :] - self._cyl_c[cyls, None, :]
+            along = (cp * self._cyl_u[cyls, None, :]).sum(axis=2)
+            across = np.linalg.norm(cp - along[:, :, None] * self._cyl_u[cyls, None, :], axis=2)
+            q_r = across - self._cyl_r[cyls, None]
+            q_h = np.abs(along) - self._cyl_h[cyls, None]
+            d = np.minimum(np.maximum(q_r, q_h), 0.0) + np.hypot(np.maximum(q_r, 0.0), np.maximum(q_h, 0.0))
             best = np.minimum(best, d.min(axis=0))
         if len(self._plane_d):
             best = np.minimum(best, (pts @ self._plane_n.T - self._plane_d).min(axis=1))

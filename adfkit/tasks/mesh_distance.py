@@ -1,7 +1,8 @@
 """The distance from points to a static tissue body's collision mesh as AMBF and PyBullet collide
-it: its triangles (AMBF's default `collision mesh type`, CONCAVE_MESH, a ``btBvhTriangleMeshShape``
-for a static body; PyBullet's ``GEOM_FORCE_CONCAVE_TRIMESH``), not their convex hull, which
-fills every channel and hole of a phantom modelled as one mesh.
+it: its triangles (AMBF's default `collision mesh type`, CONCAVE_MESH: a ``btGImpactMeshShape``
+per sub-mesh, ``afShapeUtils::createCollisionShape``; PyBullet's ``GEOM_FORCE_CONCAVE_TRIMESH``
+for a static body), not their convex hull, which fills every channel and hole of a phantom
+modelled as one mesh.
 
 Own numpy, not ``trimesh.proximity``: that needs ``rtree`` (not a dependency of the project),
 and the clearance asks for a few hundred points at a time against the triangles near them,
