@@ -420,6 +420,41 @@ def test_holes_on_a_curved_or_sloping_surface_are_read_as_lying_on_it(tmp_path, 
         world.close()
 
 
+def test_a_phantom_given_as_a_launch_file_of_several_model_files_is_composed_as_one(tmp_path):
+    """The phantom's tissue in one model file, its hole bodies and ghosts in another, a launch
+    file listing both (and a world of its own): --phantom takes the launch's model files (the
+    ghosts' parents found in the other file) and composes them as the one-file phantom; the
+    launch's world is the bundled scene's, and it says so. A launch file was refused: "this
+    looks like a launch file, not a model file"."""
+    from adfkit.model import ModelFile
+    from adfkit.scenes.suturing.own_phantom import load_phantom
+
+    one = phantom_file(tmp_path / "one", pairs=3, spacing=0.012)
+    doc, _ = read_file(one, "model")
+    folder = one.parent
+    tissue = ModelFile(namespace=doc.namespace, high_resolution_path="./meshes/", low_resolution_path="./meshes/")
+    holes = ModelFile(namespace=doc.namespace)
+    tissue.bodies = [b for b in doc.bodies if b.name == "Phantom"]
+    holes.bodies, holes.ghost_objects = [b for b in doc.bodies if b.name != "Phantom"], doc.ghost_objects
+    (folder / "parts").mkdir()
+    write_file(tissue, folder / "tissue.yaml")
+    write_file(holes, folder / "parts" / "holes.yaml")
+    (folder / "launch.yaml").write_text(
+        "world config: ./world.yaml\nmultibody configs:\n  - ./tissue.yaml\n  - ./parts/holes.yaml\n"
+    )
+    (folder / "world.yaml").write_text("enclosure size: {length: 10.0, width: 10.0, height: 3.0}\n")
+    diags: list = []
+    files = load_phantom(folder / "launch.yaml", diags)
+    assert isinstance(files, list) and len(files) == 2
+    assert any(d.rule == "phantom-launch" and "world config" in d.message for d in diags)
+    bundled = load_scene(BUNDLED / "launch.yaml")
+    a, b = compose(bundled, doc), compose(bundled, files)
+    assert b.pairs == a.pairs == [1, 2, 3] and b.lift_m == pytest.approx(a.lift_m, abs=1e-12)
+    assert b.placement == pytest.approx(a.placement, abs=1e-12)
+    names = sorted(x.name for m in b.scene.models for x in m.bodies)
+    assert names == sorted(x.name for m in a.scene.models for x in m.bodies)
+
+
 def test_a_pair_out_of_the_arms_reach_is_named_with_how_far(tmp_path):
     """Two pairs 170 mm apart: the arms, placed for their centre, reach neither; the plan says
     which hole, which joint and by how much, before anything moves."""

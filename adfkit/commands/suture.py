@@ -37,6 +37,7 @@ def add_arguments(p) -> None:
         "--phantom",
         metavar="MODEL.yaml",
         help="your phantom's model file (as the Blender add-on exports it, with Entry k / Exit k hole ghosts), "
+        "or a launch file listing its model files, "
         "played in the bundled scene in place of its phantom, the arms, needle and cameras placed for its holes",
     )
     p.add_argument(

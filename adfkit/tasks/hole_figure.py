@@ -74,10 +74,9 @@ def draw(launch: Path, pair: int, out: Path, phantom: Path | None = None) -> Non
 
     scene = load_scene(launch)
     if phantom is not None:
-        from ..adf import read_file
-        from ..scenes.suturing.own_phantom import compose
+        from ..scenes.suturing.own_phantom import compose, load_phantom
 
-        scene = compose(scene, read_file(phantom, "model")[0]).scene
+        scene = compose(scene, load_phantom(Path(phantom), [])).scene
     world = open_world(scene, Options(renderer="tiny", visuals=False))
     try:
         task = SutureTask(world, [pair], seed=0)

@@ -98,7 +98,7 @@ def _ref(text: str | None) -> str:
     return s[5:].strip() if s.upper().startswith("BODY ") else s
 
 
-def phantom_holes(model: ModelFile) -> Holes:
+def phantom_holes(model: ModelFile | _Files) -> Holes:
     """The hole ghosts of a phantom file, by pair, with where each hole is."""
     bodies = {_ref(b.identifier): b for b in model.bodies}
     out = Holes()
@@ -119,7 +119,7 @@ def phantom_holes(model: ModelFile) -> Holes:
     return out
 
 
-def check_holes(holes: Holes, model: ModelFile) -> None:
+def check_holes(holes: Holes, model: ModelFile | _Files) -> None:
     """Refuse, saying why, a phantom whose holes cannot be sutured as they stand: none at all
     (or hole bodies without their ghosts), a hole without its pair's other one, two ghosts for
     one hole, a pair so far apart that the file is in other units than metres."""
@@ -208,7 +208,7 @@ class _Placed:
         return self._t
 
 
-def tissue_top(model: ModelFile, points: np.ndarray, below: float = 0.03, triangles: bool = True) -> np.ndarray:
+def tissue_top(models: list[ModelFile], points: np.ndarray, below: float = 0.03, triangles: bool = True) -> np.ndarray:
     """For each world point (N, 3), the height of the phantom's collision surface under it (the
     first it meets looking down from ``below`` above the point); -inf where there is none within
     2 * ``below``. ``triangles``: a concave collision mesh read as the engine collides it
@@ -216,7 +216,9 @@ def tissue_top(model: ModelFile, points: np.ndarray, below: float = 0.03, triang
     from ...tasks.clearance import Tissue
     from ...tasks.sweep import march
 
-    bodies = [_Placed(b, model) for b in model.bodies if collision_primitives(b) != [] and (b.mass or 0.0) == 0.0]
+    bodies = [
+        _Placed(b, m) for m in models for b in m.bodies if collision_primitives(b) != [] and (b.mass or 0.0) == 0.0
+    ]
     shapes = Tissue(bodies, triangles=triangles)
     t = march(shapes, points + below * _up(), -_up(), far=2 * below)
     return np.where(np.isfinite(t), points[:, 2] + below - t, -np.inf)
@@ -284,19 +286,32 @@ def _moved(body: Body, t: np.ndarray) -> None:
     body.location = pose(t @ _matrix(body.location))
 
 
-def compose(bundled: Scene, phantom: ModelFile, triangles: bool = True) -> Composed:
-    """The bundled scene with ``phantom`` in place of its phantom, the rest placed for its holes
-    (the module docstring); ``triangles``: whether the engine collides a static concave mesh as
-    its triangles (tissue_top)."""
-    holes = phantom_holes(phantom)
-    own = [b.name or b.identifier for b in phantom.bodies if NEEDLE_PARTS.match(b.name or "")]
+class _Files:
+    """Several model files read as one phantom: their bodies, joints and ghosts together (a
+    ghost's parent may stand in another file, as AMBF finds it by name)."""
+
+    def __init__(self, models: list[ModelFile]) -> None:
+        self.models = models
+        self.bodies = [b for m in models for b in m.bodies]
+        self.joints = [j for m in models for j in m.joints]
+        self.ghost_objects = [g for m in models for g in m.ghost_objects]
+
+
+def compose(bundled: Scene, phantom: ModelFile | list[ModelFile], triangles: bool = True) -> Composed:
+    """The bundled scene with ``phantom`` (a model file, or the model files of a launch file) in
+    place of its phantom, the rest placed for its holes (the module docstring); ``triangles``:
+    whether the engine collides a static concave mesh as its triangles (tissue_top)."""
+    files = phantom if isinstance(phantom, list) else [phantom]
+    whole = _Files(files)
+    holes = phantom_holes(whole)
+    own = [b.name or b.identifier for b in whole.bodies if NEEDLE_PARTS.match(b.name or "")]
     if own:
         raise PhantomError(
             f"the phantom file has its own {own[0]}: --phantom puts a phantom beside the bundled needle "
             "and thread; export the phantom's bodies alone, or play your whole scene (adfkit suture SCENE)"
         )
     kept = {b.name for m in bundled.models for b in m.bodies if not BUNDLED_TISSUE.match(b.name or "")}
-    clash = sorted({b.name for b in phantom.bodies if b.name in kept})
+    clash = sorted({b.name for b in whole.bodies if b.name in kept})
     if clash:
         # the bundled scene's cameras hang from its CameraFrame: beside a second one they found no
         # parent and stayed where the bundled scene has them, whatever the placement
@@ -305,7 +320,7 @@ def compose(bundled: Scene, phantom: ModelFile, triangles: bool = True) -> Compo
             f"({'the stereo camera hangs from it' if clash[0] == 'CameraFrame' else 'the arms, the needle or the camera'}): "
             "export the phantom's tissue and hole bodies alone, or rename it"
         )
-    check_holes(holes, phantom)
+    check_holes(holes, whole)
     t = placement(holes)
     scene = copy.deepcopy(bundled)
     needle_file = None
@@ -341,7 +356,7 @@ def compose(bundled: Scene, phantom: ModelFile, triangles: bool = True) -> Compo
     grid = [(x, y, bed - TRAY_DEPTH) for x in np.linspace(sx0, sx1, 9) for y in np.linspace(sy0, sy1, 5)]
     under = np.array(grid + [(p[0], p[1], bed) for p in wire])
     placed = np.c_[under, np.ones(len(under))] @ needle_t.T
-    top = tissue_top(phantom, placed[:, :3], triangles=triangles)
+    top = tissue_top(files, placed[:, :3], triangles=triangles)
     lift = max(0.0, float(np.max(top - placed[:, 2]))) if np.isfinite(top).any() else 0.0
     if lift > 0:
         up = translation(0.0, 0.0, lift)
@@ -349,7 +364,7 @@ def compose(bundled: Scene, phantom: ModelFile, triangles: bool = True) -> Compo
             if NEEDLE_PARTS.match(b.name or ""):
                 _moved(b, up)
     needle_file.bodies.append(_tray(rects, bed, translation(0.0, 0.0, lift) @ needle_t))
-    models.append(phantom)
+    models.extend(files)
     scene.models = models
     # from the needle's end of the line on (the bundled pair 1 is there): a phantom numbered the
     # other way, sutured 1 to N, started at the far end with the thread drawn back over the pairs
@@ -358,10 +373,37 @@ def compose(bundled: Scene, phantom: ModelFile, triangles: bool = True) -> Compo
     return Composed(scene, t, lift, pairs, holes.names)
 
 
-def load_phantom(path: Path, diagnostics: list) -> ModelFile:
-    """The phantom model file, read through the input policy (a file named on the command line)."""
-    from ...adf import read_file
+def load_phantom(path: Path, diagnostics: list) -> ModelFile | list[ModelFile]:
+    """The phantom model file, read through the input policy (a file named on the command line);
+    or, for a launch file, the model files it lists (``multibody configs``), as AMBF loads them:
+    a phantom whose tissue, holes and ghosts stand in several files. Its world, colours and input
+    devices are the bundled scene's (said, where it names them)."""
+    from ...adf import load_scene, read_file
+    from ...diagnostics import warning
+    from ...model import Launch
 
-    doc, found = read_file(path, "model")
-    diagnostics.extend(found)
-    return doc
+    doc, found = read_file(path)
+    if not isinstance(doc, Launch):
+        doc, found = read_file(path, "model")
+        diagnostics.extend(found)
+        return doc
+    scene = load_scene(path, None, diagnostics)
+    kept = [
+        k
+        for k, v in (
+            ("world config", doc.world_config),
+            ("color config", doc.color_config),
+            ("input devices config", doc.input_devices_config),
+            ("plugins", doc.plugins),
+        )
+        if v
+    ]
+    if kept:
+        diagnostics.append(
+            warning(
+                "phantom-launch",
+                f"--phantom takes the model files of {path.name}; its {', '.join(kept)} not (the bundled scene's stand)",
+                doc.where(),
+            )
+        )
+    return scene.models
