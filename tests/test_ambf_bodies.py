@@ -299,3 +299,23 @@ def test_a_moment_of_inertia_of_zero_keeps_the_body_from_turning_as_in_ambf(tmp_
         assert abs(w.body("arm").world_matrix()[2, 3] - 0.6) < 1e-4
     finally:
         w.close()
+
+
+def test_mujoco_plays_one_zero_moment_beside_two_others_and_says_so(tmp_path):
+    # (0, 1e-3, 1e-3): frozen about x it is no inertia MuJoCo accepts (A + B >= C), and the MuJoCo
+    # engine refused the whole scene ("inertia must satisfy A + B >= C"); it now plays the file's
+    # moments, said with a located warning (AMBF's body turns NaN once a contact turns it)
+    path = tmp_path / "one_zero.yaml"
+    path.write_text(
+        "bodies: [BODY a]\nBODY a:\n  name: a\n  mass: 1.0\n  inertia: {ix: 0, iy: 0.001, iz: 0.001}\n"
+        "  collision shape: BOX\n  collision geometry: {x: 0.1, y: 0.1, z: 0.1}\n"
+        "  location: {position: {x: 0, y: 0, z: 0.2}}\n"
+    )
+    w = open_world(load_scene(path), Options(visuals=False, ground=True, bodies="ambf"), engine="mujoco")
+    try:
+        said = [d for d in w.diagnostics if d.rule == "runner-inertia"]
+        assert len(said) == 1 and said[0].location.line == 3
+        w.run(0.3)
+        assert np.isfinite(w.body("a").world_matrix()).all()
+    finally:
+        w.close()

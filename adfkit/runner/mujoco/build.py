@@ -259,7 +259,7 @@ def build_plan(world) -> Plan:
                 )
     stiff_static_hinges(spec, loops, world.dt, WELD_TIMECONST_STEPS, WELD_DAMPING_RATIO)
     loops += cross_model_joints(world, spec, plans_by_model, BodyPlan)  # a joint to another model's body
-    ambf_inertia(opt, spec, bodies)
+    ambf_inertia(opt, spec, bodies, world._warn)
     if world.soft is not None:
         world.soft.attach(spec, scene.all_models(), {bp.key: bp for bp in bodies})
     _lights(world, spec)
