@@ -281,3 +281,36 @@ def test_a_body_listed_with_an_empty_mapping_is_not_made_and_one_without_a_mappi
         r = loader.check_file(path, BUILD)
         assert r.ambf == "loads" and r.agree, r.as_json()
         assert r.ambf_counts["body"] == r.adfkit_counts["body"] == 2
+
+
+def test_inertia_is_compared_within_one_percent_and_a_zero_moment_as_frozen():
+    from adfkit.runner.ambf_bodies import FROZEN_INERTIA
+
+    assert loader._same_inertia((1e-3, 2e-3, 3e-3), (1.004e-3, 2e-3, 3e-3))  # the PSM's mesh links: 0.5 %
+    assert not loader._same_inertia((4.486e-3, 4.486e-3, 3.84e-4), (1.48e-2, 1.48e-2, 4.17e-4))
+    assert loader._same_inertia((0.0, 1e-3, 1e-3), (FROZEN_INERTIA, 1e-3, 1e-3))  # AMBF never turns about x
+
+
+@needs_ambf
+def test_a_bodys_inertia_is_compared_with_ambfs(tmp_path):
+    # a CONVEX_MESH body without `inertia`: AMBF's estimate and the runner's (since it grows the
+    # mesh's bounds by Bullet's 0.04 m margin as AMBF's btConvexTriangleMeshShape keeps them)
+    import trimesh
+
+    trimesh.creation.box((0.1, 0.2, 0.3)).export(tmp_path / "block.stl")
+    path = _write(
+        tmp_path,
+        "m.yaml",
+        """\
+        namespace: /ambf/env/
+        bodies: [BODY block]
+        BODY block:
+          name: block
+          mesh: block.stl
+          collision mesh type: CONVEX_MESH
+          mass: 2.0
+        """,
+    )
+    r = loader.check_file(path, BUILD)
+    assert r.ambf == "loads" and r.agree, r.as_json()
+    assert not any("inertia" in d for d in r.differences)
