@@ -256,3 +256,23 @@ def test_a_joint_between_two_static_bodies_reports_no_constraint_error(tmp_path)
         assert world.constraint_error() == 0.0
     finally:
         world.close()
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_collision_shape_ambf_does_not_know_is_said_by_both_engines(tmp_path, engine):
+    # `collision shape: Ball` (AMBF: undefined behaviour, validate: an error): the PyBullet runner
+    # said the body had no usable collision primitive, the MuJoCo engine said nothing
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+
+    path = tmp_path / "ball.yaml"
+    body = BODY.format(
+        name="a", mass=1.0, x=0.0, z=0.2, shape="  collision shape: Ball\n  collision geometry: {radius: 0.1}\n"
+    )
+    path.write_text("bodies: [BODY a]\n" + body)
+    w = open_world(load_scene(path), Options(visuals=False, ground=True), engine=engine)
+    try:
+        said = [d for d in w.diagnostics if d.rule == "runner-no-collision"]
+        assert len(said) == 1 and said[0].location.line == 3, [str(d) for d in w.diagnostics]  # the body
+    finally:
+        w.close()

@@ -354,6 +354,8 @@ def _write_geoms(
                     )
                 )
     else:
+        if not prims:  # a `collision shape` spelled as AMBF spells none (`Ball`): nothing to collide with
+            losses.append(Loss(who, "collision shape", "no usable collision primitive: the body collides with nothing"))
         for n, p in enumerate(prims):
             pose = p.pose
             if p.kind is ShapeKind.PLANE:

@@ -37,6 +37,8 @@ def warn_losses(world, m, losses) -> None:
             convex_parts_note(world.diagnostics, m.body(loss.element), loss.reason.split(" (AMBF")[0])
         elif loss.feature in _SHAPE_FEATURES:
             _shape_left_out(world, m, loss)
+        elif loss.feature == "collision shape" and "no usable collision primitive" in loss.reason:
+            world._warn("runner-no-collision", f"{loss.element}: no usable collision primitive", m.body(loss.element))
         elif loss.feature == "mass" and "PLANE" in loss.reason:  # as the PyBullet runner's runner-plane
             world._warn(
                 "runner-plane",
