@@ -198,6 +198,7 @@ class DrivenJoint:
     cfm: float = 0.0
     erp: float = AMBF_JOINT_ERP
     row_mass: float = math.inf
+    last_read: tuple[float, float] | None = None  # (t, position) of the last position command's read
     limit_erp: float = AMBF_JOINT_ERP  # the share of an overshoot its limit row takes back a physics step
     command: tuple[str, float] | None = None
 
@@ -344,6 +345,17 @@ class JointCommands:
             w.joint_effort(art, dj.index, float(lam) / cdt)
         self._rows[id(art)] = (idx, mobility, impulse, v)
 
+    def _as_ambf_reads(self, dj: DrivenJoint, q: float, t: float) -> float:
+        """A slider's position as AMBF's controller reads it (btSliderConstraint::getLinearPos: the
+        value cached when the last physics step's solve began, so a physics step old; a hinge's
+        angle it reads fresh), where each control step is one physics step under AMBF's bodies
+        (`adfkit parity` with a joint program); else ``q`` as read."""
+        w, last = self.world, dj.last_read
+        dj.last_read = (t, q)
+        if dj.kind is not JointKind.PRISMATIC or w.opt.control_substeps != 1 or w.opt.bodies != "ambf":
+            return q
+        return last[1] if last is not None and abs(t - last[0] - w.dt) < 1e-9 else q
+
     def apply(self, t: float) -> None:
         """Every joint's last command, at simulated time ``t`` (call it between control steps)."""
         w = self.world
@@ -357,7 +369,7 @@ class JointCommands:
             elif kind == "effort":
                 self._effort(dj, value)
             elif dj.motor:  # AMBF ignores a position command (with a warning) without a motor
-                current = float(w.joint_state(dj.art, [dj.index])[0][0])
+                current = self._as_ambf_reads(dj, float(w.joint_state(dj.art, [dj.index])[0][0]), t)
                 target = value
                 if dj.limits is not None:
                     target = min(max(target, dj.limits[0]), dj.limits[1])
