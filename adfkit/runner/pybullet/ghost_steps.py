@@ -19,10 +19,38 @@ rule acts inside that step (chain_ghosts)."""
 
 from __future__ import annotations
 
+import ctypes
+
 import numpy as np
 import pybullet as pb
 
-from ..ghost_rules import SLOW, ghost_accelerations, ghost_velocity, kept_under_slow_parent
+from ..ghost_rules import (
+    ALONG_FROM,
+    AMBF_GHOST_KEEP,
+    SLOW,
+    ghost_accelerations,
+    ghost_velocity,
+    kept_under_slow_parent,
+)
+from . import state_calls
+
+#: state_calls.c adfkit_ghost_link with its in and out buffers once looked up (None: not yet; False: numpy's)
+_link_c: tuple | bool | None = None
+
+
+def link_rule_in_c() -> tuple | bool:
+    """(adfkit_ghost_link, its in buffer, its out buffer), or False where state_calls.c cannot be
+    had (ADFKIT_NO_C, no compiler): ambf_ghost's rule on a link then in numpy."""
+    global _link_c
+    if _link_c is None:
+        lib = state_calls._load()
+        if lib is None:
+            _link_c = False
+        else:
+            fn, dp = lib.adfkit_ghost_link, ctypes.POINTER(ctypes.c_double)
+            fn.argtypes, fn.restype = (dp, ctypes.c_double, dp), None
+            _link_c = (fn, (ctypes.c_double * 24)(), (ctypes.c_double * 6)())
+    return _link_c
 
 
 class GhostSteps:
@@ -111,10 +139,26 @@ def ambf_ghost(world, g, held: dict, a_step: dict | None) -> None:
             continue
         held[id(sb)] = sb
         p, q, v, w = ps if sb is parent else now(sb)
-        a, alpha = ghost_accelerations(v, w, v_par, points * steps, cdt)
-        rot = np.array(pb.getMatrixFromQuaternion(q)).reshape(3, 3)  # the COM frame's
-        sb.force((sb.mass * a).tolist(), list(p))
-        sb.torque((rot @ (np.asarray(sb.inertia) * (rot.T @ alpha))).tolist())
+        f, t = link_push(v, w, v_par, points * steps, cdt, sb.mass, sb.inertia, pb.getMatrixFromQuaternion(q))
+        sb.force(f, list(p))
+        sb.torque(t)
+
+
+def link_push(v, w, v_par, points: int, cdt: float, mass: float, inertia, rot, c: tuple | bool | None = None):
+    """(force, torque) as lists: AMBF's rule on a link with velocities ``v``, ``w`` under a ghost
+    whose parent moves at ``v_par`` (ghost_rules.ghost_accelerations), as m·a at its centre of mass
+    and rot·(I ∘ rotᵀ·α), ``rot`` the COM frame's (getMatrixFromQuaternion's 9 numbers, rows);
+    in C where it can be had (``c``: link_rule_in_c(), looked up when None; False: numpy's)."""
+    if c is None:
+        c = _link_c if _link_c is not None else link_rule_in_c()
+    if c:  # the same sums in C, with numpy's rounding (state_calls.c adfkit_ghost_link)
+        fn, buf, out = c
+        buf[:] = (*v, *w, *v_par, AMBF_GHOST_KEEP**points, cdt, mass, *inertia, *rot)
+        fn(buf, ALONG_FROM, out)
+        return out[0:3], out[3:6]
+    a, alpha = ghost_accelerations(v, w, v_par, points, cdt)
+    r = np.array(rot).reshape(3, 3)
+    return (mass * a).tolist(), (r @ (np.asarray(inertia) * (r.T @ alpha))).tolist()
 
 
 def chain_ghosts(world, art) -> dict:

@@ -289,3 +289,37 @@ int adfkit_springs_apply(handle client, struct springs *S, const double *st, dou
     }
     return 0;
 }
+
+/* numpy's 3-vector dot product as its BLAS (OpenBLAS's ddot) rounds it: one fused multiply-add after another */
+static double dot3(const double *a, const double *b) { return fma(a[2], b[2], fma(a[1], b[1], a[0] * b[0])); }
+
+/* AMBF's ghost rule on a multibody link (ghost_steps.ambf_ghost: ghost_rules.ghost_accelerations,
+ * then m·a and rot·(I ∘ rotᵀ·α)) with numpy's rounding as this machine's OpenBLAS gives it (its
+ * dot as dot3, its 3x3 matrix-vector products in the order of the fused multiply-adds below; the
+ * rest is numpy's elementwise arithmetic, one IEEE operation each, the same here).
+ * in: v (3), w (3), the ghost parent's v (3), keep (AMBF_GHOST_KEEP^points), cdt, mass, inertia
+ * (3), rot (3x3, rows: the centre of mass frame's); out: force (3), torque (3). */
+void adfkit_ghost_link(const double *in, double along_from, double *out) {
+    const double *v = in, *w = in + 3, *vp = in + 6, *inertia = in + 12, *r = in + 15;
+    double keep = in[9], cdt = in[10], mass = in[11], a[3], alpha[3], t[3], u[3];
+    double slow = vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2]; /* kept_under_slow_parent's sum */
+    if (slow > along_from * along_from * (1.0 - 1e-9)) {
+        double mag = sqrt(dot3(vp, vp)), along[3] = {0.0, 0.0, 0.0};
+        if (mag > along_from) {
+            double s = dot3(v, vp) / (mag * mag);
+            for (int k = 0; k < 3; k++) along[k] = vp[k] * s;
+        }
+        for (int k = 0; k < 3; k++) {
+            a[k] = ((keep * (v[k] - along[k]) + vp[k]) - v[k]) / cdt;
+            alpha[k] = (keep * w[k] - w[k]) / cdt;
+        }
+    } else
+        for (int k = 0; k < 3; k++) {
+            a[k] = ((keep * (v[k] - 0.0) + vp[k]) - v[k]) / cdt;
+            alpha[k] = (keep * w[k] - w[k]) / cdt;
+        }
+    for (int k = 0; k < 3; k++) out[k] = mass * a[k];
+    for (int i = 0; i < 3; i++) t[i] = fma(r[6 + i], alpha[2], fma(r[3 + i], alpha[1], r[i] * alpha[0])); /* rotᵀ·α */
+    for (int i = 0; i < 3; i++) u[i] = inertia[i] * t[i];
+    for (int i = 0; i < 3; i++) out[3 + i] = fma(r[3 * i + 2], u[2], fma(r[3 * i], u[0], r[3 * i + 1] * u[1])); /* rot·u */
+}
