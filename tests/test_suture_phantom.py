@@ -455,6 +455,28 @@ def test_a_phantom_given_as_a_launch_file_of_several_model_files_is_composed_as_
     assert names == sorted(x.name for m in a.scene.models for x in m.bodies)
 
 
+def test_a_skin_body_without_its_low_resolution_mesh_is_left_out_and_said(tmp_path, capsys):
+    """A textured skin body over the phantom with no collision keys and its mesh in the
+    high-resolution folder only: AMBF looks for its collision mesh in the low-resolution folder
+    and, not finding it, does not make the body; the runner neither (it is not tissue, the pairs
+    pass: tested played in w94's audit), and `adfkit suture` now says so before the run (it said
+    nothing)."""
+    from adfkit.model import Body
+    from adfkit.tasks.episode import run_episode
+
+    path = phantom_file(tmp_path, pairs=2, spacing=0.012)
+    (tmp_path / "high_res").mkdir()
+    (tmp_path / "high_res" / "Skin.OBJ").write_text("o Skin\nv 0 0 0\nv 0.01 0 0\nv 0 0.01 0\nf 1 2 3\n")
+    doc, _ = read_file(path, "model")
+    doc.high_resolution_path = "./high_res/"
+    doc.bodies.append(Body(identifier="BODY Skin", name="Skin", mass=0.0, mesh="Skin.OBJ"))
+    write_file(doc, path)
+    m = run_episode(BUNDLED / "launch.yaml", pairs=[9], seed=0, progress=True, gif=False, phantom=path)
+    assert m["failure"].startswith("setup:")  # no pair 9: the run stops after the world is made
+    err = capsys.readouterr().err
+    assert "BODY Skin: collision mesh" in err and "Skin.OBJ not found" in err
+
+
 def test_a_pair_out_of_the_arms_reach_is_named_with_how_far(tmp_path):
     """Two pairs 170 mm apart: the arms, placed for their centre, reach neither; the plan says
     which hole, which joint and by how much, before anything moves."""
