@@ -34,12 +34,12 @@ from ..ghost_rules import (
 )
 from . import state_calls
 
-#: state_calls.c adfkit_ghost_link with its in and out buffers once looked up (None: not yet; False: numpy's)
+#: state_calls.c adfkit_ghost_link with its in and out buffer types once looked up (None: not yet; False: numpy's)
 _link_c: tuple | bool | None = None
 
 
 def link_rule_in_c() -> tuple | bool:
-    """(adfkit_ghost_link, its in buffer, its out buffer), or False where state_calls.c cannot be
+    """(adfkit_ghost_link, its in and out buffer types), or False where state_calls.c cannot be
     had (ADFKIT_NO_C, no compiler): ambf_ghost's rule on a link then in numpy."""
     global _link_c
     if _link_c is None:
@@ -47,9 +47,10 @@ def link_rule_in_c() -> tuple | bool:
         if lib is None:
             _link_c = False
         else:
-            fn, dp = lib.adfkit_ghost_link, ctypes.POINTER(ctypes.c_double)
+            # through PyDLL: called holding the GIL (nothing to wait for in it)
+            fn, dp = ctypes.PyDLL(lib.path).adfkit_ghost_link, ctypes.POINTER(ctypes.c_double)
             fn.argtypes, fn.restype = (dp, ctypes.c_double, dp), None
-            _link_c = (fn, (ctypes.c_double * 24)(), (ctypes.c_double * 6)())
+            _link_c = (fn, ctypes.c_double * 24, ctypes.c_double * 6)
     return _link_c
 
 
@@ -152,9 +153,9 @@ def link_push(v, w, v_par, points: int, cdt: float, mass: float, inertia, rot, c
     if c is None:
         c = _link_c if _link_c is not None else link_rule_in_c()
     if c:  # the same sums in C, with numpy's rounding (state_calls.c adfkit_ghost_link)
-        fn, buf, out = c
-        buf[:] = (*v, *w, *v_par, AMBF_GHOST_KEEP**points, cdt, mass, *inertia, *rot)
-        fn(buf, ALONG_FROM, out)
+        fn, ins, outs = c  # buffers of each call's own (worlds may step in threads of their own)
+        out = outs()
+        fn(ins(*v, *w, *v_par, AMBF_GHOST_KEEP**points, cdt, mass, *inertia, *rot), ALONG_FROM, out)
         return out[0:3], out[3:6]
     a, alpha = ghost_accelerations(v, w, v_par, points, cdt)
     r = np.array(rot).reshape(3, 3)
