@@ -4,7 +4,14 @@ shapes) and under the legacy flags (``--springs implicit --ghosts hole-friction 
 pybullet``), alternated ``--rounds`` times on freshly built worlds so that both see the same load;
 then, with ``--profile``, where one second of each goes, by cProfile on CPU time.
 
-    .venv/bin/python bench/runner_cpu.py [--seconds S] [--rounds R] [--profile] [--against REV] [--each]
+    .venv/bin/python bench/runner_cpu.py [--seconds S] [--rounds R] [--profile] [--ambf [DIR]]
+                                          [--against REV] [--each]
+
+With ``--ambf`` (a built AMBF tree; no DIR: ``$ADFKIT_AMBF``, else the one ``make ambf`` builds)
+each round also plays the same scene for the same seconds in ``ambf_simulator`` (headless, fixed
+1 ms steps, as ``adfkit parity`` runs it) and once for no time at all, alternated with adfkit's
+runs so that all see the same load, and prints AMBF's CPU (user + system of its process) for the
+whole run and for the run less its loading, beside adfkit's.
 
 With ``--against REV`` it times, under the run / parity settings only, this tree's runner and the
 one at git revision REV (``git archive`` into a temporary folder) in fresh processes, alternated
@@ -227,6 +234,33 @@ def profile(scene, rules: dict, seconds: float) -> None:
     print(f"    PyBullet calls: {calls} ({calls / n:.0f} a control step)")
 
 
+def scene_stage():
+    """The launch file and model indices of ``speed.scene_and_label``'s scene, for AMBF."""
+    from speed import CORPUS
+
+    launch = CORPUS / "src" / "launch.yaml"
+    if launch.is_file():
+        return launch, [6, 7, 8, 9, 10, 11]
+    from adfkit.adf import load
+
+    launch = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
+    return launch, list(range(len(load(launch, "launch").multibody_configs or [])))
+
+
+def ambf_cpu(build, seconds: float) -> float:
+    """CPU seconds (user + system) of one ``ambf_simulator`` process playing the scene for
+    ``seconds`` (0: loading it alone), as ``adfkit parity`` runs it."""
+    import resource
+
+    from adfkit.parity import ambf
+
+    launch, indices = scene_stage()
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    ambf.run(build, ambf.Stage(launch.resolve(), indices), seconds, every=max(seconds, 0.1))
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seconds", type=float, default=10.0)
@@ -234,6 +268,7 @@ def main() -> int:
     ap.add_argument("--profile", action="store_true", help="also profile 1 s of each")
     ap.add_argument("--against", metavar="REV", help="time this tree's runner against git revision REV's")
     ap.add_argument("--each", action="store_true", help="what each of AMBF's behaviours costs")
+    ap.add_argument("--ambf", nargs="?", const="", metavar="DIR", help="time AMBF on the same scene too")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
@@ -251,14 +286,32 @@ def main() -> int:
         return 0
     settings = (("adfkit run / parity defaults", run_defaults()), ("legacy flags", LEGACY))
     print(f"scene: {label}; {args.seconds:g} s simulated, PyBullet, {args.rounds} round(s) alternated")
+    build = None
+    if args.ambf is not None:
+        from adfkit.parity import ambf
+
+        build = ambf.find_build(args.ambf or None)
     cpu: dict[str, list[float]] = {name: [] for name, _ in settings}
+    whole: list[float] = []
+    loading: list[float] = []
     for _ in range(args.rounds):
         for name, rules in settings:
             cpu[name].append(step_cpu(scene, rules, args.seconds))
+        if build is not None:
+            whole.append(ambf_cpu(build, args.seconds))
+            loading.append(ambf_cpu(build, 0.0))
     for name, rules in settings:
         shown = ", ".join(f"{k} {rules[k]}" for k in RULES)
         runs = " ".join(f"{c:.2f}" for c in cpu[name])
         print(f"  {name} ({shown}): CPU {statistics.median(cpu[name]):.2f} s (runs: {runs})")
+    if build is not None:
+        runs = " ".join(f"{w:.2f}" for w in whole)
+        stepping = [w - x for w, x in zip(whole, loading)]
+        print(f"  AMBF (ambf_simulator, whole process): CPU {statistics.median(whole):.2f} s (runs: {runs})")
+        print(
+            f"  AMBF less its loading (each run less a 0 s run's {statistics.median(loading):.2f} s): "
+            f"CPU {statistics.median(stepping):.2f} s (runs: {' '.join(f'{v:.2f}' for v in stepping)})"
+        )
     if args.profile:
         for name, rules in settings:
             print(f"  where 1 s of it goes, {name} (cProfile, cumulative):")
