@@ -287,6 +287,46 @@ def _turned_over_holes(doc):
             b.location = pose(pose_to_matrix(b.location) @ rot_x(math.pi))
 
 
+def _free_on_a_table(doc):
+    """The phantom a 0.3 kg body lying 0.5 mm over a static table, its holes 5 g bodies on fixed
+    joints to it: nothing holds it but friction, and the needle pushes it."""
+    from suture_phantoms import _box
+
+    from adfkit.model import Body, Joint, Pose, Vec3
+    from adfkit.runner.rotations import pose_to_matrix
+
+    next(b for b in doc.bodies if b.name == "Phantom").mass = 0.3
+    for b in [b for b in doc.bodies if b.name.startswith(("Entry", "Exit"))]:
+        b.mass = 0.005
+        z = pose_to_matrix(b.location)[:3, 2]  # the hole's z as the joint's axis: it keeps its tilt
+        doc.joints.append(
+            Joint(
+                identifier=f"JOINT Phantom-{b.name}",
+                name=f"Phantom-{b.name}",
+                parent="BODY Phantom",
+                child=b.identifier,
+                type="fixed",
+                parent_pivot=copy.deepcopy(b.location.position),
+                parent_axis=Vec3(*map(float, z)),
+                child_pivot=Vec3(0, 0, 0),
+                child_axis=Vec3(0, 0, 1),
+            )
+        )
+    for b in doc.bodies:
+        q = b.location.position
+        b.location = Pose(Vec3(q.x, q.y, q.z + 0.0005), b.location.orientation)
+    doc.bodies.append(
+        Body(
+            identifier="BODY Table",
+            name="Table",
+            mass=0.0,
+            location=Pose(),
+            compound_collision_shape=[_box((-0.06, -0.12, -0.01), (0.06, 0.12, 0.0))],
+            collision_margin=0.0001,
+        )
+    )
+
+
 #: a modeller's phantom, changed one way, and pair 1's verdict and what its reason says (seed 0)
 ODD = {
     # the driver's jaws, closing round the wire on the tray, held 56 N on it: tool-hit-tissue on
@@ -305,6 +345,9 @@ ODD = {
     "1 mm membrane": (lambda doc: _membrane(doc), "blocked-at-entry", "blocked at Entry1"),
     # passed before; the check before the run read its cylinders as capsules filling the channels
     "curved ridge": (lambda doc: _curved_ridge(doc), None, None),
+    # the needle pushed the phantom 7.6 mm along the table and turned it 1.9°: the exit 3.7 mm
+    # outside its opening, for where the hole went
+    "free on a table": (_free_on_a_table, "exit-outside-opening", "the tissue moved during the run (Entry1 7."),
 }
 
 

@@ -233,6 +233,14 @@ def run(args) -> int:
                 else f" [{p.get('rule')}]: {p.get('reason')}"
             )
         )
+    if any(d["free"] for d in m.get("tissue_moved") or []):
+        from ..tasks.tissue_moved import said
+
+        print(
+            f"the tissue moved during the run: {said(m['tissue_moved'])} (a phantom body with a mass and "
+            "no joint holding it is pushed by the needle; give it mass 0, or a fixed joint to a body of mass 0)",
+            file=sys.stderr,
+        )
     if m.get("failure"):
         print(f"stopped: {m['failure']}", file=sys.stderr)
     rtf = m.get("real_time_factor")

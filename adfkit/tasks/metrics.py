@@ -26,6 +26,7 @@ from .holes import (
 )
 from .needle import wire_radius
 from .roles import task_roles
+from .tissue_moved import TissueStart, said
 from .verdicts import SLIP_LIMIT, SLIP_SETTLE_S, force_limits, pair_verdict, phase_pair
 
 #: N: a needle's or thread's touch this strong at its peak is written in the metrics (times the
@@ -98,6 +99,7 @@ class SutureObserver:
             _Hole(self.world, p.index, "exit", p.exit_name, p.exit) for p in task.pairs
         ]
         self.tissue = self.roles.tissue
+        self.tissue_start = TissueStart(self.tissue)  # where the tissue began (tissue_moved.py)
         # the tools' links, watched for touches when they collide with the tissue
         self._tool = (
             {id(sb): n for n, links in self.roles.robots.items() for sb in links}
@@ -420,6 +422,10 @@ class SutureObserver:
         rep = self.world.report()
         n = self.task.needle_pose()
         pairs = self.pair_results(failure, self.task.phase if failure else None)
+        moved = self.tissue_start.moved()
+        for p in pairs:
+            if any(d["free"] for d in moved) and not p["passed"] and p.get("reason"):
+                p["reason"] += f"; the tissue moved during the run ({said(moved)})"
         through = min(
             max([d["length_m"] for d in self.thread_by_pair.values()], default=0.0),
             len(self.thread) * self.element_length(),
@@ -444,6 +450,7 @@ class SutureObserver:
             # the force limits the touches were recorded and judged by, in this engine's newtons
             "force_limits_n": {**self.force_limits, "needle_event_n": self.needle_event_n},
             "switched_off": list(getattr(self.task, "switched_off", [])),
+            "tissue_moved": moved,
             "slips": self.slips,
             "tool_tissue_events": self.tool_events,
             "needle_tissue_contact_n": self.needle_contacts,
