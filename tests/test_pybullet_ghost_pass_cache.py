@@ -1,5 +1,5 @@
 """The ghosts' collision pass (runner/pybullet/ghost_pass.py) runs again only for the ghosts
-whose own pose or whose near bodies' poses moved by more than SAME_PLACE since their last pass:
+whose own pose or whose near bodies' poses moved by more than KEPT_WITHIN since their last pass:
 what it returns is what a pass of every ghost afresh returns."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ pb = pytest.importorskip("pybullet")
 from adfkit.adf import load_scene  # noqa: E402
 from adfkit.runner import Options, open_world  # noqa: E402
 from adfkit.runner.ghost_rules import SAME_PLACE  # noqa: E402
-from adfkit.runner.pybullet.ghost_pass import GhostPass  # noqa: E402
+from adfkit.runner.pybullet.ghost_pass import KEPT_WITHIN, GhostPass  # noqa: E402
 
 BUNDLED = Path(__file__).resolve().parent.parent / "sample_scenes" / "suturing" / "launch.yaml"
 #: the options adfkit run and adfkit parity play a scene with (AMBF's ghosts, springs and bodies)
@@ -62,9 +62,9 @@ def test_a_pass_of_the_ghosts_that_moved_counts_as_a_pass_of_all():
     assert max(kept) > 0 and min(kept) < 9, kept  # some kept, some passed again
 
 
-def test_a_ghost_passes_again_once_a_body_near_it_moves_past_same_place(tmp_path):
+def test_a_ghost_passes_again_once_a_body_near_it_moves_past_kept_within(tmp_path):
     """The parity scene's cube resting in its ghost slab (4 points, box-box): moved by half of
-    SAME_PLACE the ghost keeps its answer (the same dict, no pass); moved by twice SAME_PLACE, or
+    KEPT_WITHIN the ghost keeps its answer (the same dict, no pass); moved by twice KEPT_WITHIN, or
     after a collision pair changed, it is passed again. Control: the cube moved out past the slab's
     side to 1 mm from it (still near: within the contact threshold) gets what a pass afresh
     makes, no penetrating point, not the 4 kept."""
@@ -86,11 +86,11 @@ def test_a_ghost_passes_again_once_a_body_near_it_moves_past_same_place(tmp_path
 
         first = counts()
         assert first == {g.uid: {key: 4}}
-        assert counts(0.5 * SAME_PLACE)[g.uid] is first[g.uid]  # kept: no pass
-        moved = counts(2 * SAME_PLACE)
+        assert counts(0.5 * KEPT_WITHIN)[g.uid] is first[g.uid]  # kept: no pass
+        moved = counts(2 * KEPT_WITHIN)
         assert moved == first and moved[g.uid] is not first[g.uid]  # passed again: the same points
         w._pairs_epoch += 1  # as set_collision or a grasp does
-        assert counts(2 * SAME_PLACE)[g.uid] is not moved[g.uid]
+        assert counts(2 * KEPT_WITHIN)[g.uid] is not moved[g.uid]
         out = counts(dx=0.071)  # the slab's side at x 0.05, the cube 20 mm from its centre to its side
         afresh = _afresh(w, [(g, ghost_pq, [key])], {key: ((p[0] + 0.071, p[1], p[2]), q)})
         assert out == afresh == {g.uid: {}}, (out, afresh)
@@ -113,6 +113,9 @@ def test_same_place_is_within_same_place_in_every_number_and_never_for_nan():
             moved = [list(map(list, pq)) for pq in a]
             moved[i][part][-1] += 1.1 * SAME_PLACE
             assert not in_same_place(a, [tuple(map(tuple, pq)) for pq in moved]), (i, part)
+    wider = [((0.1 + 0.9 * KEPT_WITHIN, 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]]  # the bound as asked
+    assert in_same_place(a, wider, KEPT_WITHIN) and not in_same_place(a, wider)
+    assert not in_same_place(a, [((0.1 + 1.1 * KEPT_WITHIN, 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]], KEPT_WITHIN)
     nan = [((float("nan"), 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]]
     assert not in_same_place(a, nan)
     assert not in_same_place(nan, [((float("nan"), 0.2, 0.3), (0.0, 0.0, 0.0, 1.0)), a[1]])

@@ -29,16 +29,16 @@ ALONG_FROM = 1e-5
 SLOW = 1e-3
 
 
-def in_same_place(a: list, b: list) -> bool:
-    """Whether every number of the (position, quaternion) pairs ``b`` lies within SAME_PLACE of
+def in_same_place(a: list, b: list, within: float = SAME_PLACE) -> bool:
+    """Whether every number of the (position, quaternion) pairs ``b`` lies within ``within`` of
     ``a``'s (NaN never does); the first that does not ends the search (something near a ghost
     moves almost every step). A pair equal as it stands (a body read again where it rests) is
     skipped at the cost of one tuple comparison: a NaN read afresh is unequal to any other."""
     for pq_a, pq_b in zip(a, b):
         if pq_a == pq_b:
             continue
-        for va, vb in zip(pq_a, pq_b):  # |x - y| <= SAME_PLACE for each number, iterated in C
-            if not all(map(le, map(abs, map(sub, va, vb)), repeat(SAME_PLACE))):
+        for va, vb in zip(pq_a, pq_b):  # |x - y| <= within for each number, iterated in C
+            if not all(map(le, map(abs, map(sub, va, vb)), repeat(within))):
                 return False
     return True
 

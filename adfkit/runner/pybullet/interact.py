@@ -12,6 +12,7 @@ import pybullet as pb
 from ..ghost_rules import in_same_place, viscous_impulse_force
 from ..rotations import invert
 from .bodies import SimBody
+from .ghost_pass import KEPT_WITHIN
 from .ghost_steps import ambf_ghost, chain_ghosts, weightless, weightless_for_a_step
 
 # m between the three point constraints of a grasp (PyBulletWorld.actuate): the solver leaves each
@@ -156,7 +157,7 @@ class Interaction:
         copies of those bodies alone where they can be copied (ghost_pass.py: the same points), else in
         the dynamics world; a pair GJK answers (hulls) gives one point a pass, where AMBF's persistent
         manifold gathers up to four over its steps. The last answer stands while the same bodies are near
-        the same ghosts, within SAME_PLACE of where they were, and no collision pair or grasp has changed
+        the same ghosts, within KEPT_WITHIN of where they were, and no collision pair or grasp has changed
         (``poses``: those read this control step). ``_near_keys``: each ghost's box's bodies, for _overlap."""
         cid, dynamic = self.cid, self._dynamic_lookup
         near, which, where, passes = [], [self._pairs_epoch], [], []
@@ -178,7 +179,7 @@ class Interaction:
             return {}
         place = (which, where)
         last = self._manifold_place
-        if last is not None and last[0] == which and in_same_place(last[1], where):
+        if last is not None and last[0] == which and in_same_place(last[1], where, KEPT_WITHIN):
             return self._manifold_made
         # the pass in a world of the ghosts and the bodies near them alone (ghost_pass.py), else here
         made = self._ghost_pass.counts(passes, poses)
