@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import pybullet as pb
 
+from . import broadphase_margin
+
 #: Bullet's own default (btPersistentManifold.cpp), which PyBullet leaves as it is
 DEFAULT = 0.02
 
@@ -26,6 +28,9 @@ def threshold(opt) -> float:
     return DEFAULT if opt.contact_threshold is None else float(opt.contact_threshold)
 
 
-def use(value: float, cid: int) -> None:
-    """Put ``value`` in force for every world of the process (set through client ``cid``)."""
+def use(value: float, cid: int, margin: float | None = None) -> None:
+    """Put ``value`` in force for every world of the process (set through client ``cid``), and
+    the broadphase's ``margin`` where given (broadphase_margin.py: also one per process)."""
     pb.setPhysicsEngineParameter(contactBreakingThreshold=value, physicsClientId=cid)
+    if margin is not None:
+        broadphase_margin.use(margin)

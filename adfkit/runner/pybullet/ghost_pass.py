@@ -33,7 +33,7 @@ import pybullet as pb
 
 from ..ghost_rules import in_same_place
 from ..rotations import invert, matrix_to_pq
-from . import bullet_globals
+from . import broadphase_margin, bullet_globals
 from .shapes import create_collision
 
 # the copies' collision bits: a ghost meets bodies, a body meets ghosts, never another body
@@ -59,6 +59,8 @@ class GhostPass:
     def _connect(self) -> int:
         if self.cid is None:
             self.cid = pb.connect(pb.DIRECT)
+            # a world made puts PyBullet's broadphase margin back for the whole process: the dynamics world's again
+            broadphase_margin.use(self.world.broadphase_margin)
         return self.cid
 
     def _shape(self, parts) -> int:

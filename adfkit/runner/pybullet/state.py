@@ -82,7 +82,7 @@ class WorldState:
             g.placed_at = None
         self._pairs_epoch += 1
         self.limit_chains.reset()  # its motors and opened limits belong to the motion left behind
-        bullet_globals.use(self.contact_threshold, self.cid)  # the restore detects contacts (one per process)
+        bullet_globals.use(self.contact_threshold, self.cid, self.broadphase_margin)  # the restore detects contacts
         if snap.world() is self:
             self._restore_own(snap)
         else:
