@@ -32,6 +32,7 @@ from ..volumes import volume_surfaces
 from .collision import GHOST_CONTYPE, GHOST_GROUP, collision_filters, warn_losses
 from .cross_joints import cross_model_joints, stiff_static_hinges
 from .drives import add_drive, drive_limit
+from .free_hinges import hold_free_hinge, is_free_hinge
 from .inertia import ambf_inertia
 from .spec import _parse_spec, _resolve_meshes
 from .textures import apply_textures
@@ -242,6 +243,8 @@ def build_plan(world) -> Plan:
                     if np.isfinite(lo) and np.isfinite(hi) and (tag == "slide" or hi - lo < 2 * np.pi):
                         j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
                         j.range = [lo, hi]
+                    if is_free_hinge(j, tag, k, c):  # light elements joined by limits alone (free_hinges.py)
+                        hold_free_hinge(j, world.dt)
                     jn.append(j.name)
             joints.append((lk.joint, lk.kind, parent, child, jn))
         for j, kind, pb_, cb in tree.loops:
