@@ -560,3 +560,43 @@ def test_a_pair_out_of_the_arms_reach_is_named_with_how_far(tmp_path):
         )
     finally:
         world.close()
+
+
+def test_a_plan_whose_tool_comes_into_the_tissue_is_warned_of_before_the_arms_move(tmp_path):
+    """A block of tissue (its own body, Wall) standing 20 mm over the slab beside pair 1's entry,
+    where the driver's wrist goes at the end of the insertion: no grasp that reaches keeps the
+    tool off it, and the plan says so (which arm, how deep, which body and where in the file,
+    when in the suture, a hint) before anything moves; the phantom without it is planned without
+    a warning. A phantom sloping 30 degrees across its holes was played to a `reach` in the
+    pick-up with its -4.6 mm planned clearance said nowhere."""
+    from suture_phantoms import _box
+
+    from adfkit.model import Body, Pose
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.suture import SutureTask
+
+    said = {}
+    for wall in (False, True):
+        path = phantom_file(tmp_path / str(wall), pairs=2, spacing=0.012)
+        if wall:
+            doc, _ = read_file(path, "model")
+            box = _box((-0.026, -0.02, L.SLAB[2]), (-0.016, 0.02, L.SLAB[2] + 0.02))
+            doc.bodies.append(
+                Body(identifier="BODY Wall", name="Wall", mass=0.0, location=Pose(), compound_collision_shape=[box])
+            )
+            write_file(doc, path)
+        c = _compose(path)
+        world = open_world(c.scene, Options(renderer="tiny", visuals=False))
+        try:
+            task = SutureTask(world, c.pairs[:1], seed=0)
+            task.plan()
+            said[wall] = [str(d) for d in task.plan_warnings]
+            clearance = task.drive_grasps[0].clearance
+        finally:
+            world.close()
+    assert said[False] == []
+    (w,) = said[True]
+    assert clearance < -0.001
+    assert re.match(r".*phantom\.yaml:\d+:\d+: warning\[plan-tool-in-tissue\]: pair 1, the plan: psm2's tool comes ", w)
+    assert f"comes {-clearance * 1000:.1f} mm into Wall in insertion 1 (at (" in w
+    assert "hint: Wall stands in psm2's way there" in w

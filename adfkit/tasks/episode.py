@@ -118,8 +118,15 @@ def play_task(
     bar = _Bar(progress)
     failure = None
     n = 0
+    said = 0  # the plan's warnings printed so far (said as the plan is made, before the arms move)
     try:
         for phase in task.steps():
+            if progress and len(getattr(task, "plan_warnings", ())) > said:
+                bar.close()
+                for w in task.plan_warnings[said:]:
+                    print(w, file=sys.stderr)
+                said = len(task.plan_warnings)
+                bar = _Bar(progress)
             world.step(1)
             a = clock()
             obs.observe()
@@ -341,7 +348,7 @@ def run_episode(
                 "puller": getattr(task, "puller", None),
                 "engine": engine,
                 "solver_iterations": options.solver_iterations if engine != "mujoco" else None,
-                "warnings": warned,
+                "warnings": warned + [str(d) for d in getattr(task, "plan_warnings", ())],
             }
         )
         if placed is not None:

@@ -47,6 +47,10 @@ class Grasp:
     ee_in_needle: np.ndarray
     margin: float
     clearance: float = math.inf  # m the tool keeps from the tissue where the plan checked it
+    #: which of the needle poses the clearance was checked at gives it (the first's approach
+    #: along the jaw axis counts as the first), and the end effector's world pose there
+    nearest_at: int = -1
+    nearest_ee: np.ndarray | None = None
 
 
 class GraspChoice:
@@ -128,16 +132,24 @@ class GraspChoice:
             raise SutureError(f"{psm.name}: no grasp of the needle from above ({what})")
         ee_in_n = np.array([m for m, _ in cands])
         clear = np.full(len(cands), TOOL_CLEARANCE)
+        nearest = np.zeros(len(cands), dtype=int)  # where each candidate's clearance is least
+        nearest_ee = np.zeros((len(cands), 4, 4))
+
+        def fold(now: np.ndarray, i: int, ee: np.ndarray) -> np.ndarray:
+            less = now < clear
+            nearest[less], nearest_ee[less] = i, ee[less]
+            return np.minimum(clear, now)
+
         for i, pose in enumerate(clear_at):
             # the jaws as they come onto the wire there: wide open onto a needle lying on the tissue
             tool = self.tools_wide[psm.name] if i == 0 and down_at is not None else self.tools[psm.name]
             ee = pose[None] @ ee_in_n
-            clear = np.minimum(clear, clearances(self.tissue_shapes, tool, ee, TOOL_CLEARANCE))
+            clear = fold(clearances(self.tissue_shapes, tool, ee, TOOL_CLEARANCE), i, ee)
             if i == 0:  # and on the way in, along the jaw axis
                 for f in (1.0, 2 / 3, 1 / 3):
                     back = ee.copy()
                     back[:, :3, 3] -= f * BACK_OFF * ee[:, :3, 2]
-                    clear = np.minimum(clear, clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE))
+                    clear = fold(clearances(self.tissue_shapes, tool, back, TOOL_CLEARANCE), i, back)
         # the choice: the clearance (up to TOOL_CLEARANCE, in tenths of a millimetre), then the
         # wider joint margin
         clear_q = np.round(clear / 1e-4)
@@ -162,7 +174,7 @@ class GraspChoice:
             margin = worst - 0.02 * turn
             key = (float(clear_q[i]), margin)
             if worst > 0 and (best_key is None or key > best_key):
-                best, best_key = Grasp(m, margin, float(clear[i])), key
+                best, best_key = Grasp(m, margin, float(clear[i]), int(nearest[i]), nearest_ee[i].copy()), key
         if best is None:
             raise SutureError(
                 f"{psm.name}: no grasp of the needle reachable along the whole plan ({what})"

@@ -40,6 +40,7 @@ from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError 
 from .holes import boundary_body, ghost_box, hole_frame, hole_name, opening_half_extents
 from .motions import Motions, interpolate, smooth
 from .needle import fit_needle, obj_vertices, wire_radius
+from .plan_warnings import plan_warnings
 from .roles import body_roles
 
 LIFT = 0.015  # m the needle is lifted when carried between the phantom and a hole
@@ -189,6 +190,7 @@ class SutureTask(GraspChoice, Motions):
         self.clipped = 0  # set-points clipped to the joint limits
         self.reaimed = 0  # takes brought over the needle again where it moved as the tool came (Motions.take)
         self.phase_log: list[tuple[str, float]] = []  # (phase, simulated start time)
+        self.plan_warnings: list = []  # what the plan knows will go wrong (plan_warnings.py), once planned
         self.holder: str | None = None  # the PSM holding the needle
         self.held_ee_in_needle: np.ndarray | None = None
         # seeded variation of the plan
@@ -339,6 +341,7 @@ class SutureTask(GraspChoice, Motions):
                 self._plan_pair(k, p, n0)
             except SutureError as exc:
                 raise SutureError(f"{exc}{self._spread(centres)}") from exc
+        self.plan_warnings = plan_warnings(self)
 
     def _spread(self, centres: list) -> str:
         """ "; the pairs lie ... from their centre" where one lies more than SPREAD_NOTE from it:
