@@ -106,6 +106,22 @@ def add_arguments(p) -> None:
         "replays the set-points adfkit's planner gave as AMBF's position commands; both replays measured "
         "first (its verdicts judged), then the set-points",
     )
+    p.add_argument(
+        "--trials",
+        type=int,
+        default=1,
+        metavar="K",
+        help="--suture: replay the one recording K times in AMBF (following adfkit's measured joints), all but "
+        "the first nudged (every PSM joint offset by --nudge, its sign random per joint), and report each "
+        "pair's AMBF verdicts and how often they are adfkit's (default 1: one replay)",
+    )
+    p.add_argument(
+        "--nudge",
+        type=float,
+        default=1e-4,
+        metavar="RAD",
+        help="--trials: the offset of each revolute PSM joint (rad; a prismatic one a tenth of it in m) (default 1e-4)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object (a list of them for --engine both)")
 
 
@@ -181,6 +197,19 @@ def _suture(args) -> int:
                 "use --follow both to replay the set-points paced beside it",
             )
         )
+    if args.trials < 1 or args.nudge <= 0:
+        raise AdfError(error("bad-option", "--trials takes 1 or more, --nudge a positive offset", None))
+    if args.trials > 1:
+        if args.pace != "off" or follow != "measured":
+            raise AdfError(
+                error(
+                    "bad-option",
+                    "--trials replays follow adfkit's measured joints: no --pace, no --follow commands",
+                    None,
+                    "leave --pace and --follow out with --trials",
+                )
+            )
+        return _trials(args, Path(path), pairs, build)
     out = compare_suture(
         Path(path),
         parse_indices(args.indices),
@@ -235,6 +264,43 @@ def _suture(args) -> int:
         w = out["wall_s"]
         print(f"  stepping: adfkit {w['adfkit']:.1f} s (the whole episode), AMBF {w['ambf']:.1f} s")
     return 0 if out["same_verdicts"] else 1
+
+
+def _trials(args, path: Path, pairs, build) -> int:
+    from ..adf import parse_indices
+    from ..jsonout import dumps
+    from ..parity.trials import Nudge, compare_trials
+
+    nudge = Nudge(args.nudge, args.nudge / 10)
+    out = compare_trials(
+        path,
+        parse_indices(args.indices),
+        pairs,
+        build,
+        args.trials,
+        nudge,
+        args.seed,
+        progress=not args.json,
+        options=recording_options(args),
+    )
+    t = out["trials"]
+    if args.json:
+        print(dumps(out, indent=1))
+    else:
+        print(
+            f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF {t['count']} times "
+            f"following adfkit's measured joints, all but the first nudged {nudge.rad:g} rad / {nudge.m:g} m"
+        )
+        for p in t["pairs"]:
+            gaps = [g * 1e3 for g in p["tip_path_gap_m"] if g is not None and g == g]
+            rules = ", ".join(f"{r or v}" for v, r in zip(p["ambf"], p["ambf_rules"], strict=True))
+            print(
+                f"  pair {p['pair']}: adfkit {p['adfkit_rule'] or p['adfkit']}; AMBF {rules}: "
+                f"adfkit's verdict {p['same']} of {t['count']}"
+                + (", AMBF's own verdict changes with the nudge" if p["ambf_flips"] else "")
+                + (f"; tip paths {min(gaps):.1f}-{max(gaps):.1f} mm apart at most" if gaps else "")
+            )
+    return 0 if all(p["same"] == t["count"] for p in t["pairs"]) else 1
 
 
 def recording_options(args) -> dict:

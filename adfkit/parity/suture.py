@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..diagnostics import AdfError, error
+from ..model.semantics import JointKind, joint_kind
 from ..runner.rotations import invert, matrix_to_pq, pose_matrix
 from . import ambf
 from .traces import ambf_name, joint_key
@@ -86,6 +87,7 @@ class Recording:
     tools: dict[str, str] = field(default_factory=dict)  # arm -> the AMBF name of the body its actuator is on
     wall_s: float = 0.0
     options: dict = field(default_factory=dict)  # the Options adfkit's suture was recorded under (RECORD_OPTIONS)
+    prismatic: frozenset[str] = frozenset()  # the PSM joints (AMBF names) whose values are lengths, not angles
 
     def commands_for(self, follow: str) -> list[ambf.Command]:
         """The commands a replay plays: ``commands``, the set-points (no ``follow`` lines);
@@ -120,6 +122,7 @@ class _Recorder:
         self.grasps: list[tuple[float, str, str | None]] = []
         self.arms = {id(psm.art): name for name, psm in task.psms.items()}
         self.joint_names = {}
+        self.prismatic: set[str] = set()
         for j, _p, child in world.joints_made:
             art = getattr(child, "articulation", None)
             if art is None or id(art) not in self.arms:
@@ -128,6 +131,8 @@ class _Recorder:
             if idx is not None:
                 name = ambf_name(joint_key(world, j), j)
                 self.joint_names[(id(art), idx)] = name
+                if joint_kind(j.type) is JointKind.PRISMATIC:
+                    self.prismatic.add(name)
         self.last: dict[tuple, float] = {}
         self.placed = False
         self.forced = False
@@ -308,6 +313,7 @@ def record(
             tools=tools,
             wall_s=wall,
             options={k: getattr(world.opt, k) for k in RECORD_OPTIONS},
+            prismatic=frozenset(rec.prismatic),
         )
     finally:
         world.close()
@@ -648,7 +654,11 @@ def compare_suture(
 def compare_recorded(rec: Recording, launch: Path, indices, build: ambf.AmbfBuild, modes=((None, "commands"),)) -> dict:
     """A recording replayed in AMBF once per ``(pace, follow)`` mode, as ``compare_suture``
     reports it."""
-    replays = [replay(rec, build, launch, indices, p, f) for p, f in modes]
+    return judged(rec, [replay(rec, build, launch, indices, p, f) for p, f in modes])
+
+
+def judged(rec: Recording, replays: list[Replay]) -> dict:
+    """The replays' verdicts beside adfkit's, the first judged against them: the issue's JSON."""
     first = replays[0]
     mine = {v["pair"]: v for v in rec.verdicts}
     out = []

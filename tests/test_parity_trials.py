@@ -1,0 +1,130 @@
+"""The suture's verdicts in AMBF as rates (`adfkit parity --suture --trials K`): the nudge each
+trial gives the recording, the rates read from the trials' verdicts, and the premise that AMBF
+repeats a replay to the bit and a nudge moves it. The test that plays AMBF skips, with the
+reason, where no AMBF build is present."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pybullet")
+
+from adfkit.parity import ambf, suture, trials  # noqa: E402
+from adfkit.parity.traces import from_ambf  # noqa: E402
+
+BUILD, WHY = ambf.available()
+needs_ambf = pytest.mark.skipif(BUILD is None, reason=WHY)
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _recorded(steps: int = 3) -> suture.Recording:
+    """The bundled suture's first control steps, recorded with the measured joints."""
+    from adfkit.adf import load_scene
+    from adfkit.runner import Options, open_world
+    from adfkit.tasks.suture import SutureTask
+
+    world = open_world(
+        load_scene(ROOT / "sample_scenes" / "suturing" / "launch.yaml", None), Options(renderer="tiny", visuals=False)
+    )
+    try:
+        task = SutureTask(world, [1], seed=0)
+        rec = suture._Recorder(world, task, measured=True)
+        next(task.steps())
+        world.step(steps)
+        return suture.Recording(
+            rec.commands, 0.0, [], np.zeros((0, 4)), [], None, [], "", [], prismatic=frozenset(rec.prismatic)
+        )
+    finally:
+        world.close()
+
+
+def test_a_nudge_offsets_each_psm_joint_by_one_signed_constant():
+    """Every PSM joint's set-points and measured path move by the same ±1e-4 rad (the two
+    insertions, prismatic, ±1e-5 m); the other commands (place, collide, the push) are as
+    recorded; the signs differ between joints and between draws. Control: the recording's own
+    values are not already offset (a nudge of 0 gives them back)."""
+    rec = _recorded()
+    assert len(rec.prismatic) == 2 and all("insertion" in n.lower() for n in rec.prismatic)
+    rng = np.random.default_rng(0)
+    a = trials.nudged(rec, trials.Nudge(1e-4, 1e-5), rng)
+    b = trials.nudged(rec, trials.Nudge(1e-4, 1e-5), rng)
+    assert len(a) == len(rec.commands)
+    offsets: dict[str, set[float]] = {}
+    for c, n in zip(rec.commands, a, strict=True):
+        assert (c.t, c.kind, c.target, c.body, c.numbers) == (n.t, n.kind, n.target, n.body, n.numbers)
+        if c.kind in ("position", "follow"):
+            offsets.setdefault(c.target, set()).add(round(n.value - c.value, 12))
+        else:
+            assert n.value == c.value
+    assert len(offsets) == 16 and all(len(v) == 1 for v in offsets.values())
+    for name, (d,) in offsets.items():
+        assert abs(d) == pytest.approx(1e-5 if name in rec.prismatic else 1e-4)
+    assert {np.sign(d) for (d,) in offsets.values()} == {-1.0, 1.0}
+    signs_b = {c.target: np.sign(n.value - c.value) for c, n in zip(rec.commands, b, strict=True) if c.kind == "follow"}
+    assert signs_b != {k: np.sign(next(iter(v))) for k, v in offsets.items()}
+    zero = trials.nudged(rec, trials.Nudge(0.0, 0.0), np.random.default_rng(0))
+    assert [c.value for c in zero] == [c.value for c in rec.commands]
+
+
+def test_the_rates_count_adfkits_verdict_among_ambfs_and_see_a_flip():
+    """Pair 1 passed on both sides in every trial: rate 1, no flip; pair 2 adfkit passed, AMBF
+    failed in one trial of three: rate 2/3 and a flip; a change of rule alone is a flip too."""
+
+    def v(pair, verdict, rule=None):
+        return {"pair": pair, "verdict": verdict, "rule": rule}
+
+    mine = [v(1, "passed"), v(2, "passed"), v(3, "failed", "slip")]
+    runs = [
+        ([v(1, "passed"), v(2, "passed"), v(3, "failed", "slip")], {1: 0.001, 2: 0.002, 3: 0.003}),
+        ([v(1, "passed"), v(2, "failed", "thread-not-through"), v(3, "failed", "entry-missed")], {1: 0.001}),
+        ([v(1, "passed"), v(2, "passed"), v(3, "failed", "slip")], {}),
+    ]
+    out = trials.rates(mine, runs)
+    p1, p2, p3 = out["pairs"]
+    assert (p1["same"], p1["same_rate"], p1["ambf_flips"]) == (3, 1.0, False)
+    assert (p2["same"], p2["ambf_flips"]) == (2, True) and p2["same_rate"] == pytest.approx(2 / 3)
+    assert p2["ambf_rules"] == [None, "thread-not-through", None]
+    assert (p3["same"], p3["ambf_flips"]) == (3, True)  # failed every time, by another rule once
+    assert p1["tip_path_gap_m"] == [0.001, 0.001, None]
+    assert out["same_rate"] == pytest.approx((1 + 2 / 3 + 1) / 3)
+
+
+@needs_ambf
+def test_ambf_repeats_a_replay_to_the_bit_and_a_nudge_moves_it(tmp_path):
+    """The parity arm's joint following a path twice in AMBF: the same poses to the bit; the
+    same path nudged 1e-4 rad: the joint stands 1e-4 rad over (within 2e-5 past the first
+    steps) and the arm's poses differ. What the trials' rates rest on."""
+    from adfkit.scenes.parity import write_parity
+
+    stage = ambf.Stage(write_parity(tmp_path), [1])
+    joint = "/ambf/env/arm/base-arm"
+    ts = np.arange(0.0, 0.5 + 1e-9, 0.004)
+    cmds = [ambf.Command(float(t), "follow", joint, float(0.5 * np.sin(2 * np.pi * t))) for t in ts]
+    rec = suture.Recording(cmds, 0.5, [], np.zeros((0, 4)), [], None, [], "", [])
+    runs = [from_ambf(ambf.run(BUILD, stage, 0.5, 0.02, c)) for c in (cmds, cmds)]
+    nudged = trials.nudged(rec, trials.Nudge(1e-4, 1e-5), np.random.default_rng(1))
+    sign = np.sign(nudged[0].value - cmds[0].value)
+    moved = from_ambf(ambf.run(BUILD, stage, 0.5, 0.02, nudged))
+    assert np.array_equal(runs[0].poses, runs[1].poses) and np.array_equal(runs[0].joints, runs[1].joints)
+    j = runs[0].joint_names.index(joint)
+    d = (moved.joints[:, j] - runs[0].joints[:, j])[5:]
+    assert np.allclose(d, sign * 1e-4, atol=2e-5)
+    assert not np.array_equal(moved.poses, runs[0].poses)
+
+
+@needs_ambf
+def test_trials_follow_the_measured_joints_so_a_pace_is_a_bad_option(capsys):
+    """--trials replays follow adfkit's measured joints: with --pace on it is the user's error
+    (exit 2, before any suture is played), as are no trials and a nudge of 0."""
+    from adfkit.cli import main
+
+    launch = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
+    assert main(["parity", "--suture", str(launch), "--trials", "3", "--pace", "on"]) == 2
+    assert "--trials replays follow adfkit's measured joints" in capsys.readouterr().err
+    assert main(["parity", "--suture", str(launch), "--trials", "2", "--nudge", "0"]) == 2
+    assert "--nudge a positive offset" in capsys.readouterr().err
+    assert main(["parity", "--suture", str(launch), "--trials", "0"]) == 2
+    assert "--trials takes 1 or more" in capsys.readouterr().err
