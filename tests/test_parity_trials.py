@@ -128,3 +128,34 @@ def test_trials_follow_the_measured_joints_so_a_pace_is_a_bad_option(capsys):
     assert "--nudge a positive offset" in capsys.readouterr().err
     assert main(["parity", "--suture", str(launch), "--trials", "0"]) == 2
     assert "--trials takes 1 or more" in capsys.readouterr().err
+
+
+def test_the_trials_are_printed_per_pair_and_any_other_verdict_fails(monkeypatch, capsys):
+    """The text names each pair's AMBF rules in trial order, how many were adfkit's verdict and
+    when AMBF's own flipped; exit 1 when any trial differs from adfkit's on any pair, 0 when none
+    does. The nudge reaches compare_trials as named (a prismatic joint a tenth of it in m)."""
+    from adfkit.cli import main
+
+    seen = {}
+
+    def fake(path, indices, pairs, build, count, nudge, seed, progress, options):
+        seen.update(count=count, nudge=nudge, seed=seed)
+        same = seen.get("same", 1)
+        runs = [([{"pair": 1, "verdict": "passed", "rule": None}], {1: 0.0019})] * count
+        if not same:
+            runs[-1] = ([{"pair": 1, "verdict": "failed", "rule": "thread-not-through"}], {1: 0.006})
+        out = trials.rates([{"pair": 1, "verdict": "passed", "rule": None}], runs)
+        return {"seconds": 89.0, "trials": out | {"count": count}}
+
+    monkeypatch.setattr(trials, "compare_trials", fake)
+    monkeypatch.setattr(ambf, "find_build", lambda path: None)
+    assert main(["parity", "--suture", "--pairs", "1", "--trials", "3", "--nudge", "2e-4", "--seed", "5"]) == 0
+    assert seen["count"] == 3 and seen["nudge"] == trials.Nudge(2e-4, 2e-5) and seen["seed"] == 5
+    text = capsys.readouterr().out
+    assert "replayed in AMBF 3 times" in text and "pair 1: adfkit passed; AMBF passed, passed, passed" in text
+    assert "adfkit's verdict 3 of 3" in text and "flips" not in text and "1.9-1.9 mm" in text
+    seen["same"] = 0
+    assert main(["parity", "--suture", "--pairs", "1", "--trials", "3"]) == 1
+    text = capsys.readouterr().out
+    assert "AMBF passed, passed, thread-not-through: adfkit's verdict 2 of 3" in text
+    assert "AMBF's own verdict changes with the nudge" in text and "1.9-6.0 mm" in text
