@@ -178,3 +178,23 @@ def phantom_file(
     (folder / "meshes" / "Phantom.OBJ").write_text(obj_text(v, f, uvs=uv, mtllib="Phantom.mtl", material="tissue"))
     (folder / "meshes" / "Phantom.mtl").write_text("newmtl tissue\nKd 0.85 0.55 0.5\nd 1\n")
     return write_file(m, folder / "phantom.yaml")
+
+
+def tilt_phantom(path: Path, axis: str, deg: float) -> Path:
+    """The phantom file at ``path`` turned ``deg`` about world ``axis`` ("x": the line of pairs
+    runs uphill toward pair 1's end for deg > 0; "y": entry above exit for deg > 0) and raised
+    until its slab's lowest corner stands on the floor (turned about the origin, a third of it
+    went through the floor, and the needle's thread with it). Written back; returns ``path``."""
+    import numpy as np
+
+    from adfkit.runner.rotations import pose_to_matrix
+    from adfkit.scenes.suturing.frames import pose, rot_x, rot_y, translation
+
+    turn = (rot_x if axis == "x" else rot_y)(math.radians(deg))
+    corners = np.array([(sx * L.SLAB[0] / 2, sy * L.SLAB[1] / 2, 0.0, 1.0) for sx in (-1, 1) for sy in (-1, 1)])
+    up = max(0.0, -float((corners @ turn.T)[:, 2].min()))
+    doc, _ = read_file(path, "model")
+    for b in doc.bodies:
+        b.location = pose(translation(0.0, 0.0, up) @ turn @ pose_to_matrix(b.location))
+    write_file(doc, path)
+    return path

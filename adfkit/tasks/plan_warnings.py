@@ -80,7 +80,7 @@ def plan_warnings(task) -> list[Diagnostic]:
                     "plan-tool-in-tissue",
                     f"pair {task.pairs[k].index}, the plan: {arm}'s tool comes {-g.clearance * 1000:.1f} mm into "
                     f"{body} {_when(task, kind, k, g.nearest_at)} (at ({at}) mm), on the grasp that keeps it "
-                    "farthest from the tissue: expect the pair to fail there (tool-hit-tissue, pressed-on-tissue, "
+                    "farthest from the tissue: the pair may fail there (tool-hit-tissue, pressed-on-tissue, "
                     "reach)",
                     where,
                     _hint(body, arm),
