@@ -1,6 +1,7 @@
 """The broadphase's margin (runner/pybullet/broadphase_margin.py): one per process, which each
-PyBullet world puts in force before it steps; under AMBF's bodies a creeping body keeps its box
-in Bullet's tree, and the poses stay what PyBullet's own margin gives."""
+PyBullet world puts in force before it steps (PyBullet puts its own 0 back at every world it
+makes); a creeping body keeps its box in Bullet's tree, and the poses stay what PyBullet's own
+margin gives."""
 
 from __future__ import annotations
 
@@ -26,29 +27,36 @@ needs_margin = pytest.mark.skipif(
 
 
 @needs_margin
-def test_each_world_puts_its_margin_in_force_and_a_new_world_does_not_take_it_away():
-    """A world under AMBF's bodies steps with BODIES_AMBF in force, even after its ghosts' own
-    world was made mid-step (PyBullet puts 0 back at every world it makes); a world under
-    Options() puts PyBullet's 0 back before it steps, and the first world its own again."""
+def test_each_world_steps_with_the_margin_though_a_world_made_since_put_pybullets_back():
+    """A world under adfkit run's options steps with MARGIN in force, even after its ghosts' own
+    world was made mid-step; a world made since by anyone (PyBullet puts 0 back) leaves 0 in
+    force until a world of adfkit's steps, under Options() as under run's options."""
     scene = load_scene(BUNDLED, None)
     ambf = open_world(scene, Options(**AMBF))
     plain = open_world(scene, Options(visuals=False))
+    other = None
     try:
         ambf.step(3)  # its ghosts' pass world is made in the first control step
         assert ambf._ghost_pass.cid is not None
-        assert broadphase_margin.margin_now() == broadphase_margin.BODIES_AMBF > 0
-        plain.step(1)
+        assert broadphase_margin.margin_now() == broadphase_margin.MARGIN > 0
+        other = pb.connect(pb.DIRECT)
         assert broadphase_margin.margin_now() == broadphase_margin.PYBULLET == 0.0
+        plain.step(1)
+        assert broadphase_margin.margin_now() == broadphase_margin.MARGIN
+        pb.resetSimulation(physicsClientId=other)  # makes its world again: 0
+        assert broadphase_margin.margin_now() == 0.0
         ambf.step(1)
-        assert broadphase_margin.margin_now() == broadphase_margin.BODIES_AMBF
+        assert broadphase_margin.margin_now() == broadphase_margin.MARGIN
     finally:
         ambf.close()
         plain.close()
+        if other is not None:
+            pb.disconnect(other)
 
 
-def _digest(monkeypatch, margin: float, nudge: float = 0.0) -> str:
-    monkeypatch.setattr(pb_world, "BODIES_AMBF", margin)
-    w = open_world(load_scene(BUNDLED, None), Options(**AMBF))
+def _digest(monkeypatch, opt: dict, margin: float, nudge: float = 0.0) -> str:
+    monkeypatch.setattr(pb_world, "BROADPHASE_MARGIN", margin)
+    w = open_world(load_scene(BUNDLED, None), Options(**opt))
     try:
         if nudge:
             needle = w.body("Needle")
@@ -61,12 +69,13 @@ def _digest(monkeypatch, margin: float, nudge: float = 0.0) -> str:
 
 
 @needs_margin
-def test_the_margin_leaves_the_bundled_scene_where_pybullets_own_leaves_it(monkeypatch):
-    """The bundled suturing scene under adfkit run's options, 0.6 s (the thread settling on the
-    phantom, the PSMs holding): every body's state the same to the bit with BODIES_AMBF as with
-    PyBullet's 0 (the margin only keeps boxes in the tree; a pair made earlier within it has no
-    points until its bodies come within the contact threshold). Control: the needle put 1 nm
-    aside at the start ends elsewhere (the digest sees a nanometre)."""
-    ours = _digest(monkeypatch, broadphase_margin.BODIES_AMBF)
-    assert ours == _digest(monkeypatch, 0.0)
-    assert _digest(monkeypatch, 0.0, nudge=1e-9) != ours
+@pytest.mark.parametrize("opt", [AMBF, dict(visuals=False)], ids=["run", "Options"])
+def test_the_margin_leaves_the_bundled_scene_where_pybullets_own_leaves_it(monkeypatch, opt):
+    """The bundled suturing scene, 150 control steps (the thread settling on the phantom, the PSMs
+    holding), under adfkit run's options and under Options(): every body's state the same to the
+    bit with MARGIN as with PyBullet's 0 (the margin keeps boxes in the tree; a pair it makes
+    earlier has no points until its bodies come within the contact breaking threshold). Control:
+    the needle put 1 nm aside at the start ends elsewhere (the digest sees a nanometre)."""
+    ours = _digest(monkeypatch, opt, broadphase_margin.MARGIN)
+    assert ours == _digest(monkeypatch, opt, 0.0)
+    assert _digest(monkeypatch, opt, 0.0, nudge=1e-9) != ours

@@ -5,10 +5,11 @@ inside the grown one, a step does not touch the tree, and only a box that leaves
 and tested against both trees (every other body's box) for new pairs. Bullet's default is 0.05 m,
 which AMBF keeps; PyBullet sets 0 at every world it makes (createEmptyDynamicsWorld), so every body
 that moved at all, by a nanometre, tests its box against every other body's at every physics step:
-on the corpus suturing set under ``adfkit run``'s settings a tenth of the run's CPU, the PSMs'
+on the corpus suturing set a tenth of the run's CPU under ``adfkit run``'s settings, a fifth under
+``Options()``'s, the PSMs'
 creeping links and the resting thread's 40 bodies each doing it every 1 ms step. AMBF's 0.05 m here
 costs more than it saves (the thread's bodies, millimetres apart, each come to overlap every other's
-grown box: more pairs for the narrowphase every step); a margin of BODIES_AMBF a body creeping by
+grown box: more pairs for the narrowphase every step); a margin of MARGIN a body creeping by
 micrometres a step keeps for hundreds of steps, and adds few pairs.
 
 The variable is not exported: its place is read from the symbol table of PyBullet's module file
@@ -24,9 +25,9 @@ import struct
 
 import pybullet as pb
 
-#: m: the margin under AMBF's bodies (Options.bodies "ambf"): see the module
-BODIES_AMBF = 5e-4
-#: m: PyBullet's own, which every other world plays with
+#: m: the margin every PyBullet world of adfkit's plays with: see the module
+MARGIN = 5e-4
+#: m: PyBullet's own, where MARGIN cannot be put in force
 PYBULLET = 0.0
 
 _cell: ctypes.c_double | None = None

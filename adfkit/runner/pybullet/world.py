@@ -27,8 +27,7 @@ from . import stability as pb_stability
 from .articulation import AXIS, ROTARY, TREE_KINDS
 from .assemble import Assembly
 from .bodies import SimBody
-from .broadphase_margin import BODIES_AMBF
-from .broadphase_margin import PYBULLET as PYBULLET_MARGIN
+from .broadphase_margin import MARGIN as BROADPHASE_MARGIN
 from .cameras import choose_renderer, render
 from .chain import ChainModel
 from .ghost_steps import GhostSteps
@@ -73,9 +72,9 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         # millimetre-sized scene plays ~1.4x faster at 0.001 (bench/run_suturing.py). One value for
         # the whole process: put in force again before each step (bullet_globals.py)
         self.contact_threshold = params["contactBreakingThreshold"] = bullet_globals.threshold(self.opt)
-        # the broadphase's margin, one per process too (broadphase_margin.py): AMBF's bodies grow
-        # each box a little, so that a creeping body leaves the broadphase's tree alone
-        self.broadphase_margin = BODIES_AMBF if self.opt.bodies == "ambf" else PYBULLET_MARGIN
+        # the broadphase's margin, one per process too (broadphase_margin.py): each box grown a
+        # little, so that a creeping body leaves the broadphase's tree alone
+        self.broadphase_margin = BROADPHASE_MARGIN
         if self.opt.bodies == "ambf":
             params.update(AMBF_SOLVER_INFO)  # AMBF's contact solver settings (solver_info.py)
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
