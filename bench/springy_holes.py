@@ -4,9 +4,10 @@ The trial scene of docs/parity.md ("The bundled scene at rest"), a copy: each En
 0.2 kg (damping 0.04 linear, 0.1 angular) hung on a six-dof spring to the phantom (100 N/m and
 N·m/rad, damping 50, free 0-10 mm along the phantom's x, from the entry toward the exit side,
 -30..+20 degrees about y and +-5 about z, as the corpus ``Phantoms/Simple`` holes), and the
-thread's elements at 5e-5 kg·m² with 0.2 N·m/rad joints (the corpus file's).
+thread's elements at 5e-5 kg·m² with 0.2 N·m/rad joints damped 0.01 N·m·s/rad (the corpus file's;
+the bundled thread's joints have no springs, scenes/suturing/thread.py).
 
-    .venv/bin/python bench/springy_holes.py OUT_DIR [--inertia 5e-5] [--stiffness 0.2]
+    .venv/bin/python bench/springy_holes.py OUT_DIR [--inertia 5e-5] [--stiffness 0.2] [--damping 0.01]
     .venv/bin/adfkit suture OUT_DIR/launch.yaml --pairs 4 --seed 8
 
 Writes the scene and prints where; asserts nothing.
@@ -69,6 +70,7 @@ def main() -> int:
     ap.add_argument("out", type=Path)
     ap.add_argument("--inertia", type=float, default=5e-5, help="kg m2 of every thread element, each axis")
     ap.add_argument("--stiffness", type=float, default=0.2, help="N m/rad of the thread's joints")
+    ap.add_argument("--damping", type=float, default=0.01, help="N m s/rad of the thread's joints")
     a = ap.parse_args()
 
     from adfkit.adf import load, write_file
@@ -91,14 +93,15 @@ def main() -> int:
     threads = [b for b in m.bodies if (b.name or "").startswith("Thread")]
     for b in threads:
         b.inertia = Inertia(ix=a.inertia, iy=a.inertia, iz=a.inertia)
-    k = a.stiffness
+    k, c = a.stiffness, a.damping
     springs = [j for j in m.joints if j.type == "six dof spring" and "Thread" in (j.child or "")]
     for j in springs:
         j.stiffness = AxesGains(linear=Vec3(), angular=Vec3(k, k, k))
+        j.damping = AxesGains(linear=Vec3(), angular=Vec3(c, c, c))
     write_file(m, path)
     print(
         f"{a.out / 'launch.yaml'}: {len(holes)} hole bodies on springs, {len(threads)} thread elements "
-        f"at {a.inertia:g} kg m2, {len(springs)} thread joints at {k:g} N m/rad"
+        f"at {a.inertia:g} kg m2, {len(springs)} thread joints at {k:g} N m/rad, {c:g} N m s/rad"
     )
     return 0
 

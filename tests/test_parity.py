@@ -496,6 +496,38 @@ def test_the_bundled_arms_stand_still_in_ambf_as_in_adfkit(tmp_path):
     assert max(g.max_position for g in c.bodies) > 0.01
 
 
+@needs_ambf
+def test_the_bundled_thread_lies_still_in_ambf_as_in_adfkit(tmp_path):
+    """The whole bundled scene for 1 s at rest. Its thread's elements carry their capsules'
+    inertia (1.5e-8 kg·m²) and its joints their limits without springs (scenes/suturing/thread.py):
+    AMBF's thread lies as adfkit's (measured: every body within 0.53 mm, a thread element by the
+    needle; MuJoCo 0.52 mm). Negative control: the published stiffness and damping (0.02 N·m/rad,
+    0.01 N·m·s/rad) on every thread joint, whose explicit damper at Bullet's cap takes each
+    element's whole turning from both its joints every 1 ms step: AMBF's thread writhes
+    (measured 141 mm apart)."""
+    import shutil
+    from pathlib import Path
+
+    from adfkit.parity import session
+    from adfkit.scenes.suturing import thread
+
+    src = Path(__file__).resolve().parent.parent / "sample_scenes" / "suturing"
+    (c,) = session.run(session.Request(src / "launch.yaml", None, BUILD, seconds=1.0), progress=False).comparisons
+    assert max(g.max_position for g in c.bodies) < 2e-3
+    assert thread.STIFFNESS == thread.DAMPING == 0.0
+    bad = tmp_path / "suturing"
+    shutil.copytree(src, bad)
+    phantom = bad / "phantom" / "phantom.yaml"
+    text = phantom.read_text()
+    zero, lin = "{x: 0.0, y: 0.0, z: 0.0}", "    linear: {x: 0.0, y: 0.0, z: 0.0}\n"
+    springless = f"  damping:\n{lin}    angular: {zero}\n  stiffness:\n{lin}    angular: {zero}\n"
+    published = f"  damping:\n{lin}    angular: {{x: 0.01, y: 0.01, z: 0.01}}\n  stiffness:\n{lin}    angular: {{x: 0.02, y: 0.02, z: 0.02}}\n"
+    assert text.count(springless) == 39  # the thread's joints
+    phantom.write_text(text.replace(springless, published))
+    (c,) = session.run(session.Request(bad / "launch.yaml", None, BUILD, seconds=1.0), progress=False).comparisons
+    assert max(g.max_position for g in c.bodies) > 0.05
+
+
 @pytest.mark.slow
 @needs_ambf
 def test_the_suturing_pads_thread_falls_with_its_needle_as_in_ambf(tmp_path):

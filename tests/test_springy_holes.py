@@ -26,6 +26,8 @@ def test_the_copy_hangs_every_hole_on_a_spring_that_slides_it_toward_the_exit(tm
     assert all(b.mass == 0.2 for b in holes)
     threads = [b for b in m.bodies if (b.name or "").startswith("Thread")]
     assert len(threads) == 40 and all(b.inertia.ix == 5e-5 for b in threads)
+    joints = [j for j in m.joints if j.type == "six dof spring" and "Thread" in (j.child or "")]
+    assert len(joints) == 39 and all((j.stiffness.angular.x, j.damping.angular.x) == (0.2, 0.01) for j in joints)
 
     world = open_world(load_scene(out / "launch.yaml"), Options(visuals=False))
     try:

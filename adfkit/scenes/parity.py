@@ -246,17 +246,18 @@ CHALLENGE_THREAD_INERTIA = 5.0e-5
 
 
 def build_thread(inertia: float | None = None) -> ModelFile:
-    """The suture thread of the sample scene (40 capsules on six-dof springs, the published
-    settings) held at one end by a static stand-in for the needle 0.2 m up, lying level at the
-    start: it falls and swings down until it hangs. ``inertia`` (kg·m² about each axis) replaces
+    """The suture thread of the sample scene (40 capsules on six-dof springs, with the published
+    stiffness and damping, which the sample scene's own thread leaves out) held at one end by a
+    static stand-in for the needle 0.2 m up, lying level at the start: it falls and swings down
+    until it hangs. ``inertia`` (kg·m² about each axis) replaces
     the elements' own, their capsules' (the challenge phantom's elements carry 5e-5)."""
     from .suturing import layout as L
-    from .suturing.thread import thread_bodies_and_joints
+    from .suturing.thread import PUBLISHED_DAMPING, PUBLISHED_STIFFNESS, thread_bodies_and_joints
 
     needle_world = np.eye(4)
     rest = L.SLAB[2] + L.THREAD_RADIUS + 0.00001  # the height the builder lays the thread at
     needle_world[:3, 3] = (L.NEEDLE_RADIUS, 0.0, rest)  # its tail (angle pi) at x = 0, level
-    bodies, joints = thread_bodies_and_joints(needle_world)
+    bodies, joints = thread_bodies_and_joints(needle_world, PUBLISHED_STIFFNESS, PUBLISHED_DAMPING)
     lift = 0.2 - rest
     m = ModelFile(namespace="/ambf/env/thread/")
     needle = _box("Needle", (0.004, 0.004, 0.004), (L.NEEDLE_RADIUS, 0.0, 0.2))

@@ -1,7 +1,16 @@
-"""The suture thread: 40 capsule elements joined by six-dof springs with the published
-settings (angular limits ±pi/6, angular stiffness 0.02 N·m/rad, damping 0.01 N·m·s/rad,
-linear axes locked), the first element fixed to the needle's tail. Names and the element
-frame (z along the thread, the next element at -z) follow the challenge's phantom file."""
+"""The suture thread: 40 capsule elements joined by six-dof springs with the published limits
+(angular ±pi/6, linear axes locked) and neither stiffness nor damping, the first element fixed
+to the needle's tail. Names and the element frame (z along the thread, the next element at -z)
+follow the challenge's phantom file.
+
+The published stiffness and damping (0.02 N·m/rad, 0.01 N·m·s/rad) are left out: on elements of
+their capsules' inertia (1.5e-8 kg·m²) no engine plays them as springs. AMBF's springs are
+explicit, and its damper, at Bullet's cap, takes an element's whole turning each 1 ms step from
+both its joints: AMBF's thread writhes and its world blows up under the suture's replay. MuJoCo's
+joints without the damper go unstable within 10 ms. adfkit's suture (implicit springs over the
+4 ms step) divided their torques by about 3e5, a limp thread. With neither, every engine plays
+the same limp chain, held by its limits and its bodies' own velocity damping (0.9)
+(docs/parity.md, "The bundled scene at rest")."""
 
 from __future__ import annotations
 
@@ -28,8 +37,11 @@ from . import layout as L
 from .frames import pose, r, rot_x, vec
 
 COLOUR = RGBA(r=0.25, g=0.2, b=0.85, a=1.0)
-STIFFNESS = 0.02
-DAMPING = 0.01
+#: the challenge's published angular stiffness (N·m/rad) and damping (N·m·s/rad) of the thread's
+#: joints, which the parity scene's falling thread keeps (scenes/parity.py)
+PUBLISHED_STIFFNESS, PUBLISHED_DAMPING = 0.02, 0.01
+#: the bundled scene's: none (the module's docstring says why)
+STIFFNESS, DAMPING = 0.0, 0.0
 LIMIT = math.pi / 6
 
 
@@ -73,8 +85,9 @@ def thread_path(tail: np.ndarray, rest_z: float) -> list[np.ndarray]:
     return poses
 
 
-def thread_bodies_and_joints(needle_world: np.ndarray):
-    """Bodies and joints of the thread lying along world -y from the needle's tail."""
+def thread_bodies_and_joints(needle_world: np.ndarray, stiffness: float = STIFFNESS, damping: float = DAMPING):
+    """Bodies and joints of the thread lying along world -y from the needle's tail, its joints'
+    angular ``stiffness`` and ``damping`` about every axis."""
     p = L.THREAD_PITCH
     tail_local = np.array(
         [L.NEEDLE_RADIUS * math.cos(L.NEEDLE_TAIL_ANGLE), L.NEEDLE_RADIUS * math.sin(L.NEEDLE_TAIL_ANGLE), 0.0]
@@ -146,8 +159,8 @@ def thread_bodies_and_joints(needle_world: np.ndarray):
                 parent_axis=Vec3(0.0, 1.0, 0.0),
                 child_axis=Vec3(0.0, 1.0, 0.0),
                 joint_limits=limits,
-                stiffness=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(STIFFNESS, STIFFNESS, STIFFNESS)),
-                damping=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(DAMPING, DAMPING, DAMPING)),
+                stiffness=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(stiffness, stiffness, stiffness)),
+                damping=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(damping, damping, damping)),
                 equilibrium_point=AxesGains(linear=Vec3(0.0, 0.0, 0.0), angular=Vec3(0.0, 0.0, 0.0)),
                 passive=True,
             )
