@@ -118,7 +118,8 @@ def test_ambf_repeats_a_replay_to_the_bit_and_a_nudge_moves_it(tmp_path):
 @needs_ambf
 def test_trials_follow_the_measured_joints_so_a_pace_is_a_bad_option(capsys):
     """--trials replays follow adfkit's measured joints: with --pace on it is the user's error
-    (exit 2, before any suture is played), as are no trials and a nudge of 0."""
+    (exit 2, before any suture is played), as are no trials, a nudge of 0, NaN, infinite or
+    negative, and trials without --suture."""
     from adfkit.cli import main
 
     launch = ROOT / "sample_scenes" / "suturing" / "launch.yaml"
@@ -128,6 +129,11 @@ def test_trials_follow_the_measured_joints_so_a_pace_is_a_bad_option(capsys):
     assert "--nudge a positive offset" in capsys.readouterr().err
     assert main(["parity", "--suture", str(launch), "--trials", "0"]) == 2
     assert "--trials takes 1 or more" in capsys.readouterr().err
+    for bad in ("nan", "inf", "-1e-4"):
+        assert main(["parity", "--suture", str(launch), "--trials", "2", f"--nudge={bad}"]) == 2
+        assert "--nudge a positive offset" in capsys.readouterr().err
+    assert main(["parity", str(launch), "--trials", "3"]) == 2  # a scene's parity is not a suture's
+    assert "--trials replays a suture" in capsys.readouterr().err
 
 
 def test_the_trials_are_printed_per_pair_and_any_other_verdict_fails(monkeypatch, capsys):

@@ -134,6 +134,10 @@ def run(args) -> int:
 
     if args.suture:
         return _suture(args)
+    if args.trials != 1:
+        raise AdfError(
+            error("bad-option", "--trials replays a suture", None, "adfkit parity --suture [SCENE] --trials K")
+        )
     if not args.path:
         raise AdfError(error("bad-option", "name the scene to compare", None, "adfkit parity SCENE [-l 6-11]"))
     path = inputs.scene_file(args.path)
@@ -197,7 +201,7 @@ def _suture(args) -> int:
                 "use --follow both to replay the set-points paced beside it",
             )
         )
-    if args.trials < 1 or args.nudge <= 0:
+    if args.trials < 1 or not 0 < args.nudge < float("inf"):
         raise AdfError(error("bad-option", "--trials takes 1 or more, --nudge a positive offset", None))
     if args.trials > 1:
         if args.pace != "off" or follow != "measured":
