@@ -345,9 +345,9 @@ ODD = {
     "1 mm membrane": (lambda doc: _membrane(doc), "blocked-at-entry", "blocked at Entry1"),
     # passed before; the check before the run read its cylinders as capsules filling the channels
     "curved ridge": (lambda doc: _curved_ridge(doc), None, None),
-    # the needle pushed the phantom 7.6 mm along the table and turned it 1.9°: the exit 3.7 mm
-    # outside its opening, for where the hole went
-    "free on a table": (_free_on_a_table, "exit-outside-opening", "the tissue moved during the run (Entry1 7."),
+    # the needle pushed the phantom 8.0 mm along the table and turned it 2.0°: the exit 4.0 mm
+    # outside its opening, for where the hole went (the reason names the moved bodies, not how far)
+    "free on a table": (_free_on_a_table, "exit-outside-opening", "the tissue moved during the run (Entry1 "),
 }
 
 
