@@ -1,0 +1,106 @@
+"""How far AMBF stands from itself: a scene played twice in AMBF and in adfkit, the second time
+with one body's `location` moved along x by a distance nobody could measure (0.1 µm unless
+asked), and each side's largest gap to its own unmoved run beside the gap between the two sides.
+Where AMBF's own spread is as large as its gap to adfkit, that gap says nothing about adfkit
+(docs/parity.md, "The bundled scene at rest").
+
+    .venv/bin/python bench/ambf_nudged.py LAUNCH [-l N ...] --body NAME [--by 1e-7] [--seconds 2]
+        [--engine pybullet|mujoco]
+
+Prints a markdown table; asserts nothing; skips, with the reason, without an AMBF build.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+
+def nudged_copy(launch: Path, indices: list[int] | None, body: str, by: float, out: Path) -> Path:
+    """A copy of ``launch``'s folder in ``out`` whose ``BODY body`` (in the model files the launch
+    loads with ``indices``) stands ``by`` metres further along x: its `location`'s flow-style
+    `position`, as adfkit's writer and the bundled scenes write it. The copy's launch file.
+    ValueError where none of those files, or more than one, places that body so."""
+    from adfkit.adf import load_scene
+
+    src = launch.resolve().parent
+    files = {Path(m.path).resolve() for m in load_scene(launch, indices, []).all_models() if m.path}
+    files = {f for f in files if f.is_relative_to(src)}
+    dst = out / src.name
+    shutil.copytree(src, dst)
+    head = re.compile(rf"^BODY {re.escape(body)}:\s*$", re.M)
+    loc = re.compile(r"^(\s+)location:\s*\n\1\s+position:\s*\{x:\s*([-+0-9.eE]+)", re.M)
+    found = []
+    for f in sorted(files):
+        text = f.read_text(encoding="utf-8")
+        m = head.search(text)
+        if m is None:
+            continue
+        nxt = re.compile(r"^\S", re.M).search(text, m.end())  # the next top-level key ends the body
+        at = loc.search(text, m.end(), nxt.start() if nxt else len(text))
+        if at is None:
+            continue
+        x = float(at.group(2)) + by
+        found.append((dst / f.relative_to(src), text[: at.start(2)] + repr(x) + text[at.end(2) :]))
+    if len(found) != 1:
+        raise ValueError(f"{len(found)} model files of {launch} place BODY {body} with a flow-style position")
+    f, text = found[0]
+    f.write_text(text, encoding="utf-8")
+    return dst / launch.name
+
+
+def _row(label: str, c) -> str:
+    pos, ang = c.worst
+    past = sum(1 for g in c.bodies if g.max_position > c.tolerance_m or g.max_angle > c.tolerance_deg)
+    short = lambda g: g.name.rsplit("/", 1)[-1]  # noqa: E731
+    return (
+        f"| {label} | **{pos.max_position * 1e3:.3f} mm** (`{short(pos)}`) | **{ang.max_angle:.2f}°** (`{short(ang)}`) "
+        f"| {past} of {len(c.bodies)} |"
+    )
+
+
+def main(argv: list[str]) -> int:
+    from adfkit.parity import ambf, session
+    from adfkit.parity.compare import compare
+
+    ap = argparse.ArgumentParser(prog="bench/ambf_nudged.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("launch", type=Path)
+    ap.add_argument("-l", "--indices", type=int, nargs="+", default=None, help="the launch file's models")
+    ap.add_argument("--body", required=True, help="the body moved (its ADF name, e.g. Needle)")
+    ap.add_argument("--by", type=float, default=1e-7, help="m along x (default 1e-7)")
+    ap.add_argument("--seconds", type=float, default=2.0)
+    ap.add_argument("--engine", choices=("pybullet", "mujoco"), default="pybullet")
+    args = ap.parse_args(argv)
+    build, why = ambf.available()
+    if build is None:
+        print(f"skipped: {why}")
+        return 0
+    with tempfile.TemporaryDirectory(prefix="adfkit-nudged-") as tmp:
+        try:
+            copy = nudged_copy(args.launch, args.indices, args.body, args.by, Path(tmp))
+        except ValueError as e:
+            print(f"bench/ambf_nudged.py: {e}", file=sys.stderr)
+            return 2
+        runs = []
+        for path in (args.launch, copy):
+            req = session.Request(path, args.indices, build, seconds=args.seconds, engines=(args.engine,))
+            runs.append(session.run(req, progress=False).comparisons[0])
+    a, b = runs
+    print(f"{args.launch}, {args.seconds:g} s, BODY {args.body} moved {args.by:g} m along x in the second run")
+    print("\n| runs compared | largest position gap | largest angle gap | bodies past 1 mm / 1° |\n|---|---|---|---|")
+    print(_row("AMBF against adfkit", a))
+    print(_row("AMBF against adfkit, nudged", b))
+    print(_row("AMBF against AMBF nudged", compare(a.ambf, b.ambf)))
+    print(_row(f"adfkit {args.engine} against itself nudged", compare(a.adfkit, b.adfkit)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
