@@ -34,6 +34,23 @@ def test_a_pose_that_is_not_a_number_on_one_side_is_a_disagreement():
     assert compare(_trace("ambf", still), _trace("pybullet", still)).failures() == []
 
 
+def test_a_body_ambfs_world_flings_is_a_disagreement_said_with_its_time_and_speed():
+    """AMBF's world blowing up leaves numbers (its thread nudged 1 nm off its plane: bodies
+    1 m off by 44 ms, 1e12 m by 2 s), which the gaps showed as 1e15 mm and nothing more."""
+    still = np.zeros((5, 2, 7))
+    still[:, :, 6] = 1.0
+    falling = still.copy()
+    falling[:, 1, 2] = -29.0 * np.arange(5) * 0.02  # 29 m/s, the fastest fall the docs measure: no blow-up
+    thrown = falling.copy()
+    thrown[3:, 1, 0] = 40.0  # 40 m between the samples at 0.04 and 0.06 s: 2000 m/s
+    c = compare(_trace("ambf", thrown), _trace("pybullet", falling))
+    assert c.flung == [{"name": "b", "from_s": pytest.approx(0.06), "speed_m_s": pytest.approx(2000.0, rel=1e-3)}]
+    assert "AMBF's b is flung (2e+03 m/s) from 0.060 s" in c.failures()
+    assert c.as_json()["flung"] == c.flung and c.as_json()["agree"] is False
+    assert compare(_trace("ambf", falling), _trace("pybullet", falling)).flung == []
+    assert compare(_trace("ambf", falling), _trace("pybullet", thrown)).flung == []  # adfkit's: its world's watch
+
+
 @pytest.mark.skipif(BUILD is None, reason=WHY)
 def test_ambfs_world_blowing_up_on_a_zero_joint_axis_is_said(tmp_path):
     from pathlib import Path

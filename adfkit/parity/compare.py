@@ -49,6 +49,10 @@ class Comparison:
     # a matched body whose pose stops being a number on one side (AMBF's world blowing up, as under
     # a zero joint axis or a zero moment of inertia in contact): side, name, the first such time
     not_a_number: list[dict] = field(default_factory=list)
+    # a matched body of AMBF's flung by its solver (faster than runner.stability.FLUNG_SPEED between two
+    # samples: AMBF's world blowing up, as its thread at its capsules' inertia moved off its plane by
+    # 1 nm), the first such time and the speed; adfkit's own are in ``unstable`` (its world's watch)
+    flung: list[dict] = field(default_factory=list)
 
     @property
     def tip_gaps(self) -> list[Gap]:
@@ -76,6 +80,7 @@ class Comparison:
             f"{'AMBF' if d['side'] == 'ambf' else 'adfkit ' + d['side']}'s {d['name']} is not a number from {d['from_s']:.3f} s"
             for d in self.not_a_number
         ]
+        out += [f"AMBF's {d['name']} is flung ({d['speed_m_s']:.3g} m/s) from {d['from_s']:.3f} s" for d in self.flung]
         return out
 
     def as_json(self) -> dict:
@@ -111,6 +116,7 @@ class Comparison:
             "notes": self.notes,
             "adfkit_unstable": self.unstable,
             "not_a_number": self.not_a_number,
+            "flung": self.flung,
             "joint_opening": {side: o.as_json() for side, o in self.opening.items()},
         }
 
@@ -170,7 +176,10 @@ def compare(ambf: Trace, adfkit: Trace, tolerance_m: float = 1e-3, tolerance_deg
     common = np.intersect1d(ta, tb)
     ia = np.searchsorted(ta, common)
     ib = np.searchsorted(tb, common)
-    bodies, nan = [], []
+    from ..runner.stability import FLUNG_SPEED
+
+    bodies, nan, flung = [], [], []
+    dt = np.diff(common)
     if ambf.poses.size and adfkit.poses.size:
         for i, j in match(ambf.body_names, adfkit.body_names, ambf.poses[0, :, :3], adfkit.poses[0, :, :3]):
             pa, pb = ambf.poses[ia, i], adfkit.poses[ib, j]
@@ -181,6 +190,15 @@ def compare(ambf: Trace, adfkit: Trace, tolerance_m: float = 1e-3, tolerance_deg
                 bad = ~np.isfinite(p).all(axis=1)
                 if bad.any():
                     nan.append({"side": side, "name": ambf.body_names[i], "from_s": float(common[np.argmax(bad)])})
+            if dt.size:  # AMBF's world blowing up: a body thrown faster than anything in a scene moves
+                with np.errstate(invalid="ignore"):
+                    speed = np.linalg.norm(np.diff(pa[:, :3], axis=0), axis=1) / dt
+                fast = speed > FLUNG_SPEED
+                if fast.any():
+                    k = int(np.argmax(fast))
+                    flung.append(
+                        {"name": ambf.body_names[i], "from_s": float(common[k + 1]), "speed_m_s": float(speed[k])}
+                    )
     joints = []
     for i, j in match(
         ambf.joint_names,
@@ -208,4 +226,5 @@ def compare(ambf: Trace, adfkit: Trace, tolerance_m: float = 1e-3, tolerance_deg
         tolerance_m,
         tolerance_deg,
         not_a_number=nan,
+        flung=flung,
     )

@@ -236,6 +236,13 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
         for d in c.not_a_number:
             who = "AMBF" if d["side"] == "ambf" else f"adfkit {d['side']}"
             print(f"  {who}'s {d['name']} is not a number from {d['from_s']:.3f} s", file=stream)
+        if c.flung:
+            d = min(c.flung, key=lambda d: d["from_s"])
+            print(
+                f"  AMBF's world blew up: {len(c.flung)} bodies flung, the first {d['name']} "
+                f"({d['speed_m_s']:.3g} m/s) at {d['from_s']:.3f} s",
+                file=stream,
+            )
         print(
             f"  stepping: AMBF {c.ambf.wall_s:.2f} s, adfkit {eng} {c.adfkit.wall_s:.2f} s "
             f"(AMBF's whole process {out.ambf_process_s:.2f} s)",
