@@ -1,11 +1,11 @@
 """How far AMBF stands from itself: a scene played twice in AMBF and in adfkit, the second time
-with one body's `location` moved along x by a distance nobody could measure (0.1 µm unless
-asked), and each side's largest gap to its own unmoved run beside the gap between the two sides.
+with one body's `location` moved along x (or y, z) by a distance nobody could measure (0.1 µm
+unless asked), and each side's largest gap to its own unmoved run beside the gap between the two sides.
 Where AMBF's own spread is as large as its gap to adfkit, that gap says nothing about adfkit
 (docs/parity.md, "The bundled scene at rest").
 
-    .venv/bin/python bench/ambf_nudged.py LAUNCH [-l N ...] --body NAME [--by 1e-7] [--seconds 2]
-        [--engine pybullet|mujoco]
+    .venv/bin/python bench/ambf_nudged.py LAUNCH [-l N ...] --body NAME [--by 1e-7] [--axis x|y|z]
+        [--seconds 2] [--engine pybullet|mujoco]
 
 Prints a markdown table; asserts nothing; skips, with the reason, without an AMBF build.
 """
@@ -23,9 +23,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 
-def nudged_copy(launch: Path, indices: list[int] | None, body: str, by: float, out: Path) -> Path:
+def nudged_copy(launch: Path, indices: list[int] | None, body: str, by: float, out: Path, axis: str = "x") -> Path:
     """A copy of ``launch``'s folder in ``out`` whose ``BODY body`` (in the model files the launch
-    loads with ``indices``) stands ``by`` metres further along x: its `location`'s flow-style
+    loads with ``indices``) stands ``by`` metres further along ``axis``: its `location`'s flow-style
     `position`, as adfkit's writer and the bundled scenes write it. The copy's launch file.
     ValueError where none of those files, or more than one, places that body so."""
     from adfkit.adf import load_scene
@@ -36,7 +36,8 @@ def nudged_copy(launch: Path, indices: list[int] | None, body: str, by: float, o
     dst = out / src.name
     shutil.copytree(src, dst)
     head = re.compile(rf"^BODY {re.escape(body)}:\s*$", re.M)
-    loc = re.compile(r"^(\s+)location:\s*\n\1\s+position:\s*\{x:\s*([-+0-9.eE]+)", re.M)
+    before = {"x": "", "y": r"x:\s*[-+0-9.eE]+,\s*", "z": r"x:\s*[-+0-9.eE]+,\s*y:\s*[-+0-9.eE]+,\s*"}[axis]
+    loc = re.compile(rf"^(\s+)location:\s*\n\1\s+position:\s*\{{{before}{axis}:\s*([-+0-9.eE]+)", re.M)
     found = []
     for f in sorted(files):
         text = f.read_text(encoding="utf-8")
@@ -74,7 +75,8 @@ def main(argv: list[str]) -> int:
     ap.add_argument("launch", type=Path)
     ap.add_argument("-l", "--indices", type=int, nargs="+", default=None, help="the launch file's models")
     ap.add_argument("--body", required=True, help="the body moved (its ADF name, e.g. Needle)")
-    ap.add_argument("--by", type=float, default=1e-7, help="m along x (default 1e-7)")
+    ap.add_argument("--by", type=float, default=1e-7, help="m along the axis (default 1e-7)")
+    ap.add_argument("--axis", choices=("x", "y", "z"), default="x", help="the body's move (default x)")
     ap.add_argument("--seconds", type=float, default=2.0)
     ap.add_argument("--engine", choices=("pybullet", "mujoco"), default="pybullet")
     args = ap.parse_args(argv)
@@ -84,7 +86,7 @@ def main(argv: list[str]) -> int:
         return 0
     with tempfile.TemporaryDirectory(prefix="adfkit-nudged-") as tmp:
         try:
-            copy = nudged_copy(args.launch, args.indices, args.body, args.by, Path(tmp))
+            copy = nudged_copy(args.launch, args.indices, args.body, args.by, Path(tmp), args.axis)
         except ValueError as e:
             print(f"bench/ambf_nudged.py: {e}", file=sys.stderr)
             return 2
@@ -93,7 +95,9 @@ def main(argv: list[str]) -> int:
             req = session.Request(path, args.indices, build, seconds=args.seconds, engines=(args.engine,))
             runs.append(session.run(req, progress=False).comparisons[0])
     a, b = runs
-    print(f"{args.launch}, {args.seconds:g} s, BODY {args.body} moved {args.by:g} m along x in the second run")
+    print(
+        f"{args.launch}, {args.seconds:g} s, BODY {args.body} moved {args.by:g} m along {args.axis} in the second run"
+    )
     print("\n| runs compared | largest position gap | largest angle gap | bodies past 1 mm / 1° |\n|---|---|---|---|")
     print(_row("AMBF against adfkit", a))
     print(_row("AMBF against adfkit, nudged", b))

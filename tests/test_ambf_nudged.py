@@ -46,6 +46,10 @@ def test_the_copy_moves_the_named_body_along_x_and_nothing_else(tmp_path):
     assert moved == {"BODY Needle"}
     d = np.subtract(after["BODY Needle"], before["BODY Needle"])
     assert d[0] == pytest.approx(1e-7, abs=1e-15) and not d[1:].any()
+    for k, axis in ((1, "y"), (2, "z")):
+        copy = _bench().nudged_copy(launch, None, "Thread_020", -1e-9, tmp_path / axis, axis)
+        d = np.subtract(_locations(copy)["BODY Thread_020"], before["BODY Thread_020"])
+        assert d[k] == pytest.approx(-1e-9, abs=1e-16) and np.count_nonzero(d) == 1
 
 
 def test_a_body_the_loaded_models_do_not_place_once_is_refused(tmp_path):
