@@ -266,6 +266,32 @@ def test_undoing_what_ambfs_ghost_did_to_a_cube_lets_it_fall_through_the_slab(tm
     assert z_cube == pytest.approx(z_twin, abs=1e-3) and z_twin_again == pytest.approx(z_twin, abs=1e-6)
 
 
+@needs_ambf
+def test_friction_rows_started_from_zero_bring_ambfs_rolling_ball_onto_adfkits(tmp_path, monkeypatch):
+    """The plugin's ADFKIT_PARITY_FRICTION, a measurement knob: "fresh" starts every friction row
+    of AMBF's Bullet from zero, as PyBullet's Bullet does, "two" solves two friction directions per
+    contact point, as PyBullet's world does. On the parity scene's ramp the ball without rolling
+    friction ends 17.2 mm from adfkit's after 1 s as AMBF plays it (its row restarted from 0.85 of
+    its last impulse, "Friction in AMBF's Bullet"); from zero, 0.00 mm; with the second direction
+    alone, 17.2 mm again (measured). Control: the knob off, the gap is back."""
+    from adfkit.parity import session
+    from adfkit.scenes.parity import SCENES, write_parity
+
+    launch = write_parity(tmp_path)
+    req = session.Request(launch, [SCENES.index("ramp")], BUILD, seconds=1.0)
+
+    def rolling_gap() -> float:
+        (c,) = session.run(req, progress=False).comparisons
+        return next(g.max_position for g in c.bodies if g.name.endswith("/rolling"))
+
+    monkeypatch.setenv("ADFKIT_PARITY_FRICTION", "fresh")
+    assert rolling_gap() < 0.5e-3
+    monkeypatch.setenv("ADFKIT_PARITY_FRICTION", "two")
+    assert rolling_gap() > 10e-3
+    monkeypatch.delenv("ADFKIT_PARITY_FRICTION")
+    assert rolling_gap() > 10e-3
+
+
 def _parity_args(*extra: str):
     from adfkit.cli import build_parser
 

@@ -54,6 +54,8 @@
 //   Measurement knobs, which change what AMBF does (for finding out what a behaviour comes from):
 //   ADFKIT_PARITY_STILL_STATIC "1": every static body (mass 0) is put back at rest after each step
 //                           (AMBF's ghosts set the velocity of every body they sense, a static one too)
+//   ADFKIT_PARITY_FRICTION  "two" (two friction directions per contact point, PyBullet's world's), "fresh"
+//                           (every friction row started from zero, PyBullet's Bullet's), "two fresh": both
 //   ADFKIT_PARITY_UNGHOST   "SUBSTRING PARTS": the rigid bodies whose qualified names hold SUBSTRING get
 //                           back, after each step, what AMBF's ghosts changed of them: PARTS names any of
 //                           linear and angular (the velocities Bullet's step left, read at its internal
@@ -217,6 +219,17 @@ public:
         // a measurement's knob: Bullet's solver iterations (AMBF leaves them at Bullet's 10)
         int iterations = (int)env_double("ADFKIT_PARITY_SOLVER_ITERATIONS", 0.0);
         if (iterations > 0) m_world->m_bulletWorld->getSolverInfo().m_numIterations = iterations;
+        // a measurement's knob: how contacts' friction is solved; "two": two friction directions per
+        // contact point (PyBullet's world; AMBF's solves one), "fresh": every friction row started from
+        // zero (PyBullet's Bullet; AMBF's from 0.85 of its last impulse), "two fresh": both
+        const char* friction = getenv("ADFKIT_PARITY_FRICTION");
+        if (friction && *friction) {
+            string f(friction);
+            if (f.find("two") != string::npos)
+                m_world->m_bulletWorld->getSolverInfo().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+            if (f.find("fresh") != string::npos)
+                m_world->m_bulletWorld->setInternalTickCallback(&AdfkitParity::before_tick, this, true);
+        }
         const char* pace = getenv("ADFKIT_PARITY_PACE");
         if (pace && *pace) {
             istringstream ps(pace);
@@ -262,6 +275,20 @@ public:
 
 private:
     // Bullet's step ended (before AMBF's ghosts act): the velocities the ghosts will change
+    // before each physics step: the friction impulses the contact points kept from the last step
+    // forgotten, so that the solver starts every friction row from zero
+    static void before_tick(btDynamicsWorld* w, btScalar) {
+        btDispatcher* d = w->getDispatcher();
+        for (int i = 0; i < d->getNumManifolds(); i++) {
+            btPersistentManifold* m = d->getManifoldByIndexInternal(i);
+            for (int k = 0; k < m->getNumContacts(); k++) {
+                btManifoldPoint& p = m->getContactPoint(k);
+                p.m_appliedImpulseLateral1 = 0;
+                p.m_appliedImpulseLateral2 = 0;
+            }
+        }
+    }
+
     static void after_tick(btDynamicsWorld* w, btScalar) {
         AdfkitParity* self = static_cast<AdfkitParity*>(w->getWorldUserInfo());
         for (size_t i = 0; i < self->m_unghosted.size(); i++) {
