@@ -54,6 +54,8 @@
 //   Measurement knobs, which change what AMBF does (for finding out what a behaviour comes from):
 //   ADFKIT_PARITY_STILL_STATIC "1": every static body (mass 0) is put back at rest after each step
 //                           (AMBF's ghosts set the velocity of every body they sense, a static one too)
+//   ADFKIT_PARITY_JOINT_ITERATIONS "SUBSTRING N": the joints whose qualified names hold SUBSTRING solved
+//                           with N iterations of their own, the rest with the world's
 //   ADFKIT_PARITY_FRICTION  "two" (two friction directions per contact point, PyBullet's world's), "fresh"
 //                           (every friction row started from zero, PyBullet's Bullet's), "two fresh": both
 //   ADFKIT_PARITY_UNGHOST   "SUBSTRING PARTS": the rigid bodies whose qualified names hold SUBSTRING get
@@ -222,6 +224,19 @@ public:
         // a measurement's knob: how contacts' friction is solved; "two": two friction directions per
         // contact point (PyBullet's world; AMBF's solves one), "fresh": every friction row started from
         // zero (PyBullet's Bullet; AMBF's from 0.85 of its last impulse), "two fresh": both
+        // a measurement's knob: "SUBSTRING N" solves the joints whose qualified names hold SUBSTRING
+        // with N iterations of their own (btTypedConstraint::setOverrideNumSolverIterations), the
+        // rest of the world with the world's
+        const char* jointIterations = getenv("ADFKIT_PARITY_JOINT_ITERATIONS");
+        if (jointIterations && *jointIterations) {
+            istringstream js(jointIterations);
+            string name;
+            int n = 0;
+            if (!(js >> name >> n) || n <= 0) fail("ADFKIT_PARITY_JOINT_ITERATIONS: expected \"SUBSTRING N\", N > 0");
+            for (afJointPtr j : m_world->getJoints())
+                if (j->getQualifiedName().find(name) != string::npos && j->getConstraint())
+                    j->getConstraint()->setOverrideNumSolverIterations(n);
+        }
         const char* friction = getenv("ADFKIT_PARITY_FRICTION");
         if (friction && *friction) {
             string f(friction);
