@@ -13,8 +13,6 @@ Prints a markdown table; asserts nothing; skips, with the reason, without an AMB
 from __future__ import annotations
 
 import argparse
-import re
-import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -24,37 +22,22 @@ sys.path.insert(0, str(ROOT))
 
 
 def nudged_copy(launch: Path, indices: list[int] | None, body: str, by: float, out: Path, axis: str = "x") -> Path:
-    """A copy of ``launch``'s folder in ``out`` whose ``BODY body`` (in the model files the launch
-    loads with ``indices``) stands ``by`` metres further along ``axis``: its `location`'s flow-style
-    `position`, as adfkit's writer and the bundled scenes write it. The copy's launch file.
-    ValueError where none of those files, or more than one, places that body so."""
+    """A copy of the scene in ``out`` whose ``BODY body`` (in the model files the launch loads
+    with ``indices``) stands ``by`` metres further along ``axis`` of its `location`'s position
+    (adfkit.parity.spread.nudged_copy). The copy's launch file. ValueError where none of those
+    files, or more than one, places that body."""
     from adfkit.adf import load_scene
+    from adfkit.parity.spread import nudged_copy as copy_moving
 
-    src = launch.resolve().parent
-    files = {Path(m.path).resolve() for m in load_scene(launch, indices, []).all_models() if m.path}
-    files = {f for f in files if f.is_relative_to(src)}
-    dst = out / src.name
-    shutil.copytree(src, dst)
-    head = re.compile(rf"^BODY {re.escape(body)}:\s*$", re.M)
-    before = {"x": "", "y": r"x:\s*[-+0-9.eE]+,\s*", "z": r"x:\s*[-+0-9.eE]+,\s*y:\s*[-+0-9.eE]+,\s*"}[axis]
-    loc = re.compile(rf"^(\s+)location:\s*\n\1\s+position:\s*\{{{before}{axis}:\s*([-+0-9.eE]+)", re.M)
-    found = []
-    for f in sorted(files):
-        text = f.read_text(encoding="utf-8")
-        m = head.search(text)
-        if m is None:
-            continue
-        nxt = re.compile(r"^\S", re.M).search(text, m.end())  # the next top-level key ends the body
-        at = loc.search(text, m.end(), nxt.start() if nxt else len(text))
-        if at is None:
-            continue
-        x = float(at.group(2)) + by
-        found.append((dst / f.relative_to(src), text[: at.start(2)] + repr(x) + text[at.end(2) :]))
+    models = load_scene(launch, indices, []).all_models()
+    found = [Path(m.path).resolve() for m in models if m.path and m.body(f"BODY {body}")]
     if len(found) != 1:
-        raise ValueError(f"{len(found)} model files of {launch} place BODY {body} with a flow-style position")
-    f, text = found[0]
-    f.write_text(text, encoding="utf-8")
-    return dst / launch.name
+        raise ValueError(f"{len(found)} model files of {launch} place BODY {body}")
+    d = tuple(by if a == axis else 0.0 for a in "xyz")
+    copy, why = copy_moving(launch, indices, {(found[0], body): d}, out)
+    if why:
+        raise ValueError(f"BODY {body}: {why[body]}")
+    return copy
 
 
 def _row(label: str, c) -> str:

@@ -79,6 +79,17 @@ def add_arguments(p) -> None:
     p.add_argument("--no-ground", action="store_true", help="a model file: no floor under it on either side")
     p.add_argument("--tolerance-mm", type=float, default=1.0, help="largest position gap that agrees (1 mm)")
     p.add_argument("--tolerance-deg", type=float, default=1.0, help="largest orientation gap that agrees (1°)")
+    p.add_argument(
+        "--spread",
+        action="store_true",
+        help="play AMBF a second time with every free body (dynamic, no joint's child) started --spread-by "
+        "away along the diagonal of x, y and z, and give each body AMBF's own spread (its largest gap to the "
+        "first AMBF run) beside its gap to adfkit; a body past the tolerances whose gaps are within that "
+        "spread plus the tolerances is reported within AMBF's own spread and does not make the exit 1",
+    )
+    p.add_argument(
+        "--spread-by", type=float, metavar="M", help="--spread: the free bodies' nudge, in metres (default 1e-7)"
+    )
     p.add_argument("--plot", metavar="PNG", help="draw each body's position gap over time")
     p.add_argument(
         "--suture",
@@ -132,7 +143,20 @@ def run(args) -> int:
     from ..jsonout import dumps
     from ..parity import ambf, session
 
+    if args.spread_by is not None and not args.spread:
+        raise AdfError(error("bad-option", "--spread-by is the nudge of --spread", None, "add --spread"))
+    if args.spread_by is not None and not 0 < args.spread_by < float("inf"):
+        raise AdfError(error("bad-option", "--spread-by takes a positive distance in metres", None, "e.g. 1e-7"))
     if args.suture:
+        if args.spread:
+            raise AdfError(
+                error(
+                    "bad-option",
+                    "--spread plays a scene's free bodies nudged; a suture's AMBF replays are compared by --trials",
+                    None,
+                    "adfkit parity --suture [SCENE] --trials K (AMBF's verdicts under nudged joints)",
+                )
+            )
         return _suture(args)
     if args.trials != 1:
         raise AdfError(
@@ -159,6 +183,7 @@ def run(args) -> int:
         link_shapes=args.link_shapes or "body",
         tolerance_m=args.tolerance_mm / 1e3,
         tolerance_deg=args.tolerance_deg,
+        spread_by=(1e-7 if args.spread_by is None else args.spread_by) if args.spread else None,
     )
     out = session.run(req, progress=None if not args.json else False)
     from ..report import print_diagnostics

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .spread import Nudge, within
 from .traces import KINDS, Trace
 
 
@@ -53,6 +54,24 @@ class Comparison:
     # samples: AMBF's world blowing up, as its thread at its capsules' inertia moved off its plane by
     # 1 nm), the first such time and the speed; adfkit's own are in ``unstable`` (its world's watch)
     flung: list[dict] = field(default_factory=list)
+    # AMBF against itself with its free bodies nudged (spread.py), by body name: the largest position
+    # (m) and angle (°) gap to its unnudged run; None: not measured (no --spread)
+    spread: dict[str, tuple[float, float]] | None = None
+    nudge: Nudge | None = None
+    spread_notes: list[str] = field(default_factory=list)  # what the nudged AMBF run met (flung, NaN)
+
+    def past(self, g: Gap) -> bool:
+        """The body's gap passes a tolerance."""
+        return g.max_position > self.tolerance_m or g.max_angle > self.tolerance_deg
+
+    def within_spread(self, g: Gap) -> bool:
+        """The body's gap passes a tolerance but is within AMBF's own spread (spread.within)."""
+        s = (self.spread or {}).get(g.name)
+        return (
+            s is not None
+            and self.past(g)
+            and within(g.max_position, g.max_angle, *s, self.tolerance_m, self.tolerance_deg)
+        )
 
     @property
     def tip_gaps(self) -> list[Gap]:
@@ -71,7 +90,7 @@ class Comparison:
         out = [
             f"{g.name}: {g.max_position * 1e3:.3f} mm, {g.max_angle:.3f}°"
             for g in self.bodies
-            if g.max_position > self.tolerance_m or g.max_angle > self.tolerance_deg
+            if self.past(g) and not self.within_spread(g)
         ]
         out += [f"only in AMBF: {d['kind']} {d['name']}" for d in self.only_in_ambf]
         out += [f"only in adfkit: {d['kind']} {d['name']}" for d in self.only_in_adfkit]
@@ -101,6 +120,7 @@ class Comparison:
                     "final_angle_gap_deg": float(g.angle[-1]) if g.angle.size else 0.0,
                     "at_s": float(self.times[int(np.nanargmax(g.position))]) if g.position.size else 0.0,
                 }
+                | self._spread_json(g)
                 for g in self.bodies
             ],
             "largest_position_gap": {"name": pos.name, "m": pos.max_position} if pos else None,
@@ -118,6 +138,35 @@ class Comparison:
             "not_a_number": self.not_a_number,
             "flung": self.flung,
             "joint_opening": {side: o.as_json() for side, o in self.opening.items()},
+        } | ({"ambf_spread": self.spread_summary()} if self.spread is not None else {})
+
+    def _spread_json(self, g: Gap) -> dict:
+        if self.spread is None:
+            return {}
+        pos, ang = self.spread.get(g.name, (None, None))
+        return {
+            "ambf_spread_position_m": pos,
+            "ambf_spread_angle_deg": ang,
+            "within_ambf_spread": self.within_spread(g),
+        }
+
+    def spread_summary(self) -> dict:
+        """AMBF's own spread for the JSON and the text: the nudge, the largest spreads, and the
+        bodies past the tolerances within it."""
+        spread = self.spread or {}
+        pos = max(spread.items(), key=lambda kv: kv[1][0], default=None)
+        ang = max(spread.items(), key=lambda kv: kv[1][1], default=None)
+        n = self.nudge
+        return {
+            "nudge_m": n.by_m if n else None,
+            "nudges": n.directions if n else [],
+            "nudged_bodies": n.moved if n else [],
+            "not_nudged": n.not_moved if n else [],
+            "largest_position": {"name": pos[0], "m": pos[1][0]} if pos else None,
+            "largest_angle": {"name": ang[0], "deg": ang[1][1]} if ang else None,
+            "past_tolerance": sum(1 for g in self.bodies if self.past(g)),
+            "within_ambf_spread": [g.name for g in self.bodies if self.within_spread(g)],
+            "nudged_run": self.spread_notes,
         }
 
 

@@ -9,6 +9,8 @@ import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from ..diagnostics import AdfError, Diagnostic, Severity, error
 from . import ambf as ambf_run
 from . import commandfile
@@ -34,6 +36,7 @@ class Request:
     bodies: str = "ambf"  # what the PyBullet runner's bodies are (Options.bodies): AMBF's btRigidBodies
     tolerance_m: float = 1e-3
     tolerance_deg: float = 1.0
+    spread_by: float | None = None  # AMBF played again with its free bodies nudged so far (m): its own spread
 
 
 @dataclass
@@ -48,12 +51,13 @@ class Outcome:
 def check(req: Request) -> None:
     """The request's numbers, as a located error when one makes no sense."""
     bad_sub = req.control_substeps is not None and req.control_substeps < 1
-    if req.seconds <= 0 or req.every < 0 or bad_sub or req.tolerance_m < 0 or req.tolerance_deg < 0:
+    bad_spread = req.spread_by is not None and not 0 < req.spread_by < float("inf")
+    if req.seconds <= 0 or req.every < 0 or bad_sub or req.tolerance_m < 0 or req.tolerance_deg < 0 or bad_spread:
         raise AdfError(
             error(
                 "bad-option",
-                "--seconds must be positive, --every, --tolerance-mm and --tolerance-deg not negative, "
-                "--control-substeps ≥ 1",
+                "--seconds and --spread-by must be positive, --every, --tolerance-mm and --tolerance-deg not "
+                "negative, --control-substeps ≥ 1",
                 None,
                 "e.g. --seconds 2 --every 0.02",
             )
@@ -119,6 +123,7 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
         stage = _stage(scene, req, floor_z)
         rec = ambf_run.run(req.build, stage, req.seconds, req.every, commands)
         ambf_trace = from_ambf(rec, stage.staged_bodies)
+        spread = _ambf_spread(req, scene, floor_z, commands, ambf_trace) if req.spread_by is not None else None
         out = Outcome([], req, diags, rec.process_s, rec.log)
         for p in players:
             steps = int(round(req.seconds / p.per))
@@ -127,6 +132,8 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
             bar.close()
             c = compare(ambf_trace, trace, req.tolerance_m, req.tolerance_deg)
             c.unstable = [str(e) for e in p.world.watch.events]
+            if spread is not None:
+                c.spread, c.nudge, c.spread_notes = spread
             if any(cmd.kind in commandfile.JOINT_KINDS for cmd, _ in commands_read):  # driven: its tips
                 c.tips = tool_tips(list(zip(p.made["body"], p.bodies)), p.joints)
             pivots = shut_pivots(p.world, p.made)
@@ -139,6 +146,42 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
     finally:
         for w in worlds:
             w.close()
+
+
+def _ambf_spread(req: Request, scene, floor_z, commands, trace):
+    """AMBF's own spread: the scene played again in AMBF once per nudge of spread.DIRECTIONS, every
+    free body moved ``req.spread_by`` that way (spread.nudge_free_bodies); each body's largest gap
+    to ``trace`` over those runs (of two bodies of one name, the smaller), the nudge, and what the
+    nudged runs met."""
+    import tempfile
+
+    from .spread import DIRECTIONS, nudge_free_bodies
+
+    by: dict[str, tuple[float, float]] = {}
+    notes: list[str] = []
+    for direction in DIRECTIONS:
+        with tempfile.TemporaryDirectory(prefix="adfkit-spread-") as tmp:
+            try:
+                copy, nudge = nudge_free_bodies(req.path, req.indices, req.spread_by, direction, Path(tmp))
+            except ValueError as e:
+                raise AdfError(error("spread-nudge", f"--spread: {e}", None, "leave --spread out here")) from None
+            if not nudge.moved:
+                return {}, nudge, ["no free body to nudge (a dynamic body no joint holds): AMBF's spread not measured"]
+            stage = _stage(scene, replace(req, path=copy), floor_z)
+            rec = ambf_run.run(req.build, stage, req.seconds, req.every, commands)
+        c = compare(from_ambf(rec, stage.staged_bodies), trace)  # the nudged run first: its flung bodies
+        run: dict[str, tuple[float, float]] = {}
+        for g in c.bodies:
+            old = run.get(g.name, (np.inf, np.inf))
+            run[g.name] = (min(old[0], g.max_position), min(old[1], g.max_angle))
+        for name, (p, a) in run.items():
+            old = by.get(name, (0.0, 0.0))
+            by[name] = (max(old[0], p), max(old[1], a))
+        for d in c.flung[:1]:
+            notes.append(f"{direction}: {len(c.flung)} bodies flung, the first {d['name']} at {d['from_s']:.3f} s")
+        for d in c.not_a_number[:1]:
+            notes.append(f"{direction}: {d['name']} is not a number from {d['from_s']:.3f} s")
+    return by, nudge, notes
 
 
 def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
@@ -199,11 +242,12 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
                 f"{ang.max_angle:.3f}° ({ang.name})",
                 file=stream,
             )
-            print(f"  {'body':<48} {'max mm':>9} {'max °':>8} {'end mm':>9} {'end °':>8}", file=stream)
+            spread = f" {'AMBF±mm':>9} {'AMBF±°':>8}" if c.spread is not None else ""
+            print(f"  {'body':<48} {'max mm':>9} {'max °':>8} {'end mm':>9} {'end °':>8}{spread}", file=stream)
             for g in c.bodies[:rows]:
                 print(
                     f"  {g.name[-48:]:<48} {g.max_position * 1e3:9.3f} {g.max_angle:8.3f} "
-                    f"{g.position[-1] * 1e3:9.3f} {g.angle[-1]:8.3f}",
+                    f"{g.position[-1] * 1e3:9.3f} {g.angle[-1]:8.3f}{_spread_cells(c, g)}",
                     file=stream,
                 )
             if len(c.bodies) > rows:
@@ -248,11 +292,65 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
             f"(AMBF's whole process {out.ambf_process_s:.2f} s)",
             file=stream,
         )
+        if c.spread is not None:
+            _print_spread(c, stream)
         fails = c.failures()
+        explained = c.spread_summary()["within_ambf_spread"] if c.spread is not None else []
+        tol = f"{c.tolerance_m * 1e3:g} mm / {c.tolerance_deg:g}°"
         if fails:
             print(
-                f"  differ: {len(fails)} past {c.tolerance_m * 1e3:g} mm / {c.tolerance_deg:g}° or made on one side only",
+                f"  differ: {len(fails)} past {tol} or made on one side only"
+                + (" (and past AMBF's own spread)" if c.spread is not None else ""),
+                file=stream,
+            )
+        elif explained:
+            print(
+                f"  agree within AMBF's own spread: every body within {tol}, or ({len(explained)}) within "
+                f"AMBF's spread and {tol} more",
                 file=stream,
             )
         else:
             print(f"  agree: every body within {c.tolerance_m * 1e3:g} mm and {c.tolerance_deg:g}°", file=stream)
+
+
+def _spread_cells(c: Comparison, g) -> str:
+    if c.spread is None:
+        return ""
+    s = c.spread.get(g.name)
+    if s is None:
+        return f" {'-':>9} {'-':>8}"
+    return f" {s[0] * 1e3:9.3f} {s[1]:8.3f}" + ("  within AMBF's spread" if c.within_spread(g) else "")
+
+
+def _print_spread(c: Comparison, stream) -> None:
+    """AMBF's own spread: what was nudged, the largest spreads, the bodies it explains."""
+    s = c.spread_summary()
+    if not s["nudged_bodies"]:
+        print(f"  AMBF's own spread: {'; '.join(c.spread_notes)}", file=stream)
+        return
+    n = len(s["nudged_bodies"])
+    names = ", ".join(s["nudged_bodies"][:6]) + (" …" if n > 6 else "")
+    pos, ang = s["largest_position"], s["largest_angle"]
+    print(
+        f"  AMBF's own spread (AMBF {len(s['nudges'])} more times, {n} free {'body' if n == 1 else 'bodies'} "
+        f"({names}) moved {s['nudge_m']:g} m along {', '.join(s['nudges'])}): "
+        f"largest {pos['m'] * 1e3:.3f} mm ({pos['name']}), {ang['deg']:.3f}° ({ang['name']}); "
+        f"{len(s['within_ambf_spread'])} of {s['past_tolerance']} bodies past the tolerances within it",
+        file=stream,
+    )
+    past = [g for g in c.bodies if c.past(g) and not c.within_spread(g) and g.name in c.spread]
+    if past:
+        print(
+            "  past AMBF's own spread: "
+            + ", ".join(
+                f"{g.name.rsplit('/', 1)[-1]} ({g.max_position * 1e3:.3f} mm {g.max_angle:.2f}°; AMBF "
+                f"{c.spread[g.name][0] * 1e3:.3f} mm {c.spread[g.name][1]:.2f}°)"
+                for g in past[:6]
+            )
+            + (f" and {len(past) - 6} more" if len(past) > 6 else ""),
+            file=stream,
+        )
+    for d in s["not_nudged"]:
+        print(f"  not nudged: {d['name']}: {d['why']}", file=stream)
+    for note in c.spread_notes:
+        print(f"  AMBF nudged {note}", file=stream)
