@@ -13,7 +13,8 @@ DESCRIPTION = (
     "Play SCENE (a launch, world or model file) in AMBF's own simulator, headless, and in adfkit "
     "for the same simulated time, driven by the same commands, and compare every body's position "
     "and orientation over time and what each side created. Exit 1 when a body's gap passes the "
-    "tolerances or one side created something the other did not; 2 for bad input."
+    "tolerances (with --spread, also AMBF's own spread) or one side created something the other did not; "
+    "2 for bad input."
 )
 
 
@@ -82,13 +83,14 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--spread",
         action="store_true",
-        help="play AMBF a second time with every free body (dynamic, no joint's child) started --spread-by "
-        "away along the diagonal of x, y and z, and give each body AMBF's own spread (its largest gap to the "
-        "first AMBF run) beside its gap to adfkit; a body past the tolerances whose gaps are within that "
-        "spread plus the tolerances is reported within AMBF's own spread and does not make the exit 1",
+        help="play AMBF six more times, each with every dynamic root (a body of positive mass no dynamic body "
+        "holds by a joint: one on its own, a tree's first, one hanging from a static body) started --spread-by away along +x, -x, +y, -y, +z or -z, and give each body AMBF's own spread (its largest gap "
+        "to the unnudged AMBF run over the six) beside its gap to adfkit; a body past the tolerances whose "
+        "position and angle gaps are each within that spread plus the tolerance is reported within AMBF's own "
+        "spread and does not make the exit 1",
     )
     p.add_argument(
-        "--spread-by", type=float, metavar="M", help="--spread: the free bodies' nudge, in metres (default 1e-7)"
+        "--spread-by", type=float, metavar="M", help="--spread: the dynamic roots' nudge, in metres (default 1e-7)"
     )
     p.add_argument("--plot", metavar="PNG", help="draw each body's position gap over time")
     p.add_argument(
@@ -152,7 +154,7 @@ def run(args) -> int:
             raise AdfError(
                 error(
                     "bad-option",
-                    "--spread plays a scene's free bodies nudged; a suture's AMBF replays are compared by --trials",
+                    "--spread plays a scene's dynamic roots nudged; a suture's AMBF replays are compared by --trials",
                     None,
                     "adfkit parity --suture [SCENE] --trials K (AMBF's verdicts under nudged joints)",
                 )

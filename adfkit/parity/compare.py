@@ -54,7 +54,7 @@ class Comparison:
     # samples: AMBF's world blowing up, as its thread at its capsules' inertia moved off its plane by
     # 1 nm), the first such time and the speed; adfkit's own are in ``unstable`` (its world's watch)
     flung: list[dict] = field(default_factory=list)
-    # AMBF against itself with its free bodies nudged (spread.py), by body name: the largest position
+    # AMBF against itself with its dynamic roots nudged (spread.py), by body name: the largest position
     # (m) and angle (°) gap to its unnudged run; None: not measured (no --spread)
     spread: dict[str, tuple[float, float]] | None = None
     nudge: Nudge | None = None

@@ -36,7 +36,7 @@ class Request:
     bodies: str = "ambf"  # what the PyBullet runner's bodies are (Options.bodies): AMBF's btRigidBodies
     tolerance_m: float = 1e-3
     tolerance_deg: float = 1.0
-    spread_by: float | None = None  # AMBF played again with its free bodies nudged so far (m): its own spread
+    spread_by: float | None = None  # AMBF played again with its dynamic roots nudged so far (m): its own spread
 
 
 @dataclass
@@ -150,26 +150,35 @@ def run(req: Request, progress: bool | None = None) -> Outcome:
 
 def _ambf_spread(req: Request, scene, floor_z, commands, trace):
     """AMBF's own spread: the scene played again in AMBF once per nudge of spread.DIRECTIONS, every
-    free body moved ``req.spread_by`` that way (spread.nudge_free_bodies); each body's largest gap
+    dynamic root moved ``req.spread_by`` that way (spread.nudge_dynamic_roots); each body's largest gap
     to ``trace`` over those runs (of two bodies of one name, the smaller), the nudge, and what the
-    nudged runs met."""
+    nudged runs met. A nudged run whose world blew up (a body flung or not a number) gives no spread:
+    it is said and left out (AMBF's falling thread, moved 0.1 µm off its plane, blows up; in its
+    plane it stands where it stood)."""
     import tempfile
 
-    from .spread import DIRECTIONS, nudge_free_bodies
+    from .spread import DIRECTIONS, nudge_dynamic_roots
 
     by: dict[str, tuple[float, float]] = {}
     notes: list[str] = []
     for direction in DIRECTIONS:
         with tempfile.TemporaryDirectory(prefix="adfkit-spread-") as tmp:
             try:
-                copy, nudge = nudge_free_bodies(req.path, req.indices, req.spread_by, direction, Path(tmp))
+                copy, nudge = nudge_dynamic_roots(req.path, req.indices, req.spread_by, direction, Path(tmp))
             except ValueError as e:
                 raise AdfError(error("spread-nudge", f"--spread: {e}", None, "leave --spread out here")) from None
             if not nudge.moved:
-                return {}, nudge, ["no free body to nudge (a dynamic body no joint holds): AMBF's spread not measured"]
+                return {}, nudge, ["no dynamic body to nudge: AMBF's spread not measured"]
             stage = _stage(scene, replace(req, path=copy), floor_z)
             rec = ambf_run.run(req.build, stage, req.seconds, req.every, commands)
         c = compare(from_ambf(rec, stage.staged_bodies), trace)  # the nudged run first: its flung bodies
+        if c.flung or c.not_a_number:  # AMBF's world blew up: no answer of AMBF's to measure a gap against
+            first = min(c.flung + c.not_a_number, key=lambda d: d["from_s"])
+            notes.append(
+                f"{direction}: AMBF's world blew up ({len(c.flung)} bodies flung, {len(c.not_a_number)} not a "
+                f"number; the first {first['name']} at {first['from_s']:.3f} s), left out of the spread"
+            )
+            continue
         run: dict[str, tuple[float, float]] = {}
         for g in c.bodies:
             old = run.get(g.name, (np.inf, np.inf))
@@ -177,10 +186,6 @@ def _ambf_spread(req: Request, scene, floor_z, commands, trace):
         for name, (p, a) in run.items():
             old = by.get(name, (0.0, 0.0))
             by[name] = (max(old[0], p), max(old[1], a))
-        for d in c.flung[:1]:
-            notes.append(f"{direction}: {len(c.flung)} bodies flung, the first {d['name']} at {d['from_s']:.3f} s")
-        for d in c.not_a_number[:1]:
-            notes.append(f"{direction}: {d['name']} is not a number from {d['from_s']:.3f} s")
     return by, nudge, notes
 
 
@@ -300,7 +305,7 @@ def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
         if fails:
             print(
                 f"  differ: {len(fails)} past {tol} or made on one side only"
-                + (" (and past AMBF's own spread)" if c.spread is not None else ""),
+                + (" (and past AMBF's own spread)" if c.spread else ""),
                 file=stream,
             )
         elif explained:
@@ -331,11 +336,15 @@ def _print_spread(c: Comparison, stream) -> None:
     n = len(s["nudged_bodies"])
     names = ", ".join(s["nudged_bodies"][:6]) + (" …" if n > 6 else "")
     pos, ang = s["largest_position"], s["largest_angle"]
-    print(
-        f"  AMBF's own spread (AMBF {len(s['nudges'])} more times, {n} free {'body' if n == 1 else 'bodies'} "
-        f"({names}) moved {s['nudge_m']:g} m along {', '.join(s['nudges'])}): "
+    found = (
         f"largest {pos['m'] * 1e3:.3f} mm ({pos['name']}), {ang['deg']:.3f}° ({ang['name']}); "
-        f"{len(s['within_ambf_spread'])} of {s['past_tolerance']} bodies past the tolerances within it",
+        f"{len(s['within_ambf_spread'])} of {s['past_tolerance']} bodies past the tolerances within it"
+        if pos is not None
+        else "not measured: every nudged run blew up"
+    )
+    print(
+        f"  AMBF's own spread (AMBF {len(s['nudges'])} more times, {n} dynamic {'root' if n == 1 else 'roots'} "
+        f"({names}) moved {s['nudge_m']:g} m along {', '.join(s['nudges'])}): {found}",
         file=stream,
     )
     past = [g for g in c.bodies if c.past(g) and not c.within_spread(g) and g.name in c.spread]

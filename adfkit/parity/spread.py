@@ -1,5 +1,6 @@
-"""AMBF's own spread: how far AMBF stands from itself when a scene's free bodies start a distance
-nobody could measure from where the files put them. A scene that amplifies such a nudge (a thread
+"""AMBF's own spread: how far AMBF stands from itself when a scene's dynamic roots (its dynamic
+bodies no dynamic body holds by a joint) start a distance nobody could measure from where the
+files put them. A scene that amplifies such a nudge (a thread
 lying on a phantom, twisting as it creeps) gives a different answer each time its start is
 perturbed; a gap to adfkit no larger than that spread says nothing about adfkit
 (docs/parity.md, "Within a millimetre, not a degree").
@@ -20,7 +21,7 @@ from pathlib import Path
 
 import yaml
 
-#: the nudges, one AMBF run each: every free body moved along +x, -x, +y, -y, +z, then -z. One
+#: the nudges, one AMBF run each: every dynamic root moved along +x, -x, +y, -y, +z, then -z. One
 #: nudge is one draw of a chaotic answer: the bundled scene at rest, its needle moved 0.1 µm, turns
 #: a thread element 76° from AMBF's unnudged run under +x, 7° along the diagonal, 93° under -z; and
 #: a body moved along one axis keeps a symmetry the scene may have (the falling thread lies in the
@@ -53,14 +54,19 @@ def within(gap_m: float, gap_deg: float, spread_m: float, spread_deg: float, tol
     return gap_m <= spread_m + tol_m and gap_deg <= spread_deg + tol_deg
 
 
-def free_bodies(scene) -> list[tuple[Path, str]]:
-    """(model file, ADF body name) of every free body: dynamic (a positive mass) and no joint's
-    child in its model file (a tree's root or a body on its own)."""
+def dynamic_roots(scene) -> list[tuple[Path, str]]:
+    """(model file, ADF body name) of every dynamic body (a positive mass) no dynamic body holds
+    by a joint: a body on its own, the first body of a tree, or one hanging from a static body (a
+    thread from its fixed anchor, an arm's first link from its base). Moved alone, each starts
+    that much apart from what holds it and what it holds: the tree's joints start stretched by the
+    nudge (a tree moved whole, its joints as they were, kicks AMBF's bundled thread a quarter as
+    far: 22° where its needle alone moved gives 93°)."""
     out = []
     for m in scene.all_models():
-        children = {j.child for j in m.joints}
+        dynamic = {b.identifier for b in m.bodies if (b.mass or 0.0) > 0.0}
+        held = {j.child for j in m.joints if j.parent in dynamic}
         for b in m.bodies:
-            if (b.mass or 0.0) > 0.0 and b.identifier not in children and m.path:
+            if b.identifier in dynamic and b.identifier not in held and m.path:
                 out.append((Path(m.path).resolve(), b.identifier.removeprefix("BODY ")))
     return out
 
@@ -206,16 +212,16 @@ def _check(before, after, moves, root: Path, dst: Path) -> None:
                 raise ValueError(f"the nudged copy moves BODY {key[1]} otherwise than asked")
 
 
-def nudge_free_bodies(
+def nudge_dynamic_roots(
     path: Path, indices: list[int] | None, by: float, direction: str, out: Path
 ) -> tuple[Path, Nudge]:
-    """A copy of the scene (in ``out``) with every free body moved ``by`` metres along
+    """A copy of the scene (in ``out``) with every dynamic root (dynamic_roots) moved ``by`` metres along
     ``direction`` (a key of DIRECTIONS); the copy's scene file and what was moved."""
     from ..adf import load_scene
 
-    free = free_bodies(load_scene(path, indices, []))
+    bodies = dynamic_roots(load_scene(path, indices, []))
     d = tuple(by * c for c in DIRECTIONS[direction])
-    copy, why = nudged_copy(path, indices, {fb: d for fb in free}, out)
-    nudge = Nudge(by, moved=[b for _, b in free if b not in why])
+    copy, why = nudged_copy(path, indices, {fb: d for fb in bodies}, out)
+    nudge = Nudge(by, moved=[b for _, b in bodies if b not in why])
     nudge.not_moved = [{"name": b, "why": w} for b, w in why.items()]
     return copy, nudge
