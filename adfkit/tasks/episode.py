@@ -357,6 +357,7 @@ def run_episode(
                 "pairs": placed.pairs,
                 "placement": [[float(v) for v in row] for row in placed.placement],
                 "needle_bed_raised_m": placed.lift_m,
+                "needle_bed_turned_deg": placed.bed_turn_deg,
             }
         if out is not None:
             metrics["files"] = write_outputs(Path(out), metrics, obs, task, frames)

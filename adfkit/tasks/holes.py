@@ -8,6 +8,7 @@ tested on exact numbers as well as on a simulation.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -19,6 +20,35 @@ HOLE_NAME = re.compile(r"(entry|exit)\D*?(\d+)", re.IGNORECASE)
 
 #: opening half-width used when a hole body has no capsule boundary (m)
 DEFAULT_HALF_OPENING = 0.0024
+
+
+#: rad: a pair on tissue sloping more than this, for which the plan finds no grasp the arms
+#: reach, is said to lie on a slope (the 2-pair phantom 45 degrees along its line, pair 1 end
+#: down: psm2's outer_wrist_yaw 4.8 degrees past its limit; 30 degrees planned)
+STEEP = math.radians(35.0)
+
+
+def pair_tilt(entry: np.ndarray, exit_: np.ndarray) -> float:
+    """The angle (rad) from the vertical of the tissue's surface at a pair (its holes' 4x4 frames):
+    the hole axes (z, along the needle's path out of the tissue) lean opposite ways about the
+    surface's normal, so their sum, taken pointing up, is along it."""
+    u = entry[:3, 2] + exit_[:3, 2]
+    n = float(np.linalg.norm(u))
+    return 0.0 if n < 1e-9 else math.acos(min(1.0, abs(float(u[2])) / n))
+
+
+def slope_note(pairs: list[tuple[str, str, np.ndarray, np.ndarray]]) -> str:
+    """ "; Entry1 and Exit1 lie on tissue sloping n°: ..." for the steepest of the pairs (entry's
+    name, exit's name, their frames) sloping more than STEEP, else ""."""
+    steep = [(pair_tilt(e, x), a, b) for a, b, e, x in pairs if pair_tilt(e, x) > STEEP]
+    if not steep:
+        return ""
+    tilt, a, b = max(steep)
+    return (
+        f"; {a} and {b} lie on tissue sloping {math.degrees(tilt):.0f}° from level: the arms stand for level "
+        "tissue (turned about the vertical only) and do not turn the needle that far, lay the pairs on a "
+        "gentler slope"
+    )
 
 
 def hole_name(name: str) -> tuple[str, int] | None:

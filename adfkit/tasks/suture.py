@@ -37,7 +37,7 @@ from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError 
     GraspChoice,
     SutureError,
 )
-from .holes import boundary_body, ghost_box, hole_frame, hole_name, opening_half_extents
+from .holes import boundary_body, ghost_box, hole_frame, hole_label, hole_name, opening_half_extents, slope_note
 from .motions import Motions, interpolate, smooth
 from .needle import fit_needle, obj_vertices, wire_radius
 from .plan_warnings import plan_warnings
@@ -340,7 +340,9 @@ class SutureTask(GraspChoice, Motions):
             try:
                 self._plan_pair(k, p, n0)
             except SutureError as exc:
-                raise SutureError(f"{exc}{self._spread(centres)}") from exc
+                ends = (p.entry, p.exit)
+                steep = slope_note([(*map(hole_label, ends), *(hole_frame(self.world, g) for g in ends))])
+                raise SutureError(f"{exc}{self._spread(centres)}{steep}") from exc
         self.plan_warnings = plan_warnings(self)
 
     def _spread(self, centres: list) -> str:

@@ -25,7 +25,8 @@ stereo camera's frame and both PSMs stay, and are placed for the phantom's holes
   pick-up that kept the jaws off it and took a grasp that drove the wrist into the phantom at
   the first insertion (2.9 kN); lifted without the strip, the falling thread drew the needle
   1.3 mm aside as the scene settled, and the plan made there failed the same way. The tray is
-  tissue to the suture like any other body.
+  tissue to the suture like any other body. Beside holes on a slope the bed may be turned a
+  quarter turn instead, its thread running out from the line of holes (needle_bed).
 
 Pure model work (numpy and the ADF model): the scene comes back as a Scene for the runner.
 """
@@ -46,6 +47,7 @@ from ...runner.rotations import pose_to_matrix
 from ...tasks.holes import HOLE_NAME, hole_name
 from . import layout as L
 from .frames import pose, rot_z, translation
+from .needle_bed import TURN, sloped_bed
 
 #: the bundled phantom's bodies the modeller's phantom replaces (the needle's file keeps the rest)
 BUNDLED_TISSUE = re.compile(r"^(Phantom|Entry\d+|Exit\d+)$")
@@ -280,6 +282,7 @@ class Composed:
     lift_m: float  # how far the needle's bed was raised onto the phantom's tissue
     pairs: list[int]  # in the order the suture visits them: from the needle's end of the line
     names: dict[int, dict[str, str]]
+    bed_turn_deg: float = 0.0  # the needle's bed turned about the vertical beside a sloping phantom (needle_bed)
 
 
 def _moved(body: Body, t: np.ndarray) -> None:
@@ -358,6 +361,21 @@ def compose(bundled: Scene, phantom: ModelFile | list[ModelFile], triangles: boo
     placed = np.c_[under, np.ones(len(under))] @ needle_t.T
     top = tissue_top(files, placed[:, :3], triangles=triangles)
     lift = max(0.0, float(np.max(top - placed[:, 2]))) if np.isfinite(top).any() else 0.0
+
+    # on a slope, a turned lay where it leaves the bed lower (needle_bed)
+    def tops(points: np.ndarray, below: float) -> np.ndarray:
+        return tissue_top(files, points, below=below, triangles=triangles)
+
+    chosen = sloped_bed(tops, holes.frames, rects, slot, thread.reshape(-1, 3), bed, TRAY_DEPTH, needle_t)
+    turn = 0.0
+    if chosen is not None:
+        shift, lift = chosen
+        turn = TURN
+        moved = needle_t @ shift @ np.linalg.inv(needle_t)
+        needle_t = needle_t @ shift
+        for b in needle_file.bodies:
+            if NEEDLE_PARTS.match(b.name or ""):
+                _moved(b, moved)
     if lift > 0:
         up = translation(0.0, 0.0, lift)
         for b in needle_file.bodies:
@@ -370,7 +388,7 @@ def compose(bundled: Scene, phantom: ModelFile | list[ModelFile], triangles: boo
     # other way, sutured 1 to N, started at the far end with the thread drawn back over the pairs
     # it was to go through last (its pair 4 failed, entry-outside-opening by 4.9 mm)
     pairs = sorted(holes.pairs(), key=lambda k: (-along[k], k))
-    return Composed(scene, t, lift, pairs, holes.names)
+    return Composed(scene, t, lift, pairs, holes.names, turn)
 
 
 def load_phantom(path: Path, diagnostics: list) -> ModelFile | list[ModelFile]:
