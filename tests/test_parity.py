@@ -980,8 +980,8 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     }
     seen = {}
 
-    def fake(launch, indices, pairs, build, seed, progress, paces, follow, options):
-        seen["paces"], seen["follow"], seen["options"] = paces, follow, options
+    def fake(launch, indices, pairs, build, seed, progress, paces, follow, options, grasp):
+        seen["paces"], seen["follow"], seen["options"], seen["grasp"] = paces, follow, options, grasp
         return out
 
     monkeypatch.setattr(suture, "compare_suture", fake)
@@ -998,6 +998,8 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     assert main(["parity", "--suture", "--pairs", "1", "--springs", "ambf", "--control-substeps", "1"]) == 1
     assert seen["options"]["springs"] == "ambf" and seen["options"]["control_substeps"] == 1
     assert seen["follow"] == "measured"  # the default without a pace: following adfkit's measured joints
+    assert seen["grasp"] == "lies"  # AMBF's jaws take the needle where it lies, as the challenge's actuator
+    assert main(["parity", "--suture", "--pairs", "1", "--grasp", "adfkit"]) == 1 and seen["grasp"] == "adfkit"
     assert main(["parity", "--suture", "--pairs", "1", "--pace", "on"]) == 1 and seen["follow"] == "commands"
     assert main(["parity", "--suture", "--pairs", "1", "--follow", "both", "--pace", "both"]) == 1
     assert seen["follow"] == "both" and seen["paces"] == (None, suture.PACE)

@@ -144,8 +144,8 @@ def test_the_trials_are_printed_per_pair_and_any_other_verdict_fails(monkeypatch
 
     seen = {}
 
-    def fake(path, indices, pairs, build, count, nudge, seed, progress, options):
-        seen.update(count=count, nudge=nudge, seed=seed)
+    def fake(path, indices, pairs, build, count, nudge, seed, progress, options, grasp):
+        seen.update(count=count, nudge=nudge, seed=seed, grasp=grasp)
         same = seen.get("same", 1)
         runs = [([{"pair": 1, "verdict": "passed", "rule": None}], {1: 0.0019})] * count
         if not same:
@@ -157,9 +157,13 @@ def test_the_trials_are_printed_per_pair_and_any_other_verdict_fails(monkeypatch
     monkeypatch.setattr(ambf, "find_build", lambda path: None)
     assert main(["parity", "--suture", "--pairs", "1", "--trials", "3", "--nudge", "2e-4", "--seed", "5"]) == 0
     assert seen["count"] == 3 and seen["nudge"] == trials.Nudge(2e-4, 2e-5) and seen["seed"] == 5
+    assert seen["grasp"] == "lies"
     text = capsys.readouterr().out
     assert "replayed in AMBF 3 times" in text and "pair 1: adfkit passed; AMBF passed, passed, passed" in text
     assert "adfkit's verdict 3 of 3" in text and "flips" not in text and "1.9-1.9 mm" in text
+    assert main(["parity", "--suture", "--pairs", "1", "--trials", "3", "--grasp", "adfkit"]) == 0
+    assert seen["grasp"] == "adfkit"
+    capsys.readouterr()
     seen["same"] = 0
     assert main(["parity", "--suture", "--pairs", "1", "--trials", "3"]) == 1
     text = capsys.readouterr().out

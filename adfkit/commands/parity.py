@@ -120,6 +120,15 @@ def add_arguments(p) -> None:
         "first (its verdicts judged), then the set-points",
     )
     p.add_argument(
+        "--grasp",
+        choices=("lies", "adfkit"),  # parity.suture.GRASPS
+        default="lies",
+        help="--suture: where AMBF's grasps hold the needle: lies (default) where AMBF's needle lies when its "
+        "jaws take it, as the challenge's constraint actuator does; adfkit where adfkit's grasp held it (the "
+        "needle's frame in the tool's, given to AMBF's constraint actuator as its offset), so that no grasp "
+        "keeps what AMBF's needle turned in the jaws before it",
+    )
+    p.add_argument(
         "--trials",
         type=int,
         default=1,
@@ -250,6 +259,7 @@ def _suture(args) -> int:
         progress=not args.json,
         paces=paces,
         follow=follow,
+        grasp=args.grasp,
         # what the user names; the rest the suture's own, which its acceptance was run on
         options=recording_options(args),
     )
@@ -260,7 +270,8 @@ def _suture(args) -> int:
         how = "paced" if out["paced"] else how
         print(
             f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF {how} "
-            f"({out['commands']} commands)"
+            f"({out['commands']} commands; the needle held in AMBF's jaws "
+            + ("where adfkit's grasp held it)" if out.get("grasp") == "adfkit" else "where it lay)")
         )
         print("  recorded with " + ", ".join(f"{k} {v}" for k, v in out["recorded_with"].items()))
         for p in out["pairs"]:
@@ -313,6 +324,7 @@ def _trials(args, path: Path, pairs, build) -> int:
         args.seed,
         progress=not args.json,
         options=recording_options(args),
+        grasp=args.grasp,
     )
     t = out["trials"]
     if args.json:

@@ -154,11 +154,14 @@ class Command:
     target: str
     value: float = 0.0
     body: str = ""
-    numbers: tuple = ()  # place, pose: the body frame (x y z qx qy qz qw); force: (fx fy fz px py pz) in the world
+    numbers: tuple = ()  # place, pose: the body frame (x y z qx qy qz qw); force: (fx fy fz px py pz) in the world;
+    # grasp: none (the body held where it lies) or its frame in the actuator's parent's frame (held there)
 
     def line(self) -> str:
         if self.kind in ("place", "force", "pose"):
             arg = " ".join(repr(float(v)) for v in self.numbers)
+        elif self.kind == "grasp" and self.numbers:
+            arg = " ".join([self.body] + [repr(float(v)) for v in self.numbers])
         elif self.kind == "collide":
             arg = f"{self.body} {int(self.value)}"
         else:

@@ -53,13 +53,16 @@ def compare_trials(
     seed: int = 0,
     progress: bool = False,
     options: dict | None = None,
+    grasp: str = "lies",
 ) -> dict:
     """``suture.compare_suture``'s JSON for the replay following adfkit's measured joints, with
     ``trials``: the same recording replayed ``count`` times in all, all but the first nudged."""
     rec = record(launch, indices, pairs, seed, progress, measured=True, options=options)
-    first = replay(rec, build, launch, indices, None, "measured")
+    first = replay(rec, build, launch, indices, None, "measured", grasp)
     out = judged(rec, [first]) | {"scene": str(launch), "seed": seed}
-    out["trials"] = trials(rec, first.verdicts, first.gaps, build, launch, indices, count, nudge, "measured", seed)
+    out["trials"] = trials(
+        rec, first.verdicts, first.gaps, build, launch, indices, count, nudge, "measured", seed, grasp
+    )
     return out
 
 
@@ -74,6 +77,7 @@ def trials(
     nudge: Nudge = NUDGE,
     follow: str = "measured",
     seed: int = 0,
+    grasp: str = "lies",
 ) -> dict:
     """The recording replayed ``count`` times in all: ``first`` (the verdicts of the replay as
     recorded, ``first_gaps`` its tip gaps) and ``count - 1`` nudged replays (the signs drawn from
@@ -82,7 +86,7 @@ def trials(
     rng = np.random.default_rng(seed)
     runs = [(first, first_gaps)]
     for _ in range(count - 1):
-        r = replay(replace(rec, commands=nudged(rec, nudge, rng)), build, launch, indices, None, follow)
+        r = replay(replace(rec, commands=nudged(rec, nudge, rng)), build, launch, indices, None, follow, grasp)
         runs.append((r.verdicts, r.gaps))
     return rates(rec.verdicts, runs) | {"count": count, "nudge": {"rad": nudge.rad, "m": nudge.m}, "seed": seed}
 

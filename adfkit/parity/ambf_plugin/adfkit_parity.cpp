@@ -15,7 +15,9 @@
 //                           "headless": left as AMBF leaves them without a window
 //   ADFKIT_PARITY_COMMANDS  command file: one command a line, "TIME KIND TARGET [ARG]", KIND one of
 //                           position|velocity|effort (TARGET a joint's qualified name, ARG the value),
-//                           grasp (TARGET an actuator, ARG a rigid body), release (TARGET an actuator),
+//                           grasp (TARGET an actuator, ARG a rigid body [x y z qx qy qz qw]: where the
+//                           body lies, or, given its frame in the actuator's parent's frame, held
+//                           there: afConstraintActuator::actuate with that offset), release (TARGET an actuator),
 //                           place (TARGET a rigid body, ARG its body frame "x y z qx qy qz qw": set
 //                           there at rest), force (TARGET a rigid body, ARG "fx fy fz px py pz": a
 //                           force at a world point, every step until its next force command);
@@ -615,6 +617,10 @@ private:
                 if (!(ls >> c.arg)) fail(where + "grasp needs a body");
                 if (!find_actuator(c.target)) fail(where + "no constraint actuator " + c.target);
                 if (!find_body(c.arg)) fail(where + "no rigid body " + c.arg);
+                double v;
+                while (ls >> v) c.numbers.push_back(v);
+                if (!c.numbers.empty() && c.numbers.size() != 7)
+                    fail(where + "grasp takes a body, or a body and its frame in the actuator's parent (7 numbers)");
             } else if (c.kind == "release") {
                 if (!find_actuator(c.target)) fail(where + "no constraint actuator " + c.target);
             } else if (c.kind == "collide") {
@@ -648,7 +654,10 @@ private:
         while (m_nextCommand < m_commands.size() && m_commands[m_nextCommand].t <= t + 1e-9) {
             const Command& c = m_commands[m_nextCommand++];
             if (c.kind == "grasp") {
-                find_actuator(c.target)->actuate(find_body(c.arg));
+                afConstraintActuator* a = find_actuator(c.target);
+                afRigidBodyPtr body = find_body(c.arg);
+                if (c.numbers.empty()) a->actuate(body);
+                else a->actuate(body, held_at(a, body, c.numbers));
             } else if (c.kind == "release") {
                 find_actuator(c.target)->deactuate();
             } else if (c.kind == "collide") {
@@ -697,6 +706,23 @@ private:
 
     // a body set at a pose (its ADF body frame) at rest; its broadphase box moved with it (a
     // static body's is not moved by the world's own step)
+    // AMBF's offset for a grasp that holds BODY with its frame at n (x y z qx qy qz qw) in the
+    // actuator's parent's frame: the actuator's frame in the body's centre-of-mass frame, as
+    // afConstraintActuator::actuate(body) computes it from where the body lies, here from where
+    // it is to be held (the constraint then pulls it there)
+    btTransform held_at(afConstraintActuator* a, afRigidBodyPtr body, const vector<double>& n) {
+        btTransform rel(btQuaternion(n[3], n[4], n[5], n[6]), btVector3(n[0], n[1], n[2]));
+        afRigidBodyPtr parent = a->m_parentBody;
+        btTransform parentCom = parent->m_bulletRigidBody->getCenterOfMassTransform();
+        btTransform bodyCom = parentCom * parent->getInverseInertialOffsetTransform() * rel * body->getInertialOffsetTransform();
+        cTransform local = a->getLocalTransform();
+        cVector3d lp = local.getLocalPos();
+        cMatrix3d lr = local.getLocalRot();
+        btMatrix3x3 r(lr(0, 0), lr(0, 1), lr(0, 2), lr(1, 0), lr(1, 1), lr(1, 2), lr(2, 0), lr(2, 1), lr(2, 2));
+        btTransform actuatorInWorld = parentCom * btTransform(r, btVector3(lp.x(), lp.y(), lp.z()));
+        return bodyCom.inverse() * actuatorInWorld;
+    }
+
     void place(afRigidBodyPtr rb, const vector<double>& n) {
         btTransform body(btQuaternion(n[3], n[4], n[5], n[6]), btVector3(n[0], n[1], n[2]));
         btTransform com = body * rb->getInertialOffsetTransform();
