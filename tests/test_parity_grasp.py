@@ -93,3 +93,43 @@ def test_ambfs_actuator_holds_the_needle_at_the_offset_it_is_given():
     later = got[2][2:]
     assert np.linalg.norm(later - rel3[:3, 3], axis=1).max() < 1e-3
     assert np.linalg.norm(later - rel0[:3, 3], axis=1).min() > 2e-3
+
+
+def _held(needle_x) -> tuple:
+    """A recording of one grasp (psm2, at 0.1 s) and a synthetic AMBF trace, every 20 ms, of its
+    tool at rest and the needle's frame at ``needle_x(t)`` along x."""
+    from types import SimpleNamespace
+
+    from adfkit.parity.traces import Trace
+
+    times = np.arange(51) * 0.02
+    poses = np.zeros((len(times), 2, 7))
+    poses[:, :, 6] = 1.0
+    poses[:, 0, 0] = [needle_x(t) for t in times]
+    names = ["/n/Needle", "/n/Tool"]
+    trace = Trace("ambf", {"body": names, "joint": []}, names, times, poses, [], np.zeros((len(times), 0)), 0.0)
+    geom = SimpleNamespace(tip=np.array([0.01, 0.0, 0.0]), tail=np.array([-0.01, 0.0, 0.0]), arc_in_needle=np.eye(4))
+    task = SimpleNamespace(pairs=[], geom=geom)
+    rec = suture.Recording(
+        [], 1.0, [("carry 1", 0.0)], np.zeros((0, 4)), [], task, [], "/n/Needle", [],
+        grasps=[(0.1, "psm2", "/n/Needle")], tools={"psm2": "/n/Tool"},
+    )  # fmt: skip
+    return rec, trace
+
+
+def test_a_held_grasps_slip_is_read_from_where_the_constraint_pulled_the_needle():
+    """Under `--grasp adfkit` AMBF's constraint pulls the needle from where it lay (3 mm off) to
+    where adfkit's grasp held it within 60 ms: no slip, read from where it stands 0.25 s after
+    the grasp; read from where it lay at the grasp (`lies`), the pull is a 3 mm slip. Control: a
+    needle that then moves 3 mm in the jaws slips under either."""
+
+    def pulled(t):
+        return 0.003 if t <= 0.1 else max(0.0, 0.003 - (t - 0.1) * 0.05)
+
+    rec, trace = _held(pulled)
+    assert suture.AmbfObservation(rec, trace, "adfkit").slips == []
+    (slip,) = suture.AmbfObservation(rec, trace, "lies").slips
+    assert slip["slip_m"] == pytest.approx(0.003) and slip["arm"] == "psm2" and slip["phase"] == "carry 1"
+    rec, trace = _held(lambda t: pulled(t) + (0.003 if t >= 0.6 else 0.0))
+    (slip,) = suture.AmbfObservation(rec, trace, "adfkit").slips
+    assert slip["t"] == pytest.approx(0.6) and slip["slip_m"] == pytest.approx(0.003)
