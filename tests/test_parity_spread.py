@@ -163,16 +163,115 @@ def test_a_model_file_in_block_style_is_nudged_and_a_body_without_a_position_is_
     assert not (tmp_path / "out" / tmp_path.name / "blocks.yaml").is_symlink()
 
 
+def _sphere(name: str, position: str) -> str:
+    return (
+        f"BODY {name}:\n  name: {name}\n  mass: 1.0\n  location:\n    position: {position}\n"
+        "    orientation: {r: 0.0, p: 0.0, y: 0.0}\n  collision shape: SPHERE\n  collision geometry: {radius: 0.05}\n"
+    )
+
+
+def test_a_position_an_alias_shares_is_named_not_moved_and_one_used_once_is_moved(tmp_path):
+    """A body placed by a YAML alias: rewriting the anchor would move every body (and key) using
+    it, so a body whose position the file uses more than once is left where it is and named; an
+    anchor no alias uses is moved where it is written."""
+    model = tmp_path / "aliases.yaml"
+    model.write_text(
+        "bodies: [BODY a, BODY b, BODY c]\njoints: []\nhere: &p {x: 0.0, y: 0.0, z: 0.3}\n"
+        + _sphere("a", "*p")
+        + _sphere("b", "*p")
+        + _sphere("c", "&q {x: 0.5, y: 0.0, z: 0.3}")
+    )
+    copy, nudge = spread.nudge_dynamic_roots(model, None, 1e-7, "+z", tmp_path / "out")
+    assert nudge.moved == ["c"]
+    assert [d["name"] for d in nudge.not_moved] == ["a", "b"]
+    assert all("YAML anchor" in d["why"] for d in nudge.not_moved)
+    b = _places(copy)
+    assert b[("aliases.yaml", "BODY a")] == b[("aliases.yaml", "BODY b")] == (0.0, 0.0, 0.3)
+    assert b[("aliases.yaml", "BODY c")] == (0.5, 0.0, 0.3 + 1e-7)
+    # one axis shared with the orientation by an alias: rewriting it would turn the body
+    model.write_text(
+        "bodies: [BODY d]\njoints: []\n" + _sphere("d", "{x: &zero 0.0, y: 0.0, z: 0.3}").replace("r: 0.0", "r: *zero")
+    )
+    _, nudge = spread.nudge_dynamic_roots(model, None, 1e-7, "-x", tmp_path / "out2")
+    assert nudge.moved == [] and nudge.not_moved[0]["name"] == "d"
+    _, nudge = spread.nudge_dynamic_roots(model, None, 1e-7, "+y", tmp_path / "out3")  # y is its own
+    assert nudge.moved == ["d"]
+
+
 def test_spread_options_that_make_no_sense_are_refused_before_ambf_is_sought(capsys):
     for argv, said in (
         (["--suture", "--spread"], "--spread plays a scene's dynamic roots nudged"),
         (["x.yaml", "--spread-by", "1e-7"], "--spread-by is the nudge of --spread"),
         (["x.yaml", "--spread", "--spread-by", "0"], "--spread-by takes a positive distance"),
         (["x.yaml", "--spread", "--spread-by=nan"], "--spread-by takes a positive distance"),
+        # a nudge anyone could measure: a box moved 1 m (into its slab along -z) spreads 1008 mm
+        (["x.yaml", "--spread", "--spread-by", "1"], "--spread-by 1 m is not below --tolerance-mm (1 mm)"),
+        (["x.yaml", "--spread", "--spread-by", "2e-5", "--tolerance-mm", "0.01"], "not below --tolerance-mm"),
+        (["x.yaml", "--spread", "--spread-by", "2e-3", "--tolerance-mm", "5"], "is not below a millimetre"),
     ):
         assert main(["parity", *argv, "--ambf", "/nonexistent"]) == 2
         err = capsys.readouterr().err
         assert "error[bad-option]" in err and said in err and "ambf-missing" not in err
+
+    # the session's own check, for a Request made without the command line
+    from adfkit.diagnostics import AdfError
+    from adfkit.parity import session
+
+    for kw, said in (
+        ({"seconds": 0.0}, "--seconds and --spread-by must be positive"),
+        ({"spread_by": 1.0}, "--spread-by 1 m is not below --tolerance-mm"),
+        ({"spread_by": 5e-4, "tolerance_m": 0.0}, None),  # no tolerance: below a millimetre is a nudge
+    ):
+        req = session.Request(Path("x.yaml"), None, None, **{"spread_by": 1e-7} | kw)
+        if said is None:
+            session.check(req)
+            continue
+        with pytest.raises(AdfError) as e:
+            session.check(req)
+        assert said in str(e.value)
+
+
+SLAB = """bodies: [BODY slab]
+joints: []
+BODY slab:
+  name: slab
+  mass: 0.0
+  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}
+  collision shape: BOX
+  collision geometry: {x: 1.0, y: 1.0, z: 0.1}
+"""
+RESTING = """BODY box:
+  name: box
+  mass: 1.0
+  location:
+    position:
+      x: 0.0
+      y: 0.0
+      z: 0.1
+    orientation: {r: 0.0, p: 0.0, y: 0.0}
+  collision shape: BOX
+  collision geometry: {x: 0.1, y: 0.1, z: 0.1}
+"""
+
+
+@needs_ambf
+def test_a_static_scene_says_it_has_nothing_to_nudge_and_a_box_nudged_into_its_slab_stays(tmp_path, capsys):
+    """A scene of static bodies only: --spread says there is nothing to nudge, verdict unchanged.
+    A box resting on a slab, touching it, its position in block style: nudged 0.1 µm down it
+    starts that far inside the slab, and AMBF puts it back within a fraction of a micrometre
+    (measured 0.2 s: 0.41 µm, 0.00003°), as along the five other ways."""
+    static = tmp_path / "static.yaml"
+    static.write_text(SLAB)
+    assert main(["parity", str(static), "--seconds", "0.2", "--spread"]) == 0
+    out = capsys.readouterr().out
+    assert "AMBF's own spread: no dynamic body to nudge: AMBF's spread not measured" in out
+    resting = tmp_path / "resting.yaml"
+    resting.write_text(SLAB.replace("[BODY slab]", "[BODY slab, BODY box]") + RESTING)
+    assert main(["parity", str(resting), "--seconds", "0.2", "--spread", "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)["ambf_spread"]
+    assert s["nudged_bodies"] == ["box"] and s["nudged_run"] == [] and s["past_tolerance"] == 0
+    assert s["largest_position"]["name"].endswith("box") and 1e-7 <= s["largest_position"]["m"] < 2e-6
+    assert s["largest_angle"]["deg"] < 1e-3
 
 
 @needs_ambf

@@ -16,6 +16,7 @@ from . import ambf as ambf_run
 from . import commandfile
 from .compare import Comparison, compare
 from .openings import opening, shut_pivots
+from .spread import no_nudge
 from .traces import AdfkitPlayer, from_ambf, tool_tips
 
 
@@ -62,6 +63,8 @@ def check(req: Request) -> None:
                 "e.g. --seconds 2 --every 0.02",
             )
         )
+    if req.spread_by is not None and (why := no_nudge(req.spread_by, req.tolerance_m)):
+        raise AdfError(error("bad-option", why, None, "a start nobody could measure: spread_by=1e-7"))
     per = 0.001 * (req.control_substeps or 1)
     for name, v in (("--seconds", req.seconds), ("--every", req.every)):
         if abs(v / per - round(v / per)) > 1e-6:
@@ -168,7 +171,8 @@ def _ambf_spread(req: Request, scene, floor_z, commands, trace):
             except ValueError as e:
                 raise AdfError(error("spread-nudge", f"--spread: {e}", None, "leave --spread out here")) from None
             if not nudge.moved:
-                return {}, nudge, ["no dynamic body to nudge: AMBF's spread not measured"]
+                what = "no dynamic root could be nudged" if nudge.not_moved else "no dynamic body to nudge"
+                return {}, nudge, [f"{what}: AMBF's spread not measured"]
             stage = _stage(scene, replace(req, path=copy), floor_z)
             rec = ambf_run.run(req.build, stage, req.seconds, req.every, commands)
         c = compare(from_ambf(rec, stage.staged_bodies), trace)  # the nudged run first: its flung bodies
@@ -332,6 +336,8 @@ def _print_spread(c: Comparison, stream) -> None:
     s = c.spread_summary()
     if not s["nudged_bodies"]:
         print(f"  AMBF's own spread: {'; '.join(c.spread_notes)}", file=stream)
+        for d in s["not_nudged"]:
+            print(f"  not nudged: {d['name']}: {d['why']}", file=stream)
         return
     n = len(s["nudged_bodies"])
     names = ", ".join(s["nudged_bodies"][:6]) + (" …" if n > 6 else "")
@@ -341,6 +347,8 @@ def _print_spread(c: Comparison, stream) -> None:
         f"{len(s['within_ambf_spread'])} of {s['past_tolerance']} bodies past the tolerances within it"
         if pos is not None
         else "not measured: every nudged run blew up"
+        if c.spread_notes
+        else "not measured: AMBF made no body the comparison matches"
     )
     print(
         f"  AMBF's own spread (AMBF {len(s['nudges'])} more times, {n} dynamic {'root' if n == 1 else 'roots'} "

@@ -37,6 +37,27 @@ DIRECTIONS = {
 }
 
 
+#: the longest nudge --spread takes, whatever the tolerance: a millimetre (the default position
+#: tolerance) is a move anyone could measure, not a start nobody could
+LONGEST_NUDGE_M = 1e-3
+
+
+def no_nudge(by_m: float, tolerance_m: float) -> str | None:
+    """Why a nudge of ``by_m`` metres is not one --spread can take (None: it is): the nudged
+    bodies start that far from where AMBF's unnudged run starts them, so its spread is at least the
+    nudge and would excuse gaps the nudge itself made (a box moved 1 m spreads 1008 mm and 77°,
+    moved 1 m down into the slab it rests on). A nudge must stay below the position tolerance and
+    below a millimetre."""
+    limit = min(tolerance_m, LONGEST_NUDGE_M) if tolerance_m > 0 else LONGEST_NUDGE_M
+    if by_m < limit:
+        return None
+    below = "--tolerance-mm" if limit == tolerance_m else "a millimetre"
+    return (
+        f"--spread-by {by_m:g} m is not below {below} ({limit * 1e3:g} mm): the nudged bodies would start "
+        "that far from AMBF's own start, and AMBF's spread would excuse gaps the nudge itself made"
+    )
+
+
 @dataclass
 class Nudge:
     """Which bodies a nudged copy moved, and which it could not."""
@@ -132,6 +153,25 @@ def _position_nodes(root: yaml.Node, body: str) -> dict[str, yaml.ScalarNode]:
     return {a: n for a in "xyz" if isinstance(n := child(pos, a), yaml.ScalarNode) and not n.style}
 
 
+def _uses(root: yaml.Node) -> dict[int, int]:
+    """How many times each node of a composed document is reached: more than once for a node
+    written once with an anchor (``&p``) and used again by an alias (``*p``)."""
+    out: dict[int, int] = {}
+    stack, on_path = [root], set()
+    while stack:
+        n = stack.pop()
+        if n is None:  # leaving a node
+            on_path.discard(stack.pop())
+            continue
+        out[id(n)] = out.get(id(n), 0) + 1
+        if isinstance(n, yaml.MappingNode | yaml.SequenceNode) and id(n) not in on_path:
+            on_path.add(id(n))
+            stack += [id(n), None]
+            kids = [x for kv in n.value for x in kv] if isinstance(n, yaml.MappingNode) else list(n.value)
+            stack += reversed(kids)
+    return out
+
+
 def _moved_text(text: str, file: str, moves: dict[str, tuple[float, float, float]]) -> tuple[str, dict[str, str]]:
     """``text`` with each body of ``moves`` (ADF name -> metres along x, y, z) moved; why a body
     could not be, by name."""
@@ -141,12 +181,16 @@ def _moved_text(text: str, file: str, moves: dict[str, tuple[float, float, float
     for line in text.splitlines(keepends=True):
         starts.append(starts[-1] + len(line))
     root = compose(text, file)
+    uses = _uses(root)
     edits, why = [], {}
     for body, d in moves.items():
         nodes = _position_nodes(root, body)
         axes = [a for a, v in zip("xyz", d) if v != 0.0]
         if any(a not in nodes for a in axes):
             why[body] = "its file gives no plain number for its location's position " + "/".join(axes)
+            continue
+        if any(uses.get(id(nodes[a]), 0) > 1 for a in axes):  # an anchor: rewritten, every alias would move
+            why[body] = "its location's position is a YAML anchor the file uses elsewhere (an alias, *name)"
             continue
         for a, v in zip("xyz", d):
             if v == 0.0:
