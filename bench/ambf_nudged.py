@@ -13,6 +13,7 @@ Prints a markdown table; asserts nothing; skips, with the reason, without an AMB
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 from pathlib import Path
@@ -42,6 +43,8 @@ def nudged_copy(launch: Path, indices: list[int] | None, body: str, by: float, o
 
 def _row(label: str, c) -> str:
     pos, ang = c.worst
+    if pos is None or ang is None:
+        return f"| {label} | no body matched | | 0 of 0 |"
     past = sum(1 for g in c.bodies if g.max_position > c.tolerance_m or g.max_angle > c.tolerance_deg)
     short = lambda g: g.name.rsplit("/", 1)[-1]  # noqa: E731
     return (
@@ -51,6 +54,7 @@ def _row(label: str, c) -> str:
 
 
 def main(argv: list[str]) -> int:
+    from adfkit import inputs
     from adfkit.parity import ambf, session
     from adfkit.parity.compare import compare
 
@@ -67,6 +71,7 @@ def main(argv: list[str]) -> int:
     if build is None:
         print(f"skipped: {why}")
         return 0
+    root_env = os.environ.get(inputs.ROOT_ENV)
     with tempfile.TemporaryDirectory(prefix="adfkit-nudged-") as tmp:
         try:
             copy = nudged_copy(args.launch, args.indices, args.body, args.by, Path(tmp), args.axis)
@@ -77,6 +82,17 @@ def main(argv: list[str]) -> int:
         for path in (args.launch, copy):
             req = session.Request(path, args.indices, build, seconds=args.seconds, engines=(args.engine,))
             runs.append(session.run(req, progress=False).comparisons[0])
+            # the copy's meshes are links into the original's folders, which adfkit's scene tree
+            # (adfkit.inputs) refuses as outside the copy: its runner made no body of a scene whose
+            # meshes lie beside the copied files' folders (the corpus puzzles); the tree is the
+            # folder both share while the copy plays
+            os.environ[inputs.ROOT_ENV] = os.path.commonpath(
+                [os.path.realpath(tmp), str(inputs.tree_of(args.launch).root)]
+            )
+        if root_env is None:
+            os.environ.pop(inputs.ROOT_ENV, None)
+        else:
+            os.environ[inputs.ROOT_ENV] = root_env
     a, b = runs
     print(
         f"{args.launch}, {args.seconds:g} s, BODY {args.body} moved {args.by:g} m along {args.axis} in the second run"

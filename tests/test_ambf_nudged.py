@@ -90,3 +90,45 @@ def test_ambfs_falling_thread_blows_up_under_a_nanometre_where_the_challenge_ine
     # -l 11: both 1.0e-9 m, the needle's own nudge
     assert spread[4][0] > 1.0 and spread[4][1] < 1e-4
     assert spread[11][0] < 1e-8 and spread[11][1] < 1e-8
+
+
+def _box_stl(path: Path, h: float = 0.05) -> None:
+    """A binary STL of a cube of half-side ``h``: 12 triangles."""
+    import itertools
+    import struct
+
+    v = np.array(list(itertools.product((-h, h), repeat=3)))
+    faces = []
+    for axis in range(3):
+        for side in (-h, h):
+            q = [i for i in range(8) if v[i][axis] == side]
+            a, b, c, d = q[0], q[1], q[3], q[2]  # around the face
+            faces += [(a, b, c), (a, c, d)]
+    out = bytearray(b"\0" * 80) + struct.pack("<I", len(faces))
+    for f in faces:
+        out += struct.pack("<3f", 0.0, 0.0, 0.0)
+        for i in f:
+            out += struct.pack("<3f", *v[i])
+        out += b"\0\0"
+    path.write_bytes(bytes(out))
+
+
+@needs_ambf
+def test_a_scene_whose_meshes_lie_beside_its_model_folder_plays_in_adfkit_too(tmp_path, capsys):
+    """A model whose meshes lie in a sibling folder (`../meshes/`, the corpus puzzles' layout):
+    the nudged copy links that folder, which adfkit's scene tree refused as outside the copy, so
+    adfkit made no body of the copy and the bench crashed (puzzle6.yaml); now the copy plays on
+    both sides."""
+    (tmp_path / "meshes").mkdir()
+    _box_stl(tmp_path / "meshes" / "box.STL")
+    (tmp_path / "models").mkdir()
+    model = tmp_path / "models" / "box.yaml"
+    model.write_text(
+        "bodies: [BODY box]\njoints: []\nhigh resolution path: ../meshes/\nlow resolution path: ../meshes/\n"
+        "BODY box:\n  name: box\n  mesh: box.STL\n  mass: 1.0\n"
+        "  location: {position: {x: 0.0, y: 0.0, z: 0.2}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
+        "  collision shape: BOX\n  collision geometry: {x: 0.1, y: 0.1, z: 0.1}\n"
+    )
+    assert _bench().main([str(model), "--body", "box", "--axis", "z", "--seconds", "0.2"]) == 0
+    rows = [r for r in capsys.readouterr().out.splitlines() if r.startswith("| AMBF against adfkit, nudged")]
+    assert rows and "no body matched" not in rows[0] and "(`box`)" in rows[0]

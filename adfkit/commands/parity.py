@@ -90,7 +90,10 @@ def add_arguments(p) -> None:
         "spread and does not make the exit 1",
     )
     p.add_argument(
-        "--spread-by", type=float, metavar="M", help="--spread: the dynamic roots' nudge, in metres (default 1e-7)"
+        "--spread-by",
+        type=float,
+        metavar="M",
+        help="--spread: the dynamic roots' nudge, in metres (default 1e-7; below --tolerance-mm and 1 mm)",
     )
     p.add_argument("--plot", metavar="PNG", help="draw each body's position gap over time")
     p.add_argument(

@@ -233,9 +233,11 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
         raise AdfError(diags)
 
 
-def print_text(out: Outcome, stream=sys.stdout, rows: int = 12) -> None:
+def print_text(out: Outcome, stream=None, rows: int = 12) -> None:
     """The comparisons for people: the largest gaps, the bodies past the tolerances, what one
-    side made and the other did not, each side's stepping time."""
+    side made and the other did not, each side's stepping time. ``stream``: sys.stdout as it is
+    when called (a default bound at import wrote to whatever stdout was then, a test's closed one)."""
+    stream = sys.stdout if stream is None else stream
     req = out.request
     for c in out.comparisons:
         eng = c.adfkit.side
