@@ -111,6 +111,7 @@ class Comparison:
             "tolerance_m": self.tolerance_m,
             "tolerance_deg": self.tolerance_deg,
             "agree": not self.failures(),
+            "bodies_compared": len(self.bodies),
             "bodies": [
                 {
                     "name": g.name,

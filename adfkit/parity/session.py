@@ -233,6 +233,12 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
         raise AdfError(diags)
 
 
+#: said where neither side made a body both made (every body left out, e.g. for meshes not found)
+NOTHING_COMPARED = (
+    "AMBF and adfkit made no body of the same name (the warnings above say which bodies were left out and why)"
+)
+
+
 def print_text(out: Outcome, stream=None, rows: int = 12) -> None:
     """The comparisons for people: the largest gaps, the bodies past the tolerances, what one
     side made and the other did not, each side's stepping time. ``stream``: sys.stdout as it is
@@ -320,6 +326,8 @@ def print_text(out: Outcome, stream=None, rows: int = 12) -> None:
                 f"AMBF's spread and {tol} more",
                 file=stream,
             )
+        elif not c.bodies:
+            print(f"  nothing compared: {NOTHING_COMPARED}", file=stream)
         else:
             print(f"  agree: every body within {c.tolerance_m * 1e3:g} mm and {c.tolerance_deg:g}°", file=stream)
 
