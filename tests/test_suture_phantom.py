@@ -298,6 +298,7 @@ FAMILY = {
     "3 pairs 8 mm apart": dict(pairs=3, spacing=0.008),
     "5 pairs 14 mm apart": dict(pairs=5, spacing=0.014),
     "turned 30 degrees, moved": dict(pairs=4, spacing=0.011, turn_deg=30.0, at=(0.02, -0.01)),
+    "turned 90 degrees on the table, moved": dict(pairs=3, spacing=0.012, turn_deg=90.0, at=(0.01, 0.02)),
     "line slanted 30 degrees": dict(pairs=3, spacing=0.010, line_deg=30.0),
     "3 mm thicker": dict(pairs=3, spacing=0.012, thicker=0.003),
     "numbered from the other end": dict(pairs=4, spacing=0.024, numbered_back=True),
