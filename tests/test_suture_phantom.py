@@ -299,6 +299,8 @@ FAMILY = {
     "5 pairs 14 mm apart": dict(pairs=5, spacing=0.014),
     "turned 30 degrees, moved": dict(pairs=4, spacing=0.011, turn_deg=30.0, at=(0.02, -0.01)),
     "turned 90 degrees on the table, moved": dict(pairs=3, spacing=0.012, turn_deg=90.0, at=(0.01, 0.02)),
+    "turned -90 degrees on the table, moved": dict(pairs=3, spacing=0.012, turn_deg=-90.0, at=(0.01, 0.02)),
+    "turned 180 degrees on the table, moved": dict(pairs=3, spacing=0.012, turn_deg=180.0, at=(0.01, 0.02)),
     "line slanted 30 degrees": dict(pairs=3, spacing=0.010, line_deg=30.0),
     "3 mm thicker": dict(pairs=3, spacing=0.012, thicker=0.003),
     "numbered from the other end": dict(pairs=4, spacing=0.024, numbered_back=True),
@@ -670,8 +672,11 @@ def test_a_plan_whose_tool_comes_into_the_tissue_is_warned_of_before_the_arms_mo
 
 
 def _slope(axis, deg, said):
-    """A sloping phantom the placement does not handle yet: expected to pass, known to fail."""
-    return pytest.param(axis, deg, marks=pytest.mark.xfail(strict=True, reason=f"the needle's bed on a slope: {said}"))
+    """A sloping phantom not handled yet: expected to pass, known to fail with the verdict ``said``
+    (an assertion on the pair; anything raised otherwise fails the test)."""
+    return pytest.param(
+        axis, deg, marks=pytest.mark.xfail(strict=True, raises=AssertionError, reason=f"on a slope: {said}")
+    )
 
 
 #: sloping phantoms (tilt_phantom: turned, standing on the floor), pair 1, seed 0: good phantoms,
@@ -687,6 +692,10 @@ SLOPES = [
     _slope("x", -30.0, "reach in the pick-up, psm2's open jaws on SutureTray (the needle's bed turned)"),
     _slope("y", 30.0, "reach in the pick-up"),
     _slope("y", 45.0, "reach in the pick-up"),
+    # the needle through both holes, psm1's pitch link on Phantom (10.9 / 10.5 kN, one step) as it
+    # comes for the tip beyond the exit, the high side: the plan said nothing (pulling 0.09 / 0.15 mm)
+    _slope("y", -30.0, "reach in regrasp 1, psm1 missed the needle by 6.1 mm (its pitch link on Phantom)"),
+    _slope("y", -45.0, "reach in regrasp 1, psm1 missed the needle by 6.3 mm (its pitch link on Phantom)"),
 ]
 
 
