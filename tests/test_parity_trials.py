@@ -134,6 +134,8 @@ def test_trials_follow_the_measured_joints_so_a_pace_is_a_bad_option(capsys):
         assert "--nudge a positive offset" in capsys.readouterr().err
     assert main(["parity", str(launch), "--trials", "3"]) == 2  # a scene's parity is not a suture's
     assert "--trials replays a suture" in capsys.readouterr().err
+    assert main(["parity", str(launch), "--grasp", "adfkit"]) == 2  # nor is its grasp
+    assert "--grasp is how a suture's replay grasps" in capsys.readouterr().err
 
 
 def test_the_trials_are_printed_per_pair_and_any_other_verdict_fails(monkeypatch, capsys):

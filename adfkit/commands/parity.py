@@ -125,7 +125,7 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--grasp",
         choices=("lies", "adfkit"),  # parity.suture.GRASPS
-        default="lies",
+        default=None,  # lies; None tells a --grasp given without --suture
         help="--suture: where AMBF's grasps hold the needle: lies (default) where AMBF's needle lies when its "
         "jaws take it, as the challenge's constraint actuator does; adfkit where adfkit's grasp held it (the "
         "needle's frame in the tool's, given to AMBF's constraint actuator as its offset), so that no grasp "
@@ -178,6 +178,15 @@ def run(args) -> int:
     if args.trials != 1:
         raise AdfError(
             error("bad-option", "--trials replays a suture", None, "adfkit parity --suture [SCENE] --trials K")
+        )
+    if args.grasp is not None:
+        raise AdfError(
+            error(
+                "bad-option",
+                "--grasp is how a suture's replay grasps",
+                None,
+                "adfkit parity --suture [SCENE] --grasp adfkit",
+            )
         )
     if not args.path:
         raise AdfError(error("bad-option", "name the scene to compare", None, "adfkit parity SCENE [-l 6-11]"))
@@ -265,7 +274,7 @@ def _suture(args) -> int:
         progress=not args.json,
         paces=paces,
         follow=follow,
-        grasp=args.grasp,
+        grasp=args.grasp or "lies",
         # what the user names; the rest the suture's own, which its acceptance was run on
         options=recording_options(args),
     )
@@ -330,7 +339,7 @@ def _trials(args, path: Path, pairs, build) -> int:
         args.seed,
         progress=not args.json,
         options=recording_options(args),
-        grasp=args.grasp,
+        grasp=args.grasp or "lies",
     )
     t = out["trials"]
     if args.json:
