@@ -156,14 +156,12 @@ def run(args) -> int:
     from ..diagnostics import AdfError, error
     from ..jsonout import dumps
     from ..parity import ambf, session
-    from ..parity.spread import no_nudge
+    from ..parity.spread import NUDGE_HINT, no_nudge
 
     if args.spread_by is not None and not args.spread:
         raise AdfError(error("bad-option", "--spread-by is the nudge of --spread", None, "add --spread"))
-    if args.spread_by is not None and not 0 < args.spread_by < float("inf"):
-        raise AdfError(error("bad-option", "--spread-by takes a positive distance in metres", None, "e.g. 1e-7"))
     if args.spread_by is not None and (why := no_nudge(args.spread_by, args.tolerance_mm / 1e3)):
-        raise AdfError(error("bad-option", why, None, "a start nobody could measure: leave --spread-by out (1e-7 m)"))
+        raise AdfError(error("bad-option", why, None, NUDGE_HINT))
     if args.suture:
         if args.spread:
             raise AdfError(

@@ -16,7 +16,7 @@ from . import ambf as ambf_run
 from . import commandfile
 from .compare import Comparison, compare
 from .openings import opening, shut_pivots
-from .spread import no_nudge
+from .spread import NUDGE_HINT, no_nudge
 from .traces import AdfkitPlayer, from_ambf, tool_tips
 
 
@@ -52,8 +52,7 @@ class Outcome:
 def check(req: Request) -> None:
     """The request's numbers, as a located error when one makes no sense."""
     bad_sub = req.control_substeps is not None and req.control_substeps < 1
-    bad_spread = req.spread_by is not None and not 0 < req.spread_by < float("inf")
-    if req.seconds <= 0 or req.every < 0 or bad_sub or req.tolerance_m < 0 or req.tolerance_deg < 0 or bad_spread:
+    if req.seconds <= 0 or req.every < 0 or bad_sub or req.tolerance_m < 0 or req.tolerance_deg < 0:
         raise AdfError(
             error(
                 "bad-option",
@@ -64,7 +63,7 @@ def check(req: Request) -> None:
             )
         )
     if req.spread_by is not None and (why := no_nudge(req.spread_by, req.tolerance_m)):
-        raise AdfError(error("bad-option", why, None, "a start nobody could measure: spread_by=1e-7"))
+        raise AdfError(error("bad-option", why, None, NUDGE_HINT))
     per = 0.001 * (req.control_substeps or 1)
     for name, v in (("--seconds", req.seconds), ("--every", req.every)):
         if abs(v / per - round(v / per)) > 1e-6:

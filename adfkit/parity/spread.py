@@ -40,6 +40,8 @@ DIRECTIONS = {
 #: the longest nudge --spread takes, whatever the tolerance: a millimetre (the default position
 #: tolerance) is a move anyone could measure, not a start nobody could
 LONGEST_NUDGE_M = 1e-3
+#: the hint beside a nudge no_nudge refuses
+NUDGE_HINT = "a start nobody could measure: leave --spread-by out (1e-7 m)"
 
 
 def no_nudge(by_m: float, tolerance_m: float) -> str | None:
@@ -47,7 +49,9 @@ def no_nudge(by_m: float, tolerance_m: float) -> str | None:
     bodies start that far from where AMBF's unnudged run starts them, so its spread is at least the
     nudge and would excuse gaps the nudge itself made (a box moved 1 m spreads 1008 mm and 77°,
     moved 1 m down into the slab it rests on). A nudge must stay below the position tolerance and
-    below a millimetre."""
+    below a millimetre; it must be a positive number at all."""
+    if not 0 < by_m < float("inf"):
+        return "--spread-by takes a positive distance in metres"
     limit = min(tolerance_m, LONGEST_NUDGE_M) if tolerance_m > 0 else LONGEST_NUDGE_M
     if by_m < limit:
         return None
