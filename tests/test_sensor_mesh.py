@@ -57,9 +57,15 @@ def test_not_where_ambf_does_not_reach_the_mesh(tmp_path):
 def test_ambf_crashes_where_the_rule_says(tmp_path, capsys, kind, mesh):
     (tmp_path / "down.obj").write_text(TRIANGLE)
     launch = launch_with(tmp_path, {"m.yaml": _model(kind, f"  mesh: {mesh}\n")})
-    capsys.readouterr()
-    code = main(["parity", str(launch), "--seconds", "0.1", "--engine", "pybullet", "--json"])
-    said = capsys.readouterr()
     crashes = mesh == "down.obj"
+    # the unset ray count is whatever AMBF's memory held: on a quiet box every run crashed, but a
+    # full test run on a loaded box once saw a proximity one play, so a crash is looked for in up
+    # to three runs; a mesh AMBF does not find must play in every one
+    for _ in range(3 if crashes else 1):
+        capsys.readouterr()
+        code = main(["parity", str(launch), "--seconds", "0.1", "--engine", "pybullet", "--json"])
+        said = capsys.readouterr()
+        if code == 2:
+            break
     assert ("ambf-failed" in said.out + said.err) is crashes
     assert code == (2 if crashes else 0)

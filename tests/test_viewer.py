@@ -46,7 +46,8 @@ def _canvas(page) -> np.ndarray:
 
     from PIL import Image
 
-    png = page.screenshot(clip={"x": 0, "y": 160, "width": 900, "height": 600})
+    # a loaded box draws the challenge scene slowly in software: a generous time out
+    png = page.screenshot(clip={"x": 0, "y": 160, "width": 900, "height": 600}, timeout=120_000)
     return np.asarray(Image.open(BytesIO(png)).convert("RGB")).astype(np.int16)
 
 
