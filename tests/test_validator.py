@@ -121,6 +121,7 @@ EXAMPLES = {
         "error",
     ),
     "joint-same-body": (CLEAN.replace("child: BODY b", "child: BODY a"), 14, "warning"),
+    "joint-static-parent": (CLEAN.replace("mass: 1.0\n  mesh: ''\nBODY b", "mass: 0\nBODY b"), 12, "warning"),
     "joint-limits": (CLEAN + "  joint limits: {low: 1.0, high: -1.0}\n", 20, "warning"),
     "joint-pose": (
         CLEAN.replace(

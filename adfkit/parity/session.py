@@ -206,6 +206,8 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
         first = players[0].by_name["joint"][c.target][0]
         if joint_kind(first.type) in (JointKind.TORSION_SPRING, JointKind.LINEAR_SPRING) and c.kind != "effort":
             continue  # AMBF moves a spring by effort only; a position or velocity command does nothing there
+        if id(first) in players[0].inert:
+            continue  # AMBF keeps the joint and it moves nothing (World.inert_joints): nor does the command
         for player in players:
             joint, child = player.by_name["joint"][c.target]
             pushed = c.kind == "effort" and getattr(player.world, "pushes_spring", lambda _j: False)(joint)

@@ -170,6 +170,7 @@ class AdfkitPlayer:
             "body": dict(zip(self.made["body"], self.bodies)),
         }
         self.commands = JointCommands(world)
+        self.inert = {id(j) for j, _p, _c in world.inert_joints()}  # AMBF keeps them; they move nothing
         self.per = world.dt * world.opt.control_substeps
         self.poses: dict[str, np.ndarray] = {}  # a body's pose command, its body frame (4x4)
         self.steers: dict = {}  # a body's Cartesian controller under its pose commands (runner/cartesian.py)
@@ -187,7 +188,8 @@ class AdfkitPlayer:
                 self.poses[c.target] = pose_matrix(c.numbers[:3], c.numbers[3:])
             else:
                 j, child = self.by_name["joint"][c.target]
-                self.commands.command(j, child, c.kind, c.value)
+                if id(j) not in self.inert:  # a command to an inert joint moves nothing, as in AMBF
+                    self.commands.command(j, child, c.kind, c.value)
 
     def _steer(self) -> None:
         from ..runner.cartesian import PoseSteer

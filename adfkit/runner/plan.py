@@ -20,6 +20,7 @@ from ..model.semantics import (
     SENSOR_TYPES,
     JointKind,
     collision_primitives,
+    joint_kind,
     pose_or_identity,
 )
 from .names import merge_namespace
@@ -176,6 +177,47 @@ def uncreated_bodies(world, model) -> frozenset[str]:
     for j in model.joints:
         if joint_ends(model, j) & out:
             world._warn("runner-joint-body", f"{j.identifier}: parent or child body not found; skipped", j)
+    return frozenset(out)
+
+
+def holds_nothing(body, joint) -> bool:
+    """``joint`` (a hinge or slider) hangs from ``body``, a static body (mass 0) with no collision
+    shape of any kind: AMBF prints "COLLISION TYPE NOT UNDERSTOOD" and the joint holds nothing.
+    Measured in AMBF 2.0: a 0.5 kg bar hinged to such a post falls freely, unturned (19.09 m in
+    2 s; both engines held it swinging, 19.06 m apart; with a `collision shape` on the post AMBF's
+    swings within 0.75 mm of adfkit's); a dynamic body without a collision shape keeps its joints
+    (a link hinged between two others within 0.2 mm). AMBF still turns such a child by the
+    joint's controller, which adfkit leaves out, and a spring there still pulls its child to its
+    equilibrium (its limits and locked axes gone), so springs are made as before (docs/parity.md)."""
+    if joint_kind(joint.type) not in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+        return False
+    return body.mass == 0 and not (
+        body.collision_shape or body.compound_collision_shape or body.collision_mesh or body.mesh
+    )
+
+
+UNHELD_HINT = "give the parent a `collision shape` (it stays static) for the joint to hold, as in AMBF"
+
+
+def unheld_message(joint, parent_key: str) -> str:
+    return (
+        f"{joint.identifier}: its parent {parent_key} is static with no collision shape; AMBF keeps the joint "
+        "and it holds nothing (the child moves free); nothing made"
+    )
+
+
+def unheld_joints(model, world) -> frozenset[str]:
+    """Identifiers of ``model``'s joints whose parent (in the model) ``holds_nothing``, each warned
+    about in ``world``: AMBF keeps them, and they move nothing (World.inert_joints); an engine
+    that writes the whole model at once (the MuJoCo engine) leaves them out."""
+    from ..model.tree import find_body
+
+    out = set()
+    for j in model.joints:
+        p = find_body(model, j.parent, j)
+        if p is not None and holds_nothing(p, j) and p is not find_body(model, j.child, j):
+            world._warn("runner-joint-static", unheld_message(j, p.identifier), j, UNHELD_HINT)
+            out.add(j.identifier)
     return frozenset(out)
 
 

@@ -78,10 +78,11 @@ class World:
         unknown `type` (adf-format.md §8, `JOINT TYPE NOT UNDERSTOOD`) between two bodies it finds
         (one it cannot find is skipped, as every joint is), and a joint joining a body to itself
         (AMBF makes it and it moves nothing: a box falling onto the floor with one lands within
-        0.03 mm of one without). The runner makes nothing of them; AMBF lists them among its
+        0.03 mm of one without), and one whose parent is static with no collision shape (it holds
+        nothing: plan.holds_nothing). The runner makes nothing of them; AMBF lists them among its
         joints."""
         from ..model.semantics import joint_kind
-        from .plan import joint_ends
+        from .plan import holds_nothing, joint_ends
 
         out = []
         made = {id(r[0]) for r in self.joints_made}
@@ -95,7 +96,9 @@ class World:
                 if id(j) in made:
                     continue
                 parent, child = joint_ends(self.registry, local, ns, j)
-                if parent is not None and child is not None and (joint_kind(j.type) is None or parent is child):
+                if parent is None or child is None:
+                    continue
+                if joint_kind(j.type) is None or parent is child or holds_nothing(parent.body, j):
                     out.append((j, parent, child))
         return out
 

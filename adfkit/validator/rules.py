@@ -119,6 +119,12 @@ _RULES = [
     Rule("joint-zero-axis", E, "A joint axis is the zero vector (NaN frames)", "`parent axis: {x: 0, y: 0, z: 0}`"),
     Rule("joint-same-body", W, "A joint's parent and child are the same body", "`parent: BODY a`, `child: BODY a`"),
     Rule(
+        "joint-static-parent",
+        W,
+        "A hinge or slider whose parent is static with no collision shape: AMBF's joint holds nothing",
+        "`parent: BODY post` where `BODY post` has `mass: 0` and no `collision shape`",
+    ),
+    Rule(
         "joint-limits",
         W,
         "Limits incomplete, low > high, or missing the six-dof / cone-twist structure",

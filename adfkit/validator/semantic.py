@@ -505,6 +505,8 @@ class Checker:
                 )
         if j.parent is not None and j.parent == j.child:
             self.emit("joint-same-body", f"joint '{j.identifier}' joins '{j.parent}' to itself", j.where("child"))
+        if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+            self.static_parent(m, j)
         lim = j.joint_limits
         if kind in ONE_DOF and lim is not None:
             if (lim.low is None) != (lim.high is None):
@@ -659,6 +661,25 @@ class Checker:
                     "fix the body's location or the joint's pivots and axes "
                     "(the Blender add-on writes both from the scene)",
                 )
+
+    def static_parent(self, m: ModelFile, j) -> None:
+        """A hinge or slider whose parent is static (mass 0) with no collision shape of any kind:
+        AMBF prints "COLLISION TYPE NOT UNDERSTOOD" and the joint holds nothing (measured: the
+        child falls freely, unturned; runner/plan.py holds_nothing)."""
+        from ..model.tree import find_body
+
+        p: Any = find_body(m, j.parent, j)
+        if p is None or p is find_body(m, j.child, j) or p.mass != 0:
+            return
+        if p.collision_shape or p.compound_collision_shape or p.collision_mesh or p.mesh:
+            return
+        self.emit(
+            "joint-static-parent",
+            f"joint '{j.identifier}': its parent '{j.parent}' is static with no collision shape; AMBF keeps the "
+            "joint and it holds nothing (the child moves free)",
+            j.where("parent"),
+            "give the parent a `collision shape` (it stays static) for the joint to hold",
+        )
 
     def pivots_apart(self, m: ModelFile, earlier: Registry | None = None) -> None:
         """A joint that holds its pivots together (fixed, p2p, cone twist, torsion spring; a

@@ -15,7 +15,7 @@ runner adds (docs/mujoco.md): joints to another model's bodies (cross_joints.py)
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import mujoco
@@ -178,8 +178,9 @@ def build_plan(world) -> Plan:
         soft = world.soft is not None and any(sb.defined for sb in m.soft_bodies)
         if len(uncreated) < len(m.bodies) or soft:
             names, flexes = {}, {}  # type: ignore[var-annotated]
+            unheld = scene_rules.unheld_joints(m, world)  # AMBF keeps them, holding nothing; warned about
             text, ls = to_mjcf(
-                m,
+                replace(m, joints=[j for j in m.joints if j.identifier not in unheld]) if unheld else m,
                 out_dir,
                 f"m{i}",
                 tree_kinds=TREE_KINDS,

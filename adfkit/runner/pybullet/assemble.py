@@ -18,6 +18,8 @@ from ..names import Registry, merge_namespace
 from ..plan import (
     ALL_GROUPS,
     SPRING_KINDS,
+    UNHELD_HINT,
+    holds_nothing,
     is_hole,
     joint_ends,
     key_of,
@@ -26,6 +28,7 @@ from ..plan import (
     played_actuators,
     played_sensors,
     resolve_parent,
+    unheld_message,
 )
 from ..resistance import RayState, ResistanceParams
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
@@ -86,6 +89,9 @@ class Assembly:
                     continue
                 if ends[0] is ends[1]:  # AMBF keeps it, and it moves nothing (World.inert_joints)
                     self._warn("runner-joint-body", f"{j.identifier}: joins a body to itself; nothing made", j)
+                    continue
+                if holds_nothing(ends[0].body, j):  # AMBF keeps it, and it holds nothing (World.inert_joints)
+                    self._warn("runner-joint-static", unheld_message(j, ends[0].key), j, UNHELD_HINT)
                     continue
                 records.append((j, kind, ends[0], ends[1]))
         self.joints_made = [(j, parent, child) for j, _kind, parent, child in records]

@@ -1,0 +1,83 @@
+"""A joint whose parent is a static body (mass 0) with no collision shape: AMBF 2.0 prints
+"COLLISION TYPE NOT UNDERSTOOD" for the parent, keeps the joint, and a hinge or slider there
+holds nothing: the child falls freely, unturned. Measured in AMBF (`adfkit parity`, 2 s, a 0.5 kg
+bar hinged to such a post 1 m up): the bar 3.8389 m below its start after 1 s, 19.0871 m after
+2 s, its x unchanged; both engines held it swinging (19.06 m apart at 2 s). Now neither engine
+makes the joint (`runner-joint-static`; `adfkit parity` lists it on both sides) and the bar falls
+as AMBF's: PyBullet 0.000 mm over 2 s, MuJoCo 1.9 mm (its free fall). With a `collision shape` on
+the post the joint holds in AMBF (and swings within 0.75 mm of adfkit's)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from adfkit.adf import load_scene
+from adfkit.runner import Options, open_world
+
+POST = """bodies: [BODY post, BODY bar]
+joints: [JOINT hinge]
+namespace: /ambf/env/damp/
+BODY post:
+  name: post
+  mass: 0
+  shape: BOX
+  geometry: {x: 0.04, y: 0.4, z: 0.04}
+  location: {position: {x: 0, y: 0, z: 1.0}, orientation: {r: 0, p: 0, y: 0}}
+BODY bar:
+  name: bar
+  mass: 0.5
+  shape: BOX
+  geometry: {x: 0.25, y: 0.03, z: 0.03}
+  collision shape: BOX
+  collision geometry: {x: 0.25, y: 0.03, z: 0.03}
+  location: {position: {x: 0.15, y: 0.1, z: 1.0}, orientation: {r: 0, p: 0, y: 0}}
+JOINT hinge:
+  name: hinge
+  parent: BODY post
+  child: BODY bar
+  type: revolute
+  parent pivot: {x: 0.02, y: 0.1, z: 0}
+  child pivot: {x: -0.13, y: 0, z: 0}
+  parent axis: {x: 0, y: 1, z: 0}
+  child axis: {x: 0, y: 1, z: 0}
+"""
+
+#: AMBF's bar after 1 s (adfkit parity's sample of AMBF's run)
+AMBF_BAR_1S = (0.15, 0.1, -3.8389)
+
+
+@pytest.mark.parametrize("engine,tol_m", [("pybullet", 1e-4), ("mujoco", 2.5e-3)])
+def test_a_hinge_on_a_static_body_without_collision_shape_holds_nothing(tmp_path, engine, tol_m):
+    pytest.importorskip(engine)
+    (tmp_path / "m.yaml").write_text(POST)
+    world = open_world(load_scene(tmp_path / "m.yaml", None, []), Options(visuals=False, ground=False), engine=engine)
+    try:
+        assert any(d.rule == "runner-joint-static" for d in world.diagnostics)
+        assert [j.identifier for j, _p, _c in world.inert_joints()] == ["JOINT hinge"]
+        world.run(1.0)
+        m = world.body("BODY bar").world_matrix()
+    finally:
+        world.close()
+    assert np.allclose(m[:3, 3], AMBF_BAR_1S, atol=tol_m)
+    assert np.allclose(m[:3, :3], np.eye(3), atol=1e-6)  # unturned, as in AMBF
+
+
+def test_with_a_collision_shape_the_post_holds_it(tmp_path):
+    """The same post given a `collision shape`: the joint is made and the bar swings down."""
+    pytest.importorskip("pybullet")
+    held = POST.replace(
+        "  geometry: {x: 0.04, y: 0.4, z: 0.04}\n",
+        "  geometry: {x: 0.04, y: 0.4, z: 0.04}\n"
+        "  collision shape: BOX\n  collision geometry: {x: 0.04, y: 0.4, z: 0.04}\n",
+        1,
+    )
+    (tmp_path / "m.yaml").write_text(held)
+    world = open_world(load_scene(tmp_path / "m.yaml", None, []), Options(visuals=False, ground=False))
+    try:
+        assert not any(d.rule == "runner-joint-static" for d in world.diagnostics)
+        world.run(1.0)
+        z = world.body("BODY bar").world_matrix()[2, 3]
+    finally:
+        world.close()
+    assert 0.8 < z < 1.01  # on its hinge, 0.13 m from the pivot at 1.0 m
