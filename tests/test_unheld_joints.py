@@ -81,3 +81,21 @@ def test_with_a_collision_shape_the_post_holds_it(tmp_path):
     finally:
         world.close()
     assert 0.8 < z < 1.01  # on its hinge, 0.13 m from the pivot at 1.0 m
+
+
+@pytest.mark.parametrize(
+    "kind,warned",
+    [("revolute", True), ("prismatic", True), ("torsion spring", True), ("linear spring", True), ("fixed", False)],
+)
+def test_validate_warns_at_the_joints_parent(tmp_path, kind, warned):
+    """`adfkit validate` said nothing. Measured in AMBF for a hinge, a slider (a lift carriage
+    fell) and both springs (a torsion spring's flap fell, turning to its 0.9 rad equilibrium past
+    its ±0.5 rad limits; a linear spring's shuttle fell, oscillating about its equilibrium)."""
+    from adfkit.validator import validate_file
+
+    f = tmp_path / "m.yaml"
+    f.write_text(POST.replace("type: revolute", f"type: {kind}"))
+    found = [d for d in validate_file(f).diagnostics if d.rule == "joint-static-parent"]
+    assert [(d.location.line, d.severity.name) for d in found] == (
+        [(20, "WARNING")] if warned else []
+    )  # `parent: BODY post`

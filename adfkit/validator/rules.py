@@ -121,7 +121,7 @@ _RULES = [
     Rule(
         "joint-static-parent",
         W,
-        "A hinge or slider whose parent is static with no collision shape: AMBF's joint holds nothing",
+        "A hinge, slider or spring whose parent is static with no collision shape: AMBF's joint holds nothing in place",
         "`parent: BODY post` where `BODY post` has `mass: 0` and no `collision shape`",
     ),
     Rule(

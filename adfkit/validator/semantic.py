@@ -505,7 +505,7 @@ class Checker:
                 )
         if j.parent is not None and j.parent == j.child:
             self.emit("joint-same-body", f"joint '{j.identifier}' joins '{j.parent}' to itself", j.where("child"))
-        if kind in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+        if kind in ONE_DOF:
             self.static_parent(m, j)
         lim = j.joint_limits
         if kind in ONE_DOF and lim is not None:
@@ -663,9 +663,10 @@ class Checker:
                 )
 
     def static_parent(self, m: ModelFile, j) -> None:
-        """A hinge or slider whose parent is static (mass 0) with no collision shape of any kind:
-        AMBF prints "COLLISION TYPE NOT UNDERSTOOD" and the joint holds nothing (measured: the
-        child falls freely, unturned; runner/plan.py holds_nothing)."""
+        """A hinge, slider or spring whose parent is static (mass 0) with no collision shape of any
+        kind: AMBF prints "COLLISION TYPE NOT UNDERSTOOD" and the joint holds nothing in place
+        (measured: a hinged child falls freely, unturned; a spring's child falls, pulled to the
+        spring's equilibrium, past its limits; runner/plan.py holds_nothing)."""
         from ..model.tree import find_body
 
         p: Any = find_body(m, j.parent, j)
@@ -676,7 +677,7 @@ class Checker:
         self.emit(
             "joint-static-parent",
             f"joint '{j.identifier}': its parent '{j.parent}' is static with no collision shape; AMBF keeps the "
-            "joint and it holds nothing (the child moves free)",
+            "joint and it holds nothing in place (the child falls free)",
             j.where("parent"),
             "give the parent a `collision shape` (it stays static) for the joint to hold",
         )
