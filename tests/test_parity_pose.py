@@ -201,3 +201,17 @@ def test_a_pose_command_pushes_a_link_by_its_controller_block_as_ambf(tmp_path):
     assert lower.max_position < 5e-3 and lower.position[-1] < 5e-4
     i = c.ambf.body_names.index("lower")
     assert np.linalg.norm(c.ambf.poses[-1, i, :2] - (0.45, 0.0)) > 0.2  # AMBF's arm moved (to 0.36, 0.22)
+
+
+def test_a_pose_command_to_a_static_body_is_refused_where_it_is_written(tmp_path):
+    """AMBF's plugin refuses it once AMBF has loaded the scene ("pose drives a dynamic body
+    only"), an error with no place; adfkit now refuses it at the command's line first (no AMBF
+    needed: nothing is played)."""
+    (tmp_path / "m.yaml").write_text(BOX.replace("mass: 1.0", "mass: 0.0"))
+    cmd = tmp_path / "c.txt"
+    cmd.write_text("# a static box\n0.2, pose, box, 0.1 -0.05 1.2 0 0 0\n")
+    req = session.Request(tmp_path / "m.yaml", None, None, seconds=0.5, commands=cmd)  # type: ignore[arg-type]
+    with pytest.raises(AdfError) as e:
+        session.run(req, progress=False)
+    (d,) = e.value.diagnostics
+    assert d.rule == "command-target" and d.location.line == 2 and "static" in d.message

@@ -193,7 +193,8 @@ def _ambf_spread(req: Request, scene, floor_z, commands, trace):
 
 
 def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
-    """A located error for each joint command whose joint an adfkit world cannot drive: AMBF
+    """A located error for each pose command to a static body (AMBF's plugin refuses it, once
+    AMBF has loaded the scene) and each joint command whose joint an adfkit world cannot drive: AMBF
     gives every hinge and slider a motor, adfkit drives the joints of its articulations only (a
     joint closing a kinematic loop is a constraint there, without a motor; the two engines may
     close a loop at different joints)."""
@@ -201,6 +202,11 @@ def _check_drivable(read, commands, players: list[AdfkitPlayer]) -> None:
 
     diags = []
     for (_, where), c in zip(read, commands):
+        if c.kind == "pose" and players[0].by_name["body"][c.target].static:
+            why = f"a pose command steers a dynamic body only, and {c.target!r} is static (mass 0)"
+            diags.append(
+                error("command-target", why, where, "give the body a mass, or leave it out of the command file")
+            )
         if c.kind not in commandfile.JOINT_KINDS:
             continue
         first = players[0].by_name["joint"][c.target][0]
