@@ -111,6 +111,8 @@ def build_drill_model(p: DrillingParams) -> ModelFile:
             mass=0.0,
             shape="Box",
             geometry=Geometry(x=0.01, y=0.01, z=0.01),
+            collision_shape="Box",  # without one AMBF's slider holds nothing (runner/plan.py holds_nothing)
+            collision_geometry=Geometry(x=0.01, y=0.01, z=0.01),
             location=Pose(Vec3(0, 0, top + p.shaft_length)),
             color_rgba=STEEL,
         )

@@ -139,6 +139,10 @@ def build_soft_phantom(p: SoftPhantomParams | None = None) -> ModelFile:
             location=Pose(Vec3(0, 0, holder_z)),
             shape="Box",
             geometry=holder,
+            # a static body with no collision shape holds no joint in AMBF (runner/plan.py
+            # holds_nothing): its needle fell through the skin to the tray there, turned 5°
+            collision_shape="Box",
+            collision_geometry=holder,
             color_rgba=STEEL,
         )
     )
