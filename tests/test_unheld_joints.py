@@ -1,11 +1,13 @@
-"""A joint whose parent is a static body (mass 0) with no collision shape: AMBF 2.0 prints
-"COLLISION TYPE NOT UNDERSTOOD" for the parent, keeps the joint, and a hinge or slider there
-holds nothing: the child falls freely, unturned. Measured in AMBF (`adfkit parity`, 2 s, a 0.5 kg
-bar hinged to such a post 1 m up): the bar 3.8389 m below its start after 1 s, 19.0871 m after
-2 s, its x unchanged; both engines held it swinging (19.06 m apart at 2 s). Now neither engine
-makes the joint (`runner-joint-static`; `adfkit parity` lists it on both sides) and the bar falls
-as AMBF's: PyBullet 0.000 mm over 2 s, MuJoCo 1.9 mm (its free fall). With a `collision shape` on
-the post the joint holds in AMBF (and swings within 0.75 mm of adfkit's)."""
+"""A joint whose parent is a static body (mass 0) with no collision shape and no `inertia`: AMBF
+2.0 prints "COLLISION TYPE NOT UNDERSTOOD" for the parent, keeps the joint, and a hinge, slider,
+fixed or p2p joint there holds nothing: the child falls freely, unturned. Measured in AMBF
+(`adfkit parity`, a 0.5 kg bar hinged to such a post 1 m up): the bar 3.8389 m below its start
+after 1 s, 19.0871 m after 2 s, its x unchanged; both engines held it swinging (19.06 m apart at
+2 s). Now neither engine makes the joint (`runner-joint-static`; `adfkit parity` lists it on both
+sides) and the bar falls as AMBF's: PyBullet 0.000 mm over 2 s, MuJoCo 1.9 mm (its free fall).
+With a `collision shape` or an `inertia` on the post the joint holds in AMBF (the hinged bar
+swings within 0.75 mm of adfkit's with the shape; with the inertia AMBF's bar stays 4.83 m above
+a free one's after 1 s), and adfkit makes it."""
 
 from __future__ import annotations
 
@@ -63,14 +65,19 @@ def test_a_hinge_on_a_static_body_without_collision_shape_holds_nothing(tmp_path
     assert np.allclose(m[:3, :3], np.eye(3), atol=1e-6)  # unturned, as in AMBF
 
 
-def test_with_a_collision_shape_the_post_holds_it(tmp_path):
-    """The same post given a `collision shape`: the joint is made and the bar swings down."""
+@pytest.mark.parametrize(
+    "given",
+    [
+        "  collision shape: BOX\n  collision geometry: {x: 0.04, y: 0.4, z: 0.04}\n",
+        "  inertia: {ix: 0.001, iy: 0.001, iz: 0.001}\n",
+    ],
+)
+def test_with_a_collision_shape_or_an_inertia_the_post_holds_it(tmp_path, given):
+    """The same post given a `collision shape` or an `inertia`: AMBF's joint holds, and adfkit
+    makes it: the bar swings down on its hinge."""
     pytest.importorskip("pybullet")
     held = POST.replace(
-        "  geometry: {x: 0.04, y: 0.4, z: 0.04}\n",
-        "  geometry: {x: 0.04, y: 0.4, z: 0.04}\n"
-        "  collision shape: BOX\n  collision geometry: {x: 0.04, y: 0.4, z: 0.04}\n",
-        1,
+        "  geometry: {x: 0.04, y: 0.4, z: 0.04}\n", "  geometry: {x: 0.04, y: 0.4, z: 0.04}\n" + given, 1
     )
     (tmp_path / "m.yaml").write_text(held)
     world = open_world(load_scene(tmp_path / "m.yaml", None, []), Options(visuals=False, ground=False))
@@ -85,12 +92,21 @@ def test_with_a_collision_shape_the_post_holds_it(tmp_path):
 
 @pytest.mark.parametrize(
     "kind,warned",
-    [("revolute", True), ("prismatic", True), ("torsion spring", True), ("linear spring", True), ("fixed", False)],
+    [
+        ("revolute", True),
+        ("prismatic", True),
+        ("torsion spring", True),
+        ("linear spring", True),
+        ("fixed", True),
+        ("p2p", True),
+        ("cone twist", False),
+    ],
 )
 def test_validate_warns_at_the_joints_parent(tmp_path, kind, warned):
     """`adfkit validate` said nothing. Measured in AMBF for a hinge, a slider (a lift carriage
-    fell) and both springs (a torsion spring's flap fell, turning to its 0.9 rad equilibrium past
-    its ±0.5 rad limits; a linear spring's shuttle fell, oscillating about its equilibrium)."""
+    fell), a fixed and a p2p joint (the bar fell 4.84 m in 1 s) and both springs (a torsion
+    spring's flap fell, turning to its 0.9 rad equilibrium past its ±0.5 rad limits; a linear
+    spring's shuttle fell, oscillating about its equilibrium); a cone twist was not measured."""
     from adfkit.validator import validate_file
 
     f = tmp_path / "m.yaml"
@@ -99,3 +115,18 @@ def test_validate_warns_at_the_joints_parent(tmp_path, kind, warned):
     assert [(d.location.line, d.severity.name) for d in found] == (
         [(20, "WARNING")] if warned else []
     )  # `parent: BODY post`
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_a_fixed_joint_there_holds_nothing_either(tmp_path, engine):
+    """AMBF's bar on a fixed joint to the shapeless post: 4.8389 m below its start after 1 s,
+    unturned (measured; both engines held it, 4838.9 mm apart)."""
+    pytest.importorskip(engine)
+    (tmp_path / "m.yaml").write_text(POST.replace("type: revolute", "type: fixed"))
+    world = open_world(load_scene(tmp_path / "m.yaml", None, []), Options(visuals=False, ground=False), engine=engine)
+    try:
+        world.run(1.0)
+        m = world.body("BODY bar").world_matrix()
+    finally:
+        world.close()
+    assert m[2, 3] == pytest.approx(AMBF_BAR_1S[2], abs=2.5e-3)

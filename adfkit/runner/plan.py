@@ -181,27 +181,32 @@ def uncreated_bodies(world, model) -> frozenset[str]:
 
 
 def holds_nothing(body, joint) -> bool:
-    """``joint`` (a hinge or slider) hangs from ``body``, a static body (mass 0) with no collision
-    shape of any kind: AMBF prints "COLLISION TYPE NOT UNDERSTOOD" and the joint holds nothing.
-    Measured in AMBF 2.0: a 0.5 kg bar hinged to such a post falls freely, unturned (19.09 m in
-    2 s; both engines held it swinging, 19.06 m apart; with a `collision shape` on the post AMBF's
-    swings within 0.75 mm of adfkit's); a dynamic body without a collision shape keeps its joints
-    (a link hinged between two others within 0.2 mm). AMBF still turns such a child by the
-    joint's controller, which adfkit leaves out, and a spring there still pulls its child to its
-    equilibrium (its limits and locked axes gone), so springs are made as before (docs/parity.md)."""
-    if joint_kind(joint.type) not in (JointKind.REVOLUTE, JointKind.PRISMATIC):
+    """``joint`` (a hinge, slider, fixed or p2p joint) hangs from ``body``, a static body (mass 0)
+    with no collision shape of any kind and no `inertia`: AMBF prints "COLLISION TYPE NOT
+    UNDERSTOOD" and the joint holds nothing. Measured in AMBF 2.0: a 0.5 kg bar hinged to such a
+    post falls freely, unturned (19.09 m in 2 s; both engines held it swinging, 19.06 m apart),
+    as on a fixed or p2p joint (4.84 m in 1 s); given `inertia` (or a `collision shape`) the
+    post holds it, as adfkit does; `mesh: ''` is no collision shape. A dynamic body without a
+    collision shape keeps its joints (a link hinged between two others within 0.2 mm). AMBF
+    still turns such a child by the joint's controller, which adfkit leaves out, and a spring
+    there still pulls its child to its equilibrium (its limits and locked axes gone), so springs
+    are made as before (docs/parity.md)."""
+    if joint_kind(joint.type) not in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
         return False
-    return body.mass == 0 and not (
-        body.collision_shape or body.compound_collision_shape or body.collision_mesh or body.mesh
+    return (
+        body.mass == 0
+        and body.inertia is None
+        and not (body.collision_shape or body.compound_collision_shape or body.collision_mesh or body.mesh)
     )
 
 
-UNHELD_HINT = "give the parent a `collision shape` (it stays static) for the joint to hold, as in AMBF"
+UNHELD_HINT = "give the parent a `collision shape` or an `inertia` (it stays static) for the joint to hold, as in AMBF"
 
 
 def unheld_message(joint, parent_key: str) -> str:
     return (
-        f"{joint.identifier}: its parent {parent_key} is static with no collision shape; AMBF keeps the joint "
+        f"{joint.identifier}: its parent {parent_key} is static with no collision shape and no inertia; AMBF keeps "
+        "the joint "
         "and it holds nothing (the child moves free); nothing made"
     )
 

@@ -121,8 +121,8 @@ _RULES = [
     Rule(
         "joint-static-parent",
         W,
-        "A hinge, slider or spring whose parent is static with no collision shape: AMBF's joint holds nothing in place",
-        "`parent: BODY post` where `BODY post` has `mass: 0` and no `collision shape`",
+        "A joint (hinge, slider, spring, fixed, p2p) whose parent is static with no collision shape and no inertia: AMBF's joint holds nothing in place",
+        "`parent: BODY post` where `BODY post` has `mass: 0`, no `collision shape`, no `inertia`",
     ),
     Rule(
         "joint-limits",

@@ -505,7 +505,7 @@ class Checker:
                 )
         if j.parent is not None and j.parent == j.child:
             self.emit("joint-same-body", f"joint '{j.identifier}' joins '{j.parent}' to itself", j.where("child"))
-        if kind in ONE_DOF:
+        if kind in ONE_DOF or kind in (JointKind.FIXED, JointKind.P2P):
             self.static_parent(m, j)
         lim = j.joint_limits
         if kind in ONE_DOF and lim is not None:
@@ -663,23 +663,24 @@ class Checker:
                 )
 
     def static_parent(self, m: ModelFile, j) -> None:
-        """A hinge, slider or spring whose parent is static (mass 0) with no collision shape of any
-        kind: AMBF prints "COLLISION TYPE NOT UNDERSTOOD" and the joint holds nothing in place
-        (measured: a hinged child falls freely, unturned; a spring's child falls, pulled to the
-        spring's equilibrium, past its limits; runner/plan.py holds_nothing)."""
+        """A hinge, slider, spring, fixed or p2p joint whose parent is static (mass 0) with no
+        collision shape of any kind and no `inertia`: AMBF prints "COLLISION TYPE NOT UNDERSTOOD"
+        and the joint holds nothing in place (measured: a hinged, fixed or p2p child falls freely,
+        unturned; a spring's child falls, pulled to the spring's equilibrium, past its limits;
+        given `inertia`, the post holds; runner/plan.py holds_nothing)."""
         from ..model.tree import find_body
 
         p: Any = find_body(m, j.parent, j)
-        if p is None or p is find_body(m, j.child, j) or p.mass != 0:
+        if p is None or p is find_body(m, j.child, j) or p.mass != 0 or p.inertia is not None:
             return
         if p.collision_shape or p.compound_collision_shape or p.collision_mesh or p.mesh:
             return
         self.emit(
             "joint-static-parent",
-            f"joint '{j.identifier}': its parent '{j.parent}' is static with no collision shape; AMBF keeps the "
-            "joint and it holds nothing in place (the child falls free)",
+            f"joint '{j.identifier}': its parent '{j.parent}' is static with no collision shape and no inertia; "
+            "AMBF keeps the joint and it holds nothing in place (the child falls free)",
             j.where("parent"),
-            "give the parent a `collision shape` (it stays static) for the joint to hold",
+            "give the parent a `collision shape` or an `inertia` (it stays static) for the joint to hold",
         )
 
     def pivots_apart(self, m: ModelFile, earlier: Registry | None = None) -> None:
