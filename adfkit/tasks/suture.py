@@ -33,6 +33,7 @@ from .grasping import (  # noqa: F401 - JAW_DEPTH, JAW_APPROACH and SutureError 
     JAW_APPROACH,
     JAW_DEPTH,
     SURE_CLEARANCE,
+    TOOL_CLEARANCE,
     Grasp,
     GraspChoice,
     SutureError,
@@ -66,6 +67,16 @@ PULL_LIFT = 2 * LIFT
 HAND_BACK_LIFT = 2 * LIFT
 PARK_RETRACT = 0.03  # m a waiting tool is drawn back along its shaft
 CHECK_STEP = math.radians(5)  # the tool's clearance is checked at needle poses this far apart
+#: rad the insertion may be driven on past where the arc outside the tissue is shared evenly
+#: between the two grasps, where the puller's tool would come nearer the tissue than
+#: SURE_CLEARANCE as it takes the needle (SutureTask._plan_pair). On a phantom sloping 30 degrees
+#: across, the exit the high side, the puller's pitch link came 0.09 mm from the tissue as planned
+#: and struck it (10.9 kN) as it came for the tip; driven 15 degrees further, 1.5 mm, and it passed
+FURTHER = tuple(math.radians(a) for a in (2.5, 5.0, 7.5, 10.0, 12.5, 15.0))
+#: the plan's lists that _plan_pair makes again for a pair when it drives further, each with how
+#: many pairs before the one planned its entries start (a hand-back is planned with the pair after it)
+PLANNED = (("drive_grasps", 0), ("pull_grasps", 0), ("tail_clears", 0), ("pulls", 0), ("handbacks", 1))
+PLANNED += (("handback_about_tail", 1),)
 #: m from the pairs' centre (where the arms are set up, and a --phantom's placed) beyond which an
 #: arm that reaches no grasp is told how far each pair lies (the bundled pairs lie within 36 mm)
 SPREAD_NOTE = 0.04
@@ -362,7 +373,46 @@ class SutureTask(GraspChoice, Motions):
 
     def _plan_pair(self, k: int, p: HolePair, n0: np.ndarray) -> None:
         """The driver's grasp (the pick-up's, or the hand-back's) and the puller's for pair p,
-        the k-th visited."""
+        the k-th visited; where the puller's tool comes nearer the tissue than SURE_CLEARANCE,
+        the insertion driven on FURTHER: as far as keeps the puller farthest from it (the first
+        that keeps it TOOL_CLEARANCE off) while the driver keeps its own clearance."""
+        self._plan_drive_and_pull(k, p, n0)
+        if self.pull_grasps[k].clearance >= SURE_CLEARANCE:
+            return
+        kept = self._planned(k)
+        # the driver keeps what it had (up to SURE_CLEARANCE): on a slope its pick-up, on the
+        # needle's bed, is often what comes nearest, and stays so however far it drives
+        keep = min(self.drive_grasps[k].clearance, SURE_CLEARANCE) - 1e-4
+        best = self.pull_grasps[k].clearance
+        frame = self.frames[p.index]
+        b, psi_x, beyond, g_tip, g_tail = frame
+        for extra in FURTHER:
+            self.frames[p.index] = (b, psi_x, beyond + extra, g_tip, g_tail)
+            self._planned(k, drop=True)
+            try:
+                self._plan_drive_and_pull(k, p, n0)
+            except SutureError:
+                continue
+            if self.drive_grasps[k].clearance >= keep and self.pull_grasps[k].clearance > best:
+                best, frame, kept = self.pull_grasps[k].clearance, self.frames[p.index], self._planned(k)
+            if best >= TOOL_CLEARANCE:
+                break
+        self.frames[p.index] = frame
+        self._planned(k, drop=True)
+        for (n, _), v in zip(PLANNED, kept):
+            getattr(self, n).extend(v)
+
+    def _planned(self, k: int, drop: bool = False) -> list:
+        """What the plan holds for the k-th pair visited (PLANNED), dropped from it with ``drop``."""
+        out = []
+        for n, before in PLANNED:
+            held = getattr(self, n)
+            out.append(held[max(k - before, 0) :])
+            if drop:
+                del held[max(k - before, 0) :]
+        return out
+
+    def _plan_drive_and_pull(self, k: int, p: HolePair, n0: np.ndarray) -> None:
         b, psi_x, beyond, g_tip, g_tail = self.frames[p.index]
         psi_end = psi_x + beyond
         insertion = [self.lifted(self.needle_at(b, -self.approach), LIFT)]
