@@ -406,3 +406,46 @@ def test_the_suture_reads_contact_forces_alike_however_the_world_steps():
     assert read["implicit"][0] == 4 and read["ambf"][0] == 1
     assert read["ambf"][1] == pytest.approx(read["implicit"][1], rel=0.05)
     assert read["implicit"][1] > 4.0  # the needle lies on the phantom: a test of forces, not of zeros
+
+
+@needs_ambf
+def test_the_contact_points_between_two_bodies_every_step_with_the_shapes_as_bullet_holds_them(tmp_path, monkeypatch):
+    """The plugin's ADFKIT_PARITY_POINTS ("T0 T1 A B[,B...]", written to ADFKIT_PARITY_POINTS_OUT),
+    a measurement knob: every physics step from T0 to T1, each contact point between a body named
+    A and one named B. The parity stack's top box (8 cm, 0.4 kg) resting on the middle one, 0.9-1.0
+    s: one manifold a step, its four points on the top box's bottom face (4 cm under its centre),
+    the normal upright, the impulses summing to the box's weight over the 1 ms step (3.92 N on the
+    mean, 3.83-4.03 N a step, measured); the shapes line holds both boxes' shapes as Bullet holds
+    them (AMBF's compound of one box, with AMBF's 1 mm margin) and AMBF's 10 solver iterations.
+    Control: a name that matches nothing writes the shapes line alone."""
+    from adfkit.scenes.parity import write_parity
+
+    stage = ambf.Stage(write_parity(tmp_path), [2])
+    out = tmp_path / "points.jsonl"
+    monkeypatch.setenv("ADFKIT_PARITY_POINTS_OUT", str(out))
+    monkeypatch.setenv("ADFKIT_PARITY_POINTS", "0.9 1.0 stack/box3 stack/box2")
+    ambf.run(BUILD, stage, 1.0, 0.5)
+    import json
+
+    shapes, *steps = [json.loads(line) for line in out.read_text().splitlines()]
+    assert shapes["kind"] == "shapes" and shapes["double"] is True and shapes["solver"]["iterations"] == 10
+    held = {b["name"]: b["shape"] for b in shapes["bodies"]}
+    assert set(held) == {"/ambf/env/stack/box3", "/ambf/env/stack/box2"}
+    assert held["/ambf/env/stack/box3"]["type"] == "Compound"
+    box = held["/ambf/env/stack/box3"]["children"][0]["shape"]
+    assert box["type"] == "Box" and box["margin"] == pytest.approx(0.001)
+    assert len(steps) == 101 and steps[0]["t"] == pytest.approx(0.9) and steps[-1]["t"] == pytest.approx(1.0)
+    weight = [sum(p[8] for p in s["points"]) / 1e-3 for s in steps]  # N: the impulses over the 1 ms step
+    assert np.mean(weight) == pytest.approx(0.4 * 9.81, rel=0.005) and np.ptp(weight) < 0.4
+    for s in steps:
+        top_is_a = s["A"].endswith("box3")
+        assert {s["A"], s["B"]} == set(held) and len(s["points"]) == 4
+        for p in s["points"]:
+            normal = np.array(p[6]) * (1 if top_is_a else -1)  # on B, towards A: up onto the top box
+            assert normal @ [0, 0, 1] > 0.999 and abs(p[7]) < 1e-4
+            local_on_top = np.array(p[4] if top_is_a else p[5])
+            assert local_on_top[2] == pytest.approx(-0.04, abs=1e-4)
+    monkeypatch.setenv("ADFKIT_PARITY_POINTS", "0.9 1.0 stack/box3 nothing-named-so")
+    ambf.run(BUILD, stage, 1.0, 0.5)
+    lines = out.read_text().splitlines()
+    assert len(lines) == 1 and json.loads(lines[0])["bodies"][0]["name"] == "/ambf/env/stack/box3"

@@ -53,7 +53,17 @@
 //                           (A and B: a rigid body's or ghost's qualified name, "?" for anything else)
 //   ADFKIT_PARITY_VELOCITIES "1": each sample also lists every rigid body's linear velocity (m/s, the
 //                           created record's order), as Bullet holds it after AMBF's ghosts acted
-//   Measurement knobs, which change what AMBF does (for finding out what a behaviour comes from):
+//   ADFKIT_PARITY_POINTS    "T0 T1 A B[,B...]" with ADFKIT_PARITY_POINTS_OUT (a file): every physics step
+//                           from T0 to T1 simulated seconds, each contact point between a rigid body whose
+//                           qualified name holds A and one whose name holds one of the Bs, one JSON line a
+//                           manifold: {"t","A","B","breaking":the manifold's contact breaking threshold,
+//                           "rotA","rotB":each body's centre-of-mass frame (quaternion xyzw), "posA","posB",
+//                           "points":[[index0, index1 (the compound's child shapes), world point on A, on B,
+//                           local point on A, on B (centre-of-mass frames), normal on B, distance, normal
+//                           impulse, lifetime], ...]}; first a {"kind":"shapes"} line: those bodies' collision
+//                           shapes as Bullet holds them (type, margin, a capsule's radius, half height and
+//                           axis, a compound's children and their frames) and the world's collision settings
+////   Measurement knobs, which change what AMBF does (for finding out what a behaviour comes from):
 //   ADFKIT_PARITY_STILL_STATIC "1": every static body (mass 0) is put back at rest after each step
 //                           (AMBF's ghosts set the velocity of every body they sense, a static one too)
 //   ADFKIT_PARITY_JOINT_ITERATIONS "SUBSTRING N": the joints whose qualified names hold SUBSTRING solved
@@ -220,6 +230,19 @@ public:
             m_unghostBefore.resize(m_unghosted.size() * 2);
             m_world->m_bulletWorld->setInternalTickCallback(&AdfkitParity::after_tick, this, false);
         }
+        const char* points = getenv("ADFKIT_PARITY_POINTS");
+        if (points && *points) {
+            istringstream qs(points);
+            string bs;
+            if (!(qs >> m_pointsFrom >> m_pointsTo >> m_pointsA >> bs)) fail("ADFKIT_PARITY_POINTS: expected \"T0 T1 A B[,B...]\"");
+            istringstream bss(bs);
+            for (string b; getline(bss, b, ',');)
+                if (!b.empty()) m_pointsB.push_back(b);
+            const char* pout = getenv("ADFKIT_PARITY_POINTS_OUT");
+            m_pointsOut = pout ? fopen(pout, "w") : nullptr;
+            if (!m_pointsOut) fail("ADFKIT_PARITY_POINTS_OUT is not a file it can write");
+            write_shapes();
+        }
         // a measurement's knob: Bullet's solver iterations (AMBF leaves them at Bullet's 10)
         int iterations = (int)env_double("ADFKIT_PARITY_SOLVER_ITERATIONS", 0.0);
         if (iterations > 0) m_world->m_bulletWorld->getSolverInfo().m_numIterations = iterations;
@@ -276,6 +299,7 @@ public:
         if (!m_paced) m_cmdClock = t;
         else if (joints_arrived(t)) m_cmdClock += dt;
         else m_heldSteps++;
+        if (m_pointsOut && t + 1e-9 >= m_pointsFrom && t <= m_pointsTo + 1e-9) write_points(t);
         activate(m_cmdClock);
         drive(dt);
         double c = m_cmdClock;
@@ -406,6 +430,7 @@ private:
                 num(steps ? wall : 0.0).c_str(), pace.c_str(), follow.c_str());
         fflush(m_out);
         fclose(m_out);
+        if (m_pointsOut) fclose(m_pointsOut);
         _exit(0);
     }
 
@@ -535,6 +560,93 @@ private:
         for (afGhostObjectPtr g : m_world->getGhostObjects())
             if (g->m_bulletGhostObject == o) return json_text(g->getQualifiedName());
         return "\"?\"";
+    }
+
+    // ADFKIT_PARITY_POINTS: the bodies it names, their names by collision object
+    int points_side(const string& qname) const {
+        if (qname.find(m_pointsA) != string::npos) return 1;
+        for (const string& b : m_pointsB)
+            if (qname.find(b) != string::npos) return 2;
+        return 0;
+    }
+
+    static string quat(const btQuaternion& q) {
+        return "[" + num(q.x()) + "," + num(q.y()) + "," + num(q.z()) + "," + num(q.w()) + "]";
+    }
+
+    static string shape_json(const btCollisionShape* c) {
+        string s = "{\"type\":" + json_text(c->getName()) + ",\"margin\":" + num(c->getMargin());
+        if (c->getShapeType() == CAPSULE_SHAPE_PROXYTYPE) {
+            const btCapsuleShape* k = static_cast<const btCapsuleShape*>(c);
+            s += ",\"radius\":" + num(k->getRadius()) + ",\"half_height\":" + num(k->getHalfHeight()) +
+                 ",\"axis\":" + to_string(k->getUpAxis());
+        } else if (c->getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE) {
+            s += ",\"points\":" + to_string(static_cast<const btConvexHullShape*>(c)->getNumPoints());
+        } else if (c->isCompound()) {
+            const btCompoundShape* k = static_cast<const btCompoundShape*>(c);
+            s += ",\"children\":[";
+            for (int i = 0; i < k->getNumChildShapes(); i++) {
+                const btTransform& tr = k->getChildTransform(i);
+                s += (i ? ",{" : "{") + string("\"origin\":") + vec(tr.getOrigin()) + ",\"rot\":" + quat(tr.getRotation()) +
+                     ",\"shape\":" + shape_json(k->getChildShape(i)) + "}";
+            }
+            s += "]";
+        }
+        btVector3 lo, hi;
+        c->getAabb(btTransform::getIdentity(), lo, hi);
+        return s + ",\"aabb\":[" + vec(lo) + "," + vec(hi) + "],\"breaking\":" + num(c->getContactBreakingThreshold(gContactBreakingThreshold)) + "}";
+    }
+
+    void write_shapes() {
+        btDiscreteDynamicsWorld* w = m_world->m_bulletWorld;
+        const btContactSolverInfo& si = w->getSolverInfo();
+        btCollisionDispatcher* d = static_cast<btCollisionDispatcher*>(w->getDispatcher());
+        string s = "{\"kind\":\"shapes\",\"double\":" + string(sizeof(btScalar) == 8 ? "true" : "false") +
+                   ",\"gContactBreakingThreshold\":" + num(gContactBreakingThreshold) +
+                   ",\"dispatcher_flags\":" + to_string(d->getDispatcherFlags()) + ",\"solver\":{\"iterations\":" +
+                   to_string(si.m_numIterations) + ",\"erp\":" + num(si.m_erp) + ",\"erp2\":" + num(si.m_erp2) +
+                   ",\"global_cfm\":" + num(si.m_globalCfm) + ",\"split_impulse\":" + to_string(si.m_splitImpulse) +
+                   ",\"split_threshold\":" + num(si.m_splitImpulsePenetrationThreshold) + ",\"linear_slop\":" +
+                   num(si.m_linearSlop) + ",\"mode\":" + to_string(si.m_solverMode) + "},\"bodies\":[";
+        bool first = true;
+        for (afRigidBodyPtr rb : m_world->getRigidBodies()) {
+            string q = rb->getQualifiedName();
+            if (!points_side(q)) continue;
+            m_pointsNames[rb->m_bulletRigidBody] = q;
+            btRigidBody* b = rb->m_bulletRigidBody;
+            s += (first ? "{" : ",{") + string("\"name\":") + json_text(q) + ",\"processing\":" +
+                 num(b->getContactProcessingThreshold()) + ",\"ccd\":" + num(b->getCcdMotionThreshold()) +
+                 ",\"shape\":" + shape_json(b->getCollisionShape()) + "}";
+            first = false;
+        }
+        fprintf(m_pointsOut, "%s]}\n", s.c_str());
+    }
+
+    void write_points(double t) {
+        btDispatcher* d = m_world->m_bulletWorld->getDispatcher();
+        for (int i = 0; i < d->getNumManifolds(); i++) {
+            btPersistentManifold* m = d->getManifoldByIndexInternal(i);
+            int n = m->getNumContacts();
+            if (n == 0) continue;
+            auto a = m_pointsNames.find(m->getBody0()), b = m_pointsNames.find(m->getBody1());
+            if (a == m_pointsNames.end() || b == m_pointsNames.end()) continue;
+            int sa = points_side(a->second), sb = points_side(b->second);
+            if (sa == sb) continue;
+            const btTransform& ta = m->getBody0()->getWorldTransform();
+            const btTransform& tb = m->getBody1()->getWorldTransform();
+            string s = "{\"t\":" + num(t) + ",\"A\":" + json_text(a->second) + ",\"B\":" + json_text(b->second) +
+                       ",\"breaking\":" + num(m->getContactBreakingThreshold()) + ",\"posA\":" + vec(ta.getOrigin()) +
+                       ",\"rotA\":" + quat(ta.getRotation()) + ",\"posB\":" + vec(tb.getOrigin()) + ",\"rotB\":" +
+                       quat(tb.getRotation()) + ",\"points\":[";
+            for (int k = 0; k < n; k++) {
+                const btManifoldPoint& p = m->getContactPoint(k);
+                s += (k ? ",[" : "[") + to_string(p.m_index0) + "," + to_string(p.m_index1) + "," + vec(p.getPositionWorldOnA()) +
+                     "," + vec(p.getPositionWorldOnB()) + "," + vec(p.m_localPointA) + "," + vec(p.m_localPointB) + "," +
+                     vec(p.m_normalWorldOnB) + "," + num(p.getDistance()) + "," + num(p.getAppliedImpulse()) + "," +
+                     to_string(p.getLifeTime()) + "]";
+            }
+            fprintf(m_pointsOut, "%s]}\n", s.c_str());
+        }
     }
 
     // the contact manifolds Bullet kept from the last step, those holding points
@@ -811,6 +923,11 @@ private:
     long m_steps = 0;
     bool m_followGhosts = true;
     bool m_contacts = false;
+    FILE* m_pointsOut = nullptr;  // ADFKIT_PARITY_POINTS
+    double m_pointsFrom = 0.0, m_pointsTo = 0.0;
+    string m_pointsA;
+    vector<string> m_pointsB;
+    map<const btCollisionObject*, string> m_pointsNames;
     bool m_velocities = false, m_stillStatic = false;
     string m_unghostName;
     bool m_unghostLinear = false, m_unghostAngular = false, m_unghostGravity = false;
