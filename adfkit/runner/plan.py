@@ -14,7 +14,6 @@ import numpy as np
 from ..diagnostics import warning
 from ..model.semantics import (
     ACTUATOR_TYPES,
-    DEFAULT_ACTUATOR_MAX_IMPULSE,
     DEFAULT_GRAVITY,
     DEFAULT_SENSOR_RANGE,
     SENSOR_TYPES,
@@ -292,7 +291,6 @@ class Grasper:
     actuator: object
     parent: object
     location: np.ndarray  # 4x4 in the parent's ADF body frame
-    max_impulse: float
 
 
 def played_sensors(world, m, body_type=None, known=None, resistance: bool = False) -> list[SensorRays]:
@@ -366,8 +364,9 @@ def played_actuators(world, m, body_type=None, known=None) -> list[Grasper]:
         parent = resolve_parent(world, a.parent, ns, a, body_type, known)
         if parent is None:
             continue
-        imp = a.max_impulse if a.max_impulse is not None else DEFAULT_ACTUATOR_MAX_IMPULSE
-        out.append(Grasper(key_of(ns, a), a, parent, pose_to_matrix(pose_or_identity(a.location)), imp))
+        # no `max impulse` nor `tau`: AMBF 2.0 reads them and does not use them (its grasp is a
+        # btFixedConstraint without a limit; measured, runner/pybullet/interact.py GRASP_MAX_FORCE)
+        out.append(Grasper(key_of(ns, a), a, parent, pose_to_matrix(pose_or_identity(a.location))))
     return out
 
 

@@ -247,8 +247,8 @@ Actuator.type | | Constraint (any case form listed); required.
 Actuator.location | | Pose in the parent body frame.
 Actuator.visible | false | Draw the actuator.
 Actuator.visible size | 0.02 | Size of the drawn marker.
-Actuator.max impulse | 10 | Maximum constraint impulse.
-Actuator.tau | 1 | Constraint tau.
+Actuator.max impulse | 10 | Read by AMBF 2.0 and not used: its constraint holds without a limit.
+Actuator.tau | 1 | Read by AMBF 2.0 and not used.
 Camera.location | {"x": 0, "y": 0, "z": 0} | Camera position {x, y, z} (not a pose).
 Camera.look at | {"x": 0, "y": 0, "z": 0} | Point looked at {x, y, z}.
 Camera.up | {"x": 0, "y": 0, "z": 1} | Up vector {x, y, z}.

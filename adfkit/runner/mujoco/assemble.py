@@ -175,7 +175,6 @@ class Assembly:
                 by_plan[id(g.parent)],
                 mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, weld),
                 g.location,
-                g.max_impulse / self.dt,
             )
             for g, weld in plan.actuators
         ]

@@ -136,7 +136,6 @@ class MjActuator:
     parent: MjBody
     eq: int
     location: np.ndarray
-    max_force: float
     target: MjBody | None = None
     constraint: object = None
 

@@ -340,7 +340,7 @@ class Assembly:
 
     def _build_actuators(self, m, known) -> None:
         for g in played_actuators(self, m, known=known):
-            self.actuators.append(SimActuator(g.key, g.actuator, g.parent, g.location, g.max_impulse / self.dt))
+            self.actuators.append(SimActuator(g.key, g.actuator, g.parent, g.location))
 
     def _build_sensors(self, m, known) -> None:
         for r in played_sensors(self, m, known=known, resistance=self.opt.bodies == "ambf"):

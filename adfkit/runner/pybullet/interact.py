@@ -23,6 +23,11 @@ GRASP_SPAN = 0.02
 # error reduction of the grasp's constraints: the share of their gap closed per step (Bullet's 0.2 let
 # the thread's pull stretch a held needle 2 mm out of the jaws; 0.8 holds it within a fraction of that)
 GRASP_ERP = 0.8
+# the force the grasp's constraints may push with: past any they meet. AMBF's constraint actuator is a
+# btFixedConstraint with no limit; the file's `max impulse` and `tau` are read by AMBF 2.0 and not used
+# (measured: the bundled suture replayed with both at 0.001 repeats to the bit, and a 1 kg box hung from
+# an actuator with `max impulse: 0.0001` stays held). PyBullet caps a constraint at 500 N unless told
+GRASP_MAX_FORCE = 1e9
 # collision bits a ghost has during its collision pass (_manifold_points): meeting every body's
 GHOST_PASS_BITS = -1
 
@@ -51,7 +56,6 @@ class SimActuator:
     actuator: object
     parent: SimBody
     location: np.ndarray  # in the parent body frame
-    max_force: float
     constraint: list | None = None  # the grasp's constraint ids (see PyBulletWorld.actuate)
     target: SimBody | None = None
 
@@ -299,7 +303,7 @@ class Interaction:
                 pbv.tolist(),
                 physicsClientId=self.cid,
             )
-            pb.changeConstraint(c, maxForce=actuator.max_force, erp=GRASP_ERP, physicsClientId=self.cid)
+            pb.changeConstraint(c, maxForce=GRASP_MAX_FORCE, erp=GRASP_ERP, physicsClientId=self.cid)
             ids.append(c)
         actuator.constraint, actuator.target = ids, target
         self._pairs_epoch += 1
