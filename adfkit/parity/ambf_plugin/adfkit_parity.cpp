@@ -74,6 +74,11 @@
 //                           back, after each step, what AMBF's ghosts changed of them: PARTS names any of
 //                           linear and angular (the velocities Bullet's step left, read at its internal
 //                           tick callback) and gravity (the world's)
+//   ADFKIT_PARITY_GRASP_ROWS "ERP CFM N": each grasp's btFixedConstraint (AMBF's constraint actuator) gets
+//                           ERP and CFM on its six locked rows (AMBF leaves the world's, 0.2 and 0) and, N > 0,
+//                           N solver iterations of its own
+//   ADFKIT_PARITY_FINE      "T0 T1 [T0 T1 ...]": a sample every physics step from T0 to T1 (simulated s),
+//                           besides ADFKIT_PARITY_EVERY's (it changes nothing AMBF does)
 //
 // Records: {"kind":"created",...} once, {"kind":"sample",...} per sample (its "clock": the command
 // clock, the simulated time "t" when unpaced), {"kind":"end",...} last (a paced replay's "pace":
@@ -262,6 +267,19 @@ public:
                 if (j->getQualifiedName().find(name) != string::npos && j->getConstraint())
                     j->getConstraint()->setOverrideNumSolverIterations(n);
         }
+        const char* graspRows = getenv("ADFKIT_PARITY_GRASP_ROWS");
+        if (graspRows && *graspRows) {
+            istringstream gs(graspRows);
+            if (!(gs >> m_graspErp >> m_graspCfm >> m_graspIterations) || m_graspErp < 0 || m_graspCfm < 0)
+                fail("ADFKIT_PARITY_GRASP_ROWS: expected \"ERP CFM N\"");
+            m_graspRows = true;
+        }
+        const char* fine = getenv("ADFKIT_PARITY_FINE");
+        if (fine && *fine) {
+            istringstream fs(fine);
+            double a, b;
+            while (fs >> a >> b) m_fine.push_back(make_pair(a, b));
+        }
         const char* friction = getenv("ADFKIT_PARITY_FRICTION");
         if (friction && *friction) {
             string f(friction);
@@ -304,7 +322,9 @@ public:
         drive(dt);
         double c = m_cmdClock;
         bool last = c + 1e-9 >= m_seconds || (m_paced && t + 1e-9 >= m_paceMax);
-        if (last || c + 1e-9 >= m_nextSample) {
+        bool fine = false;
+        for (auto& w : m_fine) fine = fine || (c + 1e-9 >= w.first && c <= w.second + 1e-9);
+        if (last || fine || c + 1e-9 >= m_nextSample) {
             sample(m_steps);
             while (m_nextSample <= c + 1e-9) m_nextSample += m_every > 0 ? m_every : m_seconds;
         }
@@ -770,6 +790,7 @@ private:
                 afRigidBodyPtr body = find_body(c.arg);
                 if (c.numbers.empty()) a->actuate(body);
                 else a->actuate(body, held_at(a, body, c.numbers));
+                if (m_graspRows) stiffen_last_constraint();
             } else if (c.kind == "release") {
                 find_actuator(c.target)->deactuate();
             } else if (c.kind == "collide") {
@@ -818,6 +839,19 @@ private:
 
     // a body set at a pose (its ADF body frame) at rest; its broadphase box moved with it (a
     // static body's is not moved by the world's own step)
+    // the constraint the actuator just added (addConstraint appends it to the world's list): the
+    // measurement knob ADFKIT_PARITY_GRASP_ROWS's rows and iterations on it
+    void stiffen_last_constraint() {
+        btDiscreteDynamicsWorld* w = m_world->m_bulletWorld;
+        if (w->getNumConstraints() == 0) return;
+        btTypedConstraint* c = w->getConstraint(w->getNumConstraints() - 1);
+        for (int axis = 0; axis < 6; axis++) {
+            c->setParam(BT_CONSTRAINT_STOP_ERP, m_graspErp, axis);
+            c->setParam(BT_CONSTRAINT_STOP_CFM, m_graspCfm, axis);
+        }
+        if (m_graspIterations > 0) c->setOverrideNumSolverIterations(m_graspIterations);
+    }
+
     // AMBF's offset for a grasp that holds BODY with its frame at n (x y z qx qy qz qw) in the
     // actuator's parent's frame: the actuator's frame in the body's centre-of-mass frame, as
     // afConstraintActuator::actuate(body) computes it from where the body lies, here from where
@@ -920,6 +954,10 @@ private:
     afWorldPtr m_world = nullptr;
     FILE* m_out = nullptr;
     double m_seconds = 0.0, m_every = 0.0, m_nextSample = 0.0;
+    bool m_graspRows = false;
+    double m_graspErp = 0.2, m_graspCfm = 0.0;
+    int m_graspIterations = 0;
+    vector<pair<double, double>> m_fine;
     long m_steps = 0;
     bool m_followGhosts = true;
     bool m_contacts = false;
