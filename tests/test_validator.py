@@ -150,6 +150,15 @@ EXAMPLES = {
     "inertia": (CLEAN.replace("BODY b:\n", "BODY b:\n  inertia: {ix: 1, iy: 1, iz: 5}\n"), 8, "warning"),
     "static-joint": (CLEAN.replace("mass: 1.0\n  mesh: ''\nJOINT", "mass: 0.0\n  mesh: ''\nJOINT"), 14, "warning"),
     "bad-scale": (CLEAN.replace("BODY b:\n", "BODY b:\n  scale: 0\n"), 8, "warning"),
+    "margin-size": (
+        CLEAN.replace(
+            "BODY b:\n",
+            "BODY b:\n  collision shape: Cylinder\n  collision geometry: {radius: 0.02, height: 0.05}\n"
+            "  collision margin: 0.03\n",
+        ),
+        10,
+        "warning",
+    ),
     "non-finite-number": (CLEAN.replace("mass: 1.0\n  mesh: ''\nBODY b", "mass: .nan\n  mesh: ''\nBODY b"), 5, "error"),
     "absurd-value": (CLEAN.replace("parent pivot: {x: 0,", "parent pivot: {x: 1e300,"), 16, "warning"),
     "shape-name": (CLEAN.replace("BODY b:\n", "BODY b:\n  shape: Cube\n  geometry: {x: 1}\n"), 8, "error"),
@@ -224,6 +233,29 @@ def test_rule_example(rule, tmp_path):
     assert hits, [str(d) for d in res.diagnostics]
     assert (hits[0].location.line, str(hits[0].severity)) == (line, severity), str(hits[0])
     assert hits[0].location.file == str(f)
+
+
+@pytest.mark.parametrize(
+    ("geometry", "margin", "mass", "warned"),
+    [
+        # measured in AMBF (2 s on a floor): margin 0.03 on radius 0.02 pushed 60 mm above its rest by
+        # 0.5 s, 0.015 on a 0.02 m tall disc 64 mm; 0.015 and 0.02 on radius 0.02 rest at 25.0 mm
+        ("{radius: 0.02, height: 0.05}", 0.03, 0.1, True),
+        ("{radius: 0.05, height: 0.02}", 0.015, 0.1, True),
+        ("{radius: 0.02, height: 0.05}", 0.02, 0.1, False),
+        ("{radius: 0.02, height: 0.05}", 0.015, 0.1, False),
+        ("{radius: 0.02, height: 0.05}", 0.03, 0, False),  # static: nothing to push
+    ],
+)
+def test_margin_size(tmp_path, geometry, margin, mass, warned):
+    f = tmp_path / "m.yaml"
+    f.write_text(
+        "bodies: [BODY c]\nBODY c:\n  name: c\n  mass: "
+        f"{mass}\n  collision shape: Cylinder\n  collision geometry: {geometry}\n  collision margin: {margin}\n",
+        encoding="utf-8",
+    )
+    hits = [d for d in validate_file(f).diagnostics if d.rule == "margin-size"]
+    assert [d.location.line for d in hits] == ([7] if warned else [])
 
 
 LOC = "  location: {{position: {{x: {x}, y: 0, z: 0}}, orientation: {{r: 0, p: 0, y: {yaw}}}}}\n"

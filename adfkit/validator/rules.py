@@ -274,6 +274,12 @@ _RULES = [
         "A joint whose child body is static (mass 0) while its parent moves, or both static",
         "`child` with `mass: 0` on a revolute joint",
     ),
+    Rule(
+        "margin-size",
+        W,
+        "A moving body's collision cylinder with a `collision margin` above its radius or half its height: it pushes itself off what it stands on",
+        "`collision margin: 0.03` on a cylinder of radius 0.02",
+    ),
     Rule("bad-scale", W, "Scale not positive or implausible (< 0.001 or > 1000)", "`scale: 0`"),
     Rule("non-finite-number", E, "A number is NaN or infinite", "`mass: .nan`"),
     Rule(
