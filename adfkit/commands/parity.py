@@ -4,6 +4,7 @@ each created; exit 1 when they differ past the tolerances."""
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -95,6 +96,12 @@ def add_arguments(p) -> None:
         metavar="M",
         help="--spread: the dynamic roots' nudge, in metres (default 1e-7; below --tolerance-mm and 1 mm)",
     )
+    p.add_argument(
+        "--ambf-iterations",
+        metavar="N",
+        help="Bullet's solver iterations a physics step in AMBF, every AMBF run of this command (default: "
+        "AMBF's own, 10; adfkit's suture records at 50)",
+    )
     p.add_argument("--plot", metavar="PNG", help="draw each body's position gap over time")
     p.add_argument(
         "--suture",
@@ -151,6 +158,18 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
+    from ..diagnostics import AdfError, error
+    from ..parity import ambf
+
+    iterations = None
+    if args.ambf_iterations is not None and (iterations := ambf.read_iterations(args.ambf_iterations)) is None:
+        why = f"--ambf-iterations {args.ambf_iterations!r}: AMBF's solver iterations are a positive whole number"
+        raise AdfError(error("bad-option", why, None, ambf.ITERATIONS_HINT))
+    with ambf.iterations_set(iterations) as args.ambf_solver_iterations:
+        return _run(args)
+
+
+def _run(args) -> int:
     from .. import inputs
     from ..adf import parse_indices
     from ..diagnostics import AdfError, error
@@ -218,9 +237,10 @@ def run(args) -> int:
 
         plot_gaps(out.comparisons, Path(args.plot), str(path))
     if args.json:
-        objs = [c.as_json() for c in out.comparisons]
+        objs = [{**c.as_json(), "ambf_solver_iterations": args.ambf_solver_iterations} for c in out.comparisons]
         print(dumps(objs[0] if len(objs) == 1 else objs, indent=1))
     else:
+        print(iterations_line(args))
         session.print_text(out)
     return 1 if any(c.failures() for c in out.comparisons) else 0
 
@@ -276,6 +296,7 @@ def _suture(args) -> int:
         # what the user names; the rest the suture's own, which its acceptance was run on
         options=recording_options(args),
     )
+    out["ambf_solver_iterations"] = args.ambf_solver_iterations
     if args.json:
         print(dumps(out, indent=1))
     else:
@@ -287,6 +308,7 @@ def _suture(args) -> int:
             + ("where adfkit's grasp held it)" if out.get("grasp") == "adfkit" else "where it lay)")
         )
         print("  recorded with " + ", ".join(f"{k} {v}" for k, v in out["recorded_with"].items()))
+        print("  " + iterations_line(args))
         for p in out["pairs"]:
             gap = p["tip_path_gap_m"]
             print(
@@ -340,6 +362,7 @@ def _trials(args, path: Path, pairs, build) -> int:
         grasp=args.grasp or "lies",
     )
     t = out["trials"]
+    out["ambf_solver_iterations"] = args.ambf_solver_iterations
     if args.json:
         print(dumps(out, indent=1))
     else:
@@ -347,6 +370,7 @@ def _trials(args, path: Path, pairs, build) -> int:
             f"{path}: the suture, seed {args.seed}, {out['seconds']:.1f} s, replayed in AMBF {t['count']} times "
             f"following adfkit's measured joints, all but the first nudged {nudge.rad:g} rad / {nudge.m:g} m"
         )
+        print("  " + iterations_line(args))
         for p in t["pairs"]:
             gaps = [g * 1e3 for g in p["tip_path_gap_m"] if g is not None and g == g]
             rules = ", ".join(f"{r or v}" for v, r in zip(p["ambf"], p["ambf_rules"], strict=True))
@@ -369,3 +393,16 @@ def recording_options(args) -> dict:
         "link_shapes": args.link_shapes,
         "control_substeps": args.control_substeps,
     }
+
+
+def iterations_line(args) -> str:
+    """What AMBF's Bullet solver iterates a step, for the text output."""
+    from ..parity import ambf
+
+    if args.ambf_iterations is not None:
+        how = "--ambf-iterations"
+    elif ambf.read_iterations(os.environ.get(ambf.ITERATIONS_ENV, "")) is not None:
+        how = f"${ambf.ITERATIONS_ENV}"
+    else:
+        how = "AMBF's default"
+    return f"AMBF's solver iterations: {args.ambf_solver_iterations} a step ({how})"

@@ -14,7 +14,8 @@ import shutil
 import subprocess
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -27,6 +28,45 @@ SIMULATOR = Path("bin") / "lin-x86_64" / "ambf_simulator"
 #: 10 kHz a light scene waited on the pacing: the arm's 1000 steps took 0.100 s, now 0.010 s)
 PHYSICS_FLAGS = ("-g", "false", "-t", "true", "-p", "100000", "-s", "100")
 DT = 0.001
+#: Bullet's solver iterations a step in AMBF when nothing sets them: Bullet's default, which AMBF keeps
+DEFAULT_SOLVER_ITERATIONS = 10
+#: the plugin's knob that sets them (``adfkit parity --ambf-iterations N`` sets it for its runs)
+ITERATIONS_ENV = "ADFKIT_PARITY_SOLVER_ITERATIONS"
+#: the hint beside a count read_iterations refuses
+ITERATIONS_HINT = "a whole number, 1 or more (50: adfkit's suture's), or leave --ambf-iterations out (AMBF's own 10)"
+
+
+def read_iterations(text: str) -> int | None:
+    """``--ambf-iterations``'s count (None: not a positive whole number)."""
+    try:
+        n = int(text.strip())
+    except ValueError:
+        return None
+    return n if n > 0 else None
+
+
+def solver_iterations() -> int:
+    """The solver iterations AMBF runs here: the plugin's knob where it holds a positive count,
+    else AMBF's own."""
+    return read_iterations(os.environ.get(ITERATIONS_ENV, "")) or DEFAULT_SOLVER_ITERATIONS
+
+
+@contextmanager
+def iterations_set(n: int | None) -> Iterator[int]:
+    """Every AMBF run inside plays ``n`` solver iterations a step (None: as the environment says,
+    AMBF's own 10 unless the knob is set); yields the count AMBF plays."""
+    if n is None:
+        yield solver_iterations()
+        return
+    before = os.environ.get(ITERATIONS_ENV)
+    os.environ[ITERATIONS_ENV] = str(n)
+    try:
+        yield n
+    finally:
+        if before is None:
+            os.environ.pop(ITERATIONS_ENV, None)
+        else:
+            os.environ[ITERATIONS_ENV] = before
 
 
 def cache_root() -> Path:
