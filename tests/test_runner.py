@@ -375,6 +375,7 @@ FOUR_BAR = (
     "joints: [JOINT world-l1, JOINT l1-l2, JOINT l2-l3, JOINT l3-l4, JOINT l1-l4]\n"
     "ignore inter-collision: true\n"
     "BODY world:\n  name: world\n  mass: 0.0\n"
+    "  inertia: {ix: 1.0, iy: 1.0, iz: 1.0}\n"  # AMBF holds a joint on a shapeless static body only with one
     "  location: {position: {x: 0.0, y: 0.0, z: 0.0}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
     + _bar("l1", 0.1, 1.0, 0.0, "x")
     + _bar("l2", -_S / 2, 1.0 - _S / 2, math.pi / 4, "z")
@@ -424,6 +425,7 @@ def test_a_four_bar_welded_to_a_static_body_swings_with_no_constraint_on_that_bo
 SLIDING_WEIGHT = (
     "bodies: [BODY mount, BODY weight]\njoints: [JOINT mount-weight]\n{gravity}"
     "BODY mount:\n  name: mount\n  mass: 0.0\n"
+    "  inertia: {{ix: 1.0, iy: 1.0, iz: 1.0}}\n"  # AMBF holds a joint on a shapeless static body only with one
     "  location: {{position: {{x: 0.0, y: 0.0, z: 0.5}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
     "BODY weight:\n  name: weight\n  mass: 0.1\n  inertia: {{ix: 1.0e-4, iy: 1.0e-4, iz: 1.0e-4}}\n"
     "  collision shape: BOX\n  collision geometry: {{x: 0.01, y: 0.01, z: 0.01}}\n"
@@ -437,6 +439,7 @@ SLIDING_WEIGHT = (
 
 FIXED_MOUNT = (
     "BODY post:\n  name: post\n  mass: 0.0\n"
+    "  inertia: {ix: 1.0, iy: 1.0, iz: 1.0}\n"  # AMBF holds a joint on a shapeless static body only with one
     "  location: {position: {x: 0.0, y: 0.0, z: 0.6}, orientation: {r: 0.0, p: 0.0, y: 0.0}}\n"
     "JOINT post-mount:\n  name: post-mount\n  parent: BODY post\n  child: BODY mount\n  type: fixed\n"
     "  parent pivot: {x: 0.0, y: 0.0, z: -0.1}\n  child pivot: {x: 0.0, y: 0.0, z: 0.0}\n"
@@ -502,6 +505,7 @@ def test_ambfs_ghost_rule_hangs_a_cube_in_a_ghost_alike_in_both_engines(tmp_path
 HINGED_IN_GHOST = (
     "bodies: [BODY mount, BODY arm]\njoints: [JOINT mount-arm]\nghost objects: [GHOST cell]\n"
     "BODY mount:\n  name: mount\n  mass: 0.0\n"
+    "  inertia: {{ix: 1.0, iy: 1.0, iz: 1.0}}\n"  # AMBF holds a joint on a shapeless static body only with one
     "  location: {{position: {{x: 0.0, y: 0.0, z: 0.5}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}\n"
     "BODY arm:\n  name: arm\n  mass: 0.2\n  inertia: {{ix: 2.0e-5, iy: 1.0e-4, iz: 1.0e-4}}\n"
     "  damping: {{linear: 0.0, angular: 0.0}}\n"
