@@ -14,6 +14,7 @@ joints: [JOINT slab-bob]
 BODY slab:
   name: slab
   mass: 0.0
+  inertia: {ix: 1.0, iy: 1.0, iz: 1.0}  # AMBF holds a joint on a static body with no collision shape only with one
   shape: Box
   geometry: {x: 0.2, y: 0.2, z: 0.02}
   location:
