@@ -195,6 +195,15 @@ def effective_mass(body) -> float:
     return DEFAULT_MASS if body.mass is None else body.mass
 
 
+def holds_no_joint(body) -> bool:
+    """A static body (mass 0) with no collision shape of any kind and no `inertia`: AMBF makes it a
+    btEmptyShape ("COLLISION TYPE NOT UNDERSTOOD") and a hinge, slider, fixed or p2p joint hung
+    from it holds nothing (measured in AMBF 2.0; runner/plan.py holds_nothing, the validator's
+    `joint-static-parent`)."""
+    shaped = body.collision_shape or body.compound_collision_shape or body.collision_mesh or body.mesh
+    return body.mass == 0 and body.inertia is None and not shaped
+
+
 def pose_or_identity(p: Pose | None) -> Pose:
     return p if p is not None else Pose()
 

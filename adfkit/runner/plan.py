@@ -19,6 +19,7 @@ from ..model.semantics import (
     SENSOR_TYPES,
     JointKind,
     collision_primitives,
+    holds_no_joint,
     joint_kind,
     pose_or_identity,
 )
@@ -192,21 +193,17 @@ def holds_nothing(body, joint) -> bool:
     are made as before (docs/parity.md)."""
     if joint_kind(joint.type) not in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.FIXED, JointKind.P2P):
         return False
-    return (
-        body.mass == 0
-        and body.inertia is None
-        and not (body.collision_shape or body.compound_collision_shape or body.collision_mesh or body.mesh)
-    )
+    return holds_no_joint(body)
 
 
-UNHELD_HINT = "give the parent a `collision shape` or an `inertia` (it stays static) for the joint to hold, as in AMBF"
-
-
-def unheld_message(joint, parent_key: str) -> str:
-    return (
+def warn_unheld(world, joint, parent_key: str) -> None:
+    """Says, on ``world``, that ``joint`` is not made: its parent ``holds_nothing``."""
+    world._warn(
+        "runner-joint-static",
         f"{joint.identifier}: its parent {parent_key} is static with no collision shape and no inertia; AMBF keeps "
-        "the joint "
-        "and it holds nothing (the child moves free); nothing made"
+        "the joint and it holds nothing (the child moves free); nothing made",
+        joint,
+        "give the parent a `collision shape` or an `inertia` (it stays static) for the joint to hold, as in AMBF",
     )
 
 
@@ -220,7 +217,7 @@ def unheld_joints(model, world) -> frozenset[str]:
     for j in model.joints:
         p = find_body(model, j.parent, j)
         if p is not None and holds_nothing(p, j) and p is not find_body(model, j.child, j):
-            world._warn("runner-joint-static", unheld_message(j, p.identifier), j, UNHELD_HINT)
+            warn_unheld(world, j, p.identifier)
             out.add(j.identifier)
     return frozenset(out)
 

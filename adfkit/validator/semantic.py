@@ -16,6 +16,7 @@ from ..model.semantics import (
     JointKind,
     body_joint_frames,
     collision_mesh_type,
+    holds_no_joint,
     inertial_joint_twist,
     inertial_rotation,
     joint_kind,
@@ -694,9 +695,7 @@ class Checker:
         from ..model.tree import find_body
 
         p: Any = find_body(m, j.parent, j)
-        if p is None or p is find_body(m, j.child, j) or p.mass != 0 or p.inertia is not None:
-            return
-        if p.collision_shape or p.compound_collision_shape or p.collision_mesh or p.mesh:
+        if p is None or p is find_body(m, j.child, j) or not holds_no_joint(p):
             return
         self.emit(
             "joint-static-parent",

@@ -13,7 +13,7 @@ import numpy as np
 from ...converters.mjcf_write import LOOP_KINDS
 from ...model.semantics import JointKind, body_joint_frames, joint_kind
 from ..names import Registry
-from ..plan import UNHELD_HINT, holds_nothing, joint_ends, unheld_message
+from ..plan import holds_nothing, joint_ends, warn_unheld
 
 
 def cross_model_joints(world, spec, plans_by_model, body_type) -> list[tuple]:
@@ -37,7 +37,7 @@ def cross_model_joints(world, spec, plans_by_model, body_type) -> list[tuple]:
             if parent.model is child.model:
                 continue  # within one model: its tree had its reasons
             if holds_nothing(parent.body, j):  # AMBF keeps it, holding nothing (plan.holds_nothing)
-                world._warn("runner-joint-static", unheld_message(j, parent.key), j, UNHELD_HINT)
+                warn_unheld(world, j, parent.key)
                 continue
             if kind not in LOOP_KINDS:
                 world._warn(

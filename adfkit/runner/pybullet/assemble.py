@@ -18,7 +18,6 @@ from ..names import Registry, merge_namespace
 from ..plan import (
     ALL_GROUPS,
     SPRING_KINDS,
-    UNHELD_HINT,
     holds_nothing,
     is_hole,
     joint_ends,
@@ -28,7 +27,7 @@ from ..plan import (
     played_actuators,
     played_sensors,
     resolve_parent,
-    unheld_message,
+    warn_unheld,
 )
 from ..resistance import RayState, ResistanceParams
 from ..rotations import invert, matrix_to_pq, pose_to_matrix
@@ -91,7 +90,7 @@ class Assembly:
                     self._warn("runner-joint-body", f"{j.identifier}: joins a body to itself; nothing made", j)
                     continue
                 if holds_nothing(ends[0].body, j):  # AMBF keeps it, and it holds nothing (World.inert_joints)
-                    self._warn("runner-joint-static", unheld_message(j, ends[0].key), j, UNHELD_HINT)
+                    warn_unheld(self, j, ends[0].key)
                     continue
                 records.append((j, kind, ends[0], ends[1]))
         self.joints_made = [(j, parent, child) for j, _kind, parent, child in records]
