@@ -69,6 +69,8 @@ class ChainStep:
         self.drift = np.zeros((n, 6))
         # the bodies' velocities the last step left (n, 6: linear, angular, in the world's frame)
         self.carried: np.ndarray | None = None
+        # the joints' velocities the last step's contacts gave, as its pushes (None: no contact)
+        self.contact: np.ndarray | None = None
         self.step = -2  # the physics step it was last played at: a step missed, nothing is carried
 
     def velocities(
@@ -136,13 +138,21 @@ class ChainStep:
             joints.append(jt)
         if loops is not None:
             joints += loops(bodies, coms, rots, d)
+        pushed = np.zeros((len(coms), 6)) if state.pushes else None
         for k, force, at in state.pushes:
             # AMBF solves its contact rows with the joints' rows, so its motors do not push
             # through a contact; the chain's rows see the contact as the push it gave
             bd = bodies[k]
             if bd.inv_mass > 0.0:
-                bd.v = bd.v + force * self.dt * bd.inv_mass
-                bd.w = bd.w + bd.inv_inertia @ cross3(at - coms[k], force) * self.dt
+                dv, dw = force * self.dt * bd.inv_mass, bd.inv_inertia @ cross3(at - coms[k], force) * self.dt
+                bd.v, bd.w = bd.v + dv, bd.w + dw
+                pushed[k, :3] += dv
+                pushed[k, 3:] += dw
+        # what those pushes alone did to the joints (the contacts' share of the step before's change)
+        self.contact = None
+        if pushed is not None:
+            held = [Body(c, bd.inv_mass, bd.inv_inertia, bd.v, bd.w, bd.inertia) for c, bd in zip(coms, bodies)]
+            self.contact = joint_velocities(held, fk, pushed)[0]
         for k, effort in efforts.items():  # AMBF's commandEffort: the torque (force) on both bodies
             jt = joints[k]
             for b, sign in ((jt.child, 1.0), (jt.parent, -1.0)):

@@ -314,21 +314,27 @@ class JointCommands:
         chain's bodies (``chain_velocities``) and these rows drive every joint of it, the impulses
         that take the joints where its ten iterations leave them; otherwise settled together
         (``soft_row_impulses``). Each joint is pushed with its impulse over the control step,
-        within its motor's force where the rows are settled here."""
+        within its motor's force where the rows are settled here. The other forces' change in the
+        step before is taken to last, less what the contacts gave the joints where the chain step
+        took them in (World.chain_contacts)."""
         w = self.world
         art = rows[0][0].art
         idx = [dj.index for dj, _ in rows]
         v = np.asarray(w.joint_state(art, idx)[1], dtype=float)
-        free = v
         last = self._rows.get(id(art))
-        if last is not None and last[0] == idx:  # the other forces' change in the step before
-            _idx, mobility, impulse, before = last
-            free = v + (v - mobility @ impulse - before)
         mobility = w.joint_mobility(art, idx)
         chain = getattr(w, "chain_velocities", None)
         after = None
         if chain is not None and len(rows) == len(art.records):
             after = chain(art, {dj.index: (t, dj.cfm, dj.max_force * w.dt) for dj, t in rows}, {})
+        free = v
+        if last is not None and last[0] == idx:  # the other forces' change in the step before
+            change = v - last[1] @ last[2] - last[3]
+            # less the contacts' share where the chain's rows met them (as pushes, within the
+            # motors' caps) and the engine meets them again in its step: AMBF's contact rows are
+            # solved with its motor rows, not pushed against as a force that lasts
+            contact = w.chain_contacts(art) if after is not None else None
+            free = v + (change if contact is None else change - contact[idx])
         if after is not None:
             impulse = np.linalg.lstsq(mobility, after[idx] - free, rcond=None)[0]
         else:

@@ -118,6 +118,15 @@ class World:
         self._chain_stepped[id(art)] = self.steps  # AMBF's ghosts act on its links in the chain's step
         return model.velocities(motors, efforts, self.steps, self.chain_ghosts(art))
 
+    def chain_contacts(self, art) -> np.ndarray | None:
+        """The joints' velocities (by record index) the contacts of the physics step before gave
+        ``art``, as this step's chain_velocities took them in (its bodies pushed by them before
+        its rows); None where it took in none or was not played for this step."""
+        model = self._chains.get(id(art))
+        if model is None or not self.chain_stepped(art):
+            return None
+        return model.core.contact
+
     def chain_of(self, art):
         """The engine's chain_model of ``art`` (made once), None where AMBF's bodies are not asked
         for (Options.bodies) or it cannot read the articulation."""
