@@ -122,3 +122,29 @@ def test_the_chain_step_moves_an_arm_as_bullets_bodies_through_a_reversal():
     assert np.linalg.norm(bullet - bullet[0], axis=1).max() > 0.03  # the arm swung
     assert gap < 2e-6
     assert control > 1.5e-5
+
+
+def test_the_contacts_share_is_what_their_pushes_give_the_joints():
+    """ChainStep.contact, what the last step's contact pushes alone gave the joints (runner/
+    joint_commands.py takes it out of the change it extrapolates): the joint-space answer to the
+    push, M⁻¹·Q·dt, with M the arm's joint-space mass and Q the push's generalised force, both
+    worked out here from the arm's own kinematics; none without a contact."""
+    q, qd = np.array([0.4, -0.7]), np.array([0.2, -0.1])
+    state = _articulation(q, qd)
+    chain = _chain()
+    chain.velocities(state, _motors(0), {}, 0)
+    assert chain.contact is None
+    force, point = np.array([3.0, -1.0, 2.0]), state.coms[2] + np.array([0.01, 0.03, -0.02])
+    state.pushes = [(2, force, point)]
+    chain.velocities(state, _motors(1), {}, 1)
+    # each joint's unit velocity: the bodies' velocities (from the arm's kinematics) and the point's
+    unit = [_articulation(q, e) for e in np.eye(2)]
+    mass = np.zeros((2, 2))
+    for i, a in enumerate(unit):
+        for j, b in enumerate(unit):
+            for k in (1, 2):
+                inertia = state.rots[k] @ np.diag(DIAG[k - 1]) @ state.rots[k].T
+                mass[i, j] += MASS[k - 1] * a.v[k] @ b.v[k] + a.w[k] @ inertia @ b.w[k]
+    push = np.array([force @ (u.v[2] + np.cross(u.w[2], point - state.coms[2])) for u in unit])
+    assert np.allclose(chain.contact, np.linalg.solve(mass, push) * DT, rtol=1e-9, atol=1e-12)
+    assert np.abs(chain.contact).max() > 1e-3  # a push that moves the joints
