@@ -81,8 +81,14 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self._next_stability_check = 0.0
         # the broadphase keeps its overlapping pairs sorted, so a snapshot restored in place
-        # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact
-        pb.setPhysicsEngineParameter(enableFileCaching=1, deterministicOverlappingPairs=1, physicsClientId=self.cid)
+        # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact.
+        # AMBF's world leaves them in the order they were found (Bullet's default), and the solver
+        # takes the contacts in that order: sorted, a stack resting on the floor creeps sideways
+        # under 10 iterations (solver_info.py), so AMBF's bodies get AMBF's order
+        sorted_pairs = 0 if self.opt.bodies == "ambf" else 1
+        pb.setPhysicsEngineParameter(
+            enableFileCaching=1, deterministicOverlappingPairs=sorted_pairs, physicsClientId=self.cid
+        )
         self._ambf_dt = self.dt if self.opt.bodies == "ambf" else None  # AMBF's bodies (ambf_bodies.py)
         self._build()
         # AMBF's springs (Options.springs): explicit, at every physics step; PyBullet then steps one
