@@ -80,11 +80,11 @@ class PyBulletWorld(Assembly, Interaction, WorldState, World):
         pb.setPhysicsEngineParameter(physicsClientId=self.cid, **params)
         # self.constraints: (joint name, constraint id, parent, child, pivot a, pivot b, slide axis in a | None)
         self._next_stability_check = 0.0
-        # the broadphase keeps its overlapping pairs sorted, so a snapshot restored in place
-        # (restore_state) replays close (~1e-8 m); only one restored into a fresh world is exact.
-        # AMBF's world leaves them in the order they were found (Bullet's default), and the solver
-        # takes the contacts in that order: sorted, a stack resting on the floor creeps sideways
-        # under 10 iterations (solver_info.py), so AMBF's bodies get AMBF's order
+        # the broadphase's overlapping pairs: PyBullet's bodies keep them sorted (PyBullet's
+        # setting). AMBF's world leaves them in the order they were found, and the solver takes the
+        # contacts in that order: sorted, a stack resting on the floor creeps sideways under 10
+        # iterations (solver_info.py), so AMBF's bodies get AMBF's order. A restored snapshot
+        # replays no less closely unsorted (state.py)
         sorted_pairs = 0 if self.opt.bodies == "ambf" else 1
         pb.setPhysicsEngineParameter(
             enableFileCaching=1, deterministicOverlappingPairs=sorted_pairs, physicsClientId=self.cid
