@@ -132,6 +132,7 @@ def suture_rows(build) -> list[str]:
     """The suture replayed in AMBF (following the measured joints; the set-points unpaced and
     paced) on the bundled scene and the corpus set."""
     from adfkit.commands.suture import parse_pairs
+    from adfkit.parity import ambf
     from adfkit.parity.suture import PACE, compare_suture
 
     scenes = [("bundled", ROOT / "sample_scenes" / "suturing" / "launch.yaml", None)]
@@ -139,7 +140,10 @@ def suture_rows(build) -> list[str]:
         scenes.append(("corpus set", CORPUS / "src" / "launch.yaml", [6, 7, 8, 9, 10, 11]))
     rows = []
     for label, launch, indices in scenes:
-        out = compare_suture(launch, indices, parse_pairs("1,2,3,4"), build, 0, paces=(None, PACE), follow="both")
+        count, how = ambf.iterations_for(None, suture=True)  # as `adfkit parity --suture` replays
+        with ambf.iterations_set(count) as n:
+            out = compare_suture(launch, indices, parse_pairs("1,2,3,4"), build, 0, paces=(None, PACE), follow="both")
+        print(f"  ({label}: AMBF's solver iterations {n} a step, {how})", file=sys.stderr)
         measured, plain, paced = out["replays"]
         walls = (
             f"{out['wall_s']['adfkit']:.0f} s | {measured['wall_s']:.0f} s | {plain['wall_s']:.0f} s | "

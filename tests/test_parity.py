@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 from dataclasses import replace
 
@@ -982,12 +983,17 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
 
     def fake(launch, indices, pairs, build, seed, progress, paces, follow, options, grasp):
         seen["paces"], seen["follow"], seen["options"], seen["grasp"] = paces, follow, options, grasp
+        seen["iterations"] = os.environ.get(ambf.ITERATIONS_ENV)
         return out
 
     monkeypatch.setattr(suture, "compare_suture", fake)
     monkeypatch.setattr(ambf, "find_build", lambda path: None)
+    monkeypatch.delenv(ambf.ITERATIONS_ENV, raising=False)
     assert main(["parity", "--suture", "--pairs", "1", "--pace", "both"]) == 1  # the verdicts differ
     text = capsys.readouterr().out
+    # AMBF replays the suture at the solver iterations it was recorded with (50), unless told
+    assert seen["iterations"] == "50" and os.environ.get(ambf.ITERATIONS_ENV) is None
+    assert "AMBF's solver iterations: 50 a step (the suture's own, as adfkit records it;" in text
     assert seen["paces"] == (None, suture.PACE) and seen["follow"] == "commands"
     assert "pair 1: adfkit passed, AMBF failed (entry-missed" in text and "47.8 mm" in text
     assert "recorded with springs implicit, control_substeps 4" in text
@@ -1007,6 +1013,11 @@ def test_parity_suture_prints_both_replays(monkeypatch, capsys):
     # following the measured joints plays at AMBF's own time: a pace with it is a usage error
     assert main(["parity", "--suture", "--pairs", "1", "--follow", "measured", "--pace", "on"]) == 2
     assert "error[bad-option]" in capsys.readouterr().err and not seen
+    assert main(["parity", "--suture", "--pairs", "1", "--ambf-iterations", "10"]) == 1 and seen["iterations"] == "10"
+    assert "AMBF's solver iterations: 10 a step (--ambf-iterations)" in capsys.readouterr().out
+    monkeypatch.setenv(ambf.ITERATIONS_ENV, "20")
+    assert main(["parity", "--suture", "--pairs", "1"]) == 1 and seen["iterations"] == "20"
+    assert "AMBF's solver iterations: 20 a step ($ADFKIT_PARITY_SOLVER_ITERATIONS)" in capsys.readouterr().out
 
 
 @needs_ambf

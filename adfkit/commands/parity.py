@@ -4,7 +4,6 @@ each created; exit 1 when they differ past the tolerances."""
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
@@ -100,7 +99,7 @@ def add_arguments(p) -> None:
         "--ambf-iterations",
         metavar="N",
         help="Bullet's solver iterations a physics step in AMBF, every AMBF run of this command (default: "
-        "AMBF's own, 10; adfkit's suture records at 50)",
+        "AMBF's own, 10; with --suture the suture's own, 50, as adfkit records it)",
     )
     p.add_argument("--plot", metavar="PNG", help="draw each body's position gap over time")
     p.add_argument(
@@ -165,6 +164,7 @@ def run(args) -> int:
     if args.ambf_iterations is not None and (iterations := ambf.read_iterations(args.ambf_iterations)) is None:
         why = f"--ambf-iterations {args.ambf_iterations!r}: AMBF's solver iterations are a positive whole number"
         raise AdfError(error("bad-option", why, None, ambf.ITERATIONS_HINT))
+    iterations, args.ambf_iterations_from = ambf.iterations_for(iterations, args.suture)
     with ambf.iterations_set(iterations) as args.ambf_solver_iterations:
         return _run(args)
 
@@ -397,12 +397,4 @@ def recording_options(args) -> dict:
 
 def iterations_line(args) -> str:
     """What AMBF's Bullet solver iterates a step, for the text output."""
-    from ..parity import ambf
-
-    if args.ambf_iterations is not None:
-        how = "--ambf-iterations"
-    elif ambf.read_iterations(os.environ.get(ambf.ITERATIONS_ENV, "")) is not None:
-        how = f"${ambf.ITERATIONS_ENV}"
-    else:
-        how = "AMBF's default"
-    return f"AMBF's solver iterations: {args.ambf_solver_iterations} a step ({how})"
+    return f"AMBF's solver iterations: {args.ambf_solver_iterations} a step ({args.ambf_iterations_from})"

@@ -33,7 +33,10 @@ DEFAULT_SOLVER_ITERATIONS = 10
 #: the plugin's knob that sets them (``adfkit parity --ambf-iterations N`` sets it for its runs)
 ITERATIONS_ENV = "ADFKIT_PARITY_SOLVER_ITERATIONS"
 #: the hint beside a count read_iterations refuses
-ITERATIONS_HINT = "a whole number, 1 or more (50: adfkit's suture's), or leave --ambf-iterations out (AMBF's own 10)"
+ITERATIONS_HINT = (
+    "a whole number, 1 or more (10: AMBF's own; 50: adfkit's suture's), or leave --ambf-iterations out "
+    "(AMBF's own 10; with --suture the suture's 50)"
+)
 
 
 def read_iterations(text: str) -> int | None:
@@ -43,6 +46,27 @@ def read_iterations(text: str) -> int | None:
     except ValueError:
         return None
     return n if n > 0 else None
+
+
+def iterations_in_environment() -> bool:
+    """Whether the plugin's knob holds a count (set by the user, or by iterations_set)."""
+    return read_iterations(os.environ.get(ITERATIONS_ENV, "")) is not None
+
+
+def iterations_for(given: int | None, suture: bool) -> tuple[int | None, str]:
+    """The solver iterations to set for AMBF's runs (None: leave the environment as it is) and
+    where they come from: ``given`` (``--ambf-iterations``), else the plugin's knob where it is
+    set, else for a suture's replay the iterations the suture records with (both sides then solve
+    alike, as a scene's plain parity does at AMBF's own), else AMBF's own."""
+    if given is not None:
+        return given, "--ambf-iterations"
+    if iterations_in_environment():
+        return None, f"${ITERATIONS_ENV}"
+    if suture:
+        from ..tasks.episode import SOLVER_ITERATIONS
+
+        return SOLVER_ITERATIONS, "the suture's own, as adfkit records it; --ambf-iterations 10 for AMBF's default"
+    return None, "AMBF's default"
 
 
 def solver_iterations() -> int:
