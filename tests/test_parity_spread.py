@@ -319,12 +319,13 @@ def test_a_nudged_run_whose_ambf_world_blew_up_is_no_spread(tmp_path, capsys):
 @pytest.mark.slow
 def test_the_bundled_scene_at_rest_is_within_ambfs_spread_but_for_pybullets_far_elements(capsys):
     """The bundled scene at rest for 2 s in both engines (45 s with six nudged AMBF runs). Without
-    --spread 16 bodies pass 1 mm / 1° in PyBullet and 8 in MuJoCo: the thread's elements by the
+    --spread 16 bodies pass 1 mm / 1° in PyBullet and 9 in MuJoCo: the thread's elements by the
     needle turn up to 70° (MuJoCo 51°) from AMBF's. AMBF's own elements there turn up to 93° from
     their unnudged run when the needle and each arm's first link start 0.1 µm away (measured), and
     those gaps are within AMBF's spread: MuJoCo agrees within it (exit 0 alone). What is left in
     PyBullet is its own creep twist of the elements lying far along the phantom
-    (Thread_018/019/020: 7.4/15.2/1.7°, where AMBF's spread is 0.25° at most)."""
+    (Thread_018/019: 3.2/17.8°, where AMBF's spread is 0.89/1.05°, measured on this machine; AMBF's
+    own spread there is the machine's: 0.25° at most on another)."""
     argv = ["parity", str(BUNDLED), "--seconds", "2", "--engine", "both", "--json"]
     assert main([*argv, "--spread"]) == 1
     pybullet, mujoco = json.loads(capsys.readouterr().out)
@@ -338,5 +339,7 @@ def test_the_bundled_scene_at_rest_is_within_ambfs_spread_but_for_pybullets_far_
     assert rows["Thread_002"]["ambf_spread_angle_deg"] > rows["Thread_002"]["max_angle_gap_deg"] > 30
     left = past - within
     assert "Thread_019" in left and 0 < len(left) <= 5 and not doc["agree"]
-    assert rows["Thread_019"]["ambf_spread_angle_deg"] < 1.0 < rows["Thread_019"]["max_angle_gap_deg"] - 5.0
+    # AMBF's own elements there barely turn (a degree or two at most) and PyBullet's turn 10° past that
+    far = rows["Thread_019"]
+    assert far["ambf_spread_angle_deg"] < 2.0 and far["max_angle_gap_deg"] > far["ambf_spread_angle_deg"] + 10.0
     assert doc["ambf_spread"]["nudged_bodies"] == ["yaw link simple"] * 2 + ["Needle"]
